@@ -1,0 +1,40 @@
+# rockmech: every target bootstraps its own virtual environment (.venv) on first use.
+PY ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed-stamp
+
+.PHONY: install demo test lint typecheck schema bench clean
+
+$(STAMP): pyproject.toml
+	$(PY) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e ".[dev]"
+	touch $(STAMP)
+
+install: $(STAMP)
+
+## Main job on bundled data: rectangular walls on El Centro 1940, results in out/.
+demo: $(STAMP)
+	$(BIN)/rockmech demo --out out
+
+## The whole test suite: lint, format check, types, schema drift, then pytest.
+test: lint typecheck schema
+	$(BIN)/python -m pytest
+
+lint: $(STAMP)
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+
+typecheck: $(STAMP)
+	$(BIN)/mypy
+
+schema: $(STAMP)
+	$(BIN)/python -m shared_schema.export --check
+
+## Benchmarks (not part of the test suite): tables on stdout, figures in docs/.
+bench: $(STAMP)
+	$(BIN)/python benchmarks/work_precision.py
+
+clean:
+	rm -rf $(VENV) out .mypy_cache .ruff_cache .pytest_cache

@@ -1,0 +1,718 @@
+"""The kinematic-constants file: the constants of each rocking mechanism of a structure.
+
+The file is what the Rhino side writes and the solver reads (STYLE.md, habit 5). It holds,
+per mechanism, the constants of the linearised rocking equation (THEORY.md §1) for the
+positive side and, when the mechanism is not symmetric, the negative side.
+
+Notation
+--------
+I0 : generalised inertia of the mechanism at ``phi_cr`` [kg m^2]
+K : rotational stiffness of the linearised system (acts as a negative stiffness) [N m/rad]
+Q : ground-motion coefficient [kg m]
+phi_cr : critical rotation, the unstable equilibrium under gravity alone [rad]
+M_F : moment of the external static forces about the hinge, positive when it drives
+    collapse (positive rotation); the same value and sign serve both sides [N m]
+p_eq : equivalent frequency parameter, ``sqrt(K / I0)`` (Eq. 4) [rad/s]
+lam : linearised static load multiplier (Eq. 5; §1.8 for the negative side) [-]
+phi_ov : overturning rotation (Eq. 6; §1.8 for the negative side) [rad]
+eta : coefficient of restitution on the angular velocity at impact [-]
+f_n : natural frequency of the supporting structure [Hz]
+h_e : effective (modal) height of the supporting structure [m]
+h : height of the mechanism's base above the ground [m]
+
+A side is given either by its physical constants (``I0``, ``K``, ``Q``, ``phi_cr`` and
+optionally ``M_F``), from which ``p_eq``, ``lam`` and ``phi_ov`` are derived, or in the short
+form that published tables print: ``p_eq``, ``lam`` and optionally ``phi_ov`` (default
+``lam``, exact for a single block). A mechanism may also be written flat, with ``p_eq``,
+``lam`` and ``phi_ov`` next to its ``id``; they then describe the positive side.
+
+The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` forms.
+"""
+
+import json
+import math
+import re
+from typing import Any, Dict, List, Literal, Mapping, Optional, Sequence, Tuple, Union, get_args
+
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    JsonValue,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
+from pydantic_core import PydanticCustomError
+
+from shared_schema.errors import InputError
+
+__all__ = [
+    "CONSISTENCY_RTOL",
+    "ETA_SOURCES",
+    "FLAT_SIDE_KEYS",
+    "ROCKING_KINDS",
+    "SCHEMA_VERSION",
+    "TYPOLOGIES",
+    "Amplification",
+    "ConstantsFile",
+    "EtaSource",
+    "G",
+    "Mechanism",
+    "Rocking",
+    "SideConstants",
+    "Typology",
+    "Units",
+    "input_error_from_validation",
+    "parse_constants",
+]
+
+#: Version of the file format written by this module.
+SCHEMA_VERSION = "1.0"
+
+#: Standard gravity [m/s^2]; equal to ``solver_service.core.model.G``, repeated here so that
+#: the Rhino side need not import the solver.
+G = 9.80665
+
+#: Relative tolerance within which given ``p_eq``/``lam``/``phi_ov`` must match the values
+#: derived from the physical constants.
+CONSISTENCY_RTOL = 1e-9
+
+Typology = Literal[
+    "single_block", "single_block_loaded", "two_block", "multi_block", "user_defined"
+]
+Rocking = Literal["two_sided", "one_sided"]
+EtaSource = Literal[
+    "housner_general",
+    "housner_rectangular",
+    "one_sided_eq26",
+    "one_sided_alt",
+    "one_sided_energy",
+    "momentum_projection",
+    "user",
+    "published",
+]
+
+#: Allowed values of ``Mechanism.typology``.
+TYPOLOGIES: Tuple[str, ...] = get_args(Typology)
+#: Allowed values of ``Mechanism.rocking``.
+ROCKING_KINDS: Tuple[str, ...] = get_args(Rocking)
+#: Allowed values of ``Mechanism.eta_source``.
+ETA_SOURCES: Tuple[str, ...] = get_args(EtaSource)
+
+#: Keys of the short (published-table) form that may be written flat in a mechanism.
+FLAT_SIDE_KEYS = ("p_eq", "lam", "phi_ov")
+
+_PHYSICAL_KEYS = ("I0", "K", "Q", "phi_cr")
+
+_P_EQ_DESCRIPTION = "Equivalent frequency parameter p_eq = sqrt(K/I0) (THEORY Eq. 4) [rad/s], > 0."
+_LAM_DESCRIPTION = (
+    "Linearised static load multiplier: the ground acceleration that starts rocking, as a "
+    "fraction of g (THEORY Eq. 5; §1.8 for the negative side) [-], > 0."
+)
+_PHI_OV_DESCRIPTION = (
+    "Overturning rotation (THEORY Eq. 6; §1.8 for the negative side) [rad], > 0. "
+    "In the short form it defaults to lam (exact for a single block)."
+)
+
+
+def _error(field: str, message: str, error_type: str = "rockmech_value") -> PydanticCustomError:
+    """Build a validation error whose context names the offending sub-field.
+
+    ``input_error_from_validation`` appends ``field`` to the error location, because a
+    model-level validator cannot place an error on one of its fields itself.
+    """
+    # The message goes in through the context, not the template, so that braces in user
+    # values (ids) are not taken for placeholders; "field" is substituted first.
+    return PydanticCustomError(error_type, "{message}", {"field": field, "message": message})
+
+
+class Units(BaseModel):
+    """SI units of the quantities in the file.
+
+    The values are fixed: the file is always in SI. The section documents this for a reader
+    and lets a file that claims other units be rejected rather than misread.
+    """
+
+    model_config = ConfigDict(
+        strict=True,
+        extra="forbid",
+        json_schema_extra={"description": "SI units of the quantities in the file (fixed)."},
+    )
+
+    length: Literal["m"] = "m"
+    mass: Literal["kg"] = "kg"
+    angle: Literal["rad"] = "rad"
+    p_eq: Literal["rad/s"] = "rad/s"
+    I0: Literal["kg m^2"] = "kg m^2"
+    K: Literal["N m/rad"] = "N m/rad"
+    Q: Literal["kg m"] = "kg m"
+    M_F: Literal["N m"] = "N m"
+    f_n: Literal["Hz"] = "Hz"
+    h: Literal["m"] = "m"
+
+
+def _side_schema_extra(schema: Dict[str, Any]) -> None:
+    schema["description"] = (
+        "Constants of one rocking side: either the physical constants I0, K, Q, phi_cr "
+        "(and optionally M_F), from which p_eq, lam and phi_ov are derived, or the short form "
+        "p_eq, lam (and optionally phi_ov, default lam). When both are given they must agree "
+        "to a relative 1e-9."
+    )
+    schema["anyOf"] = [{"required": list(_PHYSICAL_KEYS)}, {"required": ["p_eq", "lam"]}]
+
+
+class SideConstants(BaseModel):
+    """Constants of one rocking side of a mechanism.
+
+    Give either the physical constants ``I0``, ``K``, ``Q``, ``phi_cr`` (and optionally
+    ``M_F``), or the short form ``p_eq``, ``lam`` (and optionally ``phi_ov``). Inside a
+    validated ``Mechanism`` the derived ``p_eq``, ``lam`` and ``phi_ov`` are always filled in;
+    when both forms are given they must agree to a relative 1e-9.
+
+    Attributes
+    ----------
+    I0 : float, optional
+        Generalised inertia at ``phi_cr`` [kg m^2], > 0.
+    K : float, optional
+        Rotational stiffness [N m/rad], > 0.
+    Q : float, optional
+        Ground-motion coefficient [kg m], > 0.
+    phi_cr : float, optional
+        Critical rotation [rad], > 0.
+    M_F : float, optional
+        Moment of the static forces, positive when it drives collapse [N m]. Defaults to 0
+        in the physical form; absent in the short form.
+    p_eq : float, optional
+        Equivalent frequency parameter [rad/s], > 0.
+    lam : float, optional
+        Linearised static load multiplier [-], > 0.
+    phi_ov : float, optional
+        Overturning rotation [rad], > 0.
+
+    Notes
+    -----
+    Derivation (THEORY §1, Eqs. 4-6 and §1.8), with ``s = +1`` on the positive side and
+    ``s = -1`` on the negative side::
+
+        p_eq = sqrt(K / I0)
+        lam = (K * phi_cr - s * M_F) / (g * Q)
+        phi_ov = phi_cr - s * M_F / K
+    """
+
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_side_schema_extra
+    )
+
+    I0: Optional[float] = Field(
+        None, gt=0, description="Generalised inertia of the mechanism at phi_cr [kg m^2], > 0."
+    )
+    K: Optional[float] = Field(
+        None,
+        gt=0,
+        description=(
+            "Rotational stiffness K = -V''(phi_cr) of the linearised system [N m/rad], > 0 "
+            "(it acts as a destabilising stiffness)."
+        ),
+    )
+    Q: Optional[float] = Field(
+        None, gt=0, description="Ground-motion coefficient sum(m dx_G/dphi) at phi_cr [kg m], > 0."
+    )
+    phi_cr: Optional[float] = Field(
+        None,
+        gt=0,
+        description="Critical rotation (unstable equilibrium under gravity alone) [rad], > 0.",
+    )
+    M_F: Optional[float] = Field(
+        None,
+        description=(
+            "Moment of the external static forces about the hinge at phi_cr [N m], any finite "
+            "value, positive when it drives collapse (positive rotation) on both sides. "
+            "Defaults to 0 in the physical form."
+        ),
+    )
+    p_eq: Optional[float] = Field(None, gt=0, description=_P_EQ_DESCRIPTION)
+    lam: Optional[float] = Field(None, gt=0, description=_LAM_DESCRIPTION)
+    phi_ov: Optional[float] = Field(None, gt=0, description=_PHI_OV_DESCRIPTION)
+
+    @model_validator(mode="after")
+    def _check_form(self) -> "SideConstants":
+        given = [k for k in _PHYSICAL_KEYS if getattr(self, k) is not None]
+        if given:
+            missing = [k for k in _PHYSICAL_KEYS if getattr(self, k) is None]
+            if missing:
+                raise _error(
+                    missing[0],
+                    "the physical form needs I0, K, Q and phi_cr; missing " + ", ".join(missing),
+                    "missing_constant",
+                )
+            return self
+        if self.M_F is not None:
+            raise _error(
+                "M_F",
+                "M_F is only meaningful with the physical constants I0, K, Q and phi_cr; "
+                "in the short form it is already contained in lam and phi_ov",
+            )
+        for key in ("p_eq", "lam"):
+            if getattr(self, key) is None:
+                raise _error(
+                    key,
+                    "give either the physical constants I0, K, Q and phi_cr, or p_eq and lam "
+                    f"(short form); {key} is missing",
+                    "missing_constant",
+                )
+        return self
+
+    @property
+    def is_physical(self) -> bool:
+        """True when the side was given by its physical constants (I0, K, Q, phi_cr)."""
+        return self.I0 is not None
+
+
+def _derive_side(side: SideConstants, which: str) -> SideConstants:
+    """Fill in ``p_eq``, ``lam`` and ``phi_ov`` of ``side`` (``which``: positive/negative)."""
+    if not side.is_physical:
+        if side.phi_ov is None:
+            return side.model_copy(update={"phi_ov": side.lam})
+        return side
+    assert side.I0 is not None and side.K is not None
+    assert side.Q is not None and side.phi_cr is not None
+    # THEORY §1.8: M_F keeps its sign (positive drives positive rotation), so it helps the
+    # positive side overturn and resists the negative side.
+    s = 1.0 if which == "positive" else -1.0
+    m_f = 0.0 if side.M_F is None else side.M_F
+    sign = "-" if s > 0 else "+"
+    derived = {
+        "p_eq": math.sqrt(side.K / side.I0),  # Eq. 4
+        "lam": (side.K * side.phi_cr - s * m_f) / (G * side.Q),  # Eq. 5
+        "phi_ov": side.phi_cr - s * m_f / side.K,  # Eq. 6
+    }
+    for key, formula in (
+        ("lam", f"(K*phi_cr {sign} M_F)/(g*Q)"),
+        ("phi_ov", f"phi_cr {sign} M_F/K"),
+    ):
+        if not derived[key] > 0.0:
+            raise _error(
+                key,
+                f"{formula} = {derived[key]:.6g} is not > 0: the static forces alone overturn "
+                f"the mechanism on its {which} side (M_F = {m_f:g} N m against "
+                f"K*phi_cr = {side.K * side.phi_cr:g} N m)",
+                "static_collapse",
+            )
+    for key, value in derived.items():
+        given = getattr(side, key)
+        if given is not None and not math.isclose(
+            given, value, rel_tol=CONSISTENCY_RTOL, abs_tol=0.0
+        ):
+            raise _error(
+                key,
+                f"given {key} = {given!r} disagrees with {value!r} derived from the physical "
+                f"constants (relative tolerance {CONSISTENCY_RTOL:g})",
+                "inconsistent_constant",
+            )
+    return side.model_copy(update={"M_F": m_f, **derived})
+
+
+class Amplification(BaseModel):
+    """Data for amplifying the ground motion up the structure (THEORY §7, Eqs. 27-28).
+
+    Attributes
+    ----------
+    f_n : float
+        Natural frequency of the supporting structure [Hz], > 0.
+    h_e : float
+        Effective (modal) height of the supporting structure, ``sum(m h^2)/sum(m h)`` [m], > 0.
+    h : float
+        Height of the mechanism's base above the ground [m], >= 0.
+    """
+
+    model_config = ConfigDict(
+        strict=True,
+        extra="forbid",
+        allow_inf_nan=False,
+        json_schema_extra={
+            "description": "Data for amplifying the ground motion up the structure (THEORY §7)."
+        },
+    )
+
+    f_n: float = Field(gt=0, description="Natural frequency of the supporting structure [Hz], > 0.")
+    h_e: float = Field(
+        gt=0,
+        description="Effective (modal) height of the supporting structure [m], > 0.",
+    )
+    h: float = Field(ge=0, description="Height of the mechanism's base above the ground [m], >= 0.")
+
+
+def _check_json_safe(value: Any, path: str) -> None:
+    # JsonValue lets NaN through in JSON mode, and NaN cannot be written back as JSON.
+    if isinstance(value, float) and not math.isfinite(value):
+        raise _error(path, f"must be finite, got {value!r}", "finite_number")
+    if isinstance(value, dict):
+        for key, item in value.items():
+            _check_json_safe(item, f"{path}.{key}" if path else str(key))
+    elif isinstance(value, list):
+        for i, item in enumerate(value):
+            _check_json_safe(item, f"{path}[{i}]")
+
+
+def _mechanism_schema_extra(schema: Dict[str, Any]) -> None:
+    schema["description"] = (
+        "One rocking mechanism. Give the positive side as 'positive', or flat as p_eq, lam "
+        "(and optionally phi_ov) next to the id, as published tables print them."
+    )
+    # The published-table short form may be written flat (see Mechanism._move_flat_keys).
+    props = schema["properties"]
+    props["p_eq"] = {"type": "number", "exclusiveMinimum": 0, "description": _P_EQ_DESCRIPTION}
+    props["lam"] = {"type": "number", "exclusiveMinimum": 0, "description": _LAM_DESCRIPTION}
+    props["phi_ov"] = {"type": "number", "exclusiveMinimum": 0, "description": _PHI_OV_DESCRIPTION}
+    for key in ("p_eq", "lam", "phi_ov"):
+        props[key]["description"] += " Flat short form: describes the positive side."
+    schema["required"] = [k for k in schema.get("required", []) if k != "positive"]
+    schema["oneOf"] = [
+        {
+            "required": ["positive"],
+            "not": {"anyOf": [{"required": [k]} for k in FLAT_SIDE_KEYS]},
+        },
+        {"required": ["p_eq", "lam"], "not": {"required": ["positive"]}},
+    ]
+
+
+class Mechanism(BaseModel):
+    """One rocking mechanism and its kinematic constants.
+
+    Attributes
+    ----------
+    id : str
+        Unique identifier in the file, e.g. ``"W1"``.
+    name : str
+        Descriptive name; defaults to ``id``.
+    typology : str
+        One of ``TYPOLOGIES``; ``"user_defined"`` by default.
+    rocking : str
+        ``"two_sided"`` (default) or ``"one_sided"`` (e.g. a façade restrained by
+        transverse walls, which can only rotate outward).
+    positive : SideConstants
+        Constants for positive rotation (the collapse direction).
+    negative : SideConstants, optional
+        Constants for negative rotation; absent for a symmetric mechanism. Ignored by the
+        solver for one-sided rocking.
+    eta : float, optional
+        Coefficient of restitution [-] in [-1, 1]: >= 0 for two-sided, <= 0 for one-sided.
+    eta_source : str, optional
+        Where ``eta`` comes from (one of ``ETA_SOURCES``); ``"user"`` when ``eta`` is given
+        without it.
+    amplification : Amplification, optional
+        Data for amplifying the ground motion up the structure.
+    geometry : dict, optional
+        Free-form, JSON-safe summary of the geometry (for reports and provenance).
+    provenance : dict, optional
+        Free-form, JSON-safe record of where the constants come from.
+
+    Notes
+    -----
+    The flat short form ``{"id": "W1", "p_eq": 2.15, "lam": 0.25}`` is accepted and moved
+    into ``positive`` before validation.
+    """
+
+    model_config = ConfigDict(
+        strict=True,
+        extra="forbid",
+        allow_inf_nan=False,
+        json_schema_extra=_mechanism_schema_extra,
+    )
+
+    id: str = Field(min_length=1, description="Unique identifier of the mechanism in the file.")
+    name: Optional[str] = Field(None, description="Descriptive name; defaults to id.")
+    typology: Typology = Field("user_defined", description="Typology of the mechanism.")
+    rocking: Rocking = Field(
+        "two_sided",
+        description=(
+            "two_sided: rocks both ways with impacts at phi = 0; one_sided: only positive "
+            "rotation, rebounding off a restraint (e.g. a façade held by transverse walls)."
+        ),
+    )
+    positive: SideConstants = Field(
+        description="Constants for positive rotation (the collapse direction)."
+    )
+    negative: Optional[SideConstants] = Field(
+        None,
+        description=(
+            "Constants for negative rotation, as magnitudes; absent for a symmetric "
+            "mechanism. Ignored for one-sided rocking."
+        ),
+    )
+    eta: Optional[float] = Field(
+        None,
+        ge=-1,
+        le=1,
+        description=(
+            "Coefficient of restitution on the angular velocity at impact [-], in [-1, 1]: "
+            ">= 0 for two-sided rocking, <= 0 (rebound) for one-sided rocking."
+        ),
+    )
+    eta_source: Optional[EtaSource] = Field(
+        None, description="Where eta comes from; 'user' when eta is given without it."
+    )
+    amplification: Optional[Amplification] = Field(
+        None, description="Data for amplifying the ground motion up the structure (THEORY §7)."
+    )
+    geometry: Optional[Dict[str, JsonValue]] = Field(
+        None, description="Free-form JSON summary of the geometry (lengths in m, masses in kg)."
+    )
+    provenance: Optional[Dict[str, JsonValue]] = Field(
+        None, description="Free-form JSON record of where the constants come from."
+    )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _move_flat_keys(cls, data: Any) -> Any:
+        if not isinstance(data, Mapping):
+            return data
+        flat = [k for k in FLAT_SIDE_KEYS if k in data]
+        if not flat:
+            return data
+        if "positive" in data:
+            raise _error(
+                flat[0],
+                "give the positive side either flat (p_eq, lam, phi_ov next to id) or as "
+                "'positive', not both",
+            )
+        out = {k: v for k, v in data.items() if k not in FLAT_SIDE_KEYS}
+        out["positive"] = {k: data[k] for k in flat}
+        return out
+
+    @field_validator("positive", "negative")
+    @classmethod
+    def _derive(
+        cls, side: Optional[SideConstants], info: ValidationInfo
+    ) -> Optional[SideConstants]:
+        if side is None:
+            return None
+        return _derive_side(side, info.field_name or "positive")
+
+    @field_validator("eta")
+    @classmethod
+    def _check_eta_sign(cls, eta: Optional[float], info: ValidationInfo) -> Optional[float]:
+        rocking = info.data.get("rocking")
+        if eta is None or rocking is None:
+            return eta
+        if rocking == "one_sided" and eta > 0.0:
+            raise PydanticCustomError(
+                "eta_sign",
+                "must be <= 0 for one-sided rocking (rebound off the restraint), got {eta}",
+                {"eta": eta},
+            )
+        if rocking == "two_sided" and eta < 0.0:
+            raise PydanticCustomError(
+                "eta_sign",
+                "must be >= 0 for two-sided rocking (a negative value means rebound, which "
+                "is one-sided), got {eta}",
+                {"eta": eta},
+            )
+        return eta
+
+    @field_validator("geometry", "provenance")
+    @classmethod
+    def _check_finite(cls, value: Optional[Dict[str, JsonValue]]) -> Optional[Dict[str, JsonValue]]:
+        if value is not None:
+            _check_json_safe(value, "")
+        return value
+
+    @model_validator(mode="after")
+    def _fill_defaults(self) -> "Mechanism":
+        if self.eta_source is not None and self.eta is None:
+            raise _error("eta_source", "eta_source is given but eta is not")
+        if self.eta is not None and self.eta_source is None:
+            self.eta_source = "user"
+        if self.name is None:
+            self.name = self.id
+        return self
+
+    @property
+    def one_sided(self) -> bool:
+        """True for one-sided rocking."""
+        return self.rocking == "one_sided"
+
+
+class ConstantsFile(BaseModel):
+    """A kinematic-constants file: format version, units and the mechanisms.
+
+    Attributes
+    ----------
+    schema_version : str
+        Format version, ``"1.<minor>"``; defaults to ``SCHEMA_VERSION``.
+    units : Units
+        SI units of the quantities (fixed; filled in by default).
+    mechanisms : list of Mechanism
+        At least one mechanism; ids are unique.
+
+    Examples
+    --------
+    >>> cf = ConstantsFile.model_validate({"mechanisms": [{"id": "W1", "p_eq": 2.15, "lam": 0.25}]})
+    >>> cf.mechanisms[0].positive.phi_ov
+    0.25
+    """
+
+    model_config = ConfigDict(
+        strict=True,
+        extra="forbid",
+        allow_inf_nan=False,
+        json_schema_extra={
+            "description": (
+                "Kinematic constants of the rocking mechanisms of a structure (rockmech). "
+                "All quantities in SI units."
+            )
+        },
+    )
+
+    schema_version: str = Field(
+        SCHEMA_VERSION,
+        pattern=r"^1\.[0-9]+$",
+        description="Version of the file format, '1.<minor>'.",
+    )
+    units: Units = Field(
+        default_factory=Units, description="SI units of the quantities (fixed, informative)."
+    )
+    mechanisms: List[Mechanism] = Field(
+        min_length=1, description="The mechanisms; at least one, with unique ids."
+    )
+
+    @field_validator("mechanisms")
+    @classmethod
+    def _check_unique_ids(cls, mechanisms: List[Mechanism]) -> List[Mechanism]:
+        first: Dict[str, int] = {}
+        for i, mech in enumerate(mechanisms):
+            if mech.id in first:
+                raise _error(
+                    f"[{i}]",
+                    f"duplicate mechanism id {mech.id!r} (also mechanisms[{first[mech.id]}]); "
+                    "ids must be unique",
+                    "duplicate_id",
+                )
+            first[mech.id] = i
+        return mechanisms
+
+    def get_mechanism(self, mechanism_id: str) -> Mechanism:
+        """Return the mechanism with id ``mechanism_id``.
+
+        Raises
+        ------
+        InputError
+            If there is no such mechanism.
+        """
+        for mech in self.mechanisms:
+            if mech.id == mechanism_id:
+                return mech
+        known = ", ".join(repr(m.id) for m in self.mechanisms)
+        raise InputError(f"no mechanism with id {mechanism_id!r}; the file has {known}", "id")
+
+
+def _mechanism_label(data: Any, index: int) -> str:
+    mechanisms = data.get("mechanisms") if isinstance(data, Mapping) else None
+    if isinstance(mechanisms, Sequence) and not isinstance(mechanisms, (str, bytes)):
+        if 0 <= index < len(mechanisms):
+            item = mechanisms[index]
+            mech_id = item.get("id") if isinstance(item, Mapping) else None
+            if isinstance(mech_id, str) and mech_id:
+                return f" (id {mech_id!r})"
+    return ""
+
+
+def _format_loc(loc: Sequence[Union[int, str]], data: Any, extra: Optional[str]) -> str:
+    parts: List[Union[int, str]] = list(loc)
+    if extra:
+        index = re.fullmatch(r"\[(\d+)\]", extra)
+        parts.append(int(index.group(1)) if index else extra)
+    out = ""
+    for i, part in enumerate(parts):
+        if isinstance(part, int):
+            out += f"[{part}]"
+            if i == 1 and parts[0] == "mechanisms":
+                out += _mechanism_label(data, part)
+        else:
+            out += f".{part}" if out else str(part)
+    return out
+
+
+def input_error_from_validation(exc: ValidationError, data: Any = None) -> InputError:
+    """Turn a pydantic ``ValidationError`` into an ``InputError`` naming mechanism and field.
+
+    Parameters
+    ----------
+    exc : pydantic.ValidationError
+        The error raised while validating a ``ConstantsFile``.
+    data : object, optional
+        The input as plain Python data (e.g. from ``json.loads``), used to name the
+        mechanism by its id.
+
+    Returns
+    -------
+    InputError
+        One line per error, each ``<path>: <message>``, e.g.
+        ``mechanisms[1] (id 'W2').positive.p_eq: Input should be greater than 0``.
+        ``field`` is the path of the first error.
+    """
+    lines: List[str] = []
+    paths: List[str] = []
+    for err in exc.errors(include_url=False):
+        ctx = err.get("ctx") or {}
+        extra = ctx.get("field") if isinstance(ctx.get("field"), str) else None
+        path = _format_loc(err["loc"], data, extra)
+        msg = err["msg"]
+        if err["type"] == "extra_forbidden":
+            msg = "unknown key; " + msg
+        paths.append(path)
+        lines.append(f"{path}: {msg}" if path else msg)
+    if not lines:  # pragma: no cover - pydantic never raises an empty ValidationError
+        return InputError(str(exc))
+    first_msg = lines[0][len(paths[0]) + 2 :] if paths[0] else lines[0]
+    return InputError("\n".join([first_msg, *lines[1:]]), paths[0] or None)
+
+
+def parse_constants(source: Union[str, bytes, Mapping[str, Any], Sequence[Any]]) -> ConstantsFile:
+    """Validate a kinematic-constants file given as JSON text or as plain Python data.
+
+    Parameters
+    ----------
+    source : str, bytes, dict or list
+        JSON text (parsed with pydantic's JSON mode), or data as ``json.load`` returns it.
+        A bare list is taken as the list of mechanisms.
+
+    Returns
+    -------
+    ConstantsFile
+        The validated file, with derived constants filled in.
+
+    Raises
+    ------
+    InputError
+        If the JSON is malformed or a value is invalid; the message names the mechanism
+        (index and id) and the field.
+
+    Examples
+    --------
+    >>> cf = parse_constants('[{"id": "W1", "p_eq": 2.15, "lam": 0.25, "eta": 0.9}]')
+    >>> cf.mechanisms[0].eta_source
+    'user'
+    """
+    if isinstance(source, ConstantsFile):
+        return source
+    if isinstance(source, (str, bytes)):
+        text = source.decode("utf-8-sig") if isinstance(source, bytes) else source
+        try:
+            data = json.loads(text)
+        except ValueError as exc:
+            raise InputError(f"invalid JSON: {exc}") from None
+        if isinstance(data, list):
+            text = '{"mechanisms": ' + text + "}"
+            data = {"mechanisms": data}
+        try:
+            return ConstantsFile.model_validate_json(text)
+        except ValidationError as exc:
+            raise input_error_from_validation(exc, data) from exc
+    data = {"mechanisms": list(source)} if not isinstance(source, Mapping) else source
+    try:
+        return ConstantsFile.model_validate(data)
+    except ValidationError as exc:
+        raise input_error_from_validation(exc, data) from exc

@@ -1,0 +1,89 @@
+"""Export the JSON Schema of the kinematic-constants file.
+
+Run ``python -m shared_schema.export`` after changing ``shared_schema.constants``; it writes
+``shared_schema/jsonschema/kinematic_constants.schema.json``. With ``--check`` it writes
+nothing and exits 1 when the file on disk differs from the models (a test does the same).
+"""
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any, Dict, List, Optional
+
+from shared_schema.constants import ConstantsFile
+from shared_schema.io import write_json_atomic
+
+__all__ = ["SCHEMA_PATH", "build_schema", "main", "render_schema"]
+
+#: Where the exported schema lives (shipped as package data).
+SCHEMA_PATH = Path(__file__).resolve().parent / "jsonschema" / "kinematic_constants.schema.json"
+
+#: JSON Schema dialect pydantic generates.
+DIALECT = "https://json-schema.org/draft/2020-12/schema"
+
+
+def build_schema() -> Dict[str, Any]:
+    """Return the JSON Schema of ``ConstantsFile`` as a dict.
+
+    Returns
+    -------
+    dict
+        A draft 2020-12 schema. It describes the canonical object form; the loader also
+        accepts a bare list of mechanisms.
+    """
+    schema = ConstantsFile.model_json_schema(mode="validation")
+    schema["$schema"] = DIALECT
+    schema["title"] = "rockmech kinematic-constants file"
+    return schema
+
+
+def render_schema() -> str:
+    """Return the schema as the text stored on disk (sorted keys, indent 2, final newline)."""
+    return json.dumps(build_schema(), sort_keys=True, indent=2, ensure_ascii=False) + "\n"
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    """Write the schema file, or with ``--check`` report whether it is up to date.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Command-line arguments (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 1 when ``--check`` finds the file missing or different.
+    """
+    parser = argparse.ArgumentParser(
+        prog="python -m shared_schema.export", description=__doc__.splitlines()[0]
+    )
+    parser.add_argument(
+        "--check", action="store_true", help="exit 1 if the file differs; write nothing"
+    )
+    parser.add_argument(
+        "--output", type=Path, default=SCHEMA_PATH, help=f"schema file (default: {SCHEMA_PATH})"
+    )
+    args = parser.parse_args(argv)
+    text = render_schema()
+    output: Path = args.output
+    if args.check:
+        try:
+            current = output.read_bytes().decode("utf-8")
+        except FileNotFoundError:
+            print(f"{output}: missing; run python -m shared_schema.export", file=sys.stderr)
+            return 1
+        if current != text:
+            print(f"{output}: out of date; run python -m shared_schema.export", file=sys.stderr)
+            return 1
+        print(f"{output}: up to date")
+        return 0
+    output.parent.mkdir(parents=True, exist_ok=True)
+    write_json_atomic(output, text)
+    print(f"wrote {output}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,246 @@
+"""The ``rockmech`` command line.
+
+Every command validates its inputs up front; a bad argument exits with status 2 and a
+one-line reason on stderr (``error: <field>: <what is wrong>``). With ``--json`` a command
+prints exactly one JSON document to stdout. SI units throughout, except where an option
+name says otherwise (``--a-p-g`` is in g).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, NoReturn, Optional, TypeVar
+
+import typer
+
+from shared_schema.errors import RockmechError
+
+app = typer.Typer(
+    name="rockmech",
+    help="Rocking collapse mechanisms of masonry: exact rocking solver and tools (SI units).",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def _fail(message: str) -> NoReturn:
+    typer.echo(f"error: {message}", err=True)
+    raise typer.Exit(code=2)
+
+
+def _user_errors(fn: F) -> F:
+    """Turn rockmech's own errors into a one-line message and exit status 2."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(*args, **kwargs)
+        except RockmechError as exc:
+            _fail(str(exc))
+
+    return wrapper  # type: ignore[return-value]
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+def _print_json(doc: Any) -> None:
+    typer.echo(json.dumps(doc, indent=2, default=_json_default, allow_nan=False))
+
+
+def _fmt_time(value: Optional[float]) -> str:
+    return "-" if value is None else f"{value:.4f} s"
+
+
+@app.command()
+@_user_errors
+def pulse(
+    p_eq: float = typer.Option(..., "--p-eq", help="Frequency parameter p_eq [rad/s]."),
+    lam: float = typer.Option(..., "--lam", help="Static load multiplier lambda [-]."),
+    a_p_g: float = typer.Option(
+        ...,
+        "--a-p-g",
+        help="Signed pulse amplitude [g]; > 0 first pushes towards negative "
+        "rotation (Housner's convention), < 0 first opens the mechanism.",
+    ),
+    f_p: float = typer.Option(..., "--f-p", help="Pulse frequency [Hz]."),
+    eta: Optional[float] = typer.Option(
+        None, "--eta", help="Coefficient of restitution [-] (<= 0 one-sided)."
+    ),
+    one_sided: bool = typer.Option(False, "--one-sided", help="One-sided rocking."),
+    phi_ov: Optional[float] = typer.Option(
+        None, "--phi-ov", help="Overturning rotation [rad]; defaults to lambda."
+    ),
+    shape: str = typer.Option("sine", "--shape", help="Pulse shape: sine or cosine."),
+    criterion: Optional[str] = typer.Option(
+        None, "--criterion", help="Overturning verdict: exact (default for pulses) or ratio."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+) -> None:
+    """Response of one mechanism to a one-cycle sine or cosine acceleration pulse."""
+    from .core.exact import simulate
+    from .core.excitation import Pulse
+    from .core.model import G, RockingModel
+
+    model = RockingModel.symmetric(p_eq, lam, eta, phi_ov=phi_ov, one_sided=one_sided, name="pulse")
+    model.require_eta()
+    exc = Pulse(a_p=a_p_g * G, f_p=f_p, shape=shape)
+    res = simulate(model, exc, criterion=criterion)
+    doc = {
+        "input": {
+            "p_eq": p_eq,
+            "lam": lam,
+            "phi_ov": model.positive.phi_ov,
+            "eta": eta,
+            "rocking": "one_sided" if one_sided else "two_sided",
+            "a_p_g": a_p_g,
+            "f_p": f_p,
+            "shape": shape,
+            "omega_ratio": exc.omega_p / p_eq,
+            "amplitude_ratio": abs(a_p_g) / lam,
+            "pulse_convention": "A (Zhang & Makris 2001: pulse starts at t = 0)",
+        },
+        **res.summary(),
+    }
+    if as_json:
+        _print_json(doc)
+        return
+    verdict = "OVERTURNS" if res.overturned else "survives"
+    typer.echo(
+        f"Pulse {shape} a_p = {a_p_g:g} g, f_p = {f_p:g} Hz "
+        f"(Omega = {exc.omega_p / p_eq:.4g}, A = {abs(a_p_g) / lam:.4g}): {verdict} "
+        f"[{res.criterion} criterion]"
+    )
+    typer.echo(
+        f"  peak |phi|/phi_ov = {res.peak_ratio:.6f} at {res.t_peak:.4f} s "
+        f"(error estimate {res.error_estimate:.1e}); impacts: {res.n_impacts}; "
+        f"t_overturn: {_fmt_time(res.t_overturn)}"
+    )
+
+
+@app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+@_user_errors
+def history(
+    ctx: typer.Context,
+    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    record: Path = typer.Argument(..., help="Record file: two columns, time [s] and acceleration."),
+    scale: list[float] = typer.Option(
+        [1.0], "--scale", help="Scale factors on the record, e.g. --scale 0.5 1 2."
+    ),
+    units: str = typer.Option("g", "--units", help="Acceleration units: g, m/s2 or cm/s2."),
+    criterion: Optional[str] = typer.Option(
+        None, "--criterion", help="Overturning verdict: ratio (default for records) or exact."
+    ),
+    out: Optional[Path] = typer.Option(
+        None, "--out", help="Folder for history.json and a time-history plot."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+) -> None:
+    """Time history of every mechanism in CONSTANTS under RECORD at each scale factor."""
+    from shared_schema.io import load_constants, write_json_atomic
+
+    from .adapter import models_from_file
+    from .core.exact import simulate_batch
+    from .core.records import GroundMotion
+
+    scales = list(scale)
+    for extra in ctx.args:
+        try:
+            scales.append(float(extra))
+        except ValueError:
+            _fail(f"unexpected argument {extra!r}")
+    if not constants.is_file():
+        _fail(f"constants: file not found: {constants}")
+    cf = load_constants(constants)
+    models = models_from_file(cf)
+    for model in models:
+        model.require_eta()
+    motion = GroundMotion.from_two_column(record, units=units)
+    batch = simulate_batch(models, motion.accel, scales, criterion=criterion)
+    doc: dict[str, Any] = {
+        "record": {
+            "name": motion.name,
+            "dt_s": motion.dt,
+            "pga_g": motion.pga_g,
+            "duration_s": motion.duration,
+            **motion.metadata,
+        },
+        "criterion": batch.criterion,
+        "method": batch.method,
+        "runtime_s": batch.runtime_s,
+        "results": batch.rows(),
+    }
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        write_json_atomic(out / "history.json", json.dumps(doc, indent=2) + "\n")
+        _history_plot(models, motion, max(scales), out / "history.png")
+    if as_json:
+        _print_json(doc)
+        return
+    typer.echo(
+        f"{motion.name}: PGA {motion.pga_g:.3f} g, dt {motion.dt:g} s, "
+        f"{motion.duration:.2f} s; criterion: {batch.criterion}"
+    )
+    typer.echo(
+        f"{'mechanism':<16}{'scale':>8}{'peak':>10}{'overturned':>12}"
+        f"{'t_ov [s]':>10}{'impacts':>9}{'error':>10}"
+    )
+    for row in doc["results"]:
+        t_ov = "-" if row["t_overturn"] is None else f"{row['t_overturn']:.3f}"
+        typer.echo(
+            f"{row['mechanism']:<16}{row['scale']:>8g}{row['peak_ratio']:>10.4f}"
+            f"{'yes' if row['overturned'] else 'no':>12}{t_ov:>10}{row['n_impacts']:>9}"
+            f"{row['error_estimate']:>10.1e}"
+        )
+
+
+def _history_plot(models: list[Any], motion: Any, scale: float, path: Path) -> None:
+    from .core.exact import simulate
+    from .core.model import G
+    from .report.plots import plot_time_histories
+
+    runs = [(m.name, simulate(m, motion.accel, scale=scale, dense=True)) for m in models]
+    plot_time_histories(
+        runs,
+        path,
+        record_t=motion.accel.time,
+        record_a_g=scale * motion.accel.acc / G,
+        title=f"{motion.name} x {scale:g}",
+    )
+
+
+@app.command()
+@_user_errors
+def demo(
+    out: Path = typer.Option(Path("out"), "--out", help="Output folder."),
+    record: Optional[Path] = typer.Option(
+        None, "--record", help="Two-column record in g (default: bundled El Centro 1940 N-S)."
+    ),
+) -> None:
+    """Run the bundled example: rectangular walls on El Centro 1940, exact integration."""
+    from .demo import run_demo
+
+    paths = run_demo(out, record)
+    for kind, path in paths.items():
+        typer.echo(f"wrote {kind}: {path}")
+    summary = json.loads(paths["history"].read_text())
+    for row in summary["results"]:
+        typer.echo(
+            f"  {row['mechanism']:<8} x{row['scale']:<4g} peak |phi|/phi_ov = "
+            f"{row['peak_ratio']:.4f}  {'OVERTURNS' if row['overturned'] else 'survives'}"
+        )
+
+
+def main() -> None:  # pragma: no cover - console entry point
+    """Entry point of the ``rockmech`` console script."""
+    app()

@@ -1,0 +1,480 @@
+"""Exact (closed-form, event-driven) integration of the linearised rocking equation.
+
+Between impacts the motion is solved in closed form: exactly for one-sine and one-cosine
+pulses, and exactly for sampled records taken as piecewise-linear acceleration. Impact,
+uplift, turning-point and ``|phi|/phi_ov = 1`` times are found to machine precision
+(THEORY §1.8, §6.3, §10; the argument that no event is missed is in ``_kernels``).
+
+Rules (all documented in THEORY §1.8 and §10):
+
+* uplift from rest when the drive exceeds the static multiplier, ``-a_g > g lam+`` or
+  ``a_g > g lam-``; the crossing time is exact;
+* at an impact the angular velocity is multiplied by ``eta`` (and by
+  ``phi_ov_old/phi_ov_new`` in the normalised variable, for asymmetric mechanisms);
+  one-sided mechanisms rebound (``eta <= 0``) and stay on the positive side;
+* **rest rule**: an impact whose outgoing speed is below ``V_REST_REL * p`` ends in rest.
+  This ends Zeno sequences after finitely many impacts; the excursions it drops are
+  smaller than ``V_REST_REL**2 / 2`` in ``|phi|/phi_ov``;
+* **sub-resolution uplift**: an uplift followed by a return at below the rest speed in
+  the same closed-form segment holds the body at rest to the end of that segment;
+* after the excitation the free-rocking outcome is computed exactly (``freemotion``).
+
+Every result carries ``error_estimate``: the propagated rounding error of the state
+(a first-order covariance carried through the closed-form flow and the impact saltation
+maps), times ``ERR_SAFETY``, at the time of the peak.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any, Optional, Union
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from shared_schema.errors import InputError
+
+from . import _kernels as _k
+from .excitation import Pulse, SampledAccel
+from .model import RockingModel
+from .result import CRITERIA, STATUS_MESSAGES, RockingResult
+
+__all__ = [
+    "BACKENDS",
+    "V_REST_REL",
+    "BatchResult",
+    "Cells",
+    "cells_for",
+    "kernels",
+    "simulate",
+    "simulate_batch",
+]
+
+Excitation = Union[Pulse, SampledAccel]
+
+#: Rest rule: an impact leaving at below ``V_REST_REL * p`` [1/s per rad/s] ends in rest.
+V_REST_REL = 1e-9
+#: Default impact cap per simulation.
+MAX_IMPACTS = 1_000_000
+#: Kernel back ends: numba-compiled, or the same source as plain Python.
+BACKENDS = ("auto", "numba", "python")
+#: Closed-form segments per pulse quarter when a time series is asked for.
+DENSE_PER_QUARTER = 50
+
+_KERNEL_CACHE: dict[str, ModuleType] = {}
+
+
+def kernels(backend: str = "auto") -> ModuleType:
+    """Return the kernel module for ``backend``.
+
+    ``"numba"`` is the compiled module (an error if numba is missing); ``"python"`` loads
+    a second copy of the same source with compilation switched off, so both paths run the
+    same code; ``"auto"`` prefers numba.
+    """
+    if backend not in BACKENDS:
+        raise InputError(f"must be one of {BACKENDS}, got {backend!r}", "backend")
+    if backend == "auto":
+        backend = "numba" if _k.JIT else "python"
+    if backend == "numba":
+        if not _k.JIT:
+            raise InputError("numba is not installed; use backend='python'", "backend")
+        return _k
+    if "python" not in _KERNEL_CACHE:
+        spec = importlib.util.spec_from_file_location(
+            "solver_service.core._kernels_python", _k.__file__
+        )
+        assert spec is not None and spec.loader is not None
+        mod = importlib.util.module_from_spec(spec)
+        mod.__dict__["_NO_JIT"] = True
+        spec.loader.exec_module(mod)
+        sys.modules[spec.name] = mod
+        _KERNEL_CACHE["python"] = mod
+    return _KERNEL_CACHE["python"]
+
+
+@dataclass(frozen=True)
+class Cells:
+    """An excitation as the kernels see it (see ``_kernels`` module docstring).
+
+    Attributes
+    ----------
+    kind : (n,) int
+        0: linear acceleration; 1: sinusoidal quarter period.
+    c0, c1, c2 : (n,) float
+        Linear: ``a(t_start)`` [m/s²], slope [m/s³], unused. Sinusoidal: amplitude
+        [m/s²], circular frequency [rad/s], phase [rad].
+    tstart, tend : (n,) float
+        Cell limits [s].
+    amax_after : (n,) float
+        Bound on ``|a|`` from ``tstart[i]`` to the end of the excitation [m/s²].
+    """
+
+    kind: NDArray[np.int64]
+    c0: NDArray[np.float64]
+    c1: NDArray[np.float64]
+    c2: NDArray[np.float64]
+    tstart: NDArray[np.float64]
+    tend: NDArray[np.float64]
+    amax_after: NDArray[np.float64]
+
+    @property
+    def t_end(self) -> float:
+        """End of the excitation [s]."""
+        return float(self.tend[-1])
+
+
+def _record_cells(rec: SampledAccel, t_extra: float) -> Cells:
+    acc = rec.acc
+    n = acc.size - 1
+    times = rec.time
+    c0 = acc[:-1].copy()
+    c1 = np.diff(acc) / rec.dt
+    tstart = times[:-1]
+    tend = times[1:]
+    absacc = np.abs(acc)
+    amax = np.maximum.accumulate(absacc[::-1])[::-1][:-1].copy()
+    kind = np.zeros(n, dtype=np.int64)
+    cells = Cells(kind, c0, c1, np.zeros(n), tstart.copy(), tend.copy(), amax)
+    return _append_rest(cells, t_extra)
+
+
+def _pulse_cells(pulse: Pulse, per_quarter: int, t_extra: float) -> Cells:
+    # Quarter periods hold every extremum of both shapes on a boundary, so the
+    # acceleration is monotone in each cell.
+    nq = 4 * per_quarter
+    edges = pulse.duration * np.arange(nq + 1) / nq
+    n = nq
+    cells = Cells(
+        np.ones(n, dtype=np.int64),
+        np.full(n, pulse.a_p),
+        np.full(n, pulse.omega_p),
+        np.full(n, pulse.phase),
+        edges[:-1].copy(),
+        edges[1:].copy(),
+        np.full(n, abs(pulse.a_p)),
+    )
+    return _append_rest(cells, t_extra)
+
+
+def _append_rest(cells: Cells, t_extra: float) -> Cells:
+    """Append ``t_extra`` seconds of zero acceleration (free motion in the time series)."""
+    if t_extra <= 0.0:
+        return cells
+    t0 = cells.t_end
+    return Cells(
+        np.append(cells.kind, 0),
+        np.append(cells.c0, 0.0),
+        np.append(cells.c1, 0.0),
+        np.append(cells.c2, 0.0),
+        np.append(cells.tstart, t0),
+        np.append(cells.tend, t0 + t_extra),
+        np.append(cells.amax_after, 0.0),
+    )
+
+
+def cells_for(excitation: Excitation, *, dense: bool = False, t_extra: float = 0.0) -> Cells:
+    """Cells of an excitation; ``dense`` subdivides pulses for a smooth time series."""
+    if isinstance(excitation, Pulse):
+        return _pulse_cells(excitation, DENSE_PER_QUARTER if dense else 1, t_extra)
+    if isinstance(excitation, SampledAccel):
+        return _record_cells(excitation, t_extra)
+    raise InputError(
+        f"must be a Pulse or a SampledAccel, got {type(excitation).__name__}", "excitation"
+    )
+
+
+def _check_scale(scale: float, name: str = "scale") -> float:
+    if isinstance(scale, bool) or not isinstance(scale, (int, float, np.floating, np.integer)):
+        raise InputError(f"must be a number, got {scale!r}", name)
+    value = float(scale)
+    if not (math.isfinite(value) and value > 0.0):
+        raise InputError(f"must be finite and > 0, got {scale!r}", name)
+    return value
+
+
+def _criterion(criterion: Optional[str], excitation: Excitation) -> str:
+    if criterion is None:
+        return "exact" if isinstance(excitation, Pulse) else "ratio"
+    if criterion not in CRITERIA:
+        raise InputError(f"must be one of {CRITERIA}, got {criterion!r}", "criterion")
+    return criterion
+
+
+def _params(model: RockingModel) -> NDArray[np.float64]:
+    pos, neg = model.positive, model.neg
+    return np.array(
+        [
+            pos.p_eq,
+            neg.p_eq,
+            pos.lam,
+            neg.lam,
+            pos.phi_ov,
+            neg.phi_ov,
+            model.require_eta(),
+            1.0 if model.one_sided else 0.0,
+        ]
+    )
+
+
+def _nan_to_none(value: float) -> Optional[float]:
+    return None if math.isnan(value) else float(value)
+
+
+def simulate(
+    model: RockingModel,
+    excitation: Excitation,
+    *,
+    scale: float = 1.0,
+    criterion: Optional[str] = None,
+    dense: bool = False,
+    x0: float = 0.0,
+    t_extra: float = 0.0,
+    max_impacts: int = MAX_IMPACTS,
+    backend: str = "auto",
+) -> RockingResult:
+    """Simulate one mechanism under one excitation, exactly.
+
+    Parameters
+    ----------
+    model : RockingModel
+        The mechanism; ``eta`` is required.
+    excitation : Pulse or SampledAccel
+        Ground acceleration [m/s²].
+    scale : float
+        Factor applied to the acceleration [-], > 0.
+    criterion : {"ratio", "exact"}, optional
+        Overturning verdict reported as ``overturned``; defaults to ``"exact"`` for pulses
+        and ``"ratio"`` for records (THEORY decisions).
+    dense : bool
+        Return the time series (``t``, ``ratio``): every segment end and event.
+    x0 : float
+        Initial ``phi/phi_ov``, released from rest [-]; ``|x0| < 1``.
+    t_extra : float
+        Seconds of free motion to integrate (and trace) after the excitation [s]; the
+        analytic free-rocking outcome covers the time after that in any case.
+    max_impacts : int
+        Impact cap; reaching it gives status -1.
+    backend : {"auto", "numba", "python"}
+        Kernel back end (identical results up to rounding).
+
+    Returns
+    -------
+    RockingResult
+
+    Examples
+    --------
+    >>> from solver_service.core.excitation import Pulse
+    >>> m = RockingModel.symmetric(p_eq=2.0, lam=0.2, eta=0.9)
+    >>> pulse = Pulse(a_p=-0.1 * 9.80665, f_p=1.0)     # below the uplift threshold 0.2 g
+    >>> simulate(m, pulse).peak_ratio
+    0.0
+    """
+    t_start = time.perf_counter()
+    params = _params(model)
+    scale = _check_scale(scale)
+    crit = _criterion(criterion, excitation)
+    if isinstance(x0, bool) or not (math.isfinite(float(x0)) and abs(float(x0)) < 1.0):
+        raise InputError(f"must be finite with |x0| < 1, got {x0!r}", "x0")
+    if model.one_sided and x0 < 0.0:
+        raise InputError("must be >= 0 for one-sided rocking", "x0")
+    if not (math.isfinite(float(t_extra)) and t_extra >= 0.0):
+        raise InputError(f"must be finite and >= 0, got {t_extra!r}", "t_extra")
+    if int(max_impacts) < 1:
+        raise InputError(f"must be >= 1, got {max_impacts!r}", "max_impacts")
+    cells = cells_for(excitation, dense=dense, t_extra=t_extra)
+    kern = kernels(backend)
+    cap = 0
+    if dense:
+        p_max = max(model.positive.p_eq, model.neg.p_eq)
+        n_seg = np.ceil(p_max * (cells.tend - cells.tstart) / kern.MAX_PH).clip(min=1).sum()
+        cap = int(n_seg) + 3 * min(int(max_impacts), 100_000) + 8
+    trace_t = np.empty(cap)
+    trace_x = np.empty(cap)
+    out = kern.simulate_cells(
+        cells.kind,
+        cells.c0,
+        cells.c1,
+        cells.c2,
+        cells.tstart,
+        cells.tend,
+        cells.amax_after,
+        scale,
+        *params[:7],
+        bool(params[7]),
+        float(x0),
+        V_REST_REL,
+        int(max_impacts),
+        trace_t,
+        trace_x,
+    )
+    runtime = time.perf_counter() - t_start
+    n_tr = int(out[_k.OUT_N_TRACE])
+    return RockingResult(
+        status=int(out[_k.OUT_STATUS]),
+        peak_ratio=float(out[_k.OUT_PEAK]),
+        t_peak=float(out[_k.OUT_T_PEAK]),
+        criterion=crit,
+        ratio_exceeded=not math.isnan(out[_k.OUT_T_EXCEED]),
+        t_ratio_exceeded=_nan_to_none(out[_k.OUT_T_EXCEED]),
+        collapsed=bool(out[_k.OUT_COLLAPSED]),
+        t_collapse=_nan_to_none(out[_k.OUT_T_COLLAPSE]),
+        n_impacts=int(out[_k.OUT_N_IMPACTS]),
+        n_steps=int(out[_k.OUT_N_STEPS]),
+        error_estimate=float(out[_k.OUT_ERROR]),
+        runtime_s=runtime,
+        method=f"exact:{'numba' if kern.JIT else 'python'}",
+        t=trace_t[:n_tr].copy() if dense else None,
+        ratio=trace_x[:n_tr].copy() if dense else None,
+    )
+
+
+@dataclass
+class BatchResult:
+    """Results of many mechanisms × many scale factors; arrays have shape (n_models, n_scales).
+
+    Attributes
+    ----------
+    names : list of str
+        Mechanism names, one per row.
+    scales : (k,) float
+        Scale factors, one per column [-].
+    peak_ratio, t_peak, error_estimate : (m, k) float
+        As in ``RockingResult`` [-], [s], [-].
+    ratio_exceeded, collapsed, overturned : (m, k) bool
+        Verdicts; ``overturned`` follows ``criterion``.
+    t_ratio_exceeded, t_collapse, t_overturn : (m, k) float
+        Times [s]; NaN where the event did not happen.
+    n_impacts, n_steps, status : (m, k) int
+        Work counters and status codes.
+    criterion : str
+        ``"ratio"`` or ``"exact"``.
+    runtime_s : float
+        Wall-clock time of the whole batch [s].
+    method : str
+        Integrator used.
+    """
+
+    names: list[str]
+    scales: NDArray[np.float64]
+    peak_ratio: NDArray[np.float64]
+    t_peak: NDArray[np.float64]
+    ratio_exceeded: NDArray[np.bool_]
+    t_ratio_exceeded: NDArray[np.float64]
+    collapsed: NDArray[np.bool_]
+    t_collapse: NDArray[np.float64]
+    n_impacts: NDArray[np.int64]
+    n_steps: NDArray[np.int64]
+    error_estimate: NDArray[np.float64]
+    status: NDArray[np.int64]
+    criterion: str
+    runtime_s: float
+    method: str
+
+    @property
+    def overturned(self) -> NDArray[np.bool_]:
+        """Verdict under ``criterion``, shape (m, k)."""
+        return self.ratio_exceeded if self.criterion == "ratio" else self.collapsed
+
+    @property
+    def t_overturn(self) -> NDArray[np.float64]:
+        """Time of overturning under ``criterion`` [s], NaN where none; shape (m, k)."""
+        return self.t_ratio_exceeded if self.criterion == "ratio" else self.t_collapse
+
+    def rows(self) -> list[dict[str, Any]]:
+        """One JSON-ready dict per (mechanism, scale), mechanism-major."""
+        rows = []
+        ov = self.overturned
+        tov = self.t_overturn
+        for i, name in enumerate(self.names):
+            for j, sc in enumerate(self.scales):
+                rows.append(
+                    {
+                        "mechanism": name,
+                        "scale": float(sc),
+                        "peak_ratio": float(self.peak_ratio[i, j]),
+                        "overturned": bool(ov[i, j]),
+                        "t_overturn": _nan_to_none(float(tov[i, j])),
+                        "n_impacts": int(self.n_impacts[i, j]),
+                        "error_estimate": float(self.error_estimate[i, j]),
+                        "status": int(self.status[i, j]),
+                        "message": STATUS_MESSAGES[int(self.status[i, j])],
+                    }
+                )
+        return rows
+
+
+def simulate_batch(
+    models: Sequence[RockingModel],
+    excitation: Excitation,
+    scales: ArrayLike,
+    *,
+    criterion: Optional[str] = None,
+    max_impacts: int = MAX_IMPACTS,
+    backend: str = "auto",
+) -> BatchResult:
+    """Simulate every mechanism at every scale factor in one compiled call.
+
+    Parameters
+    ----------
+    models : sequence of RockingModel
+        Mechanisms (each needs ``eta``); at least one.
+    excitation : Pulse or SampledAccel
+        Ground acceleration [m/s²].
+    scales : array_like of float
+        Scale factors [-], each finite and > 0; at least one.
+    criterion, max_impacts, backend
+        As in ``simulate``.
+
+    Returns
+    -------
+    BatchResult
+    """
+    t_start = time.perf_counter()
+    if len(models) == 0:
+        raise InputError("needs at least one mechanism", "mechanisms")
+    sc = np.atleast_1d(np.asarray(scales, dtype=float))
+    if sc.ndim != 1 or sc.size == 0:
+        raise InputError("needs at least one scale factor", "scales")
+    for j, value in enumerate(sc):
+        _check_scale(float(value), f"scales[{j}]")
+    params = np.stack([_params(m) for m in models])
+    crit = _criterion(criterion, excitation)
+    cells = cells_for(excitation)
+    kern = kernels(backend)
+    out = kern.simulate_grid(
+        cells.kind,
+        cells.c0,
+        cells.c1,
+        cells.c2,
+        cells.tstart,
+        cells.tend,
+        cells.amax_after,
+        params,
+        sc,
+        V_REST_REL,
+        int(max_impacts),
+    )
+    t_exc = out[..., _k.OUT_T_EXCEED]
+    return BatchResult(
+        names=[m.name for m in models],
+        scales=sc,
+        peak_ratio=out[..., _k.OUT_PEAK].copy(),
+        t_peak=out[..., _k.OUT_T_PEAK].copy(),
+        ratio_exceeded=~np.isnan(t_exc),
+        t_ratio_exceeded=t_exc.copy(),
+        collapsed=out[..., _k.OUT_COLLAPSED] != 0.0,
+        t_collapse=out[..., _k.OUT_T_COLLAPSE].copy(),
+        n_impacts=out[..., _k.OUT_N_IMPACTS].astype(np.int64),
+        n_steps=out[..., _k.OUT_N_STEPS].astype(np.int64),
+        error_estimate=out[..., _k.OUT_ERROR].copy(),
+        status=out[..., _k.OUT_STATUS].astype(np.int64),
+        criterion=crit,
+        runtime_s=time.perf_counter() - t_start,
+        method=f"exact:{'numba' if kern.JIT else 'python'}",
+    )

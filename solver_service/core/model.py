@@ -1,0 +1,162 @@
+"""The linearised rocking model of one mechanism (THEORY.md §1).
+
+Notation
+--------
+phi : rotation of the mechanism, positive in the direction of collapse [rad]
+x : normalised rotation used by the integrators, ``x = phi / phi_ov`` on the side in
+    motion (so ``|x|`` *is* the ratio ``|phi|/phi_ov`` that the method reports) [-]
+p_eq : equivalent frequency parameter of a side [rad/s]
+lam : linearised static load multiplier of a side (uplift acceleration / g) [-]
+phi_ov : overturning rotation of a side [rad]
+eta : coefficient of restitution on the angular velocity at impact [-];
+    ``0 <= eta <= 1`` for two-sided rocking, ``-1 <= eta <= 0`` for one-sided rebound.
+
+Equation of motion in ``x`` (Eq. 3 of THEORY.md divided by ``lam``), on side ``s = ±1``::
+
+    x'' = p_s**2 * (x - s - a_g(t) / (g * lam_s))
+
+with Housner's sign convention: a positive ground acceleration ``a_g`` opposes positive
+rotation. At an impact on ``x = 0`` the angular velocity is scaled by ``eta``; in ``x`` this
+becomes ``x' -> eta * (phi_ov_old / phi_ov_new) * x'`` (THEORY §1.8).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Optional
+
+from shared_schema.errors import InputError
+
+__all__ = ["G", "RockingModel", "RockingSide"]
+
+#: Standard gravity [m/s²].
+G = 9.80665
+
+
+def _check_positive_finite(value: float, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"must be a number, got {value!r}", name)
+    v = float(value)
+    if not math.isfinite(v) or v <= 0.0:
+        raise InputError(f"must be finite and > 0, got {value!r}", name)
+    return v
+
+
+@dataclass(frozen=True)
+class RockingSide:
+    """Constants of one rocking side.
+
+    Parameters
+    ----------
+    p_eq : float
+        Equivalent frequency parameter [rad/s], > 0.
+    lam : float
+        Linearised static load multiplier [-], > 0.
+    phi_ov : float, optional
+        Overturning rotation [rad], > 0. Defaults to ``lam`` (single block: φ_ov = λ = α).
+    """
+
+    p_eq: float
+    lam: float
+    phi_ov: float = float("nan")
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "p_eq", _check_positive_finite(self.p_eq, "p_eq"))
+        object.__setattr__(self, "lam", _check_positive_finite(self.lam, "lam"))
+        phi_ov = self.lam if math.isnan(self.phi_ov) else self.phi_ov
+        object.__setattr__(self, "phi_ov", _check_positive_finite(phi_ov, "phi_ov"))
+
+
+@dataclass(frozen=True)
+class RockingModel:
+    """A mechanism as the solver sees it: two sides, restitution and the rocking kind.
+
+    Parameters
+    ----------
+    positive : RockingSide
+        Constants for positive rotation (the collapse direction).
+    negative : RockingSide, optional
+        Constants for negative rotation (two-sided rocking). Defaults to ``positive``
+        (symmetric mechanism). Ignored for one-sided rocking.
+    eta : float, optional
+        Coefficient of restitution [-]. Required for time histories; one-sided envelopes
+        do not need it. Two-sided: ``0 <= eta <= 1``; one-sided: ``-1 <= eta <= 0``.
+    one_sided : bool
+        True for a mechanism that can only rotate positively (e.g. a façade restrained by
+        transverse walls); it rebounds off the restraint at ``x = 0``.
+    name : str
+        Identifier used in messages and outputs.
+    """
+
+    positive: RockingSide
+    negative: Optional[RockingSide] = None
+    eta: Optional[float] = None
+    one_sided: bool = False
+    name: str = field(default="mechanism")
+
+    def __post_init__(self) -> None:
+        if self.negative is None:
+            object.__setattr__(self, "negative", self.positive)
+        if self.eta is not None:
+            if isinstance(self.eta, bool) or not isinstance(self.eta, (int, float)):
+                raise InputError(f"must be a number, got {self.eta!r}", "eta")
+            eta = float(self.eta)
+            if not (-1.0 <= eta <= 1.0):
+                raise InputError(f"must be in [-1, 1], got {self.eta!r}", "eta")
+            if self.one_sided and eta > 0.0:
+                raise InputError(
+                    f"must be <= 0 for one-sided rocking (rebound off the restraint), got {eta}",
+                    "eta",
+                )
+            if not self.one_sided and eta < 0.0:
+                raise InputError(
+                    f"must be >= 0 for two-sided rocking (negative values mean rebound, "
+                    f"which is one-sided), got {eta}",
+                    "eta",
+                )
+            object.__setattr__(self, "eta", eta)
+
+    @classmethod
+    def symmetric(
+        cls,
+        p_eq: float,
+        lam: float,
+        eta: Optional[float] = None,
+        *,
+        phi_ov: Optional[float] = None,
+        one_sided: bool = False,
+        name: str = "mechanism",
+    ) -> RockingModel:
+        """Build a mechanism with the same constants on both sides.
+
+        Examples
+        --------
+        >>> m = RockingModel.symmetric(p_eq=2.0, lam=0.2, eta=0.9)
+        >>> m.negative.lam
+        0.2
+        """
+        side = RockingSide(p_eq, lam, float("nan") if phi_ov is None else phi_ov)
+        return cls(positive=side, negative=side, eta=eta, one_sided=one_sided, name=name)
+
+    @property
+    def neg(self) -> RockingSide:
+        """Constants of the negative side (equal to ``positive`` when symmetric)."""
+        assert self.negative is not None
+        return self.negative
+
+    @property
+    def is_symmetric(self) -> bool:
+        """True when both sides have the same constants (or the mechanism is one-sided)."""
+        return self.one_sided or self.positive == self.negative
+
+    def require_eta(self) -> float:
+        """Return ``eta``, or raise a clear error when a time-domain analysis needs it."""
+        if self.eta is None:
+            kind = "one-sided" if self.one_sided else "two-sided"
+            raise InputError(
+                f"a time-domain analysis of a {kind} mechanism needs a coefficient of "
+                "restitution; give eta",
+                f"{self.name}.eta",
+            )
+        return self.eta

@@ -1,0 +1,106 @@
+"""Plots of rocking results (PNG or SVG, chosen by the file suffix).
+
+matplotlib is imported inside each function, with the non-interactive Agg back end, so
+importing this module costs nothing and works on machines without a display.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any, Union
+
+import numpy as np
+
+from ..core.result import RockingResult
+
+__all__ = ["plot_time_histories"]
+
+
+def _pyplot() -> Any:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save_atomic(fig: Any, path: Union[str, Path]) -> Path:
+    """Save a figure through a temporary file in the target folder, then rename it."""
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.stem}-", suffix=out.suffix)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=120, bbox_inches="tight")
+        os.replace(tmp, out)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return out
+
+
+def plot_time_histories(
+    results: Sequence[tuple[str, RockingResult]],
+    path: Union[str, Path],
+    *,
+    record_t: Union[np.ndarray[Any, Any], None] = None,
+    record_a_g: Union[np.ndarray[Any, Any], None] = None,
+    title: str = "",
+) -> Path:
+    """Plot ``phi/phi_ov`` against time for several runs, over the ground motion.
+
+    Parameters
+    ----------
+    results : sequence of (label, RockingResult)
+        Runs made with ``dense=True``.
+    path : str or Path
+        Output file (.png or .svg); written atomically.
+    record_t, record_a_g : (n,) float, optional
+        Ground motion to draw underneath: time [s] and acceleration [g].
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
+    plt = _pyplot()
+    nrows = 2 if record_t is not None else 1
+    fig, axes = plt.subplots(
+        nrows,
+        1,
+        figsize=(9, 3.2 * nrows),
+        sharex=True,
+        squeeze=False,
+        gridspec_kw={"height_ratios": [2, 1][:nrows]},
+    )
+    ax = axes[0, 0]
+    for label, res in results:
+        if res.t is None or res.ratio is None:
+            raise ValueError(f"result {label!r} has no time series; run with dense=True")
+        verdict = " (overturned)" if res.overturned else ""
+        ax.plot(res.t, res.ratio, lw=1.0, label=f"{label}: peak {res.peak_ratio:.3f}{verdict}")
+    for level in (1.0, -1.0):
+        ax.axhline(level, color="crimson", ls="--", lw=0.8)
+    ax.set_ylabel("φ / φ_ov  [-]")
+    ax.set_ylim(-1.25, 1.25)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper right")
+    if title:
+        ax.set_title(title)
+    if record_t is not None and record_a_g is not None:
+        axr = axes[1, 0]
+        axr.plot(record_t, record_a_g, color="0.3", lw=0.6)
+        axr.set_ylabel("ground acc. [g]")
+        axr.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.tight_layout()
+    try:
+        return _save_atomic(fig, path)
+    finally:
+        plt.close(fig)

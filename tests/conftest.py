@@ -1,0 +1,26 @@
+"""Shared fixtures: paths to bundled and shared data."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+EXAMPLES = REPO / "examples"
+#: The project's shared folder (PEER records), beside the repository; absent on a user's clone.
+SHARED_RECORDS = REPO.parent / "shared" / "data" / "records"
+
+
+@pytest.fixture(scope="session")
+def elcentro_path() -> Path:
+    """The bundled, public-domain El Centro 1940 N-S record (two columns, g)."""
+    return EXAMPLES / "records" / "elcentro_NS.dat"
+
+
+@pytest.fixture(scope="session")
+def shared_records() -> Path:
+    """The shared PEER records folder; tests using it skip where it is absent."""
+    if not SHARED_RECORDS.is_dir():
+        pytest.skip(f"shared records folder not found at {SHARED_RECORDS} (not part of a clone)")
+    return SHARED_RECORDS

@@ -1,0 +1,235 @@
+"""Tests of reading and writing kinematic-constants files (shared_schema.io)."""
+
+import json
+import os
+import stat
+from pathlib import Path
+
+import pytest
+from pydantic_core import PydanticSerializationError
+
+import shared_schema.io as sio
+from shared_schema.constants import ConstantsFile, Mechanism, parse_constants
+from shared_schema.errors import InputError
+from shared_schema.io import load_constants, save_constants, write_json_atomic
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "constants"
+
+W1 = {
+    "id": "W1",
+    "rocking": "two_sided",
+    "p_eq": 2.15,
+    "lam": 0.25,
+    "eta": 0.90,
+    "amplification": {"f_n": 6.22, "h_e": 4.66, "h": 3.11},
+}
+
+
+def leftovers(directory):
+    """Files in ``directory`` other than the expected ones (e.g. temporary files)."""
+    return sorted(p.name for p in Path(directory).iterdir())
+
+
+# --- round trip --------------------------------------------------------------------------
+
+
+def test_published_table_form_round_trips_and_omits_absent_sections(tmp_path):
+    original = parse_constants({"mechanisms": [W1]})
+    path = tmp_path / "walls.json"
+    save_constants(path, original)
+    text = path.read_text(encoding="utf-8")
+    assert text.endswith("}\n")
+    assert "null" not in text
+    saved = json.loads(text)
+    mech = saved["mechanisms"][0]
+    assert set(mech) == {
+        "id",
+        "name",
+        "typology",
+        "rocking",
+        "positive",
+        "eta",
+        "eta_source",
+        "amplification",
+    }
+    assert mech["positive"] == {"p_eq": 2.15, "lam": 0.25, "phi_ov": 0.25}
+    assert saved["schema_version"] == "1.0"
+    assert saved["units"]["p_eq"] == "rad/s"
+    assert load_constants(path) == original
+
+
+def test_physical_form_round_trips_exactly(tmp_path):
+    side = {"I0": 10000.0, "K": 40000.0, "Q": 2000.0, "phi_cr": 0.1, "M_F": 1000.0}
+    original = parse_constants(
+        [
+            {
+                "id": "L1",
+                "typology": "single_block_loaded",
+                "positive": side,
+                "negative": side,
+                "geometry": {"b": 0.5, "h": 3.0, "note": None, "ratios": [1, 2.5]},
+                "provenance": {"tool": "test"},
+            }
+        ]
+    )
+    path = tmp_path / "loaded.json"
+    save_constants(path, original)
+    loaded = load_constants(path)
+    assert loaded == original
+    # Derived values are written next to the physical ones; nulls inside free-form data stay.
+    mech = json.loads(path.read_text())["mechanisms"][0]
+    assert mech["negative"]["lam"] == original.mechanisms[0].negative.lam
+    assert mech["geometry"]["note"] is None
+
+
+def test_saving_twice_gives_identical_bytes(tmp_path):
+    cf = parse_constants([W1])
+    save_constants(tmp_path / "a.json", cf)
+    save_constants(tmp_path / "b.json", load_constants(tmp_path / "a.json"))
+    assert (tmp_path / "a.json").read_bytes() == (tmp_path / "b.json").read_bytes()
+
+
+# --- loading -----------------------------------------------------------------------------
+
+
+def test_missing_file_names_the_file(tmp_path):
+    path = tmp_path / "nowhere.json"
+    with pytest.raises(InputError) as info:
+        load_constants(path)
+    assert info.value.field == str(path)
+    assert str(info.value) == f"{path}: constants file not found"
+
+
+def test_directory_instead_of_file_is_an_input_error(tmp_path):
+    with pytest.raises(InputError, match="cannot read constants file"):
+        load_constants(tmp_path)
+
+
+def test_invalid_json_names_the_file_and_position(tmp_path):
+    path = tmp_path / "broken.json"
+    path.write_text('{"mechanisms": [\n  {"id": "W1",}\n]}\n')
+    with pytest.raises(InputError) as info:
+        load_constants(path)
+    message = str(info.value)
+    assert message.startswith(f"{path}: invalid JSON")
+    assert "line 2" in message
+
+
+def test_invalid_value_names_file_mechanism_and_field(tmp_path):
+    path = tmp_path / "walls.json"
+    bad = dict(W1, id="W2", p_eq=-2.15)
+    path.write_text(json.dumps({"mechanisms": [W1, bad]}))
+    with pytest.raises(InputError) as info:
+        load_constants(path)
+    assert str(info.value) == (
+        f"{path}: mechanisms[1] (id 'W2').positive.p_eq: Input should be greater than 0"
+    )
+    # The original error, with the field path alone, is kept as the cause.
+    assert info.value.__cause__.field == "mechanisms[1] (id 'W2').positive.p_eq"
+
+
+def test_nan_literal_in_file_is_rejected(tmp_path):
+    path = tmp_path / "nan.json"
+    path.write_text('[{"id": "W1", "p_eq": NaN, "lam": 0.25}]')
+    with pytest.raises(InputError, match=r"\(id 'W1'\)\.positive\.p_eq: .*finite"):
+        load_constants(path)
+
+
+def test_bare_list_file_and_byte_order_mark_are_accepted(tmp_path):
+    path = tmp_path / "list.json"
+    path.write_bytes(b"\xef\xbb\xbf" + json.dumps([W1, dict(W1, id="W2")]).encode())
+    cf = load_constants(path)
+    assert [m.id for m in cf.mechanisms] == ["W1", "W2"]
+
+
+def test_non_utf8_file_is_an_input_error(tmp_path):
+    path = tmp_path / "latin1.json"
+    path.write_bytes('[{"id": "Fa\u00e7ade", "p_eq": 2, "lam": 0.2}]'.encode("latin-1"))
+    with pytest.raises(InputError, match="not UTF-8"):
+        load_constants(path)
+
+
+# --- atomic writes -----------------------------------------------------------------------
+
+
+def test_write_json_atomic_writes_str_and_bytes_exactly(tmp_path):
+    path = tmp_path / "x.json"
+    write_json_atomic(path, '{"a": "\u00e9"}\r\n')
+    assert path.read_bytes() == '{"a": "\u00e9"}\r\n'.encode()
+    write_json_atomic(str(path), b"[1]\n")
+    assert path.read_bytes() == b"[1]\n"
+    assert leftovers(tmp_path) == ["x.json"]
+
+
+def test_write_json_atomic_rejects_other_types_before_touching_the_disk(tmp_path):
+    with pytest.raises(TypeError, match="str or bytes"):
+        write_json_atomic(tmp_path / "x.json", {"a": 1})
+    assert leftovers(tmp_path) == []
+
+
+def test_failed_rename_leaves_previous_file_and_no_temporary_file(tmp_path, monkeypatch):
+    path = tmp_path / "x.json"
+    path.write_text("old\n")
+
+    def fail_replace(src, dst):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(sio.os, "replace", fail_replace)
+    with pytest.raises(OSError, match="No space"):
+        write_json_atomic(path, "new\n")
+    assert path.read_text() == "old\n"
+    assert leftovers(tmp_path) == ["x.json"]
+
+
+def test_failing_serialisation_leaves_previous_file_and_no_temporary_file(tmp_path):
+    path = tmp_path / "walls.json"
+    save_constants(path, parse_constants([W1]))
+    before = path.read_bytes()
+    good = parse_constants([W1]).mechanisms[0]
+    # model_construct skips validation, so an object JSON cannot hold gets through to dumping.
+    broken_mech = Mechanism.model_construct(**dict(good.__dict__, geometry={"mesh": object()}))
+    broken = ConstantsFile.model_construct(
+        schema_version="1.0", units=parse_constants([W1]).units, mechanisms=[broken_mech]
+    )
+    with pytest.raises(PydanticSerializationError):
+        save_constants(path, broken)
+    assert path.read_bytes() == before
+    assert leftovers(tmp_path) == ["walls.json"]
+
+
+def test_save_into_missing_directory_is_an_input_error(tmp_path):
+    path = tmp_path / "no" / "such" / "dir.json"
+    with pytest.raises(InputError, match="cannot write constants file"):
+        save_constants(path, parse_constants([W1]))
+
+
+@pytest.mark.skipif(os.name != "posix", reason="POSIX permission bits")
+def test_existing_file_keeps_its_permissions(tmp_path):
+    path = tmp_path / "x.json"
+    path.write_text("old\n")
+    path.chmod(0o640)
+    write_json_atomic(path, "new\n")
+    assert stat.S_IMODE(path.stat().st_mode) == 0o640
+    write_json_atomic(tmp_path / "fresh.json", "new\n")
+    assert stat.S_IMODE((tmp_path / "fresh.json").stat().st_mode) == sio.NEW_FILE_MODE
+
+
+# --- the church example ------------------------------------------------------------------
+
+
+def test_church_example_loads_with_plausible_constants():
+    cf = load_constants(EXAMPLES / "church.json")
+    assert len(cf.mechanisms) >= 6
+    kinds = {m.rocking for m in cf.mechanisms}
+    assert kinds == {"one_sided", "two_sided"}
+    assert sum(m.amplification is not None for m in cf.mechanisms) >= 2
+    for m in cf.mechanisms:
+        assert m.name is not None and m.name != m.id, m.id
+        assert 1.0 <= m.positive.p_eq <= 5.0, m.id
+        assert 0.05 <= m.positive.lam <= 0.4, m.id
+        if m.eta is not None and m.rocking == "two_sided":
+            assert 0.8 <= m.eta <= 0.97, m.id
+        if m.eta is not None and m.rocking == "one_sided":
+            assert -0.75 <= m.eta <= -0.5, m.id
+        if m.amplification is not None:
+            assert 0.5 <= m.amplification.f_n <= 15.0, m.id
