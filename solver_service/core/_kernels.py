@@ -64,6 +64,10 @@ SERIES_U = 0.5
 ROOT_MAXITER = 200
 #: Safety factor applied to the propagated rounding-error standard deviation.
 ERR_SAFETY = 10.0
+#: Cap on the standard deviation of the propagated error of x (and of x'/p): first-order
+#: propagation overstates the error where it breaks down (near-grazing impacts, long
+#: chattering), and no perturbation moves the state further than the span of the motion.
+ERR_CAP = 2.0
 
 # Layout of the output vector of one simulation.
 OUT_STATUS = 0
@@ -344,6 +348,21 @@ def _propagate_cov(pxx, pxv, pvv, p, tau, ex, ev):
 
 
 @_jit
+def _cap_cov(pxx, pxv, pvv, p):
+    """Clip the error covariance to the physical span of the motion (``ERR_CAP``)."""
+    xcap = ERR_CAP * ERR_CAP
+    vcap = xcap * p * p
+    if not pxx <= xcap:  # also catches NaN
+        pxx = xcap
+    if not pvv <= vcap:
+        pvv = vcap
+    lim = math.sqrt(pxx * pvv)
+    if not abs(pxv) <= lim:
+        pxv = lim if pxv > 0.0 else -lim
+    return pxx, pxv, pvv
+
+
+@_jit
 def simulate_cells(
     kind,
     c0,
@@ -561,6 +580,7 @@ def simulate_cells(
                     _xi, vi, ai, _ji = _state(k, a0, a1, a2, cs, ks, s, p, ta, xa, va, tau_imp)
                     ex = EPS * (abs(xa) + 1.0 + abs(ks * a0))
                     pxx, pxv, pvv = _propagate_cov(pxx, pxv, pvv, p, tau_imp, ex, ex * p)
+                    pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p)
                     t = ta + tau_imp
                     if one_sided:
                         s_new = s
@@ -606,6 +626,7 @@ def simulate_cells(
                     pxx = nxx
                     pxv = nxv
                     pvv = nvv + (c_imp * ai * dtau) ** 2
+                    pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p_new)
                     s = s_new
                     x = 0.0
                     v = v_new
@@ -616,6 +637,7 @@ def simulate_cells(
                 # No impact: advance to the segment end.
                 ex = EPS * (abs(xa) + abs(xb) + 1.0 + abs(ks * a0))
                 pxx, pxv, pvv = _propagate_cov(pxx, pxv, pvv, p, big_h, ex, ex * p)
+                pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p)
                 x = xb
                 v = vb
                 t = tb

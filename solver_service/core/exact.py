@@ -21,7 +21,10 @@ Rules (all documented in THEORY §1.8 and §10):
 
 Every result carries ``error_estimate``: the propagated rounding error of the state
 (a first-order covariance carried through the closed-form flow and the impact saltation
-maps), times ``ERR_SAFETY``, at the time of the peak.
+maps), times ``ERR_SAFETY``, at the time of the peak. Where first-order propagation
+breaks down (near-grazing impacts, long chattering) the covariance is capped at the span
+of the motion (``ERR_CAP``), so an estimate of order 1 or more means the peak is not
+resolved: the trajectory is too sensitive for any double-precision integrator.
 """
 
 from __future__ import annotations
