@@ -321,3 +321,39 @@ def test_time_history_of_one_sided_mechanism_needs_eta() -> None:
 def test_bad_scale_is_rejected(scale: float) -> None:
     with pytest.raises(InputError, match="scale"):
         simulate(RockingModel.symmetric(2.0, 0.2, 0.9), zeros(1.0), scale=scale)
+
+
+# --- Extreme parameters: never NaN, never a hang, never a failure status -------------------
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    p=st.floats(0.05, 100.0),
+    lam=st.floats(1e-4, 1.4),
+    eta=st.floats(-1.0, 1.0),
+    a_ratio=st.floats(1.0 + 1e-12, 1e6),
+    omega=st.floats(1e-3, 1e3),
+    shape=st.sampled_from(["sine", "cosine"]),
+    sign=st.sampled_from([-1.0, 1.0]),
+)
+def test_extreme_pulses_give_finite_complete_results(
+    p: float, lam: float, eta: float, a_ratio: float, omega: float, shape: str, sign: float
+) -> None:
+    model = RockingModel.symmetric(p, lam, eta, one_sided=eta < 0)
+    exc = Pulse(a_p=sign * a_ratio * G * lam, f_p=omega * p / (2 * math.pi), shape=shape)
+    res = simulate(model, exc)
+    assert res.status in (0, 1)
+    for value in (res.peak_ratio, res.t_peak, res.error_estimate):
+        assert math.isfinite(value)
+    assert 0.0 <= res.peak_ratio and (res.collapsed or res.peak_ratio < 1e3)
+    assert res.n_impacts < 10_000
+
+
+@pytest.mark.parametrize(("dt", "p"), [(1e-5, 2.0), (0.1, 100.0), (0.02, 0.05)])
+def test_extreme_time_steps_and_frequencies(dt: float, p: float) -> None:
+    rng = np.random.default_rng(7)
+    rec = SampledAccel(rng.normal(0.0, 0.3 * G, 20_000), dt)
+    for eta, one_sided in [(0.9, False), (-0.95, True), (0.0, False)]:
+        res = simulate(RockingModel.symmetric(p, 0.1, eta, one_sided=one_sided), rec)
+        assert res.status in (0, 1)
+        assert math.isfinite(res.peak_ratio) and math.isfinite(res.error_estimate)
