@@ -292,7 +292,7 @@ def _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest):
     else:
         w1 = eta * r_so * w0
         p1 = p_o
-    if w1 <= v_rest or not math.isfinite(t_ret):
+    if w1 < v_rest or w1 <= 0.0 or not math.isfinite(t_ret):
         return False, math.nan, peak, dt_peak
     qq = w1 / p1
     if qq > 1.0:

@@ -19,6 +19,25 @@ G : standard gravity [m/s²]
 
 The engine below (``_run``) is shared with the nonlinear Housner reference (``nonlinear.py``),
 which supplies its own equation of motion through a ``_Physics`` object.
+
+Design notes
+------------
+* Records are piecewise linear, so by default the integrator is restarted at every sample and
+  each segment sees a smooth (linear) acceleration. Measured on El Centro N-S (p = 2 rad/s,
+  lam = 0.15, eta = 0.9, DOP853): with restarts the peak ratio changes by < 2e-14 between
+  rtol 1e-10, 1e-12 and 1e-13 (about 30 000 right-hand-side evaluations, < 1.5 s) and
+  agrees with the exact integrator to 1e-14; without restarts (``np.interp`` across samples)
+  the error is 6e-9 to 2.3e-7 at rtol 1e-10 and 3e-10 to 7e-9 at rtol 1e-12, depending on
+  ``max_step`` (unbounded, ``dt`` or ``dt/4``), at 7 to 9 times the work. The local error
+  estimate of a Runge-Kutta step is not valid across a kink of the forcing.
+* scipy detects an event only when its sign differs at the two ends of a step, so a step
+  that holds two crossings of ``x = 0`` loses an impact. Past ``x = 0`` the motion can only
+  come back while the ground pushes towards side ``s`` beyond the uplift threshold, and in
+  such a window it cannot turn back on the correct side. Segments therefore end where such
+  a window opens, and a turning point found on the wrong side (``s*x < 0``) triggers a
+  re-integration up to it, where the impact is bracketed.
+* Events that vanish at a segment start (``x = 0`` after an impact or uplift, ``v = 0`` after
+  uplift or release) are given the sign they take just after it (``_Event``).
 """
 
 from __future__ import annotations
@@ -54,6 +73,9 @@ ERROR_SAFETY = 10.0
 
 #: Consecutive failed uplifts at one instant after which the engine gives up.
 _MAX_STALLS = 100
+
+#: Re-integrations allowed to locate an impact that a step stepped over.
+_MAX_DIP_RETRIES = 3
 
 #: Relative time below which a segment is too short to integrate and is skipped [-].
 _TIME_EPS = 8.0 * np.finfo(float).eps
@@ -279,6 +301,47 @@ class _Forcing:
         h1 = -s * float(self.samples[j]) - thr
         tu = float(self.times[j - 1]) + self.dt * (-h0) / (h1 - h0)
         return max(tu, t)
+
+    def next_window_start(self, t: float, s: int, thr: float) -> Optional[float]:
+        """First time strictly after ``t`` at which ``-s*a_g`` rises through ``thr`` [s].
+
+        Inside such a window the motion on side ``s`` cannot turn back on the correct side,
+        and past ``x = 0`` it can come back (the only way an integration step can hold two
+        crossings of ``x = 0``). Ending segments at window starts keeps every step inside a
+        window free of turning points on the correct side (see ``_run``).
+        """
+        if not self._sampled:
+            k = -s * self._amp
+            if abs(k) <= thr:
+                return None
+            phase = self._phase + (0.0 if k > 0.0 else math.pi)
+            lo = math.asin(thr / abs(k))
+            two_pi = 2.0 * math.pi
+            th0 = self._omega * t + phase
+            base = math.floor(th0 / two_pi) * two_pi
+            th = base + lo if th0 - base < lo else base + two_pi + lo
+            tw = (th - phase) / self._omega
+        else:
+            if -s * self.accel_at(t) - thr < 0.0:
+                tw_opt = self._uplift_rec(t, s, thr)
+                if tw_opt is None:
+                    return None
+                tw = tw_opt
+            else:
+                # Inside a window (or at its edge): find where it ends, then the next start.
+                key = (s, -thr)
+                ends = self._uplift_cache.get(key)
+                if ends is None:
+                    ends = np.flatnonzero(-s * self.samples - thr < 0.0)
+                    self._uplift_cache[key] = ends
+                i = int(np.searchsorted(ends, self._interval(t) + 1))
+                if i >= ends.size:
+                    return None
+                tw_opt = self._uplift_rec(float(self.times[ends[i]]), s, thr)
+                if tw_opt is None:
+                    return None
+                tw = tw_opt
+        return tw if t < tw < self.t_end else None
 
 
 # --------------------------------------------------------------------------------------------
@@ -541,16 +604,21 @@ def _run(
                 break
             t_up, s = up
             record(np.array([t_up]), np.array([0.0]))
+            # Uplift at a threshold crossing starts with zero excess (not when the excess is
+            # already positive, e.g. right after a rest that ended a Zeno sequence).
+            a_start = -s * physics.uplift_accel(s) if t_up > t else None
             t, x, v = t_up, 0.0, 0.0
-            a_start = -s * physics.uplift_accel(s)
             resting = False
             trk.t_cross_up = None
         if t >= t_end - _TIME_EPS * max(abs(t_end), 1.0):
             in_flight_at_end = True
             break
         tb = forcing.next_break(t)
+        tw = forcing.next_window_start(t, s, physics.uplift_accel(s))
+        if tw is not None and tw - t > _TIME_EPS * max(abs(t), 1.0):
+            tb = min(tb, tw)
         accel = forcing.segment_accel(t, tb, a_start)
-        a_start = None
+        uplift, a_start = a_start is not None, None
         level = physics.collapse_level(s, forcing.amax_after(t))
         if s * x > level and s * v > 0.0:
             # The bound on the remaining excitation dropped below the state at a restart.
@@ -559,17 +627,22 @@ def _run(
             break
         rhs = physics.rhs(s, accel)
         y0 = np.array([x, v])
-        sol = _solve(
-            rhs,
-            (t, tb),
-            y0,
-            method,
-            rtol,
-            atol,
-            _events(s, level, t, y0, float(rhs(t, y0)[1])),
-            max_step,
-        )
-        trk.nfev += int(sol.nfev)
+        # At an uplift x'' is zero up to round-off and the motion starts outward.
+        acc0 = 0.0 if uplift else float(rhs(t, y0)[1])
+        events = _events(s, level, t, y0, acc0)
+        t_stop = tb
+        for _ in range(_MAX_DIP_RETRIES + 1):
+            sol = _solve(rhs, (t, t_stop), y0, method, rtol, atol, events, max_step)
+            trk.nfev += int(sol.nfev)
+            # A turning point on the wrong side (s*x < 0) means that a step held two
+            # crossings of x = 0 and the impact event missed them: integrate again up to
+            # that turning point, where x is on the wrong side, so the impact is bracketed.
+            dips = [te for te, ye in zip(sol.t_events[3], sol.y_events[3]) if s * ye[0] < 0.0]
+            if not dips:
+                break
+            t_stop = float(dips[0])
+        else:
+            raise SolverError(f"could not locate an impact near t = {t_stop:.9g} s")
         t_ev: list[Array] = sol.t_events
         y_ev: list[Array] = sol.y_events
         for te, ye in zip(t_ev[2], y_ev[2]):
@@ -584,6 +657,8 @@ def _run(
         impact = sol.status == 1 and len(t_ev[0]) > 0
         if impact:
             yy[0, -1] = 0.0
+        elif t_stop != tb and sol.status != 1:
+            raise SolverError(f"an impact before t = {t_stop:.9g} s was stepped over")
         if dense:
             # Solver steps plus the event points, so that peaks and crossings are exact.
             seg_t = np.concatenate([tt[1:], t_ev[2], t_ev[3]])
@@ -631,7 +706,8 @@ def _run(
         if fo.collapses:
             collapsed = True
             status = 1
-            if s * x >= 1.0 and trk.t_cross_up is not None:
+            if fo.dt_cross == 0.0 and trk.t_cross_up is not None:
+                # Collapses on the current excursion, already past |x| = 1.
                 t_collapse = trk.t_cross_up
             else:
                 t_collapse = t + fo.dt_cross
