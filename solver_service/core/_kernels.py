@@ -348,6 +348,16 @@ def _propagate_cov(pxx, pxv, pvv, p, tau, ex, ev):
 
 
 @_jit
+def _record(trace_t, trace_x, ntr, t, x):
+    """Append ``(t, x)`` to the time-series buffers if there is room; return the new length."""
+    if ntr < trace_t.shape[0]:
+        trace_t[ntr] = t
+        trace_x[ntr] = x
+        return ntr + 1
+    return ntr
+
+
+@_jit
 def _cap_cov(pxx, pxv, pvv, p):
     """Clip the error covariance to the physical span of the motion (``ERR_CAP``)."""
     xcap = ERR_CAP * ERR_CAP
@@ -417,7 +427,6 @@ def simulate_cells(
     out = np.zeros(NOUT)
     ntr_cap = trace_t.shape[0]
     ntr = 0
-    full = 0.0
     n = kind.shape[0]
     p_max = max(p_pos, p_neg)
     ks_pos = scale / (G * lam_pos)
@@ -451,10 +460,7 @@ def simulate_cells(
     hold_until = -math.inf
     uplift_t = math.nan
     done = False
-    if ntr_cap > 0:
-        trace_t[0] = t
-        trace_x[0] = x
-        ntr = 1
+    ntr = _record(trace_t, trace_x, ntr, t, x)
 
     for i in range(n):
         if done:
@@ -476,10 +482,7 @@ def simulate_cells(
                 if mode == REST:
                     if t < hold_until:
                         t = tb
-                        if ntr < ntr_cap:
-                            trace_t[ntr] = t
-                            trace_x[ntr] = 0.0
-                            ntr += 1
+                        ntr = _record(trace_t, trace_x, ntr, t, 0.0)
                         break
                     tu = -1.0
                     su = 0.0
@@ -494,10 +497,7 @@ def simulate_cells(
                             su = -1.0
                     if tu < 0.0 or tu >= tb:
                         t = tb
-                        if ntr < ntr_cap:
-                            trace_t[ntr] = t
-                            trace_x[ntr] = 0.0
-                            ntr += 1
+                        ntr = _record(trace_t, trace_x, ntr, t, 0.0)
                         break
                     mode = FLIGHT
                     s = su
@@ -505,10 +505,7 @@ def simulate_cells(
                     v = 0.0
                     t = tu
                     uplift_t = tu
-                    if ntr < ntr_cap:
-                        trace_t[ntr] = t
-                        trace_x[ntr] = 0.0
-                        ntr += 1
+                    ntr = _record(trace_t, trace_x, ntr, t, 0.0)
                     continue
 
                 # Flight on side s from the anchor (t, x, v) to tb or to the first impact.
@@ -547,10 +544,8 @@ def simulate_cells(
                     if piece < nz:
                         tau_r = z1 if piece == 0 else z2
                         xr = _state(k, a0, a1, a2, cs, ks, s, p, ta, xa, va, tau_r)[0]
-                        if ntr < ntr_cap and s * xr >= 0.0:  # turning point
-                            trace_t[ntr] = ta + tau_r
-                            trace_x[ntr] = xr
-                            ntr += 1
+                        if s * xr >= 0.0:  # turning point
+                            ntr = _record(trace_t, trace_x, ntr, ta + tau_r, xr)
                     else:
                         tau_r = big_h
                         xr = xb
@@ -595,10 +590,7 @@ def simulate_cells(
                     v_new = c_imp * vi
                     a_now = _accel(k, a0, a1, a2, cs, t)[0]
                     acc_new = p_new * p_new * (-s_new - ks_new * a_now)
-                    if ntr < ntr_cap:
-                        trace_t[ntr] = t
-                        trace_x[ntr] = 0.0
-                        ntr += 1
+                    ntr = _record(trace_t, trace_x, ntr, t, 0.0)
                     if abs(vi) >= v_rest_rel * p:
                         n_imp += 1
                         if n_imp >= max_impacts:
@@ -645,12 +637,7 @@ def simulate_cells(
                     status = -2
                     done = True
                     break
-                if ntr < ntr_cap:
-                    trace_t[ntr] = t
-                    trace_x[ntr] = x
-                    ntr += 1
-                elif ntr_cap > 0:
-                    full = 1.0
+                ntr = _record(trace_t, trace_x, ntr, t, x)
                 # Certain collapse: moving outward beyond 1 + max future drive.
                 if s * v > 0.0 and s * x > 1.0 + ks * amax_after[i]:
                     collapsed = True
@@ -704,7 +691,7 @@ def simulate_cells(
     out[OUT_N_STEPS] = n_steps
     out[OUT_ERROR] = ERR_SAFETY * (math.sqrt(err_var) + EPS * max(peak, 1.0))
     out[OUT_N_TRACE] = ntr
-    out[OUT_TRACE_FULL] = full
+    out[OUT_TRACE_FULL] = 1.0 if ntr_cap > 0 and ntr == ntr_cap else 0.0
     return out
 
 

@@ -33,6 +33,7 @@ import importlib.util
 import math
 import sys
 import time
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from types import ModuleType
@@ -45,7 +46,7 @@ from shared_schema.errors import InputError
 
 from . import _kernels as _k
 from .excitation import Pulse, SampledAccel
-from .model import RockingModel
+from .model import RockingModel, check_positive
 from .result import CRITERIA, STATUS_MESSAGES, RockingResult
 
 __all__ = [
@@ -131,6 +132,10 @@ class Cells:
         """End of the excitation [s]."""
         return float(self.tend[-1])
 
+    def arrays(self) -> tuple[NDArray[Any], ...]:
+        """Return the arrays in the order the kernels take them."""
+        return (self.kind, self.c0, self.c1, self.c2, self.tstart, self.tend, self.amax_after)
+
 
 def _record_cells(rec: SampledAccel, t_extra: float) -> Cells:
     acc = rec.acc
@@ -190,15 +195,6 @@ def cells_for(excitation: Excitation, *, dense: bool = False, t_extra: float = 0
     raise InputError(
         f"must be a Pulse or a SampledAccel, got {type(excitation).__name__}", "excitation"
     )
-
-
-def _check_scale(scale: float, name: str = "scale") -> float:
-    if isinstance(scale, bool) or not isinstance(scale, (int, float, np.floating, np.integer)):
-        raise InputError(f"must be a number, got {scale!r}", name)
-    value = float(scale)
-    if not (math.isfinite(value) and value > 0.0):
-        raise InputError(f"must be finite and > 0, got {scale!r}", name)
-    return value
 
 
 def _criterion(criterion: Optional[str], excitation: Excitation) -> str:
@@ -280,7 +276,7 @@ def simulate(
     """
     t_start = time.perf_counter()
     params = _params(model)
-    scale = _check_scale(scale)
+    scale = check_positive(scale, "scale")
     crit = _criterion(criterion, excitation)
     if isinstance(x0, bool) or not (math.isfinite(float(x0)) and abs(float(x0)) < 1.0):
         raise InputError(f"must be finite with |x0| < 1, got {x0!r}", "x0")
@@ -300,13 +296,7 @@ def simulate(
     trace_t = np.empty(cap)
     trace_x = np.empty(cap)
     out = kern.simulate_cells(
-        cells.kind,
-        cells.c0,
-        cells.c1,
-        cells.c2,
-        cells.tstart,
-        cells.tend,
-        cells.amax_after,
+        *cells.arrays(),
         scale,
         *params[:7],
         bool(params[7]),
@@ -318,6 +308,13 @@ def simulate(
     )
     runtime = time.perf_counter() - t_start
     n_tr = int(out[_k.OUT_N_TRACE])
+    if out[_k.OUT_TRACE_FULL]:
+        warnings.warn(
+            f"time series truncated at {n_tr} points (more impacts than the buffer holds); "
+            "the scalar results are complete",
+            RuntimeWarning,
+            stacklevel=2,
+        )
     return RockingResult(
         status=int(out[_k.OUT_STATUS]),
         peak_ratio=float(out[_k.OUT_PEAK]),
@@ -445,19 +442,13 @@ def simulate_batch(
     if sc.ndim != 1 or sc.size == 0:
         raise InputError("needs at least one scale factor", "scales")
     for j, value in enumerate(sc):
-        _check_scale(float(value), f"scales[{j}]")
+        check_positive(float(value), f"scales[{j}]")
     params = np.stack([_params(m) for m in models])
     crit = _criterion(criterion, excitation)
     cells = cells_for(excitation)
     kern = kernels(backend)
     out = kern.simulate_grid(
-        cells.kind,
-        cells.c0,
-        cells.c1,
-        cells.c2,
-        cells.tstart,
-        cells.tend,
-        cells.amax_after,
+        *cells.arrays(),
         params,
         sc,
         V_REST_REL,

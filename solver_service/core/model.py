@@ -28,13 +28,14 @@ from typing import Optional
 
 from shared_schema.errors import InputError
 
-__all__ = ["G", "RockingModel", "RockingSide"]
+__all__ = ["G", "RockingModel", "RockingSide", "check_positive"]
 
 #: Standard gravity [m/s²].
 G = 9.80665
 
 
-def _check_positive_finite(value: float, name: str) -> float:
+def check_positive(value: object, name: str) -> float:
+    """Return ``value`` as a float; raise ``InputError`` naming ``name`` unless finite and > 0."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise InputError(f"must be a number, got {value!r}", name)
     v = float(value)
@@ -62,10 +63,10 @@ class RockingSide:
     phi_ov: float = float("nan")
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "p_eq", _check_positive_finite(self.p_eq, "p_eq"))
-        object.__setattr__(self, "lam", _check_positive_finite(self.lam, "lam"))
+        object.__setattr__(self, "p_eq", check_positive(self.p_eq, "p_eq"))
+        object.__setattr__(self, "lam", check_positive(self.lam, "lam"))
         phi_ov = self.lam if math.isnan(self.phi_ov) else self.phi_ov
-        object.__setattr__(self, "phi_ov", _check_positive_finite(phi_ov, "phi_ov"))
+        object.__setattr__(self, "phi_ov", check_positive(phi_ov, "phi_ov"))
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,7 @@ import numpy as np
 
 from shared_schema.errors import InputError, SolverError
 from solver_service.core.excitation import SampledAccel
-from solver_service.core.model import G, RockingModel
+from solver_service.core.model import G, RockingModel, check_positive
 from solver_service.core.reference import (
     MAX_IMPACTS,
     ZENO_VREL,
@@ -46,7 +46,6 @@ from solver_service.core.reference import (
     Excitation,
     Rhs,
     _check_common,
-    _check_positive,
     _Event,
     _first_sign,
     _Forcing,
@@ -96,8 +95,8 @@ class HousnerBlock:
     one_sided: bool = False
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "p", _check_positive(self.p, "p"))
-        alpha = _check_positive(self.alpha, "alpha")
+        object.__setattr__(self, "p", check_positive(self.p, "p"))
+        alpha = check_positive(self.alpha, "alpha")
         if not alpha < 0.5 * math.pi:
             raise InputError(f"must be in (0, pi/2) [rad], got {self.alpha!r}", "alpha")
         object.__setattr__(self, "alpha", alpha)
@@ -132,8 +131,8 @@ class HousnerBlock:
         >>> round(blk.alpha, 4), round(blk.p, 4), round(blk.eta, 4)
         (0.245, 2.6712, 0.9118)
         """
-        b_f = _check_positive(b, "b")
-        h_f = _check_positive(h, "h")
+        b_f = check_positive(b, "b")
+        h_f = check_positive(h, "h")
         r = 0.5 * math.hypot(b_f, h_f)
         alpha = math.atan2(b_f, h_f)
         eta_f = 1.0 - 1.5 * math.sin(alpha) ** 2 if eta is None else eta

@@ -54,7 +54,7 @@ from numpy.typing import NDArray
 from shared_schema.errors import InputError, SolverError
 from solver_service.core.excitation import Pulse, SampledAccel
 from solver_service.core.freemotion import free_rocking
-from solver_service.core.model import G, RockingModel
+from solver_service.core.model import G, RockingModel, check_positive
 from solver_service.core.result import CRITERIA, RockingResult
 
 __all__ = ["IVP_METHODS", "MAX_IMPACTS", "ZENO_VREL", "simulate_ivp"]
@@ -91,15 +91,6 @@ Accel = Callable[[float], float]
 # --------------------------------------------------------------------------------------------
 
 
-def _check_positive(value: object, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InputError(f"must be a number, got {value!r}", name)
-    v = float(value)
-    if not math.isfinite(v) or v <= 0.0:
-        raise InputError(f"must be finite and > 0, got {value!r}", name)
-    return v
-
-
 def _check_common(
     excitation: object,
     scale: object,
@@ -116,18 +107,18 @@ def _check_common(
         raise InputError(
             f"must be a Pulse or a SampledAccel, got {type(excitation).__name__}", "excitation"
         )
-    scale_f = _check_positive(scale, "scale")
+    scale_f = check_positive(scale, "scale")
     if method not in IVP_METHODS:
         raise InputError(f"must be one of {list(IVP_METHODS)}, got {method!r}", "method")
-    rtol_f = _check_positive(rtol, "rtol")
-    atol_f = _check_positive(atol, "atol")
+    rtol_f = check_positive(rtol, "rtol")
+    atol_f = check_positive(atol, "atol")
     if criterion is None:
         crit = "exact" if isinstance(excitation, Pulse) else "ratio"
     elif criterion in CRITERIA:
         crit = str(criterion)
     else:
         raise InputError(f"must be one of {list(CRITERIA)} or None, got {criterion!r}", "criterion")
-    zeno = _check_positive(zeno_vrel, "zeno_vrel")
+    zeno = check_positive(zeno_vrel, "zeno_vrel")
     if isinstance(max_impacts, bool) or not isinstance(max_impacts, int) or max_impacts < 0:
         raise InputError(f"must be an integer >= 0, got {max_impacts!r}", "max_impacts")
     if isinstance(x0, bool) or not isinstance(x0, (int, float)) or not math.isfinite(x0):
