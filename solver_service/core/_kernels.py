@@ -82,6 +82,8 @@ OUT_ERROR = 8
 OUT_N_TRACE = 9
 OUT_TRACE_FULL = 10
 NOUT = 11
+#: Rows of the packed cell array.
+CELL_ROWS = ("kind", "c0", "c1", "c2", "t_start", "t_end", "amax_after")
 
 REST = 0
 FLIGHT = 1
@@ -160,24 +162,33 @@ def _sgn(z):
 
 
 @_jit
-def _root(which, target, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, lo, hi, sig_lo):
+def _root(which, target, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, lo, hi, sig_lo, f_lo, f_hi):
     """Zero of component ``which`` (0: x - target, 1: x', 2: x'') in ``[lo, hi]``.
 
     ``sig_lo`` is the sign of the function just right of ``lo``; the function is assumed to
-    change sign once in the bracket. Safeguarded Newton: a Newton step is taken when it
-    stays inside the bracket and shrinks it fast enough, otherwise bisection.
+    change sign once in the bracket. ``f_lo``, ``f_hi`` are its values at the ends when known
+    (NaN otherwise) and give a regula-falsi start. Safeguarded Halley iteration (Newton for
+    ``x''``): a step is taken when it stays inside the bracket and shrinks fast enough,
+    otherwise bisection.
     Returns the root (time offset from ``ta``).
     """
     t = 0.5 * (lo + hi)
+    if f_lo - f_hi != 0.0 and math.isfinite(f_lo - f_hi):
+        t = lo + (hi - lo) * min(max(f_lo / (f_lo - f_hi), 0.01), 0.99)
     width = hi - lo
+    # Absolute time cannot be resolved finer than a few ulps of ta + t.
+    tol = 4.0 * EPS * (abs(ta) + abs(hi))
     for _ in range(ROOT_MAXITER):
         x, v, acc, jerk = _state(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, t)
+        fpp = 0.0
         if which == 0:
             f = x - target
             fp = v
+            fpp = acc
         elif which == 1:
             f = v
             fp = acc
+            fpp = jerk
         else:
             f = acc
             fp = jerk
@@ -187,12 +198,14 @@ def _root(which, target, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, lo, hi, sig
             lo = t
         else:
             hi = t
-        if hi - lo <= 2.0 * EPS * max(abs(hi), abs(lo)) or hi - lo <= 1e-300:
+        if hi - lo <= tol:
             return t
-        tn = t - f / fp if fp != 0.0 else lo - 1.0
+        # Halley's step where the second derivative is at hand, else Newton's.
+        den = 2.0 * fp * fp - f * fpp
+        tn = t - 2.0 * f * fp / den if den != 0.0 else lo - 1.0
         if lo < tn < hi and abs(tn - t) < 0.5 * width:
             width = abs(tn - t)
-            if width <= 2.0 * EPS * abs(tn):
+            if width <= tol:
                 return tn
             t = tn
         else:
@@ -240,15 +253,15 @@ def _velocity_zeros(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, aa, ja, big_h, s
         n = 0
     elif sig_a != sig_b:
         n = 1
-        z1 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, big_h, sig_a)
+        z1 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, big_h, sig_a, va, vb)
     elif sig_a != hump and _sgn(aa) == hump and _sgn(ab) == -hump:
         # x' has sign -hump at both ends and x'' turns from hump to -hump: it may dip.
-        m = _root(2, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, big_h, hump)
+        m = _root(2, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, big_h, hump, aa, ab)
         vm = _state(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, m)[1]
         if _sgn(vm) == hump:
             n = 2
-            z1 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, m, sig_a)
-            z2 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, m, big_h, hump)
+            z1 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, m, sig_a, va, vm)
+            z2 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, m, big_h, hump, vm, vb)
     return n, z1, z2, xb, vb
 
 
@@ -373,7 +386,7 @@ def _cap_cov(pxx, pxv, pvv, p):
 
 
 @_jit
-def simulate_cells(
+def _simulate(
     kind,
     c0,
     c1,
@@ -396,7 +409,7 @@ def simulate_cells(
     trace_t,
     trace_x,
 ):
-    """Integrate one mechanism through a cell sequence; return the output vector.
+    """Integrate one mechanism through a cell sequence (unpacked arguments; see ``simulate_cells``).
 
     Parameters
     ----------
@@ -556,11 +569,47 @@ def simulate_cells(
                             tau_imp = tau_l
                         else:
                             tau_imp = _root(
-                                0, 0.0, k, a0, a1, a2, cs, ks, s, p, ta, xa, va, tau_l, tau_r, s
+                                0,
+                                0.0,
+                                k,
+                                a0,
+                                a1,
+                                a2,
+                                cs,
+                                ks,
+                                s,
+                                p,
+                                ta,
+                                xa,
+                                va,
+                                tau_l,
+                                tau_r,
+                                s,
+                                s * sx_l,
+                                xr,
                             )
                         break
                     if sx_r >= 1.0 and sx_l < 1.0 and math.isnan(t_cross):
-                        tc = _root(0, s, k, a0, a1, a2, cs, ks, s, p, ta, xa, va, tau_l, tau_r, -s)
+                        tc = _root(
+                            0,
+                            s,
+                            k,
+                            a0,
+                            a1,
+                            a2,
+                            cs,
+                            ks,
+                            s,
+                            p,
+                            ta,
+                            xa,
+                            va,
+                            tau_l,
+                            tau_r,
+                            -s,
+                            s * sx_l - s,
+                            xr - s,
+                        )
                         t_cross = ta + tc
                         if math.isnan(t_exceed):
                             t_exceed = t_cross
@@ -695,10 +744,52 @@ def simulate_cells(
     return out
 
 
+@_jit
+def simulate_cells(cells, params, scale, x0, v_rest_rel, max_impacts, trace):
+    """Integrate one mechanism through a cell sequence; return the output vector.
+
+    Parameters
+    ----------
+    cells : (7, n) float
+        Rows ``kind, c0, c1, c2, t_start, t_end, amax_after`` (see ``CELL_ROWS``).
+    params : (8,) float
+        ``p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided``.
+    scale, x0, v_rest_rel, max_impacts
+        Scale factor, initial ratio, rest rule, impact cap (see ``_simulate``).
+    trace : (2, m) float
+        Time-series buffer (times, ratios); ``m = 0`` for none.
+
+    Returns
+    -------
+    (NOUT,) float array, indexed by the ``OUT_*`` constants.
+    """
+    return _simulate(
+        cells[0],
+        cells[1],
+        cells[2],
+        cells[3],
+        cells[4],
+        cells[5],
+        cells[6],
+        scale,
+        params[0],
+        params[1],
+        params[2],
+        params[3],
+        params[4],
+        params[5],
+        params[6],
+        params[7] != 0.0,
+        x0,
+        v_rest_rel,
+        max_impacts,
+        trace[0],
+        trace[1],
+    )
+
+
 @_jit_parallel
-def simulate_grid(
-    kind, c0, c1, c2, tstart, tend, amax_after, params, scales, v_rest_rel, max_impacts
-):
+def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
     """Run every mechanism (rows of ``params``) at every scale; return (m, k, NOUT).
 
     ``params[i] = (p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided)``.
@@ -709,28 +800,69 @@ def simulate_grid(
     for ij in _prange(m * nk):
         i = ij // nk
         j = ij % nk
-        empty = np.empty(0)
         out[i, j, :] = simulate_cells(
-            kind,
-            c0,
-            c1,
-            c2,
-            tstart,
-            tend,
-            amax_after,
-            scales[j],
-            params[i, 0],
-            params[i, 1],
-            params[i, 2],
-            params[i, 3],
-            params[i, 4],
-            params[i, 5],
-            params[i, 6],
-            params[i, 7] != 0.0,
-            0.0,
-            v_rest_rel,
-            max_impacts,
-            empty,
-            empty,
+            cells, params[i], scales[j], 0.0, v_rest_rel, max_impacts, np.empty((2, 0))
         )
     return out
+
+
+@_jit
+def pulse_collapses(amp, omega, phase, eta, one_sided, v_rest_rel, quarter_cells, cells):
+    """Exact outcome of a dimensionless one-cycle pulse (p = 1, g lam = 1).
+
+    ``cells`` is a scratch (7, 4 * quarter_cells) array; ``amp`` is the signed amplitude
+    ``a_p / (g lam)`` and ``omega`` the ratio ``omega_p / p``.
+    """
+    n = 4 * quarter_cells
+    period = 2.0 * math.pi / omega
+    for i in range(n):
+        cells[0, i] = 1.0
+        cells[1, i] = amp
+        cells[2, i] = omega
+        cells[3, i] = phase
+        cells[4, i] = period * i / n
+        cells[5, i] = period * (i + 1) / n
+        cells[6, i] = abs(amp)
+    params = np.array([1.0, 1.0, 1.0 / G, 1.0 / G, 1.0, 1.0, eta, 1.0 if one_sided else 0.0])
+    out = simulate_cells(cells, params, 1.0, 0.0, v_rest_rel, 1_000_000, np.empty((2, 0)))
+    return out[OUT_COLLAPSED] != 0.0
+
+
+@_jit_parallel
+def boundary_grid(omegas, eta, one_sided, sign, phase, a_scan, rtol, max_edges, v_rest_rel):
+    """Overturning edges in A for every Omega: scan ``a_scan`` and bisect each change.
+
+    Returns ``(edges, n_edges, collapsed_at_first)``: ``edges[i, :n_edges[i]]`` are the
+    amplitudes ``a_p/(g lam)`` where the outcome changes at ``omegas[i]`` (relative width
+    ``rtol``), and ``collapsed_at_first[i]`` is the outcome at ``a_scan[0]``.
+    """
+    n_om = omegas.shape[0]
+    edges = np.full((n_om, max_edges), np.nan)
+    n_edges = np.zeros(n_om, dtype=np.int64)
+    first = np.zeros(n_om, dtype=np.bool_)
+    for i in _prange(n_om):
+        cells = np.empty((7, 4))
+        om = omegas[i]
+        prev = pulse_collapses(sign * a_scan[0], om, phase, eta, one_sided, v_rest_rel, 1, cells)
+        first[i] = prev
+        ne = 0
+        for j in range(1, a_scan.shape[0]):
+            cur = pulse_collapses(sign * a_scan[j], om, phase, eta, one_sided, v_rest_rel, 1, cells)
+            if cur != prev:
+                lo = a_scan[j - 1]
+                hi = a_scan[j]
+                while hi - lo > rtol * hi:
+                    mid = 0.5 * (lo + hi)
+                    c_mid = pulse_collapses(
+                        sign * mid, om, phase, eta, one_sided, v_rest_rel, 1, cells
+                    )
+                    if c_mid == prev:
+                        lo = mid
+                    else:
+                        hi = mid
+                if ne < max_edges:
+                    edges[i, ne] = 0.5 * (lo + hi)
+                ne += 1
+                prev = cur
+        n_edges[i] = ne
+    return edges, n_edges, first

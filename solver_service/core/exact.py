@@ -108,66 +108,57 @@ class Cells:
 
     Attributes
     ----------
-    kind : (n,) int
-        0: linear acceleration; 1: sinusoidal quarter period.
-    c0, c1, c2 : (n,) float
-        Linear: ``a(t_start)`` [m/s²], slope [m/s³], unused. Sinusoidal: amplitude
-        [m/s²], circular frequency [rad/s], phase [rad].
-    tstart, tend : (n,) float
-        Cell limits [s].
-    amax_after : (n,) float
-        Bound on ``|a|`` from ``tstart[i]`` to the end of the excitation [m/s²].
+    data : (7, n) float
+        Rows (``_kernels.CELL_ROWS``): kind (0 linear, 1 sinusoidal quarter period);
+        ``c0, c1, c2`` (linear: ``a(t_start)`` [m/s²], slope [m/s³], unused; sinusoidal:
+        amplitude [m/s²], circular frequency [rad/s], phase [rad]); ``t_start``, ``t_end``
+        [s]; ``amax_after``, a bound on ``|a|`` from ``t_start`` to the end [m/s²].
     """
 
-    kind: NDArray[np.int64]
-    c0: NDArray[np.float64]
-    c1: NDArray[np.float64]
-    c2: NDArray[np.float64]
-    tstart: NDArray[np.float64]
-    tend: NDArray[np.float64]
-    amax_after: NDArray[np.float64]
+    data: NDArray[np.float64]
+
+    @property
+    def n(self) -> int:
+        """Number of cells."""
+        return int(self.data.shape[1])
 
     @property
     def t_end(self) -> float:
         """End of the excitation [s]."""
-        return float(self.tend[-1])
+        return float(self.data[5, -1])
 
-    def arrays(self) -> tuple[NDArray[Any], ...]:
-        """Return the arrays in the order the kernels take them."""
-        return (self.kind, self.c0, self.c1, self.c2, self.tstart, self.tend, self.amax_after)
+    @property
+    def widths(self) -> NDArray[np.float64]:
+        """Cell durations [s]."""
+        return np.asarray(self.data[5] - self.data[4], dtype=np.float64)
 
 
 def _record_cells(rec: SampledAccel, t_extra: float) -> Cells:
     acc = rec.acc
-    n = acc.size - 1
     times = rec.time
-    c0 = acc[:-1].copy()
-    c1 = np.diff(acc) / rec.dt
-    tstart = times[:-1]
-    tend = times[1:]
-    absacc = np.abs(acc)
-    amax = np.maximum.accumulate(absacc[::-1])[::-1][:-1].copy()
-    kind = np.zeros(n, dtype=np.int64)
-    cells = Cells(kind, c0, c1, np.zeros(n), tstart.copy(), tend.copy(), amax)
-    return _append_rest(cells, t_extra)
+    data = np.zeros((7, acc.size - 1))
+    data[1] = acc[:-1]
+    data[2] = np.diff(acc) / rec.dt
+    data[4] = times[:-1]
+    data[5] = times[1:]
+    data[6] = np.maximum.accumulate(np.abs(acc)[::-1])[::-1][:-1]
+    return _append_rest(Cells(data), t_extra)
 
 
 def _pulse_cells(pulse: Pulse, per_quarter: int, t_extra: float) -> Cells:
     # Quarter periods hold every extremum of both shapes on a boundary, so the
     # acceleration is monotone in each cell.
-    nq = 4 * per_quarter
-    edges = pulse.duration * np.arange(nq + 1) / nq
-    n = nq
-    cells = Cells(
-        np.ones(n, dtype=np.int64),
-        np.full(n, pulse.a_p),
-        np.full(n, pulse.omega_p),
-        np.full(n, pulse.phase),
-        edges[:-1].copy(),
-        edges[1:].copy(),
-        np.full(n, abs(pulse.a_p)),
-    )
-    return _append_rest(cells, t_extra)
+    n = 4 * per_quarter
+    edges = pulse.duration * np.arange(n + 1) / n
+    data = np.empty((7, n))
+    data[0] = 1.0
+    data[1] = pulse.a_p
+    data[2] = pulse.omega_p
+    data[3] = pulse.phase
+    data[4] = edges[:-1]
+    data[5] = edges[1:]
+    data[6] = abs(pulse.a_p)
+    return _append_rest(Cells(data), t_extra)
 
 
 def _append_rest(cells: Cells, t_extra: float) -> Cells:
@@ -175,15 +166,8 @@ def _append_rest(cells: Cells, t_extra: float) -> Cells:
     if t_extra <= 0.0:
         return cells
     t0 = cells.t_end
-    return Cells(
-        np.append(cells.kind, 0),
-        np.append(cells.c0, 0.0),
-        np.append(cells.c1, 0.0),
-        np.append(cells.c2, 0.0),
-        np.append(cells.tstart, t0),
-        np.append(cells.tend, t0 + t_extra),
-        np.append(cells.amax_after, 0.0),
-    )
+    rest = np.array([[0.0], [0.0], [0.0], [0.0], [t0], [t0 + t_extra], [0.0]])
+    return Cells(np.hstack([cells.data, rest]))
 
 
 def cells_for(excitation: Excitation, *, dense: bool = False, t_extra: float = 0.0) -> Cells:
@@ -291,20 +275,11 @@ def simulate(
     cap = 0
     if dense:
         p_max = max(model.positive.p_eq, model.neg.p_eq)
-        n_seg = np.ceil(p_max * (cells.tend - cells.tstart) / kern.MAX_PH).clip(min=1).sum()
+        n_seg = np.ceil(p_max * cells.widths / kern.MAX_PH).clip(min=1).sum()
         cap = int(n_seg) + 3 * min(int(max_impacts), 100_000) + 8
-    trace_t = np.empty(cap)
-    trace_x = np.empty(cap)
+    trace = np.empty((2, cap))
     out = kern.simulate_cells(
-        *cells.arrays(),
-        scale,
-        *params[:7],
-        bool(params[7]),
-        float(x0),
-        V_REST_REL,
-        int(max_impacts),
-        trace_t,
-        trace_x,
+        cells.data, params, scale, float(x0), V_REST_REL, int(max_impacts), trace
     )
     runtime = time.perf_counter() - t_start
     n_tr = int(out[_k.OUT_N_TRACE])
@@ -329,8 +304,8 @@ def simulate(
         error_estimate=float(out[_k.OUT_ERROR]),
         runtime_s=runtime,
         method=f"exact:{'numba' if kern.JIT else 'python'}",
-        t=trace_t[:n_tr].copy() if dense else None,
-        ratio=trace_x[:n_tr].copy() if dense else None,
+        t=trace[0, :n_tr].copy() if dense else None,
+        ratio=trace[1, :n_tr].copy() if dense else None,
     )
 
 
@@ -447,13 +422,7 @@ def simulate_batch(
     crit = _criterion(criterion, excitation)
     cells = cells_for(excitation)
     kern = kernels(backend)
-    out = kern.simulate_grid(
-        *cells.arrays(),
-        params,
-        sc,
-        V_REST_REL,
-        int(max_impacts),
-    )
+    out = kern.simulate_grid(cells.data, params, sc, V_REST_REL, int(max_impacts))
     t_exc = out[..., _k.OUT_T_EXCEED]
     return BatchResult(
         names=[m.name for m in models],
