@@ -328,20 +328,38 @@ def _uplift_time(kind, c0, c1, c2, cs, ks, s, t, tb):
     if g_t > 1.0:
         return t
     a_b, _ad_b = _accel(kind, c0, c1, c2, cs, tb)
-    if -s * ks * a_b <= 1.0:
+    g_b = -s * ks * a_b
+    if g_b <= 1.0:
         return -1.0
+    # g is monotone in the cell: safeguarded Newton from the regula-falsi point, then the
+    # first representable time at which g >= 1 holds.
     lo = t
     hi = tb
+    x = lo + (hi - lo) * min(max((1.0 - g_t) / (g_b - g_t), 0.0), 1.0)
+    tol = 4.0 * EPS * (abs(t) + abs(tb))
     for _ in range(ROOT_MAXITER):
-        mid = 0.5 * (lo + hi)
-        if mid <= lo or mid >= hi:
-            break
-        a_m, _ad_m = _accel(kind, c0, c1, c2, cs, mid)
-        if -s * ks * a_m >= 1.0:
-            hi = mid
+        a_x, ad_x = _accel(kind, c0, c1, c2, cs, x)
+        g = -s * ks * a_x
+        if g >= 1.0:
+            hi = x
         else:
-            lo = mid
-    return hi
+            lo = x
+        if hi - lo <= tol:
+            break
+        gd = -s * ks * ad_x
+        xn = x - (g - 1.0) / gd if gd != 0.0 else lo - 1.0
+        if not lo < xn < hi:
+            xn = 0.5 * (lo + hi)
+        if abs(xn - x) <= tol:
+            x = xn
+            break
+        x = xn
+    # Step up from the converged point to the first time where g >= 1 (bounded by hi).
+    for _ in range(8):
+        if x >= hi or -s * ks * _accel(kind, c0, c1, c2, cs, x)[0] >= 1.0:
+            break
+        x = min(x + tol, hi)
+    return min(x, hi)
 
 
 @_jit
