@@ -221,6 +221,111 @@ def _history_plot(models: list[Any], motion: Any, scale: float, path: Path) -> N
 
 @app.command()
 @_user_errors
+def envelope(
+    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    out: Path = typer.Option(..., "--out", help="Folder for envelope.json, .csv and .png."),
+    f_min: float = typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
+    f_max: float = typer.Option(10.0, "--f-max", help="Highest pulse frequency [Hz]."),
+    n: int = typer.Option(200, "--n", help="Number of log-spaced frequencies."),
+    exact: bool = typer.Option(
+        False, "--exact", help="Compute boundaries directly instead of from the library."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Also print the JSON document."),
+) -> None:
+    """Minimum overturning sine-pulse amplitude of every mechanism, and the critical bands."""
+    from shared_schema.io import load_constants
+
+    from .analysis import frequency_grid, write_envelope
+
+    f_p = frequency_grid(f_min, f_max, n)
+    if not constants.is_file():
+        _fail(f"constants: file not found: {constants}")
+    cf = load_constants(constants)
+    doc = write_envelope(
+        cf, f_p, out, exact=exact, title=f"Overturning envelopes: {constants.name}"
+    )
+    if as_json:
+        _print_json(doc)
+        return
+    typer.echo(f"wrote {out / 'envelope.json'}, envelope.csv, envelope.png")
+    typer.echo("critical mechanism by pulse frequency:")
+    for band in doc["critical"]:
+        typer.echo(f"  {band['f_min']:8.3f} - {band['f_max']:8.3f} Hz: {band['mechanism']}")
+
+
+@app.command()
+@_user_errors
+def boundary(
+    omega: float = typer.Option(..., "--omega", help="Frequency ratio omega_p / p_eq [-]."),
+    eta: Optional[float] = typer.Option(
+        None, "--eta", help="Coefficient of restitution [-] (one-sided: default 0)."
+    ),
+    one_sided: bool = typer.Option(False, "--one-sided", help="One-sided rocking."),
+    shape: str = typer.Option("sine", "--shape", help="Pulse shape: sine or cosine."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+) -> None:
+    """Every overturning interval in A = a_p/(g lam) at one frequency ratio (exact)."""
+    from .analysis import boundary_doc
+
+    doc = boundary_doc(omega, eta, one_sided=one_sided, shape=shape)
+    if as_json:
+        _print_json(doc)
+        return
+    spans = ", ".join(
+        f"[{lo:.5g}, {'A_max' if hi is None else f'{hi:.5g}'}]"
+        for lo, hi in doc["overturning_intervals"]
+    )
+    typer.echo(
+        f"Omega = {omega:g}, eta = {doc['eta']:g} ({doc['rocking']}): "
+        f"overturns for A in {spans or 'none'}"
+    )
+    typer.echo(
+        f"  scan ratio {doc['search']['scan_ratio']:.4f}, bisection to {doc['search']['rtol']:g}"
+    )
+
+
+library_app = typer.Typer(help="The library of dimensionless overturning curves.")
+app.add_typer(library_app, name="library")
+
+
+@library_app.command("build")
+@_user_errors
+def library_build(
+    out: Optional[Path] = typer.Option(
+        None, "--out", help="Output .npz (default: the package's shipped library)."
+    ),
+    n_omega: int = typer.Option(400, "--n-omega", help="Omega points, log-spaced in [0.05, 50]."),
+    eta_step: float = typer.Option(0.02, "--eta-step", help="Step of eta in [0, 1]."),
+) -> None:
+    """Compute A_min(Omega; eta) for eta in [0, 1] and the one-sided curve (about a minute)."""
+    import numpy as np
+    from rich.progress import Progress
+
+    from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
+
+    if n_omega < 2:
+        _fail(f"n_omega: must be >= 2, got {n_omega}")
+    if not 0.0 < eta_step <= 1.0:
+        _fail(f"eta_step: must be in (0, 1], got {eta_step}")
+    omega = np.geomspace(LIBRARY_OMEGA[0], LIBRARY_OMEGA[1], n_omega)
+    eta = np.unique(np.append(np.round(np.arange(0.0, 1.0, eta_step), 12), 1.0))
+
+    with Progress(transient=True) as bar:
+        task = bar.add_task("overturning curves", total=None)
+
+        def tick(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        lib = build_library(omega=omega, eta=eta, progress=tick)
+    path = lib.save(out or LIBRARY_PATH)
+    typer.echo(
+        f"wrote {path}: {lib.eta.size} two-sided curves + one-sided, {lib.omega.size} Omega, "
+        f"{lib.metadata['build_seconds']} s"
+    )
+
+
+@app.command()
+@_user_errors
 def demo(
     out: Path = typer.Option(Path("out"), "--out", help="Output folder."),
     record: Optional[Path] = typer.Option(

@@ -5,7 +5,10 @@
 * ``constants.json``: analytic kinematic constants of three rectangular walls;
 * ``history.json``: peak ``|phi|/phi_ov`` and overturning of each wall at several scale
   factors of El Centro 1940 N-S, from the exact integrator;
-* ``history.png``: the time histories under the unscaled record.
+* ``history.png``: the time histories under the unscaled record;
+* ``church_envelope.json``, ``.csv`` and ``.png``: minimum overturning pulse amplitudes
+  of the example church's mechanisms (``examples/constants/church.json``), at ground
+  level, with the critical mechanism per pulse frequency.
 """
 
 from __future__ import annotations
@@ -170,4 +173,26 @@ def run_demo(out_dir: Path, record_path: Path | None = None) -> dict[str, Path]:
         record_a_g=scale * record.accel.acc / G,
         title=f"{record.name} x {scale:g}: rocking of the demo walls (exact integrator)",
     )
-    return {"constants": constants_path, "history": history_path, "plot": plot_path}
+    env_paths = church_envelope(out_dir)
+    return {"constants": constants_path, "history": history_path, "plot": plot_path, **env_paths}
+
+
+def church_envelope(out_dir: Path) -> dict[str, Path]:
+    """Write the example church's envelopes and critical bands (JSON, CSV, PNG)."""
+    from shared_schema.io import load_constants
+
+    from .analysis import frequency_grid, write_envelope
+
+    cf = load_constants(EXAMPLES_DIR / "constants" / "church.json")
+    stem = "church_envelope"
+    write_envelope(
+        cf,
+        frequency_grid(0.1, 10.0, 200),
+        out_dir,
+        stem=stem,
+        title="Example church: overturning envelopes and the critical mechanism",
+    )
+    return {
+        kind: out_dir / f"{stem}.{ext}"
+        for kind, ext in (("envelope", "json"), ("envelope_csv", "csv"), ("envelope_plot", "png"))
+    }

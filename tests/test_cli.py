@@ -8,6 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -188,3 +189,113 @@ def test_console_script_runs_as_a_real_process() -> None:
     doc = json.loads(proc.stdout)
     direct = simulate(RockingModel.symmetric(2, 0.2, 0.9), Pulse(a_p=-1 * G, f_p=0.5))
     assert doc["peak_ratio"] == direct.peak_ratio and doc["overturned"] == direct.overturned
+
+
+# --- Envelopes, boundaries and the library (issue: envelopes) ------------------------------
+
+
+def test_envelope_writes_json_csv_and_plot(tmp_path: Path) -> None:
+    res = runner.invoke(
+        app,
+        [
+            "envelope",
+            str(EXAMPLES / "constants" / "church.json"),
+            "--out",
+            str(tmp_path),
+            "--f-min",
+            "0.2",
+            "--f-max",
+            "8",
+            "--n",
+            "60",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    doc = json.loads((tmp_path / "envelope.json").read_text())
+    assert len(doc["f_p"]) == 60 and doc["units"] == {"f_p": "Hz", "a_p": "g"}
+    assert len(doc["mechanisms"]) >= 5
+    bands = doc["critical"]
+    assert bands and bands[0]["f_min"] == doc["f_p"][0] and bands[-1]["f_max"] == doc["f_p"][-1]
+    for band in bands:
+        assert band["mechanism"] in {m["id"] for m in doc["mechanisms"]}
+    # Each band's mechanism has the lowest ground-level amplitude inside the band.
+    for k in range(len(doc["f_p"])):
+        values = {m["id"]: m["a_p_min_g"][k] for m in doc["mechanisms"] if m["a_p_min_g"][k]}
+        assert doc["governing"][k] == min(values, key=values.__getitem__)
+    csv = (tmp_path / "envelope.csv").read_text().splitlines()
+    assert len(csv) == 61 and csv[0].startswith("f_p_Hz,")
+    assert (tmp_path / "envelope.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_boundary_json_gives_every_interval() -> None:
+    res = runner.invoke(app, ["boundary", "--eta", "0.9", "--omega", "5", "--json"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    assert doc["omega"] == 5 and doc["eta"] == 0.9
+    rounded = [
+        [round(lo, 4), None if hi is None else round(hi, 4)]
+        for lo, hi in doc["overturning_intervals"]
+    ]
+    assert rounded == [[3.0186, 6.3181], [7.1681, None]]
+
+
+def test_boundary_one_sided_reports_the_governing_direction() -> None:
+    res = runner.invoke(app, ["boundary", "--one-sided", "--omega", "2", "--json"])
+    doc = json.loads(res.stdout)
+    assert doc["governing_direction"] == "positive"
+    assert doc["a_min"] == pytest.approx(1.8007, abs=1e-4)
+    assert set(doc["directions"]) == {"positive", "negative"}
+
+
+def test_library_build_writes_a_loadable_library(tmp_path: Path) -> None:
+    from solver_service.core.envelope import OverturningLibrary, boundary_curve
+
+    out = tmp_path / "lib.npz"
+    res = runner.invoke(
+        app, ["library", "build", "--out", str(out), "--n-omega", "6", "--eta-step", "0.5"]
+    )
+    assert res.exit_code == 0, res.output
+    lib = OverturningLibrary.load(out)
+    assert list(lib.eta) == [0.0, 0.5, 1.0] and lib.omega.size == 6
+    np.testing.assert_allclose(lib.a_min_two_sided[1], boundary_curve(lib.omega, 0.5).a_min)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["boundary", "--eta", "1.5", "--omega", "2"], "eta"),
+        (["boundary", "--omega", "2"], "eta"),
+        (["boundary", "--eta", "0.9", "--omega", "-1"], "omega"),
+        (["envelope", "CONST", "--out", "OUT", "--f-min", "5", "--f-max", "1"], "f_min"),
+        (["envelope", "EMPTY", "--out", "OUT"], "mechanisms"),
+        (["envelope", "BAD_HE", "--out", "OUT"], "h_e"),
+    ],
+)
+def test_envelope_and_boundary_bad_input(tmp_path: Path, args: list[str], message: str) -> None:
+    empty = tmp_path / "empty.json"
+    empty.write_text('{"mechanisms": []}')
+    bad_he = tmp_path / "bad_he.json"
+    bad_he.write_text(
+        json.dumps(
+            {
+                "mechanisms": [
+                    {
+                        "id": "T1",
+                        "p_eq": 3.0,
+                        "lam": 0.2,
+                        "eta": 0.9,
+                        "amplification": {"f_n": 5.0, "h_e": 0.0, "h": 10.0},
+                    }
+                ]
+            }
+        )
+    )
+    table = {
+        "CONST": str(EXAMPLES / "constants" / "church.json"),
+        "EMPTY": str(empty),
+        "BAD_HE": str(bad_he),
+        "OUT": str(tmp_path / "out"),
+    }
+    res = runner.invoke(app, [table.get(a, a) for a in args])
+    assert res.exit_code == 2, res.output
+    assert message in res.stderr and len(res.stderr.strip().splitlines()) == 1

@@ -44,4 +44,13 @@ def test_demo_writes_constants_results_and_plot(tmp_path: Path) -> None:
     w1 = next(r for r in doc["results"] if r["mechanism"] == "W1" and r["scale"] == 1.0)
     assert w1["overturned"] is True
     assert paths["plot"].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # The example church's envelopes: every mechanism, critical bands covering the range.
+    env = json.loads(paths["envelope"].read_text())
+    assert len(env["mechanisms"]) == len(
+        json.loads((EXAMPLES / "constants" / "church.json").read_text())["mechanisms"]
+    )
+    assert env["critical"][0]["f_min"] == pytest.approx(0.1)
+    assert env["critical"][-1]["f_max"] == pytest.approx(10.0)
+    assert paths["envelope_plot"].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert paths["envelope_csv"].read_text().count("\n") == 201
     assert not list(tmp_path.glob(".*"))  # no temporary files left behind

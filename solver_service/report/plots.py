@@ -16,7 +16,7 @@ import numpy as np
 
 from ..core.result import RockingResult
 
-__all__ = ["plot_time_histories"]
+__all__ = ["plot_envelopes", "plot_time_histories"]
 
 
 def _pyplot() -> Any:
@@ -99,6 +99,66 @@ def plot_time_histories(
         axr.set_ylabel("ground acc. [g]")
         axr.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("time [s]")
+    fig.tight_layout()
+    try:
+        return _save_atomic(fig, path)
+    finally:
+        plt.close(fig)
+
+
+def plot_envelopes(
+    envelopes: Sequence[Any],
+    bands: Sequence[dict[str, Any]],
+    path: Union[str, Path],
+    *,
+    labels: Union[dict[str, str], None] = None,
+    title: str = "",
+) -> Path:
+    """Log-log overturning envelopes at ground level, with the critical bands shaded.
+
+    Parameters
+    ----------
+    envelopes : sequence of Envelope
+        One per mechanism (``solver_service.core.envelope.Envelope``).
+    bands : sequence of dict
+        Critical bands ``{"mechanism", "f_min", "f_max"}`` [Hz].
+    path : str or Path
+        Output file (.png or .svg); written atomically.
+    labels : dict, optional
+        Legend text per mechanism name.
+    title : str
+        Figure title.
+    """
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(9, 8))
+    colours = {}
+    cmap = plt.get_cmap("tab10")
+    for k, env in enumerate(envelopes):
+        colour = cmap(k % 10)
+        colours[env.name] = colour
+        y = np.where(np.isfinite(env.a_p_min_g), env.a_p_min_g, np.nan)
+        text = (labels or {}).get(env.name, env.name)
+        ax.plot(env.f_p, y, color=colour, lw=1.4, label=text)
+    if envelopes:
+        lower = np.nanmin(
+            np.stack([np.where(np.isfinite(e.a_p_min_g), e.a_p_min_g, np.nan) for e in envelopes]),
+            axis=0,
+        )
+        ax.plot(envelopes[0].f_p, lower, color="black", lw=2.6, alpha=0.35, label="governing")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ymax = ax.get_ylim()[1]
+    for band in bands:
+        colour = colours.get(band["mechanism"], "0.5")
+        ax.axvspan(band["f_min"], band["f_max"], color=colour, alpha=0.10, lw=0)
+        mid = float(np.sqrt(band["f_min"] * band["f_max"]))
+        ax.text(mid, ymax, band["mechanism"], ha="center", va="top", fontsize=8, color=colour)
+    ax.set_xlabel("pulse frequency f_p [Hz]")
+    ax.set_ylabel("minimum overturning pulse amplitude a_p [g] (ground level)")
+    ax.grid(which="both", alpha=0.25)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.0, -0.12), ncol=1, frameon=False)
+    if title:
+        ax.set_title(title)
     fig.tight_layout()
     try:
         return _save_atomic(fig, path)

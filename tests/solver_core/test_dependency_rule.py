@@ -22,6 +22,8 @@ for name in {BLOCKED!r}:
     sys.modules[name] = None  # any import of it now raises ImportError
 import solver_service.core.model, solver_service.core.excitation, solver_service.core.result
 import solver_service.core.exact, solver_service.core.records, solver_service.core.freemotion
+import solver_service.core.envelope, solver_service.core.amplification
+import solver_service.core.reference, solver_service.core.nonlinear
 from solver_service.core.exact import simulate
 from solver_service.core.model import RockingModel
 from solver_service.core.excitation import Pulse

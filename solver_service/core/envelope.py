@@ -1,0 +1,647 @@
+"""Overturning boundaries of one-cycle pulses, their library, and mechanism envelopes.
+
+Notation (THEORY §6.2)
+----------------------
+Omega : pulse frequency over the frequency parameter, ``omega_p / p_eq`` [-]
+A : pulse amplitude over the uplift acceleration, ``a_p / (g lam)`` [-]
+A_min(Omega; eta) : smallest A that overturns (the envelope), one curve per eta
+f_p : pulse frequency [Hz]; a_p : pulse amplitude [m/s², or g where named ``_g``]
+
+The dimensionless equation ``x'' = x - sgn(x) + f(tau)`` is self-similar, so one curve per
+restitution coefficient serves every mechanism: ``a_p,min(f_p) = g lam A_min(2 pi f_p/p_eq)``.
+
+Boundaries are found with the exact integrator (``_kernels.boundary_grid``): the outcome
+(collapse or not, exact criterion) is evaluated on a log-spaced scan of A in
+``(1, A_MAX]`` and every change of outcome is bisected to relative width ``RTOL``. All
+overturning intervals are reported, including the safe islands above the first
+overturning amplitude; an island narrower than the scan step (``scan_ratio``, stated in
+every output) can be missed. Close to the uplift threshold at low Omega the outcome
+alternates on scales of 1e-4 in A (many impacts, chaotic); the optional ``n_scan_near``
+adds a scan log-spaced in ``A - 1`` from ``NEAR_MIN`` to resolve it, at ~10x the cost.
+
+Library (``OverturningLibrary``): ``A_min`` on a log grid of Omega for eta in [0, 1] and for
+one-sided rocking, generated once by ``rockmech library build`` and shipped as package data.
+Between grid points ``log A_min`` is interpolated linearly in ``log Omega`` and in eta. The
+curves jump where the overturning mode changes (impact / no impact); across such a jump
+(neighbours differing by more than ``JUMP`` in ``log A``) the lower neighbour is used, so
+the interpolation errs on the safe side there. Use ``exact=True`` to compute a mechanism's
+envelope directly where the exact jump position matters.
+
+One-sided rocking: the envelope is eta-independent (THEORY §6.4): the pulse is applied in
+both directions with no rebound (eta = 0) and the lower curve governs; in practice this is
+the pulse that first pushes against the restraint (closed form (b) of §6.3).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import os
+import tempfile
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Optional, Union
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from shared_schema.errors import InputError
+
+from .exact import kernels
+from .excitation import PULSE_SHAPES
+from .model import RockingModel, RockingSide
+
+__all__ = [
+    "A_MAX",
+    "LIBRARY_PATH",
+    "N_SCAN",
+    "RTOL",
+    "BoundaryCurve",
+    "Envelope",
+    "OverturningLibrary",
+    "boundary_curve",
+    "build_library",
+    "critical_bands",
+    "mechanism_envelope",
+]
+
+#: Largest pulse amplitude searched, as ``a_p / (g lam)``.
+A_MAX = 200.0
+#: Number of log-spaced amplitudes scanned in ``(1, A_MAX]``.
+N_SCAN = 300
+#: Smallest ``A - 1`` of the optional near-threshold scan.
+NEAR_MIN = 1e-5
+#: Relative width to which each boundary is bisected.
+RTOL = 1e-6
+#: Rest rule of the boundary search [1/s per rad/s]: excursions it drops are below 5e-9
+#: in |phi|/phi_ov, far below what can change a verdict resolved to ``RTOL``.
+V_REST_BOUNDARY = 1e-4
+#: Most outcome changes stored per Omega.
+MAX_EDGES = 64
+#: Library grid: Omega points (log-spaced in [0.05, 50]) and eta step.
+LIBRARY_OMEGA = (0.05, 50.0, 400)
+LIBRARY_ETA_STEP = 0.02
+#: The library shipped with the package.
+LIBRARY_PATH = Path(__file__).resolve().parents[1] / "data" / "overturning_library.npz"
+#: Format version of the library file.
+LIBRARY_VERSION = "1"
+#: Largest change of ``log A_min`` between neighbouring library points that counts as a smooth
+#: curve; across a larger one (a change of overturning mode) interpolation takes the lower
+#: neighbour, so its error falls on the safe side.
+JUMP = 0.04
+#: Tabulated pulse response spectrum (5 % damping, sine pulse, pseudo-acceleration):
+#: ratios f_p/f_n log-spaced over [1e-3, 1e3]; linear interpolation in log ratio.
+SPECTRUM_GRID = (1e-3, 1e3, 4001)
+SPECTRUM_ZETA = 0.05
+#: Pulse directions: +1 first pushes towards negative rotation (against a one-sided
+#: mechanism's restraint), -1 first opens the mechanism (Housner's sign convention).
+DIRECTIONS = {1: "positive", -1: "negative"}
+
+
+def _scan(a_max: float, n_scan: int, n_scan_near: int) -> NDArray[np.float64]:
+    scan = np.geomspace(1.0 + 1e-9, a_max, n_scan)
+    if n_scan_near > 0:
+        near = 1.0 + np.geomspace(NEAR_MIN, a_max - 1.0, n_scan_near)
+        scan = np.unique(np.concatenate([scan, near]))
+    return scan
+
+
+def _check_eta(eta: float, one_sided: bool) -> float:
+    if isinstance(eta, bool) or not isinstance(eta, (int, float)) or not math.isfinite(eta):
+        raise InputError(f"must be a finite number, got {eta!r}", "eta")
+    lo, hi = (-1.0, 0.0) if one_sided else (0.0, 1.0)
+    if not lo <= eta <= hi:
+        kind = "one-sided" if one_sided else "two-sided"
+        raise InputError(f"must be in [{lo:g}, {hi:g}] for {kind} rocking, got {eta!r}", "eta")
+    return float(eta)
+
+
+@dataclass
+class BoundaryCurve:
+    """Overturning intervals in A at each Omega, for one eta, shape and pulse direction.
+
+    Attributes
+    ----------
+    omega : (n,) float
+        Frequency ratios ``omega_p / p_eq`` [-].
+    edges : (n, MAX_EDGES) float
+        Amplitudes ``a_p/(g lam)`` where the outcome changes, NaN-padded.
+    n_edges : (n,) int
+        Number of valid edges per Omega.
+    collapsed_at_start : (n,) bool
+        Outcome just above A = 1 (normally False).
+    eta, one_sided, shape, direction
+        Inputs; ``direction`` is +1 or -1 (see ``DIRECTIONS``).
+    a_max, scan_ratio, rtol : float
+        Search limits: largest A, ratio between scanned amplitudes, bisection width.
+    runtime_s : float
+        Wall-clock time [s].
+    """
+
+    omega: NDArray[np.float64]
+    edges: NDArray[np.float64]
+    n_edges: NDArray[np.int64]
+    collapsed_at_start: NDArray[np.bool_]
+    eta: float
+    one_sided: bool
+    shape: str
+    direction: int
+    a_max: float
+    scan_ratio: float
+    rtol: float
+    runtime_s: float
+
+    def intervals(self, i: int) -> list[tuple[float, Optional[float]]]:
+        """Return the overturning intervals ``(A_lo, A_hi)`` at ``omega[i]``.
+
+        ``A_hi`` is None when the interval extends to ``a_max``.
+        """
+        pts = list(self.edges[i, : min(int(self.n_edges[i]), MAX_EDGES)])
+        if self.collapsed_at_start[i]:
+            pts.insert(0, 1.0)
+        out: list[tuple[float, Optional[float]]] = []
+        for k in range(0, len(pts), 2):
+            hi = pts[k + 1] if k + 1 < len(pts) else None
+            out.append((float(pts[k]), None if hi is None else float(hi)))
+        return out
+
+    @property
+    def a_min(self) -> NDArray[np.float64]:
+        """First overturning amplitude per Omega; ``inf`` if none up to ``a_max``."""
+        first = np.where(self.n_edges > 0, self.edges[:, 0], np.inf)
+        return np.where(self.collapsed_at_start, 1.0, first)
+
+
+def boundary_curve(
+    omega: ArrayLike,
+    eta: float,
+    *,
+    one_sided: bool = False,
+    shape: str = "sine",
+    direction: int = -1,
+    a_max: float = A_MAX,
+    n_scan: int = N_SCAN,
+    n_scan_near: int = 0,
+    rtol: float = RTOL,
+    backend: str = "auto",
+) -> BoundaryCurve:
+    """Every overturning interval in A at each Omega (exact integrator, exact criterion).
+
+    Parameters
+    ----------
+    omega : array_like
+        Frequency ratios ``omega_p / p_eq`` [-], each > 0.
+    eta : float
+        Restitution: [0, 1] two-sided, [-1, 0] one-sided.
+    one_sided : bool
+        One-sided rocking.
+    shape : {"sine", "cosine"}
+        Pulse shape.
+    direction : {-1, +1}
+        Sign of the pulse (see ``DIRECTIONS``); irrelevant for symmetric two-sided rocking.
+    a_max, n_scan, n_scan_near, rtol
+        Search limits (see module docstring).
+    backend : str
+        Kernel back end.
+
+    Returns
+    -------
+    BoundaryCurve
+
+    Examples
+    --------
+    Zhang & Makris (2001), eta = 0.9, Omega = 5: overturning from A = 3.0186, a safe band
+    from 6.3181 to 7.1681, overturning beyond.
+
+    >>> c = boundary_curve([5.0], 0.9)
+    >>> [(round(lo, 4), hi if hi is None else round(hi, 4)) for lo, hi in c.intervals(0)]
+    [(3.0186, 6.3181), (7.1681, None)]
+    """
+    t0 = time.perf_counter()
+    om = np.atleast_1d(np.asarray(omega, dtype=float))
+    if om.ndim != 1 or om.size == 0 or not np.all(np.isfinite(om) & (om > 0)):
+        raise InputError("must be finite and > 0 (at least one value)", "omega")
+    eta = _check_eta(eta, one_sided)
+    if shape not in PULSE_SHAPES:
+        raise InputError(f"must be one of {sorted(PULSE_SHAPES)}, got {shape!r}", "shape")
+    if direction not in DIRECTIONS:
+        raise InputError(f"must be +1 or -1, got {direction!r}", "direction")
+    if not (math.isfinite(a_max) and a_max > 1.0):
+        raise InputError(f"must be finite and > 1, got {a_max!r}", "a_max")
+    if not (0.0 < rtol < 0.1):
+        raise InputError(f"must be in (0, 0.1), got {rtol!r}", "rtol")
+    if int(n_scan) < 2:
+        raise InputError(f"must be >= 2, got {n_scan!r}", "n_scan")
+    if int(n_scan_near) < 0:
+        raise InputError(f"must be >= 0, got {n_scan_near!r}", "n_scan_near")
+    scan = _scan(a_max, int(n_scan), int(n_scan_near))
+    kern = kernels(backend)
+    edges, n_edges, first = kern.boundary_grid(
+        om,
+        eta,
+        one_sided,
+        float(direction),
+        PULSE_SHAPES[shape],
+        scan,
+        rtol,
+        MAX_EDGES,
+        V_REST_BOUNDARY,
+    )
+    return BoundaryCurve(
+        omega=om,
+        edges=edges,
+        n_edges=n_edges.astype(np.int64),
+        collapsed_at_start=first.astype(bool),
+        eta=eta,
+        one_sided=one_sided,
+        shape=shape,
+        direction=direction,
+        a_max=float(a_max),
+        scan_ratio=float(np.max(scan[1:] / scan[:-1])),
+        rtol=rtol,
+        runtime_s=time.perf_counter() - t0,
+    )
+
+
+def governing_one_sided(
+    omega: ArrayLike, eta: float = 0.0, **kwargs: Any
+) -> tuple[BoundaryCurve, BoundaryCurve, NDArray[np.float64], NDArray[np.int64]]:
+    """Both pulse directions for a one-sided mechanism; returns (pos, neg, a_min, direction)."""
+    pos = boundary_curve(omega, eta, one_sided=True, direction=1, **kwargs)
+    neg = boundary_curve(omega, eta, one_sided=True, direction=-1, **kwargs)
+    a_min = np.minimum(pos.a_min, neg.a_min)
+    direction = np.where(pos.a_min <= neg.a_min, 1, -1).astype(np.int64)
+    return pos, neg, a_min, direction
+
+
+# --- Library ----------------------------------------------------------------------------------
+
+
+@dataclass
+class OverturningLibrary:
+    """Dimensionless first-overturning curves ``A_min(Omega; eta)`` and their intervals.
+
+    Attributes
+    ----------
+    omega : (n,) float
+        Log-spaced frequency ratios [-].
+    eta : (m,) float
+        Restitution coefficients of the two-sided curves [-].
+    a_min_two_sided : (m, n) float
+        ``A_min`` per eta and Omega (``inf``: none up to ``a_max``).
+    a_min_one_sided : (n,) float
+        Eta-independent one-sided curve (governing direction).
+    direction_one_sided : (n,) int
+        Governing pulse direction of the one-sided curve (+1 / -1).
+    edges_flat, edges_offsets : float / int arrays
+        All outcome changes (two-sided, then one-sided per direction), ragged.
+    spectrum_ratio, spectrum : (k,) float
+        Pulse response spectrum ``R(f_p/f_n)`` (``SPECTRUM_ZETA``, sine, pseudo-acceleration).
+    metadata : dict
+        Version, generation date, parameters and timing.
+    """
+
+    omega: NDArray[np.float64]
+    eta: NDArray[np.float64]
+    a_min_two_sided: NDArray[np.float64]
+    a_min_one_sided: NDArray[np.float64]
+    direction_one_sided: NDArray[np.int64]
+    edges_flat: NDArray[np.float64]
+    edges_offsets: NDArray[np.int64]
+    spectrum_ratio: NDArray[np.float64]
+    spectrum: NDArray[np.float64]
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    def scale_factor(
+        self, f_p: ArrayLike, *, f_n: float, h: float, h_e: float
+    ) -> NDArray[np.float64]:
+        """Eq. 28 for pulses, ``sqrt(1 + (R(f_p/f_n) h/h_e)**2)``, from the tabulated spectrum.
+
+        Interpolation error of R is below 1e-4 relative (ratio step 0.35 %); ratios outside
+        the table use its end values.
+        """
+        r = np.asarray(f_p, dtype=float) / f_n
+        big_r = np.interp(np.log(r), np.log(self.spectrum_ratio), self.spectrum)
+        return np.asarray(np.sqrt(1.0 + (big_r * h / h_e) ** 2), dtype=np.float64)
+
+    def a_min(
+        self, omega: ArrayLike, eta: Optional[float] = None, *, one_sided: bool = False
+    ) -> NDArray[np.float64]:
+        """Interpolated ``A_min`` at ``omega`` [-] (log-linear in Omega, linear in eta).
+
+        Outside the Omega grid the end values are used (``A -> 1`` as ``Omega -> 0``).
+        """
+        om = np.log(np.atleast_1d(np.asarray(omega, dtype=float)))
+        x = np.log(self.omega)
+        if one_sided:
+            return _interp_log(om, x, self.a_min_one_sided)
+        if eta is None:
+            raise InputError("two-sided envelopes need a coefficient of restitution", "eta")
+        eta = _check_eta(eta, False)
+        j = int(np.clip(np.searchsorted(self.eta, eta) - 1, 0, self.eta.size - 2))
+        w = (eta - self.eta[j]) / (self.eta[j + 1] - self.eta[j])
+        lo = _interp_log(om, x, self.a_min_two_sided[j])
+        hi = _interp_log(om, x, self.a_min_two_sided[j + 1])
+        return _blend(lo, hi, np.full(lo.shape, w))
+
+    def save(self, path: Union[str, Path]) -> Path:
+        """Write the library atomically as a compressed ``.npz`` (no pickled objects)."""
+        out = Path(path)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        buf = io.BytesIO()
+        np.savez_compressed(
+            buf,
+            omega=self.omega,
+            eta=self.eta,
+            a_min_two_sided=self.a_min_two_sided,
+            a_min_one_sided=self.a_min_one_sided,
+            direction_one_sided=self.direction_one_sided,
+            edges_flat=self.edges_flat,
+            edges_offsets=self.edges_offsets,
+            spectrum_ratio=self.spectrum_ratio,
+            spectrum=self.spectrum,
+            metadata=np.array(json.dumps(self.metadata, sort_keys=True)),
+        )
+        fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}-")
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(buf.getvalue())
+            os.replace(tmp, out)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+        return out
+
+    @classmethod
+    def load(cls, path: Union[str, Path, None] = None) -> OverturningLibrary:
+        """Read a library file (default: the one shipped with the package)."""
+        p = Path(path) if path is not None else LIBRARY_PATH
+        if not p.is_file():
+            raise InputError(
+                f"overturning library not found at {p}; build it with `rockmech library build`",
+                "library",
+            )
+        with np.load(p, allow_pickle=False) as data:
+            return cls(
+                omega=data["omega"],
+                eta=data["eta"],
+                a_min_two_sided=data["a_min_two_sided"],
+                a_min_one_sided=data["a_min_one_sided"],
+                direction_one_sided=data["direction_one_sided"].astype(np.int64),
+                edges_flat=data["edges_flat"],
+                edges_offsets=data["edges_offsets"].astype(np.int64),
+                spectrum_ratio=data["spectrum_ratio"],
+                spectrum=data["spectrum"],
+                metadata=json.loads(str(data["metadata"])),
+            )
+
+
+def _blend(
+    lo: NDArray[np.float64], hi: NDArray[np.float64], w: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Log-linear blend of two bracketing values; the lower one across a jump (``JUMP``).
+
+    ``inf`` (no overturning up to ``a_max``) counts as a jump, so the finite neighbour wins.
+    """
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        smooth = np.exp((1.0 - w) * np.log(lo) + w * np.log(hi))
+        jump = ~(np.abs(np.log(hi / lo)) <= JUMP)
+    return np.asarray(np.where(jump, np.minimum(lo, hi), smooth), dtype=np.float64)
+
+
+def _interp_log(
+    x_new: NDArray[np.float64], x: NDArray[np.float64], a: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Interpolate ``a`` in ``x`` with ``_blend``; end values outside the grid."""
+    xc = np.clip(x_new, x[0], x[-1])
+    idx = np.clip(np.searchsorted(x, xc), 1, x.size - 1)
+    w = (xc - x[idx - 1]) / (x[idx] - x[idx - 1])
+    return _blend(a[idx - 1], a[idx], w)
+
+
+def _ragged(curves: Sequence[BoundaryCurve]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    flat: list[float] = []
+    offsets = [0]
+    for c in curves:
+        for i in range(c.omega.size):
+            flat.extend(float(e) for e in c.edges[i, : min(int(c.n_edges[i]), MAX_EDGES)])
+            offsets.append(len(flat))
+    return np.array(flat), np.array(offsets, dtype=np.int64)
+
+
+def build_library(
+    *,
+    omega: Optional[ArrayLike] = None,
+    eta: Optional[ArrayLike] = None,
+    shape: str = "sine",
+    progress: Any = None,
+) -> OverturningLibrary:
+    """Compute the library (two-sided curves over eta, and the one-sided curve).
+
+    Parameters
+    ----------
+    omega, eta : array_like, optional
+        Grids; default ``LIBRARY_OMEGA`` (400 log-spaced in [0.05, 50]) and eta from 0 to 1
+        in steps of ``LIBRARY_ETA_STEP``.
+    shape : {"sine", "cosine"}
+        Pulse shape.
+    progress : callable, optional
+        Called as ``progress(done, total)`` after each curve.
+    """
+    t0 = time.perf_counter()
+    om = (
+        np.geomspace(LIBRARY_OMEGA[0], LIBRARY_OMEGA[1], LIBRARY_OMEGA[2])
+        if omega is None
+        else np.asarray(omega, dtype=float)
+    )
+    etas = (
+        np.round(np.arange(0.0, 1.0 + 1e-9, LIBRARY_ETA_STEP), 12)
+        if eta is None
+        else np.asarray(eta, dtype=float)
+    )
+    total = etas.size + 2
+    curves = []
+    for k, e in enumerate(etas):
+        curves.append(boundary_curve(om, float(e), shape=shape))
+        if progress is not None:
+            progress(k + 1, total)
+    pos, neg, a_one, direction = governing_one_sided(om, 0.0, shape=shape)
+    if progress is not None:
+        progress(total, total)
+    flat, offsets = _ragged([*curves, pos, neg])
+    from .amplification import pulse_response_spectrum
+
+    ratio = np.geomspace(*SPECTRUM_GRID[:2], SPECTRUM_GRID[2])
+    spectrum = pulse_response_spectrum(ratio, zeta=SPECTRUM_ZETA)
+    meta = {
+        "library_version": LIBRARY_VERSION,
+        "generated": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+        "shape": shape,
+        "a_max": A_MAX,
+        "n_scan": N_SCAN,
+        "scan_ratio": curves[0].scan_ratio,
+        "rtol": RTOL,
+        "v_rest_rel": V_REST_BOUNDARY,
+        "criterion": "exact (the body cannot return)",
+        "pulse_convention": "A (Zhang & Makris 2001: pulse starts at t = 0)",
+        "one_sided": "eta = 0 (no rebound), both pulse directions, lower curve",
+        "edges_layout": "two-sided curves in eta order, then one-sided +1, then -1; "
+        "each Omega's edges between consecutive offsets",
+        "spectrum": f"pseudo-acceleration, sine pulse, zeta = {SPECTRUM_ZETA}",
+        "build_seconds": round(time.perf_counter() - t0, 3),
+    }
+    return OverturningLibrary(
+        omega=om,
+        eta=etas,
+        a_min_two_sided=np.stack([c.a_min for c in curves]),
+        a_min_one_sided=a_one,
+        direction_one_sided=direction,
+        edges_flat=flat,
+        edges_offsets=offsets,
+        spectrum_ratio=ratio,
+        spectrum=spectrum,
+        metadata=meta,
+    )
+
+
+# --- Mechanism envelopes and the critical mechanism ------------------------------------------
+
+
+@dataclass
+class Envelope:
+    """Minimum overturning pulse amplitude of one mechanism against pulse frequency.
+
+    Attributes
+    ----------
+    name : str
+        Mechanism name.
+    f_p : (n,) float
+        Pulse frequencies [Hz].
+    a_p_min_local_g : (n,) float
+        Minimum amplitude at the mechanism [g] (``inf``: none up to the search limit).
+    scale_factor : (n,) float
+        Amplification from the ground to the mechanism (1 at ground level) [-].
+    governing_side : (n,) int
+        +1 or -1: the side (two-sided asymmetric) or pulse direction (one-sided) that governs.
+    """
+
+    name: str
+    f_p: NDArray[np.float64]
+    a_p_min_local_g: NDArray[np.float64]
+    scale_factor: NDArray[np.float64]
+    governing_side: NDArray[np.int64]
+
+    @property
+    def a_p_min_g(self) -> NDArray[np.float64]:
+        """Minimum overturning amplitude of the ground pulse [g]."""
+        return self.a_p_min_local_g / self.scale_factor
+
+
+def _side_curve(
+    side: RockingSide,
+    f_p: NDArray[np.float64],
+    eta: Optional[float],
+    one_sided: bool,
+    library: Optional[OverturningLibrary],
+    exact: bool,
+) -> NDArray[np.float64]:
+    omega = 2.0 * np.pi * f_p / side.p_eq
+    if exact or library is None:
+        if one_sided:
+            a_min = governing_one_sided(omega, 0.0)[2]
+        else:
+            assert eta is not None
+            a_min = boundary_curve(omega, eta).a_min
+    else:
+        a_min = library.a_min(omega, eta, one_sided=one_sided)
+    return side.lam * a_min
+
+
+def mechanism_envelope(
+    model: RockingModel,
+    f_p: ArrayLike,
+    *,
+    library: Optional[OverturningLibrary] = None,
+    exact: bool = False,
+    scale_factor: Optional[ArrayLike] = None,
+) -> Envelope:
+    """Envelope ``a_p,min(f_p) = g lam A_min(2 pi f_p / p_eq)`` of one mechanism.
+
+    Parameters
+    ----------
+    model : RockingModel
+        The mechanism. Two-sided needs ``eta``; one-sided does not (THEORY §6.4).
+    f_p : array_like
+        Pulse frequencies [Hz], > 0.
+    library : OverturningLibrary, optional
+        Curves to interpolate; default the shipped library unless ``exact``.
+    exact : bool
+        Compute the boundary directly with the exact integrator instead.
+    scale_factor : array_like, optional
+        Amplification ``SF(f_p)`` from the ground to the mechanism (1 if omitted).
+
+    Notes
+    -----
+    Asymmetric two-sided mechanisms take, per frequency, the lower of the two sides'
+    envelopes (each side's constants used as a symmetric mechanism).
+    """
+    f = np.atleast_1d(np.asarray(f_p, dtype=float))
+    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f) & (f > 0)):
+        raise InputError("must be finite and > 0 (at least one value)", f"{model.name}.f_p")
+    eta = None
+    if not model.one_sided:
+        if model.eta is None:
+            raise InputError(
+                "a two-sided envelope needs a coefficient of restitution", f"{model.name}.eta"
+            )
+        eta = model.eta
+    if library is None and not exact:
+        library = OverturningLibrary.load()
+    pos = _side_curve(model.positive, f, eta, model.one_sided, library, exact)
+    if model.one_sided or model.is_symmetric:
+        local, side = pos, np.ones(f.size, dtype=np.int64)
+    else:
+        neg = _side_curve(model.neg, f, eta, False, library, exact)
+        local = np.minimum(pos, neg)
+        side = np.where(pos <= neg, 1, -1).astype(np.int64)
+    sf = np.ones(f.size) if scale_factor is None else np.asarray(scale_factor, dtype=float)
+    if sf.shape != f.shape or not np.all(np.isfinite(sf) & (sf >= 1.0)):
+        raise InputError("must be finite and >= 1 at every frequency", f"{model.name}.scale_factor")
+    return Envelope(model.name, f, local, sf, side)
+
+
+def critical_bands(envelopes: Sequence[Envelope]) -> tuple[NDArray[np.int64], list[dict[str, Any]]]:
+    """Find the governing mechanism at each frequency and the bands where each governs.
+
+    Returns
+    -------
+    index : (n,) int
+        Index of the mechanism with the lowest ground-level ``a_p,min`` (-1 where none
+        overturns within the search limit).
+    bands : list of dict
+        ``{"mechanism", "f_min", "f_max"}`` [Hz] for each run of frequencies with the same
+        governing mechanism (limits are the first and last frequency of the run).
+    """
+    if not envelopes:
+        raise InputError("needs at least one mechanism", "mechanisms")
+    f = envelopes[0].f_p
+    stack = np.stack([e.a_p_min_g for e in envelopes])
+    index = np.argmin(stack, axis=0).astype(np.int64)
+    index[~np.isfinite(stack.min(axis=0))] = -1
+    bands: list[dict[str, Any]] = []
+    start = 0
+    for k in range(1, f.size + 1):
+        if k == f.size or index[k] != index[start]:
+            if index[start] >= 0:
+                bands.append(
+                    {
+                        "mechanism": envelopes[index[start]].name,
+                        "f_min": float(f[start]),
+                        "f_max": float(f[k - 1]),
+                    }
+                )
+            start = k
+    return index, bands
