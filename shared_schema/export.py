@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional
 
 from shared_schema.constants import ConstantsFile
-from shared_schema.io import write_json_atomic
+from shared_schema.io import write_atomic
 
 __all__ = ["SCHEMA_PATH", "build_schema", "main", "render_schema"]
 
@@ -80,7 +80,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         print(f"{output}: up to date")
         return 0
     output.parent.mkdir(parents=True, exist_ok=True)
-    write_json_atomic(output, text)
+    write_atomic(output, text)
     print(f"wrote {output}")
     return 0
 

@@ -184,14 +184,14 @@ def write_envelope(
     exact: bool = False,
 ) -> dict[str, Any]:
     """Write ``<stem>.json``, ``<stem>.csv`` and ``<stem>.png`` (atomically); return the doc."""
-    from shared_schema.io import write_json_atomic
+    from shared_schema.io import write_atomic
 
     from .report.plots import plot_envelopes
 
     doc, envs = envelope_doc(cf, f_p, exact=exact)
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_json_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
-    write_json_atomic(out_dir / f"{stem}.csv", envelope_csv(doc))
+    write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
+    write_atomic(out_dir / f"{stem}.csv", envelope_csv(doc))
     plot_envelopes(
         envs,
         doc["critical"],

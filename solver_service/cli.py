@@ -147,7 +147,7 @@ def history(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Time history of every mechanism in CONSTANTS under RECORD at each scale factor."""
-    from shared_schema.io import load_constants, write_json_atomic
+    from shared_schema.io import load_constants, write_atomic
 
     from .adapter import models_from_file
     from .core.exact import simulate_batch
@@ -182,7 +182,7 @@ def history(
     }
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
-        write_json_atomic(out / "history.json", json.dumps(doc, indent=2) + "\n")
+        write_atomic(out / "history.json", json.dumps(doc, indent=2) + "\n")
         _history_plot(models, motion, max(scales), out / "history.png")
     if as_json:
         _print_json(doc)

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from shared_schema.constants import ConstantsFile
-from shared_schema.io import save_constants, write_json_atomic
+from shared_schema.io import save_constants, write_atomic
 
 from .adapter import models_from_file
 from .core.exact import simulate, simulate_batch
@@ -160,7 +160,7 @@ def run_demo(out_dir: Path, record_path: Path | None = None) -> dict[str, Path]:
         "results": batch.rows(),
     }
     history_path = out_dir / "history.json"
-    write_json_atomic(history_path, json.dumps(summary, indent=2) + "\n")
+    write_atomic(history_path, json.dumps(summary, indent=2) + "\n")
     scale = DEMO_PLOT_SCALE
     runs = [
         (mech.id, simulate(model, record.accel, scale=scale, dense=True))

@@ -37,9 +37,8 @@ from __future__ import annotations
 import io
 import json
 import math
-import os
-import tempfile
 import time
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -48,6 +47,7 @@ from typing import Any, Optional, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError
 
 from .exact import kernels
@@ -159,7 +159,7 @@ class BoundaryCurve:
 
         ``A_hi`` is None when the interval extends to ``a_max``.
         """
-        pts = list(self.edges[i, : min(int(self.n_edges[i]), MAX_EDGES)])
+        pts = list(self.edges[i, : int(self.n_edges[i])])
         if self.collapsed_at_start[i]:
             pts.insert(0, 1.0)
         out: list[tuple[float, Optional[float]]] = []
@@ -170,7 +170,11 @@ class BoundaryCurve:
 
     @property
     def a_min(self) -> NDArray[np.float64]:
-        """First overturning amplitude per Omega; ``inf`` if none up to ``a_max``."""
+        """First overturning amplitude the scan finds per Omega; ``inf`` if none to ``a_max``.
+
+        An overturning interval below it that is narrower than ``scan_ratio`` can be
+        missed (near the uplift threshold at low Omega; see ``n_scan_near``).
+        """
         first = np.where(self.n_edges > 0, self.edges[:, 0], np.inf)
         return np.where(self.collapsed_at_start, 1.0, first)
 
@@ -250,10 +254,17 @@ def boundary_curve(
         MAX_EDGES,
         V_REST_BOUNDARY,
     )
+    if np.any(n_edges > MAX_EDGES):
+        warnings.warn(
+            f"more than {MAX_EDGES} outcome changes at some Omega; only the first "
+            f"{MAX_EDGES} are kept",
+            RuntimeWarning,
+            stacklevel=2,
+        )
     return BoundaryCurve(
         omega=om,
         edges=edges,
-        n_edges=n_edges.astype(np.int64),
+        n_edges=np.minimum(n_edges, MAX_EDGES).astype(np.int64),
         collapsed_at_start=first.astype(bool),
         eta=eta,
         one_sided=one_sided,
@@ -365,14 +376,7 @@ class OverturningLibrary:
             spectrum=self.spectrum,
             metadata=np.array(json.dumps(self.metadata, sort_keys=True)),
         )
-        fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}-")
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                fh.write(buf.getvalue())
-            os.replace(tmp, out)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+        write_atomic(out, buf.getvalue())
         return out
 
     @classmethod
@@ -427,7 +431,7 @@ def _ragged(curves: Sequence[BoundaryCurve]) -> tuple[NDArray[np.float64], NDArr
     offsets = [0]
     for c in curves:
         for i in range(c.omega.size):
-            flat.extend(float(e) for e in c.edges[i, : min(int(c.n_edges[i]), MAX_EDGES)])
+            flat.extend(float(e) for e in c.edges[i, : int(c.n_edges[i])])
             offsets.append(len(flat))
     return np.array(flat), np.array(offsets, dtype=np.int64)
 

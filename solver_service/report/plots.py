@@ -6,8 +6,7 @@ importing this module costs nothing and works on machines without a display.
 
 from __future__ import annotations
 
-import os
-import tempfile
+import io
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Union
@@ -29,17 +28,14 @@ def _pyplot() -> Any:
 
 
 def _save_atomic(fig: Any, path: Union[str, Path]) -> Path:
-    """Save a figure through a temporary file in the target folder, then rename it."""
+    """Render a figure in memory and write it atomically (format from the suffix)."""
+    from shared_schema.atomic import write_atomic
+
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.stem}-", suffix=out.suffix)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=120, bbox_inches="tight")
-        os.replace(tmp, out)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=120, bbox_inches="tight", format=out.suffix.lstrip(".") or "png")
+    write_atomic(out, buf.getvalue())
     return out
 
 

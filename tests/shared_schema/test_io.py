@@ -8,10 +8,11 @@ from pathlib import Path
 import pytest
 from pydantic_core import PydanticSerializationError
 
+import shared_schema.atomic as atomic
 import shared_schema.io as sio
 from shared_schema.constants import ConstantsFile, Mechanism, parse_constants
 from shared_schema.errors import InputError
-from shared_schema.io import load_constants, save_constants, write_json_atomic
+from shared_schema.io import load_constants, save_constants, write_atomic
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "constants"
 
@@ -152,18 +153,18 @@ def test_non_utf8_file_is_an_input_error(tmp_path):
 # --- atomic writes -----------------------------------------------------------------------
 
 
-def test_write_json_atomic_writes_str_and_bytes_exactly(tmp_path):
+def test_write_atomic_writes_str_and_bytes_exactly(tmp_path):
     path = tmp_path / "x.json"
-    write_json_atomic(path, '{"a": "\u00e9"}\r\n')
+    write_atomic(path, '{"a": "\u00e9"}\r\n')
     assert path.read_bytes() == '{"a": "\u00e9"}\r\n'.encode()
-    write_json_atomic(str(path), b"[1]\n")
+    write_atomic(str(path), b"[1]\n")
     assert path.read_bytes() == b"[1]\n"
     assert leftovers(tmp_path) == ["x.json"]
 
 
-def test_write_json_atomic_rejects_other_types_before_touching_the_disk(tmp_path):
+def test_write_atomic_rejects_other_types_before_touching_the_disk(tmp_path):
     with pytest.raises(TypeError, match="str or bytes"):
-        write_json_atomic(tmp_path / "x.json", {"a": 1})
+        write_atomic(tmp_path / "x.json", {"a": 1})
     assert leftovers(tmp_path) == []
 
 
@@ -176,7 +177,7 @@ def test_failed_rename_leaves_previous_file_and_no_temporary_file(tmp_path, monk
 
     monkeypatch.setattr(sio.os, "replace", fail_replace)
     with pytest.raises(OSError, match="No space"):
-        write_json_atomic(path, "new\n")
+        write_atomic(path, "new\n")
     assert path.read_text() == "old\n"
     assert leftovers(tmp_path) == ["x.json"]
 
@@ -208,10 +209,10 @@ def test_existing_file_keeps_its_permissions(tmp_path):
     path = tmp_path / "x.json"
     path.write_text("old\n")
     path.chmod(0o640)
-    write_json_atomic(path, "new\n")
+    write_atomic(path, "new\n")
     assert stat.S_IMODE(path.stat().st_mode) == 0o640
-    write_json_atomic(tmp_path / "fresh.json", "new\n")
-    assert stat.S_IMODE((tmp_path / "fresh.json").stat().st_mode) == sio.NEW_FILE_MODE
+    write_atomic(tmp_path / "fresh.json", "new\n")
+    assert stat.S_IMODE((tmp_path / "fresh.json").stat().st_mode) == atomic.NEW_FILE_MODE
 
 
 # --- the church example ------------------------------------------------------------------
