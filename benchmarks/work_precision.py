@@ -30,18 +30,16 @@ How
   at rtol 1e-12 measured in the same run (both cases); 1000 scale factors <= 0.3 s.
 
 Run ``.venv/bin/python benchmarks/work_precision.py`` (or ``make bench``) for the full run,
-which rewrites ``docs/benchmarks.md`` and ``docs/img/work_precision.png``; ``--quick`` is a
-smoke run (fewer tolerances and repeats) that writes no docs unless ``--write-docs`` is given.
+which rewrites its section of ``docs/benchmarks.md`` (``_docs.write_section``) and
+``docs/img/work_precision.png``; ``--quick`` is a smoke run (fewer tolerances and repeats) that
+writes no docs unless ``--write-docs`` is given.
 """
 
 from __future__ import annotations
 
 import argparse
-import datetime
 import math
 import os
-import platform
-import subprocess
 import sys
 import tempfile
 import time
@@ -62,6 +60,7 @@ except ImportError:  # pragma: no cover - depends on the environment
     sys.exit("benchmarks/work_precision.py needs mpmath for its reference: pip install mpmath")
 
 import mpref  # noqa: E402  (benchmarks/ is not a package)
+from _docs import machine_info, write_section  # noqa: E402
 from mpmath import mp, mpf  # noqa: E402
 
 from solver_service.core.exact import simulate, simulate_batch  # noqa: E402
@@ -194,60 +193,6 @@ def md_table(headers: list[str], rows: list[list[str]]) -> str:
     out = ["| " + " | ".join(headers) + " |", "|" + "|".join("---" for _ in headers) + "|"]
     out += ["| " + " | ".join(c.replace("|", "/") for c in r) + " |" for r in rows]
     return "\n".join(out)
-
-
-def machine_info() -> dict[str, str]:
-    import matplotlib
-    import mpmath
-    import numba
-    import scipy
-
-    cpu = "unknown"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    try:
-        nproc = str(len(os.sched_getaffinity(0)))
-    except AttributeError:
-        nproc = str(os.cpu_count())
-    try:
-        commit = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"],
-            cwd=REPO,
-            capture_output=True,
-            text=True,
-            check=False,
-        ).stdout.strip()
-        # Read-only check (git diff does not write the index) for uncommitted solver changes.
-        dirty = subprocess.run(
-            ["git", "diff", "--quiet", "HEAD", "--", "solver_service", "shared_schema"],
-            cwd=REPO,
-            capture_output=True,
-            check=False,
-        ).returncode
-        if commit and dirty == 1:
-            commit += " + uncommitted changes in solver_service/"
-    except OSError:
-        commit = ""
-    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
-    return {
-        "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
-        "cpu": cpu,
-        "nproc": nproc,
-        "load": load,
-        "os": platform.platform(),
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "scipy": scipy.__version__,
-        "numba": numba.__version__,
-        "mpmath": mpmath.__version__,
-        "matplotlib": matplotlib.__version__,
-        "commit": commit or "unknown",
-    }
 
 
 # ------------------------------------------------------------------------------------------
@@ -758,12 +703,12 @@ def write_docs(
         " --quick --write-docs" if quick else ""
     )
     lines = [
-        "# Benchmarks",
+        "## Work precision (`benchmarks/work_precision.py`)",
         "",
         "Latest figures of `benchmarks/work_precision.py`. Re-run with `make bench` "
-        f"(equivalently `{cmd}`); it rewrites this file and `docs/img/work_precision.png`.",
+        f"(equivalently `{cmd}`); it rewrites this section and `docs/img/work_precision.png`.",
         "",
-        "## Machine and run",
+        "### Machine and run",
         "",
         f"- Date: {info['date']}; rockmech commit: {info['commit']}",
         f"- CPU: {info['cpu']}; nproc = {info['nproc']}; load average (1, 5, 15 min) at "
@@ -775,7 +720,7 @@ def write_docs(
         f"- Command: `{cmd}`{' (quick smoke run)' if quick else ''}; whole run "
         f"{total_s / 60:.1f} min",
         "",
-        "## Method",
+        "### Method",
         "",
         "- Yardstick: `benchmarks/mpref.py`, an independent implementation of the linearised "
         "model and of the exact integrator's rules in mpmath at 30 significant digits "
@@ -797,13 +742,13 @@ def write_docs(
         f"- Combinations are skipped when the looser tolerance of the same method took, or "
         f"is predicted to take, more than {SKIP_AFTER_S:.0f} s.",
         "",
-        "## Results",
+        "### Results",
         "",
     ]
     for case in cases:
         r = case.ref
         lines += [
-            f"### {case.title}",
+            f"#### {case.title}",
             "",
             f"Reference: peak = {mpref.mpf_str(r.peak, 25)}, collapsed = {r.collapsed}, "
             f"{r.n_impacts} impacts ({case.ref_time:.1f} s in mpmath).",
@@ -812,7 +757,7 @@ def write_docs(
         lines += [f"{n}" for n in case.notes] + ([""] if case.notes else [])
         lines += [md_table(HEAD_MAIN, main_rows(results[case.key])), ""]
     lines += [
-        "### Nonlinear Housner block (linearisation difference, not an integration error)",
+        "#### Nonlinear Housner block (linearisation difference, not an integration error)",
         "",
         "`simulate_nonlinear` with DOP853 for the block with p = p_eq and alpha = lam. "
         "'linearisation difference' is `|peak_nonlinear - peak_linear_ref| / "
@@ -824,7 +769,7 @@ def write_docs(
     for case in cases:
         lines += [f"{case.label}:", "", md_table(HEAD_NL, nl_rows(nl[case.key])), ""]
     lines += [
-        "### Incremental analysis",
+        "#### Incremental analysis",
         "",
         f"{N_SCALES} scale factors `np.linspace(0.1, 3.0, {N_SCALES})` of El Centro on the "
         f"case (b) block in one `simulate_batch` call: **{fmt_time(batch['time_s'])}** with "
@@ -833,26 +778,22 @@ def write_docs(
         "thread; "
         f"{batch['n_collapsed']} collapse, {batch['n_impacts_total']} impacts in all.",
         "",
-        "## Targets",
+        "### Targets",
         "",
         md_table(
             ["target", "result", "measured"],
             [[name, "PASS" if ok else "FAIL", val] for name, ok, val in tgt],
         ),
         "",
-        "## Work-precision diagram",
+        "### Work-precision diagram",
         "",
         "![work-precision diagram](img/work_precision.png)",
         "",
         reading(cases, results, batch),
         "",
     ]
-    DOC_MD.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".benchmarks.", suffix=".md", dir=DOC_MD.parent)
-    with os.fdopen(fd, "w", encoding="utf-8") as fh:
-        fh.write("\n".join(lines))
-    os.chmod(tmp, 0o644)
-    os.replace(tmp, DOC_MD)
+    # docs/benchmarks.md is shared: this benchmark rewrites only its own section.
+    write_section(DOC_MD, "work_precision", "\n".join(lines))
 
 
 # ------------------------------------------------------------------------------------------
@@ -872,7 +813,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     quick = bool(args.quick)
     write = (not quick) or args.write_docs
     wall0 = time.perf_counter()
-    info = machine_info()
+    info = machine_info(("numpy", "scipy", "numba", "mpmath", "matplotlib"))
     print(f"rockmech work-precision benchmark ({'quick' if quick else 'full'} run)")
     print(
         f"{info['date']} | {info['cpu']} | nproc {info['nproc']} | load {info['load']} | "
