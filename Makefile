@@ -35,6 +35,7 @@ schema: $(STAMP)
 ## Benchmarks (not part of the test suite): tables on stdout, figures in docs/.
 bench: $(STAMP)
 	$(BIN)/python benchmarks/work_precision.py
+	$(BIN)/python benchmarks/envelope_speed.py
 
 clean:
 	rm -rf $(VENV) out .mypy_cache .ruff_cache .pytest_cache

@@ -60,7 +60,7 @@ except ImportError:  # pragma: no cover - depends on the environment
     sys.exit("benchmarks/work_precision.py needs mpmath for its reference: pip install mpmath")
 
 import mpref  # noqa: E402  (benchmarks/ is not a package)
-from _docs import machine_info, write_section  # noqa: E402
+from _docs import fmt_time, machine_info, md_table, text_table, write_section  # noqa: E402
 from mpmath import mp, mpf  # noqa: E402
 
 from solver_service.core.exact import simulate, simulate_batch  # noqa: E402
@@ -169,30 +169,6 @@ def fmt_err(e: float) -> str:
     if math.isnan(e):
         return "-"
     return "0" if e == 0.0 else f"{e:.1e}"
-
-
-def fmt_time(t: float) -> str:
-    if math.isnan(t):
-        return "-"
-    if t < 1e-3:
-        return f"{t * 1e6:.0f} us"
-    if t < 1.0:
-        return f"{t * 1e3:.2f} ms"
-    return f"{t:.2f} s"
-
-
-def text_table(headers: list[str], rows: list[list[str]]) -> str:
-    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(headers)]
-    line = "  ".join(h.ljust(w) for h, w in zip(headers, widths))
-    sep = "  ".join("-" * w for w in widths)
-    body = ["  ".join(c.ljust(w) for c, w in zip(r, widths)) for r in rows]
-    return "\n".join([line, sep, *body])
-
-
-def md_table(headers: list[str], rows: list[list[str]]) -> str:
-    out = ["| " + " | ".join(headers) + " |", "|" + "|".join("---" for _ in headers) + "|"]
-    out += ["| " + " | ".join(c.replace("|", "/") for c in r) + " |" for r in rows]
-    return "\n".join(out)
 
 
 # ------------------------------------------------------------------------------------------
