@@ -221,6 +221,48 @@ def _history_plot(models: list[Any], motion: Any, scale: float, path: Path) -> N
 
 @app.command()
 @_user_errors
+def constants(
+    scene: Path = typer.Argument(..., help="Rhino .3dm file."),
+    spec: Path = typer.Argument(..., help="Mechanism spec (JSON)."),
+    output: Path = typer.Option(..., "-o", "--output", help="Kinematic-constants JSON to write."),
+    as_json: bool = typer.Option(False, "--json", help="Also print the constants JSON."),
+) -> None:
+    """Kinematic constants of every mechanism in SPEC from the solids of SCENE."""
+    from rhino_plugin.scene_3dm import Scene
+
+    from rhino_plugin.mechanisms.build import constants_from_spec
+    from shared_schema.io import save_constants
+    from shared_schema.spec import parse_spec
+
+    for label, path in (("scene", scene), ("spec", spec)):
+        if not path.is_file():
+            _fail(f"{label}: file not found: {path}")
+    spec_file = parse_spec(spec.read_bytes(), spec.name)
+    cf = constants_from_spec(
+        spec_file,
+        Scene.from_3dm(scene),
+        scene_name=scene.name,
+        spec_name=spec.name,
+        spec_dir=spec.parent,
+    )
+    save_constants(output, cf)
+    if as_json:
+        _print_json(json.loads(cf.model_dump_json(exclude_none=True)))
+        return
+    typer.echo(f"wrote {output}")
+    for m in cf.mechanisms:
+        side = m.positive
+        typer.echo(
+            f"  {m.id:<8} p_eq = {side.p_eq:.4f} rad/s  lam = {side.lam:.4f}  "
+            f"phi_ov = {side.phi_ov:.4f} rad  eta = {m.eta if m.eta is not None else '-'}"
+        )
+        notes = (m.provenance or {}).get("warnings") or []
+        for note in notes if isinstance(notes, list) else []:
+            typer.echo(f"    warning: {note}")
+
+
+@app.command()
+@_user_errors
 def envelope(
     constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
     out: Path = typer.Option(..., "--out", help="Folder for envelope.json, .csv and .png."),

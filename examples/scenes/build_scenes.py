@@ -1,0 +1,408 @@
+"""Build the example ``.3dm`` scenes, in metres, deterministically.
+
+Run ``python examples/scenes/build_scenes.py [OUT_DIR]`` (default: this folder). The object
+names, layers and ids are fixed (ids are UUID5 of ``scene/name``), so spec files can refer to
+them; README.md in this folder lists them. Only the file time stamps change between runs.
+
+Solids use several rhino3dm kinds on purpose (Brep, Extrusion, Mesh), so each reading path of
+``rhino_plugin.scene_3dm`` is exercised by the examples.
+"""
+
+import math
+import sys
+import uuid
+from pathlib import Path
+from typing import Callable, Dict, List, Sequence, Tuple
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+# UUID5 namespace of the example objects and layers.
+NAMESPACE = uuid.UUID("6f1c2a52-0d0e-4c8b-9a57-3d1e2b7a9c40")
+# Model absolute tolerance written into the files [m].
+TOLERANCE = 1e-4
+# Unit weights written as user text [kg/m^3] (spec files may override them).
+DENSITY = {"brick": 1800.0, "stone": 2600.0, "bronze": 8500.0, "concrete": 2400.0}
+
+Point = Tuple[float, float, float]
+
+
+class Builder:
+    """One scene under construction: layers, named objects, deterministic ids."""
+
+    def __init__(self, scene: str) -> None:
+        import rhino3dm
+
+        self.r3 = rhino3dm
+        self.scene = scene
+        self.model = rhino3dm.File3dm()
+        self.model.Settings.ModelUnitSystem = rhino3dm.UnitSystem.Meters
+        self.model.Settings.ModelAbsoluteTolerance = TOLERANCE
+        self.layers: Dict[str, int] = {}
+
+    def _id(self, kind: str, name: str) -> uuid.UUID:
+        return uuid.uuid5(NAMESPACE, f"{self.scene}/{kind}/{name}")
+
+    def layer(self, name: str) -> int:
+        """Return the index of a top-level layer, adding it on first use."""
+        if name not in self.layers:
+            layer = self.r3.Layer()
+            layer.Name = name
+            layer.Id = self._id("layer", name)
+            self.layers[name] = self.model.Layers.Add(layer)
+        return self.layers[name]
+
+    def attrs(self, name: str, layer: str, material: str = "") -> object:
+        """Return object attributes: name, fixed id, layer, material user text."""
+        a = self.r3.ObjectAttributes()
+        a.Name = name
+        a.Id = self._id("object", name)
+        a.LayerIndex = self.layer(layer)
+        if material:
+            a.SetUserString("material", material)
+            a.SetUserString("density_kg_m3", f"{DENSITY[material]:g}")
+        return a
+
+    def box(self, name: str, layer: str, lo: Point, hi: Point, material: str) -> None:
+        """Add a Brep box (six planar faces)."""
+        bbox = self.r3.BoundingBox(*lo, *hi)
+        brep = self.r3.Brep.CreateFromBox(self.r3.Box(bbox))
+        self.model.Objects.AddBrep(brep, self.attrs(name, layer, material))
+
+    def prism_y(
+        self,
+        name: str,
+        layer: str,
+        profile: Sequence[Tuple[float, float]],
+        y0: float,
+        y1: float,
+        material: str,
+    ) -> None:
+        """Add an Extrusion along y of a closed x-z profile [(x, z), ...], from y0 to y1."""
+        r3 = self.r3
+        pts = [r3.Point3d(x, z, 0.0) for x, z in profile]
+        curve = r3.Polyline([*pts, pts[0]]).ToPolylineCurve()
+        ext = r3.Extrusion()
+        # path towards -y with z up maps profile (x, y) to world (x, z)
+        ok = ext.SetOuterProfile(curve, True) and ext.SetPathAndUp(
+            r3.Point3d(0.0, y1, 0.0), r3.Point3d(0.0, y0, 0.0), r3.Vector3d(0.0, 0.0, 1.0)
+        )
+        _check_box(
+            ext,
+            ok,
+            name,
+            (min(x for x, _ in profile), y0, min(z for _, z in profile)),
+            (max(x for x, _ in profile), y1, max(z for _, z in profile)),
+        )
+        self.model.Objects.AddExtrusion(ext, self.attrs(name, layer, material))
+
+    def prism_z(
+        self,
+        name: str,
+        layer: str,
+        profile: Sequence[Tuple[float, float]],
+        z0: float,
+        z1: float,
+        material: str,
+    ) -> None:
+        """Add an Extrusion along z of a closed x-y profile [(x, y), ...], from z0 to z1."""
+        r3 = self.r3
+        pts = [r3.Point3d(x, y, 0.0) for x, y in profile]
+        curve = r3.Polyline([*pts, pts[0]]).ToPolylineCurve()
+        ext = r3.Extrusion()
+        # path towards +z with y up maps profile (x, y) to world (x, y)
+        ok = ext.SetOuterProfile(curve, True) and ext.SetPathAndUp(
+            r3.Point3d(0.0, 0.0, z0), r3.Point3d(0.0, 0.0, z1), r3.Vector3d(0.0, 1.0, 0.0)
+        )
+        xs, ys = [p[0] for p in profile], [p[1] for p in profile]
+        _check_box(ext, ok, name, (min(xs), min(ys), z0), (max(xs), max(ys), z1))
+        self.model.Objects.AddExtrusion(ext, self.attrs(name, layer, material))
+
+    def mesh(self, name: str, layer: str, v: np.ndarray, f: np.ndarray, material: str) -> None:
+        """Add a Mesh with double-precision vertices (AddPoint3d, not the float32 Add)."""
+        _check_closed(v, f, name)
+        m = self.r3.Mesh()
+        add_v, add_f = m.Vertices.AddPoint3d, m.Faces.AddFace
+        for x, y, z in v.tolist():
+            add_v(x, y, z)
+        for a, b, c in f.tolist():
+            add_f(a, b, c)
+        self.model.Objects.AddMesh(m, self.attrs(name, layer, material))
+
+    def line(self, name: str, layer: str, a: Point, b: Point) -> None:
+        """Add a line from a to b [m]."""
+        r3 = self.r3
+        self.model.Objects.AddLine(r3.Point3d(*a), r3.Point3d(*b), self.attrs(name, layer))
+
+    def plane_surface(
+        self,
+        name: str,
+        layer: str,
+        origin: Point,
+        xdir: Point,
+        ydir: Point,
+        xs: Tuple[float, float],
+        ys: Tuple[float, float],
+    ) -> None:
+        """Add a planar surface on a plane (origin, x and y directions) over given extents."""
+        r3 = self.r3
+        plane = r3.Plane(r3.Point3d(*origin), r3.Vector3d(*xdir), r3.Vector3d(*ydir))
+        srf = r3.PlaneSurface(plane, r3.Interval(*xs), r3.Interval(*ys))
+        self.model.Objects.AddSurface(srf, self.attrs(name, layer))
+
+    def write(self, path: Path) -> Path:
+        """Write the model (Rhino 8 format)."""
+        if not self.model.Write(str(path), 8):
+            raise OSError(f"rhino3dm could not write {path}")
+        return path
+
+
+def _check_box(ext: object, ok: bool, name: str, lo: Point, hi: Point) -> None:
+    bb = ext.GetBoundingBox()  # type: ignore[attr-defined]
+    got = (bb.Min.X, bb.Min.Y, bb.Min.Z, bb.Max.X, bb.Max.Y, bb.Max.Z)
+    if not ok or not np.allclose(got, (*lo, *hi), atol=1e-12):
+        raise RuntimeError(f"{name}: extrusion came out at {got}, expected {(*lo, *hi)}")
+
+
+def _check_closed(v: np.ndarray, f: np.ndarray, name: str) -> None:
+    """Raise unless the mesh is closed, consistently oriented and of positive volume."""
+    e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    _, n_dir = np.unique(e, axis=0, return_counts=True)
+    _, n_und = np.unique(np.sort(e, axis=1), axis=0, return_counts=True)
+    vol = np.einsum("ij,ij->i", v[f[:, 0]], np.cross(v[f[:, 1]], v[f[:, 2]])).sum() / 6.0
+    if not (np.all(n_dir == 1) and np.all(n_und == 2) and vol > 0.0):
+        raise RuntimeError(f"{name}: the generated mesh is not a closed, outward solid")
+
+
+# ---------------------------------------------------------------------- meshes
+
+
+def ring_solid(
+    rings: Sequence[Tuple[float, float, float, float, float, float]], n: int
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Return a closed mesh through horizontal elliptic rings, capped at both ends.
+
+    Parameters
+    ----------
+    rings : sequence of (z, cx, cy, rx, ry, twist)
+        Ring height, centre, semi-axes [m] and angular offset [rad], bottom to top.
+    n : int
+        Vertices per ring.
+    """
+    t = 2.0 * np.pi * np.arange(n) / n
+    z, cx, cy = rings[0][:3]
+    v = [np.array([[cx, cy, z]])]
+    for z, cx, cy, rx, ry, tw in rings:
+        v.append(
+            np.column_stack([cx + rx * np.cos(t + tw), cy + ry * np.sin(t + tw), np.full(n, z)])
+        )
+    z, cx, cy = rings[-1][:3]
+    v.append(np.array([[cx, cy, z]]))
+    verts = np.vstack(v)
+    k = np.arange(n)
+    k1 = (k + 1) % n
+    faces = [np.column_stack([np.zeros(n, int), 1 + k1, 1 + k])]  # bottom, facing down
+    for j in range(len(rings) - 1):
+        a, b = 1 + j * n, 1 + (j + 1) * n
+        faces.append(np.column_stack([a + k, a + k1, b + k1]))
+        faces.append(np.column_stack([a + k, b + k1, b + k]))
+    top, last = verts.shape[0] - 1, 1 + (len(rings) - 1) * n
+    faces.append(np.column_stack([np.full(n, top), last + k, last + k1]))
+    return verts, np.vstack(faces).astype(np.int64)
+
+
+def grid_box_solid(
+    size: Point, counts: Tuple[int, int, int], displace: Callable[[np.ndarray], np.ndarray]
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Return a closed structured mesh of the box [0, sx] x [0, sy] x [0, sz], displaced.
+
+    Each face is a grid of ``counts`` cells along its two axes; the faces are generated
+    separately and welded where their vertices coincide (same integer grid index).
+    ``displace(p)`` maps an (n, 3) array of box points to their final position.
+    """
+    n = np.asarray(counts)
+    faces_v, faces_f, offset = [], [], 0
+    # (axis, side): the face of normal +/- axis; u, v span it with u x v = outward normal
+    for axis in range(3):
+        u_ax, v_ax = (axis + 1) % 3, (axis + 2) % 3
+        for side in (0, 1):
+            iu, iv = np.meshgrid(np.arange(n[u_ax] + 1), np.arange(n[v_ax] + 1), indexing="ij")
+            idx = np.zeros((*iu.shape, 3), dtype=np.int64)
+            idx[..., axis] = side * n[axis]
+            idx[..., u_ax], idx[..., v_ax] = iu, iv
+            faces_v.append(idx.reshape(-1, 3))
+            nv = n[v_ax] + 1
+            a = (iu[:-1, :-1] * nv + iv[:-1, :-1]).ravel() + offset
+            b, c, d = a + nv, a + nv + 1, a + 1
+            tri = (
+                np.column_stack([a, b, c, a, c, d])
+                if side == 1
+                else np.column_stack([a, c, b, a, d, c])
+            ).reshape(-1, 3)
+            faces_f.append(tri)
+            offset += idx.shape[0] * idx.shape[1]
+    keys = np.vstack(faces_v)
+    uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
+    f = inverse.reshape(-1)[np.vstack(faces_f)]
+    p = uniq / n * np.asarray(size, dtype=np.float64)
+    return displace(p), f.astype(np.int64)
+
+
+# ---------------------------------------------------------------------- scenes
+
+
+def rect_wall(out: Path) -> Path:
+    b = Builder("rect_wall")
+    b.box("wall", "Walls", (0.0, 0.0, 0.0), (0.5, 1.0, 3.0), "brick")
+    b.line("axis", "Axes", (0.5, 0.0, 0.0), (0.5, 1.0, 0.0))
+    b.line("axis_back", "Axes", (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    return b.write(out / "rect_wall.3dm")
+
+
+# Column: 24-sided prism, vertices on a circle of this radius [m].
+COLUMN_R, COLUMN_H, COLUMN_SIDES = 0.3, 3.0, 24
+
+
+def statue_column(out: Path) -> Path:
+    b = Builder("statue_column")
+    # vertices at half-step angles, so one edge faces +x and one -x
+    t = 2.0 * np.pi * (np.arange(COLUMN_SIDES) + 0.5) / COLUMN_SIDES
+    profile = list(zip((COLUMN_R * np.cos(t)).tolist(), (COLUMN_R * np.sin(t)).tolist()))
+    b.prism_z("column", "Stone", profile, 0.0, COLUMN_H, "stone")
+    # bronze figure leaning towards +x: plinth, legs, torso, shoulders, neck, head
+    z0 = COLUMN_H
+    rings = [
+        (z0 + 0.00, 0.00, 0.00, 0.22, 0.20, 0.0),
+        (z0 + 0.10, 0.00, 0.00, 0.22, 0.20, 0.0),
+        (z0 + 0.12, 0.02, 0.01, 0.14, 0.10, 0.2),
+        (z0 + 0.70, 0.05, 0.02, 0.12, 0.09, 0.3),
+        (z0 + 0.76, 0.07, 0.02, 0.17, 0.11, 0.3),
+        (z0 + 1.12, 0.11, 0.03, 0.20, 0.12, 0.4),
+        (z0 + 1.18, 0.13, 0.03, 0.06, 0.05, 0.4),
+        (z0 + 1.24, 0.14, 0.03, 0.06, 0.05, 0.4),
+        (z0 + 1.28, 0.15, 0.02, 0.09, 0.09, 0.5),
+        (z0 + 1.44, 0.16, 0.02, 0.09, 0.08, 0.5),
+        (z0 + 1.50, 0.16, 0.02, 0.04, 0.04, 0.5),
+    ]
+    v, f = ring_solid(rings, 12)
+    b.mesh("statue", "Bronze", v, f, "bronze")
+    a = COLUMN_R * math.cos(math.pi / COLUMN_SIDES)  # apothem: the edge facing +x
+    b.line("axis", "Axes", (a, -COLUMN_R, 0.0), (a, COLUMN_R, 0.0))
+    b.line("axis_back", "Axes", (-a, -COLUMN_R, 0.0), (-a, COLUMN_R, 0.0))
+    return b.write(out / "statue_column.3dm")
+
+
+def facade(out: Path) -> Path:
+    b = Builder("facade")
+    # façade x in [0, 0.6] (outer face x = 0), y in [0, 6], z in [0, 8]; a pocket in the
+    # inner face, x in [0.25, 0.6], z in [3.5, 3.8], carries the first floor
+    b.prism_y(
+        "facade",
+        "Walls",
+        [
+            (0.0, 0.0),
+            (0.6, 0.0),
+            (0.6, 3.5),
+            (0.25, 3.5),
+            (0.25, 3.8),
+            (0.6, 3.8),
+            (0.6, 8.0),
+            (0.0, 8.0),
+        ],
+        0.0,
+        6.0,
+        "brick",
+    )
+    b.box("side_wall_left", "Walls", (0.6, 0.0, 0.0), (5.6, 0.6, 8.0), "brick")
+    b.box("side_wall_right", "Walls", (0.6, 5.4, 0.0), (5.6, 6.0, 8.0), "brick")
+    b.box("back_wall", "Walls", (5.6, 0.0, 0.0), (6.2, 6.0, 8.0), "brick")
+    # bears on the pocket floor (z = 3.5) over x in [0.3, 0.6]; clear of its back and top
+    b.box("floor_bearing", "Floors", (0.3, 0.6, 3.5), (5.6, 5.4, 3.7), "concrete")
+    # touches the façade's inner face (x = 0.6) only
+    b.prism_y(
+        "floor_abutting",
+        "Floors",
+        [(0.6, 6.5), (5.6, 6.5), (5.6, 6.7), (0.6, 6.7)],
+        0.6,
+        5.4,
+        "concrete",
+    )
+    b.prism_y("roof", "Roof", [(0.0, 8.0), (6.2, 8.0), (3.1, 9.6)], 0.0, 6.0, "brick")
+    # segmental barrel vault spanning façade -> back wall, springing at z = 4.0, rise 1.6 m,
+    # 0.3 m thick measured vertically; 16 straight segments
+    n_seg, span, rise, thick, z_s = 16, 5.0, 1.6, 0.3, 4.0
+    radius = (span**2 / 4.0 + rise**2) / (2.0 * rise)
+    xs = 0.6 + span * np.arange(n_seg + 1) / n_seg
+    zi = z_s + rise - radius + np.sqrt(radius**2 - (xs - 0.6 - span / 2.0) ** 2)
+    zi[0] = zi[-1] = z_s
+    intrados = list(zip(xs.tolist(), zi.tolist()))
+    extrados = [(x, z + thick) for x, z in intrados]
+    b.prism_y("vault", "Vaults", intrados[::-1] + extrados, 0.6, 5.4, "brick")
+    for name, y in (("tie_1", 2.0), ("tie_2", 4.0)):
+        b.line(name, "Ties", (0.0, y, 7.8), (6.2, y, 7.8))
+    # diagonal crack across the façade: contains x, falls 45 deg from (y 1, z 8) to (y 6, z 3)
+    s = math.sqrt(0.5)
+    b.plane_surface(
+        "crack", "Cracks", (-0.1, 1.0, 8.0), (1.0, 0.0, 0.0), (0.0, s, -s), (0.0, 0.8), (-0.5, 7.6)
+    )
+    b.line("axis", "Axes", (0.0, 0.0, 0.0), (0.0, 6.0, 0.0))
+    return b.write(out / "facade.3dm")
+
+
+# Scan wall: cells across thickness, length, height (>= 200k triangles in all).
+SCAN_SIZE, SCAN_CELLS = (0.6, 4.0, 5.0), (1, 200, 250)
+# Amplitude of the smooth surface relief of each large face [m].
+SCAN_RELIEF = 0.015
+
+
+def _relief(y: np.ndarray, z: np.ndarray, phase: float) -> np.ndarray:
+    """Smooth relief [m] of a large face: zero at the base so its bottom edges stay straight."""
+    w = np.clip(z / 0.5, 0.0, 1.0)
+    w = w * w * (3.0 - 2.0 * w)
+    s = (
+        0.5 * np.sin(2.1 * y + 1.3 * z + phase)
+        + 0.3 * np.sin(5.3 * y - 3.7 * z + 2 * phase)
+        + 0.2 * np.sin(11.0 * y + 9.0 * z + 3 * phase) * np.cos(7.0 * z - phase)
+    )
+    return SCAN_RELIEF * w * s
+
+
+def scan_wall(out: Path) -> Path:
+    b = Builder("scan_wall")
+    t = SCAN_SIZE[0]
+
+    def displace(p: np.ndarray) -> np.ndarray:
+        q = p.copy()
+        s = p[:, 0] / t  # 0 on the outer face (x = 0), 1 on the inner face
+        q[:, 0] += (1.0 - s) * _relief(p[:, 1], p[:, 2], 0.0) + s * _relief(p[:, 1], p[:, 2], 1.7)
+        return q
+
+    v, f = grid_box_solid(SCAN_SIZE, SCAN_CELLS, displace)
+    b.mesh("scan_wall", "Scan", v, f, "stone")
+    b.line("axis", "Axes", (t, 0.0, 0.0), (t, 4.0, 0.0))
+    b.line("axis_back", "Axes", (0.0, 0.0, 0.0), (0.0, 4.0, 0.0))
+    return b.write(out / "scan_wall.3dm")
+
+
+SCENES = {
+    "rect_wall": rect_wall,
+    "statue_column": statue_column,
+    "facade": facade,
+    "scan_wall": scan_wall,
+}
+
+
+def build_all(out: Path = HERE) -> List[Path]:
+    """Write every example scene into ``out``; return the paths."""
+    out.mkdir(parents=True, exist_ok=True)
+    return [build(out) for build in SCENES.values()]
+
+
+def main(argv: Sequence[str] = ()) -> None:
+    out = Path(argv[0]) if argv else HERE
+    for path in build_all(out):
+        print(f"{path}  {path.stat().st_size / 1e6:.2f} MB")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -1,0 +1,1 @@
+"""Mechanism spec + scene geometry -> kinematic constants (single block, loaded wall, ...)."""

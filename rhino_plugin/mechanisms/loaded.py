@@ -1,0 +1,294 @@
+"""Wall with added masses and static forces (A2, THEORY §2.2, Eqs. 11-16).
+
+Added elements and how they enter:
+
+* **floors**: classified from how they meet the wall. A floor whose contact with the wall
+  is a horizontal face (it rests on the wall top or a ledge; contact normal within
+  ``BEARING_ANGLE`` of vertical) is *load-bearing*: its share (``tributary``) of weight and
+  inertia acts on the wall. A floor that only abuts the wall's face (vertical contact) is
+  *non-load-bearing*: only the horizontal inertia of its share is passed to the wall. Both
+  act at the centroid of the contact area. A floor that touches no wall is an error.
+* **roof**: its share of weight is a load-bearing mass at its contact with the wall; its
+  thrust ``H = W_r L/(8 f)`` (span and rise from its bounding box in the wall's frame) is an
+  outward static force there, unless it is a tied truss.
+* **vaults**: the thrust table (``thrust.ThrustTable``) gives the vertical load ``V`` and
+  thrust ``H`` from the construction class and rise/span (bounding box); ``V/g`` is a
+  load-bearing mass and ``H`` an outward static force, both at the springing (the contact
+  with the wall).
+* **tie-bars**: a restraining (inward) force where the bar meets the façade's outer face
+  (the vertical plane through the axis).
+
+Constants (about ``phi_cr = alpha_c``): ``I0 = I_O + sum M_i R_i²`` (added masses as point
+masses), ``K = M_c g R_c``, ``Q = M_c* R_c* cos(alpha_c* - alpha_c)``,
+``M_F = sum F_k R_k cos(alpha_k - alpha_c)``; ``lam``, ``p_eq`` and ``phi_ov`` follow (Eq. 16).
+The summary also reports the exact static multiplier at rest for comparison (§2.2 check).
+"""
+
+import math
+from typing import Any, Dict, List, Tuple
+
+import numpy as np
+
+from shared_schema.errors import GeometryError, InputError
+
+__all__ = ["BEARING_ANGLE", "loaded_side"]
+
+#: Standard gravity [m/s²].
+G = 9.80665
+#: A contact whose normal is within this angle of vertical counts as bearing [rad].
+BEARING_ANGLE = math.radians(30.0)
+
+
+def _solids(scene: Any, selectors: Any, where: str) -> Tuple[List[Any], List[str], List[str]]:
+    from rhino_plugin.geometry.validate import check_solid
+    from rhino_plugin.mechanisms.single import _objects
+
+    meshes, ids, notes = [], [], []
+    for obj in _objects(scene, selectors, where):
+        mesh, warn = check_solid(scene.mesh(obj))
+        meshes.append(mesh)
+        ids.append(obj.id)
+        notes.extend(warn)
+    return meshes, ids, notes
+
+
+def _contact(
+    meshes: List[Any], wall: List[Any], where: str
+) -> Tuple[float, np.ndarray, np.ndarray]:
+    """Largest planar contact between an element's solids and the wall's solids."""
+    from rhino_plugin.geometry.contact import find_contact
+
+    best = None
+    for a in meshes:
+        for b in wall:
+            hit = find_contact(a, b)
+            if hit is not None and (best is None or hit[0] > best[0]):
+                best = hit
+    if best is None:
+        raise GeometryError(
+            f"{where}: touches no wall (no shared face with the mechanism's solids)"
+        )
+    return best
+
+
+def _box(meshes: List[Any], side: Any) -> Tuple[float, float, float]:
+    """Extent normal to the wall, along the wall, and height of the elements [m]."""
+    from rhino_plugin.geometry.frames import bounding_box_in_frame
+
+    lo, hi = None, None
+    for mesh in meshes:
+        a, b = bounding_box_in_frame(mesh, side.point, side.outward, side.direction)
+        lo = a if lo is None else np.minimum(lo, a)
+        hi = b if hi is None else np.maximum(hi, b)
+    assert lo is not None and hi is not None
+    ext = hi - lo
+    return float(ext[0]), float(ext[1]), float(abs(ext[2]))
+
+
+Loads = List[Tuple[float, np.ndarray, str]]
+Result = Tuple[Dict[str, float], Dict[str, Any], List[str]]
+
+
+def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Result:
+    """Constants of a loaded wall about one axis, its summary and warnings.
+
+    Parameters
+    ----------
+    spec : MechanismSpec
+        With ``floors``, ``roof``, ``vaults`` and ``tie_bars`` as declared.
+    scene : Scene
+        The scene.
+    body : single.Body
+        The wall (and adjacent walls) after cracks.
+    side : single.RockingSide
+        The rocking side.
+    table : thrust.ThrustTable
+        Vault thrust table.
+    """
+    from rhino_plugin.geometry.massprops import mass_properties
+    from rhino_plugin.mechanisms.thrust import roof_thrust
+
+    where = spec.id
+    bearing: Loads = []  # (mass [kg], point, label)
+    nonbearing: Loads = []
+    forces: Loads = []  # (outward force [N], point, label)
+    elements: List[Dict[str, Any]] = []
+    notes: List[str] = []
+    wall = body.meshes
+
+    for k, floor in enumerate(spec.floors or []):
+        label = f"{where}.floors[{k}]"
+        meshes, ids, warn = _solids(scene, floor.objects, label)
+        notes.extend(warn)
+        mass = floor.tributary * sum(mass_properties(m, floor.density).mass for m in meshes)
+        area, point, normal = _contact(meshes, wall, label)
+        is_bearing = abs(float(normal[2])) >= math.cos(BEARING_ANGLE)
+        (bearing if is_bearing else nonbearing).append((mass, point, label))
+        elements.append(
+            {
+                "element": label,
+                "objects": ids,
+                "kind": "floor",
+                "load_bearing": is_bearing,
+                "mass_kg": mass,
+                "contact_area_m2": area,
+                "at_m": [float(v) for v in point],
+            }
+        )
+
+    if spec.roof is not None:
+        label = f"{where}.roof"
+        roof = spec.roof
+        meshes, ids, warn = _solids(scene, roof.objects, label)
+        notes.extend(warn)
+        weight = G * sum(mass_properties(m, roof.density).mass for m in meshes)
+        area, point, _ = _contact(meshes, wall, label)
+        span, _, rise = _box(meshes, side)
+        thrust = roof_thrust(weight, span, rise, roof.tied)
+        bearing.append((roof.tributary * weight / G, point, label))
+        if thrust > 0.0:
+            forces.append((thrust, point, label))
+        elements.append(
+            {
+                "element": label,
+                "objects": ids,
+                "kind": "roof",
+                "weight_N": weight,
+                "bearing_mass_kg": roof.tributary * weight / G,
+                "span_m": span,
+                "rise_m": rise,
+                "thrust_N": thrust,
+                "tied": roof.tied,
+                "at_m": [float(v) for v in point],
+            }
+        )
+
+    for k, vault in enumerate(spec.vaults or []):
+        label = f"{where}.vaults[{k}]"
+        meshes, ids, warn = _solids(scene, vault.objects, label)
+        notes.extend(warn)
+        span_n, span_p, rise = _box(meshes, side)
+        if span_n <= 0.0 or span_p <= 0.0 or rise <= 0.0:
+            raise GeometryError(f"{label}: degenerate bounding box (span or rise is zero)")
+        v_area, h_area = table.per_area(vault.construction_class, rise / span_n, label)
+        plan = span_n * span_p
+        area, point, _ = _contact(meshes, wall, label)
+        bearing.append((v_area * plan / G, point, label))
+        forces.append((h_area * plan, point, label))
+        elements.append(
+            {
+                "element": label,
+                "objects": ids,
+                "kind": "vault",
+                "construction_class": vault.construction_class,
+                "span_m": span_n,
+                "length_m": span_p,
+                "rise_m": rise,
+                "rise_span": rise / span_n,
+                "V_N": v_area * plan,
+                "H_N": h_area * plan,
+                "table": table.name,
+                "at_m": [float(v) for v in point],
+            }
+        )
+
+    for k, tie in enumerate(spec.tie_bars or []):
+        label = f"{where}.tie_bars[{k}]"
+        from rhino_plugin.mechanisms.single import _objects
+
+        obj = _objects(scene, [tie.object], label)[0]
+        start, end = scene.line(obj)
+        point = _face_point(start, end, side, body.size, label)
+        forces.append((-tie.force, point, label))
+        elements.append(
+            {
+                "element": label,
+                "objects": [obj.id],
+                "kind": "tie_bar",
+                "force_N": tie.force,
+                "at_m": [float(v) for v in point],
+            }
+        )
+
+    return _constants(body, side, bearing, nonbearing, forces, elements, notes)
+
+
+def _face_point(
+    start: np.ndarray, end: np.ndarray, side: Any, size: float, where: str
+) -> np.ndarray:
+    """Where a tie-bar line crosses the façade's outer face (vertical plane through the axis)."""
+    d = end - start
+    denom = float(np.dot(d, side.outward))
+    if abs(denom) < 1e-12 * max(float(np.linalg.norm(d)), 1.0):
+        raise GeometryError(f"{where}: the tie-bar is parallel to the façade and never meets it")
+    t = float(np.dot(side.point - start, side.outward)) / denom
+    tol = 1e-3 * size / max(float(np.linalg.norm(d)), 1e-12)
+    if not -tol <= t <= 1.0 + tol:
+        raise GeometryError(f"{where}: the tie-bar does not reach the façade's outer face")
+    return start + t * d
+
+
+def _constants(
+    body: Any,
+    side: Any,
+    bearing: Loads,
+    nonbearing: Loads,
+    forces: Loads,
+    elements: List[Dict[str, Any]],
+    notes: List[str],
+) -> Result:
+    m_w = float(body.props.mass)
+    g_w = np.asarray(body.props.com, dtype=float)
+    m_c = m_w + sum(m for m, _, _ in bearing)
+    g_c = (m_w * g_w + sum(m * p for m, p, _ in bearing)) / m_c
+    m_cs = m_c + sum(m for m, _, _ in nonbearing)
+    g_cs = (m_c * g_c + sum(m * p for m, p, _ in nonbearing)) / m_cs
+    r_c, a_c = side.polar(g_c)
+    r_cs, a_cs = side.polar(g_cs)
+    if not 0.0 < a_c < math.pi / 2:
+        raise GeometryError("the loaded wall's centre of mass is not inside its base")
+    i0 = side.I_O + sum(m * side.polar(p)[0] ** 2 for m, p, _ in bearing)
+    f_tot = sum(f for f, _, _ in forces)
+    m_f = 0.0
+    fx = 0.0
+    fz = 0.0
+    for f, p, _ in forces:
+        r_k, a_k = side.polar(p)
+        m_f += f * r_k * math.cos(a_k - a_c)
+        fz += f * r_k * math.cos(a_k)
+        fx += f * r_k * math.sin(a_k)
+    k = m_c * G * r_c
+    q = m_cs * r_cs * math.cos(a_cs - a_c)
+    # Exact static multiplier at rest (virtual work at phi = 0), for comparison with lam.
+
+    def z(p: np.ndarray) -> float:  # height above the axis
+        r, a = side.polar(p)
+        return float(r * math.cos(a))
+
+    def x(p: np.ndarray) -> float:  # horizontal distance from the axis towards G
+        r, a = side.polar(p)
+        return float(r * math.sin(a))
+
+    over = m_w * z(g_w) + sum(m * z(p) for m, p, _ in bearing + nonbearing)
+    lam_exact = (G * m_c * x(g_c) - sum(f * z(p) for f, p, _ in forces)) / (G * over)
+    summary: Dict[str, Any] = {
+        "M_c_kg": m_c,
+        "R_c_m": r_c,
+        "alpha_c_rad": a_c,
+        "M_c_star_kg": m_cs,
+        "R_c_star_m": r_cs,
+        "alpha_c_star_rad": a_cs,
+        "F_N": f_tot,
+        "static_multiplier_exact": lam_exact,
+        "elements": elements,
+    }
+    if f_tot != 0.0:
+        summary["R_f_m"] = math.hypot(fx, fz) / abs(f_tot)
+        summary["alpha_f_rad"] = math.atan2(fx / f_tot, fz / f_tot)
+    if m_f >= k * a_c:
+        raise InputError(
+            f"the static forces alone overturn the wall (M_F = {m_f:.4g} N m >= K phi_cr = "
+            f"{k * a_c:.4g} N m)",
+            "forces",
+        )
+    return {"I0": i0, "K": k, "Q": q, "phi_cr": a_c, "M_F": m_f}, summary, notes

@@ -1,0 +1,268 @@
+"""Single rocking block (A1): objects and densities -> M, G, I_O, R, alpha -> constants.
+
+Notation (THEORY §0, §2.1)
+--------------------------
+O : rotation axis (a line through ``point`` along unit ``direction``)
+G : centre of mass [m]; M : mass [kg]
+R : distance from the axis to G [m]; alpha : angle of OG from the vertical [rad]
+I_O : moment of inertia about the axis [kg m²]
+
+Constants per side (Eqs. 7-10): ``I0 = I_O``, ``K = M g R``, ``phi_cr = alpha``, ``Q = M R``,
+so ``p_eq = sqrt(M g R / I_O)`` and ``lam = phi_ov = alpha``.
+
+The negative rocking side (two-sided rocking) turns about the opposite base edge: the
+user's ``axis_negative``, or the axis moved across the base footprint (the base vertices'
+farthest extent from the axis, horizontally towards G).
+"""
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Sequence, Tuple
+
+import numpy as np
+
+from shared_schema.errors import GeometryError, InputError
+
+__all__ = [
+    "AXIS_TILT_TOL",
+    "Body",
+    "RockingSide",
+    "load_body",
+    "negative_axis",
+    "resolve_axis",
+    "rocking_side",
+]
+
+#: Standard gravity [m/s²].
+G = 9.80665
+#: Largest tilt of a "horizontal" axis [rad] unless the spec allows inclined axes.
+AXIS_TILT_TOL = 1e-3
+#: Tolerance, relative to the body size, for an axis touching the body's base.
+TOUCH_RTOL = 1e-3
+
+
+@dataclass
+class Body:
+    """The solids of a mechanism after cracks, with their mass properties."""
+
+    props: Any  # rhino_plugin.geometry.massprops.MassProps (combined)
+    parts: List[Any]  # MassProps per solid
+    meshes: List[Any]  # TriMesh per solid, after cracks
+    vertices: np.ndarray  # (n, 3) all vertices of the cut solids [m]
+    object_ids: List[str]
+    warnings: List[str] = field(default_factory=list)
+
+    @property
+    def size(self) -> float:
+        """Diagonal of the bounding box [m]."""
+        return float(np.linalg.norm(self.vertices.max(axis=0) - self.vertices.min(axis=0)))
+
+
+@dataclass
+class RockingSide:
+    """Geometry of one rocking side.
+
+    Attributes
+    ----------
+    point, direction : (3,) float
+        Axis point and unit direction [m].
+    r_vec : (3,) float
+        Perpendicular vector from the axis to G [m].
+    outward : (3,) float
+        Horizontal unit vector in the direction of collapse (away from G).
+    R, alpha, I_O : float
+        [m], [rad], [kg m²].
+    """
+
+    point: np.ndarray
+    direction: np.ndarray
+    r_vec: np.ndarray
+    outward: np.ndarray
+    R: float
+    alpha: float
+    I_O: float
+
+    def polar(self, p: Sequence[float]) -> Tuple[float, float]:
+        """Distance and angle from the vertical (positive towards G) of a point [m, rad]."""
+        d = np.asarray(p, dtype=float) - self.point
+        r = d - np.dot(d, self.direction) * self.direction
+        return float(np.linalg.norm(r)), math.atan2(float(np.dot(r, -self.outward)), float(r[2]))
+
+
+def _objects(scene: Any, selectors: Sequence[Any], where: str) -> List[Any]:
+    found: List[Any] = []
+    for sel in selectors:
+        hits = scene.find(sel)
+        if not hits:
+            raise InputError(f"no object matches {sel!r}", where)
+        found.extend(hits)
+    return found
+
+
+def _crack_plane(scene: Any, crack: Any, where: str) -> Tuple[np.ndarray, np.ndarray]:
+    if crack.object is not None:
+        objs = _objects(scene, [crack.object], where)
+        return scene.plane(objs[0])
+    p = np.asarray(crack.points, dtype=float)
+    n = np.cross(p[1] - p[0], p[2] - p[0])
+    norm = float(np.linalg.norm(n))
+    if norm == 0.0:
+        raise InputError("the three points are collinear", where)
+    return p[0], n / norm
+
+
+def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
+    """Validate the spec's solids, cut them by its cracks and compute their mass properties."""
+    from rhino_plugin.geometry.cut import cut_by_plane
+    from rhino_plugin.geometry.massprops import combine, mass_properties
+    from rhino_plugin.geometry.validate import check_solid
+
+    where = f"{spec.id}"
+    solids: List[Tuple[Any, float]] = []
+    ids: List[str] = []
+    warnings: List[str] = []
+    for k, group in enumerate(spec.groups):
+        for obj in _objects(scene, group.objects, f"{where}.groups[{k}]"):
+            mesh, notes = check_solid(scene.mesh(obj))
+            warnings.extend(notes)
+            solids.append((mesh, group.density))
+            ids.append(obj.id)
+    for k, crack in enumerate(spec.cracks):
+        point, normal = _crack_plane(scene, crack, f"{where}.cracks[{k}]")
+        keep = crack.keep
+        if keep == "axis_side":
+            keep = "positive" if float(np.dot(axis_mid - point, normal)) >= 0.0 else "negative"
+        sign = 1.0 if keep == "positive" else -1.0
+        kept: List[Tuple[Any, float]] = []
+        cut_any = False
+        for mesh, density in solids:
+            dist = (mesh.vertices - point) @ normal * sign
+            if dist.min() >= 0.0:
+                kept.append((mesh, density))
+            elif dist.max() > 0.0:
+                kept.append((cut_by_plane(mesh, point, normal, keep=keep), density))
+                cut_any = True
+        if not cut_any:
+            raise GeometryError(
+                f"{where}.cracks[{k}]: the crack plane misses the body (it cuts no solid)"
+            )
+        solids = kept
+    if not solids:
+        raise GeometryError(f"{where}: nothing is left of the body after the cracks")
+    parts = [mass_properties(mesh, density) for mesh, density in solids]
+    props = combine(parts, name=spec.id)
+    verts = np.vstack([mesh.vertices for mesh, _ in solids])
+    return Body(props, parts, [mesh for mesh, _ in solids], verts, ids, warnings)
+
+
+def resolve_axis(scene: Any, axis: Any, where: str) -> Tuple[np.ndarray, np.ndarray]:
+    """Axis end points [m] from a line object or from the spec's two points."""
+    if axis.object is not None:
+        objs = _objects(scene, [axis.object], where)
+        start, end = scene.line(objs[0])
+    else:
+        start, end = np.asarray(axis.start, dtype=float), np.asarray(axis.end, dtype=float)
+    if float(np.linalg.norm(end - start)) == 0.0:
+        raise InputError("the axis has zero length", where)
+    return np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+
+
+def rocking_side(
+    body: Body, start: np.ndarray, end: np.ndarray, *, where: str, allow_tilt: bool = False
+) -> RockingSide:
+    """Check an axis against the body and compute R, alpha and I_O about it.
+
+    Raises
+    ------
+    GeometryError
+        Axis not horizontal (unless allowed), not touching the body's base, or the centre
+        of mass not above it.
+    """
+    u = (end - start) / float(np.linalg.norm(end - start))
+    tilt = math.asin(min(abs(float(u[2])), 1.0))
+    if tilt > AXIS_TILT_TOL and not allow_tilt:
+        raise GeometryError(
+            f"{where}: the axis is inclined by {math.degrees(tilt):.3f} deg; a rocking axis "
+            "must be horizontal (set allow_non_horizontal_axis to accept it)"
+        )
+    tol = TOUCH_RTOL * body.size
+    d = body.vertices - start
+    perp = d - np.outer(d @ u, u)
+    dist = np.linalg.norm(perp, axis=1)
+    if dist.min() > tol:
+        raise GeometryError(
+            f"{where}: the axis does not touch the body (closest vertex {dist.min():.4f} m away)"
+        )
+    z_axis = float(start[2] + u[2] * np.dot(body.props.com - start, u))
+    if body.vertices[:, 2].min() < z_axis - tol:
+        raise GeometryError(
+            f"{where}: the axis is not at the body's base (the body reaches "
+            f"{z_axis - body.vertices[:, 2].min():.4f} m below it)"
+        )
+    g = np.asarray(body.props.com, dtype=float)
+    dg = g - start
+    r_vec = dg - np.dot(dg, u) * u
+    horiz = r_vec.copy()
+    horiz[2] = 0.0
+    h_norm = float(np.linalg.norm(horiz))
+    if r_vec[2] <= 0.0:
+        raise GeometryError(f"{where}: the centre of mass is not above the axis")
+    if h_norm <= tol * 1e-3:
+        raise GeometryError(
+            f"{where}: the centre of mass is vertically above the axis (alpha = 0): the "
+            "body is in unstable equilibrium; check the axis"
+        )
+    outward = -horiz / h_norm
+    big_r = float(np.linalg.norm(r_vec))
+    alpha = math.atan2(h_norm, float(r_vec[2]))
+    i_o = float(body.props.inertia_about_axis(start, u))
+    return RockingSide(start, u, r_vec, outward, big_r, alpha, i_o)
+
+
+def negative_axis(body: Body, side: RockingSide) -> Tuple[np.ndarray, np.ndarray]:
+    """Return the opposite base edge: the axis moved across the base footprint towards G."""
+    tol = TOUCH_RTOL * body.size
+    z0 = float(side.point[2])
+    base = body.vertices[body.vertices[:, 2] <= z0 + tol]
+    inward = -side.outward
+    reach = float(np.max((base - side.point) @ inward))
+    if reach <= tol:
+        raise GeometryError("cannot derive the negative-side axis: the base has no width")
+    start = side.point + reach * inward
+    return start, start + side.direction
+
+
+def side_constants(body: Body, side: RockingSide) -> Dict[str, float]:
+    """Eqs. 7-10: I0, K, Q, phi_cr, M_F of a plain block about one axis."""
+    m = float(body.props.mass)
+    return {"I0": side.I_O, "K": m * G * side.R, "Q": m * side.R, "phi_cr": side.alpha, "M_F": 0.0}
+
+
+def side_summary(side: RockingSide) -> Dict[str, Any]:
+    """Geometry of a side for the constants file's summary."""
+    return {
+        "axis_point_m": [float(v) for v in side.point],
+        "axis_direction": [float(v) for v in side.direction],
+        "R_m": side.R,
+        "alpha_rad": side.alpha,
+        "I_O_kg_m2": side.I_O,
+    }
+
+
+def eta_two_sided(body: Body, pos: RockingSide, neg: RockingSide) -> Tuple[float, Dict[str, float]]:
+    """Housner's general form for both impact directions; the larger (conservative) is used."""
+    from rhino_plugin.mechanisms.restitution import housner_general
+
+    m = float(body.props.mass)
+    u = pos.direction
+    i_g = float(u @ np.asarray(body.props.inertia_com) @ u)
+    g = np.asarray(body.props.com, dtype=float)
+
+    def perp(point: np.ndarray) -> np.ndarray:
+        d = g - point
+        return d - np.dot(d, u) * u
+
+    r_pos, r_neg = perp(pos.point), perp(neg.point)
+    to_neg = housner_general(m, i_g, r_pos, r_neg, neg.I_O)
+    to_pos = housner_general(m, i_g, r_neg, r_pos, pos.I_O)
+    return max(to_neg, to_pos), {"eta_pos_to_neg": to_neg, "eta_neg_to_pos": to_pos}

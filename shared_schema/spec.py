@@ -1,0 +1,274 @@
+"""The mechanism spec: which objects of a scene form each mechanism, and how.
+
+A spec file says, per mechanism, which objects (by name, layer or id) form its density
+groups, where the rotation axis is, which cracks cut off the collapsing part, the rocking
+kind, and the added elements that exist: floors, roof, vaults and tie-bars. Only declared
+elements are computed; absent sections stay absent in every output. Unknown keys are
+errors. Lengths are in metres once the scene is read (file units are converted), densities
+in kg/m³, forces in N.
+
+Python 3.9-clean: imported by Rhino 8.
+"""
+
+from typing import Any, Dict, List, Literal, Optional, Union
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from shared_schema.constants import Amplification
+from shared_schema.errors import InputError
+
+__all__ = [
+    "SPEC_VERSION",
+    "Axis",
+    "Crack",
+    "DensityGroup",
+    "Floor",
+    "MechanismSpec",
+    "Roof",
+    "SpecFile",
+    "TieBar",
+    "Vault",
+    "parse_spec",
+]
+
+#: Format version of spec files.
+SPEC_VERSION = "1.0"
+
+_STRICT = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
+
+#: An object selector: a name, or one of {"name": ...}, {"layer": ...}, {"id": ...}.
+Selector = Union[str, Dict[Literal["name", "layer", "id"], str]]
+Point3 = List[float]
+
+
+def _point(value: List[float], what: str) -> List[float]:
+    if len(value) != 3:
+        raise ValueError(f"{what} must have 3 coordinates [m], got {len(value)}")
+    return value
+
+
+class DensityGroup(BaseModel):
+    """Objects of one material.
+
+    Attributes
+    ----------
+    objects : list of selectors
+        Objects by name (a string) or ``{"name"|"layer"|"id": ...}``; at least one.
+    density : float
+        Density [kg/m³], > 0.
+    label : str, optional
+        Material name for reports (e.g. "stone", "bronze").
+    """
+
+    model_config = _STRICT
+    objects: List[Selector] = Field(min_length=1, description="Object selectors.")
+    density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
+    label: Optional[str] = Field(default=None, description="Material name for reports.")
+
+
+class Axis(BaseModel):
+    """A rotation axis: a line object of the scene, or two points [m]."""
+
+    model_config = _STRICT
+    object: Optional[Selector] = Field(default=None, description="A line object.")
+    start: Optional[Point3] = Field(default=None, description="First point [m].")
+    end: Optional[Point3] = Field(default=None, description="Second point [m].")
+
+    @model_validator(mode="after")
+    def _one_form(self) -> "Axis":
+        by_points = self.start is not None or self.end is not None
+        if (self.object is None) == (not by_points):
+            raise ValueError("give either 'object' or both 'start' and 'end'")
+        if by_points:
+            if self.start is None or self.end is None:
+                raise ValueError("give both 'start' and 'end'")
+            _point(self.start, "start")
+            _point(self.end, "end")
+        return self
+
+
+class Crack(BaseModel):
+    """A crack plane that cuts off the collapsing part.
+
+    ``keep`` is ``"axis_side"`` (default: keep the part that contains the rotation axis),
+    ``"positive"`` or ``"negative"`` (the side the plane normal points to, or the other).
+    """
+
+    model_config = _STRICT
+    object: Optional[Selector] = Field(default=None, description="A planar object.")
+    points: Optional[List[Point3]] = Field(default=None, description="Three points [m].")
+    keep: Literal["axis_side", "positive", "negative"] = "axis_side"
+
+    @model_validator(mode="after")
+    def _one_form(self) -> "Crack":
+        if (self.object is None) == (self.points is None):
+            raise ValueError("give either 'object' or 'points' (three points)")
+        if self.points is not None:
+            if len(self.points) != 3:
+                raise ValueError(f"'points' needs exactly 3 points, got {len(self.points)}")
+            for k, p in enumerate(self.points):
+                _point(p, f"points[{k}]")
+        return self
+
+
+class Floor(BaseModel):
+    """A floor: classified load-bearing or not from how it meets the wall.
+
+    ``tributary`` is the share of its weight and inertia the wall carries (0.5: a floor
+    spanning between the wall and one parallel support).
+    """
+
+    model_config = _STRICT
+    objects: List[Selector] = Field(min_length=1)
+    density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
+    tributary: float = Field(default=0.5, gt=0, le=1, description="Share carried by the wall.")
+
+
+class Roof(BaseModel):
+    """A pitched roof: weight share on the wall and thrust from its bounding box (§5)."""
+
+    model_config = _STRICT
+    objects: List[Selector] = Field(min_length=1)
+    density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
+    tributary: float = Field(default=0.5, gt=0, le=1, description="Share carried by the wall.")
+    tied: bool = Field(default=False, description="Tied truss (no thrust on the wall).")
+
+
+class Vault(BaseModel):
+    """A vault springing from the wall: thrusts from the thrust table (§5)."""
+
+    model_config = _STRICT
+    objects: List[Selector] = Field(min_length=1)
+    construction_class: Literal["a", "b", "c", "d", "e"] = Field(
+        description="Ungewitter construction class a-e (see the thrust table)."
+    )
+
+
+class TieBar(BaseModel):
+    """A tie-bar: a line object ending on the façade, and its force [N] (> 0, restraining)."""
+
+    model_config = _STRICT
+    object: Selector
+    force: float = Field(gt=0, description="Tie force [N], > 0; it restrains the wall.")
+
+
+class MechanismSpec(BaseModel):
+    """One mechanism: its objects, axis, cracks and added elements.
+
+    Attributes
+    ----------
+    id, name : str
+        Identifier and description.
+    typology : {"single_block", "single_block_loaded"}
+        Plain block (A1) or wall with added masses and forces (A2).
+    rocking : {"two_sided", "one_sided"}
+        Rocking kind.
+    groups : list of DensityGroup
+        The body: one group per density.
+    axis : Axis
+        Rotation axis for positive rotation (the collapse direction).
+    axis_negative : Axis, optional
+        Axis of the other rocking side (two-sided); derived from the base footprint if absent.
+    allow_non_horizontal_axis : bool
+        Accept an inclined axis (off by default).
+    cracks : list of Crack
+        Planes cutting off the collapsing part.
+    eta : float, optional
+        Coefficient of restitution given by the user (overrides the rules).
+    eta_rule : str, optional
+        One-sided rule: "one_sided_eq26" (default), "one_sided_alt", "one_sided_energy".
+    amplification : Amplification, optional
+        Passed through to the constants file.
+    floors, roof, vaults, tie_bars
+        Added elements (``single_block_loaded`` only); declare only those that exist.
+    """
+
+    model_config = _STRICT
+    id: str = Field(min_length=1)
+    name: Optional[str] = None
+    typology: Literal["single_block", "single_block_loaded"] = "single_block"
+    rocking: Literal["two_sided", "one_sided"] = "two_sided"
+    groups: List[DensityGroup] = Field(min_length=1)
+    axis: Axis
+    axis_negative: Optional[Axis] = None
+    allow_non_horizontal_axis: bool = False
+    cracks: List[Crack] = Field(default_factory=list)
+    eta: Optional[float] = Field(default=None, ge=-1, le=1)
+    eta_rule: Optional[Literal["one_sided_eq26", "one_sided_alt", "one_sided_energy"]] = None
+    amplification: Optional[Amplification] = None
+    floors: Optional[List[Floor]] = None
+    roof: Optional[Roof] = None
+    vaults: Optional[List[Vault]] = None
+    tie_bars: Optional[List[TieBar]] = None
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "MechanismSpec":
+        added = [k for k in ("floors", "roof", "vaults", "tie_bars") if getattr(self, k)]
+        if added and self.typology != "single_block_loaded":
+            raise ValueError(
+                f"added elements ({', '.join(added)}) need typology 'single_block_loaded'"
+            )
+        if self.eta is not None:
+            if self.rocking == "one_sided" and self.eta > 0:
+                raise ValueError("eta must be <= 0 for one-sided rocking")
+            if self.rocking == "two_sided" and self.eta < 0:
+                raise ValueError("eta must be >= 0 for two-sided rocking")
+        if self.eta_rule is not None and self.rocking != "one_sided":
+            raise ValueError("eta_rule applies to one-sided rocking only")
+        if self.axis_negative is not None and self.rocking == "one_sided":
+            raise ValueError("axis_negative applies to two-sided rocking only")
+        return self
+
+
+class SpecFile(BaseModel):
+    """A mechanism-spec file: version and mechanisms (ids unique)."""
+
+    model_config = _STRICT
+    spec_version: str = SPEC_VERSION
+    thrust_table: Optional[str] = Field(
+        default=None, description="Path of a user thrust table (JSON), relative to the spec."
+    )
+    mechanisms: List[MechanismSpec] = Field(min_length=1)
+
+    @field_validator("mechanisms")
+    @classmethod
+    def _unique_ids(cls, mechs: List[MechanismSpec]) -> List[MechanismSpec]:
+        seen = set()
+        for m in mechs:
+            if m.id in seen:
+                raise ValueError(f"duplicate mechanism id {m.id!r}")
+            seen.add(m.id)
+        return mechs
+
+
+def parse_spec(text: Union[str, bytes], source: str = "spec") -> SpecFile:
+    """Validate a spec file's JSON text; errors name the mechanism and the field.
+
+    Raises
+    ------
+    InputError
+        With a message like ``spec.json: mechanisms[0] (id 'W1').groups[0].density: ...``.
+    """
+    try:
+        return SpecFile.model_validate_json(text)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        loc = list(err["loc"])
+        path = ""
+        for part in loc:
+            path += f"[{part}]" if isinstance(part, int) else (f".{part}" if path else str(part))
+        data: Any = None
+        try:
+            import json
+
+            data = json.loads(text)
+        except ValueError:
+            pass
+        if len(loc) >= 2 and loc[0] == "mechanisms" and isinstance(loc[1], int):
+            try:
+                ident = data["mechanisms"][loc[1]]["id"]
+                path = path.replace(f"mechanisms[{loc[1]}]", f"mechanisms[{loc[1]}] (id {ident!r})")
+            except (TypeError, KeyError, IndexError):
+                pass
+        msg = err["msg"].replace("Value error, ", "")
+        raise InputError(f"{path}: {msg}" if path else msg, source) from None
