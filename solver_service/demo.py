@@ -8,7 +8,10 @@
 * ``history.png``: the time histories under the unscaled record;
 * ``church_envelope.json``, ``.csv`` and ``.png``: minimum overturning pulse amplitudes
   of the example church's mechanisms (``examples/constants/church.json``), at ground
-  level, with the critical mechanism per pulse frequency.
+  level, with the critical mechanism per pulse frequency;
+* ``facade_constants.json`` and ``facade_envelope.{json,csv,png}``: the CAD path end to
+  end, from the example façade scene (``examples/scenes/facade.3dm``, with floors, roof,
+  vault, tie-bars and a crack) and its spec to kinematic constants and envelopes.
 """
 
 from __future__ import annotations
@@ -174,7 +177,47 @@ def run_demo(out_dir: Path, record_path: Path | None = None) -> dict[str, Path]:
         title=f"{record.name} x {scale:g}: rocking of the demo walls (exact integrator)",
     )
     env_paths = church_envelope(out_dir)
-    return {"constants": constants_path, "history": history_path, "plot": plot_path, **env_paths}
+    cad_paths = facade_from_scene(out_dir)
+    return {
+        "constants": constants_path,
+        "history": history_path,
+        "plot": plot_path,
+        **env_paths,
+        **cad_paths,
+    }
+
+
+def facade_from_scene(out_dir: Path) -> dict[str, Path]:
+    """Scene -> constants -> envelopes for the example façade (the CAD path end to end)."""
+    from rhino_plugin.mechanisms.build import constants_from_spec
+    from rhino_plugin.scene_3dm import Scene
+    from shared_schema.spec import parse_spec
+
+    from .analysis import frequency_grid, write_envelope
+
+    scene_path = EXAMPLES_DIR / "scenes" / "facade.3dm"
+    spec_path = EXAMPLES_DIR / "specs" / "facade.spec.json"
+    cf = constants_from_spec(
+        parse_spec(spec_path.read_bytes(), spec_path.name),
+        Scene.from_3dm(scene_path),
+        scene_name=scene_path.name,
+        spec_name=spec_path.name,
+        spec_dir=spec_path.parent,
+    )
+    constants_path = out_dir / "facade_constants.json"
+    save_constants(constants_path, cf)
+    write_envelope(
+        cf,
+        frequency_grid(0.1, 10.0, 200),
+        out_dir,
+        stem="facade_envelope",
+        title="Example façade (from facade.3dm): overturning envelopes",
+    )
+    return {
+        "facade_constants": constants_path,
+        "facade_envelope": out_dir / "facade_envelope.json",
+        "facade_envelope_plot": out_dir / "facade_envelope.png",
+    }
 
 
 def church_envelope(out_dir: Path) -> dict[str, Path]:

@@ -53,4 +53,11 @@ def test_demo_writes_constants_results_and_plot(tmp_path: Path) -> None:
     assert env["critical"][-1]["f_max"] == pytest.approx(10.0)
     assert paths["envelope_plot"].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert paths["envelope_csv"].read_text().count("\n") == 201
+    # The CAD path end to end: scene -> constants -> envelope.
+    facade = json.loads(paths["facade_constants"].read_text())
+    assert [m["id"] for m in facade["mechanisms"]] == ["F1", "F2"]
+    assert facade["mechanisms"][0]["provenance"]["scene"] == "facade.3dm"
+    env_f = json.loads(paths["facade_envelope"].read_text())
+    assert {m["id"] for m in env_f["mechanisms"]} == {"F1", "F2"} and env_f["critical"]
+    assert paths["facade_envelope_plot"].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert not list(tmp_path.glob(".*"))  # no temporary files left behind
