@@ -10,6 +10,8 @@ from typing import Any, Callable
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from rhino_plugin.mechanisms.build import constants_from_spec
@@ -450,3 +452,70 @@ def test_cli_constants_bad_input_is_one_line(tmp_path: Path) -> None:
     assert res.exit_code == 2 and "ghost" in res.stderr
     assert len(res.stderr.strip().splitlines()) == 1
     assert not (tmp_path / "c.json").exists()
+
+
+# --- Property: asymmetric pivots ----------------------------------------------------------------
+
+
+def _trapezoid_body(base: float, top: float, shift: float, height: float) -> Any:
+    """A prism whose x-z section is a trapezoid, as a mechanisms Body (no scene needed)."""
+    from rhino_plugin.geometry.massprops import mass_properties
+    from rhino_plugin.geometry.mesh import TriMesh
+    from rhino_plugin.mechanisms.single import Body
+
+    prof = [(0.0, 0.0), (base, 0.0), (shift + top, height), (shift, height)]
+    v = np.array([(x, y, z) for y in (0.0, 1.0) for x, z in prof])
+    f = np.array(
+        [
+            [0, 1, 2],
+            [0, 2, 3],
+            [4, 6, 5],
+            [4, 7, 6],  # caps y = 0 and y = 1
+            [0, 4, 5],
+            [0, 5, 1],
+            [1, 5, 6],
+            [1, 6, 2],
+            [2, 6, 7],
+            [2, 7, 3],
+            [3, 7, 4],
+            [3, 4, 0],
+        ]
+    )
+    mesh = TriMesh(v, f, "trapezoid")
+    props = mass_properties(mesh, 2000.0)
+    if props.volume < 0:  # keep the outward orientation whatever the profile's winding
+        mesh = TriMesh(v, f[:, ::-1], "trapezoid")
+        props = mass_properties(mesh, 2000.0)
+    return Body(props, [props], [mesh], v, ["t"])
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    base=st.floats(0.3, 1.5),
+    top=st.floats(0.1, 1.5),
+    shift=st.floats(-0.3, 0.6),
+    height=st.floats(1.0, 5.0),
+)
+def test_asymmetric_pivots_sign_behaviour(
+    base: float, top: float, shift: float, height: float
+) -> None:
+    from rhino_plugin.mechanisms import single
+
+    body = _trapezoid_body(base, top, shift, height)
+    g = np.asarray(body.props.com)
+    if not 0.05 * base < g[0] < 0.95 * base:
+        return  # centre of mass outside (or at the edge of) the base: not a rocking block
+    right = single.rocking_side(body, np.array([base, 0, 0]), np.array([base, 1, 0]), where="r")
+    left_pts = single.negative_axis(body, right)
+    left = single.rocking_side(body, *left_pts, where="l")
+    assert left.point[0] == pytest.approx(0.0, abs=1e-12)
+    assert np.dot(left.outward, right.outward) < 0  # the two sides collapse opposite ways
+    # The edge horizontally nearer the centre of mass gives the smaller alpha (and lambda).
+    nearer_right = (base - g[0]) < g[0]
+    assert (right.alpha < left.alpha) == nearer_right or abs(base - 2 * g[0]) < 1e-9
+    eta, both = single.eta_two_sided(body, right, left)
+    # Same numerator, so the two directions differ exactly by the ratio of pivot inertias.
+    assert both["eta_pos_to_neg"] * left.I_O == pytest.approx(
+        both["eta_neg_to_pos"] * right.I_O, rel=1e-12
+    )
+    assert eta == max(both.values()) and eta <= 1.0
