@@ -228,9 +228,8 @@ def constants(
     as_json: bool = typer.Option(False, "--json", help="Also print the constants JSON."),
 ) -> None:
     """Kinematic constants of every mechanism in SPEC from the solids of SCENE."""
-    from rhino_plugin.scene_3dm import Scene
-
     from rhino_plugin.mechanisms.build import constants_from_spec
+    from rhino_plugin.scene_3dm import Scene
     from shared_schema.io import save_constants
     from shared_schema.spec import parse_spec
 
