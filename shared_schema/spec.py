@@ -24,6 +24,7 @@ __all__ = [
     "DensityGroup",
     "Floor",
     "MechanismSpec",
+    "Overburden",
     "Roof",
     "SpecFile",
     "TieBar",
@@ -144,6 +145,24 @@ class Vault(BaseModel):
     )
 
 
+class Overburden(BaseModel):
+    """What loads the top of a two-block wall: objects (weight share) or a given force [N]."""
+
+    model_config = _STRICT
+    objects: Optional[List[Selector]] = Field(default=None, min_length=1)
+    density: Optional[float] = Field(default=None, gt=0, description="Density [kg/m^3].")
+    tributary: float = Field(default=0.5, gt=0, le=1, description="Share carried by the wall.")
+    force: Optional[float] = Field(default=None, ge=0, description="Given overburden N [N].")
+
+    @model_validator(mode="after")
+    def _one_form(self) -> "Overburden":
+        if (self.force is None) == (self.objects is None):
+            raise ValueError("give either 'objects' (with 'density') or 'force'")
+        if self.objects is not None and self.density is None:
+            raise ValueError("'objects' need a 'density'")
+        return self
+
+
 class TieBar(BaseModel):
     """A tie-bar: a line object ending on the façade, and its force [N] (> 0, restraining)."""
 
@@ -186,7 +205,7 @@ class MechanismSpec(BaseModel):
     model_config = _STRICT
     id: str = Field(min_length=1)
     name: Optional[str] = None
-    typology: Literal["single_block", "single_block_loaded"] = "single_block"
+    typology: Literal["single_block", "single_block_loaded", "two_block"] = "single_block"
     rocking: Literal["two_sided", "one_sided"] = "two_sided"
     groups: List[DensityGroup] = Field(min_length=1)
     axis: Axis
@@ -200,6 +219,15 @@ class MechanismSpec(BaseModel):
     roof: Optional[Roof] = None
     vaults: Optional[List[Vault]] = None
     tie_bars: Optional[List[TieBar]] = None
+    overburden: Optional[Overburden] = None
+    f_mt: Optional[float] = Field(
+        default=None, ge=0, description="Mortar tensile strength [Pa] (two_block; default 0)."
+    )
+    eccentricity: Optional[Literal["static_moment", "potential"]] = Field(
+        default=None,
+        description="Eccentric overburden (two_block): as a static moment (the method, "
+        "default) or exactly inside the potential.",
+    )
 
     @model_validator(mode="after")
     def _consistent(self) -> "MechanismSpec":
@@ -213,6 +241,11 @@ class MechanismSpec(BaseModel):
                 raise ValueError("eta must be <= 0 for one-sided rocking")
             if self.rocking == "two_sided" and self.eta < 0:
                 raise ValueError("eta must be >= 0 for two-sided rocking")
+        two = [k for k in ("overburden", "f_mt", "eccentricity") if getattr(self, k) is not None]
+        if two and self.typology != "two_block":
+            raise ValueError(f"{', '.join(two)} need typology 'two_block'")
+        if self.typology == "two_block" and self.cracks:
+            raise ValueError("a two-block wall is split at the hinge height; give no cracks")
         if self.eta_rule is not None and self.rocking != "one_sided":
             raise ValueError("eta_rule applies to one-sided rocking only")
         if self.axis_negative is not None and self.rocking == "one_sided":

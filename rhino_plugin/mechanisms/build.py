@@ -49,6 +49,8 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
         "rocking": spec.rocking,
     }
     warnings = list(body.warnings)
+    if spec.typology == "two_block":
+        return _two_block_entry(spec, scene, body, pos, entry, geometry, warnings)
     if spec.typology == "single_block_loaded":
         if spec.rocking == "two_sided":
             raise InputError(
@@ -117,6 +119,41 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
     if spec.amplification is not None:
         entry["amplification"] = spec.amplification.model_dump()
     geometry["restitution"] = eta_info
+    entry["geometry"] = geometry
+    entry["provenance"] = {"object_ids": body.object_ids, "warnings": warnings}
+    return entry
+
+
+def _two_block_entry(
+    spec: Any,
+    scene: Any,
+    body: Any,
+    pos: Any,
+    entry: Dict[str, Any],
+    geometry: Dict[str, Any],
+    warnings: List[str],
+) -> Dict[str, Any]:
+    """Fill in a two-block wall's entry (A3; see ``two_block_cad``)."""
+    from rhino_plugin.mechanisms.two_block_cad import two_block_sides
+
+    positive, negative, eta, summary = two_block_sides(spec, scene, body, pos)
+    entry["positive"] = positive
+    if negative is not None and not _same(positive, negative):
+        entry["negative"] = negative
+    geometry["two_block"] = summary
+    if spec.eta is not None:
+        entry["eta"], entry["eta_source"] = spec.eta, "user"
+        if eta is not None:
+            geometry["restitution"] = {"computed": eta}
+    elif eta is not None:
+        if eta < 0.0:
+            warnings.append(
+                f"{spec.id}: the momentum projection gives eta = {eta:.4f} < 0; eta set to 0"
+            )
+            eta = 0.0
+        entry["eta"], entry["eta_source"] = eta, "momentum_projection"
+    if spec.amplification is not None:
+        entry["amplification"] = spec.amplification.model_dump()
     entry["geometry"] = geometry
     entry["provenance"] = {"object_ids": body.object_ids, "warnings": warnings}
     return entry

@@ -519,3 +519,44 @@ def test_asymmetric_pivots_sign_behaviour(
         both["eta_neg_to_pos"] * right.I_O, rel=1e-12
     )
     assert eta == max(both.values()) and eta <= 1.0
+
+
+# --- Two-block wall from a scene (A3) -----------------------------------------------------------
+
+
+def two_block_scene(b: Any) -> None:
+    b.box("wall", "Walls", (0, 0, 0), (0.3, 2.0, 4.0), "brick")
+    b.box("slab", "Floors", (0.0, 0, 4.0), (4.0, 2.0, 4.2), "concrete")  # bears on the wall top
+    b.line("axis", "Axes", (0.3, 0, 0), (0.3, 2.0, 0))
+
+
+def test_two_block_wall_matches_the_rectangular_closed_form(tmp_path: Path) -> None:
+    from rhino_plugin.mechanisms.two_block import hinge_height, rectangular_two_block
+
+    scene = scene_of(tmp_path, two_block_scene)
+    mech = block(
+        "T", typology="two_block", f_mt=1.0e5, overburden={"objects": ["slab"], "density": 2400}
+    )
+    t = constants(scene, mech)["T"]
+    b, h, length, rho = 0.3, 4.0, 2.0, 1800.0
+    n = 0.5 * 2400 * 4.0 * 2.0 * 0.2 * G  # half the slab bears on the wall
+    h_c = hinge_height(h, rho * b * h * length * G, n, 1.0e5, length * b)
+    summary = t["geometry"]["two_block"]
+    assert summary["h_c_m"] == pytest.approx(h_c, rel=1e-12)
+    assert summary["overburden_N"] == pytest.approx(n, rel=1e-12)
+    # The slab's contact is the whole top face: N acts at its centre, xi = 0.5 from H.
+    ref = rectangular_two_block(b, h, h_c, length, rho, overburden=n, xi=0.5)
+    for key in ("I0", "K", "Q", "phi_cr", "M_F", "p_eq", "lam"):
+        assert t["positive"][key] == pytest.approx(getattr(ref, key), rel=1e-10), key
+    assert "negative" not in t  # symmetric wall and centred load
+    assert t["eta_source"] == "momentum_projection" and 0.0 < t["eta"] < 1.0
+
+
+def test_two_block_needs_an_overburden_or_tensile_strength(tmp_path: Path) -> None:
+    scene = scene_of(tmp_path, two_block_scene)
+    with pytest.raises(GeometryError, match="no two-block mechanism"):
+        constants(scene, block("T", typology="two_block"))
+    with pytest.raises(InputError, match="f_mt"):
+        parse_spec(json.dumps({"mechanisms": [block("T", typology="two_block", f_mt=-1.0)]}))
+    with pytest.raises(InputError, match="two_block"):
+        parse_spec(json.dumps({"mechanisms": [block("T", f_mt=1.0)]}))

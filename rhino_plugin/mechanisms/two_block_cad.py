@@ -1,0 +1,149 @@
+"""Two-block wall (A3) from CAD solids: hinge height, split, constants for both sides.
+
+The wall (the spec's groups) is restrained at top and bottom. In its rocking plane
+(x outward from the base axis O, z up):
+
+* thickness ``b`` and height ``h`` come from the wall's extent (inner face at ``x = -b``);
+* the overburden N is the weight share of the objects bearing on the wall top (acting at the
+  centroid of their contact with the wall, which fixes its eccentricity), or a given force
+  (acting on the wall's centre line);
+* the intermediate hinge height follows Eq. 17, ``h_c = h / (1 + sqrt((N + f_mt l b) /
+  (N + W + f_mt l b)))``, and the wall is cut by the horizontal plane at ``h_c``;
+* hinges: O at the base outer edge, C at ``h_c`` on the inner face, H at the top outer edge
+  (THEORY §2.3); the negative side mirrors them about the wall's mid-plane;
+* restitution: the momentum projection of THEORY §3.4 between the two hinge sets, unless
+  the spec gives ``eta``.
+
+The maths of the linkage is in ``two_block``.
+"""
+
+from typing import Any, Dict, List, Optional, Tuple
+
+import numpy as np
+
+from shared_schema.errors import GeometryError
+
+__all__ = ["two_block_sides"]
+
+#: Standard gravity [m/s²].
+G = 9.80665
+
+
+def _planar(parts: List[Any], origin: np.ndarray, outward: np.ndarray, axis: np.ndarray) -> Any:
+    from rhino_plugin.geometry.massprops import combine
+    from rhino_plugin.mechanisms.two_block import PlanarBody
+
+    props = combine(parts, name="block")
+    d = np.asarray(props.com, dtype=float) - origin
+    i_g = float(axis @ np.asarray(props.inertia_com) @ axis)
+    return PlanarBody(float(props.mass), (float(d @ outward), float(d[2])), i_g)
+
+
+def _mirror(body: Any, b: float) -> Any:
+    from rhino_plugin.mechanisms.two_block import PlanarBody
+
+    x, z = body.com
+    return PlanarBody(body.mass, (-b - x, z), body.i_g)
+
+
+def two_block_sides(
+    spec: Any, scene: Any, body: Any, pos: Any
+) -> Tuple[Dict[str, float], Optional[Dict[str, float]], Optional[float], Dict[str, Any]]:
+    """Constants of both sides of a two-block wall, eta (or None) and a summary."""
+    from rhino_plugin.geometry.cut import cut_by_plane
+    from rhino_plugin.geometry.massprops import mass_properties
+    from rhino_plugin.mechanisms.loaded import _contact, _solids
+    from rhino_plugin.mechanisms.two_block import (
+        hinge_height,
+        two_block_constants,
+        two_block_restitution,
+    )
+
+    where = spec.id
+    o, out, ax = pos.point, pos.outward, pos.direction
+    rel = body.vertices - o
+    xs, zs, ys = rel @ out, rel[:, 2], rel @ ax
+    b = float(-xs.min())
+    h = float(zs.max())
+    length = float(ys.max() - ys.min())
+    if b <= 0.0 or h <= 0.0:
+        raise GeometryError(f"{where}: the wall has no thickness or height behind its axis")
+    weight = float(body.props.mass) * G
+    ob = spec.overburden
+    n = 0.0
+    x_p = -0.5 * b  # a given force acts on the wall's centre line
+    overburden_ids: List[str] = []
+    if ob is not None and ob.force is not None:
+        n = float(ob.force)
+    elif ob is not None:
+        meshes, overburden_ids, _ = _solids(scene, ob.objects, f"{where}.overburden")
+        n = ob.tributary * G * sum(mass_properties(m, ob.density).mass for m in meshes)
+        _, point, _ = _contact(meshes, body.meshes, f"{where}.overburden")
+        x_p = float((point - o) @ out)
+    f_mt = float(spec.f_mt or 0.0)
+    h_c = hinge_height(h, weight, n, f_mt, length * b)
+    if h_c >= h * (1.0 - 1e-9):
+        raise GeometryError(
+            f"{where}: with no overburden and no mortar tensile strength the hinge forms at the "
+            "top (Eq. 17), so there is no two-block mechanism; give 'overburden' or 'f_mt'"
+        )
+
+    plane_point = o + np.array([0.0, 0.0, h_c])
+    up = np.array([0.0, 0.0, 1.0])
+    lower: List[Any] = []
+    upper: List[Any] = []
+    for mesh, part in zip(body.meshes, body.parts):
+        z = mesh.vertices[:, 2] - plane_point[2]
+        if z.max() <= 0.0:
+            lower.append(part)
+        elif z.min() >= 0.0:
+            upper.append(part)
+        else:
+            lower.append(
+                mass_properties(cut_by_plane(mesh, plane_point, up, keep="negative"), part.density)
+            )
+            upper.append(
+                mass_properties(cut_by_plane(mesh, plane_point, up, keep="positive"), part.density)
+            )
+    if not lower or not upper:
+        raise GeometryError(f"{where}: the split plane at h_c = {h_c:.3f} m misses the wall")
+    b1 = _planar(lower, o, out, ax)
+    b2 = _planar(upper, o, out, ax)
+    hinges = ((0.0, 0.0), (-b, h_c), (0.0, h))
+    mirrored = ((-b, 0.0), (0.0, h_c), (-b, h))
+    ecc = spec.eccentricity or "static_moment"
+    res = two_block_constants(
+        b1, b2, *hinges, overburden=n, overburden_point=(x_p, h), eccentricity=ecc
+    )
+    positive = {"I0": res.I0, "K": res.K, "Q": res.Q, "phi_cr": res.phi_cr, "M_F": res.M_F}
+    negative = None
+    eta = None
+    if spec.rocking == "two_sided":
+        neg = two_block_constants(
+            _mirror(b1, b),
+            _mirror(b2, b),
+            *hinges,
+            overburden=n,
+            overburden_point=(-b - x_p, h),
+            eccentricity=ecc,
+        )
+        negative = {"I0": neg.I0, "K": neg.K, "Q": neg.Q, "phi_cr": neg.phi_cr, "M_F": neg.M_F}
+        eta = two_block_restitution(b1, b2, *hinges, *mirrored)
+    summary: Dict[str, Any] = {
+        "thickness_m": b,
+        "height_m": h,
+        "length_m": length,
+        "weight_N": weight,
+        "overburden_N": n,
+        "overburden_x_m": x_p,
+        "f_mt_Pa": f_mt,
+        "h_c_m": h_c,
+        "eccentricity": ecc,
+        "lower_mass_kg": b1.mass,
+        "upper_mass_kg": b2.mass,
+        "static_multiplier_exact": res.details.get("lam_static_exact"),
+        "details": {k: float(v) for k, v in res.details.items()},
+    }
+    if overburden_ids:
+        summary["overburden_objects"] = overburden_ids
+    return positive, negative, eta, summary
