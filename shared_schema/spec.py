@@ -23,6 +23,7 @@ __all__ = [
     "Crack",
     "DensityGroup",
     "Floor",
+    "Hinges",
     "MechanismSpec",
     "Overburden",
     "Roof",
@@ -171,6 +172,24 @@ class TieBar(BaseModel):
     force: float = Field(gt=0, description="Tie force [N], > 0; it restrains the wall.")
 
 
+#: A hinge: a point [x, y, z] in metres, or a line object (its mid-point; its direction is
+#: the hinge axis).
+Hinge = Union[Point3, Selector]
+
+
+class Hinges(BaseModel):
+    """The four hinges of a three-block mechanism (THEORY §2.4).
+
+    A and D are on the ground; block 1 joins A and B, block 2 B and C, block 3 D and C.
+    """
+
+    model_config = _STRICT
+    A: Hinge
+    B: Hinge
+    C: Hinge
+    D: Hinge
+
+
 class MechanismSpec(BaseModel):
     """One mechanism: its objects, axis, cracks and added elements.
 
@@ -205,10 +224,17 @@ class MechanismSpec(BaseModel):
     model_config = _STRICT
     id: str = Field(min_length=1)
     name: Optional[str] = None
-    typology: Literal["single_block", "single_block_loaded", "two_block"] = "single_block"
+    typology: Literal["single_block", "single_block_loaded", "two_block", "multi_block"] = (
+        "single_block"
+    )
     rocking: Literal["two_sided", "one_sided"] = "two_sided"
-    groups: List[DensityGroup] = Field(min_length=1)
-    axis: Axis
+    groups: Optional[List[DensityGroup]] = Field(default=None, min_length=1)
+    axis: Optional[Axis] = None
+    blocks: Optional[List[List[DensityGroup]]] = Field(
+        default=None, min_length=3, max_length=3, description="multi_block: three blocks."
+    )
+    hinges: Optional[Hinges] = None
+    hinges_negative: Optional[Hinges] = None
     axis_negative: Optional[Axis] = None
     allow_non_horizontal_axis: bool = False
     cracks: List[Crack] = Field(default_factory=list)
@@ -231,6 +257,24 @@ class MechanismSpec(BaseModel):
 
     @model_validator(mode="after")
     def _consistent(self) -> "MechanismSpec":
+        if self.typology == "multi_block":
+            if self.blocks is None or self.hinges is None:
+                raise ValueError("a multi_block mechanism needs 'blocks' (three) and 'hinges'")
+            if self.groups is not None or self.axis is not None or self.cracks:
+                raise ValueError(
+                    "a multi_block mechanism takes 'blocks' and 'hinges', not "
+                    "'groups', 'axis' or 'cracks'"
+                )
+            if self.rocking == "two_sided" and self.hinges_negative is None:
+                raise ValueError(
+                    "two-sided rocking of a multi_block mechanism needs "
+                    "'hinges_negative' (the mirrored hinge set)"
+                )
+        else:
+            if self.groups is None or self.axis is None:
+                raise ValueError(f"a {self.typology} mechanism needs 'groups' and 'axis'")
+            if self.blocks is not None or self.hinges is not None:
+                raise ValueError("'blocks' and 'hinges' need typology 'multi_block'")
         added = [k for k in ("floors", "roof", "vaults", "tie_bars") if getattr(self, k)]
         if added and self.typology != "single_block_loaded":
             raise ValueError(

@@ -31,6 +31,8 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
     from rhino_plugin.mechanisms.restitution import ONE_SIDED_RULES, one_sided
 
     where = spec.id
+    if spec.typology == "multi_block":
+        return _multi_block_entry(spec, scene)
     start, end = single.resolve_axis(scene, spec.axis, f"{where}.axis")
     body = single.load_body(spec, scene, 0.5 * (start + end))
     pos = single.rocking_side(
@@ -156,6 +158,37 @@ def _two_block_entry(
         entry["amplification"] = spec.amplification.model_dump()
     entry["geometry"] = geometry
     entry["provenance"] = {"object_ids": body.object_ids, "warnings": warnings}
+    return entry
+
+
+def _multi_block_entry(spec: Any, scene: Any) -> Dict[str, Any]:
+    """Fill in a three-block, four-hinge mechanism's entry (A4; see ``multi_block_cad``)."""
+    from rhino_plugin.mechanisms.multi_block_cad import multi_block_sides
+
+    positive, negative, eta, summary, ids = multi_block_sides(spec, scene)
+    warnings = summary.pop("warnings")
+    entry: Dict[str, Any] = {
+        "id": spec.id,
+        "name": spec.name or spec.id,
+        "typology": spec.typology,
+        "rocking": spec.rocking,
+        "positive": positive,
+    }
+    if negative is not None and not _same(positive, negative):
+        entry["negative"] = negative
+    if spec.eta is not None:
+        entry["eta"], entry["eta_source"] = spec.eta, "user"
+    elif eta is not None:
+        if eta < 0.0:
+            warnings.append(
+                f"{spec.id}: the momentum projection gives eta = {eta:.4f} < 0; eta set to 0"
+            )
+            eta = 0.0
+        entry["eta"], entry["eta_source"] = eta, "momentum_projection"
+    if spec.amplification is not None:
+        entry["amplification"] = spec.amplification.model_dump()
+    entry["geometry"] = {"multi_block": summary}
+    entry["provenance"] = {"object_ids": ids, "warnings": warnings}
     return entry
 
 

@@ -560,3 +560,72 @@ def test_two_block_needs_an_overburden_or_tensile_strength(tmp_path: Path) -> No
         parse_spec(json.dumps({"mechanisms": [block("T", typology="two_block", f_mt=-1.0)]}))
     with pytest.raises(InputError, match="two_block"):
         parse_spec(json.dumps({"mechanisms": [block("T", f_mt=1.0)]}))
+
+
+# --- Three blocks, four hinges from a scene (A4) ------------------------------------------------
+
+
+def frame_scene(b: Any) -> None:
+    # Two 0.5 x 4 m columns 3 m apart and a 0.5 m deep beam on top, 1 m long.
+    b.box("col_left", "Frame", (0, 0, 0), (0.5, 1, 4), "stone")
+    b.box("col_right", "Frame", (3.5, 0, 0), (4.0, 1, 4), "stone")
+    b.box("beam", "Frame", (0, 0, 4), (4.0, 1, 4.5), "stone")
+
+
+def frame_spec(**extra: Any) -> dict:  # type: ignore[type-arg]
+    mech = {
+        "id": "P",
+        "typology": "multi_block",
+        "blocks": [
+            [{"objects": ["col_left"], "density": 2000}],
+            [{"objects": ["beam"], "density": 2000}],
+            [{"objects": ["col_right"], "density": 2000}],
+        ],
+        "hinges": {"A": [0.5, 0.5, 0], "B": [0, 0.5, 4], "C": [3.5, 0.5, 4], "D": [4, 0.5, 0]},
+        "hinges_negative": {
+            "A": [0, 0.5, 0],
+            "B": [0.5, 0.5, 4],
+            "C": [4, 0.5, 4],
+            "D": [3.5, 0.5, 0],
+        },
+    }
+    mech.update(extra)
+    return mech
+
+
+def test_portal_frame_matches_makris_vassiliou_through_the_cad_path(tmp_path: Path) -> None:
+    from rhino_plugin.mechanisms.multi_block import (
+        four_bar_constants,
+        four_bar_restitution,
+        portal_frame,
+    )
+
+    p = constants(scene_of(tmp_path, frame_scene), frame_spec())["P"]
+    blocks, pos, neg = portal_frame(0.5, 4.0, 3.0, 0.5, 2000.0)
+    ref = four_bar_constants(blocks, *pos, direction=1)
+    for key in ("I0", "K", "Q", "phi_cr", "p_eq", "lam"):
+        assert p["positive"][key] == pytest.approx(getattr(ref, key), rel=1e-10), key
+    # Makris & Vassiliou (2013): theta_cr = alpha, p_eq = p sqrt((1 + 2 g)/(1 + 3 g)).
+    alpha = math.atan(0.5 / 4.0)
+    r = 0.5 * math.hypot(0.5, 4.0)
+    gamma = (4.0 * 0.5) / (2 * 0.5 * 4.0)  # beam mass over twice a column's
+    assert p["positive"]["phi_cr"] == pytest.approx(alpha, rel=1e-10)
+    expected_p = math.sqrt(3 * G / (4 * r)) * math.sqrt((1 + 2 * gamma) / (1 + 3 * gamma))
+    assert p["positive"]["p_eq"] == pytest.approx(expected_p, rel=1e-10)
+    assert "negative" not in p  # the mirrored set gives the same constants
+    eta_mv = (1 - 1.5 * math.sin(alpha) ** 2 + 3 * gamma * math.cos(2 * alpha)) / (1 + 3 * gamma)
+    assert p["eta"] == pytest.approx(eta_mv, rel=1e-10)
+    assert p["eta"] == pytest.approx(four_bar_restitution(blocks, pos, neg), rel=1e-12)
+    assert p["eta_source"] == "momentum_projection"
+
+
+def test_multi_block_spec_errors(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="hinges_negative"):
+        parse_spec(json.dumps({"mechanisms": [frame_spec(hinges_negative=None)]}))
+    with pytest.raises(InputError, match="groups"):
+        parse_spec(
+            json.dumps({"mechanisms": [frame_spec(groups=[{"objects": ["beam"], "density": 1}])]})
+        )
+    same_sense = frame_spec(hinges_negative=frame_spec()["hinges"])
+    with pytest.raises(InputError, match="mirrored"):
+        constants(scene_of(tmp_path, frame_scene), same_sense)
