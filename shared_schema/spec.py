@@ -265,11 +265,8 @@ class MechanismSpec(BaseModel):
                     "a multi_block mechanism takes 'blocks' and 'hinges', not "
                     "'groups', 'axis' or 'cracks'"
                 )
-            if self.rocking == "two_sided" and self.hinges_negative is None:
-                raise ValueError(
-                    "two-sided rocking of a multi_block mechanism needs "
-                    "'hinges_negative' (the mirrored hinge set)"
-                )
+            if self.rocking == "one_sided" and self.hinges_negative is not None:
+                raise ValueError("hinges_negative applies to two-sided rocking only")
         else:
             if self.groups is None or self.axis is None:
                 raise ValueError(f"a {self.typology} mechanism needs 'groups' and 'axis'")

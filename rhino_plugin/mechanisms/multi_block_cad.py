@@ -30,22 +30,46 @@ def _hinge_point(scene: Any, hinge: Any, where: str) -> np.ndarray:
     return 0.5 * (np.asarray(start, dtype=float) + np.asarray(end, dtype=float))
 
 
-def _blocks(scene: Any, spec: Any) -> Tuple[List[Any], List[str], List[str]]:
+def _blocks(scene: Any, spec: Any) -> Tuple[List[Any], List[np.ndarray], List[str], List[str]]:
     from rhino_plugin.geometry.massprops import combine, mass_properties
     from rhino_plugin.geometry.validate import check_solid
     from rhino_plugin.mechanisms.single import _objects
 
-    props, ids, notes = [], [], []
+    props, verts, ids, notes = [], [], [], []
     for k, groups in enumerate(spec.blocks):
         parts = []
+        pts = []
         for j, group in enumerate(groups):
             for obj in _objects(scene, group.objects, f"{spec.id}.blocks[{k}][{j}]"):
                 mesh, warn = check_solid(scene.mesh(obj))
                 notes.extend(warn)
                 parts.append(mass_properties(mesh, group.density))
+                pts.append(mesh.vertices)
                 ids.append(obj.id)
         props.append(combine(parts, name=f"{spec.id}.blocks[{k}]"))
-    return props, ids, notes
+        verts.append(np.vstack(pts))
+    return props, verts, ids, notes
+
+
+#: Band (fraction of a block's height) around a hinge in which the block's width is taken.
+MIRROR_BAND = 0.01
+
+
+def _mirrored(hinges: List[Tuple[float, float]], columns: List[np.ndarray]) -> List[Any]:
+    """Return the derived negative set: each hinge reflected across its column at its height.
+
+    A and B are reflected within block 1, C and D within block 3 (``columns`` are those
+    blocks' vertices in planar (x, z)). For rectangular columns this swaps each column's
+    corners, as for a portal frame.
+    """
+    out = []
+    for k, (x, z) in enumerate(hinges):
+        xz = columns[0] if k < 2 else columns[1]
+        band = MIRROR_BAND * float(np.ptp(xz[:, 1]))
+        near = xz[np.abs(xz[:, 1] - z) <= band, 0]
+        xs = near if near.size else xz[:, 0]
+        out.append((float(xs.min() + xs.max() - x), z))
+    return out
 
 
 def _solve(blocks: Any, pts: List[Any], where: str) -> Any:
@@ -72,7 +96,7 @@ def multi_block_sides(
     from rhino_plugin.mechanisms.two_block import PlanarBody
 
     where = spec.id
-    props, ids, notes = _blocks(scene, spec)
+    props, verts, ids, notes = _blocks(scene, spec)
     names = ("A", "B", "C", "D")
     pos3 = [_hinge_point(scene, getattr(spec.hinges, n), f"{where}.hinges.{n}") for n in names]
     origin = pos3[0]
@@ -104,12 +128,22 @@ def multi_block_sides(
         "block_masses_kg": [b.mass for b in blocks],
         "positive": {"sense": direction, **{k: float(v) for k, v in res.details.items()}},
     }
-    if spec.hinges_negative is not None:
-        neg3 = [
-            _hinge_point(scene, getattr(spec.hinges_negative, n), f"{where}.hinges_negative.{n}")
-            for n in names
-        ]
-        hinges_neg = [planar(p) for p in neg3]
+    if spec.rocking == "two_sided":
+        if spec.hinges_negative is not None:
+            neg3 = [
+                _hinge_point(
+                    scene, getattr(spec.hinges_negative, n), f"{where}.hinges_negative.{n}"
+                )
+                for n in names
+            ]
+            hinges_neg = [planar(p) for p in neg3]
+        else:
+            cols = [
+                np.column_stack([(verts[k] - origin) @ ex, verts[k][:, 2] - origin[2]])
+                for k in (0, 2)
+            ]
+            hinges_neg = _mirrored(hinges_pos, cols)
+            summary["hinges_negative_derived"] = [list(h) for h in hinges_neg]
         res_n, dir_n = _solve(blocks, hinges_neg, f"{where}.hinges_negative")
         if dir_n == direction:
             raise InputError(

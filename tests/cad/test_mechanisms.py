@@ -619,9 +619,20 @@ def test_portal_frame_matches_makris_vassiliou_through_the_cad_path(tmp_path: Pa
     assert p["eta_source"] == "momentum_projection"
 
 
+def test_derived_negative_hinges_equal_the_mirrored_set(tmp_path: Path) -> None:
+    scene = scene_of(tmp_path, frame_scene)
+    given = constants(scene, frame_spec())["P"]
+    derived = constants(scene, frame_spec(hinges_negative=None))["P"]
+    # portal_frame's negative set, in planar coordinates measured from A = (0.5, 0).
+    expected = [[-0.5, 0.0], [0.0, 4.0], [3.5, 4.0], [3.0, 0.0]]
+    got = derived["geometry"]["multi_block"]["hinges_negative_derived"]
+    np.testing.assert_allclose(got, expected, atol=1e-12)
+    assert derived["eta"] == pytest.approx(given["eta"], rel=1e-12)
+
+
 def test_multi_block_spec_errors(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="hinges_negative"):
-        parse_spec(json.dumps({"mechanisms": [frame_spec(hinges_negative=None)]}))
+        parse_spec(json.dumps({"mechanisms": [frame_spec(rocking="one_sided")]}))
     with pytest.raises(InputError, match="groups"):
         parse_spec(
             json.dumps({"mechanisms": [frame_spec(groups=[{"objects": ["beam"], "density": 1}])]})
