@@ -384,11 +384,122 @@ def scan_wall(out: Path) -> Path:
     return b.write(out / "scan_wall.3dm")
 
 
+def two_block_wall(out: Path) -> Path:
+    b = Builder("two_block_wall")
+    # wall restrained at top and bottom, outer face x = 0.3; the slab bears on its whole top
+    b.box("wall", "Walls", (0.0, 0.0, 0.0), (0.3, 3.0, 4.0), "brick")
+    b.box("floor", "Floors", (0.0, 0.0, 4.0), (4.0, 3.0, 4.2), "concrete")
+    b.line("axis", "Axes", (0.3, 0.0, 0.0), (0.3, 3.0, 0.0))
+    b.line("axis_back", "Axes", (0.0, 0.0, 0.0), (0.0, 3.0, 0.0))
+    return b.write(out / "two_block_wall.3dm")
+
+
+Hinge2 = Tuple[float, float]
+
+
+def _hinge_lines(
+    b: Builder, positive: Sequence[Hinge2], negative: Sequence[Hinge2], y0: float, y1: float
+) -> None:
+    """Add the hinge lines of both sets, (x, z) points run along y from y0 to y1."""
+    for suffix, hinges in (("", positive), ("_neg", negative)):
+        for label, (x, z) in zip("ABCD", hinges):
+            b.line(f"hinge_{label}{suffix}", "Hinges", (x, y0, z), (x, y1, z))
+
+
+# Side aisle: wall, pier and a segmental arch ring (vault) between them [m].
+AISLE_LENGTH = 4.0
+AISLE_WALL = (0.0, 0.6, 5.0)  # x0, x1, height
+AISLE_PIER = (4.6, 5.05, 5.0)
+# Vault: bears on the wall top over x in [0.3, 0.6] and on the whole pier top; intrados a
+# segmental arch of span 4 m and rise 1.2 m springing at z = 5; 0.3 m thick (vertically).
+AISLE_VAULT_BEARING_X0, AISLE_VAULT_SEGMENTS = 0.3, 12
+AISLE_VAULT_RISE, AISLE_VAULT_THICK = 1.2, 0.3
+
+
+def side_aisle_profiles() -> Dict[str, List[Tuple[float, float]]]:
+    """x-z profiles of the side aisle's wall, vault and pier."""
+    wx0, wx1, wh = AISLE_WALL
+    px0, px1, ph = AISLE_PIER
+    span, rise, thick = px0 - wx1, AISLE_VAULT_RISE, AISLE_VAULT_THICK
+    radius = (span**2 / 4.0 + rise**2) / (2.0 * rise)
+    n = AISLE_VAULT_SEGMENTS
+    xs = wx1 + span * np.arange(n + 1) / n
+    zi = wh + rise - radius + np.sqrt(radius**2 - (xs - wx1 - span / 2.0) ** 2)
+    zi[0] = zi[-1] = wh
+    intrados = list(zip(xs.tolist(), zi.tolist()))
+    extrados = [(x, z + thick) for x, z in intrados]
+    vault = [
+        (AISLE_VAULT_BEARING_X0, wh),
+        *intrados,
+        (px1, ph),
+        (px1, ph + thick),
+        *extrados[::-1],
+        (AISLE_VAULT_BEARING_X0, wh + thick),
+    ]
+    return {
+        "wall": [(wx0, 0.0), (wx1, 0.0), (wx1, wh), (wx0, wh)],
+        "vault": vault,
+        "pier": [(px0, 0.0), (px1, 0.0), (px1, ph), (px0, ph)],
+    }
+
+
+def side_aisle(out: Path) -> Path:
+    b = Builder("side_aisle")
+    prof = side_aisle_profiles()
+    b.prism_y("wall", "Walls", prof["wall"], 0.0, AISLE_LENGTH, "stone")
+    b.prism_y("vault", "Vaults", prof["vault"], 0.0, AISLE_LENGTH, "brick")
+    b.prism_y("pier", "Piers", prof["pier"], 0.0, AISLE_LENGTH, "stone")
+    wx0, wx1, wh = AISLE_WALL
+    px0, px1, ph = AISLE_PIER
+    # towards +x: the wall turns about its +x base edge and carries the vault on the -x edge of
+    # its bearing; the pier turns about its +x base edge and carries the vault on its -x top edge
+    positive = ((wx1, 0.0), (AISLE_VAULT_BEARING_X0, wh), (px0, ph), (px1, 0.0))
+    negative = ((wx0, 0.0), (wx1, wh), (px1, ph), (px0, 0.0))
+    _hinge_lines(b, positive, negative, 0.0, AISLE_LENGTH)
+    return b.write(out / "side_aisle.3dm")
+
+
+def portal_frame_hinges(
+    b: float, h: float, span: float, b_r: float, h_r: float
+) -> Tuple[Tuple[Hinge2, ...], Tuple[Hinge2, ...]]:
+    """Hinge sets (A, B, C, D) of ``multi_block.portal_frame``, towards +x and towards -x."""
+    x_r = b + span
+    positive = ((b, 0.0), (0.0, h), (x_r, h_r), (x_r + b_r, 0.0))
+    negative = ((0.0, 0.0), (b, h), (x_r + b_r, h_r), (x_r, 0.0))
+    return positive, negative
+
+
+def portal_frame(out: Path) -> Path:
+    b = Builder("portal_frame")
+    # Makris & Vassiliou's frame: two 0.5 x 4 m columns 3 m apart, a 0.5 m deep beam, 1 m long
+    b.box("column_left", "Columns", (0.0, 0.0, 0.0), (0.5, 1.0, 4.0), "stone")
+    b.box("beam", "Beams", (0.0, 0.0, 4.0), (4.0, 1.0, 4.5), "stone")
+    b.box("column_right", "Columns", (3.5, 0.0, 0.0), (4.0, 1.0, 4.0), "stone")
+    _hinge_lines(b, *portal_frame_hinges(0.5, 4.0, 3.0, 0.5, 4.0), 0.0, 1.0)
+    return b.write(out / "portal_frame.3dm")
+
+
+def asym_frame(out: Path) -> Path:
+    b = Builder("asym_frame")
+    # left column 0.5 x 4.0, right column 0.7 x 3.6, clear span 3.0; the beam is the sheared
+    # prism of multi_block.portal_frame: vertical ends, lower edge (0, 4.0) -> (4.2, 3.6)
+    b.box("column_left", "Columns", (0.0, 0.0, 0.0), (0.5, 1.0, 4.0), "stone")
+    beam = [(0.0, 4.0), (4.2, 3.6), (4.2, 4.1), (0.0, 4.5)]
+    b.prism_y("beam", "Beams", beam, 0.0, 1.0, "stone")
+    b.box("column_right", "Columns", (3.5, 0.0, 0.0), (4.2, 1.0, 3.6), "stone")
+    _hinge_lines(b, *portal_frame_hinges(0.5, 4.0, 3.0, 0.7, 3.6), 0.0, 1.0)
+    return b.write(out / "asym_frame.3dm")
+
+
 SCENES = {
     "rect_wall": rect_wall,
     "statue_column": statue_column,
     "facade": facade,
     "scan_wall": scan_wall,
+    "two_block_wall": two_block_wall,
+    "side_aisle": side_aisle,
+    "portal_frame": portal_frame,
+    "asym_frame": asym_frame,
 }
 
 

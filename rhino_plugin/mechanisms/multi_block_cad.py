@@ -126,7 +126,7 @@ def multi_block_sides(
     summary: Dict[str, Any] = {
         "plane_x_axis": [float(v) for v in ex],
         "block_masses_kg": [b.mass for b in blocks],
-        "positive": {"sense": direction, **{k: float(v) for k, v in res.details.items()}},
+        "positive": {"collapse_sense": direction, **{k: float(v) for k, v in res.details.items()}},
     }
     if spec.rocking == "two_sided":
         if spec.hinges_negative is not None:
@@ -159,6 +159,9 @@ def multi_block_sides(
             "M_F": res_n.M_F,
         }
         eta = four_bar_restitution(blocks, tuple(hinges_pos), tuple(hinges_neg))
-        summary["negative"] = {"sense": dir_n, **{k: float(v) for k, v in res_n.details.items()}}
+        summary["negative"] = {
+            "collapse_sense": dir_n,
+            **{k: float(v) for k, v in res_n.details.items()},
+        }
     summary["warnings"] = notes
     return positive, negative, eta, summary, ids

@@ -16,7 +16,16 @@ from rhino_plugin.geometry.mesh import TriMesh
 from rhino_plugin.scene_3dm import Scene
 
 SCENES = Path(__file__).resolve().parents[2] / "examples" / "scenes"
-FILES = ["rect_wall.3dm", "statue_column.3dm", "facade.3dm", "scan_wall.3dm"]
+FILES = [
+    "rect_wall.3dm",
+    "statue_column.3dm",
+    "facade.3dm",
+    "scan_wall.3dm",
+    "two_block_wall.3dm",
+    "side_aisle.3dm",
+    "portal_frame.3dm",
+    "asym_frame.3dm",
+]
 SOLID_KINDS = ("mesh", "brep", "extrusion")
 # Namespace of the fixed object ids, as documented in the README.
 ID_NAMESPACE = uuid.UUID("6f1c2a52-0d0e-4c8b-9a57-3d1e2b7a9c40")
@@ -31,6 +40,36 @@ VOLUMES = {
     ("facade.3dm", "roof"): 0.5 * 6.2 * 1.6 * 6,
     ("facade.3dm", "vault"): 5.0 * 0.3 * 4.8,
     ("statue_column.3dm", "column"): 0.5 * 24 * 0.3**2 * np.sin(2 * np.pi / 24) * 3.0,
+    ("two_block_wall.3dm", "wall"): 0.3 * 3.0 * 4.0,
+    ("two_block_wall.3dm", "floor"): 4.0 * 3.0 * 0.2,
+    ("side_aisle.3dm", "wall"): 0.6 * 5.0 * 4.0,
+    ("side_aisle.3dm", "vault"): (0.3 + 4.0 + 0.45) * 0.3 * 4.0,
+    ("side_aisle.3dm", "pier"): 0.45 * 5.0 * 4.0,
+    ("portal_frame.3dm", "column_left"): 0.5 * 4.0,
+    ("portal_frame.3dm", "beam"): 4.0 * 0.5,
+    ("portal_frame.3dm", "column_right"): 0.5 * 4.0,
+    ("asym_frame.3dm", "column_left"): 0.5 * 4.0,
+    ("asym_frame.3dm", "beam"): 4.2 * 0.5,
+    ("asym_frame.3dm", "column_right"): 0.7 * 3.6,
+}
+# Hinge lines of the four-bar scenes: (x, z) of A, B, C, D, positive set then mirrored set;
+# each runs along y over the scene's length.
+HINGES = {
+    "side_aisle.3dm": (
+        4.0,
+        [(0.6, 0), (0.3, 5), (4.6, 5), (5.05, 0)],
+        [(0, 0), (0.6, 5), (5.05, 5), (4.6, 0)],
+    ),
+    "portal_frame.3dm": (
+        1.0,
+        [(0.5, 0), (0, 4), (3.5, 4), (4, 0)],
+        [(0, 0), (0.5, 4), (4, 4), (3.5, 0)],
+    ),
+    "asym_frame.3dm": (
+        1.0,
+        [(0.5, 0), (0, 4), (3.5, 3.6), (4.2, 0)],
+        [(0, 0), (0.5, 4), (4.2, 3.6), (3.5, 0)],
+    ),
 }
 
 
@@ -147,7 +186,7 @@ def test_scan_wall_is_a_large_irregular_mesh(
     assert set(np.unique(base[:, 0])) == {0.0, 0.6}  # straight bottom edges
 
 
-@pytest.mark.parametrize("name", FILES)
+@pytest.mark.parametrize("name", [n for n in FILES if n not in HINGES])
 def test_axes_lie_on_the_base_of_the_body(
     name: str, committed: Dict[str, Scene], committed_geometry: Dict[str, Dict[str, object]]
 ) -> None:
@@ -175,6 +214,30 @@ def test_facade_elements_touch_the_facade_as_described(
     point, normal = g["crack"][1], g["crack"][2]  # type: ignore[index]
     np.testing.assert_allclose(abs(normal @ np.array([0, 1, 1]) / np.sqrt(2)), 1.0, atol=1e-12)
     assert (np.array([0.3, 1.0, 8.0]) - point) @ normal == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("name", sorted(HINGES))
+def test_hinge_lines_are_edges_of_the_solids(
+    name: str, committed: Dict[str, Scene], committed_geometry: Dict[str, Dict[str, object]]
+) -> None:
+    scene = committed[name]
+    length, positive, negative = HINGES[name]
+    corners = np.vstack(
+        [
+            committed_geometry[name][o.name][1]  # type: ignore[index]
+            for o in scene.objects
+            if o.kind in SOLID_KINDS
+        ]
+    )
+    for suffix, points in (("", positive), ("_neg", negative)):
+        for label, (x, z) in zip("ABCD", points):
+            (obj,) = scene.find(f"hinge_{label}{suffix}")
+            start, end = scene.line(obj)
+            np.testing.assert_allclose(start, [x, 0.0, z], rtol=0, atol=1e-12)
+            np.testing.assert_allclose(end, [x, length, z], rtol=0, atol=1e-12)
+            # both ends are vertices of a solid: the hinge is an edge of the blocks
+            for p in (start, end):
+                assert np.linalg.norm(corners - p, axis=1).min() < 1e-12, obj.label()
 
 
 def test_build_script_is_deterministic(
