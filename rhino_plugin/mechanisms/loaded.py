@@ -31,7 +31,7 @@ import numpy as np
 
 from shared_schema.errors import GeometryError, InputError
 
-__all__ = ["BEARING_ANGLE", "loaded_side"]
+__all__ = ["BEARING_ANGLE", "element_solids", "largest_contact", "loaded_side"]
 
 #: Standard gravity [m/s²].
 G = 9.80665
@@ -39,12 +39,15 @@ G = 9.80665
 BEARING_ANGLE = math.radians(30.0)
 
 
-def _solids(scene: Any, selectors: Any, where: str) -> Tuple[List[Any], List[str], List[str]]:
+def element_solids(
+    scene: Any, selectors: Any, where: str
+) -> Tuple[List[Any], List[str], List[str]]:
+    """Return the validated solids of an element's objects, their ids and repair warnings."""
     from rhino_plugin.geometry.validate import check_solid
-    from rhino_plugin.mechanisms.single import _objects
+    from rhino_plugin.mechanisms.single import find_objects
 
     meshes, ids, notes = [], [], []
-    for obj in _objects(scene, selectors, where):
+    for obj in find_objects(scene, selectors, where):
         mesh, warn = check_solid(scene.mesh(obj))
         meshes.append(mesh)
         ids.append(obj.id)
@@ -52,10 +55,10 @@ def _solids(scene: Any, selectors: Any, where: str) -> Tuple[List[Any], List[str
     return meshes, ids, notes
 
 
-def _contact(
+def largest_contact(
     meshes: List[Any], wall: List[Any], where: str
 ) -> Tuple[float, np.ndarray, np.ndarray]:
-    """Largest planar contact between an element's solids and the wall's solids."""
+    """Return the largest planar contact between an element's solids and the wall's solids."""
     from rhino_plugin.geometry.contact import find_contact
 
     best = None
@@ -118,10 +121,10 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
 
     for k, floor in enumerate(spec.floors or []):
         label = f"{where}.floors[{k}]"
-        meshes, ids, warn = _solids(scene, floor.objects, label)
+        meshes, ids, warn = element_solids(scene, floor.objects, label)
         notes.extend(warn)
         mass = floor.tributary * sum(mass_properties(m, floor.density).mass for m in meshes)
-        area, point, normal = _contact(meshes, wall, label)
+        area, point, normal = largest_contact(meshes, wall, label)
         is_bearing = abs(float(normal[2])) >= math.cos(BEARING_ANGLE)
         (bearing if is_bearing else nonbearing).append((mass, point, label))
         elements.append(
@@ -139,10 +142,10 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
     if spec.roof is not None:
         label = f"{where}.roof"
         roof = spec.roof
-        meshes, ids, warn = _solids(scene, roof.objects, label)
+        meshes, ids, warn = element_solids(scene, roof.objects, label)
         notes.extend(warn)
         weight = G * sum(mass_properties(m, roof.density).mass for m in meshes)
-        area, point, _ = _contact(meshes, wall, label)
+        area, point, _ = largest_contact(meshes, wall, label)
         span, _, rise = _box(meshes, side)
         thrust = roof_thrust(weight, span, rise, roof.tied)
         bearing.append((roof.tributary * weight / G, point, label))
@@ -165,14 +168,14 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
 
     for k, vault in enumerate(spec.vaults or []):
         label = f"{where}.vaults[{k}]"
-        meshes, ids, warn = _solids(scene, vault.objects, label)
+        meshes, ids, warn = element_solids(scene, vault.objects, label)
         notes.extend(warn)
         span_n, span_p, rise = _box(meshes, side)
         if span_n <= 0.0 or span_p <= 0.0 or rise <= 0.0:
             raise GeometryError(f"{label}: degenerate bounding box (span or rise is zero)")
         v_area, h_area = table.per_area(vault.construction_class, rise / span_n, label)
         plan = span_n * span_p
-        area, point, _ = _contact(meshes, wall, label)
+        area, point, _ = largest_contact(meshes, wall, label)
         bearing.append((v_area * plan / G, point, label))
         forces.append((h_area * plan, point, label))
         elements.append(
@@ -194,9 +197,9 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
 
     for k, tie in enumerate(spec.tie_bars or []):
         label = f"{where}.tie_bars[{k}]"
-        from rhino_plugin.mechanisms.single import _objects
+        from rhino_plugin.mechanisms.single import find_objects
 
-        obj = _objects(scene, [tie.object], label)[0]
+        obj = find_objects(scene, [tie.object], label)[0]
         start, end = scene.line(obj)
         point = _face_point(start, end, side, body.size, label)
         forces.append((-tie.force, point, label))

@@ -21,11 +21,11 @@ __all__ = ["multi_block_sides"]
 
 
 def _hinge_point(scene: Any, hinge: Any, where: str) -> np.ndarray:
-    from rhino_plugin.mechanisms.single import _objects
+    from rhino_plugin.mechanisms.single import find_objects
 
     if isinstance(hinge, list):
         return np.asarray(hinge, dtype=float)
-    obj = _objects(scene, [hinge], where)[0]
+    obj = find_objects(scene, [hinge], where)[0]
     start, end = scene.line(obj)
     return 0.5 * (np.asarray(start, dtype=float) + np.asarray(end, dtype=float))
 
@@ -33,14 +33,14 @@ def _hinge_point(scene: Any, hinge: Any, where: str) -> np.ndarray:
 def _blocks(scene: Any, spec: Any) -> Tuple[List[Any], List[np.ndarray], List[str], List[str]]:
     from rhino_plugin.geometry.massprops import combine, mass_properties
     from rhino_plugin.geometry.validate import check_solid
-    from rhino_plugin.mechanisms.single import _objects
+    from rhino_plugin.mechanisms.single import find_objects
 
     props, verts, ids, notes = [], [], [], []
     for k, groups in enumerate(spec.blocks):
         parts = []
         pts = []
         for j, group in enumerate(groups):
-            for obj in _objects(scene, group.objects, f"{spec.id}.blocks[{k}][{j}]"):
+            for obj in find_objects(scene, group.objects, f"{spec.id}.blocks[{k}][{j}]"):
                 mesh, warn = check_solid(scene.mesh(obj))
                 notes.extend(warn)
                 parts.append(mass_properties(mesh, group.density))

@@ -27,6 +27,7 @@ __all__ = [
     "AXIS_TILT_TOL",
     "Body",
     "RockingSide",
+    "find_objects",
     "load_body",
     "negative_axis",
     "resolve_axis",
@@ -89,7 +90,8 @@ class RockingSide:
         return float(np.linalg.norm(r)), math.atan2(float(np.dot(r, -self.outward)), float(r[2]))
 
 
-def _objects(scene: Any, selectors: Sequence[Any], where: str) -> List[Any]:
+def find_objects(scene: Any, selectors: Sequence[Any], where: str) -> List[Any]:
+    """Return the objects matching every selector; one that matches nothing is an error."""
     found: List[Any] = []
     for sel in selectors:
         hits = scene.find(sel)
@@ -101,7 +103,7 @@ def _objects(scene: Any, selectors: Sequence[Any], where: str) -> List[Any]:
 
 def _crack_plane(scene: Any, crack: Any, where: str) -> Tuple[np.ndarray, np.ndarray]:
     if crack.object is not None:
-        objs = _objects(scene, [crack.object], where)
+        objs = find_objects(scene, [crack.object], where)
         return scene.plane(objs[0])
     p = np.asarray(crack.points, dtype=float)
     n = np.cross(p[1] - p[0], p[2] - p[0])
@@ -122,7 +124,7 @@ def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
     ids: List[str] = []
     warnings: List[str] = []
     for k, group in enumerate(spec.groups):
-        for obj in _objects(scene, group.objects, f"{where}.groups[{k}]"):
+        for obj in find_objects(scene, group.objects, f"{where}.groups[{k}]"):
             mesh, notes = check_solid(scene.mesh(obj))
             warnings.extend(notes)
             solids.append((mesh, group.density))
@@ -158,7 +160,7 @@ def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
 def resolve_axis(scene: Any, axis: Any, where: str) -> Tuple[np.ndarray, np.ndarray]:
     """Axis end points [m] from a line object or from the spec's two points."""
     if axis.object is not None:
-        objs = _objects(scene, [axis.object], where)
+        objs = find_objects(scene, [axis.object], where)
         start, end = scene.line(objs[0])
     else:
         start, end = np.asarray(axis.start, dtype=float), np.asarray(axis.end, dtype=float)

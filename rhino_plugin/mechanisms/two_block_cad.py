@@ -52,7 +52,7 @@ def two_block_sides(
     """Constants of both sides of a two-block wall, eta (or None) and a summary."""
     from rhino_plugin.geometry.cut import cut_by_plane
     from rhino_plugin.geometry.massprops import mass_properties
-    from rhino_plugin.mechanisms.loaded import _contact, _solids
+    from rhino_plugin.mechanisms.loaded import element_solids, largest_contact
     from rhino_plugin.mechanisms.two_block import (
         hinge_height,
         two_block_constants,
@@ -76,9 +76,9 @@ def two_block_sides(
     if ob is not None and ob.force is not None:
         n = float(ob.force)
     elif ob is not None:
-        meshes, overburden_ids, _ = _solids(scene, ob.objects, f"{where}.overburden")
+        meshes, overburden_ids, _ = element_solids(scene, ob.objects, f"{where}.overburden")
         n = ob.tributary * G * sum(mass_properties(m, ob.density).mass for m in meshes)
-        _, point, _ = _contact(meshes, body.meshes, f"{where}.overburden")
+        _, point, _ = largest_contact(meshes, body.meshes, f"{where}.overburden")
         x_p = float((point - o) @ out)
     f_mt = float(spec.f_mt or 0.0)
     h_c = hinge_height(h, weight, n, f_mt, length * b)
