@@ -1,20 +1,30 @@
 """Ground-motion records: reading, validation and metadata.
 
-Formats read here:
+Formats read here (``GroundMotion.from_file`` picks one by name or by the file):
 
-* two columns, time [s] and acceleration, whitespace- or comma-separated, ``#`` comments
-  allowed (``GroundMotion.from_two_column``).
+* ``"at2"``: PEER NGA ``.AT2``: four header lines (title; event, date, station, component;
+  units; ``NPTS=..., DT=...``), then the samples in g, several per line
+  (``GroundMotion.from_at2``);
+* ``"two_column"``: time [s] and acceleration, whitespace- or comma-separated, ``#``
+  comments allowed (``GroundMotion.from_two_column``);
+* ``"one_column"``: one acceleration per line, the time step given by the caller
+  (``GroundMotion.from_one_column``);
+* ``"csv"``: comma-separated with a header row; a time column or a given time step
+  (``GroundMotion.from_csv``).
 
-Units of acceleration are named explicitly: ``"g"``, ``"m/s2"`` or ``"cm/s2"``. Inside,
-everything is SI (m/s²).
+Units of acceleration are named explicitly: ``"g"``, ``"m/s2"`` or ``"cm/s2"``; only AT2
+files state their own. Inside, everything is SI (m/s²). Every sample of a file is kept,
+including a short last line.
 """
 
 from __future__ import annotations
 
+import csv
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Union
+from typing import Any, Optional, Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,12 +34,34 @@ from shared_schema.errors import InputError
 from .excitation import SampledAccel
 from .model import G
 
-__all__ = ["UNITS", "GroundMotion"]
+__all__ = ["DT_RTOL", "FORMATS", "UNITS", "GroundMotion"]
 
 #: Acceleration units and their factor to m/s².
 UNITS = {"g": G, "m/s2": 1.0, "cm/s2": 0.01}
 #: Relative tolerance on the spacing of time stamps read from a file.
 DT_RTOL = 1e-6
+#: Record formats ``GroundMotion.from_file`` reads.
+FORMATS = ("at2", "two_column", "one_column", "csv")
+#: File extensions (lower case) that fix the format.
+_EXTENSIONS = {".at2": "at2", ".csv": "csv"}
+#: Units named on line 3 of an AT2 file, upper case without spaces -> our units.
+_AT2_UNITS = {
+    "G": "g",
+    "CM/S/S": "cm/s2",
+    "CM/SEC/SEC": "cm/s2",
+    "CM/S2": "cm/s2",
+    "CM/SEC2": "cm/s2",
+    "GAL": "cm/s2",
+    "M/S/S": "m/s2",
+    "M/SEC/SEC": "m/s2",
+    "M/S2": "m/s2",
+}
+_UNITS_HINT = "give units: g, m/s2 or cm/s2"
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?"
+_DATE = re.compile(r"\d{1,2}/\d{1,2}/\d{2,4}")
+
+PathLike = Union[str, Path]
+Column = Union[str, int, None]
 
 
 def _unit_factor(units: str) -> float:
@@ -38,7 +70,15 @@ def _unit_factor(units: str) -> float:
     return UNITS[units]
 
 
-def _read_text(path: Union[str, Path]) -> tuple[Path, str]:
+def _check_dt(dt: Any) -> float:
+    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.floating, np.integer)):
+        raise InputError(f"must be a finite number > 0 [s], got {dt!r}", "dt")
+    if not (math.isfinite(float(dt)) and dt > 0):
+        raise InputError(f"must be finite and > 0 [s], got {dt!r}", "dt")
+    return float(dt)
+
+
+def _read_text(path: PathLike) -> tuple[Path, str]:
     p = Path(path)
     if not p.is_file():
         raise InputError(f"record file not found: {p}", "record")
@@ -46,6 +86,110 @@ def _read_text(path: Union[str, Path]) -> tuple[Path, str]:
         return p, p.read_text(encoding="utf-8", errors="strict")
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"cannot read record file {p}: {exc}", "record") from exc
+
+
+def _data_lines(text: str) -> list[tuple[int, str, str]]:
+    """``(line number, raw line, line without comment)`` of every non-blank data line."""
+    out = []
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        line = raw.split("#", 1)[0].strip()
+        if line:
+            out.append((lineno, raw, line))
+    return out
+
+
+def _to_float(token: str, where: str, raw: str) -> float:
+    try:
+        return float(token)
+    except ValueError:
+        raise InputError(f"{where}: not a number: {raw.strip()!r}", "record") from None
+
+
+def _check_samples(a: NDArray[np.float64], name: str) -> None:
+    if a.size < 2:
+        raise InputError(f"{name}: needs at least 2 samples, got {a.size}", "record")
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        raise InputError(
+            f"{name}: sample {int(bad[0])} is not finite ({a[bad[0]]!r}); "
+            f"{bad.size} non-finite sample(s) in all",
+            "record",
+        )
+
+
+def _uniform_step(t: NDArray[np.float64], name: str) -> float:
+    """Time step [s] of strictly increasing, uniform (within ``DT_RTOL``) time stamps."""
+    bad = np.flatnonzero(~np.isfinite(t))
+    if bad.size:
+        raise InputError(f"{name}: time of sample {int(bad[0])} is not finite", "record")
+    steps = np.diff(t)
+    if np.any(steps <= 0.0):
+        k = int(np.flatnonzero(steps <= 0.0)[0])
+        raise InputError(
+            f"{name}: time is not strictly increasing at sample {k + 1} "
+            f"(t = {t[k]} then {t[k + 1]})",
+            "record",
+        )
+    dt = float((t[-1] - t[0]) / (t.size - 1))
+    worst = int(np.argmax(np.abs(steps - dt)))
+    if abs(steps[worst] - dt) > DT_RTOL * dt:
+        raise InputError(
+            f"{name}: time step is not uniform (step {worst + 1} is {steps[worst]:.6g} s, "
+            f"mean {dt:.6g} s); resample the record",
+            "record",
+        )
+    if not math.isfinite(dt) or dt <= 0.0:
+        raise InputError(f"{name}: invalid time step {dt!r}", "record")
+    return dt
+
+
+def _at2_station(line: str) -> dict[str, str]:
+    """Event, date, station and component from line 2 of an AT2 file, as far as they parse.
+
+    NGA-West2 writes ``event, m/d/yyyy, station, component``; older NGA files
+    ``EVENT m/d/yy hhmm, STATION, COMPONENT``.
+    """
+    parts = [s.strip() for s in line.split(",")]
+    meta = {"event": "", "date": "", "station": "", "component": ""}
+    if len(parts) >= 4 and _DATE.fullmatch(parts[1]):
+        meta.update(event=parts[0], date=parts[1], station=", ".join(parts[2:-1]))
+        meta["component"] = parts[-1]
+    elif len(parts) >= 3:
+        date = _DATE.search(parts[0])
+        meta["event"] = parts[0][: date.start()].strip() if date else parts[0]
+        meta["date"] = date.group(0) if date else ""
+        meta.update(station=", ".join(parts[1:-1]), component=parts[-1])
+    else:
+        meta["event"] = line.strip()
+    return meta
+
+
+def _at2_npts_dt(line: str, name: str) -> tuple[int, float]:
+    """``NPTS`` and ``DT`` [s] from line 4 of an AT2 file (both header styles)."""
+    npts = re.search(r"NPTS\s*=\s*(\d+)", line, re.IGNORECASE)
+    dt = re.search(rf"DT\s*=\s*({_NUMBER})", line, re.IGNORECASE)
+    if npts and dt:
+        return int(npts.group(1)), float(dt.group(1))
+    # Older NGA files: "  2048   .0066   NPTS, DT".
+    old = re.match(rf"\s*(\d+)\s+({_NUMBER})\s+NPTS\s*,\s*DT", line, re.IGNORECASE)
+    if old:
+        return int(old.group(1)), float(old.group(2))
+    raise InputError(f"{name} line 4: cannot find NPTS and DT in {line.strip()!r}", "record")
+
+
+def _resolve_column(col: Column, header: list[str], arg: str, name: str) -> int:
+    n = len(header)
+    if isinstance(col, int) and not isinstance(col, bool):
+        if not -n <= col < n:
+            raise InputError(f"{name} has {n} columns, got column index {col}", arg)
+        return col % n
+    if isinstance(col, str):
+        if col in header:
+            return header.index(col)
+        folded = [h.casefold() for h in header]
+        if col.strip().casefold() in folded:
+            return folded.index(col.strip().casefold())
+    raise InputError(f"{name} has no column {col!r}; columns are {header}", arg)
 
 
 @dataclass(frozen=True)
@@ -102,7 +246,138 @@ class GroundMotion:
         return cls(SampledAccel(np.asarray(acc, dtype=float) * factor, dt), name, meta)
 
     @classmethod
-    def from_two_column(cls, path: Union[str, Path], *, units: str = "g") -> GroundMotion:
+    def from_file(
+        cls,
+        path: PathLike,
+        *,
+        format: Optional[str] = None,
+        units: Optional[str] = None,
+        dt: Optional[float] = None,
+    ) -> GroundMotion:
+        """Read a record in any of ``FORMATS``, named or detected.
+
+        Parameters
+        ----------
+        path : str or Path
+            The record file.
+        format : {"at2", "two_column", "one_column", "csv"}, optional
+            By default from the extension (``.AT2``, ``.csv``), else from the first data
+            line: two numbers are ``two_column``, one is ``one_column``.
+        units : {"g", "m/s2", "cm/s2"}, optional
+            Units of acceleration; required for every format but AT2, which states its own
+            (if given for AT2 it must agree).
+        dt : float, optional
+            Time step [s] for files without a time column (``one_column``, ``csv``);
+            refused where the file has its own.
+
+        Raises
+        ------
+        InputError
+            Unknown or undetectable format (field ``format``), missing units (``units``),
+            missing or superfluous ``dt`` (``dt``), or a bad file (``record``).
+        """
+        p = Path(path)
+        if format is None:
+            fmt = _detect_format(p)
+        elif format in FORMATS:
+            fmt = format
+        else:
+            raise InputError(
+                f"unknown record format {format!r} for {p.name}; formats are {list(FORMATS)}",
+                "format",
+            )
+        if fmt == "at2":
+            if dt is not None:
+                raise InputError(f"{p.name} is AT2 and states its own time step", "dt")
+            motion = cls.from_at2(p)
+            if units is not None and units != motion.metadata["units"]:
+                raise InputError(
+                    f"{p.name} states units {motion.metadata['units']!r}, got {units!r}",
+                    "units",
+                )
+            return motion
+        if units is None:
+            raise InputError(f"{_UNITS_HINT} ({fmt} file {p.name} does not state them)", "units")
+        if fmt == "two_column":
+            if dt is not None:
+                raise InputError(f"{p.name} has a time column; do not give dt", "dt")
+            return cls.from_two_column(p, units=units)
+        if fmt == "one_column":
+            if dt is None:
+                raise InputError(f"one_column file {p.name} needs a time step dt [s]", "dt")
+            return cls.from_one_column(p, dt, units)
+        return cls.from_csv(p, units, dt=dt)
+
+    @classmethod
+    def from_at2(cls, path: PathLike) -> GroundMotion:
+        """Read a PEER NGA ``.AT2`` acceleration record.
+
+        Parameters
+        ----------
+        path : str or Path
+            The file: title line; ``event, date, station, component``; units
+            (``... IN UNITS OF G``); ``NPTS=..., DT=... SEC``; then ``NPTS`` values,
+            several per line. Every value is kept, the short last line included.
+
+        Raises
+        ------
+        InputError
+            Missing file, short header, unknown units, a velocity or displacement file,
+            unparsable values, or a count of values other than ``NPTS``.
+
+        Notes
+        -----
+        ``metadata`` holds ``event``, ``date``, ``station``, ``component`` (parsed from
+        line 2 as far as possible; ``header`` keeps the raw line), ``dt`` [s], ``npts``,
+        ``units``, ``source`` (file name), ``format`` and ``pga_g``.
+        """
+        p, text = _read_text(path)
+        lines = text.splitlines()
+        if len(lines) < 4:
+            raise InputError(
+                f"{p.name}: AT2 needs 4 header lines, got {len(lines)} line(s)", "record"
+            )
+        kind = lines[2].upper()
+        if "ACCELERATION" not in kind:
+            raise InputError(
+                f"{p.name} line 3: not an acceleration record: {lines[2].strip()!r}", "record"
+            )
+        unit_word = kind.rsplit("UNITS OF", 1)[-1].replace(" ", "") if "UNITS OF" in kind else ""
+        if unit_word not in _AT2_UNITS:
+            raise InputError(
+                f"{p.name} line 3: unknown units in {lines[2].strip()!r}; "
+                f"known: {sorted(_AT2_UNITS)}",
+                "record",
+            )
+        units = _AT2_UNITS[unit_word]
+        npts, dt = _at2_npts_dt(lines[3], p.name)
+        _check_dt(dt)
+        values: list[float] = []
+        for lineno, raw in enumerate(lines[4:], start=5):
+            where = f"{p.name} line {lineno}"
+            values.extend(_to_float(tok, where, raw) for tok in raw.split())
+        if len(values) != npts:
+            raise InputError(
+                f"{p.name}: header says NPTS={npts}, but the file has {len(values)} values",
+                "record",
+            )
+        a = np.array(values, dtype=float)
+        _check_samples(a, p.name)
+        meta: dict[str, Any] = {
+            **_at2_station(lines[1]),
+            "header": lines[1].strip(),
+            "source": p.name,
+            "format": "at2",
+            "units": units,
+            "dt": dt,
+            "npts": npts,
+        }
+        motion = cls(SampledAccel(a * UNITS[units], dt), p.stem, meta)
+        meta["pga_g"] = motion.pga_g
+        return motion
+
+    @classmethod
+    def from_two_column(cls, path: PathLike, *, units: str = "g") -> GroundMotion:
         """Read a two-column file: time [s] and acceleration in ``units``.
 
         Parameters
@@ -111,7 +386,8 @@ class GroundMotion:
             Text file; whitespace or commas separate the columns; lines starting with
             ``#`` are comments.
         units : {"g", "m/s2", "cm/s2"}
-            Units of the acceleration column.
+            Units of the acceleration column (default ``"g"`` kept for old callers;
+            ``from_file`` requires it).
 
         Raises
         ------
@@ -122,47 +398,175 @@ class GroundMotion:
         factor = _unit_factor(units)
         p, text = _read_text(path)
         rows: list[tuple[float, float]] = []
-        for lineno, raw in enumerate(text.splitlines(), start=1):
-            line = raw.split("#", 1)[0].replace(",", " ").strip()
-            if not line:
-                continue
-            parts = line.split()
+        for lineno, raw, line in _data_lines(text):
+            parts = line.replace(",", " ").split()
+            where = f"{p.name} line {lineno}"
             if len(parts) != 2:
                 raise InputError(
-                    f"{p.name} line {lineno}: expected 2 columns (time, acceleration), "
-                    f"got {len(parts)}",
+                    f"{where}: expected 2 columns (time, acceleration), got {len(parts)}",
                     "record",
                 )
-            try:
-                rows.append((float(parts[0]), float(parts[1])))
-            except ValueError:
-                raise InputError(
-                    f"{p.name} line {lineno}: not a number: {raw.strip()!r}", "record"
-                ) from None
-        if len(rows) < 2:
-            raise InputError(f"{p.name}: needs at least 2 samples, got {len(rows)}", "record")
-        data = np.array(rows)
+            rows.append((_to_float(parts[0], where, raw), _to_float(parts[1], where, raw)))
+        data = np.array(rows, dtype=float).reshape(-1, 2)
         t, a = data[:, 0], data[:, 1]
-        bad = np.flatnonzero(~np.isfinite(data).all(axis=1))
-        if bad.size:
-            raise InputError(f"{p.name}: sample {int(bad[0])} is not finite", "record")
-        steps = np.diff(t)
-        if np.any(steps <= 0.0):
-            k = int(np.flatnonzero(steps <= 0.0)[0])
-            raise InputError(
-                f"{p.name}: time is not strictly increasing at sample {k + 1} "
-                f"(t = {t[k]} then {t[k + 1]})",
-                "record",
-            )
-        dt = (t[-1] - t[0]) / (t.size - 1)
-        worst = int(np.argmax(np.abs(steps - dt)))
-        if abs(steps[worst] - dt) > DT_RTOL * dt:
-            raise InputError(
-                f"{p.name}: time step is not uniform (step {worst + 1} is {steps[worst]:.6g} s, "
-                f"mean {dt:.6g} s); resample the record",
-                "record",
-            )
-        if not math.isfinite(dt) or dt <= 0.0:
-            raise InputError(f"{p.name}: invalid time step {dt!r}", "record")
+        _check_samples(a, p.name)
+        dt = _uniform_step(t, p.name)
         meta = {"source": p.name, "format": "two_column", "units": units, "npts": int(t.size)}
         return cls(SampledAccel(a * factor, dt, t0=float(t[0])), p.stem, meta)
+
+    @classmethod
+    def from_one_column(cls, path: PathLike, dt: float, units: str) -> GroundMotion:
+        """Read one acceleration per line, in ``units``, sampled every ``dt`` [s].
+
+        Parameters
+        ----------
+        path : str or Path
+            Text file; ``#`` starts a comment; blank lines are skipped.
+        dt : float
+            Sampling interval [s], finite and > 0.
+        units : {"g", "m/s2", "cm/s2"}
+            Units of the values.
+
+        Raises
+        ------
+        InputError
+            Bad ``dt`` or ``units``, missing file, a line with other than one number,
+            fewer than 2 samples or non-finite values.
+        """
+        dt = _check_dt(dt)
+        factor = _unit_factor(units)
+        p, text = _read_text(path)
+        values: list[float] = []
+        for lineno, raw, line in _data_lines(text):
+            parts = line.replace(",", " ").split()
+            where = f"{p.name} line {lineno}"
+            if len(parts) != 1:
+                raise InputError(f"{where}: expected 1 column, got {len(parts)}", "record")
+            values.append(_to_float(parts[0], where, raw))
+        a = np.array(values, dtype=float)
+        _check_samples(a, p.name)
+        meta = {"source": p.name, "format": "one_column", "units": units, "npts": int(a.size)}
+        return cls(SampledAccel(a * factor, dt), p.stem, meta)
+
+    @classmethod
+    def from_csv(
+        cls,
+        path: PathLike,
+        units: str,
+        time_column: Column = None,
+        accel_column: Column = None,
+        dt: Optional[float] = None,
+    ) -> GroundMotion:
+        """Read a comma-separated file with a header row.
+
+        Parameters
+        ----------
+        path : str or Path
+            The file; ``#`` comment lines and blank lines are skipped. If the first row is
+            all numbers it is data (no header) and columns can only be given by index.
+        units : {"g", "m/s2", "cm/s2"}
+            Units of the acceleration column.
+        time_column, accel_column : str or int, optional
+            Columns by header name (exact, else case-insensitive) or 0-based index. By
+            default time is column 0 and acceleration the first other column.
+        dt : float, optional
+            Time step [s] for a file without a time column. Then ``time_column`` must not
+            be given, and ``accel_column`` defaults to the only column.
+
+        Raises
+        ------
+        InputError
+            Bad ``units``/``dt``/columns, missing file, unparsable cells, fewer than 2
+            samples, non-finite values, or time not strictly increasing and uniform.
+        """
+        factor = _unit_factor(units)
+        if dt is not None:
+            dt = _check_dt(dt)
+            if time_column is not None:
+                raise InputError("give either a time column or dt, not both", "dt")
+        p, text = _read_text(path)
+        rows = [(n, raw, next(csv.reader([ln]))) for n, raw, ln in _data_lines(text)]
+        if not rows:
+            raise InputError(f"{p.name}: needs at least 2 samples, got 0", "record")
+        first = [c.strip() for c in rows[0][2]]
+        try:
+            [float(c) for c in first]
+            header = [str(i) for i in range(len(first))]
+            names = False
+        except ValueError:
+            header, rows, names = first, rows[1:], True
+        if dt is None:
+            if len(header) < 2:
+                raise InputError(f"{p.name} has no time column; give dt [s]", "dt")
+            it: Optional[int] = _resolve_column(
+                0 if time_column is None else time_column, header, "time_column", p.name
+            )
+            default_acc = 1 if it == 0 else 0
+        else:
+            it = None
+            if accel_column is None and len(header) != 1:
+                raise InputError(
+                    f"{p.name} has {len(header)} columns {header}; name the acceleration one",
+                    "accel_column",
+                )
+            default_acc = 0
+        ia = _resolve_column(
+            default_acc if accel_column is None else accel_column, header, "accel_column", p.name
+        )
+        if ia == it:
+            raise InputError(f"{p.name}: time and acceleration are the same column", "accel_column")
+        need = max(ia, -1 if it is None else it) + 1
+        t_list: list[float] = []
+        a_list: list[float] = []
+        for lineno, raw, cells in rows:
+            where = f"{p.name} line {lineno}"
+            if len(cells) < need:
+                raise InputError(
+                    f"{where}: expected {len(header)} columns, got {len(cells)}", "record"
+                )
+            a_list.append(_to_float(cells[ia].strip(), where, raw))
+            if it is not None:
+                t_list.append(_to_float(cells[it].strip(), where, raw))
+        a = np.array(a_list, dtype=float)
+        _check_samples(a, p.name)
+        t0 = 0.0
+        if it is not None:
+            t = np.array(t_list, dtype=float)
+            dt, t0 = _uniform_step(t, p.name), float(t[0])
+        assert dt is not None
+        meta = {
+            "source": p.name,
+            "format": "csv",
+            "units": units,
+            "npts": int(a.size),
+            "time_column": header[it] if (it is not None and names) else it,
+            "accel_column": header[ia] if names else ia,
+        }
+        return cls(SampledAccel(a * factor, dt, t0=t0), p.stem, meta)
+
+
+def _detect_format(p: Path) -> str:
+    """Format of a record file from its extension, else from its first data line."""
+    fmt = _EXTENSIONS.get(p.suffix.lower())
+    if fmt is not None:
+        return fmt
+    _, text = _read_text(p)
+    if text.lstrip().upper().startswith("PEER NGA"):
+        return "at2"
+    lines = _data_lines(text)
+    if not lines:
+        raise InputError(f"{p.name} is empty: no data lines to read", "record")
+    first = lines[0][2].replace(",", " ").split()
+    try:
+        [float(x) for x in first]
+    except ValueError:
+        first = []
+    if len(first) == 2:
+        return "two_column"
+    if len(first) == 1:
+        return "one_column"
+    raise InputError(
+        f"cannot tell the format of {p.name} (line {lines[0][0]}: {lines[0][1].strip()!r}); "
+        f"give format, one of {list(FORMATS)}",
+        "format",
+    )
