@@ -133,11 +133,24 @@ def pulse(
 def history(
     ctx: typer.Context,
     constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
-    record: Path = typer.Argument(..., help="Record file: two columns, time [s] and acceleration."),
+    record: Path = typer.Argument(
+        ..., help="Record file: PEER AT2, two columns (t, a), one column (with --dt) or CSV."
+    ),
     scale: list[float] = typer.Option(
         [1.0], "--scale", help="Scale factors on the record, e.g. --scale 0.5 1 2."
     ),
-    units: str = typer.Option("g", "--units", help="Acceleration units: g, m/s2 or cm/s2."),
+    units: Optional[str] = typer.Option(
+        None,
+        "--units",
+        help="Acceleration units: g, m/s2 or cm/s2; AT2 files state their own, two-column "
+        "files default to g, other formats need it.",
+    ),
+    record_format: Optional[str] = typer.Option(
+        None, "--format", help="at2, two_column, one_column or csv (default: detected)."
+    ),
+    dt: Optional[float] = typer.Option(
+        None, "--dt", help="Time step [s] of a record without a time column."
+    ),
     criterion: Optional[str] = typer.Option(
         None, "--criterion", help="Overturning verdict: ratio (default for records) or exact."
     ),
@@ -151,7 +164,7 @@ def history(
 
     from .adapter import models_from_file
     from .core.exact import simulate_batch
-    from .core.records import GroundMotion
+    from .core.records import GroundMotion, detect_format
 
     scales = list(scale)
     for extra in ctx.args:
@@ -165,7 +178,10 @@ def history(
     models = models_from_file(cf)
     for model in models:
         model.require_eta()
-    motion = GroundMotion.from_two_column(record, units=units)
+    fmt = record_format or detect_format(record)
+    if units is None and fmt == "two_column":
+        units = "g"  # the two-column t [s], a [g] convention of the bundled record
+    motion = GroundMotion.from_file(record, format=fmt, units=units, dt=dt)
     batch = simulate_batch(models, motion.accel, scales, criterion=criterion)
     doc: dict[str, Any] = {
         "record": {

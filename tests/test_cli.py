@@ -299,3 +299,50 @@ def test_envelope_and_boundary_bad_input(tmp_path: Path, args: list[str], messag
     res = runner.invoke(app, [table.get(a, a) for a in args])
     assert res.exit_code == 2, res.output
     assert message in res.stderr and len(res.stderr.strip().splitlines()) == 1
+
+
+# --- Record formats through rockmech history ------------------------------------------------
+
+
+def test_history_reads_csv_and_one_column_records(tmp_path: Path) -> None:
+    constants = str(EXAMPLES / "constants" / "rect_walls.json")
+    data = np.loadtxt(EXAMPLES / "records" / "elcentro_NS.dat")
+    csv = tmp_path / "ec.csv"
+    csv.write_text("time_s,acc_cm_s2\n" + "\n".join(f"{t},{a * 980.665}" for t, a in data))
+    one = tmp_path / "ec.txt"
+    one.write_text("\n".join(str(a) for a in data[:, 1]))
+    ref = json.loads(
+        runner.invoke(
+            app, ["history", constants, str(EXAMPLES / "records" / "elcentro_NS.dat"), "--json"]
+        ).stdout
+    )
+    for args in (
+        [str(csv), "--units", "cm/s2"],
+        [str(one), "--units", "g", "--dt", "0.02", "--format", "one_column"],
+    ):
+        res = runner.invoke(app, ["history", constants, *args, "--json"])
+        assert res.exit_code == 0, res.output
+        got = json.loads(res.stdout)
+        for a, b in zip(got["results"], ref["results"]):
+            assert a["peak_ratio"] == pytest.approx(b["peak_ratio"], rel=1e-9, abs=1e-12)
+            assert a["overturned"] == b["overturned"]
+    missing = runner.invoke(app, ["history", constants, str(csv)])
+    assert missing.exit_code == 2 and "units" in missing.stderr
+
+
+def test_history_reads_peer_at2(shared_records: Path) -> None:
+    res = runner.invoke(
+        app,
+        [
+            "history",
+            str(EXAMPLES / "constants" / "rect_walls.json"),
+            str(shared_records / "RSN126_GAZLI_GAZ000.AT2"),
+            "--json",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    assert doc["record"]["npts"] == 2048 and doc["record"]["pga_g"] == pytest.approx(
+        0.702, abs=1e-3
+    )
+    assert doc["record"]["station"] == "Karakyr"

@@ -34,7 +34,7 @@ from shared_schema.errors import InputError
 from .excitation import SampledAccel
 from .model import G
 
-__all__ = ["DT_RTOL", "FORMATS", "UNITS", "GroundMotion"]
+__all__ = ["DT_RTOL", "FORMATS", "UNITS", "GroundMotion", "detect_format"]
 
 #: Acceleration units and their factor to m/s².
 UNITS = {"g": G, "m/s2": 1.0, "cm/s2": 0.01}
@@ -278,7 +278,7 @@ class GroundMotion:
         """
         p = Path(path)
         if format is None:
-            fmt = _detect_format(p)
+            fmt = detect_format(p)
         elif format in FORMATS:
             fmt = format
         else:
@@ -545,8 +545,8 @@ class GroundMotion:
         return cls(SampledAccel(a * factor, dt, t0=t0), p.stem, meta)
 
 
-def _detect_format(p: Path) -> str:
-    """Format of a record file from its extension, else from its first data line."""
+def detect_format(p: Path) -> str:
+    """Return the format of a record file: from its extension, else its first data line."""
     fmt = _EXTENSIONS.get(p.suffix.lower())
     if fmt is not None:
         return fmt
