@@ -26,7 +26,15 @@ from .core.envelope import (
     mechanism_envelope,
 )
 
-__all__ = ["boundary_doc", "envelope_csv", "envelope_doc", "frequency_grid", "write_envelope"]
+__all__ = [
+    "SF_METHODS",
+    "boundary_doc",
+    "envelope_csv",
+    "envelope_doc",
+    "frequency_grid",
+    "history_doc",
+    "write_envelope",
+]
 
 
 def _finite_or_none(values: np.ndarray[Any, Any]) -> list[Optional[float]]:
@@ -199,4 +207,81 @@ def write_envelope(
         labels={m.id: f"{m.id}: {m.name}" for m in cf.mechanisms},
         title=title,
     )
+    return doc
+
+
+#: Scale-factor methods of time histories: none, or Eq. 28 from the record's spectrum.
+SF_METHODS = ("none", "eq28")
+
+
+def history_doc(
+    cf: ConstantsFile,
+    motion: Any,
+    scales: list[float],
+    *,
+    sf: str = "none",
+    criterion: Optional[str] = None,
+) -> dict[str, Any]:
+    """Time histories of every mechanism at every scale, as a JSON-ready document.
+
+    With ``sf = "eq28"`` a mechanism with ``amplification {f_n, h_e, h}`` receives the record
+    scaled by ``SF = sqrt(1 + (S_a(T_n)/PGA · h/h_e)²)`` (Eq. 28; ``S_a`` from the record's
+    exact 5 %-damped spectrum at ``T_n = 1/f_n``) on top of each user scale; mechanisms at
+    ground level are not scaled. Each row then carries ``effective_scale``, and the document
+    the factor with its formula and inputs.
+    """
+    from .core.codes import sf_eq28
+    from .core.exact import simulate_batch
+    from .core.model import G
+    from .core.spectra import response_spectrum
+
+    if sf not in SF_METHODS:
+        raise InputError(f"must be one of {list(SF_METHODS)}, got {sf!r}", "sf")
+    models = [to_rocking_model(m) for m in cf.mechanisms]
+    for model in models:
+        model.require_eta()
+    factors: dict[str, Any] = {}
+    rows: list[dict[str, Any]] = []
+    runtime = 0.0
+    crit, method = "", ""
+    groups: list[tuple[list[Any], float, Optional[str]]] = []
+    if sf == "none":
+        groups.append((models, 1.0, None))
+    else:
+        for mech, model in zip(cf.mechanisms, models):
+            factor = 1.0
+            if mech.amplification is not None:
+                amp = mech.amplification
+                spec = response_spectrum(motion.accel.acc, motion.dt, [1.0 / amp.f_n])
+                info = sf_eq28(float(spec.psa[0]) / G, motion.pga_g, amp.h, amp.h_e)
+                factor = float(info["value"])
+                factors[mech.id] = info
+            groups.append(([model], factor, mech.id))
+    for group, factor, _ in groups:
+        batch = simulate_batch(
+            group, motion.accel, [s * factor for s in scales], criterion=criterion
+        )
+        runtime += batch.runtime_s
+        crit, method = batch.criterion, batch.method
+        for row in batch.rows():
+            if sf != "none":
+                row["effective_scale"] = row["scale"]
+                row["scale"] = row["scale"] / factor
+            rows.append(row)
+    doc: dict[str, Any] = {
+        "record": {
+            "name": motion.name,
+            "dt_s": motion.dt,
+            "pga_g": motion.pga_g,
+            "duration_s": motion.duration,
+            **motion.metadata,
+        },
+        "criterion": crit,
+        "method": method,
+        "runtime_s": runtime,
+        "results": rows,
+    }
+    if sf != "none":
+        doc["scale_factor_method"] = sf
+        doc["scale_factors"] = factors
     return doc

@@ -151,6 +151,12 @@ def history(
     dt: Optional[float] = typer.Option(
         None, "--dt", help="Time step [s] of a record without a time column."
     ),
+    sf: str = typer.Option(
+        "none",
+        "--sf",
+        help="Scale factor up the structure for mechanisms with amplification data: none, or "
+        "eq28 (from the record's 5 % spectrum at T_n = 1/f_n).",
+    ),
     criterion: Optional[str] = typer.Option(
         None, "--criterion", help="Overturning verdict: ratio (default for records) or exact."
     ),
@@ -163,7 +169,7 @@ def history(
     from shared_schema.io import load_constants, write_atomic
 
     from .adapter import models_from_file
-    from .core.exact import simulate_batch
+    from .analysis import history_doc
     from .core.records import GroundMotion, detect_format
 
     scales = list(scale)
@@ -176,26 +182,11 @@ def history(
         _fail(f"constants: file not found: {constants}")
     cf = load_constants(constants)
     models = models_from_file(cf)
-    for model in models:
-        model.require_eta()
     fmt = record_format or detect_format(record)
     if units is None and fmt == "two_column":
         units = "g"  # the two-column t [s], a [g] convention of the bundled record
     motion = GroundMotion.from_file(record, format=fmt, units=units, dt=dt)
-    batch = simulate_batch(models, motion.accel, scales, criterion=criterion)
-    doc: dict[str, Any] = {
-        "record": {
-            "name": motion.name,
-            "dt_s": motion.dt,
-            "pga_g": motion.pga_g,
-            "duration_s": motion.duration,
-            **motion.metadata,
-        },
-        "criterion": batch.criterion,
-        "method": batch.method,
-        "runtime_s": batch.runtime_s,
-        "results": batch.rows(),
-    }
+    doc = history_doc(cf, motion, scales, sf=sf, criterion=criterion)
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         write_atomic(out / "history.json", json.dumps(doc, indent=2) + "\n")
@@ -205,7 +196,7 @@ def history(
         return
     typer.echo(
         f"{motion.name}: PGA {motion.pga_g:.3f} g, dt {motion.dt:g} s, "
-        f"{motion.duration:.2f} s; criterion: {batch.criterion}"
+        f"{motion.duration:.2f} s; criterion: {doc['criterion']}"
     )
     typer.echo(
         f"{'mechanism':<16}{'scale':>8}{'peak':>10}{'overturned':>12}"

@@ -346,3 +346,44 @@ def test_history_reads_peer_at2(shared_records: Path) -> None:
         0.702, abs=1e-3
     )
     assert doc["record"]["station"] == "Karakyr"
+
+
+def test_history_with_eq28_scales_only_the_amplified_mechanisms(tmp_path: Path) -> None:
+    from solver_service.core.codes import sf_eq28
+    from solver_service.core.spectra import response_spectrum
+
+    constants = tmp_path / "c.json"
+    constants.write_text(
+        json.dumps(
+            {
+                "mechanisms": [
+                    {"id": "GROUND", "p_eq": 2.2, "lam": 0.17, "eta": 0.95},
+                    {
+                        "id": "TOWER",
+                        "p_eq": 2.2,
+                        "lam": 0.17,
+                        "eta": 0.95,
+                        "amplification": {"f_n": 3.0, "h_e": 10.0, "h": 12.0},
+                    },
+                ]
+            }
+        )
+    )
+    record = EXAMPLES / "records" / "elcentro_NS.dat"
+    res = runner.invoke(
+        app, ["history", str(constants), str(record), "--scale", "0.4", "--sf", "eq28", "--json"]
+    )
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    motion = GroundMotion.from_two_column(record)
+    sa_g = response_spectrum(motion.accel.acc, motion.dt, [1 / 3.0]).psa[0] / G
+    factor = sf_eq28(sa_g, motion.pga_g, 12.0, 10.0)["value"]
+    assert doc["scale_factors"]["TOWER"]["value"] == pytest.approx(factor, rel=1e-12)
+    assert "GROUND" not in doc["scale_factors"]
+    rows = {r["mechanism"]: r for r in doc["results"]}
+    assert rows["GROUND"]["effective_scale"] == 0.4
+    assert rows["TOWER"]["effective_scale"] == pytest.approx(0.4 * factor, rel=1e-12)
+    direct = simulate(RockingModel.symmetric(2.2, 0.17, 0.95), motion.accel, scale=0.4 * factor)
+    assert rows["TOWER"]["peak_ratio"] == direct.peak_ratio
+    bad = runner.invoke(app, ["history", str(constants), str(record), "--sf", "ec99"])
+    assert bad.exit_code == 2 and "sf" in bad.stderr

@@ -53,6 +53,9 @@ def test_demo_writes_constants_results_and_plot(tmp_path: Path) -> None:
     assert env["critical"][-1]["f_max"] == pytest.approx(10.0)
     assert paths["envelope_plot"].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert paths["envelope_csv"].read_text().count("\n") == 201
+    hist = json.loads(paths["church_history"].read_text())
+    assert hist["scale_factor_method"] == "eq28" and hist["scale_factors"]
+    assert all(v["value"] >= 1.0 for v in hist["scale_factors"].values())
     # The CAD path end to end: scene -> constants -> envelope.
     facade = json.loads(paths["facade_constants"].read_text())
     assert [m["id"] for m in facade["mechanisms"]] == ["F1", "F2"]
