@@ -41,6 +41,7 @@ from scipy.optimize import brentq
 from shared_schema.errors import InputError
 
 from .excitation import PULSE_SHAPES
+from .model import check_non_negative, check_number, check_positive
 
 __all__ = [
     "QUANTITIES",
@@ -226,31 +227,8 @@ def _free_peak(x0: float, dx0: float, zeta: float, wd: float) -> float:
 # --- validation ---------------------------------------------------------------------------
 
 
-def _finite(value: object, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InputError(f"must be a number, got {value!r}", name)
-    v = float(value)
-    if not math.isfinite(v):
-        raise InputError(f"must be finite, got {value!r}", name)
-    return v
-
-
-def _positive(value: object, name: str) -> float:
-    v = _finite(value, name)
-    if v <= 0.0:
-        raise InputError(f"must be > 0, got {value!r}", name)
-    return v
-
-
-def _non_negative(value: object, name: str) -> float:
-    v = _finite(value, name)
-    if v < 0.0:
-        raise InputError(f"must be >= 0, got {value!r}", name)
-    return v
-
-
 def _check_options(zeta: object, quantity: object, shape: object) -> float:
-    z = _finite(zeta, "zeta")
+    z = check_number(zeta, "zeta")
     if not 0.0 <= z < 1.0:
         raise InputError(f"must be in [0, 1), got {zeta!r}", "zeta")
     if quantity not in QUANTITIES:
@@ -365,9 +343,9 @@ def sdof_pulse_peak(
     >>> round(sdof_pulse_peak(2.0, 2.0, 1.5), 3)
     4.05
     """
-    fn = _positive(f_n, "f_n")
-    fp = _positive(f_p, "f_p")
-    ap = _finite(a_p, "a_p")
+    fn = check_positive(f_n, "f_n")
+    fp = check_positive(f_p, "f_p")
+    ap = check_number(a_p, "a_p")
     r = pulse_response_spectrum(fp / fn, zeta=zeta, quantity=quantity, shape=shape)
     return float(r) * abs(ap)
 
@@ -412,9 +390,9 @@ def pulse_scale_factor(
     >>> float(pulse_scale_factor(1.0, f_n=2.0, h=0.0, h_e=3.0))
     1.0
     """
-    fn = _positive(f_n, "f_n")
-    hh = _non_negative(h, "h")
-    he = _positive(h_e, "h_e")
+    fn = check_positive(f_n, "f_n")
+    hh = check_non_negative(h, "h")
+    he = check_positive(h_e, "h_e")
     fp = _positive_array(f_p, "f_p")
     spec = pulse_response_spectrum(fp / fn, zeta=zeta, quantity=quantity, shape=shape)
     return np.asarray(np.hypot(1.0, spec * (hh / he)), dtype=np.float64)
@@ -449,10 +427,10 @@ def scale_factor(sa_g: float, pga_g: float, h: float, h_e: float) -> float:
     >>> round(scale_factor(0.19, 0.155, 4.60, 4.54), 3)
     1.595
     """
-    sa = _non_negative(sa_g, "sa_g")
-    ag = _positive(pga_g, "pga_g")
-    hh = _non_negative(h, "h")
-    he = _positive(h_e, "h_e")
+    sa = check_non_negative(sa_g, "sa_g")
+    ag = check_positive(pga_g, "pga_g")
+    hh = check_non_negative(h, "h")
+    he = check_positive(h_e, "h_e")
     return math.hypot(1.0, sa / ag * hh / he)
 
 

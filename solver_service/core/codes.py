@@ -17,12 +17,10 @@ h_i, h_n : height of level i and of the top of the structure [m] (NZS 1170.5)
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
-from shared_schema.errors import InputError
-
 from .amplification import scale_factor
+from .model import check_non_negative, check_positive
 
 __all__ = ["sf_ec8", "sf_eq28", "sf_nzs"]
 
@@ -32,33 +30,6 @@ NZS_LOW_HEIGHT = 12.0
 NZS_LOW_FRACTION = 0.2
 #: NZS 1170.5 §8.3: the general value of ``C_Hi``.
 NZS_CAP = 3.0
-
-
-def _number(value: object, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        try:
-            v = float(value)  # type: ignore[arg-type]
-        except (TypeError, ValueError):
-            raise InputError(f"must be a number, got {value!r}", name) from None
-    else:
-        v = float(value)
-    if not math.isfinite(v):
-        raise InputError(f"must be finite, got {value!r}", name)
-    return v
-
-
-def _positive(value: object, name: str) -> float:
-    v = _number(value, name)
-    if v <= 0.0:
-        raise InputError(f"must be > 0, got {value!r}", name)
-    return v
-
-
-def _non_negative(value: object, name: str) -> float:
-    v = _number(value, name)
-    if v < 0.0:
-        raise InputError(f"must be >= 0, got {value!r}", name)
-    return v
 
 
 def sf_eq28(sa_g: float, pga_g: float, h: float, h_e: float) -> dict[str, Any]:
@@ -90,10 +61,10 @@ def sf_eq28(sa_g: float, pga_g: float, h: float, h_e: float) -> dict[str, Any]:
     1.595
     """
     inputs = {
-        "sa_g": _non_negative(sa_g, "sa_g"),
-        "pga_g": _positive(pga_g, "pga_g"),
-        "h": _non_negative(h, "h"),
-        "h_e": _positive(h_e, "h_e"),
+        "sa_g": check_non_negative(sa_g, "sa_g"),
+        "pga_g": check_positive(pga_g, "pga_g"),
+        "h": check_non_negative(h, "h"),
+        "h_e": check_positive(h_e, "h_e"),
     }
     return {
         "value": scale_factor(**inputs),
@@ -139,11 +110,11 @@ def sf_ec8(z: float, H: float, T_a: float, T_1: float, S: float = 1.0) -> dict[s
     >>> sf_ec8(10.0, 10.0, 0.0, 0.5)["value"]
     2.5
     """
-    zz = _non_negative(z, "z")
-    hh = _positive(H, "H")
-    ta = _non_negative(T_a, "T_a")
-    t1 = _positive(T_1, "T_1")
-    s = _positive(S, "S")
+    zz = check_non_negative(z, "z")
+    hh = check_positive(H, "H")
+    ta = check_non_negative(T_a, "T_a")
+    t1 = check_positive(T_1, "T_1")
+    s = check_positive(S, "S")
     bracket = 3.0 * (1.0 + zz / hh) / (1.0 + (1.0 - ta / t1) ** 2) - 0.5
     return {
         "value": s * max(1.0, bracket),
@@ -180,8 +151,8 @@ def sf_nzs(h_i: float, h_n: float) -> dict[str, Any]:
     >>> round(sf_nzs(4.6, 4.6)["value"], 2)
     1.77
     """
-    hi = _non_negative(h_i, "h_i")
-    hn = _positive(h_n, "h_n")
+    hi = check_non_negative(h_i, "h_i")
+    hn = check_positive(h_n, "h_n")
     candidates = {"3.0": NZS_CAP}
     if hi < NZS_LOW_HEIGHT:
         candidates["1 + h_i/6"] = 1.0 + hi / 6.0

@@ -26,21 +26,51 @@ import math
 from dataclasses import dataclass, field
 from typing import Optional
 
+import numpy as np
+
 from shared_schema.errors import InputError
 
-__all__ = ["G", "RockingModel", "RockingSide", "check_positive"]
+__all__ = [
+    "G",
+    "RockingModel",
+    "RockingSide",
+    "check_non_negative",
+    "check_number",
+    "check_positive",
+]
 
 #: Standard gravity [m/s²].
 G = 9.80665
 
 
-def check_positive(value: object, name: str) -> float:
-    """Return ``value`` as a float; raise ``InputError`` naming ``name`` unless finite and > 0."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
+def check_number(value: object, name: str) -> float:
+    """Return ``value`` as a float; raise ``InputError`` naming ``name`` unless a finite number.
+
+    Booleans are refused; numpy scalars are accepted.
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(
+        value, (int, float, np.integer, np.floating)
+    ):
         raise InputError(f"must be a number, got {value!r}", name)
     v = float(value)
-    if not math.isfinite(v) or v <= 0.0:
+    if not math.isfinite(v):
+        raise InputError(f"must be finite, got {value!r}", name)
+    return v
+
+
+def check_positive(value: object, name: str) -> float:
+    """Return ``value`` as a float; raise ``InputError`` naming ``name`` unless finite and > 0."""
+    v = check_number(value, name)
+    if v <= 0.0:
         raise InputError(f"must be finite and > 0, got {value!r}", name)
+    return v
+
+
+def check_non_negative(value: object, name: str) -> float:
+    """Return ``value`` as a float; raise ``InputError`` naming ``name`` unless finite and >= 0."""
+    v = check_number(value, name)
+    if v < 0.0:
+        raise InputError(f"must be >= 0, got {value!r}", name)
     return v
 
 

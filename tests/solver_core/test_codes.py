@@ -90,3 +90,8 @@ def test_invalid_inputs_name_the_field(call: object, field: str) -> None:
 
 def test_doctests() -> None:
     assert doctest.testmod(codes).failed == 0
+
+
+def test_booleans_are_not_numbers() -> None:
+    with pytest.raises(InputError, match="h_i"):
+        sf_nzs(True, 10.0)  # type: ignore[arg-type]
