@@ -31,8 +31,29 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
     from rhino_plugin.mechanisms.restitution import ONE_SIDED_RULES, one_sided
 
     where = spec.id
+    entry: Dict[str, Any] = {
+        "id": spec.id,
+        "name": spec.name or spec.id,
+        "typology": spec.typology,
+        "rocking": spec.rocking,
+    }
     if spec.typology == "multi_block":
-        return _multi_block_entry(spec, scene)
+        from rhino_plugin.mechanisms.multi_block_cad import multi_block_sides
+
+        positive, negative, eta, summary, ids = multi_block_sides(spec, scene)
+        warnings = summary.pop("warnings")
+        return _finish(
+            spec,
+            entry,
+            {"multi_block": summary},
+            positive,
+            negative,
+            eta,
+            "momentum_projection",
+            {},
+            ids,
+            warnings,
+        )
     start, end = single.resolve_axis(scene, spec.axis, f"{where}.axis")
     body = single.load_body(spec, scene, 0.5 * (start + end))
     pos = single.rocking_side(
@@ -44,15 +65,24 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
         "com_m": [float(v) for v in body.props.com],
         "positive": single.side_summary(pos),
     }
-    entry: Dict[str, Any] = {
-        "id": spec.id,
-        "name": spec.name or spec.id,
-        "typology": spec.typology,
-        "rocking": spec.rocking,
-    }
     warnings = list(body.warnings)
     if spec.typology == "two_block":
-        return _two_block_entry(spec, scene, body, pos, entry, geometry, warnings)
+        from rhino_plugin.mechanisms.two_block_cad import two_block_sides
+
+        positive, negative, eta, summary = two_block_sides(spec, scene, body, pos)
+        geometry["two_block"] = summary
+        return _finish(
+            spec,
+            entry,
+            geometry,
+            positive,
+            negative,
+            eta,
+            "momentum_projection",
+            {},
+            body.object_ids,
+            warnings,
+        )
     if spec.typology == "single_block_loaded":
         if spec.rocking == "two_sided":
             raise InputError(
@@ -60,17 +90,16 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
                 "side); use one_sided",
                 f"{where}.rocking",
             )
-        consts, loaded_summary, notes = loaded_side(spec, scene, body, pos, table)
+        positive, loaded_summary, notes = loaded_side(spec, scene, body, pos, table)
         warnings.extend(notes)
         geometry["loaded"] = loaded_summary
         m_eta = loaded_summary["M_c_kg"]
-        r_eta, a_eta, i_eta = loaded_summary["R_c_m"], loaded_summary["alpha_c_rad"], consts["I0"]
-        entry["positive"] = consts
+        r_eta, a_eta, i_eta = loaded_summary["R_c_m"], loaded_summary["alpha_c_rad"], positive["I0"]
     else:
-        consts = single.side_constants(body, pos)
-        entry["positive"] = consts
+        positive = single.side_constants(body, pos)
         m_eta, r_eta, a_eta, i_eta = float(body.props.mass), pos.R, pos.alpha, pos.I_O
-    eta_info: Dict[str, Any] = {}
+    negative = None
+    eta_info: Dict[str, Any]
     if spec.rocking == "two_sided":
         if spec.axis_negative is not None:
             n_start, n_end = single.resolve_axis(
@@ -90,104 +119,61 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
                 "the negative-side axis must lie on the other side of the centre of mass",
                 f"{where}.axis_negative",
             )
-        neg_consts = single.side_constants(body, neg)
+        negative = single.side_constants(body, neg)
         geometry["negative"] = single.side_summary(neg)
-        if not _same(consts, neg_consts):
-            entry["negative"] = neg_consts
         eta, eta_info = single.eta_two_sided(body, pos, neg)
         source = "housner_general"
-        if eta < 0.0:
-            warnings.append(
-                f"{where}: Housner's rule gives eta = {eta:.4f} < 0 (a very stocky body); "
-                "eta set to 0"
-            )
-            eta = 0.0
     else:
-        rule = spec.eta_rule or "one_sided_eq26"
-        eta = one_sided(m_eta, r_eta, a_eta, i_eta, rule)
-        eta_info = {"rule": ONE_SIDED_RULES[rule]}
-        source = rule
-        if eta > 0.0:
-            warnings.append(
-                f"{where}: {rule} gives eta = {eta:.4f} > 0 (a stocky body does not rebound); "
-                "eta set to 0"
-            )
-            eta = 0.0
-    if spec.eta is not None:
-        entry["eta"], entry["eta_source"] = spec.eta, "user"
-        eta_info["computed"] = eta
-    else:
-        entry["eta"], entry["eta_source"] = eta, source
-    if spec.amplification is not None:
-        entry["amplification"] = spec.amplification.model_dump()
-    geometry["restitution"] = eta_info
-    entry["geometry"] = geometry
-    entry["provenance"] = {"object_ids": body.object_ids, "warnings": warnings}
-    return entry
+        source = spec.eta_rule or "one_sided_eq26"
+        eta = one_sided(m_eta, r_eta, a_eta, i_eta, source)
+        eta_info = {"rule": ONE_SIDED_RULES[source]}
+    return _finish(
+        spec, entry, geometry, positive, negative, eta, source, eta_info, body.object_ids, warnings
+    )
 
 
-def _two_block_entry(
+def _finish(
     spec: Any,
-    scene: Any,
-    body: Any,
-    pos: Any,
     entry: Dict[str, Any],
     geometry: Dict[str, Any],
+    positive: Dict[str, float],
+    negative: Optional[Dict[str, float]],
+    eta: Optional[float],
+    source: str,
+    eta_info: Dict[str, Any],
+    ids: List[str],
     warnings: List[str],
 ) -> Dict[str, Any]:
-    """Fill in a two-block wall's entry (A3; see ``two_block_cad``)."""
-    from rhino_plugin.mechanisms.two_block_cad import two_block_sides
+    """Complete an entry: sides, restitution, amplification, geometry and provenance.
 
-    positive, negative, eta, summary = two_block_sides(spec, scene, body, pos)
+    The negative side is stored only where it differs from the positive one. A computed
+    ``eta`` outside the range of the rocking kind ([0, 1] two-sided, [-1, 0] one-sided; a
+    very stocky body) is clamped with a warning; a user ``eta`` overrides it, and the
+    computed value is kept in the geometry summary.
+    """
     entry["positive"] = positive
     if negative is not None and not _same(positive, negative):
         entry["negative"] = negative
-    geometry["two_block"] = summary
+    if eta is not None:
+        lo, hi = (-1.0, 0.0) if spec.rocking == "one_sided" else (0.0, 1.0)
+        if not lo <= eta <= hi:
+            clamped = min(max(eta, lo), hi)
+            warnings.append(
+                f"{spec.id}: {source} gives eta = {eta:.4f}, outside [{lo:g}, {hi:g}] for "
+                f"{spec.rocking} rocking (a very stocky body); eta set to {clamped:g}"
+            )
+            eta = clamped
     if spec.eta is not None:
         entry["eta"], entry["eta_source"] = spec.eta, "user"
         if eta is not None:
-            geometry["restitution"] = {"computed": eta}
+            eta_info["computed"] = eta
     elif eta is not None:
-        if eta < 0.0:
-            warnings.append(
-                f"{spec.id}: the momentum projection gives eta = {eta:.4f} < 0; eta set to 0"
-            )
-            eta = 0.0
-        entry["eta"], entry["eta_source"] = eta, "momentum_projection"
+        entry["eta"], entry["eta_source"] = eta, source
+    if eta_info:
+        geometry["restitution"] = eta_info
     if spec.amplification is not None:
         entry["amplification"] = spec.amplification.model_dump()
     entry["geometry"] = geometry
-    entry["provenance"] = {"object_ids": body.object_ids, "warnings": warnings}
-    return entry
-
-
-def _multi_block_entry(spec: Any, scene: Any) -> Dict[str, Any]:
-    """Fill in a three-block, four-hinge mechanism's entry (A4; see ``multi_block_cad``)."""
-    from rhino_plugin.mechanisms.multi_block_cad import multi_block_sides
-
-    positive, negative, eta, summary, ids = multi_block_sides(spec, scene)
-    warnings = summary.pop("warnings")
-    entry: Dict[str, Any] = {
-        "id": spec.id,
-        "name": spec.name or spec.id,
-        "typology": spec.typology,
-        "rocking": spec.rocking,
-        "positive": positive,
-    }
-    if negative is not None and not _same(positive, negative):
-        entry["negative"] = negative
-    if spec.eta is not None:
-        entry["eta"], entry["eta_source"] = spec.eta, "user"
-    elif eta is not None:
-        if eta < 0.0:
-            warnings.append(
-                f"{spec.id}: the momentum projection gives eta = {eta:.4f} < 0; eta set to 0"
-            )
-            eta = 0.0
-        entry["eta"], entry["eta_source"] = eta, "momentum_projection"
-    if spec.amplification is not None:
-        entry["amplification"] = spec.amplification.model_dump()
-    entry["geometry"] = {"multi_block": summary}
     entry["provenance"] = {"object_ids": ids, "warnings": warnings}
     return entry
 
