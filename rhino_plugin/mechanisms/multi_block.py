@@ -45,10 +45,10 @@ floats in about 60 cheap evaluations. A critical rotation narrower than ``SCAN_S
 """
 
 import math
-from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Sequence, Tuple
+from dataclasses import dataclass
+from typing import List, Optional, Sequence, Tuple
 
-from rhino_plugin.mechanisms.two_block import PlanarBody
+from rhino_plugin.mechanisms.two_block import LinkageResult, PlanarBody
 from shared_schema.errors import GeometryError, InputError
 
 __all__ = [
@@ -81,7 +81,7 @@ HINGE_NAMES = ("A", "B", "C", "D")
 
 
 @dataclass(frozen=True)
-class FourBarResult:
+class FourBarResult(LinkageResult):
     """Kinematic constants of one hinge set (THEORY §2.4, Eqs. 1-6).
 
     Attributes
@@ -104,16 +104,6 @@ class FourBarResult:
         ``lam_static = dV0/(g Q0)``; ``L1``, ``L2``, ``L3`` [m]; ``sense`` (+1 when theta
         is anticlockwise in the x-z plane, -1 when clockwise); ``xC``, ``zC`` at ``phi_cr``.
     """
-
-    I0: float
-    K: float
-    Q: float
-    phi_cr: float
-    M_F: float
-    p_eq: float
-    lam: float
-    phi_ov: float
-    details: Dict[str, float] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

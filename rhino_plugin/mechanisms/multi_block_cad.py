@@ -120,7 +120,7 @@ def multi_block_sides(
     )
     hinges_pos = [planar(p) for p in pos3]
     res, direction = _solve(blocks, hinges_pos, f"{where}.hinges")
-    positive = {"I0": res.I0, "K": res.K, "Q": res.Q, "phi_cr": res.phi_cr, "M_F": res.M_F}
+    positive = res.constants()
     negative = None
     eta = None
     summary: Dict[str, Any] = {
@@ -151,13 +151,7 @@ def multi_block_sides(
                 "one; give the mirrored set",
                 f"{where}.hinges_negative",
             )
-        negative = {
-            "I0": res_n.I0,
-            "K": res_n.K,
-            "Q": res_n.Q,
-            "phi_cr": res_n.phi_cr,
-            "M_F": res_n.M_F,
-        }
+        negative = res_n.constants()
         eta = four_bar_restitution(blocks, tuple(hinges_pos), tuple(hinges_neg))
         summary["negative"] = {
             "collapse_sense": dir_n,

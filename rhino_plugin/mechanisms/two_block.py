@@ -109,7 +109,36 @@ class PlanarBody:
 
 
 @dataclass(frozen=True)
-class TwoBlockResult:
+class LinkageResult:
+    """Kinematic constants of a linkage mechanism about ``phi = phi_cr`` (THEORY §1.2).
+
+    Attributes
+    ----------
+    I0, K, Q, phi_cr, M_F : float
+        Eq. 1's constants [kg m²], [N m/rad], [kg m], [rad], [N m].
+    p_eq, lam, phi_ov : float
+        Eqs. 4-6 [1/s], [-], [rad].
+    details : dict of str to float
+        Mechanism-specific diagnostics (see the subclasses).
+    """
+
+    I0: float
+    K: float
+    Q: float
+    phi_cr: float
+    M_F: float
+    p_eq: float
+    lam: float
+    phi_ov: float
+    details: Dict[str, float] = field(default_factory=dict)
+
+    def constants(self) -> Dict[str, float]:
+        """Return the side's constants as the kinematic-constants file stores them."""
+        return {"I0": self.I0, "K": self.K, "Q": self.Q, "phi_cr": self.phi_cr, "M_F": self.M_F}
+
+
+@dataclass(frozen=True)
+class TwoBlockResult(LinkageResult):
     """Kinematic constants of a two-block mechanism about ``phi = phi_cr`` (THEORY §1.2).
 
     Attributes
@@ -137,15 +166,6 @@ class TwoBlockResult:
         The treatment of an eccentric overburden that was used (``ECCENTRICITY_OPTIONS``).
     """
 
-    I0: float
-    K: float
-    Q: float
-    phi_cr: float
-    M_F: float
-    p_eq: float
-    lam: float
-    phi_ov: float
-    details: Dict[str, float] = field(default_factory=dict)
     eccentricity: str = "static_moment"
 
 

@@ -115,7 +115,7 @@ def two_block_sides(
     res = two_block_constants(
         b1, b2, *hinges, overburden=n, overburden_point=(x_p, h), eccentricity=ecc
     )
-    positive = {"I0": res.I0, "K": res.K, "Q": res.Q, "phi_cr": res.phi_cr, "M_F": res.M_F}
+    positive = res.constants()
     negative = None
     eta = None
     if spec.rocking == "two_sided":
@@ -127,7 +127,7 @@ def two_block_sides(
             overburden_point=(-b - x_p, h),
             eccentricity=ecc,
         )
-        negative = {"I0": neg.I0, "K": neg.K, "Q": neg.Q, "phi_cr": neg.phi_cr, "M_F": neg.M_F}
+        negative = neg.constants()
         eta = two_block_restitution(b1, b2, *hinges, *mirrored)
     summary: Dict[str, Any] = {
         "thickness_m": b,
