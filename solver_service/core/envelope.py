@@ -52,7 +52,7 @@ from shared_schema.errors import InputError
 
 from .exact import kernels
 from .excitation import PULSE_SHAPES
-from .model import RockingModel, RockingSide
+from .model import RockingModel, RockingSide, check_eta
 
 __all__ = [
     "A_MAX",
@@ -107,16 +107,6 @@ def _scan(a_max: float, n_scan: int, n_scan_near: int) -> NDArray[np.float64]:
         near = 1.0 + np.geomspace(NEAR_MIN, a_max - 1.0, n_scan_near)
         scan = np.unique(np.concatenate([scan, near]))
     return scan
-
-
-def _check_eta(eta: float, one_sided: bool) -> float:
-    if isinstance(eta, bool) or not isinstance(eta, (int, float)) or not math.isfinite(eta):
-        raise InputError(f"must be a finite number, got {eta!r}", "eta")
-    lo, hi = (-1.0, 0.0) if one_sided else (0.0, 1.0)
-    if not lo <= eta <= hi:
-        kind = "one-sided" if one_sided else "two-sided"
-        raise InputError(f"must be in [{lo:g}, {hi:g}] for {kind} rocking, got {eta!r}", "eta")
-    return float(eta)
 
 
 @dataclass
@@ -228,7 +218,7 @@ def boundary_curve(
     om = np.atleast_1d(np.asarray(omega, dtype=float))
     if om.ndim != 1 or om.size == 0 or not np.all(np.isfinite(om) & (om > 0)):
         raise InputError("must be finite and > 0 (at least one value)", "omega")
-    eta = _check_eta(eta, one_sided)
+    eta = check_eta(eta, one_sided)
     if shape not in PULSE_SHAPES:
         raise InputError(f"must be one of {sorted(PULSE_SHAPES)}, got {shape!r}", "shape")
     if direction not in DIRECTIONS:
@@ -351,7 +341,7 @@ class OverturningLibrary:
             return _interp_log(om, x, self.a_min_one_sided)
         if eta is None:
             raise InputError("two-sided envelopes need a coefficient of restitution", "eta")
-        eta = _check_eta(eta, False)
+        eta = check_eta(eta, False)
         j = int(np.clip(np.searchsorted(self.eta, eta) - 1, 0, self.eta.size - 2))
         w = (eta - self.eta[j]) / (self.eta[j + 1] - self.eta[j])
         lo = _interp_log(om, x, self.a_min_two_sided[j])

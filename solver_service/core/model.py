@@ -34,6 +34,7 @@ __all__ = [
     "G",
     "RockingModel",
     "RockingSide",
+    "check_eta",
     "check_non_negative",
     "check_number",
     "check_positive",
@@ -72,6 +73,27 @@ def check_non_negative(value: object, name: str) -> float:
     if v < 0.0:
         raise InputError(f"must be >= 0, got {value!r}", name)
     return v
+
+
+def check_eta(value: object, one_sided: bool, name: str = "eta") -> float:
+    """Return a coefficient of restitution as a float, checked against the rocking kind.
+
+    Two-sided rocking takes ``0 <= eta <= 1``; one-sided rocking rebounds, ``-1 <= eta <= 0``.
+    """
+    eta = check_number(value, name)
+    if not -1.0 <= eta <= 1.0:
+        raise InputError(f"must be in [-1, 1], got {value!r}", name)
+    if one_sided and eta > 0.0:
+        raise InputError(
+            f"must be <= 0 for one-sided rocking (rebound off the restraint), got {eta}", name
+        )
+    if not one_sided and eta < 0.0:
+        raise InputError(
+            f"must be >= 0 for two-sided rocking (negative values mean rebound, which is "
+            f"one-sided), got {eta}",
+            name,
+        )
+    return eta
 
 
 @dataclass(frozen=True)
@@ -130,23 +152,7 @@ class RockingModel:
         if self.negative is None:
             object.__setattr__(self, "negative", self.positive)
         if self.eta is not None:
-            if isinstance(self.eta, bool) or not isinstance(self.eta, (int, float)):
-                raise InputError(f"must be a number, got {self.eta!r}", "eta")
-            eta = float(self.eta)
-            if not (-1.0 <= eta <= 1.0):
-                raise InputError(f"must be in [-1, 1], got {self.eta!r}", "eta")
-            if self.one_sided and eta > 0.0:
-                raise InputError(
-                    f"must be <= 0 for one-sided rocking (rebound off the restraint), got {eta}",
-                    "eta",
-                )
-            if not self.one_sided and eta < 0.0:
-                raise InputError(
-                    f"must be >= 0 for two-sided rocking (negative values mean rebound, "
-                    f"which is one-sided), got {eta}",
-                    "eta",
-                )
-            object.__setattr__(self, "eta", eta)
+            object.__setattr__(self, "eta", check_eta(self.eta, self.one_sided))
 
     @classmethod
     def symmetric(
