@@ -10,14 +10,16 @@ from __future__ import annotations
 import contextlib
 import datetime
 import importlib.metadata
+import math
 import os
 import platform
 import re
 import subprocess
 import tempfile
+import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Union
+from typing import Any, Callable, List, Tuple, Union
 
 REPO = Path(__file__).resolve().parent.parent
 #: The shared results file.
@@ -205,3 +207,21 @@ def md_table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     out = ["| " + " | ".join(headers) + " |", "|" + "|".join("---" for _ in headers) + "|"]
     out += ["| " + " | ".join(c.replace("|", "/") for c in r) + " |" for r in rows]
     return "\n".join(out)
+
+
+def best_of(
+    fn: Callable[[], Any], repeats: int, budget_s: float = math.inf
+) -> Tuple[float, List[float], Any]:
+    """Return the best wall time [s] of up to ``repeats`` calls, all times, and the last result.
+
+    A series stops early once its calls add up to ``budget_s`` seconds.
+    """
+    times: List[float] = []
+    out = None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+        if sum(times) > budget_s:
+            break
+    return min(times), times, out

@@ -39,7 +39,7 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import Any, Optional
 
 import numpy as np
 
@@ -50,6 +50,7 @@ if str(HERE) not in sys.path:
 
 from _docs import (  # noqa: E402  (benchmarks/ is not a package)
     DOC_MD,
+    best_of,
     fmt_time,
     load_average,
     machine_info,
@@ -163,17 +164,6 @@ class IvpRow:
             "there too: an island narrower than the scan step",
             "unconfirmed": "DISAGREES: no such edge in boundary_curve or the exact integrator",
         }[self.kind]
-
-
-def best_of(fn: Callable[[], Any], repeats: int) -> tuple[float, list[float], Any]:
-    """Best wall time [s] of ``repeats`` calls, all times, and the last result."""
-    times: list[float] = []
-    out = None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), times, out
 
 
 def verdict(ok: Optional[bool]) -> str:

@@ -45,7 +45,7 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import Any, Optional
 
 import numpy as np
 
@@ -60,7 +60,14 @@ except ImportError:  # pragma: no cover - depends on the environment
     sys.exit("benchmarks/work_precision.py needs mpmath for its reference: pip install mpmath")
 
 import mpref  # noqa: E402  (benchmarks/ is not a package)
-from _docs import fmt_time, machine_info, md_table, text_table, write_section  # noqa: E402
+from _docs import (  # noqa: E402
+    best_of,
+    fmt_time,
+    machine_info,
+    md_table,
+    text_table,
+    write_section,
+)
 from mpmath import mp, mpf  # noqa: E402
 
 from solver_service.core.exact import simulate, simulate_batch  # noqa: E402
@@ -142,19 +149,6 @@ class Row:
 # ------------------------------------------------------------------------------------------
 # Helpers
 # ------------------------------------------------------------------------------------------
-
-
-def best_of(fn: Callable[[], Any], repeats: int) -> tuple[float, Any, int]:
-    """Best wall time of up to ``repeats`` calls (stops after ``REPEAT_BUDGET_S``)."""
-    times: list[float] = []
-    out = None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-        if sum(times) > REPEAT_BUDGET_S:
-            break
-    return min(times), out, len(times)
 
 
 def rel_err(peak: float, ref: Any) -> float:
@@ -252,9 +246,12 @@ def run_exact(case: Case, quick: bool) -> list[Row]:
         t0 = time.perf_counter()
         simulate(case.model, case.excitation, backend=backend)
         warm = time.perf_counter() - t0
-        t, res, n = best_of(
-            lambda b=backend: simulate(case.model, case.excitation, backend=b), reps
+        t, times, res = best_of(
+            lambda b=backend: simulate(case.model, case.excitation, backend=b),
+            reps,
+            budget_s=REPEAT_BUDGET_S,
         )
+        n = len(times)
         rows.append(
             Row(
                 method=f"exact ({backend})",
@@ -290,7 +287,8 @@ def run_ivp(case: Case, rtols: tuple[float, ...], quick: bool) -> list[Row]:
                 return simulate_ivp(case.model, case.excitation, method=m, rtol=r, atol=a)
 
             try:
-                t, res, n = best_of(call, 1 if quick else REPEATS_REF)
+                t, times, res = best_of(call, 1 if quick else REPEATS_REF, budget_s=REPEAT_BUDGET_S)
+                n = len(times)
             except Exception as exc:  # report, do not stop the benchmark
                 rows.append(
                     Row(method, rtol, math.nan, math.nan, math.nan, -1, False, 1, f"failed: {exc}")
@@ -330,12 +328,14 @@ def run_nonlinear(case: Case, rtols: tuple[float, ...]) -> list[Row]:
     rows = []
     for rtol in rtols:
         try:
-            t, res, n = best_of(
+            t, times, res = best_of(
                 lambda r=rtol: simulate_nonlinear(
                     case.block, case.excitation, method="DOP853", rtol=r, atol=ATOL_FACTOR * r
                 ),
                 1,
+                budget_s=REPEAT_BUDGET_S,
             )
+            n = len(times)
         except Exception as exc:
             rows.append(Row("DOP853", rtol, math.nan, math.nan, math.nan, -1, False, 1, str(exc)))
             continue
@@ -373,12 +373,21 @@ def run_batch(case: Case, quick: bool) -> dict[str, Any]:
     warm = time.perf_counter() - t0
     reps = 1 if quick else REPEATS_BATCH
     threads = numba.get_num_threads()
-    t, res, n = best_of(lambda: simulate_batch([case.model], case.excitation, scales), reps)
+    t, times, res = best_of(
+        lambda: simulate_batch([case.model], case.excitation, scales),
+        reps,
+        budget_s=REPEAT_BUDGET_S,
+    )
+    n = len(times)
     # Single-thread figure, to separate the per-core speed from the parallel speed-up (which
     # other load on the machine eats first).
     numba.set_num_threads(1)
     try:
-        t1, _, _ = best_of(lambda: simulate_batch([case.model], case.excitation, scales), reps)
+        t1, _, _ = best_of(
+            lambda: simulate_batch([case.model], case.excitation, scales),
+            reps,
+            budget_s=REPEAT_BUDGET_S,
+        )
     finally:
         numba.set_num_threads(threads)
     out = {
@@ -544,7 +553,9 @@ def pulse_batch_time(case: Case, quick: bool) -> float:
     scales = np.linspace(0.9, 1.1, N_SCALES)
     simulate_batch([case.model], case.excitation, scales)
     t, _, _ = best_of(
-        lambda: simulate_batch([case.model], case.excitation, scales), 1 if quick else 5
+        lambda: simulate_batch([case.model], case.excitation, scales),
+        1 if quick else 5,
+        budget_s=REPEAT_BUDGET_S,
     )
     return t / N_SCALES
 
