@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
 import numpy as np
 
-from shared_schema.constants import ConstantsFile
+from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError
 
 from .adapter import to_rocking_model
@@ -25,15 +26,22 @@ from .core.envelope import (
     governing_one_sided,
     mechanism_envelope,
 )
+from .core.model import check_positive
 
 __all__ = [
     "SF_METHODS",
+    "Building",
     "boundary_doc",
     "envelope_csv",
     "envelope_doc",
     "frequency_grid",
     "history_doc",
+    "log_grid",
+    "mechanism_scale_factor",
+    "record_doc",
+    "record_pulse_doc",
     "write_envelope",
+    "write_history",
 ]
 
 
@@ -41,16 +49,78 @@ def _finite_or_none(values: np.ndarray[Any, Any]) -> list[Optional[float]]:
     return [float(v) if math.isfinite(v) else None for v in values]
 
 
-def frequency_grid(f_min: float, f_max: float, n: int) -> np.ndarray[Any, Any]:
-    """Log-spaced pulse frequencies [Hz], validated."""
-    for name, value in (("f_min", f_min), ("f_max", f_max)):
+#: One-line description of the pulse extraction (``core.pulses``).
+PULSE_METHOD = "zero-crossing lobes: two adjacent half-cycles, a_p = the smaller peak"
+
+
+def log_grid(
+    lo: float, hi: float, n: int, *, names: tuple[str, str] = ("f_min", "f_max")
+) -> np.ndarray[Any, Any]:
+    """Return ``n`` log-spaced values from ``lo`` to ``hi``, validated (errors use ``names``)."""
+    for name, value in zip(names, (lo, hi)):
         if not (math.isfinite(value) and value > 0):
             raise InputError(f"must be finite and > 0, got {value!r}", name)
-    if f_min >= f_max:
-        raise InputError(f"must be below f_max ({f_max!r}), got {f_min!r}", "f_min")
+    if lo >= hi:
+        raise InputError(f"must be below {names[1]} ({hi!r}), got {lo!r}", names[0])
     if n < 2:
         raise InputError(f"must be >= 2, got {n!r}", "n")
-    return np.geomspace(f_min, f_max, n)
+    return np.geomspace(lo, hi, n)
+
+
+def frequency_grid(f_min: float, f_max: float, n: int) -> np.ndarray[Any, Any]:
+    """Log-spaced pulse frequencies [Hz], validated."""
+    return log_grid(f_min, f_max, n)
+
+
+def record_doc(
+    motion: Any,
+    periods: np.ndarray[Any, Any],
+    *,
+    zeta: float = 0.05,
+    n_pulses: int = 5,
+    f_min: Optional[float] = None,
+    f_max: Optional[float] = None,
+) -> dict[str, Any]:
+    """Describe a record: metadata, largest sine pulses and exact response spectrum.
+
+    Parameters
+    ----------
+    motion : GroundMotion
+        The record.
+    periods : (m,) float
+        Natural periods of the spectrum [s].
+    zeta : float
+        Damping ratio [-].
+    n_pulses : int
+        How many of the largest pulses to list.
+    f_min, f_max : float, optional
+        Pulse search range [Hz].
+    """
+    from .core.pulses import extract_pulses
+    from .core.spectra import response_spectrum
+
+    found = extract_pulses(motion.accel, f_min=f_min, f_max=f_max, n=n_pulses)
+    spec = response_spectrum(motion.accel.acc, motion.dt, periods, zeta)
+    return {
+        "record": {
+            "name": motion.name,
+            "n_samples": len(motion.accel.acc),
+            "dt_s": motion.dt,
+            "pga_g": motion.pga_g,
+            "duration_s": motion.duration,
+            **motion.metadata,
+        },
+        "pulses": [p.to_dict() for p in found],
+        "pulse_method": PULSE_METHOD,
+        "spectrum": {
+            "damping": spec.zeta,
+            "periods_s": [float(v) for v in spec.periods],
+            "psa_g": [float(v) for v in spec.psa_g],
+            "sd_m": [float(v) for v in spec.sd],
+            "method": "exact piecewise-linear recursion (Nigam-Jennings)",
+            "runtime_s": spec.runtime_s,
+        },
+    }
 
 
 def envelope_doc(
@@ -190,13 +260,19 @@ def write_envelope(
     stem: str = "envelope",
     title: str = "",
     exact: bool = False,
+    record_pulse: Optional[dict[str, Any]] = None,
 ) -> dict[str, Any]:
-    """Write ``<stem>.json``, ``<stem>.csv`` and ``<stem>.png`` (atomically); return the doc."""
+    """Write ``<stem>.json``, ``<stem>.csv`` and ``<stem>.png`` (atomically); return the doc.
+
+    ``record_pulse`` (from ``record_pulse_doc``) is added to the JSON and drawn on the plot.
+    """
     from shared_schema.io import write_atomic
 
     from .report.plots import plot_envelopes
 
     doc, envs = envelope_doc(cf, f_p, exact=exact)
+    if record_pulse is not None:
+        doc["record_pulse"] = record_pulse
     out_dir.mkdir(parents=True, exist_ok=True)
     write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
     write_atomic(out_dir / f"{stem}.csv", envelope_csv(doc))
@@ -206,12 +282,138 @@ def write_envelope(
         out_dir / f"{stem}.png",
         labels={m.id: f"{m.id}: {m.name}" for m in cf.mechanisms},
         title=title,
+        pulse_points=None if record_pulse is None else record_pulse["points"],
     )
     return doc
 
 
-#: Scale-factor methods of time histories: none, or Eq. 28 from the record's spectrum.
-SF_METHODS = ("none", "eq28")
+def record_pulse_doc(
+    cf: ConstantsFile,
+    motion: Any,
+    scales: list[float],
+    *,
+    f_min: Optional[float] = None,
+    f_max: Optional[float] = None,
+    exact: bool = False,
+) -> dict[str, Any]:
+    """Compare a record's largest sine pulse, at several scale factors, with every envelope.
+
+    Each point ``(f_p, s |a_p|)`` lists the mechanisms whose ground-level envelope lies at
+    or below it at ``f_p``: those the pulse alone would overturn at scale ``s``. For
+    one-sided mechanisms the envelope is the lower of the two pulse directions, so the
+    verdict is the conservative one.
+
+    Parameters
+    ----------
+    cf : ConstantsFile
+        The mechanisms.
+    motion : GroundMotion
+        The record.
+    scales : list of float
+        Scale factors on the record [-], each > 0.
+    f_min, f_max : float, optional
+        Frequency range to search for the pulse [Hz].
+    exact : bool
+        Evaluate the envelopes at ``f_p`` by the exact boundary search, not the library.
+    """
+    from .core.pulses import largest_pulse
+
+    for j, value in enumerate(scales):
+        check_positive(value, f"scales[{j}]")
+    pulse = largest_pulse(motion.accel, f_min=f_min, f_max=f_max)
+    at_fp, _ = envelope_doc(cf, np.array([pulse.f_p]), exact=exact)
+    a_min = {m["id"]: m["a_p_min_g"][0] for m in at_fp["mechanisms"]}
+    points = []
+    for scale in scales:
+        a_p = scale * abs(pulse.a_p_g)
+        points.append(
+            {
+                "scale": scale,
+                "f_p_hz": pulse.f_p,
+                "a_p_g": a_p,
+                "overturns": [k for k, v in a_min.items() if v is not None and a_p >= v],
+            }
+        )
+    return {
+        "record": motion.name,
+        "pulse": pulse.to_dict(),
+        "method": PULSE_METHOD,
+        "a_p_min_g_at_f_p": a_min,
+        "points": points,
+    }
+
+
+#: Scale-factor methods of time histories: none, Eq. 28 from the record's spectrum, or the
+#: EN 1998-1 and NZS 1170.5 code factors (THEORY §7.3-7.4).
+SF_METHODS = ("none", "eq28", "ec8", "nzs")
+
+
+@dataclass(frozen=True)
+class Building:
+    """What the code scale factors need to know about the supporting structure.
+
+    Attributes
+    ----------
+    height : float, optional
+        Height of the building above its foundation, ``H`` (EC8) or ``h_n`` (NZS) [m], > 0.
+    soil_factor : float
+        EC8 soil factor ``S`` [-], > 0; 1 gives the bare amplification.
+    element_period : float
+        EC8 fundamental period of the element ``T_a`` [s], >= 0; 0 (the default) takes the
+        rocking mechanism as rigid before uplift.
+    """
+
+    height: Optional[float] = None
+    soil_factor: float = 1.0
+    element_period: float = 0.0
+
+
+def mechanism_scale_factor(
+    mech: Mechanism, motion: Any, sf: str, building: Building = Building()
+) -> Optional[dict[str, Any]]:
+    """Scale factor of the record up the structure for one mechanism, or None at ground level.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The mechanism; only those with ``amplification {f_n, h_e, h}`` are scaled.
+    motion : GroundMotion
+        The record (Eq. 28 uses its exact 5 %-damped spectrum at ``T_n = 1/f_n``).
+    sf : {"eq28", "ec8", "nzs"}
+        Method. EC8 takes ``z = h``, ``T_1 = 1/f_n``; NZS takes ``h_i = h``.
+    building : Building
+        Building height (EC8 and NZS), soil factor and element period (EC8).
+
+    Returns
+    -------
+    dict or None
+        ``{"value", "method", "formula", "inputs"}`` (``solver_service.core.codes``).
+    """
+    from .core.codes import sf_ec8, sf_eq28, sf_nzs
+    from .core.model import G
+    from .core.spectra import response_spectrum
+
+    if sf not in SF_METHODS:
+        raise InputError(f"must be one of {list(SF_METHODS)}, got {sf!r}", "sf")
+    amp = mech.amplification
+    if sf == "none" or amp is None:
+        return None
+    if sf == "eq28":
+        spec = response_spectrum(motion.accel.acc, motion.dt, [1.0 / amp.f_n])
+        return sf_eq28(float(spec.psa[0]) / G, motion.pga_g, amp.h, amp.h_e)
+    if building.height is None:
+        raise InputError(f"--sf {sf} needs the height of the building [m]", "building_height")
+    if amp.h > building.height:
+        raise InputError(
+            f"mechanism {mech.id!r} sits at h = {amp.h:g} m, above the building "
+            f"({building.height:g} m)",
+            "building_height",
+        )
+    if sf == "nzs":
+        return sf_nzs(amp.h, building.height)
+    return sf_ec8(
+        amp.h, building.height, building.element_period, 1.0 / amp.f_n, building.soil_factor
+    )
 
 
 def history_doc(
@@ -220,54 +422,64 @@ def history_doc(
     scales: list[float],
     *,
     sf: str = "none",
+    building: Building = Building(),
     criterion: Optional[str] = None,
+    at_height: Optional[float] = None,
 ) -> dict[str, Any]:
     """Time histories of every mechanism at every scale, as a JSON-ready document.
 
-    With ``sf = "eq28"`` a mechanism with ``amplification {f_n, h_e, h}`` receives the record
-    scaled by ``SF = sqrt(1 + (S_a(T_n)/PGA · h/h_e)²)`` (Eq. 28; ``S_a`` from the record's
-    exact 5 %-damped spectrum at ``T_n = 1/f_n``) on top of each user scale; mechanisms at
-    ground level are not scaled. Each row then carries ``effective_scale``, and the document
-    the factor with its formula and inputs.
-    """
-    from .core.codes import sf_eq28
-    from .core.exact import simulate_batch
-    from .core.model import G
-    from .core.spectra import response_spectrum
+    With ``sf`` other than ``"none"`` a mechanism with ``amplification {f_n, h_e, h}``
+    receives the record times its scale factor (``mechanism_scale_factor``) on top of each
+    user scale; mechanisms at ground level are not scaled. Each row then carries
+    ``effective_scale``, and the document the factors with their formulas and inputs.
 
-    if sf not in SF_METHODS:
-        raise InputError(f"must be one of {list(SF_METHODS)}, got {sf!r}", "sf")
+    With ``at_height = z`` [m] each row also gives ``peak_displacement_m``, the horizontal
+    displacement of a point ``z`` above the rotation axis, ``z · max|phi|`` (small
+    rotations), to compare with shake-table measurements. For a two-sided mechanism with
+    different ``phi_ov`` on its two sides it is the bound ``z · peak_ratio · max(phi_ov)``,
+    flagged ``peak_displacement_is_bound``.
+    """
+    from .core.exact import simulate_batch
+
+    if at_height is not None:
+        at_height = check_positive(at_height, "at_height")
     models = [to_rocking_model(m) for m in cf.mechanisms]
     for model in models:
         model.require_eta()
     factors: dict[str, Any] = {}
-    rows: list[dict[str, Any]] = []
+    groups: dict[float, list[int]] = {}  # mechanisms sharing a factor share one batch
+    for i, mech in enumerate(cf.mechanisms):
+        info = mechanism_scale_factor(mech, motion, sf, building)
+        if info is not None:
+            factors[mech.id] = info
+        groups.setdefault(1.0 if info is None else float(info["value"]), []).append(i)
+    per_mech: list[list[dict[str, Any]]] = [[] for _ in models]
     runtime = 0.0
     crit, method = "", ""
-    groups: list[tuple[list[Any], float, Optional[str]]] = []
-    if sf == "none":
-        groups.append((models, 1.0, None))
-    else:
-        for mech, model in zip(cf.mechanisms, models):
-            factor = 1.0
-            if mech.amplification is not None:
-                amp = mech.amplification
-                spec = response_spectrum(motion.accel.acc, motion.dt, [1.0 / amp.f_n])
-                info = sf_eq28(float(spec.psa[0]) / G, motion.pga_g, amp.h, amp.h_e)
-                factor = float(info["value"])
-                factors[mech.id] = info
-            groups.append(([model], factor, mech.id))
-    for group, factor, _ in groups:
+    for factor, members in groups.items():
         batch = simulate_batch(
-            group, motion.accel, [s * factor for s in scales], criterion=criterion
+            [models[i] for i in members],
+            motion.accel,
+            [s * factor for s in scales],
+            criterion=criterion,
         )
         runtime += batch.runtime_s
         crit, method = batch.criterion, batch.method
-        for row in batch.rows():
+        rows = batch.rows()
+        for k, i in enumerate(members):
+            per_mech[i] = rows[k * len(scales) : (k + 1) * len(scales)]
+    for model, mech_rows in zip(models, per_mech):
+        pos, neg = model.positive, model.neg
+        phi_ov = pos.phi_ov if model.one_sided else max(pos.phi_ov, neg.phi_ov)
+        for row, user_scale in zip(mech_rows, scales):
             if sf != "none":
                 row["effective_scale"] = row["scale"]
-                row["scale"] = row["scale"] / factor
-            rows.append(row)
+                row["scale"] = user_scale
+            if at_height is not None:
+                row["peak_displacement_m"] = at_height * row["peak_ratio"] * phi_ov
+                if not model.one_sided and pos.phi_ov != neg.phi_ov:
+                    row["peak_displacement_is_bound"] = True
+    rows = [row for mech_rows in per_mech for row in mech_rows]
     doc: dict[str, Any] = {
         "record": {
             "name": motion.name,
@@ -284,4 +496,58 @@ def history_doc(
     if sf != "none":
         doc["scale_factor_method"] = sf
         doc["scale_factors"] = factors
+    if at_height is not None:
+        doc["displacement"] = {"height_m": at_height, "formula": "u = z * max|phi| [m]"}
+    return doc
+
+
+def write_history(
+    cf: ConstantsFile,
+    motion: Any,
+    scales: list[float],
+    out_dir: Path,
+    *,
+    stem: str = "history",
+    title: str = "",
+    max_panels: int = 6,
+    **options: Any,
+) -> dict[str, Any]:
+    """Write ``<stem>.json``, ``<stem>.png`` and ``<stem>_record.png``; return the doc.
+
+    ``<stem>.png`` shows ``phi/phi_ov`` of every mechanism against time, one panel per
+    scale (at most ``max_panels``, evenly chosen, the largest always included);
+    ``<stem>_record.png`` the record with its largest sine pulse and its 5 % spectrum.
+    ``options`` go to ``history_doc``.
+    """
+    from shared_schema.io import write_atomic
+
+    from .core.exact import simulate
+    from .report.plots import plot_ratio_histories, plot_record
+
+    doc = history_doc(cf, motion, scales, **options)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
+    order = sorted(set(scales))
+    picks = sorted(
+        {order[round(k)] for k in np.linspace(0, len(order) - 1, min(max_panels, len(order)))}
+    )
+    factors = {k: v["value"] for k, v in doc.get("scale_factors", {}).items()}
+    panels = []
+    for scale in picks:
+        runs = [
+            (
+                mech.id,
+                simulate(
+                    to_rocking_model(mech),
+                    motion.accel,
+                    scale=scale * factors.get(mech.id, 1.0),
+                    criterion=options.get("criterion"),
+                    dense=True,
+                ),
+            )
+            for mech in cf.mechanisms
+        ]
+        panels.append((scale, runs))
+    plot_ratio_histories(panels, out_dir / f"{stem}.png", title=title or motion.name)
+    plot_record(motion, out_dir / f"{stem}_record.png")
     return doc

@@ -128,69 +128,109 @@ def pulse(
     )
 
 
+# Options shared by every command that reads a ground-motion record.
+_RECORD_ARG = typer.Argument(
+    ..., help="Record file: PEER AT2, two columns (t, a), one column (with --dt) or CSV."
+)
+_UNITS_OPT = typer.Option(
+    None,
+    "--units",
+    help="Acceleration units: g, m/s2 or cm/s2; AT2 files state their own, two-column "
+    "files default to g, other formats need it.",
+)
+_FORMAT_OPT = typer.Option(
+    None, "--format", help="at2, two_column, one_column or csv (default: detected)."
+)
+_DT_OPT = typer.Option(None, "--dt", help="Time step [s] of a record without a time column.")
+
+
+def _read_record(path: Path, fmt: Optional[str], units: Optional[str], dt: Optional[float]) -> Any:
+    from .core.records import GroundMotion, detect_format
+
+    fmt = fmt or detect_format(path)
+    if units is None and fmt == "two_column":
+        units = "g"  # the two-column t [s], a [g] convention of the bundled record
+    return GroundMotion.from_file(path, format=fmt, units=units, dt=dt)
+
+
+def _read_constants(path: Path) -> Any:
+    from shared_schema.io import load_constants
+
+    if not path.is_file():
+        _fail(f"constants: file not found: {path}")
+    return load_constants(path)
+
+
+def _scales(first: list[float], extra: list[str]) -> list[float]:
+    """Collect the --scale values, also those typed after the first (``--scale 0.5 1 2``)."""
+    scales = list(first)
+    for token in extra:
+        try:
+            scales.append(float(token))
+        except ValueError:
+            _fail(f"unexpected argument {token!r}")
+    return scales
+
+
 @app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
 @_user_errors
 def history(
     ctx: typer.Context,
     constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
-    record: Path = typer.Argument(
-        ..., help="Record file: PEER AT2, two columns (t, a), one column (with --dt) or CSV."
-    ),
+    record: Path = _RECORD_ARG,
     scale: list[float] = typer.Option(
         [1.0], "--scale", help="Scale factors on the record, e.g. --scale 0.5 1 2."
     ),
-    units: Optional[str] = typer.Option(
-        None,
-        "--units",
-        help="Acceleration units: g, m/s2 or cm/s2; AT2 files state their own, two-column "
-        "files default to g, other formats need it.",
-    ),
-    record_format: Optional[str] = typer.Option(
-        None, "--format", help="at2, two_column, one_column or csv (default: detected)."
-    ),
-    dt: Optional[float] = typer.Option(
-        None, "--dt", help="Time step [s] of a record without a time column."
-    ),
+    units: Optional[str] = _UNITS_OPT,
+    record_format: Optional[str] = _FORMAT_OPT,
+    dt: Optional[float] = _DT_OPT,
     sf: str = typer.Option(
         "none",
         "--sf",
-        help="Scale factor up the structure for mechanisms with amplification data: none, or "
-        "eq28 (from the record's 5 % spectrum at T_n = 1/f_n).",
+        help="Scale factor up the structure for mechanisms with amplification data: none; "
+        "eq28 (from the record's 5 % spectrum at T_n = 1/f_n); ec8 (EN 1998-1 §4.3.5.2, "
+        "needs --building-height); nzs (NZS 1170.5 C_Hi, needs --building-height).",
+    ),
+    building_height: Optional[float] = typer.Option(
+        None, "--building-height", help="Height of the building H = h_n [m] (ec8, nzs)."
+    ),
+    soil_factor: float = typer.Option(1.0, "--soil-factor", help="EC8 soil factor S [-]."),
+    element_period: float = typer.Option(
+        0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
+    ),
+    at_height: Optional[float] = typer.Option(
+        None,
+        "--at-height",
+        help="Also report the peak displacement [m] of a point this far [m] above each "
+        "mechanism's rotation axis (to compare with shake-table tests).",
     ),
     criterion: Optional[str] = typer.Option(
         None, "--criterion", help="Overturning verdict: ratio (default for records) or exact."
     ),
     out: Optional[Path] = typer.Option(
-        None, "--out", help="Folder for history.json and a time-history plot."
+        None,
+        "--out",
+        help="Folder for history.json, history.png (phi/phi_ov per scale) and "
+        "history_record.png (record, largest pulse and spectrum).",
     ),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Time history of every mechanism in CONSTANTS under RECORD at each scale factor."""
-    from shared_schema.io import load_constants, write_atomic
+    from .analysis import Building, history_doc, write_history
 
-    from .adapter import models_from_file
-    from .analysis import history_doc
-    from .core.records import GroundMotion, detect_format
-
-    scales = list(scale)
-    for extra in ctx.args:
-        try:
-            scales.append(float(extra))
-        except ValueError:
-            _fail(f"unexpected argument {extra!r}")
-    if not constants.is_file():
-        _fail(f"constants: file not found: {constants}")
-    cf = load_constants(constants)
-    models = models_from_file(cf)
-    fmt = record_format or detect_format(record)
-    if units is None and fmt == "two_column":
-        units = "g"  # the two-column t [s], a [g] convention of the bundled record
-    motion = GroundMotion.from_file(record, format=fmt, units=units, dt=dt)
-    doc = history_doc(cf, motion, scales, sf=sf, criterion=criterion)
+    scales = _scales(scale, ctx.args)
+    cf = _read_constants(constants)
+    motion = _read_record(record, record_format, units, dt)
+    options: dict[str, Any] = {
+        "sf": sf,
+        "building": Building(building_height, soil_factor, element_period),
+        "criterion": criterion,
+        "at_height": at_height,
+    }
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        write_atomic(out / "history.json", json.dumps(doc, indent=2) + "\n")
-        _history_plot(models, motion, max(scales), out / "history.png")
+        doc = write_history(cf, motion, scales, out, **options)
+    else:
+        doc = history_doc(cf, motion, scales, **options)
     if as_json:
         _print_json(doc)
         return
@@ -198,9 +238,12 @@ def history(
         f"{motion.name}: PGA {motion.pga_g:.3f} g, dt {motion.dt:g} s, "
         f"{motion.duration:.2f} s; criterion: {doc['criterion']}"
     )
+    for mech_id, info in doc.get("scale_factors", {}).items():
+        typer.echo(f"  SF {mech_id}: {info['value']:.4f} = {info['formula']}")
+    disp = at_height is not None
     typer.echo(
         f"{'mechanism':<16}{'scale':>8}{'peak':>10}{'overturned':>12}"
-        f"{'t_ov [s]':>10}{'impacts':>9}{'error':>10}"
+        f"{'t_ov [s]':>10}{'impacts':>9}{'error':>10}" + (f"{'u_peak [m]':>12}" if disp else "")
     )
     for row in doc["results"]:
         t_ov = "-" if row["t_overturn"] is None else f"{row['t_overturn']:.3f}"
@@ -208,22 +251,65 @@ def history(
             f"{row['mechanism']:<16}{row['scale']:>8g}{row['peak_ratio']:>10.4f}"
             f"{'yes' if row['overturned'] else 'no':>12}{t_ov:>10}{row['n_impacts']:>9}"
             f"{row['error_estimate']:>10.1e}"
+            + (f"{row['peak_displacement_m']:>12.4g}" if disp else "")
         )
+    if out is not None:
+        typer.echo(f"wrote {out / 'history.json'}, history.png, history_record.png")
 
 
-def _history_plot(models: list[Any], motion: Any, scale: float, path: Path) -> None:
-    from .core.exact import simulate
-    from .core.model import G
-    from .report.plots import plot_time_histories
+@app.command("record")
+@_user_errors
+def record_info(
+    record: Path = _RECORD_ARG,
+    units: Optional[str] = _UNITS_OPT,
+    record_format: Optional[str] = _FORMAT_OPT,
+    dt: Optional[float] = _DT_OPT,
+    zeta: float = typer.Option(0.05, "--damping", help="Damping ratio of the spectrum [-]."),
+    t_min: float = typer.Option(0.02, "--t-min", help="Shortest period of the spectrum [s]."),
+    t_max: float = typer.Option(10.0, "--t-max", help="Longest period of the spectrum [s]."),
+    n: int = typer.Option(100, "--n", help="Number of log-spaced periods."),
+    pulses: int = typer.Option(5, "--pulses", help="How many of the largest pulses to list."),
+    f_min: Optional[float] = typer.Option(None, "--f-min", help="Pulse search: lowest f_p [Hz]."),
+    f_max: Optional[float] = typer.Option(None, "--f-max", help="Pulse search: highest f_p [Hz]."),
+    out: Optional[Path] = typer.Option(
+        None, "--out", help="Folder for record.json and record.png (record and spectrum)."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+) -> None:
+    """Describe a record: metadata, largest sine pulses and exact response spectrum."""
+    from .analysis import log_grid, record_doc
 
-    runs = [(m.name, simulate(m, motion.accel, scale=scale, dense=True)) for m in models]
-    plot_time_histories(
-        runs,
-        path,
-        record_t=motion.accel.time,
-        record_a_g=scale * motion.accel.acc / G,
-        title=f"{motion.name} x {scale:g}",
+    motion = _read_record(record, record_format, units, dt)
+    periods = log_grid(t_min, t_max, n, names=("t_min", "t_max"))
+    doc = record_doc(motion, periods, zeta=zeta, n_pulses=pulses, f_min=f_min, f_max=f_max)
+    if out is not None:
+        from shared_schema.io import write_atomic
+
+        from .report.plots import plot_record
+
+        out.mkdir(parents=True, exist_ok=True)
+        write_atomic(out / "record.json", json.dumps(doc, indent=2) + "\n")
+        plot_record(motion, out / "record.png", periods=periods, zeta=zeta)
+    if as_json:
+        _print_json(doc)
+        return
+    typer.echo(
+        f"{motion.name}: {len(motion.accel.acc)} samples, dt {motion.dt:g} s, "
+        f"{motion.duration:.2f} s, PGA {motion.pga_g:.4f} g"
     )
+    typer.echo("largest one-cycle sine pulses (a_p signed: > 0 first accelerates positively):")
+    for p in doc["pulses"]:
+        typer.echo(
+            f"  a_p = {p['a_p_g']:+.4f} g  f_p = {p['f_p_hz']:.3f} Hz  t = {p['t_start_s']:.3f} s"
+        )
+    spec = doc["spectrum"]
+    k = max(range(len(spec["psa_g"])), key=lambda i: spec["psa_g"][i])
+    typer.echo(
+        f"spectrum ({100 * zeta:g} %): peak PSA {spec['psa_g'][k]:.4f} g at "
+        f"T = {spec['periods_s'][k]:.3f} s ({spec['runtime_s'] * 1e3:.1f} ms)"
+    )
+    if out is not None:
+        typer.echo(f"wrote {out / 'record.json'}, record.png")
 
 
 @app.command()
@@ -267,9 +353,10 @@ def constants(
             typer.echo(f"    warning: {note}")
 
 
-@app.command()
+@app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
 @_user_errors
 def envelope(
+    ctx: typer.Context,
     constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
     out: Path = typer.Option(..., "--out", help="Folder for envelope.json, .csv and .png."),
     f_min: float = typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
@@ -278,19 +365,37 @@ def envelope(
     exact: bool = typer.Option(
         False, "--exact", help="Compute boundaries directly instead of from the library."
     ),
+    record: Optional[Path] = typer.Option(
+        None,
+        "--record",
+        help="Draw this record's largest sine pulse on the plot, at each --record-scale.",
+    ),
+    record_scale: list[float] = typer.Option(
+        [0.5, 1.0, 2.0], "--record-scale", help="Scale factors of the record's pulse [-]."
+    ),
+    units: Optional[str] = _UNITS_OPT,
+    record_format: Optional[str] = _FORMAT_OPT,
+    dt: Optional[float] = _DT_OPT,
     as_json: bool = typer.Option(False, "--json", help="Also print the JSON document."),
 ) -> None:
     """Minimum overturning sine-pulse amplitude of every mechanism, and the critical bands."""
-    from shared_schema.io import load_constants
-
-    from .analysis import frequency_grid, write_envelope
+    from .analysis import frequency_grid, record_pulse_doc, write_envelope
 
     f_p = frequency_grid(f_min, f_max, n)
-    if not constants.is_file():
-        _fail(f"constants: file not found: {constants}")
-    cf = load_constants(constants)
+    cf = _read_constants(constants)
+    pulse = None
+    if record is not None:
+        motion = _read_record(record, record_format, units, dt)
+        pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), exact=exact)
+    elif ctx.args:
+        _fail(f"unexpected argument {ctx.args[0]!r}")
     doc = write_envelope(
-        cf, f_p, out, exact=exact, title=f"Overturning envelopes: {constants.name}"
+        cf,
+        f_p,
+        out,
+        exact=exact,
+        title=f"Overturning envelopes: {constants.name}",
+        record_pulse=pulse,
     )
     if as_json:
         _print_json(doc)
@@ -299,6 +404,15 @@ def envelope(
     typer.echo("critical mechanism by pulse frequency:")
     for band in doc["critical"]:
         typer.echo(f"  {band['f_min']:8.3f} - {band['f_max']:8.3f} Hz: {band['mechanism']}")
+    if pulse is not None:
+        p = pulse["pulse"]
+        typer.echo(
+            f"largest pulse of {pulse['record']}: {abs(p['a_p_g']):.4f} g at "
+            f"{p['f_p_hz']:.3f} Hz (t = {p['t_start_s']:.2f} s)"
+        )
+        for point in pulse["points"]:
+            names = ", ".join(point["overturns"]) or "none"
+            typer.echo(f"  x{point['scale']:g}: {point['a_p_g']:.4f} g overturns {names}")
 
 
 @app.command()

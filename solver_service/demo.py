@@ -5,12 +5,14 @@
 * ``constants.json``: analytic kinematic constants of three rectangular walls;
 * ``history.json``: peak ``|phi|/phi_ov`` and overturning of each wall at several scale
   factors of El Centro 1940 N-S, from the exact integrator;
-* ``history.png``: the time histories under the unscaled record;
+* ``history.png``: the time histories ``phi/phi_ov``, one panel per scale factor, and
+  ``history_record.png``: the record with its largest sine pulse and its spectrum;
 * ``church_envelope.json``, ``.csv`` and ``.png``: minimum overturning pulse amplitudes
   of the example church's mechanisms (``examples/constants/church.json``), at ground
   level, with the critical mechanism per pulse frequency;
-* ``church_history.json``: El Centro 1940 against the church's mechanisms, each scaled up
-  the structure by Eq. 28 (from the record's 5 % spectrum at its natural period);
+* ``church_history.json`` and ``.png``: El Centro 1940 against the church's mechanisms,
+  each scaled up the structure by Eq. 28 (from the record's 5 % spectrum at its natural
+  period);
 * ``facade_constants.json`` and ``facade_envelope.{json,csv,png}``: the CAD path end to
   end, from the example façade scene (``examples/scenes/facade.3dm``, with floors, roof,
   vault, tie-bars and a crack) and its spec to kinematic constants and envelopes.
@@ -18,18 +20,13 @@
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from shared_schema.constants import ConstantsFile
-from shared_schema.io import save_constants, write_atomic
+from shared_schema.io import save_constants
 
-from .adapter import models_from_file
-from .core.exact import simulate, simulate_batch
 from .core.model import G
 from .core.records import GroundMotion
 
@@ -51,8 +48,6 @@ DEMO_WALLS = (
 )
 #: Scale factors applied to the record in the demo.
 DEMO_SCALES = (0.5, 1.0, 1.5, 2.0, 3.0)
-#: Scale factor of the plotted time histories: the record as recorded.
-DEMO_PLOT_SCALE = 1.0
 
 
 def rectangular_block(
@@ -141,7 +136,7 @@ def run_demo(out_dir: Path, record_path: Path | None = None) -> dict[str, Path]:
     dict
         Paths of the written files by kind.
     """
-    from .report.plots import plot_time_histories
+    from .analysis import write_history
 
     out_dir.mkdir(parents=True, exist_ok=True)
     record_path = record_path or EXAMPLES_DIR / "records" / "elcentro_NS.dat"
@@ -149,42 +144,21 @@ def run_demo(out_dir: Path, record_path: Path | None = None) -> dict[str, Path]:
     cf = demo_constants()
     constants_path = out_dir / "constants.json"
     save_constants(constants_path, cf)
-    models = models_from_file(cf)
-    batch = simulate_batch(models, record.accel, np.array(DEMO_SCALES))
-    summary = {
-        "record": {
-            "name": record.name,
-            "dt_s": record.dt,
-            "pga_g": record.pga_g,
-            "duration_s": record.duration,
-            **record.metadata,
-        },
-        "criterion": batch.criterion,
-        "method": batch.method,
-        "runtime_s": batch.runtime_s,
-        "results": batch.rows(),
-    }
-    history_path = out_dir / "history.json"
-    write_atomic(history_path, json.dumps(summary, indent=2) + "\n")
-    scale = DEMO_PLOT_SCALE
-    runs = [
-        (mech.id, simulate(model, record.accel, scale=scale, dense=True))
-        for mech, model in zip(cf.mechanisms, models)
-    ]
-    plot_path = plot_time_histories(
-        runs,
-        out_dir / "history.png",
-        record_t=record.accel.time,
-        record_a_g=scale * record.accel.acc / G,
-        title=f"{record.name} x {scale:g}: rocking of the demo walls (exact integrator)",
+    write_history(
+        cf,
+        record,
+        list(DEMO_SCALES),
+        out_dir,
+        title=f"{record.name}: rocking of the demo walls (exact integrator)",
     )
     env_paths = church_envelope(out_dir)
     env_paths["church_history"] = church_history(out_dir, record)
     cad_paths = facade_from_scene(out_dir)
     return {
         "constants": constants_path,
-        "history": history_path,
-        "plot": plot_path,
+        "history": out_dir / "history.json",
+        "plot": out_dir / "history.png",
+        "record_plot": out_dir / "history_record.png",
         **env_paths,
         **cad_paths,
     }
@@ -231,14 +205,20 @@ def church_history(out_dir: Path, record: GroundMotion) -> Path:
     """
     from shared_schema.io import load_constants
 
-    from .analysis import history_doc
+    from .analysis import write_history
 
     cf = load_constants(EXAMPLES_DIR / "constants" / "church.json")
     cf = cf.model_copy(update={"mechanisms": [m for m in cf.mechanisms if m.eta is not None]})
-    doc = history_doc(cf, record, list(DEMO_SCALES), sf="eq28")
-    path = out_dir / "church_history.json"
-    write_atomic(path, json.dumps(doc, indent=2) + "\n")
-    return path
+    write_history(
+        cf,
+        record,
+        list(DEMO_SCALES),
+        out_dir,
+        stem="church_history",
+        title=f"{record.name} on the example church, scaled up the structure by Eq. 28",
+        sf="eq28",
+    )
+    return out_dir / "church_history.json"
 
 
 def church_envelope(out_dir: Path) -> dict[str, Path]:

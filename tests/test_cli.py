@@ -74,7 +74,8 @@ def test_history_writes_json_and_plot(tmp_path: Path) -> None:
     )
     assert res.exit_code == 0, res.output
     assert json.loads((tmp_path / "history.json").read_text())["results"]
-    assert (tmp_path / "history.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    for name in ("history.png", "history_record.png"):
+        assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 @pytest.mark.parametrize(
@@ -387,3 +388,155 @@ def test_history_with_eq28_scales_only_the_amplified_mechanisms(tmp_path: Path) 
     assert rows["TOWER"]["peak_ratio"] == direct.peak_ratio
     bad = runner.invoke(app, ["history", str(constants), str(record), "--sf", "ec99"])
     assert bad.exit_code == 2 and "sf" in bad.stderr
+
+
+def _two_level_constants(tmp_path: Path) -> Path:
+    constants = tmp_path / "c.json"
+    constants.write_text(
+        json.dumps(
+            {
+                "mechanisms": [
+                    {"id": "GROUND", "p_eq": 2.2, "lam": 0.17, "eta": 0.95},
+                    {
+                        "id": "TOWER",
+                        "p_eq": 2.2,
+                        "lam": 0.17,
+                        "eta": 0.95,
+                        "amplification": {"f_n": 3.0, "h_e": 10.0, "h": 12.0},
+                    },
+                ]
+            }
+        )
+    )
+    return constants
+
+
+@pytest.mark.parametrize(
+    ("method", "extra", "expected"),
+    [
+        # EN 1998-1 §4.3.5.2, rigid element (T_a = 0): 3(1 + z/H)/2 - 0.5, times S.
+        ("ec8", ["--soil-factor", "1.15"], 1.15 * (1.5 * (1 + 12.0 / 20.0) - 0.5)),
+        # NZS 1170.5 C_Hi: h_i = 12 m is not < 12 m, nor < 0.2 h_n: the cap 3.0.
+        ("nzs", [], 3.0),
+    ],
+)
+def test_history_with_code_scale_factors(
+    tmp_path: Path, method: str, extra: list[str], expected: float
+) -> None:
+    constants = _two_level_constants(tmp_path)
+    record = EXAMPLES / "records" / "elcentro_NS.dat"
+    args = ["history", str(constants), str(record), "--scale", "0.3", "--sf", method]
+    res = runner.invoke(app, [*args, "--building-height", "20", *extra, "--json"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    assert doc["scale_factor_method"] == method
+    info = doc["scale_factors"]["TOWER"]
+    assert info["value"] == pytest.approx(expected, rel=1e-14)
+    assert info["formula"] and info["inputs"]
+    rows = {r["mechanism"]: r for r in doc["results"]}
+    assert rows["TOWER"]["effective_scale"] == pytest.approx(0.3 * expected, rel=1e-14)
+    assert rows["GROUND"]["effective_scale"] == 0.3
+    motion = GroundMotion.from_two_column(record)
+    direct = simulate(RockingModel.symmetric(2.2, 0.17, 0.95), motion.accel, scale=0.3 * expected)
+    assert rows["TOWER"]["peak_ratio"] == direct.peak_ratio
+    # Without the building height, and with the mechanism above the building: clear errors.
+    missing = runner.invoke(app, args)
+    assert missing.exit_code == 2 and "building_height" in missing.stderr
+    low = runner.invoke(app, [*args, "--building-height", "8"])
+    assert low.exit_code == 2 and "'TOWER' sits at h = 12 m, above the building" in low.stderr
+
+
+def test_history_displacement_at_a_height(tmp_path: Path) -> None:
+    record = EXAMPLES / "records" / "elcentro_NS.dat"
+    constants = EXAMPLES / "constants" / "rect_walls.json"
+    res = runner.invoke(
+        app,
+        ["history", str(constants), str(record), "--scale", "0.6", "--at-height", "2.5", "--json"],
+    )
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    assert doc["displacement"]["height_m"] == 2.5
+    from shared_schema.io import load_constants
+    from solver_service.adapter import models_from_file
+
+    motion = GroundMotion.from_two_column(record)
+    for model, row in zip(models_from_file(load_constants(constants)), doc["results"]):
+        dense = simulate(model, motion.accel, scale=0.6, dense=True)
+        assert dense.ratio is not None
+        # Independent: the largest |phi| over the traced response, in radians, times z.
+        phi = np.where(dense.ratio >= 0, model.positive.phi_ov, model.neg.phi_ov) * dense.ratio
+        peak_phi = float(np.max(np.abs(phi)))
+        if not row["overturned"]:
+            assert row["peak_displacement_m"] == pytest.approx(2.5 * peak_phi, rel=1e-9)
+        assert "peak_displacement_is_bound" not in row
+    bad = runner.invoke(app, ["history", str(constants), str(record), "--at-height", "0"])
+    assert bad.exit_code == 2 and "at_height" in bad.stderr
+
+
+def test_record_command_gives_pulses_and_the_spectrum(tmp_path: Path) -> None:
+    from solver_service.core.pulses import extract_pulses
+    from solver_service.core.spectra import response_spectrum
+
+    record = EXAMPLES / "records" / "elcentro_NS.dat"
+    res = runner.invoke(
+        app, ["record", str(record), "--n", "20", "--pulses", "3", "--out", str(tmp_path), "--json"]
+    )
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    motion = GroundMotion.from_two_column(record)
+    assert doc["record"]["n_samples"] == 2688
+    assert doc["record"]["pga_g"] == pytest.approx(motion.pga_g)
+    expected = extract_pulses(motion.accel, n=3)
+    assert [p["f_p_hz"] for p in doc["pulses"]] == [p.f_p for p in expected]
+    periods = np.geomspace(0.02, 10.0, 20)
+    spec = response_spectrum(motion.accel.acc, motion.dt, periods)
+    assert doc["spectrum"]["psa_g"] == pytest.approx(list(spec.psa_g), rel=1e-12)
+    assert (tmp_path / "record.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert json.loads((tmp_path / "record.json").read_text()) == doc
+    bad = runner.invoke(app, ["record", str(record), "--t-min", "0"])
+    assert bad.exit_code == 2 and "t_min" in bad.stderr
+
+
+def test_envelope_with_a_records_pulse_agrees_with_the_exact_solver(tmp_path: Path) -> None:
+    record = EXAMPLES / "records" / "elcentro_NS.dat"
+    constants = EXAMPLES / "constants" / "rect_walls.json"
+    res = runner.invoke(
+        app,
+        [
+            "envelope",
+            str(constants),
+            "--out",
+            str(tmp_path),
+            "--exact",
+            "--n",
+            "12",
+            "--record",
+            str(record),
+            "--record-scale",
+            "0.3",
+            "1",
+            "3",
+            "--json",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    rp = doc["record_pulse"]
+    assert [p["scale"] for p in rp["points"]] == [0.3, 1.0, 3.0]
+    from shared_schema.io import load_constants
+    from solver_service.adapter import models_from_file
+
+    # Each verdict against a direct exact run of that pulse (both directions; governing).
+    for point in rp["points"]:
+        for model in models_from_file(load_constants(constants)):
+            a_min = rp["a_p_min_g_at_f_p"][model.name]
+            if abs(point["a_p_g"] / a_min - 1) < 1e-3:
+                continue  # too close to the boundary to be a fair check
+            runs = [
+                simulate(model, Pulse(sign * point["a_p_g"] * G, point["f_p_hz"]))
+                for sign in (1.0, -1.0)
+            ]
+            collapsed = any(r.collapsed for r in runs)
+            assert collapsed == (model.name in point["overturns"]), (point, model.name)
+    assert any(p["overturns"] for p in rp["points"])
+    assert not rp["points"][0]["overturns"]

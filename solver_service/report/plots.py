@@ -15,7 +15,12 @@ import numpy as np
 
 from ..core.result import RockingResult
 
-__all__ = ["plot_envelopes", "plot_time_histories"]
+__all__ = [
+    "plot_envelopes",
+    "plot_ratio_histories",
+    "plot_record",
+    "plot_time_histories",
+]
 
 
 def _pyplot() -> Any:
@@ -102,6 +107,124 @@ def plot_time_histories(
         plt.close(fig)
 
 
+def plot_ratio_histories(
+    panels: Sequence[tuple[float, Sequence[tuple[str, RockingResult]]]],
+    path: Union[str, Path],
+    *,
+    title: str = "",
+) -> Path:
+    """Plot ``phi/phi_ov`` of several mechanisms against time, one panel per scale factor.
+
+    Parameters
+    ----------
+    panels : sequence of (scale, [(label, RockingResult), ...])
+        Runs made with ``dense=True``; a mechanism keeps its colour in every panel.
+    path : str or Path
+        Output file (.png or .svg); written atomically.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
+    plt = _pyplot()
+    n = max(len(panels), 1)
+    fig, axes = plt.subplots(n, 1, figsize=(9, 1.2 + 2.1 * n), sharex=True, squeeze=False)
+    cmap = plt.get_cmap("tab10")
+    colours: dict[str, Any] = {}
+    for ax, (scale, runs) in zip(axes[:, 0], panels):
+        for label, res in runs:
+            if res.t is None or res.ratio is None:
+                raise ValueError(f"result {label!r} has no time series; run with dense=True")
+            colour = colours.setdefault(label, cmap(len(colours) % 10))
+            mark = " ×" if res.overturned else ""
+            ax.plot(res.t, res.ratio, lw=0.9, color=colour, label=f"{label}{mark}")
+            if res.overturned and res.t_overturn is not None:
+                ax.axvline(res.t_overturn, color=colour, ls=":", lw=0.8)
+        for level in (1.0, -1.0):
+            ax.axhline(level, color="crimson", ls="--", lw=0.7)
+        ax.set_ylim(-1.2, 1.2)
+        ax.set_ylabel(f"φ/φ_ov  (×{scale:g})")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper right", ncol=min(len(runs), 5))
+    axes[-1, 0].set_xlabel("time [s]")
+    if title:
+        axes[0, 0].set_title(f"{title}  (× overturned; dotted: time of overturning)")
+    fig.tight_layout()
+    try:
+        return _save_atomic(fig, path)
+    finally:
+        plt.close(fig)
+
+
+def plot_record(
+    motion: Any,
+    path: Union[str, Path],
+    *,
+    periods: Union[np.ndarray[Any, Any], None] = None,
+    zeta: float = 0.05,
+) -> Path:
+    """Plot a record with its largest sine pulse, and its elastic response spectrum.
+
+    Parameters
+    ----------
+    motion : GroundMotion
+        The record.
+    path : str or Path
+        Output file (.png or .svg); written atomically.
+    periods : (m,) float, optional
+        Natural periods of the spectrum [s]; default 100 log-spaced from 0.02 to 10 s.
+    zeta : float
+        Damping ratio of the spectrum [-].
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
+    from ..core.model import G
+    from ..core.pulses import extract_pulses
+    from ..core.spectra import response_spectrum
+
+    plt = _pyplot()
+    t_n = np.geomspace(0.02, 10.0, 100) if periods is None else np.asarray(periods, dtype=float)
+    spec = response_spectrum(motion.accel.acc, motion.dt, t_n, zeta)
+    fig, (ax_a, ax_s) = plt.subplots(
+        1, 2, figsize=(11, 3.6), gridspec_kw={"width_ratios": [1.7, 1]}
+    )
+    ax_a.plot(motion.accel.time, motion.accel.acc / G, color="0.35", lw=0.6)
+    found = extract_pulses(motion.accel, n=1)
+    if found:
+        p = found[0]
+        ax_a.axvspan(p.t_start, p.t_start + p.duration, color="crimson", alpha=0.12, lw=0)
+        tp = np.linspace(p.t_start, p.t_start + p.duration, 200)
+        ax_a.plot(
+            tp,
+            p.a_p_g * np.sin(2 * np.pi * p.f_p * (tp - p.t_start)),
+            color="crimson",
+            lw=1.6,
+            label=f"largest sine pulse: {abs(p.a_p_g):.3f} g at {p.f_p:.2f} Hz",
+        )
+        ax_a.legend(fontsize=8, loc="upper right")
+    ax_a.set_xlabel("time [s]")
+    ax_a.set_ylabel("ground acceleration [g]")
+    ax_a.set_title(f"{motion.name}: PGA {motion.pga_g:.3f} g, dt {motion.dt:g} s")
+    ax_a.grid(alpha=0.3)
+    ax_s.plot(spec.periods, spec.psa_g, color="navy", lw=1.2)
+    ax_s.set_xscale("log")
+    ax_s.set_xlabel("natural period T_n [s]")
+    ax_s.set_ylabel(f"PSA [g] ({100 * zeta:g} % damping)")
+    ax_s.set_title("elastic response spectrum (exact)")
+    ax_s.grid(which="both", alpha=0.3)
+    fig.tight_layout()
+    try:
+        return _save_atomic(fig, path)
+    finally:
+        plt.close(fig)
+
+
 def plot_envelopes(
     envelopes: Sequence[Any],
     bands: Sequence[dict[str, Any]],
@@ -109,6 +232,7 @@ def plot_envelopes(
     *,
     labels: Union[dict[str, str], None] = None,
     title: str = "",
+    pulse_points: Union[Sequence[dict[str, Any]], None] = None,
 ) -> Path:
     """Log-log overturning envelopes at ground level, with the critical bands shaded.
 
@@ -124,6 +248,9 @@ def plot_envelopes(
         Legend text per mechanism name.
     title : str
         Figure title.
+    pulse_points : sequence of dict, optional
+        A record's largest pulse at several scale factors, ``{"scale", "f_p_hz",
+        "a_p_g"}`` (``|a_p|`` [g]); drawn as points joined by a line and labelled by scale.
     """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(9, 8))
@@ -141,6 +268,18 @@ def plot_envelopes(
             axis=0,
         )
         ax.plot(envelopes[0].f_p, lower, color="black", lw=2.6, alpha=0.35, label="governing")
+    if pulse_points:
+        fx = [p["f_p_hz"] for p in pulse_points]
+        fy = [p["a_p_g"] for p in pulse_points]
+        ax.plot(fx, fy, "k-", lw=0.7, marker="o", ms=5, mfc="gold", label="record's largest pulse")
+        for p in pulse_points:
+            ax.annotate(
+                f"×{p['scale']:g}",
+                (p["f_p_hz"], p["a_p_g"]),
+                textcoords="offset points",
+                xytext=(6, -3),
+                fontsize=7,
+            )
     ax.set_xscale("log")
     ax.set_yscale("log")
     ymax = ax.get_ylim()[1]
