@@ -40,6 +40,7 @@ __all__ = [
     "mechanism_scale_factor",
     "record_doc",
     "record_pulse_doc",
+    "run_scaled",
     "write_envelope",
     "write_history",
 ]
@@ -416,6 +417,51 @@ def mechanism_scale_factor(
     )
 
 
+def run_scaled(
+    cf: ConstantsFile,
+    models: list[Any],
+    motion: Any,
+    scales: list[float],
+    sf: str = "none",
+    building: Building = Building(),
+    criterion: Optional[str] = None,
+) -> tuple[dict[str, Any], list[tuple[list[int], Any]]]:
+    """Run every mechanism at every scale, each record scaled up the structure by ``sf``.
+
+    Mechanisms that share a factor (all those at ground level) share one compiled batch.
+
+    Returns
+    -------
+    factors : dict
+        Scale-factor record (``mechanism_scale_factor``) per mechanism id that has one.
+    batches : list of (indices, BatchResult)
+        Which mechanisms (indices into ``cf.mechanisms``) each batch ran; the batch's
+        ``scales`` are the effective ones (user scale times factor).
+    """
+    from .core.exact import simulate_batch
+
+    factors: dict[str, Any] = {}
+    groups: dict[float, list[int]] = {}
+    for i, mech in enumerate(cf.mechanisms):
+        info = mechanism_scale_factor(mech, motion, sf, building)
+        if info is not None:
+            factors[mech.id] = info
+        groups.setdefault(1.0 if info is None else float(info["value"]), []).append(i)
+    batches = [
+        (
+            members,
+            simulate_batch(
+                [models[i] for i in members],
+                motion.accel,
+                [s * factor for s in scales],
+                criterion=criterion,
+            ),
+        )
+        for factor, members in groups.items()
+    ]
+    return factors, batches
+
+
 def history_doc(
     cf: ConstantsFile,
     motion: Any,
@@ -439,35 +485,19 @@ def history_doc(
     different ``phi_ov`` on its two sides it is the bound ``z · peak_ratio · max(phi_ov)``,
     flagged ``peak_displacement_is_bound``.
     """
-    from .core.exact import simulate_batch
-
     if at_height is not None:
         at_height = check_positive(at_height, "at_height")
     models = [to_rocking_model(m) for m in cf.mechanisms]
     for model in models:
         model.require_eta()
-    factors: dict[str, Any] = {}
-    groups: dict[float, list[int]] = {}  # mechanisms sharing a factor share one batch
-    for i, mech in enumerate(cf.mechanisms):
-        info = mechanism_scale_factor(mech, motion, sf, building)
-        if info is not None:
-            factors[mech.id] = info
-        groups.setdefault(1.0 if info is None else float(info["value"]), []).append(i)
+    factors, batches = run_scaled(cf, models, motion, scales, sf, building, criterion)
     per_mech: list[list[dict[str, Any]]] = [[] for _ in models]
-    runtime = 0.0
-    crit, method = "", ""
-    for factor, members in groups.items():
-        batch = simulate_batch(
-            [models[i] for i in members],
-            motion.accel,
-            [s * factor for s in scales],
-            criterion=criterion,
-        )
-        runtime += batch.runtime_s
-        crit, method = batch.criterion, batch.method
+    for members, batch in batches:
         rows = batch.rows()
         for k, i in enumerate(members):
             per_mech[i] = rows[k * len(scales) : (k + 1) * len(scales)]
+    runtime = sum(batch.runtime_s for _, batch in batches)
+    crit, method = batches[0][1].criterion, batches[0][1].method
     for model, mech_rows in zip(models, per_mech):
         pos, neg = model.positive, model.neg
         phi_ov = pos.phi_ov if model.one_sided else max(pos.phi_ov, neg.phi_ov)

@@ -314,6 +314,119 @@ def record_info(
 
 @app.command()
 @_user_errors
+def ida(
+    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    records: list[Path] = typer.Argument(..., help="Record files (any supported format)."),
+    scales: str = typer.Option(
+        ...,
+        "--scales",
+        help="Intensity levels: a list 0.25,0.5,1,2 or a log range start:stop:n (0.1:3:20).",
+    ),
+    im: str = typer.Option(
+        "scale", "--im", help="Intensity measure: scale (factor on each record) or pga [g]."
+    ),
+    units: Optional[str] = _UNITS_OPT,
+    record_format: Optional[str] = _FORMAT_OPT,
+    dt: Optional[float] = _DT_OPT,
+    sf: str = typer.Option(
+        "none", "--sf", help="Scale factor up the structure: none, eq28, ec8 or nzs."
+    ),
+    building_height: Optional[float] = typer.Option(
+        None, "--building-height", help="Height of the building H = h_n [m] (ec8, nzs)."
+    ),
+    soil_factor: float = typer.Option(1.0, "--soil-factor", help="EC8 soil factor S [-]."),
+    element_period: float = typer.Option(
+        0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
+    ),
+    criterion: Optional[str] = typer.Option(
+        None, "--criterion", help="Overturning verdict: ratio (default) or exact."
+    ),
+    scheduler: Optional[str] = typer.Option(
+        None,
+        "--scheduler",
+        help="dask.distributed scheduler address (tcp://host:8786); default: run locally.",
+    ),
+    timeout: float = typer.Option(
+        10.0, "--timeout", help="Seconds to wait for the Dask scheduler to answer [s]."
+    ),
+    progress: Optional[bool] = typer.Option(
+        None, "--progress/--no-progress", help="Progress bar (default: on a terminal)."
+    ),
+    out: Optional[Path] = typer.Option(
+        None, "--out", help="Folder for ida.json, ida.csv and ida.png (fragility curves)."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+) -> None:
+    """Incremental dynamic analysis: overturned fraction per intensity and fragility fits."""
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
+
+    from .analysis import Building
+    from .core.model import check_positive
+    from .ida import ida_csv, parse_levels, run_ida
+
+    levels = parse_levels(scales)
+    cf = _read_constants(constants)
+    motions = [_read_record(path, record_format, units, dt) for path in records]
+    console = Console(stderr=True)
+    show = console.is_terminal if progress is None else progress
+    bar = Progress(
+        "[progress.description]{task.description}",
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        disable=not show,
+        transient=True,
+    )
+    with bar:
+        task = bar.add_task("records", total=len(motions))
+        doc = run_ida(
+            cf,
+            motions,
+            levels,
+            im=im,
+            sf=sf,
+            building=Building(building_height, soil_factor, element_period),
+            criterion=criterion,
+            scheduler=scheduler,
+            progress=lambda done, total: bar.update(task, completed=done),
+            timeout=check_positive(timeout, "timeout"),
+        )
+    if out is not None:
+        from shared_schema.io import write_atomic
+
+        from .report.plots import plot_fragility
+
+        out.mkdir(parents=True, exist_ok=True)
+        write_atomic(out / "ida.json", json.dumps(doc, indent=2) + "\n")
+        write_atomic(out / "ida.csv", ida_csv(doc))
+        plot_fragility(doc, out / "ida.png", title=f"Fragility: {constants.name}")
+    if as_json:
+        _print_json(doc)
+        return
+    backend = doc["backend"]
+    where = "locally" if backend["kind"] == "local" else f"on Dask at {backend['scheduler']}"
+    typer.echo(
+        f"{doc['runs']} runs ({len(motions)} records x {len(levels)} levels x "
+        f"{len(cf.mechanisms)} mechanisms) {where} in {doc['runtime_s']:.2f} s; "
+        f"largest error estimate {doc['max_error_estimate']:.1e}"
+    )
+    unit = doc["intensity"]["units"]
+    for mech in doc["mechanisms"]:
+        fit = mech["fragility"]
+        if "median" in fit:
+            text = f"median {fit['median']:.4g} {unit}, beta {fit['beta']:.3f}"
+        else:
+            text = "no fit"
+        note = f" ({fit['note']})" if "note" in fit else ""
+        typer.echo(f"  {mech['id']:<12} {text}{note}")
+    if out is not None:
+        typer.echo(f"wrote {out / 'ida.json'}, ida.csv, ida.png")
+
+
+@app.command()
+@_user_errors
 def constants(
     scene: Path = typer.Argument(..., help="Rhino .3dm file."),
     spec: Path = typer.Argument(..., help="Mechanism spec (JSON)."),
@@ -506,6 +619,89 @@ def demo(
             f"  {row['mechanism']:<8} x{row['scale']:<4g} peak |phi|/phi_ov = "
             f"{row['peak_ratio']:.4f}  {'OVERTURNS' if row['overturned'] else 'survives'}"
         )
+
+
+@app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+@_user_errors
+def report(
+    ctx: typer.Context,
+    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    out: Path = typer.Option(..., "-o", "--out", help="HTML file to write."),
+    record: Optional[Path] = typer.Option(
+        None, "--record", help="Record for time histories and its spectrum (any format)."
+    ),
+    scale: list[float] = typer.Option([1.0], "--scale", help="Scale factors on the record."),
+    units: Optional[str] = _UNITS_OPT,
+    record_format: Optional[str] = _FORMAT_OPT,
+    dt: Optional[float] = _DT_OPT,
+    sf: str = typer.Option(
+        "none", "--sf", help="Scale factor up the structure: none, eq28, ec8 or nzs."
+    ),
+    building_height: Optional[float] = typer.Option(
+        None, "--building-height", help="Height of the building H = h_n [m] (ec8, nzs)."
+    ),
+    soil_factor: float = typer.Option(1.0, "--soil-factor", help="EC8 soil factor S [-]."),
+    element_period: float = typer.Option(
+        0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
+    ),
+    criterion: Optional[str] = typer.Option(
+        None, "--criterion", help="Verdict of the time histories: ratio (default) or exact."
+    ),
+    f_min: float = typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
+    f_max: float = typer.Option(10.0, "--f-max", help="Highest pulse frequency [Hz]."),
+    n: int = typer.Option(200, "--n", help="Number of log-spaced frequencies."),
+    exact: bool = typer.Option(False, "--exact", help="Exact envelopes, not the library."),
+    title: Optional[str] = typer.Option(None, "--title", help="Title of the report."),
+) -> None:
+    """One self-contained HTML report: constants, envelopes, and with --record its histories."""
+    from .analysis import Building, frequency_grid
+    from .report.html import build_report, input_source, write_report
+
+    scales = _scales(scale, ctx.args)
+    f_p = frequency_grid(f_min, f_max, n)
+    cf = _read_constants(constants)
+    sources = [input_source("constants", constants.name, constants.read_bytes())]
+    motion = None
+    if record is not None:
+        motion = _read_record(record, record_format, units, dt)
+        sources.append(input_source("record", record.name, record.read_bytes()))
+    options = {"scales": scales, "sf": sf, "building_height": building_height}
+    options.update(soil_factor=soil_factor, element_period=element_period, criterion=criterion)
+    options.update(f_min=f_min, f_max=f_max, n=n, exact=exact)
+    text = build_report(
+        cf,
+        f_p,
+        motion=motion,
+        scales=scales,
+        history={
+            "sf": sf,
+            "building": Building(building_height, soil_factor, element_period),
+            "criterion": criterion,
+        },
+        exact=exact,
+        title=title or f"rockmech report: {constants.name}",
+        sources=sources,
+        request=options,
+    )
+    typer.echo(f"wrote {write_report(out, text)}")
+
+
+@app.command()
+@_user_errors
+def serve(
+    host: Optional[str] = typer.Option(
+        None, "--host", help="Interface to bind (default 127.0.0.1: this machine only)."
+    ),
+    port: Optional[int] = typer.Option(None, "--port", help="TCP port (default 8000)."),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Compute processes (default 2)."),
+    timeout: Optional[float] = typer.Option(
+        None, "--timeout", help="Compute time budget per request [s] (default 30)."
+    ),
+) -> None:
+    """Run the REST service (FastAPI + uvicorn); settings also from ROCKMECH_* variables."""
+    from .api.server import run, settings_with
+
+    run(settings_with(host=host, port=port, compute_workers=workers, compute_timeout_s=timeout))
 
 
 def main() -> None:  # pragma: no cover - console entry point

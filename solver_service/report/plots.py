@@ -17,6 +17,7 @@ from ..core.result import RockingResult
 
 __all__ = [
     "plot_envelopes",
+    "plot_fragility",
     "plot_ratio_histories",
     "plot_record",
     "plot_time_histories",
@@ -294,6 +295,54 @@ def plot_envelopes(
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.0, -0.12), ncol=1, frameon=False)
     if title:
         ax.set_title(title)
+    fig.tight_layout()
+    try:
+        return _save_atomic(fig, path)
+    finally:
+        plt.close(fig)
+
+
+def plot_fragility(doc: dict[str, Any], path: Union[str, Path], *, title: str = "") -> Path:
+    """Plot IDA results: overturned fraction per level and the fitted lognormal curves.
+
+    Parameters
+    ----------
+    doc : dict
+        The document of ``solver_service.ida.run_ida``.
+    path : str or Path
+        Output file (.png or .svg); written atomically.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
+    from ..core.fragility import lognormal_cdf
+
+    plt = _pyplot()
+    levels = np.asarray(doc["intensity"]["levels"], dtype=float)
+    fig, ax = plt.subplots(figsize=(8, 5))
+    cmap = plt.get_cmap("tab10")
+    x = np.geomspace(levels.min() / 1.5, levels.max() * 1.5, 300)
+    for k, mech in enumerate(doc["mechanisms"]):
+        colour = cmap(k % 10)
+        fit = mech["fragility"]
+        label = mech["id"]
+        if "median" in fit:
+            ax.plot(x, lognormal_cdf(x, fit["median"], fit["beta"]), color=colour, lw=1.3)
+            label += f": median {fit['median']:.3g}, β {fit['beta']:.2f}"
+        ax.plot(levels, mech["fraction"], "o", color=colour, ms=4, label=label)
+    ax.set_xscale("log")
+    ax.set_ylim(-0.03, 1.03)
+    unit = doc["intensity"]["units"]
+    name = "scale factor [-]" if doc["intensity"]["measure"] == "scale" else f"PGA [{unit}]"
+    ax.set_xlabel(name)
+    ax.set_ylabel(f"fraction of {len(doc['records'])} records that overturn")
+    ax.grid(which="both", alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")
+    ax.set_title(title or "Fragility from incremental dynamic analysis (lognormal MLE)")
     fig.tight_layout()
     try:
         return _save_atomic(fig, path)

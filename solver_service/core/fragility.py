@@ -1,0 +1,152 @@
+"""Lognormal fragility curves from incremental dynamic analysis (multiple-stripe data).
+
+At each intensity level ``x_j`` (a scale factor, or a PGA in g) ``z_j`` of ``n_j`` records
+overturn a mechanism. The fragility ``P(overturn | x) = Phi(ln(x/theta)/beta)`` is fitted by
+maximum likelihood on the binomial counts (Baker 2015, "Efficient analytical fragility
+function fitting using dynamic structural analysis", Earthquake Spectra 31(1)):
+
+    max over (theta, beta) of  sum_j [ z_j ln Phi(u_j) + (n_j - z_j) ln(1 - Phi(u_j)) ],
+    u_j = ln(x_j/theta)/beta.
+
+The log-probabilities are evaluated with ``scipy.special.log_ndtr``, so the tails stay
+finite. ``theta`` is the median (the intensity that overturns half the records) and ``beta``
+the logarithmic standard deviation [-].
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Optional
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from shared_schema.errors import InputError
+
+__all__ = ["BETA_BOUNDS", "FragilityFit", "fit_lognormal", "lognormal_cdf"]
+
+#: Search bounds of beta [-]: below 0.01 the curve is a step, above 5 it is flat.
+BETA_BOUNDS = (0.01, 5.0)
+
+
+@dataclass(frozen=True)
+class FragilityFit:
+    """A fitted lognormal fragility curve, or why none could be fitted.
+
+    Attributes
+    ----------
+    median : float or None
+        ``theta``, the intensity at which half the records overturn (units of the levels).
+    beta : float or None
+        Logarithmic standard deviation [-].
+    log_likelihood : float or None
+        The maximised binomial log-likelihood.
+    note : str
+        How to read the fit (e.g. a sharp step that pins ``beta`` at its bound), or why
+        there is no fit.
+    """
+
+    median: Optional[float]
+    beta: Optional[float]
+    log_likelihood: Optional[float]
+    note: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        """Return a JSON-ready dict (absent values omitted)."""
+        doc: dict[str, Any] = {"method": "binomial maximum likelihood (Baker 2015)"}
+        if self.median is not None:
+            doc.update(median=self.median, beta=self.beta, log_likelihood=self.log_likelihood)
+        if self.note:
+            doc["note"] = self.note
+        return doc
+
+
+def lognormal_cdf(x: ArrayLike, median: float, beta: float) -> np.ndarray[Any, Any]:
+    """Return ``Phi(ln(x/median)/beta)`` at intensities ``x`` (> 0)."""
+    from scipy.special import ndtr
+
+    return np.asarray(ndtr(np.log(np.asarray(x, dtype=float) / median) / beta))
+
+
+def fit_lognormal(levels: ArrayLike, n_overturned: ArrayLike, n_records: ArrayLike) -> FragilityFit:
+    """Fit a lognormal fragility curve to counts of overturning records per intensity level.
+
+    Parameters
+    ----------
+    levels : (k,) array_like of float
+        Intensity levels, each finite and > 0 (any units; the median has the same).
+    n_overturned : (k,) array_like of int
+        Records that overturned the mechanism at each level, ``0 <= z_j <= n_j``.
+    n_records : (k,) array_like of int or int
+        Records run at each level, >= 1.
+
+    Returns
+    -------
+    FragilityFit
+        ``median`` and ``beta`` are None, with a note, when no record overturns at any
+        level or every record overturns at every level (the median then lies outside the
+        levels run).
+
+    Raises
+    ------
+    InputError
+        Levels not finite and > 0 (field ``levels``), or counts out of range
+        (``n_overturned``, ``n_records``).
+
+    Examples
+    --------
+    >>> x = np.array([0.1, 0.2, 0.4, 0.8])
+    >>> fit = fit_lognormal(x, (1000 * lognormal_cdf(x, 0.3, 0.5)).round(), 1000)
+    >>> round(fit.median, 2), round(fit.beta, 2)
+    (0.3, 0.5)
+    """
+    from scipy.optimize import minimize
+    from scipy.special import log_ndtr
+
+    x = np.atleast_1d(np.asarray(levels, dtype=float))
+    z = np.atleast_1d(np.asarray(n_overturned, dtype=float))
+    n = np.broadcast_to(np.asarray(n_records, dtype=float), x.shape).copy()
+    if x.ndim != 1 or x.size == 0 or not np.all(np.isfinite(x) & (x > 0)):
+        raise InputError("must be a non-empty list of finite levels > 0", "levels")
+    if z.shape != x.shape or np.any((z < 0) | (z > n)) or np.any(z != np.round(z)):
+        raise InputError(
+            "must be whole counts between 0 and n_records, one per level", "n_overturned"
+        )
+    if np.any(n < 1):
+        raise InputError("must be >= 1 at every level", "n_records")
+    if not np.any(z > 0):
+        return FragilityFit(None, None, None, f"no record overturned it (median > {x.max():g})")
+    if np.all(z == n):
+        return FragilityFit(None, None, None, f"every record overturned it (median < {x.min():g})")
+    lx = np.log(x)
+
+    def nll(p: np.ndarray[Any, Any]) -> float:
+        u = (lx - p[0]) / p[1]
+        return -float(np.sum(z * log_ndtr(u) + (n - z) * log_ndtr(-u)))
+
+    frac = z / n
+    above = np.flatnonzero(frac >= 0.5)
+    start = lx[above[0]] if above.size else lx.max()
+    span = max(lx.max() - lx.min(), 1.0)
+    bounds = [(lx.min() - 2 * span, lx.max() + 2 * span), BETA_BOUNDS]
+    best = min(
+        (
+            minimize(
+                nll,
+                np.array([start, b0]),
+                method="Nelder-Mead",
+                bounds=bounds,
+                options={"xatol": 1e-10, "fatol": 1e-12, "maxiter": 2000},
+            )
+            for b0 in (0.1, 0.4, 1.0)
+        ),
+        key=lambda r: float(r.fun),
+    )
+    ln_theta, beta = (float(v) for v in best.x)
+    note = ""
+    if beta <= BETA_BOUNDS[0] * (1 + 1e-6):
+        note = "the data step from none to all overturning: beta is not resolved by the levels"
+    elif ln_theta <= bounds[0][0] + 1e-9 or ln_theta >= bounds[0][1] - 1e-9:
+        note = "the median lies far outside the levels run: extrapolated"
+    return FragilityFit(math.exp(ln_theta), beta, -float(best.fun), note)

@@ -1,0 +1,334 @@
+"""Incremental dynamic analysis: many records × many intensities × many mechanisms.
+
+The unit of work is one record (``run_record``): every mechanism at every intensity level
+in one compiled, parallel batch (``exact.simulate_batch``). ``run_ida`` runs the records
+in-process by default, or maps the same function over the records on a dask.distributed
+cluster when a scheduler address is given (chunked by record; only plain data, arrays and
+the function's import path travel to the workers). The fraction of records that overturn
+each mechanism at each level is then fitted with a lognormal fragility curve
+(``core.fragility``).
+
+Intensity measures: ``"scale"`` (the levels are scale factors on every record, [-]) or
+``"pga"`` (the levels are target peak ground accelerations [g]; each record is scaled to
+them).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from typing import Any, Optional
+
+import numpy as np
+
+from shared_schema.constants import ConstantsFile
+from shared_schema.errors import InputError
+
+from .adapter import to_rocking_model
+from .analysis import Building, run_scaled
+from .core.model import check_positive
+
+__all__ = ["IM_MEASURES", "ida_csv", "parse_levels", "run_ida", "run_record"]
+
+#: Intensity measures and their units.
+IM_MEASURES = {"scale": "-", "pga": "g"}
+
+#: Seconds to wait for a Dask scheduler before giving up.
+CONNECT_TIMEOUT_S = 10.0
+
+
+def run_record(
+    constants: dict[str, Any],
+    acc: np.ndarray[Any, Any],
+    dt: float,
+    name: str,
+    levels: list[float],
+    im: str = "scale",
+    options: Optional[dict[str, Any]] = None,
+) -> dict[str, Any]:
+    """Run one record against every mechanism at every intensity level.
+
+    Parameters
+    ----------
+    constants : dict
+        The kinematic-constants document (``ConstantsFile.model_dump()``).
+    acc : (n,) float
+        Ground acceleration [m/s²].
+    dt : float
+        Sampling interval [s].
+    name : str
+        Record name.
+    levels : list of float
+        Intensity levels, ascending (units of ``im``).
+    im : {"scale", "pga"}
+        Intensity measure.
+    options : dict, optional
+        ``sf``, ``building`` (dict of ``analysis.Building``) and ``criterion``.
+
+    Returns
+    -------
+    dict
+        ``overturned``, ``peak_ratio``, ``error_estimate`` and ``status`` as (m, k) arrays
+        (mechanisms × levels), ``scale_factors`` per mechanism id, ``pga_g`` and
+        ``runtime_s``.
+    """
+    from .core.records import GroundMotion
+
+    opts = dict(options or {})
+    cf = ConstantsFile.model_validate(constants)
+    motion = GroundMotion.from_samples(acc, dt, name=name)
+    if im == "pga":
+        scales = [level / motion.pga_g for level in levels]
+    else:
+        scales = list(levels)
+    models = [to_rocking_model(m) for m in cf.mechanisms]
+    factors, batches = run_scaled(
+        cf,
+        models,
+        motion,
+        scales,
+        opts.get("sf", "none"),
+        Building(**opts.get("building", {})),
+        opts.get("criterion"),
+    )
+    shape = (len(models), len(scales))
+    out = {
+        "overturned": np.zeros(shape, dtype=bool),
+        "peak_ratio": np.zeros(shape),
+        "error_estimate": np.zeros(shape),
+        "status": np.zeros(shape, dtype=np.int64),
+    }
+    for members, batch in batches:
+        for key in out:
+            out[key][members] = getattr(batch, key)
+    return {
+        **out,
+        "name": name,
+        "pga_g": motion.pga_g,
+        "dt_s": dt,
+        "n_samples": len(acc),
+        "scale_factors": {k: float(v["value"]) for k, v in factors.items()},
+        "criterion": batches[0][1].criterion,
+        "method": batches[0][1].method,
+        "runtime_s": sum(b.runtime_s for _, b in batches),
+    }
+
+
+def _levels(levels: Sequence[float]) -> list[float]:
+    if len(levels) == 0:
+        raise InputError("needs at least one intensity level", "scales")
+    out = [check_positive(v, f"scales[{j}]") for j, v in enumerate(levels)]
+    if len(set(out)) != len(out):
+        raise InputError("has repeated levels", "scales")
+    return sorted(out)
+
+
+def _dask_client(address: str, timeout: float) -> Any:
+    try:
+        from dask.distributed import Client
+    except ImportError as exc:  # pragma: no cover - dask is a declared dependency
+        raise InputError(f"needs dask.distributed ({exc})", "scheduler") from exc
+    try:
+        return Client(address, timeout=timeout, set_as_default=False)  # type: ignore[no-untyped-call]
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise InputError(
+            f"cannot reach the Dask scheduler at {address} within {timeout:g} s ({exc})",
+            "scheduler",
+        ) from exc
+
+
+def _collect(
+    payloads: list[dict[str, Any]],
+    scheduler: Optional[str],
+    progress: Optional[Callable[[int, int], None]],
+    timeout: float,
+) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """Run ``run_record`` over the payloads, locally or on Dask; results in input order."""
+    results: list[Any] = [None] * len(payloads)
+    if scheduler is None:
+        for i, payload in enumerate(payloads):
+            results[i] = run_record(**payload)
+            if progress is not None:
+                progress(i + 1, len(payloads))
+        return results, {"kind": "local"}
+    from dask.distributed import as_completed
+
+    client = _dask_client(scheduler, timeout)
+    try:
+        n_workers = len(client.scheduler_info().get("workers", {}))
+        futures = [client.submit(run_record, **p, pure=False) for p in payloads]
+        index = {f.key: i for i, f in enumerate(futures)}
+        with client.as_current():
+            for done, future in enumerate(as_completed(futures), start=1):  # type: ignore[no-untyped-call]
+                results[index[future.key]] = future.result()
+                if progress is not None:
+                    progress(done, len(payloads))
+    finally:
+        client.close()
+    return results, {"kind": "dask", "scheduler": scheduler, "n_workers": n_workers}
+
+
+def run_ida(
+    cf: ConstantsFile,
+    motions: Sequence[Any],
+    levels: Sequence[float],
+    *,
+    im: str = "scale",
+    sf: str = "none",
+    building: Optional[Building] = None,
+    criterion: Optional[str] = None,
+    scheduler: Optional[str] = None,
+    progress: Optional[Callable[[int, int], None]] = None,
+    timeout: float = CONNECT_TIMEOUT_S,
+) -> dict[str, Any]:
+    """Incremental dynamic analysis with lognormal fragility fits, as a JSON-ready document.
+
+    Parameters
+    ----------
+    cf : ConstantsFile
+        The mechanisms (each needs ``eta``).
+    motions : sequence of GroundMotion
+        The records, at least one.
+    levels : sequence of float
+        Intensity levels, each > 0 and distinct: scale factors [-] or PGAs [g] (``im``).
+    im : {"scale", "pga"}
+        Intensity measure.
+    sf : {"none", "eq28", "ec8", "nzs"}
+        Scale factor up the structure for mechanisms with amplification data (per record;
+        see ``analysis.mechanism_scale_factor``).
+    building : Building, optional
+        For the code scale factors.
+    criterion : {"ratio", "exact"}, optional
+        Overturning verdict (default: ``ratio``, the method's criterion for records).
+    scheduler : str, optional
+        Address of a dask.distributed scheduler (``tcp://host:8786``); None runs locally.
+    progress : callable, optional
+        Called as ``progress(records_done, n_records)``.
+    timeout : float
+        Seconds to wait for the scheduler [s].
+
+    Returns
+    -------
+    dict
+        ``intensity``, ``records``, per mechanism ``n_overturned``, ``fraction``,
+        ``first_overturning_level`` (per record) and ``fragility`` (median, beta), plus
+        ``runs``, ``runtime_s``, ``max_error_estimate`` and ``backend``.
+
+    Raises
+    ------
+    InputError
+        No records, a bad level, an unknown ``im``, or an unreachable scheduler (field
+        ``scheduler``, with the address).
+    """
+    from .core.fragility import fit_lognormal
+
+    if im not in IM_MEASURES:
+        raise InputError(f"must be one of {list(IM_MEASURES)}, got {im!r}", "im")
+    if len(motions) == 0:
+        raise InputError("needs at least one record", "records")
+    lv = _levels(levels)
+    building = building or Building()
+    for mech in cf.mechanisms:
+        to_rocking_model(mech).require_eta()
+    constants = cf.model_dump(mode="json", exclude_none=True)
+    options = {
+        "sf": sf,
+        "building": {
+            "height": building.height,
+            "soil_factor": building.soil_factor,
+            "element_period": building.element_period,
+        },
+        "criterion": criterion,
+    }
+    payloads = [
+        {
+            "constants": constants,
+            "acc": m.accel.acc,
+            "dt": m.dt,
+            "name": m.name,
+            "levels": lv,
+            "im": im,
+            "options": options,
+        }
+        for m in motions
+    ]
+    start = time.perf_counter()
+    results, backend = _collect(payloads, scheduler, progress, timeout)
+    wall = time.perf_counter() - start
+    overturned = np.stack([r["overturned"] for r in results])  # (records, mechs, levels)
+    counts = overturned.sum(axis=0)
+    n_rec = len(results)
+    mechanisms = []
+    for i, mech in enumerate(cf.mechanisms):
+        first = []
+        for r in results:
+            hit = np.flatnonzero(r["overturned"][i])
+            first.append(lv[int(hit[0])] if hit.size else None)
+        entry: dict[str, Any] = {
+            "id": mech.id,
+            "n_overturned": [int(c) for c in counts[i]],
+            "fraction": [float(c) / n_rec for c in counts[i]],
+            "first_overturning_level": first,
+            "fragility": fit_lognormal(lv, counts[i], n_rec).to_dict(),
+        }
+        factors = [r["scale_factors"].get(mech.id) for r in results]
+        if any(f is not None for f in factors):
+            entry["scale_factors"] = factors
+        mechanisms.append(entry)
+    status = np.stack([r["status"] for r in results])
+    doc: dict[str, Any] = {
+        "intensity": {"measure": im, "units": IM_MEASURES[im], "levels": lv},
+        "records": [
+            {"name": r["name"], "pga_g": r["pga_g"], "dt_s": r["dt_s"], "n_samples": r["n_samples"]}
+            for r in results
+        ],
+        "criterion": results[0]["criterion"],
+        "method": results[0]["method"],
+        "mechanisms": mechanisms,
+        "runs": int(overturned.size),
+        "runtime_s": wall,
+        "compute_s": float(sum(r["runtime_s"] for r in results)),
+        "max_error_estimate": float(max(np.max(r["error_estimate"]) for r in results)),
+        "backend": backend,
+    }
+    if sf != "none":
+        doc["scale_factor_method"] = sf
+    incomplete = int(np.count_nonzero(status < 0))
+    if incomplete:
+        doc["incomplete_runs"] = incomplete
+    return doc
+
+
+def ida_csv(doc: dict[str, Any]) -> str:
+    """Return the overturned fractions as CSV: level, then one column per mechanism."""
+    unit = doc["intensity"]["units"]
+    head = f"{doc['intensity']['measure']}_{'g' if unit == 'g' else '-'}"
+    lines = [head + "," + ",".join(f"fraction_{m['id']}" for m in doc["mechanisms"])]
+    for j, level in enumerate(doc["intensity"]["levels"]):
+        cells = [f"{m['fraction'][j]:.6g}" for m in doc["mechanisms"]]
+        lines.append(f"{level:.6g}," + ",".join(cells))
+    return "\n".join(lines) + "\n"
+
+
+def parse_levels(text: str) -> list[float]:
+    """Parse intensity levels: ``"0.1,0.2,0.5"`` or a log range ``"0.1:3:20"`` (start:stop:n).
+
+    Raises
+    ------
+    InputError
+        Text that is neither form (field ``scales``).
+    """
+    try:
+        if ":" in text:
+            lo, hi, n = text.split(":")
+            count = int(n)
+            if count < 2 or not (0 < float(lo) < float(hi)) or not math.isfinite(float(hi)):
+                raise ValueError
+            return [float(v) for v in np.geomspace(float(lo), float(hi), count)]
+        return [float(v) for v in text.replace(" ", ",").split(",") if v]
+    except ValueError:
+        raise InputError(
+            f"expected a list like 0.1,0.2,0.5 or a log range start:stop:n, got {text!r}",
+            "scales",
+        ) from None

@@ -1,0 +1,145 @@
+"""Incremental dynamic analysis: local runs against direct simulations; a real Dask cluster."""
+
+from __future__ import annotations
+
+import json
+import socket
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from shared_schema.errors import InputError
+from shared_schema.io import load_constants
+from solver_service.adapter import models_from_file
+from solver_service.cli import app
+from solver_service.core.exact import simulate
+from solver_service.core.records import GroundMotion
+from solver_service.ida import parse_levels, run_ida
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+CONSTANTS = EXAMPLES / "constants" / "rect_walls.json"
+LEVELS = [0.2, 0.5, 1.0, 2.0, 3.5]
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def motions(elcentro_path: Path) -> list[GroundMotion]:
+    """El Centro N-S and two distinct motions made from it (reversed in time, and negated)."""
+    ns = GroundMotion.from_file(elcentro_path, units="g")
+    acc = ns.accel.acc
+    return [
+        ns,
+        GroundMotion.from_samples(acc[::-1].copy(), ns.dt, name="reversed"),
+        GroundMotion.from_samples(-acc, ns.dt, name="negated"),
+    ]
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def test_local_ida_counts_equal_direct_simulations(motions: list[GroundMotion]) -> None:
+    cf = load_constants(CONSTANTS)
+    seen: list[int] = []
+    doc = run_ida(cf, motions, LEVELS[::-1], progress=lambda done, total: seen.append(done))
+    assert seen == [1, 2, 3]
+    assert doc["intensity"] == {"measure": "scale", "units": "-", "levels": LEVELS}
+    assert doc["runs"] == len(motions) * len(LEVELS) * len(cf.mechanisms)
+    for model, mech in zip(models_from_file(cf), doc["mechanisms"]):
+        verdicts = np.array(
+            [[simulate(model, m.accel, scale=s).overturned for s in LEVELS] for m in motions]
+        )
+        assert mech["n_overturned"] == verdicts.sum(axis=0).tolist()
+        assert mech["fraction"] == pytest.approx(verdicts.mean(axis=0).tolist())
+        for row, first in zip(verdicts, mech["first_overturning_level"]):
+            assert first == (LEVELS[int(np.argmax(row))] if row.any() else None)
+    assert doc["backend"] == {"kind": "local"}
+    assert "scale_factors" not in doc["mechanisms"][0]
+
+
+def test_pga_intensity_scales_each_record_to_the_level(motions: list[GroundMotion]) -> None:
+    cf = load_constants(CONSTANTS)
+    levels = [0.1, 0.3, 0.6]
+    doc = run_ida(cf, motions, levels, im="pga")
+    assert doc["intensity"]["units"] == "g"
+    model = models_from_file(cf)[0]
+    expected = [
+        sum(simulate(model, m.accel, scale=lv / m.pga_g).overturned for m in motions)
+        for lv in levels
+    ]
+    assert doc["mechanisms"][0]["n_overturned"] == expected
+
+
+def test_dask_local_cluster_gives_the_local_numbers(motions: list[GroundMotion]) -> None:
+    distributed = pytest.importorskip("distributed")
+    cf = load_constants(CONSTANTS)
+    local = run_ida(cf, motions, LEVELS)
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        remote = run_ida(cf, motions, LEVELS, scheduler=cluster.scheduler_address)
+    assert remote["backend"]["kind"] == "dask"
+    assert remote["backend"]["n_workers"] == 2
+    for key in ("intensity", "records", "mechanisms", "runs", "max_error_estimate", "criterion"):
+        assert remote[key] == local[key], key
+
+
+def test_unreachable_scheduler_is_a_clear_error_not_a_hang(motions: list[GroundMotion]) -> None:
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    start = time.perf_counter()
+    with pytest.raises(InputError, match=f"cannot reach the Dask scheduler at {address}"):
+        run_ida(load_constants(CONSTANTS), motions[:1], [1.0], scheduler=address, timeout=1.0)
+    assert time.perf_counter() - start < 30.0  # bounded by the timeout, with margin
+    res = runner.invoke(
+        app,
+        [
+            *("ida", str(CONSTANTS), str(EXAMPLES / "records" / "elcentro_NS.dat")),
+            *("--scales", "1", "--scheduler", address, "--timeout", "1"),
+        ],
+    )
+    assert res.exit_code == 2 and address in res.stderr and "scheduler" in res.stderr
+
+
+def test_cli_ida_writes_json_csv_and_plot(tmp_path: Path, elcentro_path: Path) -> None:
+    res = runner.invoke(
+        app,
+        [
+            *("ida", str(CONSTANTS), str(elcentro_path), str(elcentro_path)),
+            *("--scales", "0.3:3:6", "--out", str(tmp_path), "--no-progress"),
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    doc = json.loads((tmp_path / "ida.json").read_text())
+    assert doc["intensity"]["levels"] == pytest.approx(np.geomspace(0.3, 3, 6).tolist())
+    csv = (tmp_path / "ida.csv").read_text().splitlines()
+    assert csv[0] == "scale_-,fraction_W1,fraction_W2,fraction_F1" and len(csv) == 7
+    assert (tmp_path / "ida.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "median" in res.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--scales", "abc"], "scales: expected a list"),
+        (["--scales", "0,1"], "scales[0]"),
+        (["--scales", "1,1"], "repeated"),
+        (["--scales", "1", "--im", "pgv"], "im: must be one of"),
+        (["--scales", "1", "--timeout", "0"], "timeout"),
+    ],
+)
+def test_cli_ida_bad_input(args: list[str], message: str) -> None:
+    record = str(EXAMPLES / "records" / "elcentro_NS.dat")
+    res = runner.invoke(app, ["ida", str(CONSTANTS), record, *args])
+    assert res.exit_code == 2 and message in res.stderr, res.output
+
+
+def test_parse_levels() -> None:
+    assert parse_levels("0.1, 0.2,0.5") == [0.1, 0.2, 0.5]
+    assert parse_levels("1:100:3") == pytest.approx([1.0, 10.0, 100.0])
+    with pytest.raises(InputError, match="scales"):
+        parse_levels("1:0.5:3")
