@@ -37,6 +37,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/work_precision.py
 	$(BIN)/python benchmarks/envelope_speed.py
 	$(BIN)/python benchmarks/geometry_speed.py
+	$(BIN)/python benchmarks/records_speed.py
 
 clean:
 	rm -rf $(VENV) out .mypy_cache .ruff_cache .pytest_cache
