@@ -1,0 +1,359 @@
+"""RM_Analyse: envelopes, critical bands, time histories or a pulse on a constants file.
+
+The analyses run through the Python API (``solver_service.analysis``; the pure-Python
+kernels are used where numba is missing, as in Rhino 8's CPython 3.9) or, when a service
+URL is configured, through the REST service: ``POST <url>/api/v1/envelope``, ``/history``
+and ``/pulse`` with the JSON bodies of ``shared_schema.api`` (``EnvelopeRequest``,
+``HistoryRequest``, ``PulseRequest``). The client is plain ``urllib``; an error answer's
+``detail`` is shown as the message.
+
+Units: frequencies [Hz], pulse amplitudes [g], scale factors [-].
+
+Python 3.9-clean: imported by Rhino 8.
+"""
+
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Sequence
+
+from rhino_plugin.flows.mechanisms import _number
+from rhino_plugin.flows.prompter import Cancelled, Prompter
+from shared_schema.errors import InputError, RockmechError
+
+__all__ = [
+    "ANALYSES",
+    "AnalysisResult",
+    "ServiceClient",
+    "analyse_flow",
+    "load_constants_files",
+    "run_envelopes",
+    "run_history",
+    "run_pulse",
+]
+
+#: What RM_Analyse offers.
+ANALYSES = ("Envelopes", "History", "Pulse")
+#: Record units as Rhino option names (no "/" allowed there) -> records' unit names.
+RECORD_UNITS = {"g": "g", "ms2": "m/s2", "cms2": "cm/s2"}
+#: Seconds the service client waits for an answer.
+SERVICE_TIMEOUT_S = 300.0
+#: Frequencies of the envelopes [-]: log-spaced points between f_min and f_max.
+N_FREQUENCIES = 200
+
+
+@dataclass
+class AnalysisResult:
+    """What an analysis produced.
+
+    Attributes
+    ----------
+    kind : str
+        One of :data:`ANALYSES`.
+    doc : dict
+        The JSON result (as the CLI's ``--json`` and the service return it).
+    summary : list of str
+        Lines for the command line.
+    plot : str, optional
+        PNG to show (local runs of envelopes and histories).
+    files : list of str
+        Files written.
+    """
+
+    kind: str
+    doc: Dict[str, Any]
+    summary: List[str] = field(default_factory=list)
+    plot: Optional[str] = None
+    files: List[str] = field(default_factory=list)
+
+
+class ServiceClient:
+    """A minimal JSON client of the rockmech REST service (``/api/v1``).
+
+    Parameters
+    ----------
+    base_url : str
+        E.g. ``http://127.0.0.1:8000`` (with or without a trailing ``/``).
+    timeout_s : float
+        Seconds to wait for an answer [s].
+    """
+
+    def __init__(self, base_url: str, timeout_s: float = SERVICE_TIMEOUT_S) -> None:
+        url = base_url.strip().rstrip("/")
+        if not url.startswith(("http://", "https://")):
+            raise InputError(f"the service URL must start with http:// or https://, got {url!r}")
+        self.base_url = url
+        self.timeout_s = float(timeout_s)
+
+    def post(self, endpoint: str, payload: Dict[str, Any]) -> Dict[str, Any]:
+        """POST ``payload`` as JSON to ``/api/v1/<endpoint>`` and return the JSON answer.
+
+        Raises
+        ------
+        InputError
+            The service refused the request (its ``detail`` is the message, field
+            ``service``), could not be reached, or did not answer JSON.
+        """
+        import urllib.error
+        import urllib.request
+
+        url = f"{self.base_url}/api/v1/{endpoint}"
+        request = urllib.request.Request(
+            url,
+            data=json.dumps(payload).encode("utf-8"),
+            headers={"Content-Type": "application/json", "Accept": "application/json"},
+            method="POST",
+        )
+        try:
+            with urllib.request.urlopen(request, timeout=self.timeout_s) as response:
+                body = response.read()
+        except urllib.error.HTTPError as exc:
+            raw = exc.read()
+            try:
+                detail = json.loads(raw.decode("utf-8")).get("detail")
+            except (ValueError, AttributeError):
+                detail = None
+            text = detail if isinstance(detail, str) else raw.decode("utf-8", "replace")[:500]
+            raise InputError(f"{url} answered {exc.code}: {text}", "service") from None
+        except (urllib.error.URLError, OSError) as exc:
+            reason = getattr(exc, "reason", exc)
+            raise InputError(
+                f"cannot reach the rockmech service at {url}: {reason}", "service"
+            ) from None
+        try:
+            doc = json.loads(body.decode("utf-8"))
+        except ValueError:
+            raise InputError(f"{url} did not answer JSON", "service") from None
+        if not isinstance(doc, dict):
+            raise InputError(f"{url} answered {type(doc).__name__}, expected an object", "service")
+        return doc
+
+
+def load_constants_files(paths: Sequence[str]) -> Any:
+    """Read one or more constants files as one (mechanism ids must differ)."""
+    from shared_schema.constants import ConstantsFile
+    from shared_schema.io import load_constants
+
+    if not paths:
+        raise InputError("no constants file was given", "constants")
+    mechanisms: List[Any] = []
+    seen: Dict[str, str] = {}
+    for path in paths:
+        for mech in load_constants(path).mechanisms:
+            if mech.id in seen:
+                raise InputError(
+                    f"mechanism id {mech.id!r} is in both {seen[mech.id]} and {path}", "constants"
+                )
+            seen[mech.id] = str(path)
+            mechanisms.append(mech)
+    return ConstantsFile(mechanisms=mechanisms)
+
+
+def _constants_json(cf: Any) -> Dict[str, Any]:
+    return dict(json.loads(cf.model_dump_json(exclude_none=True)))
+
+
+def _band_lines(doc: Dict[str, Any]) -> List[str]:
+    lines = ["critical mechanism by pulse frequency:"]
+    for band in doc.get("critical") or []:
+        lines.append(f"  {band['mechanism']}: {band['f_min']:.3g} to {band['f_max']:.3g} Hz")
+    return lines
+
+
+def run_envelopes(
+    cf: Any,
+    *,
+    f_min: float = 0.1,
+    f_max: float = 10.0,
+    n: int = N_FREQUENCIES,
+    out_dir: str,
+    stem: str = "envelope",
+    client: Optional[ServiceClient] = None,
+) -> AnalysisResult:
+    """Overturning envelopes of every mechanism and the critical bands (``rockmech envelope``)."""
+    from pathlib import Path
+
+    from shared_schema.atomic import write_atomic
+
+    os.makedirs(out_dir, exist_ok=True)
+    json_path = os.path.join(out_dir, f"{stem}.json")
+    if client is not None:
+        payload = {"constants": _constants_json(cf), "f_min": f_min, "f_max": f_max, "n": n}
+        doc = client.post("envelope", payload)
+        write_atomic(json_path, json.dumps(doc, indent=2) + "\n")
+        return AnalysisResult("Envelopes", doc, _band_lines(doc), None, [json_path])
+    from solver_service.analysis import frequency_grid, write_envelope
+
+    doc = write_envelope(
+        cf, frequency_grid(f_min, f_max, n), Path(out_dir), stem=stem, title="Overturning envelopes"
+    )
+    plot = os.path.join(out_dir, f"{stem}.png")
+    files = [json_path, os.path.join(out_dir, f"{stem}.csv"), plot]
+    return AnalysisResult("Envelopes", doc, _band_lines(doc), plot, files)
+
+
+def _history_lines(doc: Dict[str, Any]) -> List[str]:
+    lines = []
+    for row in doc.get("results") or []:
+        verdict = "OVERTURNS" if row.get("overturned") else "survives"
+        lines.append(
+            f"  {row['mechanism']} x {row['scale']:g}: peak |phi|/phi_ov = "
+            f"{row['peak_ratio']:.4f}, {verdict}"
+        )
+    return lines
+
+
+def run_history(
+    cf: Any,
+    record: str,
+    *,
+    units: Optional[str],
+    scales: Sequence[float],
+    out_dir: str,
+    stem: str = "history",
+    client: Optional[ServiceClient] = None,
+) -> AnalysisResult:
+    """Time histories of every mechanism at every scale factor (``rockmech history``)."""
+    from pathlib import Path
+
+    from shared_schema.atomic import write_atomic
+    from solver_service.core.records import GroundMotion
+
+    motion = GroundMotion.from_file(record, units=units)
+    os.makedirs(out_dir, exist_ok=True)
+    json_path = os.path.join(out_dir, f"{stem}.json")
+    if client is not None:
+        samples = {
+            "accel": [float(a) for a in motion.accel.acc],
+            "dt": float(motion.dt),
+            "units": "m/s2",
+            "name": motion.name,
+        }
+        payload = {"constants": _constants_json(cf), "record": samples, "scales": list(scales)}
+        doc = client.post("history", payload)
+        write_atomic(json_path, json.dumps(doc, indent=2) + "\n")
+        return AnalysisResult("History", doc, _history_lines(doc), None, [json_path])
+    from solver_service.analysis import write_history
+
+    doc = write_history(cf, motion, list(scales), Path(out_dir), stem=stem, title=motion.name)
+    plot = os.path.join(out_dir, f"{stem}.png")
+    files = [json_path, plot, os.path.join(out_dir, f"{stem}_record.png")]
+    return AnalysisResult("History", doc, _history_lines(doc), plot, files)
+
+
+def run_pulse(
+    cf: Any, mechanism: str, *, a_p_g: float, f_p: float, client: Optional[ServiceClient] = None
+) -> AnalysisResult:
+    """Response of one mechanism to a one-cycle sine pulse (``rockmech pulse``)."""
+    mech = next((m for m in cf.mechanisms if m.id == mechanism), None)
+    if mech is None:
+        ids = [m.id for m in cf.mechanisms]
+        raise InputError(f"no mechanism {mechanism!r}; the file has {ids}", "mechanism")
+    if client is not None:
+        side = mech.positive
+        payload = {
+            "p_eq": side.p_eq,
+            "lam": side.lam,
+            "phi_ov": side.phi_ov,
+            "eta": mech.eta,
+            "one_sided": mech.rocking == "one_sided",
+            "a_p_g": a_p_g,
+            "f_p": f_p,
+        }
+        doc = client.post("pulse", payload)
+    else:
+        from solver_service.adapter import to_rocking_model
+        from solver_service.core.exact import simulate
+        from solver_service.core.excitation import Pulse
+        from solver_service.core.model import G
+
+        model = to_rocking_model(mech)
+        model.require_eta()
+        doc = simulate(model, Pulse(a_p=a_p_g * G, f_p=f_p)).summary()
+    verdict = "OVERTURNS" if doc.get("overturned") else "survives"
+    line = f"  {mechanism}: sine pulse a_p = {a_p_g:g} g, f_p = {f_p:g} Hz: {verdict}"
+    if "peak_ratio" in doc:
+        line += f" (peak |phi|/phi_ov = {doc['peak_ratio']:.4f})"
+    return AnalysisResult("Pulse", doc, [line])
+
+
+def _num(prompter: Prompter, prompt: str, what: str, default: Optional[float] = None) -> float:
+    return _number(prompter.get_number(prompt, default), what, what, above=0.0)
+
+
+def analyse_flow(
+    prompter: Prompter,
+    out_dir: str,
+    *,
+    current: Sequence[str] = (),
+    service_url: Optional[str] = None,
+) -> Optional[AnalysisResult]:
+    """Ask what to analyse and run it; messages go to ``prompter.message``.
+
+    Parameters
+    ----------
+    prompter : Prompter
+    out_dir : str
+        Folder of the result files.
+    current : sequence of str
+        Constants files of the current document's mechanisms (offered as "Current").
+    service_url : str, optional
+        The REST service; when given, the user may run there instead of locally.
+
+    Returns
+    -------
+    AnalysisResult or None
+        ``None`` when cancelled or refused (the reason was shown).
+    """
+    try:
+        sources = ["File", "Current"] if current else ["File"]
+        source = prompter.get_option("Constants from", sources, 1 if current else 0)
+        if source == "Current":
+            paths = list(current)
+        else:
+            paths = [prompter.get_file("Kinematic-constants file", [".json"])]
+        cf = load_constants_files(paths)
+        kind = prompter.get_option("Analysis", list(ANALYSES), 0)
+        client = None
+        if service_url:
+            if prompter.get_option("Run on", ["Local", "Service"], 0) == "Service":
+                client = ServiceClient(service_url)
+        if kind == "Envelopes":
+            f_min = _num(prompter, "Lowest pulse frequency [Hz]", "f_min [Hz]", 0.1)
+            f_max = _num(prompter, "Highest pulse frequency [Hz]", "f_max [Hz]", 10.0)
+            result = run_envelopes(cf, f_min=f_min, f_max=f_max, out_dir=out_dir, client=client)
+        elif kind == "History":
+            record = prompter.get_file("Ground-motion record", [".at2", ".txt", ".dat", ".csv"])
+            units = RECORD_UNITS[prompter.get_option("Record units", list(RECORD_UNITS), 0)]
+            scales = [_num(prompter, "Scale factor", "scale factor", 1.0)]
+            while True:
+                more = prompter.get_number("Another scale factor (Enter when done)", None, True)
+                if more is None:
+                    break
+                scales.append(_number(more, "scale factor", "scale factor", above=0.0))
+            fmt_units = None if record.lower().endswith(".at2") else units
+            result = run_history(
+                cf, record, units=fmt_units, scales=scales, out_dir=out_dir, client=client
+            )
+        else:
+            ids = [m.id for m in cf.mechanisms]
+            mechanism = prompter.get_option("Mechanism", ids, 0)
+            a_p = prompter.get_number("Pulse amplitude a_p [g] (signed)", None)
+            a_p_g = _number(a_p, "a_p [g]", "a_p_g")
+            f_p = _num(prompter, "Pulse frequency f_p [Hz]", "f_p [Hz]", 1.0)
+            result = run_pulse(cf, mechanism, a_p_g=a_p_g, f_p=f_p, client=client)
+    except Cancelled:
+        prompter.message("RM_Analyse: cancelled.")
+        return None
+    except (RockmechError, ValueError) as exc:
+        prompter.message(f"RM_Analyse: {exc}")
+        return None
+    where = "the service" if client is not None else "the Python API"
+    prompter.message(
+        f"RM_Analyse: {result.kind.lower()} of {len(cf.mechanisms)} mechanism(s) via {where}"
+    )
+    for line in result.summary:
+        prompter.message(line)
+    for path in result.files:
+        prompter.message(f"  wrote {path}")
+    return result
