@@ -1,0 +1,497 @@
+"""Request and response models of the rockmech REST service (``/api/v1``).
+
+Requests are strict: a boolean is not a number, a string is not a number, NaN and infinity
+are refused, and unknown keys are errors. Range checks that the command line also makes
+(``p_eq > 0``, ``eta`` in [-1, 1], ...) are left to the solver, so that the service gives the
+same message as ``rockmech``; their limits are still stated in the published schema.
+
+Responses mirror the JSON documents that ``rockmech ... --json`` prints. Optional sections
+that do not apply are absent, not ``null``; a number is ``null`` only where its value is not
+finite (an overflow on extreme inputs, or "none up to the search limit").
+
+Units are SI, except where a name says otherwise (``a_p_g`` and ``pga_g`` are in g).
+Python 3.9-clean: no ``X | Y`` annotations.
+"""
+
+from typing import Annotated, Any, Dict, List, Literal, Optional, Union
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from shared_schema.constants import Amplification, ConstantsFile
+
+__all__ = [
+    "RECORD_UNITS",
+    "Band",
+    "ConstantsForm",
+    "ConstantsResponse",
+    "Ec8Request",
+    "EnvelopeMechanism",
+    "EnvelopeRequest",
+    "EnvelopeResponse",
+    "Eq28Request",
+    "ErrorResponse",
+    "HealthResponse",
+    "HistoryForm",
+    "HistoryRequest",
+    "HistoryResponse",
+    "HistoryRow",
+    "NzsRequest",
+    "PulseInput",
+    "PulseRequest",
+    "PulseResponse",
+    "RecordFileOptions",
+    "RecordInfo",
+    "RecordSamples",
+    "ReportForm",
+    "ReportRequest",
+    "ScaleFactorRequest",
+    "ScaleFactorResponse",
+    "SpectrumCurve",
+    "SpectrumForm",
+    "SpectrumRequest",
+    "SpectrumResponse",
+]
+
+#: Acceleration units a record may be given in.
+RECORD_UNITS = ("g", "m/s2", "cm/s2")
+
+_REQUEST = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
+_RESPONSE = ConfigDict(extra="allow")
+
+
+def _gt0(description: str) -> Any:
+    return Field(description=description, json_schema_extra={"exclusiveMinimum": 0})
+
+
+# --- requests ---------------------------------------------------------------------------------
+
+
+class PulseRequest(BaseModel):
+    """One mechanism under a one-cycle sine or cosine pulse (``rockmech pulse``)."""
+
+    model_config = _REQUEST
+
+    p_eq: float = _gt0("Frequency parameter p_eq [rad/s], > 0.")
+    lam: float = _gt0("Static load multiplier lambda [-], > 0.")
+    a_p_g: float = Field(
+        description="Signed pulse amplitude [g]; > 0 first pushes towards negative rotation "
+        "(Housner's convention), < 0 first opens the mechanism."
+    )
+    f_p: float = _gt0("Pulse frequency [Hz], > 0.")
+    eta: Optional[float] = Field(
+        None,
+        description="Coefficient of restitution [-], in [0, 1] two-sided, [-1, 0] one-sided; "
+        "required for a time-domain analysis.",
+        json_schema_extra={"minimum": -1, "maximum": 1},
+    )
+    one_sided: bool = Field(False, description="One-sided rocking.")
+    phi_ov: Optional[float] = Field(
+        None,
+        description="Overturning rotation [rad], > 0; defaults to lambda.",
+        json_schema_extra={"exclusiveMinimum": 0},
+    )
+    shape: str = Field(
+        "sine", description="Pulse shape.", json_schema_extra={"enum": ["sine", "cosine"]}
+    )
+    criterion: Optional[str] = Field(
+        None,
+        description="Overturning verdict: exact (default for pulses) or ratio.",
+        json_schema_extra={"enum": ["exact", "ratio", None]},
+    )
+
+
+class RecordSamples(BaseModel):
+    """A ground-acceleration record given as samples at a uniform time step."""
+
+    model_config = _REQUEST
+
+    accel: List[float] = Field(
+        min_length=2, description="Acceleration samples, in `units`, at a uniform step `dt`."
+    )
+    dt: float = _gt0("Time step [s], > 0.")
+    units: Literal["g", "m/s2", "cm/s2"] = Field(description="Units of `accel`.")
+    name: str = Field(
+        "record", min_length=1, max_length=200, description="Name used in results and reports."
+    )
+
+
+class EnvelopeRequest(BaseModel):
+    """Overturning envelopes of every mechanism and the critical bands (``rockmech envelope``)."""
+
+    model_config = _REQUEST
+
+    constants: ConstantsFile = Field(description="The kinematic-constants file.")
+    f_min: float = Field(0.1, description="Lowest pulse frequency [Hz], > 0.")
+    f_max: float = Field(10.0, description="Highest pulse frequency [Hz], > f_min.")
+    n: int = Field(200, description="Number of log-spaced frequencies, >= 2.")
+    exact: bool = Field(
+        False, description="Compute the boundaries directly instead of from the library."
+    )
+
+
+class _BuildingOptions(BaseModel):
+    """Code scale factors and displacements of time histories (``rockmech history``)."""
+
+    building_height: Optional[float] = Field(
+        None, description="Height of the building H = h_n [m] (sf ec8 and nzs)."
+    )
+    soil_factor: float = Field(1.0, description="EC8 soil factor S [-].")
+    element_period: float = Field(0.0, description="EC8 period of the element T_a [s]; 0 = rigid.")
+    at_height: Optional[float] = Field(
+        None,
+        description="Also report the peak displacement [m] of a point this far [m] above each "
+        "mechanism's rotation axis.",
+    )
+
+
+class _HistoryOptions(_BuildingOptions):
+    """Scale factors and verdict of time histories (``rockmech history``)."""
+
+    scales: List[float] = Field(
+        [1.0], min_length=1, description="Scale factors on the record [-], each > 0."
+    )
+    sf: str = Field(
+        "none",
+        description="Scale factor up the structure for mechanisms with amplification data: "
+        "none; eq28 (from the record's 5 % spectrum at T_n = 1/f_n); ec8 (EN 1998-1 "
+        "§4.3.5.2) or nzs (NZS 1170.5 C_Hi), both with building_height.",
+        json_schema_extra={"enum": ["none", "eq28", "ec8", "nzs"]},
+    )
+    criterion: Optional[str] = Field(
+        None,
+        description="Overturning verdict: ratio (default for records) or exact.",
+        json_schema_extra={"enum": ["ratio", "exact", None]},
+    )
+
+
+class _ReportOptions(_HistoryOptions):
+    """Envelope options and title of a report (``rockmech report``)."""
+
+    f_min: float = Field(0.1, description="Lowest pulse frequency of the envelopes [Hz].")
+    f_max: float = Field(10.0, description="Highest pulse frequency of the envelopes [Hz].")
+    n: int = Field(200, description="Number of log-spaced envelope frequencies, >= 2.")
+    exact: bool = Field(False, description="Exact envelopes instead of the library.")
+    title: Optional[str] = Field(None, max_length=200, description="Title of the report.")
+
+
+class HistoryRequest(_HistoryOptions):
+    """Time histories of every mechanism at every scale factor (``rockmech history``)."""
+
+    model_config = _REQUEST
+
+    constants: ConstantsFile = Field(description="The kinematic-constants file.")
+    record: RecordSamples = Field(description="The ground motion.")
+
+
+class _SpectrumOptions(BaseModel):
+    """Spectrum and pulse-search options (``rockmech record``)."""
+
+    zeta: float = Field(0.05, description="Damping ratio of the spectrum [-], in [0, 1).")
+    t_min: float = Field(0.02, description="Shortest period of the spectrum [s], > 0.")
+    t_max: float = Field(10.0, description="Longest period of the spectrum [s], > t_min.")
+    n: int = Field(100, description="Number of log-spaced periods, >= 2.")
+    pulses: int = Field(5, description="How many of the largest sine pulses to list, >= 1.")
+    f_min: Optional[float] = Field(None, description="Pulse search: lowest f_p [Hz].")
+    f_max: Optional[float] = Field(None, description="Pulse search: highest f_p [Hz].")
+
+
+class SpectrumRequest(_SpectrumOptions):
+    """A record's exact elastic response spectrum and largest sine pulses (``rockmech record``)."""
+
+    model_config = _REQUEST
+
+    record: RecordSamples = Field(description="The ground motion.")
+
+
+class Eq28Request(BaseModel):
+    """Eq. 28 scale factor ``sqrt(1 + (S_a/a_g h/h_e)^2)``: from S_a and PGA, or from a record."""
+
+    model_config = _REQUEST
+
+    method: Literal["eq28"]
+    h: float = Field(description="Height of the mechanism [m], >= 0.")
+    h_e: float = _gt0("Effective (modal) height of the structure [m], > 0.")
+    sa_g: Optional[float] = Field(None, description="Spectral acceleration S_a(T_n) [g], >= 0.")
+    pga_g: Optional[float] = Field(None, description="Peak ground acceleration [g], > 0.")
+    record: Optional[RecordSamples] = Field(
+        None, description="A record instead of sa_g and pga_g (needs f_n)."
+    )
+    f_n: Optional[float] = Field(
+        None, description="Natural frequency of the structure [Hz], > 0 (with record)."
+    )
+
+
+class Ec8Request(BaseModel):
+    """EN 1998-1 §4.3.5.2 amplification for an element at height z."""
+
+    model_config = _REQUEST
+
+    method: Literal["ec8"]
+    z: float = Field(description="Height of the element above the foundation [m], >= 0.")
+    H: float = _gt0("Height of the building [m], > 0.")
+    T_a: float = Field(description="Fundamental period of the element [s], >= 0.")
+    T_1: float = _gt0("Fundamental period of the building [s], > 0.")
+    S: float = Field(1.0, description="Soil factor [-], > 0.")
+
+
+class NzsRequest(BaseModel):
+    """NZS 1170.5 §8.3 floor height coefficient C_Hi."""
+
+    model_config = _REQUEST
+
+    method: Literal["nzs"]
+    h_i: float = Field(description="Height of the level above the base [m], >= 0.")
+    h_n: float = _gt0("Height of the top of the structure [m], > 0.")
+
+
+#: One scale-factor request, chosen by ``method``.
+ScaleFactorRequest = Annotated[
+    Union[Eq28Request, Ec8Request, NzsRequest], Field(discriminator="method")
+]
+
+
+class ReportRequest(_ReportOptions):
+    """An HTML report: constants, envelopes, and with a record its time histories and spectrum."""
+
+    model_config = _REQUEST
+
+    constants: ConstantsFile = Field(description="The kinematic-constants file.")
+    record: Optional[RecordSamples] = Field(
+        None, description="A ground motion for time histories and its spectrum."
+    )
+
+
+# --- multipart forms (the text fields next to uploaded files) ---------------------------------
+
+# Form fields arrive as text, so these models convert text to numbers (lax mode); NaN,
+# infinity and unknown fields are still refused, and "true" is not a number.
+_FORM = ConfigDict(strict=False, extra="forbid", allow_inf_nan=False)
+
+
+class RecordFileOptions(BaseModel):
+    """How to read an uploaded record file (as ``rockmech history`` options)."""
+
+    model_config = _FORM
+
+    format: Optional[str] = Field(
+        None,
+        description="at2, two_column, one_column or csv (default: detected).",
+        json_schema_extra={"enum": ["at2", "two_column", "one_column", "csv"]},
+    )
+    units: Optional[str] = Field(
+        None,
+        description="Acceleration units: g, m/s2 or cm/s2; AT2 files state their own, "
+        "two-column files default to g, other formats need it.",
+        json_schema_extra={"enum": list(RECORD_UNITS)},
+    )
+    dt: Optional[float] = Field(
+        None,
+        description="Time step [s] of a record without a time column.",
+        json_schema_extra={"exclusiveMinimum": 0},
+    )
+
+
+class HistoryForm(RecordFileOptions, _HistoryOptions):
+    """Multipart form of ``history``: files ``constants`` and ``record``, plus these fields."""
+
+
+class SpectrumForm(RecordFileOptions, _SpectrumOptions):
+    """Multipart form of ``spectrum``: file ``record``, plus these fields."""
+
+
+class ReportForm(RecordFileOptions, _ReportOptions):
+    """Multipart form of ``report``: file ``constants``, optional file ``record``, and these."""
+
+
+class ConstantsForm(BaseModel):
+    """Multipart form of ``constants``: files ``scene`` (.3dm) and ``spec`` (JSON) only."""
+
+    model_config = _FORM
+
+
+# --- responses --------------------------------------------------------------------------------
+
+
+class ErrorResponse(BaseModel):
+    """An error: the message ``rockmech`` would print after ``error:``."""
+
+    detail: str = Field(description="What is wrong, naming the field or file.")
+    field: Optional[str] = Field(None, description="Path of the offending field, when known.")
+    error: str = Field(description="Kind of error, e.g. InputError or BudgetExceeded.")
+
+
+class HealthResponse(BaseModel):
+    """Service status."""
+
+    status: Literal["ok"]
+    version: str = Field(description="rockmech version.")
+    compute_workers: int = Field(description="Compute processes ready or busy.")
+    compute_timeout_s: float = Field(description="Compute time budget per request [s].")
+
+
+class PulseInput(BaseModel):
+    """The pulse problem as solved, with its dimensionless ratios."""
+
+    model_config = _RESPONSE
+
+    p_eq: Optional[float]
+    lam: Optional[float]
+    phi_ov: Optional[float]
+    eta: Optional[float]
+    rocking: Literal["two_sided", "one_sided"]
+    a_p_g: Optional[float]
+    f_p: Optional[float]
+    shape: str
+    omega_ratio: Optional[float] = Field(description="Omega = omega_p / p_eq [-].")
+    amplitude_ratio: Optional[float] = Field(description="A = |a_p| / (g lam) [-].")
+    pulse_convention: str
+
+
+class PulseResponse(BaseModel):
+    """Response of one mechanism to a pulse (``rockmech pulse --json``)."""
+
+    model_config = _RESPONSE
+
+    input: PulseInput
+    peak_ratio: Optional[float] = Field(description="Peak |phi|/phi_ov [-].")
+    t_peak: Optional[float] = Field(None, description="Time of the peak [s].")
+    overturned: bool
+    t_overturn: Optional[float] = Field(description="Time of overturning [s], or null.")
+    criterion: str
+    ratio_exceeded: bool
+    collapsed: bool
+    n_impacts: int
+    n_steps: int
+    error_estimate: Optional[float] = Field(
+        None, description="Estimated absolute error of peak_ratio [-]."
+    )
+    runtime_s: Optional[float]
+    status: int
+    message: str
+    method: str
+
+
+class Band(BaseModel):
+    """A run of frequencies where one mechanism governs."""
+
+    mechanism: str
+    f_min: Optional[float] = Field(description="First frequency of the band [Hz].")
+    f_max: Optional[float] = Field(description="Last frequency of the band [Hz].")
+
+
+class EnvelopeMechanism(BaseModel):
+    """Envelope of one mechanism; amplification fields only for mechanisms above ground."""
+
+    model_config = _RESPONSE
+
+    id: str
+    name: Optional[str]
+    rocking: str
+    p_eq: Optional[float]
+    lam: Optional[float]
+    a_p_min_g: List[Optional[float]] = Field(
+        description="Minimum overturning ground pulse amplitude [g] per frequency; null: "
+        "none up to the search limit."
+    )
+    eta: Optional[float] = None
+    amplification: Optional[Amplification] = None
+    a_p_min_local_g: Optional[List[Optional[float]]] = None
+    scale_factor: Optional[List[Optional[float]]] = None
+    governing_side: Optional[List[int]] = None
+
+
+class EnvelopeResponse(BaseModel):
+    """Envelopes and the critical mechanism per frequency (``rockmech envelope --json``)."""
+
+    model_config = _RESPONSE
+
+    units: Dict[str, str]
+    f_p: List[Optional[float]] = Field(description="Pulse frequencies [Hz].")
+    mechanisms: List[EnvelopeMechanism]
+    critical: List[Band]
+    governing: List[Optional[str]]
+    method: Dict[str, Any]
+
+
+class RecordInfo(BaseModel):
+    """The record as read: name, step, PGA, duration and what the reader found."""
+
+    model_config = _RESPONSE
+
+    name: str
+    dt_s: Optional[float]
+    pga_g: Optional[float]
+    duration_s: Optional[float]
+
+
+class HistoryRow(BaseModel):
+    """One mechanism at one scale factor."""
+
+    model_config = _RESPONSE
+
+    mechanism: str
+    scale: Optional[float]
+    peak_ratio: Optional[float]
+    overturned: bool
+    t_overturn: Optional[float]
+    n_impacts: int
+    error_estimate: Optional[float]
+    status: int
+    message: str
+    effective_scale: Optional[float] = None
+    peak_displacement_m: Optional[float] = None
+    peak_displacement_is_bound: Optional[bool] = None
+
+
+class HistoryResponse(BaseModel):
+    """Time histories (``rockmech history --json``)."""
+
+    model_config = _RESPONSE
+
+    record: RecordInfo
+    criterion: str
+    method: str
+    runtime_s: Optional[float]
+    results: List[HistoryRow]
+    scale_factor_method: Optional[str] = None
+    scale_factors: Optional[Dict[str, Dict[str, Any]]] = None
+    displacement: Optional[Dict[str, Any]] = None
+
+
+class SpectrumCurve(BaseModel):
+    """An elastic response spectrum."""
+
+    model_config = _RESPONSE
+
+    damping: Optional[float] = Field(description="Damping ratio [-].")
+    periods_s: List[Optional[float]]
+    psa_g: List[Optional[float]] = Field(description="Pseudo-spectral acceleration [g].")
+    sd_m: List[Optional[float]] = Field(description="Spectral displacement [m].")
+    method: str
+    runtime_s: Optional[float]
+
+
+class SpectrumResponse(BaseModel):
+    """A record's spectrum and largest sine pulses (``rockmech record --json``)."""
+
+    model_config = _RESPONSE
+
+    record: RecordInfo
+    pulses: List[Dict[str, Any]] = Field(description="Largest one-cycle sine pulses.")
+    pulse_method: str
+    spectrum: SpectrumCurve
+
+
+class ScaleFactorResponse(BaseModel):
+    """A scale factor with its method, formula and inputs."""
+
+    model_config = _RESPONSE
+
+    value: Optional[float]
+    method: str
+    formula: str
+    inputs: Dict[str, Optional[float]]
+
+
+#: The constants endpoint answers with a kinematic-constants file.
+ConstantsResponse = ConstantsFile

@@ -1,0 +1,127 @@
+"""Multipart forms of the service: which files and text fields each endpoint takes.
+
+The text fields are validated by the form models of ``shared_schema.api`` (text converted
+to numbers, NaN and unknown fields refused); the files are passed to the compute process as
+bytes and read there, under their sanitised names, exactly as ``rockmech`` reads files.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from pydantic import BaseModel
+from starlette.datastructures import FormData, UploadFile
+
+from shared_schema.api import ConstantsForm, HistoryForm, ReportForm, SpectrumForm
+
+__all__ = ["FORMS", "FormSpec", "form_fields", "multipart_schema"]
+
+
+@dataclass(frozen=True)
+class FormSpec:
+    """One endpoint's multipart form.
+
+    Attributes
+    ----------
+    model : type of BaseModel
+        Validates the text fields.
+    files : dict
+        File parts: name -> (required, description).
+    """
+
+    model: type[BaseModel]
+    files: dict[str, tuple[bool, str]]
+
+    @property
+    def constants(self) -> bool:
+        """True when the form takes a constants file."""
+        return "constants" in self.files
+
+    @property
+    def record_required(self) -> bool:
+        """True when the record file is required."""
+        return self.files.get("record", (False, ""))[0]
+
+    @property
+    def lists(self) -> set[str]:
+        """Fields that may repeat (arrays)."""
+        props = self.model.model_json_schema()["properties"]
+        return {k for k, v in props.items() if _is_array(v)}
+
+
+def _is_array(prop: dict[str, Any]) -> bool:
+    if prop.get("type") == "array":
+        return True
+    return any(p.get("type") == "array" for p in prop.get("anyOf", []))
+
+
+_CONSTANTS = (True, "Kinematic-constants JSON file.")
+_RECORD = "Record file: PEER AT2, two columns (t, a), one column (with dt) or CSV."
+
+#: The forms, by endpoint.
+FORMS = {
+    "history": FormSpec(HistoryForm, {"constants": _CONSTANTS, "record": (True, _RECORD)}),
+    "spectrum": FormSpec(SpectrumForm, {"record": (True, _RECORD)}),
+    "report": FormSpec(ReportForm, {"constants": _CONSTANTS, "record": (False, _RECORD)}),
+    "constants": FormSpec(
+        ConstantsForm,
+        {"scene": (True, "Rhino .3dm file."), "spec": (True, "Mechanism spec (JSON).")},
+    ),
+}
+
+
+def form_fields(form: FormData, spec: FormSpec) -> dict[str, Any]:
+    """Collect the text fields of ``form`` (files excluded) for ``spec.model``.
+
+    Raises
+    ------
+    ValueError
+        A text field holds a file, or a single-valued field is repeated.
+    """
+    lists = spec.lists
+    out: dict[str, Any] = {}
+    for key in dict.fromkeys(form.keys()):
+        if key in spec.files:
+            continue
+        values = form.getlist(key)
+        if any(isinstance(v, UploadFile) for v in values):
+            raise ValueError(f"{key}: expected a text field, got a file")
+        if key in lists:
+            out[key] = list(values)
+        elif len(values) > 1:
+            raise ValueError(f"{key}: give one value, got {len(values)}")
+        else:
+            out[key] = values[0]
+    return out
+
+
+def _not_null(prop: dict[str, Any]) -> dict[str, Any]:
+    """Drop null from a form field schema (anyOf, enum, default): form text is never null."""
+    out = dict(prop)
+    if out.get("default", 0) is None:
+        del out["default"]
+    options = [p for p in out.pop("anyOf", []) if p.get("type") != "null"]
+    if len(options) == 1:
+        out.update(options[0])
+    elif options:
+        out["anyOf"] = options
+    if "enum" in out:
+        out["enum"] = [v for v in out["enum"] if v is not None]
+    return out
+
+
+def multipart_schema(spec: FormSpec) -> dict[str, Any]:
+    """Return the OpenAPI schema of a multipart form (text fields and file parts)."""
+    schema = spec.model.model_json_schema()
+    schema.pop("title", None)
+    props = {k: _not_null(v) for k, v in schema.get("properties", {}).items()}
+    required = list(schema.get("required", []))
+    for name, (needed, text) in spec.files.items():
+        props[name] = {"type": "string", "format": "binary", "description": text}
+        if needed:
+            required.append(name)
+    schema["properties"] = props
+    schema["required"] = required
+    schema["additionalProperties"] = False
+    return schema

@@ -1,0 +1,245 @@
+"""A bounded pool of compute processes with a time budget per job.
+
+Why processes. The solver's numba kernels cannot be interrupted from outside, and a
+thread cannot be killed, so a computation that overruns its budget in a thread would keep
+a core busy (and its memory) until it ended by itself. In a separate process it can be
+abandoned safely: the pool ends that process (SIGKILL), answers 503 and starts a fresh
+process in its place. The server process itself never computes, so it stays responsive.
+
+Why not ``concurrent.futures.ProcessPoolExecutor``: it pickles its messages and cannot end
+one worker without breaking the whole pool. Here each worker speaks framed JSON on its
+stdin/stdout (``solver_service.api.worker``), and no pickle is used.
+
+Every process warms its kernels up before it takes work (numba loads them from its cache),
+so a replacement does not make the next request pay for compilation.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import logging
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Optional
+
+__all__ = ["BudgetExceeded", "ComputePool", "PoolBusy", "WorkerLost", "WorkerResult"]
+
+log = logging.getLogger("rockmech.pool")
+
+#: Largest line the pool reads from a worker [bytes] (headers are small; bodies are framed).
+STREAM_LIMIT = 1 << 20
+#: Seconds a worker is given to exit after its stdin closes, before it is killed.
+EXIT_GRACE_S = 2.0
+
+
+class BudgetExceeded(Exception):
+    """A job ran past the compute time budget; its process was ended."""
+
+
+class PoolBusy(Exception):
+    """No compute process became free in time."""
+
+
+class WorkerLost(Exception):
+    """A compute process ended while it worked on a job (it has been replaced)."""
+
+
+@dataclass(frozen=True)
+class WorkerResult:
+    """A job's answer from a worker."""
+
+    status: int
+    media_type: str
+    body: bytes
+
+
+@dataclass(eq=False)
+class _Worker:
+    proc: asyncio.subprocess.Process
+    jobs: int = 0
+
+
+class ComputePool:
+    """Run jobs in ``size`` worker processes, each job within ``timeout_s`` seconds.
+
+    Parameters
+    ----------
+    size : int
+        Number of worker processes.
+    timeout_s : float
+        Compute time budget of one job [s].
+    queue_timeout_s : float
+        Longest wait for a free worker [s].
+    startup_timeout_s : float
+        Longest start-up of one worker [s].
+    limits : dict
+        Size limits passed to every job.
+    """
+
+    def __init__(
+        self,
+        size: int,
+        timeout_s: float,
+        queue_timeout_s: float,
+        startup_timeout_s: float,
+        limits: dict[str, int],
+    ) -> None:
+        self.size = size
+        self.timeout_s = timeout_s
+        self.queue_timeout_s = queue_timeout_s
+        self.startup_timeout_s = startup_timeout_s
+        self.limits = dict(limits)
+        self._idle: asyncio.Queue[_Worker] = asyncio.Queue()
+        self._all: set[_Worker] = set()
+        self._tasks: set[asyncio.Task[None]] = set()
+        self._closing = False
+
+    @property
+    def alive(self) -> int:
+        """Number of worker processes that are running."""
+        return sum(1 for w in self._all if w.proc.returncode is None)
+
+    def pids(self) -> list[int]:
+        """Process ids of the running workers (for memory reports)."""
+        return [w.proc.pid for w in self._all if w.proc.returncode is None]
+
+    async def start(self) -> None:
+        """Start every worker and wait until each has warmed up."""
+        await asyncio.gather(*(self._spawn() for _ in range(self.size)))
+
+    async def _spawn(self) -> None:
+        proc = await asyncio.create_subprocess_exec(
+            sys.executable,
+            "-m",
+            "solver_service.api.worker",
+            stdin=asyncio.subprocess.PIPE,
+            stdout=asyncio.subprocess.PIPE,
+            limit=STREAM_LIMIT,
+        )
+        worker = _Worker(proc)
+        self._all.add(worker)
+        try:
+            assert proc.stdout is not None
+            line = await asyncio.wait_for(proc.stdout.readline(), self.startup_timeout_s)
+            if not json.loads(line or b"{}").get("ready"):
+                raise RuntimeError(f"compute process {proc.pid} did not start")
+        except BaseException:
+            await self._end(worker)
+            raise
+        if self._closing:
+            await self._end(worker)
+            return
+        self._idle.put_nowait(worker)
+
+    def _replace(self, worker: _Worker) -> None:
+        """End ``worker`` now (SIGKILL) and start a replacement in the background."""
+        self._all.discard(worker)
+        if worker.proc.returncode is None:
+            with contextlib.suppress(ProcessLookupError):
+                worker.proc.kill()
+
+        async def replace() -> None:
+            await self._end(worker)
+            if not self._closing:
+                try:
+                    await self._spawn()
+                except Exception:  # pragma: no cover - logged; the pool runs one short
+                    log.exception("could not start a replacement compute process")
+
+        task = asyncio.get_running_loop().create_task(replace())
+        self._tasks.add(task)
+        task.add_done_callback(self._tasks.discard)
+
+    async def _end(self, worker: _Worker, grace_s: float = 0.0) -> None:
+        self._all.discard(worker)
+        proc = worker.proc
+        if proc.returncode is None and grace_s > 0 and proc.stdin is not None:
+            proc.stdin.close()
+            with contextlib.suppress(asyncio.TimeoutError):
+                await asyncio.wait_for(proc.wait(), grace_s)
+        if proc.returncode is None:
+            with contextlib.suppress(ProcessLookupError):
+                proc.kill()
+            await proc.wait()
+
+    async def run(
+        self, kind: str, params: dict[str, Any], blobs: Sequence[bytes] = ()
+    ) -> WorkerResult:
+        """Run one job and return its answer.
+
+        Raises
+        ------
+        PoolBusy
+            No worker became free within ``queue_timeout_s``.
+        BudgetExceeded
+            The job took longer than ``timeout_s``; its worker was ended and is being
+            replaced.
+        WorkerLost
+            The worker ended during the job (for example killed by the operating system).
+        """
+        try:
+            worker = await asyncio.wait_for(self._idle.get(), self.queue_timeout_s)
+        except asyncio.TimeoutError:
+            raise PoolBusy(
+                f"all {self.size} compute processes stayed busy for {self.queue_timeout_s:g} s"
+            ) from None
+        header: dict[str, Any] = {"kind": kind, "params": params, "limits": self.limits}
+        header["blobs"] = [len(b) for b in blobs]
+        start = time.perf_counter()
+        try:
+            result = await asyncio.wait_for(self._exchange(worker, header, blobs), self.timeout_s)
+        except asyncio.TimeoutError:
+            self._replace(worker)
+            raise BudgetExceeded(
+                f"the computation took longer than the service's budget of "
+                f"{self.timeout_s:g} s per request (ROCKMECH_COMPUTE_TIMEOUT_S) and was "
+                "stopped; ask for less work (fewer mechanisms, scale factors, frequencies "
+                "or samples, or the library instead of exact envelopes), or run it with "
+                "the rockmech command line"
+            ) from None
+        except (OSError, asyncio.IncompleteReadError, ValueError) as exc:
+            code = worker.proc.returncode
+            self._replace(worker)
+            raise WorkerLost(
+                f"the compute process stopped while working on this request "
+                f"(exit code {code}); the input may be too large or malformed"
+            ) from exc
+        except BaseException:  # cancelled mid-exchange: the worker's state is unknown
+            self._replace(worker)
+            raise
+        worker.jobs += 1
+        log.debug("job %s took %.3f s", kind, time.perf_counter() - start)
+        self._idle.put_nowait(worker)
+        return result
+
+    async def _exchange(
+        self, worker: _Worker, header: dict[str, Any], blobs: Sequence[bytes]
+    ) -> WorkerResult:
+        proc = worker.proc
+        assert proc.stdin is not None and proc.stdout is not None
+        proc.stdin.write(json.dumps(header, allow_nan=False).encode("utf-8") + b"\n")
+        for blob in blobs:
+            proc.stdin.write(blob)
+        await proc.stdin.drain()
+        line = await proc.stdout.readline()
+        if not line:
+            raise asyncio.IncompleteReadError(b"", None)
+        answer = json.loads(line)
+        body = await proc.stdout.readexactly(int(answer["size"]))
+        return WorkerResult(int(answer["status"]), str(answer["media_type"]), body)
+
+    async def close(self) -> None:
+        """Stop every worker (they exit when their stdin closes; stragglers are killed)."""
+        self._closing = True
+        for task in list(self._tasks):
+            task.cancel()
+        await asyncio.gather(*self._tasks, return_exceptions=True)
+        await asyncio.gather(*(self._end(w, EXIT_GRACE_S) for w in list(self._all)))
+
+    def info(self) -> dict[str, Optional[int]]:
+        """Return worker counts for the health endpoint."""
+        return {"alive": self.alive, "idle": self._idle.qsize()}

@@ -1,0 +1,135 @@
+"""Run the service with uvicorn (``rockmech serve``), in this process or in a child process."""
+
+from __future__ import annotations
+
+import contextlib
+import subprocess
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from shared_schema.errors import InputError
+
+from .settings import Settings
+
+__all__ = ["background_server", "free_port", "process_rss_bytes", "run", "settings_with"]
+
+
+def settings_with(**overrides: Any) -> Settings:
+    """Return the settings from the environment, with the given non-None values on top.
+
+    Raises
+    ------
+    InputError
+        A value is out of range (the message names the setting).
+    """
+    given = {k: v for k, v in overrides.items() if v is not None}
+    try:
+        return Settings(**given)
+    except ValidationError as exc:
+        err = exc.errors(include_url=False)[0]
+        field = ".".join(str(p) for p in err["loc"])
+        raise InputError(f"{err['msg']}, got {err.get('input')!r}", field) from None
+
+
+def run(settings: Settings) -> None:
+    """Serve until interrupted (uvicorn, one event loop; compute in worker processes)."""
+    import uvicorn
+
+    from .app import create_app
+
+    uvicorn.run(
+        create_app(settings),
+        host=settings.host,
+        port=settings.port,
+        log_level=settings.log_level,
+        access_log=False,
+    )
+
+
+def free_port() -> int:
+    """Return a TCP port that is free on the loopback interface now."""
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+@contextlib.contextmanager
+def background_server(
+    settings: dict[str, Any], log: Path, *, start_timeout_s: float = 120.0
+) -> Iterator[tuple[str, subprocess.Popen[bytes]]]:
+    """Run ``rockmech serve`` in a child process on a free loopback port (tests, benchmarks).
+
+    Parameters
+    ----------
+    settings : dict
+        Settings, passed as ``ROCKMECH_<NAME>`` environment variables (others are cleared).
+    log : Path
+        File for the server's output.
+    start_timeout_s : float
+        Longest wait for ``/api/v1/health`` to answer [s].
+
+    Yields
+    ------
+    (url, process)
+        Base URL ``http://127.0.0.1:<port>`` and the server process; it is stopped (SIGTERM,
+        then SIGKILL after 30 s) on exit.
+    """
+    import os
+    import signal
+    import sys
+    import time
+    import urllib.error
+    import urllib.request
+
+    port = free_port()
+    env = {k: v for k, v in os.environ.items() if not k.startswith("ROCKMECH_")}
+    env.update({f"ROCKMECH_{k.upper()}": str(v) for k, v in settings.items()})
+    code = "from solver_service.cli import main; main()"
+    cmd = [sys.executable, "-c", code, "serve", "--port", str(port)]
+    with log.open("wb") as out:
+        proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, env=env)
+    url = f"http://127.0.0.1:{port}"
+    try:
+        deadline = time.monotonic() + start_timeout_s
+        while True:
+            if proc.poll() is not None:
+                raise RuntimeError(f"server exited with {proc.returncode}: {log.read_text()}")
+            try:
+                with urllib.request.urlopen(f"{url}/api/v1/health", timeout=2) as res:
+                    if res.status == 200:
+                        break
+            except (urllib.error.URLError, ConnectionError, TimeoutError):
+                pass
+            if time.monotonic() > deadline:
+                raise RuntimeError(f"server did not start in {start_timeout_s:g} s")
+            time.sleep(0.2)
+        yield url, proc
+    finally:
+        proc.send_signal(signal.SIGTERM)
+        try:
+            proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+def process_rss_bytes(pid: int) -> int:
+    """Resident memory of process ``pid`` and its children (Linux ``/proc``) [bytes]."""
+    total = 0
+    try:
+        kids = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
+    except OSError:
+        kids = []
+    for p in [pid, *map(int, kids)]:
+        try:
+            for line in Path(f"/proc/{p}/status").read_text().splitlines():
+                if line.startswith("VmRSS:"):
+                    total += int(line.split()[1]) * 1024
+        except OSError:
+            continue
+    return total

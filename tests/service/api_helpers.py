@@ -1,0 +1,83 @@
+"""Helpers of the service tests: a real ``rockmech serve`` (uvicorn) on a free loopback port,
+and the ``rockmech`` command line run in-process, the independent path results are compared with.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import subprocess
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from typer.testing import CliRunner
+
+from solver_service.api.server import background_server
+from solver_service.cli import app
+
+REPO = Path(__file__).resolve().parents[2]
+EXAMPLES = REPO / "examples"
+#: Seconds a server may take to start (two compute processes warm their kernels up).
+START_TIMEOUT_S = 120.0
+#: Settings of the shared test server (small limits, so limit tests stay cheap).
+TEST_SETTINGS = {
+    "compute_workers": 2,
+    "compute_timeout_s": 120,
+    "max_body_bytes": 4 * 1024 * 1024,
+    "max_samples": 100_000,
+    "max_mechanisms": 20,
+    "max_scales": 20,
+}
+
+runner = CliRunner()
+"""In-process runner of the ``rockmech`` command line."""
+
+
+@dataclass
+class Server:
+    """A running service: its base URL, process and log file."""
+
+    url: str
+    proc: subprocess.Popen[bytes]
+    log: Path
+
+    def children(self) -> list[int]:
+        """Process ids of the server's compute processes."""
+        path = Path(f"/proc/{self.proc.pid}/task/{self.proc.pid}/children")
+        return [int(p) for p in path.read_text().split()]
+
+
+@contextlib.contextmanager
+def start_server(tmp: Path, **settings: Any) -> Iterator[Server]:
+    """Start ``rockmech serve`` with ``ROCKMECH_*`` settings on a free port; stop it after."""
+    log = tmp / "server.log"
+    with background_server(settings, log, start_timeout_s=START_TIMEOUT_S) as (url, proc):
+        yield Server(url, proc, log)
+
+
+def cli_json(*args: str) -> Any:
+    """Run ``rockmech ARGS --json`` in-process and return its document."""
+    res = runner.invoke(app, [*args, "--json"])
+    assert res.exit_code == 0, res.output
+    return json.loads(res.stdout)
+
+
+def cli_error(*args: str, cwd: Path | None = None) -> str:
+    """Run ``rockmech ARGS`` (optionally in ``cwd``), expect failure, return its message."""
+    with contextlib.chdir(cwd) if cwd is not None else contextlib.nullcontext():
+        res = runner.invoke(app, list(args))
+    assert res.exit_code == 2, res.output
+    line = res.stderr.strip()
+    assert line.startswith("error: "), line
+    return line[len("error: ") :]
+
+
+def without_runtime(doc: Any) -> Any:
+    """Drop wall-clock fields (``runtime_s``), which differ between two runs."""
+    if isinstance(doc, dict):
+        return {k: without_runtime(v) for k, v in doc.items() if k != "runtime_s"}
+    if isinstance(doc, list):
+        return [without_runtime(v) for v in doc]
+    return doc
