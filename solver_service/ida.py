@@ -127,8 +127,10 @@ def _levels(levels: Sequence[float]) -> list[float]:
 def _dask_client(address: str, timeout: float) -> Any:
     try:
         from dask.distributed import Client
-    except ImportError as exc:  # pragma: no cover - dask is a declared dependency
-        raise InputError(f"needs dask.distributed ({exc})", "scheduler") from exc
+    except ImportError as exc:  # pragma: no cover - dask is in the dev extra
+        raise InputError(
+            f"needs dask.distributed: pip install 'rockmech[dask]' ({exc})", "scheduler"
+        ) from exc
     try:
         return Client(address, timeout=timeout, set_as_default=False)  # type: ignore[no-untyped-call]
     except (OSError, TimeoutError, ValueError) as exc:

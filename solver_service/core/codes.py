@@ -115,7 +115,8 @@ def sf_ec8(z: float, H: float, T_a: float, T_1: float, S: float = 1.0) -> dict[s
     ta = check_non_negative(T_a, "T_a")
     t1 = check_positive(T_1, "T_1")
     s = check_positive(S, "S")
-    bracket = 3.0 * (1.0 + zz / hh) / (1.0 + (1.0 - ta / t1) ** 2) - 0.5
+    gap = 1.0 - ta / t1
+    bracket = 3.0 * (1.0 + zz / hh) / (1.0 + gap * gap) - 0.5  # gap * gap: inf, never OverflowError
     return {
         "value": s * max(1.0, bracket),
         "method": "EN 1998-1 §4.3.5.2 (non-structural elements)",

@@ -108,6 +108,12 @@ def plot_time_histories(
         plt.close(fig)
 
 
+def _log_plottable(values: np.ndarray[Any, Any]) -> np.ndarray[Any, Any]:
+    """Return the values with the non-finite and non-positive ones as NaN (gaps in a log plot)."""
+    v = np.asarray(values, dtype=float)
+    return np.where(np.isfinite(v) & (v > 0), v, np.nan)
+
+
 def plot_ratio_histories(
     panels: Sequence[tuple[float, Sequence[tuple[str, RockingResult]]]],
     path: Union[str, Path],
@@ -260,14 +266,14 @@ def plot_envelopes(
     for k, env in enumerate(envelopes):
         colour = cmap(k % 10)
         colours[env.name] = colour
-        y = np.where(np.isfinite(env.a_p_min_g), env.a_p_min_g, np.nan)
+        y = _log_plottable(env.a_p_min_g)
         text = (labels or {}).get(env.name, env.name)
         ax.plot(env.f_p, y, color=colour, lw=1.4, label=text)
     if envelopes:
-        lower = np.nanmin(
-            np.stack([np.where(np.isfinite(e.a_p_min_g), e.a_p_min_g, np.nan) for e in envelopes]),
-            axis=0,
-        )
+        curves = np.stack([_log_plottable(e.a_p_min_g) for e in envelopes])
+        lower = np.full(curves.shape[1], np.nan)
+        some = ~np.all(np.isnan(curves), axis=0)
+        lower[some] = np.nanmin(curves[:, some], axis=0)
         ax.plot(envelopes[0].f_p, lower, color="black", lw=2.6, alpha=0.35, label="governing")
     if pulse_points:
         fx = [p["f_p_hz"] for p in pulse_points]
@@ -282,7 +288,9 @@ def plot_envelopes(
                 fontsize=7,
             )
     ax.set_xscale("log")
-    ax.set_yscale("log")
+    # A log axis needs at least one positive value (degenerate constants may give none).
+    drawn = [np.asarray(line.get_ydata(), dtype=float) for line in ax.lines]
+    ax.set_yscale("log" if any(np.any(np.isfinite(y)) for y in drawn) else "linear")
     ymax = ax.get_ylim()[1]
     for band in bands:
         colour = colours.get(band["mechanism"], "0.5")

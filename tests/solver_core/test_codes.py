@@ -95,3 +95,9 @@ def test_doctests() -> None:
 def test_booleans_are_not_numbers() -> None:
     with pytest.raises(InputError, match="h_i"):
         sf_nzs(True, 10.0)  # type: ignore[arg-type]
+
+
+def test_ec8_extreme_period_ratio_is_finite() -> None:
+    # (1 - T_a/T_1)^2 overflows a float: the bracket goes to -0.5 and the floor 1 holds.
+    info = sf_ec8(5.0, 10.0, 1e300, 1e-10)
+    assert info["value"] == 1.0 and info["inputs"]["bracket"] == -0.5
