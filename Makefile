@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 
-.PHONY: install demo test lint typecheck schema bench clean
+.PHONY: install demo test lint typecheck pyright schema bench numerics serve clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -29,6 +29,11 @@ lint: $(STAMP)
 typecheck: $(STAMP)
 	$(BIN)/mypy
 
+## The Rhino glue against RhinoCommon (pyright + rhino-stubs-typed; needs node on PATH).
+## `make test` runs the same check in tests/rhino_glue/test_static.py.
+pyright: $(STAMP)
+	$(BIN)/pyright --pythonpath $(BIN)/python
+
 schema: $(STAMP)
 	$(BIN)/python -m shared_schema.export --check
 
@@ -38,6 +43,19 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/envelope_speed.py
 	$(BIN)/python benchmarks/geometry_speed.py
 	$(BIN)/python benchmarks/records_speed.py
+	$(BIN)/python benchmarks/load.py
+
+## Numerics report (docs/numerics.md, docs/img/, solver_service/data/linearisation_map.npz):
+## work precision of every integrator, stiff cases, linearisation map, extreme-case sweep.
+numerics: $(STAMP)
+	$(BIN)/python benchmarks/numerics_wp.py
+	$(BIN)/python benchmarks/stiff.py
+	$(BIN)/python benchmarks/linearisation_map.py
+	$(BIN)/python benchmarks/extremes.py
+
+## The REST service on http://127.0.0.1:8000 (settings: ROCKMECH_* variables; docs/service.md).
+serve: $(STAMP)
+	$(BIN)/rockmech serve
 
 clean:
 	rm -rf $(VENV) out .mypy_cache .ruff_cache .pytest_cache

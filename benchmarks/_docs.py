@@ -41,8 +41,8 @@ def _markers(name: str) -> tuple[str, str]:
     return f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
 
 
-def _with_header(text: str) -> str:
-    """Put ``HEADER`` before the first section, replacing an old title-and-paragraph header.
+def _with_header(text: str, header: str = HEADER) -> str:
+    """Put ``header`` before the first section, replacing an old title-and-paragraph header.
 
     Text before the first section that is more than a title and one paragraph is not a
     header; it is kept below ``HEADER``.
@@ -57,7 +57,7 @@ def _with_header(text: str) -> str:
     )
     if is_header:
         head = ""
-    return HEADER + "\n" + (head.strip() + "\n\n" if head.strip() else "") + rest
+    return header + "\n" + (head.strip() + "\n\n" if head.strip() else "") + rest
 
 
 @contextlib.contextmanager
@@ -76,7 +76,7 @@ def _dir_lock(folder: Path) -> Iterator[None]:
         os.close(fd)  # closing releases the lock
 
 
-def write_section(path: Union[str, Path], name: str, markdown: str) -> Path:
+def write_section(path: Union[str, Path], name: str, markdown: str, header: str = HEADER) -> Path:
     """Replace (or append) section ``name`` of the markdown file ``path``, atomically.
 
     Parameters
@@ -88,10 +88,13 @@ def write_section(path: Union[str, Path], name: str, markdown: str) -> Path:
         ``<!-- END name -->``.
     markdown : str
         New content of the section (without the markers).
+    header : str
+        Title and paragraph kept at the top of the file (``HEADER`` for
+        ``docs/benchmarks.md``; other result files give their own).
 
     Notes
     -----
-    The rest of the file is kept as it is, except the header, which is set to ``HEADER``.
+    The rest of the file is kept as it is, except the header, which is set to ``header``.
     The new text goes to a temporary file in the same folder that then replaces ``path``
     (``os.replace``), so a reader never sees a half-written file.
     """
@@ -107,7 +110,7 @@ def write_section(path: Union[str, Path], name: str, markdown: str) -> Path:
             text = text[:i] + block + text[j + len(end) :]
         else:
             text = (text.rstrip() + "\n\n" if text.strip() else "") + block + "\n"
-        text = _with_header(text).rstrip() + "\n"
+        text = _with_header(text, header).rstrip() + "\n"
         fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent)
         try:
             with os.fdopen(fd, "w", encoding="utf-8") as fh:

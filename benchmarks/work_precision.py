@@ -307,6 +307,7 @@ def run_ivp(case: Case, rtols: tuple[float, ...], quick: bool) -> list[Row]:
                     collapsed=res.collapsed,
                     repeats=n,
                     note=note,
+                    err_est=res.error_estimate / max(res.peak_ratio, 1e-300),
                 )
             )
             print(
@@ -788,17 +789,8 @@ def write_docs(
 # ------------------------------------------------------------------------------------------
 
 
-def main(argv: Optional[list[str]] = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="smoke run: fewer rtols and repeats")
-    ap.add_argument(
-        "--write-docs",
-        action="store_true",
-        help="write docs/benchmarks.md and the diagram also in --quick mode",
-    )
-    args = ap.parse_args(argv)
-    quick = bool(args.quick)
-    write = (not quick) or args.write_docs
+def measure(quick: bool) -> tuple[list[Case], dict[str, list[Row]], dict[str, Any]]:
+    """Run every measurement; return the cases, their rows and the extras (nonlinear, batch)."""
     wall0 = time.perf_counter()
     info = machine_info(("numpy", "scipy", "numba", "mpmath", "matplotlib"))
     print(f"rockmech work-precision benchmark ({'quick' if quick else 'full'} run)")
@@ -828,7 +820,20 @@ def main(argv: Optional[list[str]] = None) -> int:
         nl[case.key] = run_nonlinear(case, nl_rtols)
     print("\nIncremental analysis", flush=True)
     batch = run_batch(cases[1], quick)
+    extra = {"info": info, "nl": nl, "batch": batch, "wall0": wall0}
+    return cases, results, extra
 
+
+def report(
+    cases: list[Case],
+    results: dict[str, list[Row]],
+    extra: dict[str, Any],
+    *,
+    quick: bool,
+    write: bool,
+) -> None:
+    """Print the tables and targets; write docs/benchmarks.md and the diagram if ``write``."""
+    info, nl, batch = extra["info"], extra["nl"], extra["batch"]
     print("\n" + "=" * 100)
     for case in cases:
         r = case.ref
@@ -853,13 +858,27 @@ def main(argv: Optional[list[str]] = None) -> int:
     print("\nTargets")
     for name, ok, val in tgt:
         print(f"  {'PASS' if ok else 'FAIL'}  {name}: {val}")
-    total = time.perf_counter() - wall0
+    total = time.perf_counter() - extra["wall0"]
     info["load_end"] = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     print(f"\nWhole run: {total:.0f} s; load average at the end: {info['load_end']}")
     if write:
         plot(cases, results, DOC_PNG)
         write_docs(info, cases, results, nl, batch, tgt, total, quick)
         print(f"wrote {DOC_MD.relative_to(REPO)} and {DOC_PNG.relative_to(REPO)}")
+
+
+def main(argv: Optional[list[str]] = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="smoke run: fewer rtols and repeats")
+    ap.add_argument(
+        "--write-docs",
+        action="store_true",
+        help="write docs/benchmarks.md and the diagram also in --quick mode",
+    )
+    args = ap.parse_args(argv)
+    quick = bool(args.quick)
+    cases, results, extra = measure(quick)
+    report(cases, results, extra, quick=quick, write=(not quick) or args.write_docs)
     return 0
 
 

@@ -126,6 +126,8 @@ def pulse(
         f"(error estimate {res.error_estimate:.1e}); impacts: {res.n_impacts}; "
         f"t_overturn: {_fmt_time(res.t_overturn)}"
     )
+    for note in res.warnings:
+        typer.echo(f"warning: {note}", err=True)
 
 
 # Options shared by every command that reads a ground-motion record.
@@ -644,6 +646,9 @@ def report(
     element_period: float = typer.Option(
         0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
     ),
+    at_height: Optional[float] = typer.Option(
+        None, "--at-height", help="Also tabulate the peak displacement [m] this far [m] up."
+    ),
     criterion: Optional[str] = typer.Option(
         None, "--criterion", help="Verdict of the time histories: ratio (default) or exact."
     ),
@@ -666,7 +671,8 @@ def report(
         motion = _read_record(record, record_format, units, dt)
         sources.append(input_source("record", record.name, record.read_bytes()))
     options = {"scales": scales, "sf": sf, "building_height": building_height}
-    options.update(soil_factor=soil_factor, element_period=element_period, criterion=criterion)
+    options.update(soil_factor=soil_factor, element_period=element_period, at_height=at_height)
+    options.update(criterion=criterion)
     options.update(f_min=f_min, f_max=f_max, n=n, exact=exact)
     text = build_report(
         cf,
@@ -677,6 +683,7 @@ def report(
             "sf": sf,
             "building": Building(building_height, soil_factor, element_period),
             "criterion": criterion,
+            "at_height": at_height,
         },
         exact=exact,
         title=title or f"rockmech report: {constants.name}",

@@ -81,7 +81,13 @@ OUT_N_STEPS = 7
 OUT_ERROR = 8
 OUT_N_TRACE = 9
 OUT_TRACE_FULL = 10
-NOUT = 11
+OUT_N_UPLIFTS = 11
+OUT_N_RESTS = 12
+OUT_N_LOG = 13
+NOUT = 14
+#: Rows of the optional impact log (``simulate_cells_logged``): time [s], side before the
+#: impact, ``x'`` arriving and ``x'`` leaving (0 when the impact ends in rest) [1/s].
+LOG_ROWS = ("t", "side", "v_in", "v_out")
 #: Rows of the packed cell array.
 CELL_ROWS = ("kind", "c0", "c1", "c2", "t_start", "t_end", "amax_after")
 
@@ -426,6 +432,7 @@ def _simulate(
     max_impacts,
     trace_t,
     trace_x,
+    log,
 ):
     """Integrate one mechanism through a cell sequence (unpacked arguments; see ``simulate_cells``).
 
@@ -450,6 +457,9 @@ def _simulate(
         Impact cap.
     trace_t, trace_x : (m,) arrays
         Output buffers for the time series (size 0: no trace).
+    log : (4, k) array
+        Output buffer for the impact log (rows ``LOG_ROWS``; ``k = 0``: no log). Every
+        impact is logged, also those below the rest speed that end in rest.
 
     Returns
     -------
@@ -458,6 +468,10 @@ def _simulate(
     out = np.zeros(NOUT)
     ntr_cap = trace_t.shape[0]
     ntr = 0
+    nlog_cap = log.shape[1]
+    nlog = 0
+    n_up = 0
+    n_rest = 0
     n = kind.shape[0]
     p_max = max(p_pos, p_neg)
     ks_pos = scale / (G * lam_pos)
@@ -536,6 +550,7 @@ def _simulate(
                     v = 0.0
                     t = tu
                     uplift_t = tu
+                    n_up += 1
                     ntr = _record(trace_t, trace_x, ntr, t, 0.0)
                     continue
 
@@ -658,12 +673,20 @@ def _simulate(
                     a_now = _accel(k, a0, a1, a2, cs, t)[0]
                     acc_new = p_new * p_new * (-s_new - ks_new * a_now)
                     ntr = _record(trace_t, trace_x, ntr, t, 0.0)
+                    ends_in_rest = abs(v_new) < v_rest_rel * p_new or vi == 0.0
+                    if nlog < nlog_cap:
+                        log[0, nlog] = t
+                        log[1, nlog] = s
+                        log[2, nlog] = vi
+                        log[3, nlog] = 0.0 if ends_in_rest else v_new
+                        nlog += 1
                     if abs(vi) >= v_rest_rel * p:
                         n_imp += 1
                         if n_imp >= max_impacts:
                             status = -1
                             done = True
-                    if abs(v_new) < v_rest_rel * p_new or vi == 0.0:
+                    if ends_in_rest:
+                        n_rest += 1
                         # Rest rule (ends Zeno sequences, THEORY §10). A null excursion right
                         # after uplift in this segment holds the body until the segment ends.
                         if uplift_t >= t_sub0 and abs(vi) < v_rest_rel * p:
@@ -759,6 +782,9 @@ def _simulate(
     out[OUT_ERROR] = ERR_SAFETY * (math.sqrt(err_var) + EPS * max(peak, 1.0))
     out[OUT_N_TRACE] = ntr
     out[OUT_TRACE_FULL] = 1.0 if ntr_cap > 0 and ntr == ntr_cap else 0.0
+    out[OUT_N_UPLIFTS] = n_up
+    out[OUT_N_RESTS] = n_rest
+    out[OUT_N_LOG] = nlog
     return out
 
 
@@ -780,6 +806,17 @@ def simulate_cells(cells, params, scale, x0, v_rest_rel, max_impacts, trace):
     Returns
     -------
     (NOUT,) float array, indexed by the ``OUT_*`` constants.
+    """
+    return simulate_cells_logged(
+        cells, params, scale, x0, v_rest_rel, max_impacts, trace, np.empty((4, 0))
+    )
+
+
+@_jit
+def simulate_cells_logged(cells, params, scale, x0, v_rest_rel, max_impacts, trace, log):
+    """``simulate_cells`` that also fills the impact log ``log`` (4, k); see ``LOG_ROWS``.
+
+    The log holds the first ``k`` impacts; ``out[OUT_N_LOG]`` says how many were written.
     """
     return _simulate(
         cells[0],
@@ -803,6 +840,7 @@ def simulate_cells(cells, params, scale, x0, v_rest_rel, max_impacts, trace):
         max_impacts,
         trace[0],
         trace[1],
+        log,
     )
 
 

@@ -47,6 +47,7 @@ from shared_schema.errors import InputError
 from . import _kernels as _k
 from .excitation import Pulse, SampledAccel
 from .model import RockingModel, check_positive
+from .nonlinear import linearisation_warnings
 from .result import CRITERIA, STATUS_MESSAGES, RockingResult
 
 __all__ = [
@@ -70,6 +71,11 @@ MAX_IMPACTS = 1_000_000
 BACKENDS = ("auto", "numba", "python")
 #: Closed-form segments per pulse quarter when a time series is asked for.
 DENSE_PER_QUARTER = 50
+#: An error estimate of the peak ratio at or above this [-] means the peak is not resolved
+#: (the covariance reached its cap, ``_kernels.ERR_CAP``): the result says so.
+UNRESOLVED_ERROR = 0.1
+#: Most impacts kept in an impact log (``impact_log=True``); later ones are counted only.
+IMPACT_LOG_CAP = 1_000_000
 
 _KERNEL_CACHE: dict[str, ModuleType] = {}
 
@@ -220,6 +226,7 @@ def simulate(
     t_extra: float = 0.0,
     max_impacts: int = MAX_IMPACTS,
     backend: str = "auto",
+    impact_log: bool = False,
 ) -> RockingResult:
     """Simulate one mechanism under one excitation, exactly.
 
@@ -245,10 +252,16 @@ def simulate(
         Impact cap; reaching it gives status -1.
     backend : {"auto", "numba", "python"}
         Kernel back end (identical results up to rounding).
+    impact_log : bool
+        Return every impact in ``RockingResult.impacts`` (time, side, arriving and leaving
+        ``x'``), up to ``IMPACT_LOG_CAP`` impacts; used to check energy at impacts.
 
     Returns
     -------
     RockingResult
+        ``warnings`` says when the peak is not resolved (``error_estimate >=
+        UNRESOLVED_ERROR``) and when the case lies where the linearised model is more than
+        10 % off Housner's nonlinear block (``nonlinear.linearisation_warnings``).
 
     Examples
     --------
@@ -278,11 +291,24 @@ def simulate(
         n_seg = np.ceil(p_max * cells.widths / kern.MAX_PH).clip(min=1).sum()
         cap = int(n_seg) + 3 * min(int(max_impacts), 100_000) + 8
     trace = np.empty((2, cap))
-    out = kern.simulate_cells(
-        cells.data, params, scale, float(x0), V_REST_REL, int(max_impacts), trace
+    n_log = min(int(max_impacts), IMPACT_LOG_CAP) + 2 if impact_log else 0
+    log = np.empty((4, n_log))
+    out = kern.simulate_cells_logged(
+        cells.data, params, scale, float(x0), V_REST_REL, int(max_impacts), trace, log
     )
     runtime = time.perf_counter() - t_start
     n_tr = int(out[_k.OUT_N_TRACE])
+    notes = []
+    err = float(out[_k.OUT_ERROR])
+    if err >= UNRESOLVED_ERROR:
+        notes.append(
+            f"The peak is not resolved: its error estimate is {err:.2g} (>= "
+            f"{UNRESOLVED_ERROR:g}); the motion is too sensitive to its input (near-grazing "
+            "impacts or long chattering) for any double-precision integrator."
+        )
+    notes += linearisation_warnings(
+        model, excitation.omega_p if isinstance(excitation, Pulse) else None
+    )
     if out[_k.OUT_TRACE_FULL]:
         warnings.warn(
             f"time series truncated at {n_tr} points (more impacts than the buffer holds); "
@@ -301,11 +327,15 @@ def simulate(
         t_collapse=_nan_to_none(out[_k.OUT_T_COLLAPSE]),
         n_impacts=int(out[_k.OUT_N_IMPACTS]),
         n_steps=int(out[_k.OUT_N_STEPS]),
-        error_estimate=float(out[_k.OUT_ERROR]),
+        error_estimate=err,
         runtime_s=runtime,
         method=f"exact:{'numba' if kern.JIT else 'python'}",
         t=trace[0, :n_tr].copy() if dense else None,
         ratio=trace[1, :n_tr].copy() if dense else None,
+        n_uplifts=int(out[_k.OUT_N_UPLIFTS]),
+        n_rests=int(out[_k.OUT_N_RESTS]),
+        impacts=log[:, : int(out[_k.OUT_N_LOG])].copy() if impact_log else None,
+        warnings=notes,
     )
 
 

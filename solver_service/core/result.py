@@ -78,6 +78,18 @@ class RockingResult:
     t, ratio : (m,) float or None
         Time series when asked for: times [s] and signed ``phi/phi_ov`` (negative while
         rocking on the negative side).
+    n_uplifts, n_rests : int
+        Work counters: uplifts from rest, and impacts that ended in rest (the rest rule that
+        ends Zeno sequences, or ``eta = 0``).
+    impacts : (4, n) float or None
+        Impact log: rows time [s], side before the impact (+1/-1), ``d(phi/phi_ov)/dt``
+        arriving and leaving [1/s] (leaving is 0 when the impact ends in rest). The exact
+        integrator returns it when asked (``exact.simulate(..., impact_log=True)``); the
+        time-stepping references always do.
+    warnings : list of str
+        Conditions a user should know about (an unresolved peak, a case where the
+        linearised model is far from the nonlinear block, ...); also appended to
+        ``message``.
     """
 
     status: int
@@ -95,6 +107,10 @@ class RockingResult:
     method: str
     t: Optional[NDArray[np.float64]] = field(default=None, repr=False)
     ratio: Optional[NDArray[np.float64]] = field(default=None, repr=False)
+    n_uplifts: int = 0
+    n_rests: int = 0
+    impacts: Optional[NDArray[np.float64]] = field(default=None, repr=False)
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -103,8 +119,8 @@ class RockingResult:
 
     @property
     def message(self) -> str:
-        """Human-readable status."""
-        return STATUS_MESSAGES[self.status]
+        """Human-readable status, followed by the warnings if there are any."""
+        return " ".join([STATUS_MESSAGES[self.status], *self.warnings])
 
     @property
     def overturned(self) -> bool:
@@ -132,5 +148,6 @@ class RockingResult:
             "runtime_s": self.runtime_s,
             "status": self.status,
             "message": self.message,
+            "warnings": list(self.warnings),
             "method": self.method,
         }

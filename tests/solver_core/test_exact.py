@@ -15,6 +15,7 @@ from solver_service.core.exact import kernels, simulate, simulate_batch
 from solver_service.core.excitation import Pulse, SampledAccel
 from solver_service.core.model import G, RockingModel, RockingSide
 from solver_service.core.records import GroundMotion
+from solver_service.core.result import STATUS_MESSAGES
 
 P, LAM = 2.0, 0.2
 BACKENDS = ["numba", "python"]
@@ -357,3 +358,76 @@ def test_extreme_time_steps_and_frequencies(dt: float, p: float) -> None:
         res = simulate(RockingModel.symmetric(p, 0.1, eta, one_sided=one_sided), rec)
         assert res.status in (0, 1)
         assert math.isfinite(res.peak_ratio) and math.isfinite(res.error_estimate)
+
+
+# --- Impact log, work counters and warnings (issue 7) ---------------------------------------
+
+
+def test_impact_log_is_identical_on_both_backends(elcentro_path) -> None:  # type: ignore[no-untyped-def]
+    rec = GroundMotion.from_two_column(elcentro_path).accel
+    model = RockingModel.symmetric(2.0, 0.15, 0.9)
+    a, b = (simulate(model, rec, impact_log=True, backend=be) for be in BACKENDS)
+    assert a.impacts is not None and b.impacts is not None
+    assert a.impacts.shape == b.impacts.shape
+    # Every counted impact is logged, and so is every sub-threshold one (it ends in rest).
+    assert a.n_impacts <= a.impacts.shape[1] <= a.n_impacts + a.n_rests
+    np.testing.assert_allclose(a.impacts, b.impacts, rtol=1e-12, atol=1e-15)
+    assert (a.n_uplifts, a.n_rests) == (b.n_uplifts, b.n_rests)
+    assert simulate(model, rec).impacts is None  # the log is opt-in
+
+
+def test_impact_log_follows_the_impact_rule_and_loses_energy(elcentro_path) -> None:  # type: ignore[no-untyped-def]
+    rec = GroundMotion.from_two_column(elcentro_path).accel
+    res = simulate(RockingModel.symmetric(2.0, 0.15, 0.9), rec, impact_log=True)
+    assert res.impacts is not None
+    t, side, v_in, v_out = res.impacts
+    moving = v_out != 0.0
+    np.testing.assert_allclose(v_out[moving], 0.9 * v_in[moving], rtol=1e-15)
+    assert np.all(side * v_in <= 0.0)  # arrives moving towards phi = 0
+    assert np.all(np.diff(t) > 0.0)
+    # THEORY §1.8 at x = 0: E = (x'/p)^2 - 1 never increases at an impact.
+    assert np.all((v_out / 2.0) ** 2 <= (v_in / 2.0) ** 2)
+
+
+def test_counters_of_a_free_zeno_sequence() -> None:
+    res = simulate(RockingModel.symmetric(P, LAM, 0.5), zeros(10.0), x0=0.9, impact_log=True)
+    assert res.impacts is not None
+    # Released in flight: no uplift; one rest ends the Zeno sequence; every impact logged.
+    assert res.n_uplifts == 0 and res.n_rests == 1
+    assert res.impacts.shape[1] == res.n_impacts + (1 if abs(res.impacts[2, -1]) < 1e-9 * P else 0)
+    assert res.impacts[3, -1] == 0.0
+    # Free motion conserves E between impacts: the speed leaving one impact is the speed
+    # arriving at the next.
+    np.testing.assert_allclose(np.abs(res.impacts[3, :-1]), np.abs(res.impacts[2, 1:]), rtol=1e-9)
+
+
+def test_one_sided_rebound_log_points_outward() -> None:
+    model = RockingModel.symmetric(P, LAM, -0.7, one_sided=True)
+    res = simulate(model, zeros(10.0), x0=0.8, impact_log=True)
+    assert res.impacts is not None and res.impacts.shape[1] >= 5
+    _, side, v_in, v_out = res.impacts
+    assert np.all(side == 1.0) and np.all(v_in < 0.0) and np.all(v_out >= 0.0)
+    np.testing.assert_allclose(v_out[v_out > 0], 0.7 * np.abs(v_in[v_out > 0]), rtol=1e-15)
+
+
+def test_unresolved_peak_is_said_in_warnings_and_message() -> None:
+    rng = np.random.default_rng(102)
+    acc = rng.normal(0.0, 1.0, 2001)
+    rec = SampledAccel(acc * 0.8 * G / np.max(np.abs(acc)), 1e-3)
+    model = RockingModel.symmetric(20.0, 0.2, -1.0, one_sided=True)
+    res = simulate(model, rec)
+    assert res.error_estimate >= 0.1
+    assert any("not resolved" in w for w in res.warnings)
+    assert "not resolved" in res.message and res.message.startswith(STATUS_MESSAGES[res.status])
+    assert res.summary()["warnings"] == res.warnings
+    calm = simulate(RockingModel.symmetric(2.0, 0.15, 0.9), pulse(1.3, 3.0))
+    assert calm.warnings == [] and calm.message == STATUS_MESSAGES[calm.status]
+
+
+def test_stocky_mechanism_carries_a_linearisation_warning() -> None:
+    stocky = RockingModel.symmetric(2.0, 1.0, 0.0)
+    res = simulate(stocky, Pulse(a_p=-2.0 * G, f_p=5.0 * 2.0 / (2 * math.pi)))
+    assert any("linearised model may be off" in w for w in res.warnings)
+    slender = RockingModel.symmetric(2.0, 0.05, 0.9)
+    res = simulate(slender, Pulse(a_p=-0.1 * G, f_p=1.0))
+    assert not any("linearised" in w for w in res.warnings)

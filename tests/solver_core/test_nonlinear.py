@@ -247,3 +247,31 @@ def test_bad_rectangle_and_arguments_are_rejected() -> None:
         with pytest.raises(InputError) as info:
             simulate_nonlinear(block, zeros(1.0), **kw)  # type: ignore[arg-type]
         assert info.value.field == field
+
+
+# -- impact log and error estimate (issue 7) ----------------------------------------------------
+
+
+def test_impact_log_scales_angular_velocity_by_eta_and_alternates_sides() -> None:
+    block = HousnerBlock(p=3.0, alpha=0.3, eta=0.8)
+    r = simulate_nonlinear(block, zeros(6.0), x0=0.9)
+    assert r.impacts is not None and r.impacts.shape[1] == r.n_impacts >= 5
+    t, side, v_in, v_out = r.impacts
+    moving = v_out != 0.0
+    np.testing.assert_allclose(v_out[moving], 0.8 * v_in[moving], rtol=1e-15)
+    assert np.all(side[1:] == -side[:-1])
+    assert np.all(np.diff(t) > 0.0)
+    # Free motion conserves energy between impacts: |v| arriving = |v| leaving the previous
+    # (to the integrator's tolerances, atol = 1e-12 on x and its rate).
+    np.testing.assert_allclose(np.abs(v_in[1:]), np.abs(v_out[:-1]), rtol=1e-8, atol=1e-12)
+    # The first impact happens at the closed-form quarter period.
+    assert t[0] == pytest.approx(quarter_period(block, 0.9 * block.alpha), rel=1e-9)
+
+
+def test_error_estimate_grows_with_the_number_of_events() -> None:
+    block = HousnerBlock(p=3.0, alpha=0.3, eta=0.8)
+    r = simulate_nonlinear(block, zeros(6.0), x0=0.9, rtol=1e-8, atol=1e-10)
+    n_events = r.n_impacts + r.n_uplifts
+    assert r.error_estimate == pytest.approx(
+        10.0 * max(1e-8 * r.peak_ratio, 1e-10) * math.sqrt(1 + n_events)
+    )
