@@ -29,7 +29,7 @@ import numpy as np
 from rhino_plugin.geometry.mesh import TriMesh
 from shared_schema.errors import GeometryError, InputError
 
-__all__ = ["Scene", "SceneObject", "triangulate_polygon"]
+__all__ = ["Scene", "SceneObject", "solid_mesh", "triangulate_polygon"]
 
 # Vertices closer than this fraction of the object's bounding-box diagonal are welded.
 MERGE_RTOL = 1e-9
@@ -379,19 +379,7 @@ class Scene:
                 f"{obj.label()}: a {obj.kind} is not a solid; select a closed mesh, "
                 "polysurface or extrusion"
             )
-        v = self._to_m(v)
-        v, f = _weld(v, f)
-        if f.shape[0] == 0:
-            raise GeometryError(f"{obj.label()}: the {obj.kind} has no faces")
-        f, closed, n_open = _orient_outward(v, f)
-        if require_closed and not closed:
-            raise GeometryError(
-                f"{obj.label()}: the {obj.kind} is not a closed solid ({n_open} open or "
-                "non-manifold edges); close it in Rhino (Cap, Join, or MeshRepair / FillMeshHoles)"
-            )
-        return TriMesh(
-            v, f, obj.name or obj.label(), {"id": obj.id, "layer": obj.layer, "kind": obj.kind}
-        )
+        return solid_mesh(self._to_m(v), f, obj, require_closed=require_closed)
 
     def _brep_arrays(
         self, brep: Any, obj: SceneObject, stored: Any = None
@@ -723,6 +711,41 @@ def _tessellate_planar_brep(brep: Any, obj: SceneObject) -> Tuple[np.ndarray, np
         tris.extend((flat[a], flat[b], flat[c]) for a, b, c in local)
     v = np.array(coords, dtype=np.float64).reshape(-1, 3)
     return v, np.array(tris, dtype=np.int64).reshape(-1, 3)
+
+
+def solid_mesh(
+    v: np.ndarray, f: np.ndarray, obj: SceneObject, *, require_closed: bool = True
+) -> TriMesh:
+    """Weld, orient outward and check a triangle mesh of a scene object.
+
+    Parameters
+    ----------
+    v : (n, 3) float
+        Vertices [m].
+    f : (m, 3) int
+        Triangles.
+    obj : SceneObject
+        The object the mesh came from (named in errors and kept in the mesh's metadata).
+    require_closed : bool
+        Refuse a mesh with open or non-manifold edges.
+
+    Raises
+    ------
+    GeometryError
+        No faces, or not closed when ``require_closed``.
+    """
+    v, f = _weld(v, f)
+    if f.shape[0] == 0:
+        raise GeometryError(f"{obj.label()}: the {obj.kind} has no faces")
+    f, closed, n_open = _orient_outward(v, f)
+    if require_closed and not closed:
+        raise GeometryError(
+            f"{obj.label()}: the {obj.kind} is not a closed solid ({n_open} open or "
+            "non-manifold edges); close it in Rhino (Cap, Join, or MeshRepair / FillMeshHoles)"
+        )
+    return TriMesh(
+        v, f, obj.name or obj.label(), {"id": obj.id, "layer": obj.layer, "kind": obj.kind}
+    )
 
 
 def _weld(v: np.ndarray, f: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:

@@ -369,6 +369,10 @@ class PulseResponse(BaseModel):
     status: int
     message: str
     method: str
+    warnings: List[str] = Field(
+        default_factory=list,
+        description="Where the linearised model may be off by > 10 %, or the peak is unresolved.",
+    )
 
 
 class Band(BaseModel):
@@ -456,6 +460,9 @@ class HistoryResponse(BaseModel):
     scale_factor_method: Optional[str] = None
     scale_factors: Optional[Dict[str, Dict[str, Any]]] = None
     displacement: Optional[Dict[str, Any]] = None
+    warnings: Optional[Dict[str, List[str]]] = Field(
+        None, description="Per mechanism, where the linearised model may be off by > 10 %."
+    )
 
 
 class SpectrumCurve(BaseModel):

@@ -34,16 +34,97 @@ __all__ = [
     "boundary_doc",
     "envelope_csv",
     "envelope_doc",
+    "finite_json",
     "frequency_grid",
     "history_doc",
+    "linearisation_notes",
     "log_grid",
     "mechanism_scale_factor",
+    "pulse_doc",
     "record_doc",
     "record_pulse_doc",
     "run_scaled",
     "write_envelope",
     "write_history",
 ]
+
+
+def finite_json(value: Any) -> Any:
+    """Replace non-finite floats by None and numpy scalars by Python numbers, recursively.
+
+    ``json.dumps`` never calls ``default`` for floats, so NaN and infinity must be cleaned
+    before serialising (``allow_nan=False`` then guards the result).
+    """
+    if isinstance(value, dict):
+        return {str(k): finite_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite_json(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def pulse_doc(
+    p_eq: float,
+    lam: float,
+    a_p_g: float,
+    f_p: float,
+    *,
+    eta: Optional[float] = None,
+    one_sided: bool = False,
+    phi_ov: Optional[float] = None,
+    shape: str = "sine",
+    criterion: Optional[str] = None,
+) -> dict[str, Any]:
+    """Response of one mechanism to a one-cycle pulse, as ``rockmech pulse --json`` prints it.
+
+    Parameters
+    ----------
+    p_eq : float
+        Frequency parameter [rad/s].
+    lam : float
+        Static load multiplier [-].
+    a_p_g : float
+        Signed pulse amplitude [g] (> 0 first pushes towards negative rotation).
+    f_p : float
+        Pulse frequency [Hz].
+    eta : float, optional
+        Coefficient of restitution [-].
+    one_sided : bool
+        One-sided rocking.
+    phi_ov : float, optional
+        Overturning rotation [rad]; defaults to ``lam``.
+    shape : {"sine", "cosine"}
+        Pulse shape.
+    criterion : {"exact", "ratio"}, optional
+        Overturning verdict (default ``exact`` for pulses).
+    """
+    from .core.exact import simulate
+    from .core.excitation import Pulse
+    from .core.model import G, RockingModel
+
+    model = RockingModel.symmetric(p_eq, lam, eta, phi_ov=phi_ov, one_sided=one_sided, name="pulse")
+    model.require_eta()
+    exc = Pulse(a_p=a_p_g * G, f_p=f_p, shape=shape)
+    res = simulate(model, exc, criterion=criterion)
+    return {
+        "input": {
+            "p_eq": p_eq,
+            "lam": lam,
+            "phi_ov": model.positive.phi_ov,
+            "eta": eta,
+            "rocking": "one_sided" if one_sided else "two_sided",
+            "a_p_g": a_p_g,
+            "f_p": f_p,
+            "shape": shape,
+            "omega_ratio": exc.omega_p / p_eq,
+            "amplitude_ratio": abs(a_p_g) / lam,
+            "pulse_convention": "A (Zhang & Makris 2001: pulse starts at t = 0)",
+        },
+        **res.summary(),
+    }
 
 
 def _finite_or_none(values: np.ndarray[Any, Any]) -> list[Optional[float]]:
@@ -528,7 +609,22 @@ def history_doc(
         doc["scale_factors"] = factors
     if at_height is not None:
         doc["displacement"] = {"height_m": at_height, "formula": "u = z * max|phi| [m]"}
+    notes = linearisation_notes(cf, models)
+    if notes:
+        doc["warnings"] = notes
     return doc
+
+
+def linearisation_notes(cf: ConstantsFile, models: list[Any]) -> dict[str, list[str]]:
+    """Mechanisms whose record response the linear model may miss by more than 10 %.
+
+    Returns ``{mechanism id: [warning, ...]}`` for those only
+    (``core.nonlinear.linearisation_warnings``; see docs/numerics.md).
+    """
+    from .core.nonlinear import linearisation_warnings
+
+    notes = {m.id: linearisation_warnings(model) for m, model in zip(cf.mechanisms, models)}
+    return {k: v for k, v in notes.items() if v}
 
 
 def write_history(

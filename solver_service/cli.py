@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import functools
 import json
-import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NoReturn, Optional, TypeVar
@@ -48,14 +47,10 @@ def _user_errors(fn: F) -> F:
     return wrapper  # type: ignore[return-value]
 
 
-def _json_default(value: Any) -> Any:
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
-
-
 def _print_json(doc: Any) -> None:
-    typer.echo(json.dumps(doc, indent=2, default=_json_default, allow_nan=False))
+    from .analysis import finite_json
+
+    typer.echo(json.dumps(finite_json(doc), indent=2, allow_nan=False))
 
 
 def _fmt_time(value: Optional[float]) -> str:
@@ -88,45 +83,34 @@ def pulse(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Response of one mechanism to a one-cycle sine or cosine acceleration pulse."""
-    from .core.exact import simulate
-    from .core.excitation import Pulse
-    from .core.model import G, RockingModel
+    from .analysis import pulse_doc
 
-    model = RockingModel.symmetric(p_eq, lam, eta, phi_ov=phi_ov, one_sided=one_sided, name="pulse")
-    model.require_eta()
-    exc = Pulse(a_p=a_p_g * G, f_p=f_p, shape=shape)
-    res = simulate(model, exc, criterion=criterion)
-    doc = {
-        "input": {
-            "p_eq": p_eq,
-            "lam": lam,
-            "phi_ov": model.positive.phi_ov,
-            "eta": eta,
-            "rocking": "one_sided" if one_sided else "two_sided",
-            "a_p_g": a_p_g,
-            "f_p": f_p,
-            "shape": shape,
-            "omega_ratio": exc.omega_p / p_eq,
-            "amplitude_ratio": abs(a_p_g) / lam,
-            "pulse_convention": "A (Zhang & Makris 2001: pulse starts at t = 0)",
-        },
-        **res.summary(),
-    }
+    doc = pulse_doc(
+        p_eq,
+        lam,
+        a_p_g,
+        f_p,
+        eta=eta,
+        one_sided=one_sided,
+        phi_ov=phi_ov,
+        shape=shape,
+        criterion=criterion,
+    )
     if as_json:
         _print_json(doc)
         return
-    verdict = "OVERTURNS" if res.overturned else "survives"
+    verdict = "OVERTURNS" if doc["overturned"] else "survives"
     typer.echo(
         f"Pulse {shape} a_p = {a_p_g:g} g, f_p = {f_p:g} Hz "
-        f"(Omega = {exc.omega_p / p_eq:.4g}, A = {abs(a_p_g) / lam:.4g}): {verdict} "
-        f"[{res.criterion} criterion]"
+        f"(Omega = {doc['input']['omega_ratio']:.4g}, A = {doc['input']['amplitude_ratio']:.4g}):"
+        f" {verdict} [{doc['criterion']} criterion]"
     )
     typer.echo(
-        f"  peak |phi|/phi_ov = {res.peak_ratio:.6f} at {res.t_peak:.4f} s "
-        f"(error estimate {res.error_estimate:.1e}); impacts: {res.n_impacts}; "
-        f"t_overturn: {_fmt_time(res.t_overturn)}"
+        f"  peak |phi|/phi_ov = {doc['peak_ratio']:.6f} at {doc['t_peak']:.4f} s "
+        f"(error estimate {doc['error_estimate']:.1e}); impacts: {doc['n_impacts']}; "
+        f"t_overturn: {_fmt_time(doc['t_overturn'])}"
     )
-    for note in res.warnings:
+    for note in doc["warnings"]:
         typer.echo(f"warning: {note}", err=True)
 
 
@@ -144,6 +128,21 @@ _FORMAT_OPT = typer.Option(
     None, "--format", help="at2, two_column, one_column or csv (default: detected)."
 )
 _DT_OPT = typer.Option(None, "--dt", help="Time step [s] of a record without a time column.")
+# Options of the scale factor up the structure (history, ida, report).
+_SF_OPT = typer.Option(
+    "none",
+    "--sf",
+    help="Scale factor up the structure for mechanisms with amplification data: none; "
+    "eq28 (from the record's 5 % spectrum at T_n = 1/f_n); ec8 (EN 1998-1 §4.3.5.2, "
+    "needs --building-height); nzs (NZS 1170.5 C_Hi, needs --building-height).",
+)
+_BUILDING_HEIGHT_OPT = typer.Option(
+    None, "--building-height", help="Height of the building H = h_n [m] (ec8, nzs)."
+)
+_SOIL_FACTOR_OPT = typer.Option(1.0, "--soil-factor", help="EC8 soil factor S [-].")
+_ELEMENT_PERIOD_OPT = typer.Option(
+    0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
+)
 
 
 def _read_record(path: Path, fmt: Optional[str], units: Optional[str], dt: Optional[float]) -> Any:
@@ -186,20 +185,10 @@ def history(
     units: Optional[str] = _UNITS_OPT,
     record_format: Optional[str] = _FORMAT_OPT,
     dt: Optional[float] = _DT_OPT,
-    sf: str = typer.Option(
-        "none",
-        "--sf",
-        help="Scale factor up the structure for mechanisms with amplification data: none; "
-        "eq28 (from the record's 5 % spectrum at T_n = 1/f_n); ec8 (EN 1998-1 §4.3.5.2, "
-        "needs --building-height); nzs (NZS 1170.5 C_Hi, needs --building-height).",
-    ),
-    building_height: Optional[float] = typer.Option(
-        None, "--building-height", help="Height of the building H = h_n [m] (ec8, nzs)."
-    ),
-    soil_factor: float = typer.Option(1.0, "--soil-factor", help="EC8 soil factor S [-]."),
-    element_period: float = typer.Option(
-        0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
-    ),
+    sf: str = _SF_OPT,
+    building_height: Optional[float] = _BUILDING_HEIGHT_OPT,
+    soil_factor: float = _SOIL_FACTOR_OPT,
+    element_period: float = _ELEMENT_PERIOD_OPT,
     at_height: Optional[float] = typer.Option(
         None,
         "--at-height",
@@ -255,6 +244,9 @@ def history(
             f"{row['error_estimate']:>10.1e}"
             + (f"{row['peak_displacement_m']:>12.4g}" if disp else "")
         )
+    for mech_id, notes in doc.get("warnings", {}).items():
+        for note in notes:
+            typer.echo(f"warning: {mech_id}: {note}", err=True)
     if out is not None:
         typer.echo(f"wrote {out / 'history.json'}, history.png, history_record.png")
 
@@ -330,16 +322,10 @@ def ida(
     units: Optional[str] = _UNITS_OPT,
     record_format: Optional[str] = _FORMAT_OPT,
     dt: Optional[float] = _DT_OPT,
-    sf: str = typer.Option(
-        "none", "--sf", help="Scale factor up the structure: none, eq28, ec8 or nzs."
-    ),
-    building_height: Optional[float] = typer.Option(
-        None, "--building-height", help="Height of the building H = h_n [m] (ec8, nzs)."
-    ),
-    soil_factor: float = typer.Option(1.0, "--soil-factor", help="EC8 soil factor S [-]."),
-    element_period: float = typer.Option(
-        0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
-    ),
+    sf: str = _SF_OPT,
+    building_height: Optional[float] = _BUILDING_HEIGHT_OPT,
+    soil_factor: float = _SOIL_FACTOR_OPT,
+    element_period: float = _ELEMENT_PERIOD_OPT,
     criterion: Optional[str] = typer.Option(
         None, "--criterion", help="Overturning verdict: ratio (default) or exact."
     ),
@@ -636,16 +622,10 @@ def report(
     units: Optional[str] = _UNITS_OPT,
     record_format: Optional[str] = _FORMAT_OPT,
     dt: Optional[float] = _DT_OPT,
-    sf: str = typer.Option(
-        "none", "--sf", help="Scale factor up the structure: none, eq28, ec8 or nzs."
-    ),
-    building_height: Optional[float] = typer.Option(
-        None, "--building-height", help="Height of the building H = h_n [m] (ec8, nzs)."
-    ),
-    soil_factor: float = typer.Option(1.0, "--soil-factor", help="EC8 soil factor S [-]."),
-    element_period: float = typer.Option(
-        0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
-    ),
+    sf: str = _SF_OPT,
+    building_height: Optional[float] = _BUILDING_HEIGHT_OPT,
+    soil_factor: float = _SOIL_FACTOR_OPT,
+    element_period: float = _ELEMENT_PERIOD_OPT,
     at_height: Optional[float] = typer.Option(
         None, "--at-height", help="Also tabulate the peak displacement [m] this far [m] up."
     ),

@@ -540,3 +540,28 @@ def test_envelope_with_a_records_pulse_agrees_with_the_exact_solver(tmp_path: Pa
             assert collapsed == (model.name in point["overturns"]), (point, model.name)
     assert any(p["overturns"] for p in rp["points"])
     assert not rp["points"][0]["overturns"]
+
+
+def test_history_warns_where_the_linear_model_is_off(tmp_path: Path) -> None:
+    from solver_service.core.nonlinear import linearisation_warnings
+
+    constants = tmp_path / "c.json"
+    constants.write_text(
+        json.dumps(
+            {
+                "mechanisms": [
+                    {"id": "SLENDER", "p_eq": 2.0, "lam": 0.1, "eta": 0.95},
+                    {"id": "SQUAT", "p_eq": 2.0, "lam": 0.6, "eta": 0.5},
+                ]
+            }
+        )
+    )
+    record = str(EXAMPLES / "records" / "elcentro_NS.dat")
+    res = runner.invoke(app, ["history", str(constants), record, "--json"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    expected = linearisation_warnings(RockingModel.symmetric(2.0, 0.6, 0.5))
+    assert expected and doc["warnings"] == {"SQUAT": expected}
+    table = runner.invoke(app, ["history", str(constants), record])
+    assert f"warning: SQUAT: {expected[0]}" in table.stderr
+    assert "SLENDER:" not in table.stderr

@@ -19,7 +19,7 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 
 from rhino_plugin.geometry.mesh import TriMesh
-from rhino_plugin.scene_3dm import Scene, SceneObject, _orient_outward, _weld
+from rhino_plugin.scene_3dm import Scene, SceneObject, solid_mesh
 from shared_schema.errors import GeometryError
 
 __all__ = ["Prepared", "PreparedScene"]
@@ -110,18 +110,7 @@ class PreparedScene(Scene):
             )
         v = self._to_m(np.asarray(geo.vertices, dtype=np.float64).reshape(-1, 3))
         f = np.asarray(geo.faces, dtype=np.int64).reshape(-1, 3)
-        v, f = _weld(v, f)
-        if f.shape[0] == 0:
-            raise GeometryError(f"{obj.label()}: the {obj.kind} has no faces")
-        f, closed, n_open = _orient_outward(v, f)
-        if require_closed and not closed:
-            raise GeometryError(
-                f"{obj.label()}: the {obj.kind} is not a closed solid ({n_open} open or "
-                "non-manifold edges); close it in Rhino (Cap, Join, or MeshRepair / FillMeshHoles)"
-            )
-        return TriMesh(
-            v, f, obj.name or obj.label(), {"id": obj.id, "layer": obj.layer, "kind": obj.kind}
-        )
+        return solid_mesh(v, f, obj, require_closed=require_closed)
 
     def line(self, obj: SceneObject) -> Tuple[np.ndarray, np.ndarray]:
         """Return the end points [m] of a straight line object."""

@@ -63,22 +63,11 @@ class JobOutput:
     body: bytes
 
 
-def _finite(value: Any) -> Any:
-    """Replace non-finite floats by None and numpy scalars by Python numbers, recursively."""
-    if isinstance(value, dict):
-        return {str(k): _finite(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite(v) for v in value]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
 def dumps(doc: Any) -> bytes:
     """Serialise a result document as compact UTF-8 JSON (non-finite numbers become null)."""
-    return json.dumps(_finite(doc), allow_nan=False, separators=(",", ":")).encode("utf-8")
+    from ..analysis import finite_json
+
+    return json.dumps(finite_json(doc), allow_nan=False, separators=(",", ":")).encode("utf-8")
 
 
 def safe_filename(name: Optional[str], default: str) -> str:
@@ -277,38 +266,23 @@ def pulse_doc(params: dict[str, Any], limits: Optional[dict[str, int]] = None) -
     limits : dict, optional
         The service's size limits (bound the work); none from the command line.
     """
-    from ..core.exact import simulate
-    from ..core.excitation import Pulse
-    from ..core.model import G, RockingModel
+    from ..analysis import pulse_doc as doc
 
-    p_eq, lam, a_p_g, f_p = params["p_eq"], params["lam"], params["a_p_g"], params["f_p"]
-    eta, one_sided = params.get("eta"), bool(params.get("one_sided", False))
+    p_eq, f_p = params["p_eq"], params["f_p"]
     if limits is not None and _positive(p_eq, f_p):
         # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
         check_work(p_eq / f_p, limits, "the pulse", "f_p")
-    shape = params.get("shape", "sine")
-    model = RockingModel.symmetric(
-        p_eq, lam, eta, phi_ov=params.get("phi_ov"), one_sided=one_sided, name="pulse"
+    return doc(
+        p_eq,
+        params["lam"],
+        params["a_p_g"],
+        f_p,
+        eta=params.get("eta"),
+        one_sided=bool(params.get("one_sided", False)),
+        phi_ov=params.get("phi_ov"),
+        shape=params.get("shape", "sine"),
+        criterion=params.get("criterion"),
     )
-    model.require_eta()
-    exc = Pulse(a_p=a_p_g * G, f_p=f_p, shape=shape)
-    res = simulate(model, exc, criterion=params.get("criterion"))
-    return {
-        "input": {
-            "p_eq": p_eq,
-            "lam": lam,
-            "phi_ov": model.positive.phi_ov,
-            "eta": eta,
-            "rocking": "one_sided" if one_sided else "two_sided",
-            "a_p_g": a_p_g,
-            "f_p": f_p,
-            "shape": shape,
-            "omega_ratio": exc.omega_p / p_eq,
-            "amplitude_ratio": abs(a_p_g) / lam,
-            "pulse_convention": "A (Zhang & Makris 2001: pulse starts at t = 0)",
-        },
-        **res.summary(),
-    }
 
 
 def _pulse(params: dict[str, Any], blobs: list[bytes], limits: dict[str, int]) -> bytes:
