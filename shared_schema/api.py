@@ -445,6 +445,7 @@ class HistoryRow(BaseModel):
     effective_scale: Optional[float] = None
     peak_displacement_m: Optional[float] = None
     peak_displacement_is_bound: Optional[bool] = None
+    warnings: Optional[List[str]] = Field(None, description="Present when the peak is unresolved.")
 
 
 class HistoryResponse(BaseModel):

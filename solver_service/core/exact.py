@@ -215,6 +215,14 @@ def _nan_to_none(value: float) -> Optional[float]:
     return None if math.isnan(value) else float(value)
 
 
+def _unresolved(err: float) -> str:
+    return (
+        f"The peak is not resolved: its error estimate is {err:.2g} (>= "
+        f"{UNRESOLVED_ERROR:g}); the motion is too sensitive to its input (near-grazing "
+        "impacts or long chattering) for any double-precision integrator."
+    )
+
+
 def simulate(
     model: RockingModel,
     excitation: Excitation,
@@ -301,11 +309,7 @@ def simulate(
     notes = []
     err = float(out[_k.OUT_ERROR])
     if err >= UNRESOLVED_ERROR:
-        notes.append(
-            f"The peak is not resolved: its error estimate is {err:.2g} (>= "
-            f"{UNRESOLVED_ERROR:g}); the motion is too sensitive to its input (near-grazing "
-            "impacts or long chattering) for any double-precision integrator."
-        )
+        notes.append(_unresolved(err))
     notes += linearisation_warnings(
         model, excitation.omega_p if isinstance(excitation, Pulse) else None
     )
@@ -392,25 +396,31 @@ class BatchResult:
         return self.t_ratio_exceeded if self.criterion == "ratio" else self.t_collapse
 
     def rows(self) -> list[dict[str, Any]]:
-        """One JSON-ready dict per (mechanism, scale), mechanism-major."""
+        """One JSON-ready dict per (mechanism, scale), mechanism-major.
+
+        A row whose peak is not resolved (``error_estimate >= UNRESOLVED_ERROR``) says so in
+        ``warnings``; the key is absent otherwise.
+        """
         rows = []
         ov = self.overturned
         tov = self.t_overturn
         for i, name in enumerate(self.names):
             for j, sc in enumerate(self.scales):
-                rows.append(
-                    {
-                        "mechanism": name,
-                        "scale": float(sc),
-                        "peak_ratio": float(self.peak_ratio[i, j]),
-                        "overturned": bool(ov[i, j]),
-                        "t_overturn": _nan_to_none(float(tov[i, j])),
-                        "n_impacts": int(self.n_impacts[i, j]),
-                        "error_estimate": float(self.error_estimate[i, j]),
-                        "status": int(self.status[i, j]),
-                        "message": STATUS_MESSAGES[int(self.status[i, j])],
-                    }
-                )
+                err = float(self.error_estimate[i, j])
+                row: dict[str, Any] = {
+                    "mechanism": name,
+                    "scale": float(sc),
+                    "peak_ratio": float(self.peak_ratio[i, j]),
+                    "overturned": bool(ov[i, j]),
+                    "t_overturn": _nan_to_none(float(tov[i, j])),
+                    "n_impacts": int(self.n_impacts[i, j]),
+                    "error_estimate": err,
+                    "status": int(self.status[i, j]),
+                    "message": STATUS_MESSAGES[int(self.status[i, j])],
+                }
+                if err >= UNRESOLVED_ERROR:
+                    row["warnings"] = [_unresolved(err)]
+                rows.append(row)
         return rows
 
 

@@ -431,3 +431,29 @@ def test_stocky_mechanism_carries_a_linearisation_warning() -> None:
     slender = RockingModel.symmetric(2.0, 0.05, 0.9)
     res = simulate(slender, Pulse(a_p=-0.1 * G, f_p=1.0))
     assert not any("linearised" in w for w in res.warnings)
+
+
+def test_batch_rows_flag_an_unresolved_peak() -> None:
+    from solver_service.core.exact import UNRESOLVED_ERROR, BatchResult
+
+    one = np.ones((1, 2))
+    batch = BatchResult(
+        names=["M"],
+        scales=np.array([1.0, 2.0]),
+        peak_ratio=0.5 * one,
+        t_peak=one,
+        ratio_exceeded=np.zeros((1, 2), dtype=bool),
+        t_ratio_exceeded=np.full((1, 2), np.nan),
+        collapsed=np.zeros((1, 2), dtype=bool),
+        t_collapse=np.full((1, 2), np.nan),
+        n_impacts=np.ones((1, 2), dtype=np.int64),
+        n_steps=np.ones((1, 2), dtype=np.int64),
+        error_estimate=np.array([[1e-12, UNRESOLVED_ERROR]]),
+        status=np.zeros((1, 2), dtype=np.int64),
+        criterion="ratio",
+        runtime_s=0.0,
+        method="exact",
+    )
+    first, second = batch.rows()
+    assert "warnings" not in first
+    assert second["warnings"] and "not resolved" in second["warnings"][0]
