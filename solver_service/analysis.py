@@ -32,6 +32,7 @@ __all__ = [
     "SF_METHODS",
     "Building",
     "boundary_doc",
+    "dense_runs",
     "envelope_csv",
     "envelope_doc",
     "finite_json",
@@ -41,6 +42,7 @@ __all__ = [
     "log_grid",
     "mechanism_scale_factor",
     "pulse_doc",
+    "read_record",
     "record_doc",
     "record_pulse_doc",
     "run_scaled",
@@ -154,35 +156,18 @@ def frequency_grid(f_min: float, f_max: float, n: int) -> np.ndarray[Any, Any]:
     return log_grid(f_min, f_max, n)
 
 
-def record_doc(
-    motion: Any,
-    periods: np.ndarray[Any, Any],
-    *,
-    zeta: float = 0.05,
-    n_pulses: int = 5,
-    f_min: Optional[float] = None,
-    f_max: Optional[float] = None,
-) -> dict[str, Any]:
-    """Describe a record: metadata, largest sine pulses and exact response spectrum.
+def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> dict[str, Any]:
+    """Describe a record: metadata, its largest sine pulses and its response spectrum.
 
     Parameters
     ----------
     motion : GroundMotion
         The record.
-    periods : (m,) float
-        Natural periods of the spectrum [s].
-    zeta : float
-        Damping ratio [-].
-    n_pulses : int
-        How many of the largest pulses to list.
-    f_min, f_max : float, optional
-        Pulse search range [Hz].
+    spectrum : Spectrum
+        Its response spectrum (``core.spectra.response_spectrum``).
+    pulses : list of ExtractedPulse
+        Its largest sine pulses (``core.pulses.extract_pulses``).
     """
-    from .core.pulses import extract_pulses
-    from .core.spectra import response_spectrum
-
-    found = extract_pulses(motion.accel, f_min=f_min, f_max=f_max, n=n_pulses)
-    spec = response_spectrum(motion.accel.acc, motion.dt, periods, zeta)
     return {
         "record": {
             "name": motion.name,
@@ -192,15 +177,15 @@ def record_doc(
             "duration_s": motion.duration,
             **motion.metadata,
         },
-        "pulses": [p.to_dict() for p in found],
+        "pulses": [p.to_dict() for p in pulses],
         "pulse_method": PULSE_METHOD,
         "spectrum": {
-            "damping": spec.zeta,
-            "periods_s": [float(v) for v in spec.periods],
-            "psa_g": [float(v) for v in spec.psa_g],
-            "sd_m": [float(v) for v in spec.sd],
+            "damping": spectrum.zeta,
+            "periods_s": [float(v) for v in spectrum.periods],
+            "psa_g": [float(v) for v in spectrum.psa_g],
+            "sd_m": [float(v) for v in spectrum.sd],
             "method": "exact piecewise-linear recursion (Nigam-Jennings)",
-            "runtime_s": spec.runtime_s,
+            "runtime_s": spectrum.runtime_s,
         },
     }
 
@@ -627,6 +612,60 @@ def linearisation_notes(cf: ConstantsFile, models: list[Any]) -> dict[str, list[
     return {k: v for k, v in notes.items() if v}
 
 
+def dense_runs(
+    cf: ConstantsFile, motion: Any, doc: dict[str, Any], scale: float
+) -> list[tuple[str, float, Any]]:
+    """Time series of every mechanism at one user scale, as a history document ran it.
+
+    Each mechanism gets the document's scale factor up the structure on top of ``scale``
+    and the document's overturning criterion.
+
+    Returns
+    -------
+    list of (mechanism id, effective scale, RockingResult)
+        The results carry ``t`` and ``ratio`` (``dense=True``).
+    """
+    from .core.exact import simulate
+
+    factors = {k: v["value"] for k, v in doc.get("scale_factors", {}).items()}
+    runs = []
+    for mech in cf.mechanisms:
+        effective = scale * factors.get(mech.id, 1.0)
+        res = simulate(
+            to_rocking_model(mech),
+            motion.accel,
+            scale=effective,
+            criterion=doc["criterion"],
+            dense=True,
+        )
+        runs.append((mech.id, effective, res))
+    return runs
+
+
+def read_record(
+    path: Path,
+    fmt: Optional[str] = None,
+    units: Optional[str] = None,
+    dt: Optional[float] = None,
+) -> Any:
+    """Read a record as ``rockmech`` does: format detected, a two-column file in g by default.
+
+    Parameters
+    ----------
+    path : Path
+        The record file.
+    fmt, units, dt
+        As ``GroundMotion.from_file``; ``units`` defaults to g for a two-column file (the
+        t [s], a [g] convention of the bundled record).
+    """
+    from .core.records import GroundMotion, detect_format
+
+    fmt = fmt or detect_format(path)
+    if units is None and fmt == "two_column":
+        units = "g"
+    return GroundMotion.from_file(path, format=fmt, units=units, dt=dt)
+
+
 def write_history(
     cf: ConstantsFile,
     motion: Any,
@@ -647,7 +686,6 @@ def write_history(
     """
     from shared_schema.io import write_atomic
 
-    from .core.exact import simulate
     from .report.plots import plot_ratio_histories, plot_record
 
     doc = history_doc(cf, motion, scales, **options)
@@ -657,23 +695,10 @@ def write_history(
     picks = sorted(
         {order[round(k)] for k in np.linspace(0, len(order) - 1, min(max_panels, len(order)))}
     )
-    factors = {k: v["value"] for k, v in doc.get("scale_factors", {}).items()}
-    panels = []
-    for scale in picks:
-        runs = [
-            (
-                mech.id,
-                simulate(
-                    to_rocking_model(mech),
-                    motion.accel,
-                    scale=scale * factors.get(mech.id, 1.0),
-                    criterion=options.get("criterion"),
-                    dense=True,
-                ),
-            )
-            for mech in cf.mechanisms
-        ]
-        panels.append((scale, runs))
+    panels = [
+        (scale, [(mech_id, res) for mech_id, _, res in dense_runs(cf, motion, doc, scale)])
+        for scale in picks
+    ]
     plot_ratio_histories(panels, out_dir / f"{stem}.png", title=title or motion.name)
     plot_record(motion, out_dir / f"{stem}_record.png")
     return doc

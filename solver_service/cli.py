@@ -146,12 +146,9 @@ _ELEMENT_PERIOD_OPT = typer.Option(
 
 
 def _read_record(path: Path, fmt: Optional[str], units: Optional[str], dt: Optional[float]) -> Any:
-    from .core.records import GroundMotion, detect_format
+    from .analysis import read_record
 
-    fmt = fmt or detect_format(path)
-    if units is None and fmt == "two_column":
-        units = "g"  # the two-column t [s], a [g] convention of the bundled record
-    return GroundMotion.from_file(path, format=fmt, units=units, dt=dt)
+    return read_record(path, fmt, units, dt)
 
 
 def _read_constants(path: Path) -> Any:
@@ -272,10 +269,14 @@ def record_info(
 ) -> None:
     """Describe a record: metadata, largest sine pulses and exact response spectrum."""
     from .analysis import log_grid, record_doc
+    from .core.pulses import extract_pulses
+    from .core.spectra import response_spectrum
 
     motion = _read_record(record, record_format, units, dt)
     periods = log_grid(t_min, t_max, n, names=("t_min", "t_max"))
-    doc = record_doc(motion, periods, zeta=zeta, n_pulses=pulses, f_min=f_min, f_max=f_max)
+    found = extract_pulses(motion.accel, f_min=f_min, f_max=f_max, n=pulses)
+    spectrum = response_spectrum(motion.accel.acc, motion.dt, periods, zeta)
+    doc = record_doc(motion, spectrum, found)
     if out is not None:
         from shared_schema.io import write_atomic
 
@@ -283,7 +284,7 @@ def record_info(
 
         out.mkdir(parents=True, exist_ok=True)
         write_atomic(out / "record.json", json.dumps(doc, indent=2) + "\n")
-        plot_record(motion, out / "record.png", periods=periods, zeta=zeta)
+        plot_record(motion, out / "record.png", spectrum=spectrum, pulses=found)
     if as_json:
         _print_json(doc)
         return

@@ -304,8 +304,7 @@ def run_ida(
 
 def ida_csv(doc: dict[str, Any]) -> str:
     """Return the overturned fractions as CSV: level, then one column per mechanism."""
-    unit = doc["intensity"]["units"]
-    head = f"{doc['intensity']['measure']}_{'g' if unit == 'g' else '-'}"
+    head = f"{doc['intensity']['measure']}_{doc['intensity']['units']}"
     lines = [head + "," + ",".join(f"fraction_{m['id']}" for m in doc["mechanisms"])]
     for j, level in enumerate(doc["intensity"]["levels"]):
         cells = [f"{m['fraction'][j]:.6g}" for m in doc["mechanisms"]]

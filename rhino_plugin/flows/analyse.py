@@ -217,9 +217,9 @@ def run_history(
     from pathlib import Path
 
     from shared_schema.atomic import write_atomic
-    from solver_service.core.records import GroundMotion
+    from solver_service.analysis import read_record
 
-    motion = GroundMotion.from_file(record, units=units)
+    motion = read_record(Path(record), units=units)
     os.makedirs(out_dir, exist_ok=True)
     json_path = os.path.join(out_dir, f"{stem}.json")
     if client is not None:

@@ -221,7 +221,8 @@ def motion_from_params(
     As ``rockmech history``: the format is detected when not given, and a two-column file
     without units is taken to be in g.
     """
-    from ..core.records import GroundMotion, detect_format
+    from ..analysis import read_record
+    from ..core.records import GroundMotion
 
     max_samples = limits["max_samples"]
     if record is not None:
@@ -241,11 +242,7 @@ def motion_from_params(
         path = Path(folder) / name
         path.write_bytes(blob)
         try:
-            fmt = upload.get("format") or detect_format(path)
-            units = upload.get("units")
-            if units is None and fmt == "two_column":
-                units = "g"  # the CLI's two-column t [s], a [g] convention
-            motion = GroundMotion.from_file(path, format=fmt, units=units, dt=upload.get("dt"))
+            motion = read_record(path, upload.get("format"), upload.get("units"), upload.get("dt"))
         except InputError as exc:
             raise _strip_folder(exc, folder) from None
     check_limit(motion.accel.n, max_samples, "samples", "record", "max_samples")
@@ -343,20 +340,18 @@ def _blob(blobs: list[bytes]) -> Optional[bytes]:
 
 def _spectrum(params: dict[str, Any], blobs: list[bytes], limits: dict[str, int]) -> bytes:
     from ..analysis import log_grid, record_doc
+    from ..core.pulses import extract_pulses
+    from ..core.spectra import response_spectrum
 
     check_limit(params["n"], limits["max_samples"], "periods", "n", "max_samples")
     motion = motion_from_params(params.get("record"), params.get("upload"), _blob(blobs), limits)
     periods = log_grid(params["t_min"], params["t_max"], params["n"], names=("t_min", "t_max"))
     check_record_work(motion, limits, t_min=float(periods[0]))
-    doc = record_doc(
-        motion,
-        periods,
-        zeta=params["zeta"],
-        n_pulses=params["pulses"],
-        f_min=params.get("f_min"),
-        f_max=params.get("f_max"),
+    found = extract_pulses(
+        motion.accel, f_min=params.get("f_min"), f_max=params.get("f_max"), n=params["pulses"]
     )
-    return dumps(doc)
+    spectrum = response_spectrum(motion.accel.acc, motion.dt, periods, params["zeta"])
+    return dumps(record_doc(motion, spectrum, found))
 
 
 def scale_factor_doc(params: dict[str, Any], limits: dict[str, int]) -> dict[str, Any]:

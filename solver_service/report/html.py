@@ -226,28 +226,14 @@ def _history_table(doc: dict[str, Any]) -> str:
 def _history_figures(
     cf: Any, motion: Any, doc: dict[str, Any], scales: Sequence[float], folder: Path
 ) -> list[str]:
-    from ..adapter import to_rocking_model
-    from ..core.exact import simulate
+    from ..analysis import dense_runs
     from ..core.model import G
     from .plots import plot_time_histories
 
     top = max(scales)
-    effective = {
-        r["mechanism"]: r.get("effective_scale", r["scale"])
-        for r in doc["results"]
-        if r["scale"] == top
-    }
-    runs = []
-    for mech in cf.mechanisms:
-        scale = float(effective.get(mech.id, top))
-        res = simulate(
-            to_rocking_model(mech),
-            motion.accel,
-            scale=scale,
-            dense=True,
-            criterion=doc["criterion"],
-        )
-        runs.append((f"{mech.id} ×{scale:.3g}", res))
+    runs = [
+        (f"{mech_id} ×{scale:.3g}", res) for mech_id, scale, res in dense_runs(cf, motion, doc, top)
+    ]
     figures = []
     for k in range(0, len(runs), MAX_TRACES):
         part = runs[k : k + MAX_TRACES]

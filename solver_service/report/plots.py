@@ -172,6 +172,8 @@ def plot_record(
     *,
     periods: Union[np.ndarray[Any, Any], None] = None,
     zeta: float = 0.05,
+    spectrum: Any = None,
+    pulses: Union[Sequence[Any], None] = None,
 ) -> Path:
     """Plot a record with its largest sine pulse, and its elastic response spectrum.
 
@@ -185,6 +187,10 @@ def plot_record(
         Natural periods of the spectrum [s]; default 100 log-spaced from 0.02 to 10 s.
     zeta : float
         Damping ratio of the spectrum [-].
+    spectrum : Spectrum, optional
+        The spectrum, when already computed (then ``periods`` and ``zeta`` are not used).
+    pulses : sequence of ExtractedPulse, optional
+        The record's pulses, largest first, when already found; the first is drawn.
 
     Returns
     -------
@@ -196,15 +202,17 @@ def plot_record(
     from ..core.spectra import response_spectrum
 
     plt = _pyplot()
-    t_n = np.geomspace(0.02, 10.0, 100) if periods is None else np.asarray(periods, dtype=float)
-    spec = response_spectrum(motion.accel.acc, motion.dt, t_n, zeta)
+    if spectrum is None:
+        t_n = np.geomspace(0.02, 10.0, 100) if periods is None else np.asarray(periods, float)
+        spectrum = response_spectrum(motion.accel.acc, motion.dt, t_n, zeta)
+    if pulses is None:
+        pulses = extract_pulses(motion.accel, n=1)
     fig, (ax_a, ax_s) = plt.subplots(
         1, 2, figsize=(11, 3.6), gridspec_kw={"width_ratios": [1.7, 1]}
     )
     ax_a.plot(motion.accel.time, motion.accel.acc / G, color="0.35", lw=0.6)
-    found = extract_pulses(motion.accel, n=1)
-    if found:
-        p = found[0]
+    if pulses:
+        p = pulses[0]
         ax_a.axvspan(p.t_start, p.t_start + p.duration, color="crimson", alpha=0.12, lw=0)
         tp = np.linspace(p.t_start, p.t_start + p.duration, 200)
         ax_a.plot(
@@ -219,10 +227,10 @@ def plot_record(
     ax_a.set_ylabel("ground acceleration [g]")
     ax_a.set_title(f"{motion.name}: PGA {motion.pga_g:.3f} g, dt {motion.dt:g} s")
     ax_a.grid(alpha=0.3)
-    ax_s.plot(spec.periods, spec.psa_g, color="navy", lw=1.2)
+    ax_s.plot(spectrum.periods, spectrum.psa_g, color="navy", lw=1.2)
     ax_s.set_xscale("log")
     ax_s.set_xlabel("natural period T_n [s]")
-    ax_s.set_ylabel(f"PSA [g] ({100 * zeta:g} % damping)")
+    ax_s.set_ylabel(f"PSA [g] ({100 * spectrum.zeta:g} % damping)")
     ax_s.set_title("elastic response spectrum (exact)")
     ax_s.grid(which="both", alpha=0.3)
     fig.tight_layout()
