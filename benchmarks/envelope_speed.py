@@ -60,7 +60,6 @@ from _docs import (  # noqa: E402  (benchmarks/ is not a package)
 )
 
 from shared_schema.constants import ConstantsFile, parse_constants  # noqa: E402
-from solver_service.analysis import envelope_doc, frequency_grid  # noqa: E402
 from solver_service.core.envelope import (  # noqa: E402
     LIBRARY_PATH,
     MAX_EDGES,
@@ -73,6 +72,7 @@ from solver_service.core.exact import simulate  # noqa: E402
 from solver_service.core.excitation import Pulse  # noqa: E402
 from solver_service.core.model import G, RockingModel  # noqa: E402
 from solver_service.core.reference import simulate_ivp  # noqa: E402
+from solver_service.workflows.documents import envelope_doc, frequency_grid  # noqa: E402
 
 #: The eta curve of (1): Omega grid (log-spaced) and restitution.
 CURVE_OMEGA = (0.05, 50.0, 400)

@@ -47,6 +47,7 @@ from pydantic import (
 from pydantic_core import PydanticCustomError
 
 from shared_schema.errors import InputError
+from shared_schema.rules import G, eta_problem
 
 __all__ = [
     "CONSISTENCY_RTOL",
@@ -71,9 +72,6 @@ __all__ = [
 #: Version of the file format written by this module.
 SCHEMA_VERSION = "1.0"
 
-#: Standard gravity [m/s^2]; equal to ``solver_service.core.model.G``, repeated here so that
-#: the Rhino side need not import the solver.
-G = 9.80665
 
 #: Relative tolerance within which given ``p_eq``/``lam``/``phi_ov`` must match the values
 #: derived from the physical constants.
@@ -497,19 +495,9 @@ class Mechanism(BaseModel):
         rocking = info.data.get("rocking")
         if eta is None or rocking is None:
             return eta
-        if rocking == "one_sided" and eta > 0.0:
-            raise PydanticCustomError(
-                "eta_sign",
-                "must be <= 0 for one-sided rocking (rebound off the restraint), got {eta}",
-                {"eta": eta},
-            )
-        if rocking == "two_sided" and eta < 0.0:
-            raise PydanticCustomError(
-                "eta_sign",
-                "must be >= 0 for two-sided rocking (a negative value means rebound, which "
-                "is one-sided), got {eta}",
-                {"eta": eta},
-            )
+        problem = eta_problem(eta, rocking == "one_sided")
+        if problem is not None:
+            raise PydanticCustomError("eta_sign", problem)
         return eta
 
     @field_validator("geometry", "provenance")

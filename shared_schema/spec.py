@@ -16,6 +16,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from shared_schema.constants import Amplification
 from shared_schema.errors import InputError
+from shared_schema.rules import eta_problem
 
 __all__ = [
     "SPEC_VERSION",
@@ -278,10 +279,9 @@ class MechanismSpec(BaseModel):
                 f"added elements ({', '.join(added)}) need typology 'single_block_loaded'"
             )
         if self.eta is not None:
-            if self.rocking == "one_sided" and self.eta > 0:
-                raise ValueError("eta must be <= 0 for one-sided rocking")
-            if self.rocking == "two_sided" and self.eta < 0:
-                raise ValueError("eta must be >= 0 for two-sided rocking")
+            problem = eta_problem(self.eta, self.rocking == "one_sided")
+            if problem is not None:
+                raise ValueError(f"eta {problem}")
         two = [k for k in ("overburden", "f_mt", "eccentricity") if getattr(self, k) is not None]
         if two and self.typology != "two_block":
             raise ValueError(f"{', '.join(two)} need typology 'two_block'")

@@ -17,6 +17,26 @@ from typing import Any, NoReturn, Optional, TypeVar
 import typer
 
 from shared_schema.errors import RockmechError
+from shared_schema.io import save_constants, write_atomic
+
+from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
+from .core.model import check_positive
+from .demo import run_demo
+from .ida import ida_csv, parse_levels, run_ida
+from .report.html import build_report, input_source, write_report
+from .report.plots import plot_fragility
+from .workflows.documents import (
+    boundary_doc,
+    frequency_grid,
+    history_doc,
+    log_grid,
+    pulse_doc,
+    record_analysis,
+    record_pulse_doc,
+)
+from .workflows.inputs import constants_from_files, read_constants, read_record
+from .workflows.outputs import finite_json, write_envelope, write_history, write_record
+from .workflows.scaling import Building
 
 app = typer.Typer(
     name="rockmech",
@@ -48,7 +68,6 @@ def _user_errors(fn: F) -> F:
 
 
 def _print_json(doc: Any) -> None:
-    from .analysis import finite_json
 
     typer.echo(json.dumps(finite_json(doc), indent=2, allow_nan=False))
 
@@ -83,8 +102,6 @@ def pulse(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Response of one mechanism to a one-cycle sine or cosine acceleration pulse."""
-    from .analysis import pulse_doc
-
     doc = pulse_doc(
         p_eq,
         lam,
@@ -145,20 +162,6 @@ _ELEMENT_PERIOD_OPT = typer.Option(
 )
 
 
-def _read_record(path: Path, fmt: Optional[str], units: Optional[str], dt: Optional[float]) -> Any:
-    from .analysis import read_record
-
-    return read_record(path, fmt, units, dt)
-
-
-def _read_constants(path: Path) -> Any:
-    from shared_schema.io import load_constants
-
-    if not path.is_file():
-        _fail(f"constants: file not found: {path}")
-    return load_constants(path)
-
-
 def _scales(first: list[float], extra: list[str]) -> list[float]:
     """Collect the --scale values, also those typed after the first (``--scale 0.5 1 2``)."""
     scales = list(first)
@@ -204,11 +207,9 @@ def history(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Time history of every mechanism in CONSTANTS under RECORD at each scale factor."""
-    from .analysis import Building, history_doc, write_history
-
     scales = _scales(scale, ctx.args)
-    cf = _read_constants(constants)
-    motion = _read_record(record, record_format, units, dt)
+    cf = read_constants(constants)
+    motion = read_record(record, record_format, units, dt)
     options: dict[str, Any] = {
         "sf": sf,
         "building": Building(building_height, soil_factor, element_period),
@@ -268,23 +269,13 @@ def record_info(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Describe a record: metadata, largest sine pulses and exact response spectrum."""
-    from .analysis import log_grid, record_doc
-    from .core.pulses import extract_pulses
-    from .core.spectra import response_spectrum
-
-    motion = _read_record(record, record_format, units, dt)
+    motion = read_record(record, record_format, units, dt)
     periods = log_grid(t_min, t_max, n, names=("t_min", "t_max"))
-    found = extract_pulses(motion.accel, f_min=f_min, f_max=f_max, n=pulses)
-    spectrum = response_spectrum(motion.accel.acc, motion.dt, periods, zeta)
-    doc = record_doc(motion, spectrum, found)
+    doc, spectrum, found = record_analysis(
+        motion, periods, zeta, n_pulses=pulses, f_min=f_min, f_max=f_max
+    )
     if out is not None:
-        from shared_schema.io import write_atomic
-
-        from .report.plots import plot_record
-
-        out.mkdir(parents=True, exist_ok=True)
-        write_atomic(out / "record.json", json.dumps(doc, indent=2) + "\n")
-        plot_record(motion, out / "record.png", spectrum=spectrum, pulses=found)
+        write_record(motion, doc, spectrum, found, out)
     if as_json:
         _print_json(doc)
         return
@@ -350,13 +341,9 @@ def ida(
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
-    from .analysis import Building
-    from .core.model import check_positive
-    from .ida import ida_csv, parse_levels, run_ida
-
     levels = parse_levels(scales)
-    cf = _read_constants(constants)
-    motions = [_read_record(path, record_format, units, dt) for path in records]
+    cf = read_constants(constants)
+    motions = [read_record(path, record_format, units, dt) for path in records]
     console = Console(stderr=True)
     show = console.is_terminal if progress is None else progress
     bar = Progress(
@@ -383,10 +370,6 @@ def ida(
             timeout=check_positive(timeout, "timeout"),
         )
     if out is not None:
-        from shared_schema.io import write_atomic
-
-        from .report.plots import plot_fragility
-
         out.mkdir(parents=True, exist_ok=True)
         write_atomic(out / "ida.json", json.dumps(doc, indent=2) + "\n")
         write_atomic(out / "ida.csv", ida_csv(doc))
@@ -423,22 +406,7 @@ def constants(
     as_json: bool = typer.Option(False, "--json", help="Also print the constants JSON."),
 ) -> None:
     """Kinematic constants of every mechanism in SPEC from the solids of SCENE."""
-    from rhino_plugin.mechanisms.build import constants_from_spec
-    from rhino_plugin.scene_3dm import Scene
-    from shared_schema.io import save_constants
-    from shared_schema.spec import parse_spec
-
-    for label, path in (("scene", scene), ("spec", spec)):
-        if not path.is_file():
-            _fail(f"{label}: file not found: {path}")
-    spec_file = parse_spec(spec.read_bytes(), spec.name)
-    cf = constants_from_spec(
-        spec_file,
-        Scene.from_3dm(scene),
-        scene_name=scene.name,
-        spec_name=spec.name,
-        spec_dir=spec.parent,
-    )
+    cf = constants_from_files(scene, spec)
     save_constants(output, cf)
     if as_json:
         _print_json(json.loads(cf.model_dump_json(exclude_none=True)))
@@ -481,13 +449,11 @@ def envelope(
     as_json: bool = typer.Option(False, "--json", help="Also print the JSON document."),
 ) -> None:
     """Minimum overturning sine-pulse amplitude of every mechanism, and the critical bands."""
-    from .analysis import frequency_grid, record_pulse_doc, write_envelope
-
     f_p = frequency_grid(f_min, f_max, n)
-    cf = _read_constants(constants)
+    cf = read_constants(constants)
     pulse = None
     if record is not None:
-        motion = _read_record(record, record_format, units, dt)
+        motion = read_record(record, record_format, units, dt)
         pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), exact=exact)
     elif ctx.args:
         _fail(f"unexpected argument {ctx.args[0]!r}")
@@ -529,8 +495,6 @@ def boundary(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Every overturning interval in A = a_p/(g lam) at one frequency ratio (exact)."""
-    from .analysis import boundary_doc
-
     doc = boundary_doc(omega, eta, one_sided=one_sided, shape=shape)
     if as_json:
         _print_json(doc)
@@ -565,8 +529,6 @@ def library_build(
     import numpy as np
     from rich.progress import Progress
 
-    from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
-
     if n_omega < 2:
         _fail(f"n_omega: must be >= 2, got {n_omega}")
     if not 0.0 < eta_step <= 1.0:
@@ -597,8 +559,6 @@ def demo(
     ),
 ) -> None:
     """Run the bundled example: rectangular walls on El Centro 1940, exact integration."""
-    from .demo import run_demo
-
     paths = run_demo(out, record)
     for kind, path in paths.items():
         typer.echo(f"wrote {kind}: {path}")
@@ -640,16 +600,13 @@ def report(
     title: Optional[str] = typer.Option(None, "--title", help="Title of the report."),
 ) -> None:
     """One self-contained HTML report: constants, envelopes, and with --record its histories."""
-    from .analysis import Building, frequency_grid
-    from .report.html import build_report, input_source, write_report
-
     scales = _scales(scale, ctx.args)
     f_p = frequency_grid(f_min, f_max, n)
-    cf = _read_constants(constants)
+    cf = read_constants(constants)
     sources = [input_source("constants", constants.name, constants.read_bytes())]
     motion = None
     if record is not None:
-        motion = _read_record(record, record_format, units, dt)
+        motion = read_record(record, record_format, units, dt)
         sources.append(input_source("record", record.name, record.read_bytes()))
     options = {"scales": scales, "sf": sf, "building_height": building_height}
     options.update(soil_factor=soil_factor, element_period=element_period, at_height=at_height)
@@ -687,6 +644,7 @@ def serve(
     ),
 ) -> None:
     """Run the REST service (FastAPI + uvicorn); settings also from ROCKMECH_* variables."""
+    # fastapi and uvicorn (the service extra) are loaded only by the command that needs them.
     from .api.server import run, settings_with
 
     run(settings_with(host=host, port=port, compute_workers=workers, compute_timeout_s=timeout))

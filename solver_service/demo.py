@@ -25,10 +25,13 @@ from pathlib import Path
 from typing import Any
 
 from shared_schema.constants import ConstantsFile
-from shared_schema.io import save_constants
+from shared_schema.io import load_constants, save_constants
 
 from .core.model import G
 from .core.records import GroundMotion
+from .workflows.documents import frequency_grid
+from .workflows.inputs import constants_from_files
+from .workflows.outputs import write_envelope, write_history
 
 __all__ = ["DEMO_WALLS", "EXAMPLES_DIR", "rectangular_block", "run_demo"]
 
@@ -136,8 +139,6 @@ def run_demo(out_dir: Path, record_path: Path | None = None) -> dict[str, Path]:
     dict
         Paths of the written files by kind.
     """
-    from .analysis import write_history
-
     out_dir.mkdir(parents=True, exist_ok=True)
     record_path = record_path or EXAMPLES_DIR / "records" / "elcentro_NS.dat"
     record = GroundMotion.from_two_column(record_path, units="g")
@@ -166,21 +167,9 @@ def run_demo(out_dir: Path, record_path: Path | None = None) -> dict[str, Path]:
 
 def facade_from_scene(out_dir: Path) -> dict[str, Path]:
     """Scene -> constants -> envelopes for the example façade (the CAD path end to end)."""
-    from rhino_plugin.mechanisms.build import constants_from_spec
-    from rhino_plugin.scene_3dm import Scene
-    from shared_schema.spec import parse_spec
-
-    from .analysis import frequency_grid, write_envelope
-
     scene_path = EXAMPLES_DIR / "scenes" / "facade.3dm"
     spec_path = EXAMPLES_DIR / "specs" / "facade.spec.json"
-    cf = constants_from_spec(
-        parse_spec(spec_path.read_bytes(), spec_path.name),
-        Scene.from_3dm(scene_path),
-        scene_name=scene_path.name,
-        spec_name=spec_path.name,
-        spec_dir=spec_path.parent,
-    )
+    cf = constants_from_files(scene_path, spec_path)
     constants_path = out_dir / "facade_constants.json"
     save_constants(constants_path, cf)
     write_envelope(
@@ -203,10 +192,6 @@ def church_history(out_dir: Path, record: GroundMotion) -> Path:
     The church's mechanisms with a coefficient of restitution are used (a time history
     needs one; the one-sided façade without eta is an envelope-only example).
     """
-    from shared_schema.io import load_constants
-
-    from .analysis import write_history
-
     cf = load_constants(EXAMPLES_DIR / "constants" / "church.json")
     cf = cf.model_copy(update={"mechanisms": [m for m in cf.mechanisms if m.eta is not None]})
     write_history(
@@ -223,10 +208,6 @@ def church_history(out_dir: Path, record: GroundMotion) -> Path:
 
 def church_envelope(out_dir: Path) -> dict[str, Path]:
     """Write the example church's envelopes and critical bands (JSON, CSV, PNG)."""
-    from shared_schema.io import load_constants
-
-    from .analysis import frequency_grid, write_envelope
-
     cf = load_constants(EXAMPLES_DIR / "constants" / "church.json")
     stem = "church_envelope"
     write_envelope(

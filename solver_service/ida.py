@@ -25,9 +25,9 @@ import numpy as np
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 
-from .adapter import to_rocking_model
-from .analysis import Building, run_scaled
 from .core.model import check_positive
+from .workflows.adapter import to_rocking_model
+from .workflows.scaling import Building, run_scaled
 
 __all__ = ["IM_MEASURES", "ida_csv", "parse_levels", "run_ida", "run_record"]
 

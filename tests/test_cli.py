@@ -457,7 +457,7 @@ def test_history_displacement_at_a_height(tmp_path: Path) -> None:
     doc = json.loads(res.stdout)
     assert doc["displacement"]["height_m"] == 2.5
     from shared_schema.io import load_constants
-    from solver_service.adapter import models_from_file
+    from solver_service.workflows.adapter import models_from_file
 
     motion = GroundMotion.from_two_column(record)
     for model, row in zip(models_from_file(load_constants(constants)), doc["results"]):
@@ -524,7 +524,7 @@ def test_envelope_with_a_records_pulse_agrees_with_the_exact_solver(tmp_path: Pa
     rp = doc["record_pulse"]
     assert [p["scale"] for p in rp["points"]] == [0.3, 1.0, 3.0]
     from shared_schema.io import load_constants
-    from solver_service.adapter import models_from_file
+    from solver_service.workflows.adapter import models_from_file
 
     # Each verdict against a direct exact run of that pulse (both directions; governing).
     for point in rp["points"]:

@@ -13,11 +13,11 @@ from typer.testing import CliRunner
 
 from shared_schema.errors import InputError
 from shared_schema.io import load_constants
-from solver_service.adapter import models_from_file
 from solver_service.cli import app
 from solver_service.core.exact import simulate
 from solver_service.core.records import GroundMotion
 from solver_service.ida import parse_levels, run_ida
+from solver_service.workflows.adapter import models_from_file
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 CONSTANTS = EXAMPLES / "constants" / "rect_walls.json"

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from shared_schema.constants import ConstantsFile
-from solver_service.analysis import envelope_doc
 from solver_service.report.plots import plot_envelopes
+from solver_service.workflows.documents import envelope_doc
 
 PNG = b"\x89PNG\r\n\x1a\n"
 

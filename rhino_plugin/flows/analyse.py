@@ -19,7 +19,14 @@ from typing import Any, Dict, List, Optional, Sequence
 
 from rhino_plugin.flows.mechanisms import _number
 from rhino_plugin.flows.prompter import Cancelled, Prompter
+from shared_schema.atomic import write_atomic
+from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError, RockmechError
+from shared_schema.io import load_constants
+from solver_service.workflows.adapter import to_rocking_model
+from solver_service.workflows.documents import frequency_grid, model_pulse_doc
+from solver_service.workflows.inputs import read_record
+from solver_service.workflows.outputs import write_envelope, write_history
 
 __all__ = [
     "ANALYSES",
@@ -131,9 +138,6 @@ class ServiceClient:
 
 def load_constants_files(paths: Sequence[str]) -> Any:
     """Read one or more constants files as one (mechanism ids must differ)."""
-    from shared_schema.constants import ConstantsFile
-    from shared_schema.io import load_constants
-
     if not paths:
         raise InputError("no constants file was given", "constants")
     mechanisms: List[Any] = []
@@ -173,8 +177,6 @@ def run_envelopes(
     """Overturning envelopes of every mechanism and the critical bands (``rockmech envelope``)."""
     from pathlib import Path
 
-    from shared_schema.atomic import write_atomic
-
     os.makedirs(out_dir, exist_ok=True)
     json_path = os.path.join(out_dir, f"{stem}.json")
     if client is not None:
@@ -182,7 +184,6 @@ def run_envelopes(
         doc = client.post("envelope", payload)
         write_atomic(json_path, json.dumps(doc, indent=2) + "\n")
         return AnalysisResult("Envelopes", doc, _band_lines(doc), None, [json_path])
-    from solver_service.analysis import frequency_grid, write_envelope
 
     doc = write_envelope(
         cf, frequency_grid(f_min, f_max, n), Path(out_dir), stem=stem, title="Overturning envelopes"
@@ -216,9 +217,6 @@ def run_history(
     """Time histories of every mechanism at every scale factor (``rockmech history``)."""
     from pathlib import Path
 
-    from shared_schema.atomic import write_atomic
-    from solver_service.analysis import read_record
-
     motion = read_record(Path(record), units=units)
     os.makedirs(out_dir, exist_ok=True)
     json_path = os.path.join(out_dir, f"{stem}.json")
@@ -233,7 +231,6 @@ def run_history(
         doc = client.post("history", payload)
         write_atomic(json_path, json.dumps(doc, indent=2) + "\n")
         return AnalysisResult("History", doc, _history_lines(doc), None, [json_path])
-    from solver_service.analysis import write_history
 
     doc = write_history(cf, motion, list(scales), Path(out_dir), stem=stem, title=motion.name)
     plot = os.path.join(out_dir, f"{stem}.png")
@@ -262,14 +259,7 @@ def run_pulse(
         }
         doc = client.post("pulse", payload)
     else:
-        from solver_service.adapter import to_rocking_model
-        from solver_service.core.exact import simulate
-        from solver_service.core.excitation import Pulse
-        from solver_service.core.model import G
-
-        model = to_rocking_model(mech)
-        model.require_eta()
-        doc = simulate(model, Pulse(a_p=a_p_g * G, f_p=f_p)).summary()
+        doc = model_pulse_doc(to_rocking_model(mech), a_p_g, f_p)
     verdict = "OVERTURNS" if doc.get("overturned") else "survives"
     line = f"  {mechanism}: sine pulse a_p = {a_p_g:g} g, f_p = {f_p:g} Hz: {verdict}"
     if "peak_ratio" in doc:

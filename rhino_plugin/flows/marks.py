@@ -12,6 +12,9 @@ from typing import Any, List, Tuple
 
 import numpy as np
 
+from rhino_plugin.mechanisms.multi_block_cad import _hinge_point
+from rhino_plugin.mechanisms.single import resolve_axis
+
 __all__ = ["Mark", "check_marks"]
 
 Point = Tuple[float, float, float]
@@ -48,9 +51,6 @@ def check_marks(spec_file: Any, scene: Any, constants: Any) -> List[Mark]:
         mass ``"<id> G"``, the two-block hinge height ``"<id> h_c"``, and the multi-block
         hinges ``"<id> A"`` ... ``"<id> D"`` (and ``"<id> A-"`` ... for the negative set).
     """
-    from rhino_plugin.mechanisms.multi_block_cad import _hinge_point
-    from rhino_plugin.mechanisms.single import resolve_axis
-
     s = float(scene.unit_scale)
     marks: List[Mark] = []
     for spec, mech in zip(spec_file.mechanisms, constants.mechanisms):

@@ -25,8 +25,13 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Sequence
 
+from rhino_plugin.flows.marks import check_marks
 from rhino_plugin.flows.prompter import Cancelled, Point, Prompter
+from rhino_plugin.mechanisms.build import constants_from_spec
+from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError, RockmechError
+from shared_schema.io import save_constants
+from shared_schema.spec import parse_spec
 
 __all__ = [
     "COMMANDS",
@@ -435,9 +440,6 @@ def write_outputs(spec_path: str, spec_text: str, constants_path: str, constants
     The spec is written first. If the constants cannot be written, the spec file is put
     back as it was (removed if it is new), so the pair on disk always belongs together.
     """
-    from shared_schema.atomic import write_atomic
-    from shared_schema.io import save_constants
-
     os.makedirs(os.path.dirname(os.path.abspath(spec_path)), exist_ok=True)
     previous: Optional[bytes] = None
     if os.path.isfile(spec_path):
@@ -502,10 +504,6 @@ def run_mechanism_command(
         ``None`` when the user cancelled or an answer was invalid; the reason went to
         ``prompter.message`` and no file was written.
     """
-    from rhino_plugin.flows.marks import check_marks
-    from rhino_plugin.mechanisms.build import constants_from_spec
-    from shared_schema.spec import parse_spec
-
     if command not in COMMANDS:
         raise ValueError(f"unknown command {command!r}; expected one of {sorted(COMMANDS)}")
     typology, prefix = COMMANDS[command]

@@ -12,7 +12,11 @@ Python 3.9-clean: imported by Rhino 8.
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from rhino_plugin.flows.mechanisms import ROCKING, _number
+from rhino_plugin.flows.prepared import PreparedScene
+from rhino_plugin.mechanisms.build import constants_from_spec
+from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
+from shared_schema.spec import parse_spec
 
 __all__ = ["constants_from_prepared", "parse_constants_text", "spec_from_parameters"]
 
@@ -120,10 +124,6 @@ def constants_from_prepared(
     -------
     shared_schema.constants.ConstantsFile
     """
-    from rhino_plugin.flows.prepared import PreparedScene
-    from rhino_plugin.mechanisms.build import constants_from_spec
-    from shared_schema.spec import parse_spec
-
     names = [name for name, _, _ in records]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
@@ -140,8 +140,6 @@ def constants_from_prepared(
 
 def parse_constants_text(text: Any) -> Any:
     """Parse a constants file from JSON text (as the components pass it along)."""
-    from shared_schema.constants import parse_constants
-
     if not isinstance(text, str) or not text.strip():
         raise InputError("connect a kinematic-constants JSON text", "constants")
     return parse_constants(text)

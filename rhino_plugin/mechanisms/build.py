@@ -11,8 +11,15 @@ from typing import Any, Dict, List, Optional
 
 import numpy as np
 
+from rhino_plugin.mechanisms import single
+from rhino_plugin.mechanisms.loaded import loaded_side
+from rhino_plugin.mechanisms.multi_block_cad import multi_block_sides
+from rhino_plugin.mechanisms.restitution import ONE_SIDED_RULES, one_sided
+from rhino_plugin.mechanisms.thrust import ThrustTable
+from rhino_plugin.mechanisms.two_block_cad import two_block_sides
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
+from shared_schema.rules import eta_range
 
 __all__ = ["constants_from_spec", "mechanism_entry"]
 
@@ -26,10 +33,6 @@ def _same(a: Dict[str, float], b: Dict[str, float]) -> bool:
 
 def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
     """One mechanism of the constants file from its spec."""
-    from rhino_plugin.mechanisms import single
-    from rhino_plugin.mechanisms.loaded import loaded_side
-    from rhino_plugin.mechanisms.restitution import ONE_SIDED_RULES, one_sided
-
     where = spec.id
     entry: Dict[str, Any] = {
         "id": spec.id,
@@ -38,8 +41,6 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
         "rocking": spec.rocking,
     }
     if spec.typology == "multi_block":
-        from rhino_plugin.mechanisms.multi_block_cad import multi_block_sides
-
         positive, negative, eta, summary, ids = multi_block_sides(spec, scene)
         warnings = summary.pop("warnings")
         return _finish(
@@ -67,8 +68,6 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
     }
     warnings = list(body.warnings)
     if spec.typology == "two_block":
-        from rhino_plugin.mechanisms.two_block_cad import two_block_sides
-
         positive, negative, eta, summary = two_block_sides(spec, scene, body, pos)
         geometry["two_block"] = summary
         return _finish(
@@ -155,7 +154,7 @@ def _finish(
     if negative is not None and not _same(positive, negative):
         entry["negative"] = negative
     if eta is not None:
-        lo, hi = (-1.0, 0.0) if spec.rocking == "one_sided" else (0.0, 1.0)
+        lo, hi = eta_range(spec.rocking == "one_sided")
         if not lo <= eta <= hi:
             clamped = min(max(eta, lo), hi)
             warnings.append(
@@ -187,8 +186,6 @@ def constants_from_spec(
     spec_dir: Optional[Path] = None,
 ) -> ConstantsFile:
     """Kinematic-constants file for every mechanism of a spec file."""
-    from rhino_plugin.mechanisms.thrust import ThrustTable
-
     table_path = None
     if spec_file.thrust_table is not None:
         table_path = Path(spec_file.thrust_table)

@@ -29,12 +29,17 @@ from typing import Any, Dict, List, Tuple
 
 import numpy as np
 
+from rhino_plugin.geometry.contact import find_contact
+from rhino_plugin.geometry.frames import bounding_box_in_frame
+from rhino_plugin.geometry.massprops import mass_properties
+from rhino_plugin.geometry.validate import check_solid
+from rhino_plugin.mechanisms.single import find_objects
+from rhino_plugin.mechanisms.thrust import roof_thrust
 from shared_schema.errors import GeometryError, InputError
+from shared_schema.rules import G
 
 __all__ = ["BEARING_ANGLE", "element_solids", "largest_contact", "loaded_side"]
 
-#: Standard gravity [m/s²].
-G = 9.80665
 #: A contact whose normal is within this angle of vertical counts as bearing [rad].
 BEARING_ANGLE = math.radians(30.0)
 
@@ -43,9 +48,6 @@ def element_solids(
     scene: Any, selectors: Any, where: str
 ) -> Tuple[List[Any], List[str], List[str]]:
     """Return the validated solids of an element's objects, their ids and repair warnings."""
-    from rhino_plugin.geometry.validate import check_solid
-    from rhino_plugin.mechanisms.single import find_objects
-
     meshes, ids, notes = [], [], []
     for obj in find_objects(scene, selectors, where):
         mesh, warn = check_solid(scene.mesh(obj))
@@ -59,8 +61,6 @@ def largest_contact(
     meshes: List[Any], wall: List[Any], where: str
 ) -> Tuple[float, np.ndarray, np.ndarray]:
     """Return the largest planar contact between an element's solids and the wall's solids."""
-    from rhino_plugin.geometry.contact import find_contact
-
     best = None
     for a in meshes:
         for b in wall:
@@ -76,8 +76,6 @@ def largest_contact(
 
 def _box(meshes: List[Any], side: Any) -> Tuple[float, float, float]:
     """Extent normal to the wall, along the wall, and height of the elements [m]."""
-    from rhino_plugin.geometry.frames import bounding_box_in_frame
-
     lo, hi = None, None
     for mesh in meshes:
         a, b = bounding_box_in_frame(mesh, side.point, side.outward, side.direction)
@@ -108,9 +106,6 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
     table : thrust.ThrustTable
         Vault thrust table.
     """
-    from rhino_plugin.geometry.massprops import mass_properties
-    from rhino_plugin.mechanisms.thrust import roof_thrust
-
     where = spec.id
     bearing: Loads = []  # (mass [kg], point, label)
     nonbearing: Loads = []
@@ -197,7 +192,6 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
 
     for k, tie in enumerate(spec.tie_bars or []):
         label = f"{where}.tie_bars[{k}]"
-        from rhino_plugin.mechanisms.single import find_objects
 
         obj = find_objects(scene, [tie.object], label)[0]
         start, end = scene.line(obj)

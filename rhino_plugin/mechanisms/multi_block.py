@@ -50,6 +50,7 @@ from typing import List, Optional, Sequence, Tuple
 
 from rhino_plugin.mechanisms.two_block import LinkageResult, PlanarBody
 from shared_schema.errors import GeometryError, InputError
+from shared_schema.rules import G
 
 __all__ = [
     "SCAN_STEP",
@@ -62,8 +63,6 @@ __all__ = [
     "portal_frame",
 ]
 
-#: Standard gravity [m/s²].
-G = 9.80665
 #: Step of the scan for the first sign change of dV/dtheta [rad].
 SCAN_STEP = 2e-3
 #: Hinges closer than this, relative to the linkage's size, coincide.

@@ -15,13 +15,17 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
+from rhino_plugin.geometry.massprops import combine, mass_properties
+from rhino_plugin.geometry.validate import check_solid
+from rhino_plugin.mechanisms.multi_block import four_bar_constants, four_bar_restitution
+from rhino_plugin.mechanisms.single import find_objects
+from rhino_plugin.mechanisms.two_block import PlanarBody
 from shared_schema.errors import GeometryError, InputError
 
 __all__ = ["multi_block_sides"]
 
 
 def _hinge_point(scene: Any, hinge: Any, where: str) -> np.ndarray:
-    from rhino_plugin.mechanisms.single import find_objects
 
     if isinstance(hinge, list):
         return np.asarray(hinge, dtype=float)
@@ -31,9 +35,6 @@ def _hinge_point(scene: Any, hinge: Any, where: str) -> np.ndarray:
 
 
 def _blocks(scene: Any, spec: Any) -> Tuple[List[Any], List[np.ndarray], List[str], List[str]]:
-    from rhino_plugin.geometry.massprops import combine, mass_properties
-    from rhino_plugin.geometry.validate import check_solid
-    from rhino_plugin.mechanisms.single import find_objects
 
     props, verts, ids, notes = [], [], [], []
     for k, groups in enumerate(spec.blocks):
@@ -73,7 +74,6 @@ def _mirrored(hinges: List[Tuple[float, float]], columns: List[np.ndarray]) -> L
 
 
 def _solve(blocks: Any, pts: List[Any], where: str) -> Any:
-    from rhino_plugin.mechanisms.multi_block import four_bar_constants
 
     last: Optional[Exception] = None
     for direction in (1, -1):
@@ -92,9 +92,6 @@ def multi_block_sides(
     Dict[str, float], Optional[Dict[str, float]], Optional[float], Dict[str, Any], List[str]
 ]:
     """Constants of both hinge sets, eta (or None), a summary and object ids."""
-    from rhino_plugin.mechanisms.multi_block import four_bar_restitution
-    from rhino_plugin.mechanisms.two_block import PlanarBody
-
     where = spec.id
     props, verts, ids, notes = _blocks(scene, spec)
     names = ("A", "B", "C", "D")

@@ -21,7 +21,12 @@ from typing import Any, Dict, List, Sequence, Tuple
 
 import numpy as np
 
+from rhino_plugin.geometry.cut import cut_by_plane
+from rhino_plugin.geometry.massprops import combine, mass_properties
+from rhino_plugin.geometry.validate import check_solid
+from rhino_plugin.mechanisms.restitution import housner_general
 from shared_schema.errors import GeometryError, InputError
+from shared_schema.rules import G
 
 __all__ = [
     "AXIS_TILT_TOL",
@@ -34,8 +39,6 @@ __all__ = [
     "rocking_side",
 ]
 
-#: Standard gravity [m/s²].
-G = 9.80665
 #: Largest tilt of a "horizontal" axis [rad] unless the spec allows inclined axes.
 AXIS_TILT_TOL = 1e-3
 #: Tolerance, relative to the body size, for an axis touching the body's base.
@@ -115,10 +118,6 @@ def _crack_plane(scene: Any, crack: Any, where: str) -> Tuple[np.ndarray, np.nda
 
 def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
     """Validate the spec's solids, cut them by its cracks and compute their mass properties."""
-    from rhino_plugin.geometry.cut import cut_by_plane
-    from rhino_plugin.geometry.massprops import combine, mass_properties
-    from rhino_plugin.geometry.validate import check_solid
-
     where = f"{spec.id}"
     solids: List[Tuple[Any, float]] = []
     ids: List[str] = []
@@ -253,8 +252,6 @@ def side_summary(side: RockingSide) -> Dict[str, Any]:
 
 def eta_two_sided(body: Body, pos: RockingSide, neg: RockingSide) -> Tuple[float, Dict[str, float]]:
     """Housner's general form for both impact directions; the larger (conservative) is used."""
-    from rhino_plugin.mechanisms.restitution import housner_general
-
     m = float(body.props.mass)
     u = pos.direction
     i_g = float(u @ np.asarray(body.props.inertia_com) @ u)

@@ -27,13 +27,12 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple, Union
 
 from shared_schema.errors import InputError
+from shared_schema.rules import G
 
 __all__ = ["DEFAULT_TABLE", "ThrustTable", "estimate_rows", "roof_thrust"]
 
 #: The shipped table.
 DEFAULT_TABLE = Path(__file__).resolve().parent / "data" / "vault_thrust.json"
-#: Standard gravity [m/s²].
-G = 9.80665
 #: Construction classes of the estimate: shell thickness [m] and density [kg/m³].
 CLASSES = {
     "a": (0.125, 1400.0),

@@ -49,6 +49,7 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from shared_schema.errors import GeometryError, InputError
+from shared_schema.rules import G, check_non_negative, check_positive
 
 __all__ = [
     "ECCENTRICITY_OPTIONS",
@@ -62,8 +63,6 @@ __all__ = [
     "two_block_restitution",
 ]
 
-#: Standard gravity [m/s²].
-G = 9.80665
 #: Treatments of an eccentric overburden (see the module docstring), for provenance.
 ECCENTRICITY_OPTIONS = {
     "static_moment": "N at H inside V; eccentric part as M_F = -N d(z_P - z_H)/dphi (Eq. 23)",
@@ -179,20 +178,6 @@ def _point(p: Sequence[float], name: str) -> Point2:
     return (x, z)
 
 
-def _nonneg(value: float, name: str) -> float:
-    v = float(value)
-    if not (math.isfinite(v) and v >= 0.0):
-        raise InputError(f"must be finite and >= 0, got {value!r}", name)
-    return v
-
-
-def _positive(value: float, name: str) -> float:
-    v = float(value)
-    if not (math.isfinite(v) and v > 0.0):
-        raise InputError(f"must be finite and > 0, got {value!r}", name)
-    return v
-
-
 def hinge_height(h: float, weight: float, overburden: float, f_mt: float, area: float) -> float:
     """Height of the intermediate hinge of a vertically spanning strip (Eq. 17).
 
@@ -233,11 +218,11 @@ def hinge_height(h: float, weight: float, overburden: float, f_mt: float, area: 
     >>> hinge_height(3.0, weight=1e4, overburden=0.0, f_mt=0.0, area=0.3)
     3.0
     """
-    h = _positive(h, "h")
-    w = _nonneg(weight, "weight")
-    n = _nonneg(overburden, "overburden")
-    f = _nonneg(f_mt, "f_mt")
-    a = _nonneg(area, "area")
+    h = check_positive(h, "h")
+    w = check_non_negative(weight, "weight")
+    n = check_non_negative(overburden, "overburden")
+    f = check_non_negative(f_mt, "f_mt")
+    a = check_non_negative(area, "area")
     top = n + f * a
     if top + w <= 0.0:
         raise InputError("N + W + f_mt A must be > 0 (nothing loads the wall)", "weight")
@@ -498,7 +483,7 @@ def two_block_constants(
         if not isinstance(body, PlanarBody):
             raise InputError(f"must be a PlanarBody, got {type(body).__name__}", name)
     o, c, h = _point(O, "O"), _point(C, "C"), _point(H, "H")
-    n = _nonneg(overburden, "overburden")
+    n = check_non_negative(overburden, "overburden")
     p_load = h if overburden_point is None else _point(overburden_point, "overburden_point")
     _check_chain([("O", o), ("C", c), ("H", h)], (lower, upper))
     chain = _Chain(o, c, h)
@@ -622,7 +607,7 @@ def two_block_restitution(
 
 
 def _check_rect(b: float, h: float, h_c: float) -> Tuple[float, float, float]:
-    b, h, h_c = _positive(b, "b"), _positive(h, "h"), _positive(h_c, "h_c")
+    b, h, h_c = check_positive(b, "b"), check_positive(h, "h"), check_positive(h_c, "h_c")
     if not h_c < h:
         raise InputError(f"must be in (0, h) = (0, {h}), got {h_c}", "h_c")
     return b, h, h_c
@@ -646,7 +631,7 @@ def rectangular_bodies(
         Lower and upper block; ``i_g = m (b² + h_k²) / 12``.
     """
     b, h, h_c = _check_rect(b, h, h_c)
-    rho_l = _positive(density, "density") * _positive(length, "length")
+    rho_l = check_positive(density, "density") * check_positive(length, "length")
     out = []
     for z0, hk in ((0.0, h_c), (h_c, h - h_c)):
         m = rho_l * b * hk

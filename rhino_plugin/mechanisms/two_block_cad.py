@@ -21,17 +21,22 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
+from rhino_plugin.geometry.cut import cut_by_plane
+from rhino_plugin.geometry.massprops import combine, mass_properties
+from rhino_plugin.mechanisms.loaded import element_solids, largest_contact
+from rhino_plugin.mechanisms.two_block import (
+    PlanarBody,
+    hinge_height,
+    two_block_constants,
+    two_block_restitution,
+)
 from shared_schema.errors import GeometryError
+from shared_schema.rules import G
 
 __all__ = ["two_block_sides"]
 
-#: Standard gravity [m/s²].
-G = 9.80665
-
 
 def _planar(parts: List[Any], origin: np.ndarray, outward: np.ndarray, axis: np.ndarray) -> Any:
-    from rhino_plugin.geometry.massprops import combine
-    from rhino_plugin.mechanisms.two_block import PlanarBody
 
     props = combine(parts, name="block")
     d = np.asarray(props.com, dtype=float) - origin
@@ -40,7 +45,6 @@ def _planar(parts: List[Any], origin: np.ndarray, outward: np.ndarray, axis: np.
 
 
 def _mirror(body: Any, b: float) -> Any:
-    from rhino_plugin.mechanisms.two_block import PlanarBody
 
     x, z = body.com
     return PlanarBody(body.mass, (-b - x, z), body.i_g)
@@ -50,15 +54,6 @@ def two_block_sides(
     spec: Any, scene: Any, body: Any, pos: Any
 ) -> Tuple[Dict[str, float], Optional[Dict[str, float]], Optional[float], Dict[str, Any]]:
     """Constants of both sides of a two-block wall, eta (or None) and a summary."""
-    from rhino_plugin.geometry.cut import cut_by_plane
-    from rhino_plugin.geometry.massprops import mass_properties
-    from rhino_plugin.mechanisms.loaded import element_solids, largest_contact
-    from rhino_plugin.mechanisms.two_block import (
-        hinge_height,
-        two_block_constants,
-        two_block_restitution,
-    )
-
     where = spec.id
     o, out, ax = pos.point, pos.outward, pos.direction
     rel = body.vertices - o

@@ -44,9 +44,11 @@ from shared_schema.api import (
 )
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
+from shared_schema.export import render_schema
 
+from .errors import error_body
 from .forms import FORMS, FormSpec, form_fields, multipart_schema
-from .jobs import error_body
+from .hops import RockmechHops, hops_router
 from .limits import BodyLimit, too_large_message
 from .pool import BudgetExceeded, ComputePool, PoolBusy, WorkerLost
 from .settings import Settings
@@ -315,7 +317,6 @@ def create_app(settings: Optional[Settings] = None) -> FastAPI:
         responses={200: {"content": {"application/schema+json": {"schema": {"type": "object"}}}}},
     )
     async def constants_schema() -> Response:
-        from shared_schema.export import render_schema
 
         return Response(render_schema(), media_type="application/schema+json")
 
@@ -452,8 +453,6 @@ def create_app(settings: Optional[Settings] = None) -> FastAPI:
         return await compute("constants", params, [scene[0], spec[0]])
 
     app.include_router(router)
-
-    from .hops import RockmechHops, hops_router
 
     def run_job_from_thread(kind: str, params: dict[str, Any]) -> tuple[int, str, bytes]:
         import anyio.from_thread

@@ -25,7 +25,32 @@ from typing import Any, Optional
 
 import numpy as np
 
+from rhino_plugin.mechanisms.build import constants_from_spec
+from rhino_plugin.scene_3dm import Scene
+from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError, RockmechError
+from shared_schema.spec import parse_spec
+
+from ..core import codes
+from ..core.envelope import OverturningLibrary
+from ..core.exact import simulate, simulate_batch
+from ..core.excitation import Pulse, SampledAccel
+from ..core.model import G, RockingModel, check_positive
+from ..core.records import GroundMotion
+from ..core.spectra import STEPS_PER_PERIOD, response_spectrum
+from ..report.html import SPECTRUM_PERIODS, build_report, input_source
+from ..workflows.documents import (
+    envelope_doc,
+    frequency_grid,
+    history_doc,
+    log_grid,
+    record_analysis,
+)
+from ..workflows.documents import pulse_doc as doc
+from ..workflows.inputs import read_record
+from ..workflows.outputs import finite_json
+from ..workflows.scaling import Building
+from .errors import error_body
 
 __all__ = [
     "JOBS",
@@ -65,8 +90,6 @@ class JobOutput:
 
 def dumps(doc: Any) -> bytes:
     """Serialise a result document as compact UTF-8 JSON (non-finite numbers become null)."""
-    from ..analysis import finite_json
-
     return json.dumps(finite_json(doc), allow_nan=False, separators=(",", ":")).encode("utf-8")
 
 
@@ -142,8 +165,6 @@ def check_record_work(
     The exact integrator cuts each sample interval into segments of at most ``1/p`` seconds;
     the spectrum into ``STEPS_PER_PERIOD`` sub-steps per shortest period.
     """
-    from ..core.spectra import STEPS_PER_PERIOD
-
     if p_max is not None and _positive(p_max):
         check_work(_record_steps(motion, p_max), limits, "the time history", "record")
     if t_min is not None and _positive(t_min):
@@ -163,16 +184,12 @@ def _history_work(cf: Any, motion: Any, sf: str, limits: dict[str, int]) -> None
 def _library() -> Any:
     global _LIBRARY
     if _LIBRARY is None:
-        from ..core.envelope import OverturningLibrary
-
         _LIBRARY = OverturningLibrary.load()
     return _LIBRARY
 
 
 def _constants(data: Any, label: str, limits: dict[str, int]) -> Any:
     """Validate a constants file given as data (JSON body) or bytes (upload)."""
-    from shared_schema.constants import parse_constants
-
     if isinstance(data, bytes):
         try:
             text = data.decode("utf-8-sig")
@@ -221,9 +238,6 @@ def motion_from_params(
     As ``rockmech history``: the format is detected when not given, and a two-column file
     without units is taken to be in g.
     """
-    from ..analysis import read_record
-    from ..core.records import GroundMotion
-
     max_samples = limits["max_samples"]
     if record is not None:
         check_limit(len(record["accel"]), max_samples, "samples", "record", "max_samples")
@@ -263,8 +277,6 @@ def pulse_doc(params: dict[str, Any], limits: Optional[dict[str, int]] = None) -
     limits : dict, optional
         The service's size limits (bound the work); none from the command line.
     """
-    from ..analysis import pulse_doc as doc
-
     p_eq, f_p = params["p_eq"], params["f_p"]
     if limits is not None and _positive(p_eq, f_p):
         # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
@@ -287,14 +299,12 @@ def _pulse(params: dict[str, Any], blobs: list[bytes], limits: dict[str, int]) -
 
 
 def _grid(f_min: float, f_max: float, n: int, limits: dict[str, int]) -> Any:
-    from ..analysis import frequency_grid
 
     check_limit(n, limits["max_samples"], "frequencies", "n", "max_samples")
     return frequency_grid(f_min, f_max, n)
 
 
 def _envelope(params: dict[str, Any], blobs: list[bytes], limits: dict[str, int]) -> bytes:
-    from ..analysis import envelope_doc
 
     f_p = _grid(params["f_min"], params["f_max"], params["n"], limits)
     cf = _constants(params["constants"], "constants", limits)
@@ -305,8 +315,6 @@ def _envelope(params: dict[str, Any], blobs: list[bytes], limits: dict[str, int]
 
 def history_options(params: dict[str, Any]) -> dict[str, Any]:
     """Keyword arguments of ``history_doc`` from a request (as ``rockmech history``)."""
-    from ..analysis import Building
-
     building = Building(params["building_height"], params["soil_factor"], params["element_period"])
     return {
         "sf": params["sf"],
@@ -317,7 +325,6 @@ def history_options(params: dict[str, Any]) -> dict[str, Any]:
 
 
 def _history(params: dict[str, Any], blobs: list[bytes], limits: dict[str, int]) -> bytes:
-    from ..analysis import history_doc
 
     scales = _scales(params["scales"], limits)
     cf = _constants(_constants_source(params, blobs), params["constants_label"], limits)
@@ -339,25 +346,24 @@ def _blob(blobs: list[bytes]) -> Optional[bytes]:
 
 
 def _spectrum(params: dict[str, Any], blobs: list[bytes], limits: dict[str, int]) -> bytes:
-    from ..analysis import log_grid, record_doc
-    from ..core.pulses import extract_pulses
-    from ..core.spectra import response_spectrum
 
     check_limit(params["n"], limits["max_samples"], "periods", "n", "max_samples")
     motion = motion_from_params(params.get("record"), params.get("upload"), _blob(blobs), limits)
     periods = log_grid(params["t_min"], params["t_max"], params["n"], names=("t_min", "t_max"))
     check_record_work(motion, limits, t_min=float(periods[0]))
-    found = extract_pulses(
-        motion.accel, f_min=params.get("f_min"), f_max=params.get("f_max"), n=params["pulses"]
+    doc, _, _ = record_analysis(
+        motion,
+        periods,
+        params["zeta"],
+        n_pulses=params["pulses"],
+        f_min=params.get("f_min"),
+        f_max=params.get("f_max"),
     )
-    spectrum = response_spectrum(motion.accel.acc, motion.dt, periods, params["zeta"])
-    return dumps(record_doc(motion, spectrum, found))
+    return dumps(doc)
 
 
 def scale_factor_doc(params: dict[str, Any], limits: dict[str, int]) -> dict[str, Any]:
     """Return a code or paper scale factor (``solver_service.core.codes``) with its inputs."""
-    from ..core import codes
-
     method = params["method"]
     if method == "ec8":
         return codes.sf_ec8(params["z"], params["H"], params["T_a"], params["T_1"], params["S"])
@@ -373,8 +379,6 @@ def scale_factor_doc(params: dict[str, Any], limits: dict[str, int]) -> dict[str
         return codes.sf_eq28(params["sa_g"], params["pga_g"], params["h"], params["h_e"])
     if any(given):
         raise InputError("give either a record or sa_g and pga_g, not both", "record")
-    from ..core.model import G, check_positive
-    from ..core.spectra import response_spectrum
 
     if params.get("f_n") is None:
         raise InputError("eq28 from a record needs the natural frequency f_n [Hz]", "f_n")
@@ -392,7 +396,6 @@ def _scale_factor(params: dict[str, Any], blobs: list[bytes], limits: dict[str, 
 
 
 def _scene_constants(params: dict[str, Any], blobs: list[bytes], limits: dict[str, int]) -> bytes:
-    from shared_schema.spec import parse_spec
 
     scene_name = safe_filename(params.get("scene_name"), "scene.3dm")
     spec_name = safe_filename(params.get("spec_name"), "spec.json")
@@ -408,9 +411,6 @@ def _scene_constants(params: dict[str, Any], blobs: list[bytes], limits: dict[st
         len(spec_file.mechanisms), limits["max_mechanisms"], "mechanisms", "spec", "max_mechanisms"
     )
     try:
-        from rhino_plugin.mechanisms.build import constants_from_spec
-        from rhino_plugin.scene_3dm import Scene
-
         scene = Scene.from_bytes(scene_bytes, scene_name)
     except ImportError as exc:
         raise ServiceUnavailable(
@@ -422,8 +422,6 @@ def _scene_constants(params: dict[str, Any], blobs: list[bytes], limits: dict[st
 
 
 def _report(params: dict[str, Any], blobs: list[bytes], limits: dict[str, int]) -> bytes:
-    from ..analysis import frequency_grid
-    from ..report.html import SPECTRUM_PERIODS, build_report, input_source
 
     scales = _scales(params["scales"], limits)
     check_limit(params["n"], limits["max_samples"], "frequencies", "n", "max_samples")
@@ -463,11 +461,6 @@ def _report(params: dict[str, Any], blobs: list[bytes], limits: dict[str, int]) 
 
 def _warmup(params: dict[str, Any], blobs: list[bytes], limits: dict[str, int]) -> bytes:
     """Compile (or load from numba's cache) every kernel a request may need, once."""
-    from ..core.exact import simulate, simulate_batch
-    from ..core.excitation import Pulse, SampledAccel
-    from ..core.model import RockingModel
-    from ..core.spectra import response_spectrum
-
     model = RockingModel.symmetric(2.0, 0.2, 0.9)
     simulate(model, Pulse(a_p=-3.0, f_p=1.0))
     acc = 3.0 * np.sin(np.linspace(0.0, 6.0, 61))
@@ -490,14 +483,6 @@ JOBS: dict[str, tuple[str, Job]] = {
     "report": ("text/html; charset=utf-8", _report),
     "warmup": ("application/json", _warmup),
 }
-
-
-def error_body(kind: str, message: str, field: Optional[str] = None) -> bytes:
-    """Return the JSON body of an error answer (``shared_schema.api.ErrorResponse``)."""
-    doc: dict[str, Any] = {"detail": message, "error": kind}
-    if field:
-        doc["field"] = field
-    return json.dumps(doc).encode("utf-8")
 
 
 def run_job(

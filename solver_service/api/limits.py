@@ -15,7 +15,7 @@ from __future__ import annotations
 from starlette.exceptions import HTTPException
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from .jobs import error_body
+from .errors import error_body
 
 __all__ = ["DRAIN_MAX", "BodyLimit", "BodyTooLarge", "too_large_message"]
 

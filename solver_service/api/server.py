@@ -12,6 +12,7 @@ from pydantic import ValidationError
 
 from shared_schema.errors import InputError
 
+from .app import create_app
 from .settings import Settings
 
 __all__ = ["background_server", "free_port", "process_rss_bytes", "run", "settings_with"]
@@ -37,8 +38,6 @@ def settings_with(**overrides: Any) -> Settings:
 def run(settings: Settings) -> None:
     """Serve until interrupted (uvicorn, one event loop; compute in worker processes)."""
     import uvicorn
-
-    from .app import create_app
 
     uvicorn.run(
         create_app(settings),

@@ -22,7 +22,8 @@ import sys
 import traceback
 from typing import Any, BinaryIO
 
-from .jobs import JobOutput, error_body, run_job
+from .errors import error_body
+from .jobs import JobOutput, run_job
 
 __all__ = ["main", "serve_forever"]
 

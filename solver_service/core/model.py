@@ -26,9 +26,14 @@ import math
 from dataclasses import dataclass, field
 from typing import Optional
 
-import numpy as np
-
 from shared_schema.errors import InputError
+from shared_schema.rules import (
+    G,
+    check_eta,
+    check_non_negative,
+    check_number,
+    check_positive,
+)
 
 __all__ = [
     "G",
@@ -39,61 +44,6 @@ __all__ = [
     "check_number",
     "check_positive",
 ]
-
-#: Standard gravity [m/s²].
-G = 9.80665
-
-
-def check_number(value: object, name: str) -> float:
-    """Return ``value`` as a float; raise ``InputError`` naming ``name`` unless a finite number.
-
-    Booleans are refused; numpy scalars are accepted.
-    """
-    if isinstance(value, (bool, np.bool_)) or not isinstance(
-        value, (int, float, np.integer, np.floating)
-    ):
-        raise InputError(f"must be a number, got {value!r}", name)
-    v = float(value)
-    if not math.isfinite(v):
-        raise InputError(f"must be finite, got {value!r}", name)
-    return v
-
-
-def check_positive(value: object, name: str) -> float:
-    """Return ``value`` as a float; raise ``InputError`` naming ``name`` unless finite and > 0."""
-    v = check_number(value, name)
-    if v <= 0.0:
-        raise InputError(f"must be finite and > 0, got {value!r}", name)
-    return v
-
-
-def check_non_negative(value: object, name: str) -> float:
-    """Return ``value`` as a float; raise ``InputError`` naming ``name`` unless finite and >= 0."""
-    v = check_number(value, name)
-    if v < 0.0:
-        raise InputError(f"must be >= 0, got {value!r}", name)
-    return v
-
-
-def check_eta(value: object, one_sided: bool, name: str = "eta") -> float:
-    """Return a coefficient of restitution as a float, checked against the rocking kind.
-
-    Two-sided rocking takes ``0 <= eta <= 1``; one-sided rocking rebounds, ``-1 <= eta <= 0``.
-    """
-    eta = check_number(value, name)
-    if not -1.0 <= eta <= 1.0:
-        raise InputError(f"must be in [-1, 1], got {value!r}", name)
-    if one_sided and eta > 0.0:
-        raise InputError(
-            f"must be <= 0 for one-sided rocking (rebound off the restraint), got {eta}", name
-        )
-    if not one_sided and eta < 0.0:
-        raise InputError(
-            f"must be >= 0 for two-sided rocking (negative values mean rebound, which is "
-            f"one-sided), got {eta}",
-            name,
-        )
-    return eta
 
 
 @dataclass(frozen=True)

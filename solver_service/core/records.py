@@ -30,18 +30,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from shared_schema.errors import InputError
+from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, G
 
 from .excitation import SampledAccel
-from .model import G
 
 __all__ = ["DT_RTOL", "FORMATS", "UNITS", "GroundMotion", "detect_format"]
 
-#: Acceleration units and their factor to m/s².
-UNITS = {"g": G, "m/s2": 1.0, "cm/s2": 0.01}
+#: Acceleration units and their factor to m/s² (``shared_schema.rules``).
+UNITS = RECORD_UNITS
 #: Relative tolerance on the spacing of time stamps read from a file.
 DT_RTOL = 1e-6
-#: Record formats ``GroundMotion.from_file`` reads.
-FORMATS = ("at2", "two_column", "one_column", "csv")
+#: Record formats ``GroundMotion.from_file`` reads (``shared_schema.rules``).
+FORMATS = RECORD_FORMATS
 #: File extensions (lower case) that fix the format.
 _EXTENSIONS = {".at2": "at2", ".csv": "csv"}
 #: Units named on line 3 of an AT2 file, upper case without spaces -> our units.

@@ -31,6 +31,14 @@ from typing import Any, Optional
 
 import numpy as np
 
+from shared_schema.atomic import write_atomic
+
+from ..core.model import G
+from ..core.spectra import response_spectrum
+from ..workflows.documents import envelope_doc, history_doc
+from ..workflows.scaling import dense_runs
+from .plots import plot_envelopes, plot_record, plot_time_histories
+
 __all__ = ["MAX_TRACES", "build_report", "input_source", "write_report"]
 
 #: Mechanisms drawn per time-history figure (more are split over several figures).
@@ -226,9 +234,6 @@ def _history_table(doc: dict[str, Any]) -> str:
 def _history_figures(
     cf: Any, motion: Any, doc: dict[str, Any], scales: Sequence[float], folder: Path
 ) -> list[str]:
-    from ..analysis import dense_runs
-    from ..core.model import G
-    from .plots import plot_time_histories
 
     top = max(scales)
     runs = [
@@ -255,9 +260,6 @@ def _history_figures(
 
 
 def _record_section(cf: Any, motion: Any, folder: Path) -> str:
-    from ..core.model import G
-    from ..core.spectra import response_spectrum
-    from .plots import plot_record
 
     periods = np.geomspace(*SPECTRUM_PERIODS[:2], int(SPECTRUM_PERIODS[2]))
     draw = functools.partial(plot_record, motion, folder / "record.png", periods=periods)
@@ -377,9 +379,6 @@ def build_report(
     str
         The page.
     """
-    from ..analysis import envelope_doc, history_doc
-    from .plots import plot_envelopes
-
     env, envelopes = envelope_doc(cf, np.asarray(f_p, dtype=float), exact=exact, library=library)
     hist = None
     if motion is not None:
@@ -431,8 +430,6 @@ def build_report(
 
 def write_report(path: Path, text: str) -> Path:
     """Write the report atomically and return its path."""
-    from shared_schema.atomic import write_atomic
-
     path.parent.mkdir(parents=True, exist_ok=True)
     write_atomic(path, text)
     return path

@@ -13,7 +13,13 @@ from typing import Any, Union
 
 import numpy as np
 
+from shared_schema.atomic import write_atomic
+
+from ..core.fragility import lognormal_cdf
+from ..core.model import G
+from ..core.pulses import extract_pulses
 from ..core.result import RockingResult
+from ..core.spectra import response_spectrum
 
 __all__ = [
     "plot_envelopes",
@@ -35,8 +41,6 @@ def _pyplot() -> Any:
 
 def _save_atomic(fig: Any, path: Union[str, Path]) -> Path:
     """Render a figure in memory and write it atomically (format from the suffix)."""
-    from shared_schema.atomic import write_atomic
-
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     buf = io.BytesIO()
@@ -197,10 +201,6 @@ def plot_record(
     Path
         The written file.
     """
-    from ..core.model import G
-    from ..core.pulses import extract_pulses
-    from ..core.spectra import response_spectrum
-
     plt = _pyplot()
     if spectrum is None:
         t_n = np.geomspace(0.02, 10.0, 100) if periods is None else np.asarray(periods, float)
@@ -335,8 +335,6 @@ def plot_fragility(doc: dict[str, Any], path: Union[str, Path], *, title: str = 
     Path
         The written file.
     """
-    from ..core.fragility import lognormal_cdf
-
     plt = _pyplot()
     levels = np.asarray(doc["intensity"]["levels"], dtype=float)
     fig, ax = plt.subplots(figsize=(8, 5))

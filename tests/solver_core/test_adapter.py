@@ -7,9 +7,9 @@ import pytest
 import shared_schema.constants as sc
 from shared_schema.constants import Mechanism, SideConstants, parse_constants
 from shared_schema.errors import InputError
-from solver_service.adapter import models_from_file, to_rocking_model
 from solver_service.core import model as core_model
 from solver_service.core.model import RockingModel, RockingSide
+from solver_service.workflows.adapter import models_from_file, to_rocking_model
 
 W1 = {"id": "W1", "rocking": "two_sided", "p_eq": 2.15, "lam": 0.25, "eta": 0.90}
 LOADED_SIDE = {"I0": 10000.0, "K": 40000.0, "Q": 2000.0, "phi_cr": 0.1, "M_F": 1000.0}

@@ -10,7 +10,6 @@ from scipy.optimize import brentq
 
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
-from solver_service.analysis import envelope_doc, frequency_grid
 from solver_service.core.amplification import pulse_scale_factor
 from solver_service.core.envelope import (
     LIBRARY_ETA_STEP,
@@ -25,6 +24,7 @@ from solver_service.core.exact import simulate
 from solver_service.core.excitation import Pulse
 from solver_service.core.model import G, RockingModel
 from solver_service.core.reference import simulate_ivp
+from solver_service.workflows.documents import envelope_doc, frequency_grid
 
 OMEGA = np.array([0.25, 0.5, 1, 2, 3, 4, 5, 6, 8, 10], dtype=float)
 # THEORY §6.5, minimum overturning A = a_p/(g lam) (3 decimals printed).

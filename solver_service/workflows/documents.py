@@ -1,23 +1,21 @@
-"""Analyses over a kinematic-constants file, as JSON-ready documents (CLI and REST share them).
+"""JSON-ready documents of every analysis (CLI ``--json``, REST answers, Rhino flows).
 
-Units: frequencies in Hz, pulse amplitudes in g (names end in ``_g``).
+Units: frequencies in Hz, pulse amplitudes and PGA in g (names end in ``_g``), SI otherwise.
 """
 
 from __future__ import annotations
 
-import json
 import math
-from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Optional
 
 import numpy as np
 
-from shared_schema.constants import ConstantsFile, Mechanism
+from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
+from shared_schema.rules import G
 
-from .adapter import to_rocking_model
-from .core.envelope import (
+from ..core.amplification import pulse_scale_factor
+from ..core.envelope import (
     A_MAX,
     Envelope,
     OverturningLibrary,
@@ -26,46 +24,30 @@ from .core.envelope import (
     governing_one_sided,
     mechanism_envelope,
 )
-from .core.model import check_positive
+from ..core.exact import simulate
+from ..core.excitation import Pulse
+from ..core.model import RockingModel, check_positive
+from ..core.nonlinear import linearisation_warnings
+from ..core.pulses import extract_pulses, largest_pulse
+from ..core.records import GroundMotion
+from ..core.spectra import Spectrum, response_spectrum
+from .adapter import to_rocking_model
+from .scaling import Building, run_scaled
 
 __all__ = [
-    "SF_METHODS",
-    "Building",
+    "PULSE_METHOD",
     "boundary_doc",
-    "dense_runs",
-    "envelope_csv",
     "envelope_doc",
-    "finite_json",
     "frequency_grid",
     "history_doc",
     "linearisation_notes",
     "log_grid",
-    "mechanism_scale_factor",
+    "model_pulse_doc",
     "pulse_doc",
-    "read_record",
+    "record_analysis",
     "record_doc",
     "record_pulse_doc",
-    "run_scaled",
-    "write_envelope",
-    "write_history",
 ]
-
-
-def finite_json(value: Any) -> Any:
-    """Replace non-finite floats by None and numpy scalars by Python numbers, recursively.
-
-    ``json.dumps`` never calls ``default`` for floats, so NaN and infinity must be cleaned
-    before serialising (``allow_nan=False`` then guards the result).
-    """
-    if isinstance(value, dict):
-        return {str(k): finite_json(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [finite_json(v) for v in value]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
 
 
 def pulse_doc(
@@ -103,26 +85,51 @@ def pulse_doc(
     criterion : {"exact", "ratio"}, optional
         Overturning verdict (default ``exact`` for pulses).
     """
-    from .core.exact import simulate
-    from .core.excitation import Pulse
-    from .core.model import G, RockingModel
-
     model = RockingModel.symmetric(p_eq, lam, eta, phi_ov=phi_ov, one_sided=one_sided, name="pulse")
+    return model_pulse_doc(model, a_p_g, f_p, shape=shape, criterion=criterion)
+
+
+def model_pulse_doc(
+    model: RockingModel,
+    a_p_g: float,
+    f_p: float,
+    *,
+    shape: str = "sine",
+    criterion: Optional[str] = None,
+) -> dict[str, Any]:
+    """Response of a rocking model (either side may differ) to a one-cycle pulse.
+
+    The document of ``pulse_doc``; the Rhino flow uses it for mechanisms of a constants file.
+
+    Parameters
+    ----------
+    model : RockingModel
+        The mechanism; two-sided models need ``eta``.
+    a_p_g : float
+        Signed pulse amplitude [g] (> 0 first pushes towards negative rotation).
+    f_p : float
+        Pulse frequency [Hz].
+    shape : {"sine", "cosine"}
+        Pulse shape.
+    criterion : {"exact", "ratio"}, optional
+        Overturning verdict (default ``exact`` for pulses).
+    """
     model.require_eta()
     exc = Pulse(a_p=a_p_g * G, f_p=f_p, shape=shape)
     res = simulate(model, exc, criterion=criterion)
+    pos = model.positive
     return {
         "input": {
-            "p_eq": p_eq,
-            "lam": lam,
-            "phi_ov": model.positive.phi_ov,
-            "eta": eta,
-            "rocking": "one_sided" if one_sided else "two_sided",
+            "p_eq": pos.p_eq,
+            "lam": pos.lam,
+            "phi_ov": pos.phi_ov,
+            "eta": model.eta,
+            "rocking": "one_sided" if model.one_sided else "two_sided",
             "a_p_g": a_p_g,
             "f_p": f_p,
             "shape": shape,
-            "omega_ratio": exc.omega_p / p_eq,
-            "amplitude_ratio": abs(a_p_g) / lam,
+            "omega_ratio": exc.omega_p / pos.p_eq,
+            "amplitude_ratio": abs(a_p_g) / pos.lam,
             "pulse_convention": "A (Zhang & Makris 2001: pulse starts at t = 0)",
         },
         **res.summary(),
@@ -190,6 +197,44 @@ def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> dict[str, Any]:
     }
 
 
+def record_analysis(
+    motion: GroundMotion,
+    periods: Any,
+    zeta: float = 0.05,
+    *,
+    n_pulses: int = 5,
+    f_min: Optional[float] = None,
+    f_max: Optional[float] = None,
+) -> tuple[dict[str, Any], Spectrum, list[Any]]:
+    """Compute the spectrum and largest sine pulses of a record once, with their document.
+
+    Parameters
+    ----------
+    motion : GroundMotion
+        The record.
+    periods : array_like of float
+        Periods of the spectrum [s].
+    zeta : float
+        Damping ratio [-].
+    n_pulses : int
+        How many of the largest pulses to list.
+    f_min, f_max : float, optional
+        Pulse search range [Hz].
+
+    Returns
+    -------
+    doc : dict
+        ``record_doc`` (``rockmech record --json``, ``POST /spectrum``).
+    spectrum : Spectrum
+        The spectrum, for plots.
+    pulses : list of ExtractedPulse
+        The pulses, for plots.
+    """
+    found = extract_pulses(motion.accel, f_min=f_min, f_max=f_max, n=n_pulses)
+    spectrum = response_spectrum(motion.accel.acc, motion.dt, periods, zeta)
+    return record_doc(motion, spectrum, found), spectrum, found
+
+
 def envelope_doc(
     cf: ConstantsFile,
     f_p: np.ndarray[Any, Any],
@@ -223,8 +268,6 @@ def envelope_doc(
             if library is not None:
                 sf = library.scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
             else:
-                from .core.amplification import pulse_scale_factor
-
                 sf = pulse_scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
         env = mechanism_envelope(model, f_p, library=library, exact=exact, scale_factor=sf)
         envelopes.append(env)
@@ -308,52 +351,6 @@ def boundary_doc(
     return doc
 
 
-def envelope_csv(doc: dict[str, Any]) -> str:
-    """Return an envelope document as CSV: f_p [Hz], a_p_min [g] per mechanism, governing."""
-    ids = [m["id"] for m in doc["mechanisms"]]
-    lines = ["f_p_Hz," + ",".join(f"a_p_min_g_{i}" for i in ids) + ",governing"]
-    for k, f in enumerate(doc["f_p"]):
-        vals = [m["a_p_min_g"][k] for m in doc["mechanisms"]]
-        cells = ["" if v is None else f"{v:.6g}" for v in vals]
-        lines.append(f"{f:.6g}," + ",".join(cells) + f",{doc['governing'][k] or ''}")
-    return "\n".join(lines) + "\n"
-
-
-def write_envelope(
-    cf: ConstantsFile,
-    f_p: np.ndarray[Any, Any],
-    out_dir: Path,
-    *,
-    stem: str = "envelope",
-    title: str = "",
-    exact: bool = False,
-    record_pulse: Optional[dict[str, Any]] = None,
-) -> dict[str, Any]:
-    """Write ``<stem>.json``, ``<stem>.csv`` and ``<stem>.png`` (atomically); return the doc.
-
-    ``record_pulse`` (from ``record_pulse_doc``) is added to the JSON and drawn on the plot.
-    """
-    from shared_schema.io import write_atomic
-
-    from .report.plots import plot_envelopes
-
-    doc, envs = envelope_doc(cf, f_p, exact=exact)
-    if record_pulse is not None:
-        doc["record_pulse"] = record_pulse
-    out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
-    write_atomic(out_dir / f"{stem}.csv", envelope_csv(doc))
-    plot_envelopes(
-        envs,
-        doc["critical"],
-        out_dir / f"{stem}.png",
-        labels={m.id: f"{m.id}: {m.name}" for m in cf.mechanisms},
-        title=title,
-        pulse_points=None if record_pulse is None else record_pulse["points"],
-    )
-    return doc
-
-
 def record_pulse_doc(
     cf: ConstantsFile,
     motion: Any,
@@ -383,8 +380,6 @@ def record_pulse_doc(
     exact : bool
         Evaluate the envelopes at ``f_p`` by the exact boundary search, not the library.
     """
-    from .core.pulses import largest_pulse
-
     for j, value in enumerate(scales):
         check_positive(value, f"scales[{j}]")
     pulse = largest_pulse(motion.accel, f_min=f_min, f_max=f_max)
@@ -408,124 +403,6 @@ def record_pulse_doc(
         "a_p_min_g_at_f_p": a_min,
         "points": points,
     }
-
-
-#: Scale-factor methods of time histories: none, Eq. 28 from the record's spectrum, or the
-#: EN 1998-1 and NZS 1170.5 code factors (THEORY §7.3-7.4).
-SF_METHODS = ("none", "eq28", "ec8", "nzs")
-
-
-@dataclass(frozen=True)
-class Building:
-    """What the code scale factors need to know about the supporting structure.
-
-    Attributes
-    ----------
-    height : float, optional
-        Height of the building above its foundation, ``H`` (EC8) or ``h_n`` (NZS) [m], > 0.
-    soil_factor : float
-        EC8 soil factor ``S`` [-], > 0; 1 gives the bare amplification.
-    element_period : float
-        EC8 fundamental period of the element ``T_a`` [s], >= 0; 0 (the default) takes the
-        rocking mechanism as rigid before uplift.
-    """
-
-    height: Optional[float] = None
-    soil_factor: float = 1.0
-    element_period: float = 0.0
-
-
-def mechanism_scale_factor(
-    mech: Mechanism, motion: Any, sf: str, building: Building = Building()
-) -> Optional[dict[str, Any]]:
-    """Scale factor of the record up the structure for one mechanism, or None at ground level.
-
-    Parameters
-    ----------
-    mech : Mechanism
-        The mechanism; only those with ``amplification {f_n, h_e, h}`` are scaled.
-    motion : GroundMotion
-        The record (Eq. 28 uses its exact 5 %-damped spectrum at ``T_n = 1/f_n``).
-    sf : {"eq28", "ec8", "nzs"}
-        Method. EC8 takes ``z = h``, ``T_1 = 1/f_n``; NZS takes ``h_i = h``.
-    building : Building
-        Building height (EC8 and NZS), soil factor and element period (EC8).
-
-    Returns
-    -------
-    dict or None
-        ``{"value", "method", "formula", "inputs"}`` (``solver_service.core.codes``).
-    """
-    from .core.codes import sf_ec8, sf_eq28, sf_nzs
-    from .core.model import G
-    from .core.spectra import response_spectrum
-
-    if sf not in SF_METHODS:
-        raise InputError(f"must be one of {list(SF_METHODS)}, got {sf!r}", "sf")
-    amp = mech.amplification
-    if sf == "none" or amp is None:
-        return None
-    if sf == "eq28":
-        spec = response_spectrum(motion.accel.acc, motion.dt, [1.0 / amp.f_n])
-        return sf_eq28(float(spec.psa[0]) / G, motion.pga_g, amp.h, amp.h_e)
-    if building.height is None:
-        raise InputError(f"--sf {sf} needs the height of the building [m]", "building_height")
-    if amp.h > building.height:
-        raise InputError(
-            f"mechanism {mech.id!r} sits at h = {amp.h:g} m, above the building "
-            f"({building.height:g} m)",
-            "building_height",
-        )
-    if sf == "nzs":
-        return sf_nzs(amp.h, building.height)
-    return sf_ec8(
-        amp.h, building.height, building.element_period, 1.0 / amp.f_n, building.soil_factor
-    )
-
-
-def run_scaled(
-    cf: ConstantsFile,
-    models: list[Any],
-    motion: Any,
-    scales: list[float],
-    sf: str = "none",
-    building: Building = Building(),
-    criterion: Optional[str] = None,
-) -> tuple[dict[str, Any], list[tuple[list[int], Any]]]:
-    """Run every mechanism at every scale, each record scaled up the structure by ``sf``.
-
-    Mechanisms that share a factor (all those at ground level) share one compiled batch.
-
-    Returns
-    -------
-    factors : dict
-        Scale-factor record (``mechanism_scale_factor``) per mechanism id that has one.
-    batches : list of (indices, BatchResult)
-        Which mechanisms (indices into ``cf.mechanisms``) each batch ran; the batch's
-        ``scales`` are the effective ones (user scale times factor).
-    """
-    from .core.exact import simulate_batch
-
-    factors: dict[str, Any] = {}
-    groups: dict[float, list[int]] = {}
-    for i, mech in enumerate(cf.mechanisms):
-        info = mechanism_scale_factor(mech, motion, sf, building)
-        if info is not None:
-            factors[mech.id] = info
-        groups.setdefault(1.0 if info is None else float(info["value"]), []).append(i)
-    batches = [
-        (
-            members,
-            simulate_batch(
-                [models[i] for i in members],
-                motion.accel,
-                [s * factor for s in scales],
-                criterion=criterion,
-            ),
-        )
-        for factor, members in groups.items()
-    ]
-    return factors, batches
 
 
 def history_doc(
@@ -606,99 +483,5 @@ def linearisation_notes(cf: ConstantsFile, models: list[Any]) -> dict[str, list[
     Returns ``{mechanism id: [warning, ...]}`` for those only
     (``core.nonlinear.linearisation_warnings``; see docs/numerics.md).
     """
-    from .core.nonlinear import linearisation_warnings
-
     notes = {m.id: linearisation_warnings(model) for m, model in zip(cf.mechanisms, models)}
     return {k: v for k, v in notes.items() if v}
-
-
-def dense_runs(
-    cf: ConstantsFile, motion: Any, doc: dict[str, Any], scale: float
-) -> list[tuple[str, float, Any]]:
-    """Time series of every mechanism at one user scale, as a history document ran it.
-
-    Each mechanism gets the document's scale factor up the structure on top of ``scale``
-    and the document's overturning criterion.
-
-    Returns
-    -------
-    list of (mechanism id, effective scale, RockingResult)
-        The results carry ``t`` and ``ratio`` (``dense=True``).
-    """
-    from .core.exact import simulate
-
-    factors = {k: v["value"] for k, v in doc.get("scale_factors", {}).items()}
-    runs = []
-    for mech in cf.mechanisms:
-        effective = scale * factors.get(mech.id, 1.0)
-        res = simulate(
-            to_rocking_model(mech),
-            motion.accel,
-            scale=effective,
-            criterion=doc["criterion"],
-            dense=True,
-        )
-        runs.append((mech.id, effective, res))
-    return runs
-
-
-def read_record(
-    path: Path,
-    fmt: Optional[str] = None,
-    units: Optional[str] = None,
-    dt: Optional[float] = None,
-) -> Any:
-    """Read a record as ``rockmech`` does: format detected, a two-column file in g by default.
-
-    Parameters
-    ----------
-    path : Path
-        The record file.
-    fmt, units, dt
-        As ``GroundMotion.from_file``; ``units`` defaults to g for a two-column file (the
-        t [s], a [g] convention of the bundled record).
-    """
-    from .core.records import GroundMotion, detect_format
-
-    fmt = fmt or detect_format(path)
-    if units is None and fmt == "two_column":
-        units = "g"
-    return GroundMotion.from_file(path, format=fmt, units=units, dt=dt)
-
-
-def write_history(
-    cf: ConstantsFile,
-    motion: Any,
-    scales: list[float],
-    out_dir: Path,
-    *,
-    stem: str = "history",
-    title: str = "",
-    max_panels: int = 6,
-    **options: Any,
-) -> dict[str, Any]:
-    """Write ``<stem>.json``, ``<stem>.png`` and ``<stem>_record.png``; return the doc.
-
-    ``<stem>.png`` shows ``phi/phi_ov`` of every mechanism against time, one panel per
-    scale (at most ``max_panels``, evenly chosen, the largest always included);
-    ``<stem>_record.png`` the record with its largest sine pulse and its 5 % spectrum.
-    ``options`` go to ``history_doc``.
-    """
-    from shared_schema.io import write_atomic
-
-    from .report.plots import plot_ratio_histories, plot_record
-
-    doc = history_doc(cf, motion, scales, **options)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
-    order = sorted(set(scales))
-    picks = sorted(
-        {order[round(k)] for k in np.linspace(0, len(order) - 1, min(max_panels, len(order)))}
-    )
-    panels = [
-        (scale, [(mech_id, res) for mech_id, _, res in dense_runs(cf, motion, doc, scale)])
-        for scale in picks
-    ]
-    plot_ratio_histories(panels, out_dir / f"{stem}.png", title=title or motion.name)
-    plot_record(motion, out_dir / f"{stem}_record.png")
-    return doc

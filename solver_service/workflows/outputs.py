@@ -1,0 +1,134 @@
+"""Files written from the documents: JSON, CSV and PNG, each atomically.
+
+matplotlib is imported by ``solver_service.report.plots`` only when a plot is drawn.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any, Optional
+
+import numpy as np
+
+from shared_schema.atomic import write_atomic
+from shared_schema.constants import ConstantsFile
+
+from ..report.plots import plot_envelopes, plot_ratio_histories, plot_record
+from .documents import envelope_doc, history_doc
+from .scaling import dense_runs
+
+__all__ = ["envelope_csv", "finite_json", "write_envelope", "write_history", "write_record"]
+
+
+def finite_json(value: Any) -> Any:
+    """Replace non-finite floats by None and numpy scalars by Python numbers, recursively.
+
+    ``json.dumps`` never calls ``default`` for floats, so NaN and infinity must be cleaned
+    before serialising (``allow_nan=False`` then guards the result).
+    """
+    if isinstance(value, dict):
+        return {str(k): finite_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite_json(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def envelope_csv(doc: dict[str, Any]) -> str:
+    """Return an envelope document as CSV: f_p [Hz], a_p_min [g] per mechanism, governing."""
+    ids = [m["id"] for m in doc["mechanisms"]]
+    lines = ["f_p_Hz," + ",".join(f"a_p_min_g_{i}" for i in ids) + ",governing"]
+    for k, f in enumerate(doc["f_p"]):
+        vals = [m["a_p_min_g"][k] for m in doc["mechanisms"]]
+        cells = ["" if v is None else f"{v:.6g}" for v in vals]
+        lines.append(f"{f:.6g}," + ",".join(cells) + f",{doc['governing'][k] or ''}")
+    return "\n".join(lines) + "\n"
+
+
+def write_envelope(
+    cf: ConstantsFile,
+    f_p: np.ndarray[Any, Any],
+    out_dir: Path,
+    *,
+    stem: str = "envelope",
+    title: str = "",
+    exact: bool = False,
+    record_pulse: Optional[dict[str, Any]] = None,
+) -> dict[str, Any]:
+    """Write ``<stem>.json``, ``<stem>.csv`` and ``<stem>.png`` (atomically); return the doc.
+
+    ``record_pulse`` (from ``record_pulse_doc``) is added to the JSON and drawn on the plot.
+    """
+    doc, envs = envelope_doc(cf, f_p, exact=exact)
+    if record_pulse is not None:
+        doc["record_pulse"] = record_pulse
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
+    write_atomic(out_dir / f"{stem}.csv", envelope_csv(doc))
+    plot_envelopes(
+        envs,
+        doc["critical"],
+        out_dir / f"{stem}.png",
+        labels={m.id: f"{m.id}: {m.name}" for m in cf.mechanisms},
+        title=title,
+        pulse_points=None if record_pulse is None else record_pulse["points"],
+    )
+    return doc
+
+
+def write_history(
+    cf: ConstantsFile,
+    motion: Any,
+    scales: list[float],
+    out_dir: Path,
+    *,
+    stem: str = "history",
+    title: str = "",
+    max_panels: int = 6,
+    **options: Any,
+) -> dict[str, Any]:
+    """Write ``<stem>.json``, ``<stem>.png`` and ``<stem>_record.png``; return the doc.
+
+    ``<stem>.png`` shows ``phi/phi_ov`` of every mechanism against time, one panel per
+    scale (at most ``max_panels``, evenly chosen, the largest always included);
+    ``<stem>_record.png`` the record with its largest sine pulse and its 5 % spectrum.
+    ``options`` go to ``history_doc``.
+    """
+    doc = history_doc(cf, motion, scales, **options)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
+    order = sorted(set(scales))
+    picks = sorted(
+        {order[round(k)] for k in np.linspace(0, len(order) - 1, min(max_panels, len(order)))}
+    )
+    panels = [
+        (scale, [(mech_id, res) for mech_id, _, res in dense_runs(cf, motion, doc, scale)])
+        for scale in picks
+    ]
+    plot_ratio_histories(panels, out_dir / f"{stem}.png", title=title or motion.name)
+    plot_record(motion, out_dir / f"{stem}_record.png")
+    return doc
+
+
+def write_record(
+    motion: Any, doc: dict[str, Any], spectrum: Any, pulses: list[Any], out_dir: Path
+) -> None:
+    """Write ``record.json`` and ``record.png`` (the record, its pulses and its spectrum).
+
+    Parameters
+    ----------
+    motion : GroundMotion
+        The record.
+    doc, spectrum, pulses
+        As ``documents.record_analysis`` returns them.
+    out_dir : Path
+        Output folder (created if missing).
+    """
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_atomic(out_dir / "record.json", json.dumps(doc, indent=2) + "\n")
+    plot_record(motion, out_dir / "record.png", spectrum=spectrum, pulses=pulses)

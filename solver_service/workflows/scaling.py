@@ -1,0 +1,157 @@
+"""Scale factors of records up the structure, and the batched runs that apply them.
+
+Mechanisms above ground level (those with ``amplification {f_n, h_e, h}``) receive the record
+times a scale factor: Eq. 28 from the record's own spectrum, or the EN 1998-1 and NZS 1170.5
+code factors (docs/theory.md §7.3-7.4). Mechanisms at ground level are not scaled.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Optional
+
+from shared_schema.constants import ConstantsFile, Mechanism
+from shared_schema.errors import InputError
+from shared_schema.rules import SF_METHODS, G
+
+from ..core.codes import sf_ec8, sf_eq28, sf_nzs
+from ..core.exact import simulate, simulate_batch
+from ..core.spectra import response_spectrum
+from .adapter import to_rocking_model
+
+__all__ = ["SF_METHODS", "Building", "dense_runs", "mechanism_scale_factor", "run_scaled"]
+
+
+@dataclass(frozen=True)
+class Building:
+    """What the code scale factors need to know about the supporting structure.
+
+    Attributes
+    ----------
+    height : float, optional
+        Height of the building above its foundation, ``H`` (EC8) or ``h_n`` (NZS) [m], > 0.
+    soil_factor : float
+        EC8 soil factor ``S`` [-], > 0; 1 gives the bare amplification.
+    element_period : float
+        EC8 fundamental period of the element ``T_a`` [s], >= 0; 0 (the default) takes the
+        rocking mechanism as rigid before uplift.
+    """
+
+    height: Optional[float] = None
+    soil_factor: float = 1.0
+    element_period: float = 0.0
+
+
+def mechanism_scale_factor(
+    mech: Mechanism, motion: Any, sf: str, building: Building = Building()
+) -> Optional[dict[str, Any]]:
+    """Scale factor of the record up the structure for one mechanism, or None at ground level.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The mechanism; only those with ``amplification {f_n, h_e, h}`` are scaled.
+    motion : GroundMotion
+        The record (Eq. 28 uses its exact 5 %-damped spectrum at ``T_n = 1/f_n``).
+    sf : {"eq28", "ec8", "nzs"}
+        Method. EC8 takes ``z = h``, ``T_1 = 1/f_n``; NZS takes ``h_i = h``.
+    building : Building
+        Building height (EC8 and NZS), soil factor and element period (EC8).
+
+    Returns
+    -------
+    dict or None
+        ``{"value", "method", "formula", "inputs"}`` (``solver_service.core.codes``).
+    """
+    if sf not in SF_METHODS:
+        raise InputError(f"must be one of {list(SF_METHODS)}, got {sf!r}", "sf")
+    amp = mech.amplification
+    if sf == "none" or amp is None:
+        return None
+    if sf == "eq28":
+        spec = response_spectrum(motion.accel.acc, motion.dt, [1.0 / amp.f_n])
+        return sf_eq28(float(spec.psa[0]) / G, motion.pga_g, amp.h, amp.h_e)
+    if building.height is None:
+        raise InputError(f"--sf {sf} needs the height of the building [m]", "building_height")
+    if amp.h > building.height:
+        raise InputError(
+            f"mechanism {mech.id!r} sits at h = {amp.h:g} m, above the building "
+            f"({building.height:g} m)",
+            "building_height",
+        )
+    if sf == "nzs":
+        return sf_nzs(amp.h, building.height)
+    return sf_ec8(
+        amp.h, building.height, building.element_period, 1.0 / amp.f_n, building.soil_factor
+    )
+
+
+def run_scaled(
+    cf: ConstantsFile,
+    models: list[Any],
+    motion: Any,
+    scales: list[float],
+    sf: str = "none",
+    building: Building = Building(),
+    criterion: Optional[str] = None,
+) -> tuple[dict[str, Any], list[tuple[list[int], Any]]]:
+    """Run every mechanism at every scale, each record scaled up the structure by ``sf``.
+
+    Mechanisms that share a factor (all those at ground level) share one compiled batch.
+
+    Returns
+    -------
+    factors : dict
+        Scale-factor record (``mechanism_scale_factor``) per mechanism id that has one.
+    batches : list of (indices, BatchResult)
+        Which mechanisms (indices into ``cf.mechanisms``) each batch ran; the batch's
+        ``scales`` are the effective ones (user scale times factor).
+    """
+    factors: dict[str, Any] = {}
+    groups: dict[float, list[int]] = {}
+    for i, mech in enumerate(cf.mechanisms):
+        info = mechanism_scale_factor(mech, motion, sf, building)
+        if info is not None:
+            factors[mech.id] = info
+        groups.setdefault(1.0 if info is None else float(info["value"]), []).append(i)
+    batches = [
+        (
+            members,
+            simulate_batch(
+                [models[i] for i in members],
+                motion.accel,
+                [s * factor for s in scales],
+                criterion=criterion,
+            ),
+        )
+        for factor, members in groups.items()
+    ]
+    return factors, batches
+
+
+def dense_runs(
+    cf: ConstantsFile, motion: Any, doc: dict[str, Any], scale: float
+) -> list[tuple[str, float, Any]]:
+    """Time series of every mechanism at one user scale, as a history document ran it.
+
+    Each mechanism gets the document's scale factor up the structure on top of ``scale``
+    and the document's overturning criterion.
+
+    Returns
+    -------
+    list of (mechanism id, effective scale, RockingResult)
+        The results carry ``t`` and ``ratio`` (``dense=True``).
+    """
+    factors = {k: v["value"] for k, v in doc.get("scale_factors", {}).items()}
+    runs = []
+    for mech in cf.mechanisms:
+        effective = scale * factors.get(mech.id, 1.0)
+        res = simulate(
+            to_rocking_model(mech),
+            motion.accel,
+            scale=effective,
+            criterion=doc["criterion"],
+            dense=True,
+        )
+        runs.append((mech.id, effective, res))
+    return runs
