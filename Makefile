@@ -28,6 +28,7 @@ lint: $(STAMP)
 
 typecheck: $(STAMP)
 	$(BIN)/mypy
+	$(BIN)/mypy --config-file mypy-py39.ini
 
 ## The Rhino glue against RhinoCommon (pyright + rhino-stubs-typed; needs node on PATH).
 ## `make test` runs the same check in tests/rhino_glue/test_static.py.

@@ -27,6 +27,7 @@ __all__ = [
     "RECORD_UNITS",
     "ROCKING_KINDS",
     "SF_METHODS",
+    "TYPOLOGIES",
     "G",
     "check_choice",
     "check_eta",
@@ -39,6 +40,10 @@ __all__ = [
 
 #: Standard gravity [m/s²].
 G = 9.80665
+
+#: Mechanism typologies a spec can ask for; each has a builder in
+#: ``rhino_plugin.mechanisms.build.MECHANISMS`` (constants files also take ``user_defined``).
+TYPOLOGIES: Tuple[str, ...] = ("single_block", "single_block_loaded", "two_block", "multi_block")
 
 #: Rocking kinds: two-sided (rocks about both edges) or one-sided (rebounds off a restraint).
 ROCKING_KINDS: Tuple[str, ...] = ("two_sided", "one_sided")

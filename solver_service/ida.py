@@ -25,7 +25,9 @@ import numpy as np
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 
+from .core.fragility import fit_lognormal
 from .core.model import check_positive
+from .core.records import GroundMotion
 from .workflows.adapter import to_rocking_model
 from .workflows.scaling import Building, run_scaled
 
@@ -73,8 +75,6 @@ def run_record(
         (mechanisms × levels), ``scale_factors`` per mechanism id, ``pga_g`` and
         ``runtime_s``.
     """
-    from .core.records import GroundMotion
-
     opts = dict(options or {})
     cf = ConstantsFile.model_validate(constants)
     motion = GroundMotion.from_samples(acc, dt, name=name)
@@ -223,8 +223,6 @@ def run_ida(
         No records, a bad level, an unknown ``im``, or an unreachable scheduler (field
         ``scheduler``, with the address).
     """
-    from .core.fragility import fit_lognormal
-
     if im not in IM_MEASURES:
         raise InputError(f"must be one of {list(IM_MEASURES)}, got {im!r}", "im")
     if len(motions) == 0:

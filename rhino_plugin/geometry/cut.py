@@ -18,6 +18,7 @@ import numpy as np
 from shared_schema.errors import GeometryError, InputError
 
 from .mesh import TriMesh
+from .validate import check_solid
 
 __all__ = ["cut_by_plane", "split_by_plane"]
 
@@ -75,8 +76,6 @@ def split_by_plane(mesh: TriMesh, point: np.ndarray, normal: np.ndarray) -> Tupl
     polygons of the section, so V(positive) + V(negative) = V to rounding.
     """
     import manifold3d
-
-    from .validate import check_solid
 
     p, n = _plane(point, normal)
     check_solid(mesh, repair=False)

@@ -18,6 +18,7 @@ import numpy as np
 from shared_schema.errors import InputError
 
 from .mesh import TriMesh
+from .validate import check_solid
 
 __all__ = ["MassProps", "combine", "mass_properties"]
 
@@ -182,8 +183,6 @@ def mass_properties(mesh: TriMesh, density: float, *, repair: bool = True) -> Ma
     >>> round(p.mass, 12), p.com.round(12).tolist()
     (100.0, [0.25, 0.25, 0.25])
     """
-    from .validate import check_solid
-
     try:
         rho = float(density)
     except (TypeError, ValueError):

@@ -49,6 +49,7 @@ import numpy as np
 
 from shared_schema.errors import GeometryError
 
+from .frames import plane_basis
 from .mesh import TriMesh
 
 __all__ = ["check_solid", "shell_labels"]
@@ -363,8 +364,6 @@ def _fill_holes(vertices: np.ndarray, faces: np.ndarray) -> Tuple[np.ndarray, in
     """
     import manifold3d
     import shapely
-
-    from .frames import plane_basis
 
     loops = _boundary_loops(faces, len(vertices))
     if loops is None:

@@ -33,7 +33,8 @@ from rhino_plugin.geometry.contact import find_contact
 from rhino_plugin.geometry.frames import bounding_box_in_frame
 from rhino_plugin.geometry.massprops import mass_properties
 from rhino_plugin.geometry.validate import check_solid
-from rhino_plugin.mechanisms.single import find_objects
+from rhino_plugin.mechanisms.base import MechanismSides
+from rhino_plugin.mechanisms.single import find_objects, rigid_body, rigid_body_sides
 from rhino_plugin.mechanisms.thrust import roof_thrust
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.rules import G
@@ -289,3 +290,23 @@ def _constants(
             "forces",
         )
     return {"I0": i0, "K": k, "Q": q, "phi_cr": a_c, "M_F": m_f}, summary, notes
+
+
+def build_loaded_wall(spec: Any, scene: Any, table: Any) -> MechanismSides:
+    """Builder of typology ``single_block_loaded`` (docs/theory.md §2.2).
+
+    Added masses and forces act on one side only, so the wall rocks one-sided.
+    """
+    if spec.rocking == "two_sided":
+        raise InputError(
+            "two-sided rocking of a loaded wall is not supported (added forces act on one "
+            "side); use one_sided",
+            f"{spec.id}.rocking",
+        )
+    body, pos, geometry = rigid_body(spec, scene)
+    warnings = list(body.warnings)
+    positive, summary, notes = loaded_side(spec, scene, body, pos, table)
+    warnings.extend(notes)
+    geometry["loaded"] = summary
+    inertia = (summary["M_c_kg"], summary["R_c_m"], summary["alpha_c_rad"], positive["I0"])
+    return rigid_body_sides(spec, scene, body, pos, geometry, positive, inertia, warnings)

@@ -17,6 +17,7 @@ import numpy as np
 
 from rhino_plugin.geometry.massprops import combine, mass_properties
 from rhino_plugin.geometry.validate import check_solid
+from rhino_plugin.mechanisms.base import MechanismSides
 from rhino_plugin.mechanisms.multi_block import four_bar_constants, four_bar_restitution
 from rhino_plugin.mechanisms.single import find_objects
 from rhino_plugin.mechanisms.two_block import PlanarBody
@@ -156,3 +157,12 @@ def multi_block_sides(
         }
     summary["warnings"] = notes
     return positive, negative, eta, summary, ids
+
+
+def build_multi_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
+    """Builder of typology ``multi_block`` (docs/theory.md §2.4); ``table`` is unused."""
+    positive, negative, eta, summary, ids = multi_block_sides(spec, scene)
+    warnings = summary.pop("warnings")
+    return MechanismSides(
+        positive, negative, eta, "momentum_projection", {"multi_block": summary}, ids, warnings
+    )

@@ -24,7 +24,8 @@ import numpy as np
 from rhino_plugin.geometry.cut import cut_by_plane
 from rhino_plugin.geometry.massprops import combine, mass_properties
 from rhino_plugin.geometry.validate import check_solid
-from rhino_plugin.mechanisms.restitution import housner_general
+from rhino_plugin.mechanisms.base import MechanismSides
+from rhino_plugin.mechanisms.restitution import ONE_SIDED_RULES, housner_general, one_sided
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.rules import G
 
@@ -265,3 +266,99 @@ def eta_two_sided(body: Body, pos: RockingSide, neg: RockingSide) -> Tuple[float
     to_neg = housner_general(m, i_g, r_pos, r_neg, neg.I_O)
     to_pos = housner_general(m, i_g, r_neg, r_pos, pos.I_O)
     return max(to_neg, to_pos), {"eta_pos_to_neg": to_neg, "eta_neg_to_pos": to_pos}
+
+
+def rigid_body(spec: Any, scene: Any) -> Tuple[Body, RockingSide, Dict[str, Any]]:
+    """Load a mechanism's body and its positive rocking side, with the geometry summary.
+
+    The start of every typology that rocks one rigid body about a drawn axis (single
+    block, loaded wall, and the two-block wall before its split).
+
+    Returns
+    -------
+    body : Body
+        The solids with their densities, cracks applied.
+    side : RockingSide
+        The positive side about ``spec.axis``.
+    geometry : dict
+        ``mass_kg``, ``volume_m3``, ``com_m`` and the positive side's summary.
+    """
+    where = spec.id
+    start, end = resolve_axis(scene, spec.axis, f"{where}.axis")
+    body = load_body(spec, scene, 0.5 * (start + end))
+    pos = rocking_side(
+        body, start, end, where=f"{where}.axis", allow_tilt=spec.allow_non_horizontal_axis
+    )
+    geometry: Dict[str, Any] = {
+        "mass_kg": float(body.props.mass),
+        "volume_m3": float(sum(p.volume for p in body.parts)),
+        "com_m": [float(v) for v in body.props.com],
+        "positive": side_summary(pos),
+    }
+    return body, pos, geometry
+
+
+def _negative_side(spec: Any, scene: Any, body: Body, pos: RockingSide) -> RockingSide:
+    """Return the negative side of a two-sided body (``axis_negative`` or the opposite edge)."""
+    where = spec.id
+    if spec.axis_negative is not None:
+        n_start, n_end = resolve_axis(scene, spec.axis_negative, f"{where}.axis_negative")
+    else:
+        n_start, n_end = negative_axis(body, pos)
+    neg = rocking_side(
+        body,
+        n_start,
+        n_end,
+        where=f"{where}.axis_negative",
+        allow_tilt=spec.allow_non_horizontal_axis,
+    )
+    if float(np.dot(neg.outward, pos.outward)) >= 0.0:
+        raise InputError(
+            "the negative-side axis must lie on the other side of the centre of mass",
+            f"{where}.axis_negative",
+        )
+    return neg
+
+
+def rigid_body_sides(
+    spec: Any,
+    scene: Any,
+    body: Body,
+    pos: RockingSide,
+    geometry: Dict[str, Any],
+    positive: Dict[str, float],
+    restitution_body: Tuple[float, float, float, float],
+    warnings: List[str],
+) -> MechanismSides:
+    """Finish a rigid body's sides: the negative side (two-sided) and eta.
+
+    Parameters
+    ----------
+    restitution_body : (M [kg], R [m], alpha [rad], I_O [kg m²])
+        The body the one-sided restitution rule (Eq. 26) sees.
+    """
+    negative = None
+    eta_info: Dict[str, Any]
+    if spec.rocking == "two_sided":
+        neg = _negative_side(spec, scene, body, pos)
+        negative = side_constants(body, neg)
+        geometry["negative"] = side_summary(neg)
+        eta, eta_info = eta_two_sided(body, pos, neg)
+        source = "housner_general"
+    else:
+        source = spec.eta_rule or "one_sided_eq26"
+        eta = one_sided(*restitution_body, source)
+        eta_info = {"rule": ONE_SIDED_RULES[source]}
+    return MechanismSides(
+        positive, negative, eta, source, geometry, body.object_ids, warnings, eta_info
+    )
+
+
+def build_single_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
+    """Builder of typology ``single_block`` (docs/theory.md §2.1); ``table`` is unused."""
+    body, pos, geometry = rigid_body(spec, scene)
+    positive = side_constants(body, pos)
+    inertia = (float(body.props.mass), pos.R, pos.alpha, pos.I_O)
+    return rigid_body_sides(
+        spec, scene, body, pos, geometry, positive, inertia, list(body.warnings)
+    )

@@ -23,7 +23,9 @@ import numpy as np
 
 from rhino_plugin.geometry.cut import cut_by_plane
 from rhino_plugin.geometry.massprops import combine, mass_properties
+from rhino_plugin.mechanisms.base import MechanismSides
 from rhino_plugin.mechanisms.loaded import element_solids, largest_contact
+from rhino_plugin.mechanisms.single import rigid_body
 from rhino_plugin.mechanisms.two_block import (
     PlanarBody,
     hinge_height,
@@ -142,3 +144,19 @@ def two_block_sides(
     if overburden_ids:
         summary["overburden_objects"] = overburden_ids
     return positive, negative, eta, summary
+
+
+def build_two_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
+    """Builder of typology ``two_block`` (docs/theory.md §2.3); ``table`` is unused."""
+    body, pos, geometry = rigid_body(spec, scene)
+    positive, negative, eta, summary = two_block_sides(spec, scene, body, pos)
+    geometry["two_block"] = summary
+    return MechanismSides(
+        positive,
+        negative,
+        eta,
+        "momentum_projection",
+        geometry,
+        body.object_ids,
+        list(body.warnings),
+    )

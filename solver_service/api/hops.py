@@ -80,7 +80,7 @@ def _strict_number(value: Any) -> float:
 def _strict_integer(value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, int):
         raise HopsError(422, f"expected an integer, got {value!r}")
-    return value
+    return int(value)
 
 
 def _strict_boolean(value: Any) -> bool:

@@ -50,6 +50,7 @@ from numpy.typing import ArrayLike, NDArray
 from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError
 
+from .amplification import pulse_response_spectrum
 from .exact import kernels
 from .excitation import PULSE_SHAPES
 from .model import RockingModel, RockingSide, check_eta
@@ -466,7 +467,6 @@ def build_library(
     if progress is not None:
         progress(total, total)
     flat, offsets = _ragged([*curves, pos, neg])
-    from .amplification import pulse_response_spectrum
 
     ratio = np.geomspace(*SPECTRUM_GRID[:2], SPECTRUM_GRID[2])
     spectrum = pulse_response_spectrum(ratio, zeta=SPECTRUM_ZETA)

@@ -1,0 +1,202 @@
+"""The house rules (CONTRIBUTING.md): floors, no import circles, own imports at the top.
+
+Every module of the project is walked (not a hand list) and every import in it, at the top
+of the file or inside a function, is resolved to the project module it names.
+
+Floors, each importing only from its own floor or below:
+
+0. formats and domain rules: ``shared_schema``;
+1. maths: ``solver_service.core``, ``rhino_plugin.geometry``, ``rhino_plugin.mechanisms``
+   and the scene readers (``rhino_plugin.scene*``);
+2. workflows and documents: ``solver_service.workflows``, ``solver_service.report``,
+   ``solver_service.ida``, ``solver_service.demo``;
+3. front ends: ``solver_service.cli``, ``solver_service.api``, ``rhino_plugin.flows``,
+   ``rhino_plugin.rhino``, the Grasshopper components and the public ``rockmech`` package.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Optional
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("shared_schema", "solver_service", "rhino_plugin", "rockmech")
+
+#: Module-name prefixes and their floors; the longest matching prefix wins.
+FLOORS = {
+    "shared_schema": 0,
+    "solver_service.core": 1,
+    "rhino_plugin.geometry": 1,
+    "rhino_plugin.mechanisms": 1,
+    "rhino_plugin.scene_3dm": 1,
+    "solver_service.workflows": 2,
+    "solver_service.report": 2,
+    "solver_service.ida": 2,
+    "solver_service.demo": 2,
+    "solver_service.cli": 3,
+    "solver_service.api": 3,
+    "rhino_plugin.flows": 3,
+    "rhino_plugin.rhino": 3,
+    "rhino_plugin.components": 3,
+    "rockmech": 3,
+}
+#: Package ``__init__`` modules hold no code of a floor; they may be imported from anywhere.
+PACKAGE_INITS = {"solver_service", "rhino_plugin"}
+FLOOR_NAMES = ("formats and rules", "maths", "workflows", "front ends")
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def _modules() -> dict[str, Path]:
+    found = {}
+    for package in PACKAGES:
+        folder = ROOT / package
+        if folder.is_dir():
+            for path in sorted(folder.rglob("*.py")):
+                found[_module_name(path)] = path
+    return found
+
+
+MODULES = _modules()
+
+
+def floor_of(module: str) -> Optional[int]:
+    """Floor of a project module (None for the bare package inits)."""
+    if module in PACKAGE_INITS:
+        return None
+    matches = [p for p in FLOORS if module == p or module.startswith(p + ".")]
+    return FLOORS[max(matches, key=len)] if matches else None
+
+
+def _resolve(importer: str, node: ast.ImportFrom) -> str:
+    if not node.level:
+        return node.module or ""
+    is_package = MODULES[importer].name == "__init__.py"
+    base = importer.split(".")
+    base = base if is_package else base[:-1]
+    base = base[: len(base) - (node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
+
+
+def _target(name: str) -> Optional[str]:
+    """The project module an imported dotted name refers to (the longest existing prefix)."""
+    parts = name.split(".")
+    for k in range(len(parts), 0, -1):
+        candidate = ".".join(parts[:k])
+        if candidate in MODULES:
+            return candidate
+    return None
+
+
+def imports(module: str) -> Iterator[tuple[str, int, bool]]:
+    """Yield ``(imported project module, line, inside a function)`` for one module."""
+    tree = ast.parse(MODULES[module].read_text(encoding="utf-8"))
+
+    def walk(node: ast.AST, in_function: bool) -> Iterator[tuple[str, int, bool]]:
+        for child in ast.iter_child_nodes(node):
+            inner = in_function or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef))
+            if isinstance(child, ast.Import):
+                for alias in child.names:
+                    target = _target(alias.name)
+                    if target:
+                        yield target, child.lineno, in_function
+            elif isinstance(child, ast.ImportFrom):
+                base = _resolve(module, child)
+                for alias in child.names:
+                    target = _target(f"{base}.{alias.name}") or _target(base)
+                    if target:
+                        yield target, child.lineno, in_function
+            else:
+                yield from walk(child, inner)
+
+    yield from walk(tree, False)
+
+
+def test_every_module_has_a_floor() -> None:
+    assert len(MODULES) > 80
+    for module in MODULES:
+        if module not in PACKAGE_INITS:
+            assert floor_of(module) is not None, module
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_module_imports_only_its_floor_or_below(module: str) -> None:
+    own = floor_of(module)
+    if own is None:
+        return
+    for target, line, _ in imports(module):
+        floor = floor_of(target)
+        if floor is not None and floor > own:
+            pytest.fail(
+                f"{module} (floor {own}, {FLOOR_NAMES[own]}) imports {target} (floor {floor}, "
+                f"{FLOOR_NAMES[floor]}) at line {line}"
+            )
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components with more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_import_circles() -> None:
+    graph = {m: {t for t, _, _ in imports(m) if t != m} for m in MODULES}
+    assert _cycles(graph) == []
+
+
+def test_cycle_finder_finds_a_circle() -> None:
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+
+
+def test_floor_check_catches_a_maths_module_importing_a_workflow() -> None:
+    assert floor_of("solver_service.core.exact") == 1
+    assert floor_of("solver_service.workflows.documents") == 2
+    assert floor_of("rhino_plugin.flows.analyse") == 3
+    assert floor_of("rhino_plugin.scene_3dm") == 1
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_own_modules_are_imported_at_the_top(module: str) -> None:
+    """A project import inside a function needs a comment above it saying why."""
+    lines = MODULES[module].read_text(encoding="utf-8").splitlines()
+    for target, line, in_function in imports(module):
+        if in_function and not lines[line - 2].strip().startswith("#"):
+            pytest.fail(f"{module} imports {target} inside a function at line {line} (no reason)")
