@@ -199,7 +199,7 @@ def envelope_doc(
 ) -> tuple[dict[str, Any], list[Envelope]]:
     """Ground-level envelopes of every mechanism and the critical bands.
 
-    Mechanisms with ``amplification`` are corrected by ``SF(f_p)`` (THEORY §7); the others
+    Mechanisms with ``amplification`` are corrected by ``SF(f_p)`` (theory §7); the others
     skip that work entirely.
 
     Returns
@@ -411,7 +411,7 @@ def record_pulse_doc(
 
 
 #: Scale-factor methods of time histories: none, Eq. 28 from the record's spectrum, or the
-#: EN 1998-1 and NZS 1170.5 code factors (THEORY §7.3-7.4).
+#: EN 1998-1 and NZS 1170.5 code factors (theory §7.3-7.4).
 SF_METHODS = ("none", "eq28", "ec8", "nzs")
 
 
