@@ -19,7 +19,7 @@ What every case must hold (``check``)
 -------------------------------------
 1. **finite**: ``peak_ratio``, ``t_peak``, ``error_estimate`` and the event times are finite;
    a body that does not collapse stays below the certain-collapse level
-   ``1 + scale max|a_g|/(g lam)`` (THEORY §10);
+   ``1 + scale max|a_g|/(g lam)`` (theory §10);
 2. **no hang**: the status is not -1 unless the case sets a small impact cap on purpose,
    and the work is bounded by the counters: closed-form stretches
    ``n_steps <= n_segments + n_uplifts + n_impact_events`` (every stretch starts at a
@@ -638,7 +638,7 @@ def _energy_violations(case: Case, log: np.ndarray) -> list[str]:
         ov_out = np.where(new_side > 0, m.positive.phi_ov, m.neg.phi_ov)
     symmetric = case.nonlinear or case.model.is_symmetric
     if symmetric:
-        # THEORY §1.8 at x = 0: E = (x'/p)^2 - 1 on both sides of the impact.
+        # theory §1.8 at x = 0: E = (x'/p)^2 - 1 on both sides of the impact.
         e_in = (v_in / p_in) ** 2 - 1.0
         e_out = (v_out / p_out) ** 2 - 1.0
         gain = e_out - e_in
@@ -862,7 +862,7 @@ def markdown(outs: list[Outcome], info: dict[str, str], level: str, total_s: flo
         f"**{len(outs)} cases, {n_bad} with a violated property.** Each case is checked for: "
         "finite outputs and a peak below the certain-collapse level; no hang (status -1 only "
         "where a small impact cap is set on purpose, and the work counters within "
-        "`n_steps <= n_segments + n_uplifts + n_impact_events`); E of THEORY §1.8 never "
+        "`n_steps <= n_segments + n_uplifts + n_impact_events`); E of theory §1.8 never "
         "increased by an impact (angular speed for asymmetric mechanisms) and conserved "
         "between impacts of free motion; status, message and warnings consistent with the "
         "outcome; and, where the 30-digit mpmath reference is affordable, "

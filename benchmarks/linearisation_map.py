@@ -3,7 +3,7 @@
 What is measured (issue 7, part 4)
 ----------------------------------
 For a rigid block of slenderness ``alpha`` (the linear model has ``lam = phi_ov = alpha``,
-THEORY §2.1) and restitution ``eta = max(0, 1 - 1.5 sin²alpha)`` (Housner's rectangular
+theory §2.1) and restitution ``eta = max(0, 1 - 1.5 sin²alpha)`` (Housner's rectangular
 block, Eq. 25):
 
 1. **Minimum overturning amplitude** of a one-sine pulse, over ``alpha`` in [0.01, 1.2] and
@@ -334,7 +334,7 @@ def markdown(res: dict[str, Any], info: dict[str, str], total_s: float) -> str:
             f"numerics`); {total_s / 60:.1f} min on {info['cpu']}, nproc {info['nproc']}, "
             f"{info['date']}, commit {info['commit']}.",
             "",
-            "The linearised model (THEORY §1, `lam = phi_ov = alpha` for a block) against "
+            "The linearised model (theory §1, `lam = phi_ov = alpha` for a block) against "
             "Housner's nonlinear block (`simulate_nonlinear`, DOP853 at rtol "
             f"{NL_RTOL:g}), with Housner's restitution `eta = max(0, 1 - 1.5 sin²alpha)`. "
             "Left: the first overturning amplitude of a one-sine pulse, `a_lin / a_nl - 1` "
@@ -359,7 +359,7 @@ def markdown(res: dict[str, Any], info: dict[str, str], total_s: float) -> str:
             f"alpha <= {alpha_low} rad at Omega <= 3. Most errors are negative: the linear "
             "model overturns at a lower amplitude (it is conservative), at low Omega almost "
             "exactly by alpha/tan(alpha) - 1 because it uplifts at g alpha instead of "
-            "g tan(alpha) (THEORY §8.5). The error grows with alpha and with Omega: at high "
+            "g tan(alpha) (theory §8.5). The error grows with alpha and with Omega: at high "
             "Omega the pulse that overturns is several g and the rotations are no longer "
             "small. The largest unconservative (positive) error is "
             f"{100 * err[ip, jp]:+.1f} % at alpha = {al[ip]:g}, Omega = {om[jp]:g}. On a "
@@ -374,7 +374,7 @@ def markdown(res: dict[str, Any], info: dict[str, str], total_s: float) -> str:
             "of the grid cell around the point, so it errs high), and `exact.simulate` adds a "
             "warning to the result (`warnings`, `message`; shown by `rockmech pulse`) when the "
             f"estimate exceeds {100 * WARN_LINEARISATION:.0f} %. For a mechanism, alpha is "
-            "taken as lambda of each side (the equivalent block of THEORY §1.4: lambda = "
+            "taken as lambda of each side (the equivalent block of theory §1.4: lambda = "
             "alpha for a single block); for records, which have no Omega, the El Centro "
             "error (median over p) is used: single peaks on a record scatter widely (a "
             "chaotic response with hundreds of impacts), so the median shows the systematic "

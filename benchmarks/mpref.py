@@ -1,32 +1,32 @@
 """Independent high-precision reference for the linearised rocking model (mpmath, 30 digits).
 
-This module re-implements, from THEORY.md alone and without importing any of the project's
+This module re-implements, from docs/theory.md alone and without importing any of the project's
 solvers, the rules that the exact integrator (``solver_service.core.exact``) follows, in
 ``mpmath`` arithmetic at ``DPS = 30`` significant digits. It is the yardstick of the
 work-precision benchmark (``benchmarks/work_precision.py``) and may be used by tests.
 
-Model (THEORY §1.4, §1.8), in ``x = phi/phi_ov(s)`` on side ``s = ±1``::
+Model (theory §1.4, §1.8), in ``x = phi/phi_ov(s)`` on side ``s = ±1``::
 
     x'' = p_s**2 * (x - s - q(t)),      q(t) = scale * a_g(t) / (g * lam_s),   g = 9.80665
 
 * uplift from rest when the drive ``-s q(t)`` exceeds 1 (the crossing time is solved exactly);
 * impact at ``x = 0``: two-sided ``s -> -s``, ``v -> eta (phi_ov_s/phi_ov_new) v``; one-sided
   ``v -> eta v`` (``eta <= 0``, rebound);
-* rest rule: an impact that leaves ``|v| < V_REST_REL * p_new`` ends at rest (THEORY §10);
+* rest rule: an impact that leaves ``|v| < V_REST_REL * p_new`` ends at rest (theory §10);
   an impact is counted when it arrives with ``|v| >= V_REST_REL * p`` (the exact integrator
   counts the same way);
 * a null excursion (back at rest at the very instant of an uplift) holds the body at rest to
-  the end of the current cell (THEORY §10, sub-resolution uplift; counted in ``n_holds``);
+  the end of the current cell (theory §10, sub-resolution uplift; counted in ``n_holds``);
 * certain collapse during the excitation: ``s x > 1 + max_future|a_g| scale/(g lam_s)`` while
-  ``s v > 0`` (THEORY §10), checked at the end of every closed-form interval;
-* after the excitation, the free-rocking outcome of THEORY §1.8 decides exactly (current
+  ``s v > 0`` (theory §10), checked at the end of every closed-form interval;
+* after the excitation, the free-rocking outcome of theory §1.8 decides exactly (current
   excursion, then at most one more).
 
 Closed forms and event location
 -------------------------------
 *Sampled record* (linear acceleration between samples, ``q = q0 + q1 tau`` from the anchor
 ``(t_a, x_a, v_a)``), written about the anchor so nothing of size ``lam`` cancels
-(THEORY §10)::
+(theory §10)::
 
     x(tau)  = x_a + v_a sinh(u)/p + A (cosh u - 1) - q1 (sinh u - u)/p,   u = p tau,
     x'(tau) = (v_a - q1) cosh u + A p sinh u + q1,                        A = x_a - s - q0.
@@ -80,7 +80,7 @@ __all__ = [
 DPS = 30
 #: Standard gravity [m/s²], as defined (exact decimal).
 G_EXACT = "9.80665"
-#: Rest rule: an impact leaving at below ``V_REST_REL * p`` ends in rest (THEORY §10).
+#: Rest rule: an impact leaving at below ``V_REST_REL * p`` ends in rest (theory §10).
 V_REST_REL = 1e-9
 #: Pulse cells per quarter period in which turning points are searched.
 PULSE_SUBCELLS = 64
@@ -151,7 +151,7 @@ class MPResult:
         Peak ``|phi|/phi_ov`` over the motion including the free-rocking tail [-];
         1 when the body collapses.
     collapsed : bool
-        The body can no longer come back (THEORY §1.8, §10).
+        The body can no longer come back (theory §1.8, §10).
     n_impacts : int
         Impacts arriving with ``|v| >= V_REST_REL * p`` during the excitation.
     t_peak : mpf
@@ -455,7 +455,7 @@ class _Sim:
             if self.t == self.t_uplift:
                 # Back at rest at the very instant of the uplift (a null excursion): hold the
                 # body to the end of the current cell, as the exact integrator does
-                # (sub-resolution uplift, THEORY §10). Counted in ``n_holds``.
+                # (sub-resolution uplift, theory §10). Counted in ``n_holds``.
                 self.hold_until = self.t_cell_end
                 self.n_holds += 1
         else:
@@ -468,7 +468,7 @@ class _Sim:
         self.sig0 = s
 
     def check_collapse(self, qmax_future: Any) -> bool:
-        """Certain collapse during the excitation (THEORY §10)."""
+        """Certain collapse during the excitation (theory §10)."""
         s = self.s
         if self.flight and s * self.v > 0 and s * self.x > 1 + qmax_future * self.ks(s):
             self.collapsed = True
@@ -476,7 +476,7 @@ class _Sim:
         return False
 
     def free_tail(self) -> None:
-        """Exact outcome of the free motion after the excitation (THEORY §1.8)."""
+        """Exact outcome of the free motion after the excitation (theory §1.8)."""
         if not self.flight or self.collapsed:
             return
         s = self.s

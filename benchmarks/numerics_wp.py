@@ -11,12 +11,12 @@ what is measured:
   also rewrites the ``work_precision`` section of ``docs/benchmarks.md``;
 * **nonlinear reference** (``simulate_nonlinear``, the same four methods at rtol 1e-4 ...
   1e-12): free rocking of Housner's block from rest, whose impact times are known in closed
-  form (elliptic integrals of the energy, THEORY §2.1, evaluated with ``mpmath.quad`` at 30
+  form (elliptic integrals of the energy, theory §2.1, evaluated with ``mpmath.quad`` at 30
   digits); error = largest error of the first ``NL_IMPACTS`` impact times over the last
   of them;
 * **overturning-boundary search** (``envelope.boundary_curve``) at bisection widths rtol
   1e-2 ... 1e-9: one-sided rocking with ``eta = 0`` can only overturn without impact, so its
-  boundary is the closed form of THEORY §6.3 (a) or (b), solved with ``mpmath.findroot`` at
+  boundary is the closed form of theory §6.3 (a) or (b), solved with ``mpmath.findroot`` at
   30 digits; error = largest relative error of ``A_min`` over ``N_OMEGA`` frequencies;
 * **response spectrum** (``spectra.response_spectrum``, numba and numpy back ends, and,
   for comparison, the peak taken at the samples only with ``scipy.signal.lsim``): against
@@ -177,7 +177,7 @@ def run_nonlinear(quick: bool) -> list[Point]:
 
 
 def closed_form_a(omega: float, case: str) -> float:
-    """Mode-2 overturning amplitude A (THEORY §6.3 (a) or (b)) at 30 digits."""
+    """Mode-2 overturning amplitude A (theory §6.3 (a) or (b)) at 30 digits."""
     with mp.workdps(DPS):
         om = mpf(omega)
         if case == "a":
@@ -478,7 +478,7 @@ def markdown(pts: list[Point], info: dict[str, str], total_s: float, quick: bool
             "against the closed-form impact times of free rocking (elliptic integrals of the "
             f"energy, `mpmath.quad` at {DPS} digits; error = largest impact-time error over "
             f"the first {NL_IMPACTS} impacts, relative to the last impact time); the boundary "
-            "search against the mode-2 closed forms of THEORY §6.3 (one-sided rocking with "
+            "search against the mode-2 closed forms of theory §6.3 (one-sided rocking with "
             f"eta = 0, {N_OMEGA} Omega in [{B_OMEGA[0]:g}, {B_OMEGA[1]:g}], `mpmath.findroot`; "
             "error = largest relative error of A_min); the response spectrum against the "
             "closed-form damped-oscillator response to the piecewise-linear record in mpmath "

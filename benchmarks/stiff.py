@@ -321,7 +321,7 @@ def markdown(
         "LSODA, though cheapest, miscounts impacts on both records at every tolerance "
         "(its interpolant locates events worst): do not use it for the reference. Loose "
         "tolerances change the impact count, so the verdict can change: never use scipy's "
-        "default tolerances for the nonlinear reference (THEORY §10).",
+        "default tolerances for the nonlinear reference (theory §10).",
     ]
     return "\n".join(lines)
 

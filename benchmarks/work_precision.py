@@ -183,7 +183,7 @@ def pulse_case() -> Case:
     notes.append(
         f"The requested A = {PULSE_A_REQUESTED} collapses (mpmath reference: collapsed="
         f"{asked.collapsed}, {asked.n_impacts} impact(s)); at Omega = 3, eta = 0.9 the "
-        "linearised model overturns from A = 1.404 (THEORY §6.5), so A = "
+        "linearised model overturns from A = 1.404 (theory §6.5), so A = "
         f"{PULSE_A_USED} is used: a case with an impact and no collapse."
     )
     return Case(

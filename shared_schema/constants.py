@@ -1,7 +1,7 @@
 """The kinematic-constants file: the constants of each rocking mechanism of a structure.
 
 The file is what the Rhino side writes and the solver reads (STYLE.md, habit 5). It holds,
-per mechanism, the constants of the linearised rocking equation (THEORY.md §1) for the
+per mechanism, the constants of the linearised rocking equation (docs/theory.md §1) for the
 positive side and, when the mechanism is not symmetric, the negative side.
 
 Notation
@@ -104,13 +104,13 @@ FLAT_SIDE_KEYS = ("p_eq", "lam", "phi_ov")
 
 _PHYSICAL_KEYS = ("I0", "K", "Q", "phi_cr")
 
-_P_EQ_DESCRIPTION = "Equivalent frequency parameter p_eq = sqrt(K/I0) (THEORY Eq. 4) [rad/s], > 0."
+_P_EQ_DESCRIPTION = "Equivalent frequency parameter p_eq = sqrt(K/I0) (theory Eq. 4) [rad/s], > 0."
 _LAM_DESCRIPTION = (
     "Linearised static load multiplier: the ground acceleration that starts rocking, as a "
-    "fraction of g (THEORY Eq. 5; §1.8 for the negative side) [-], > 0."
+    "fraction of g (theory Eq. 5; §1.8 for the negative side) [-], > 0."
 )
 _PHI_OV_DESCRIPTION = (
-    "Overturning rotation (THEORY Eq. 6; §1.8 for the negative side) [rad], > 0. "
+    "Overturning rotation (theory Eq. 6; §1.8 for the negative side) [rad], > 0. "
     "In the short form it defaults to lam (exact for a single block)."
 )
 
@@ -191,7 +191,7 @@ class SideConstants(BaseModel):
 
     Notes
     -----
-    Derivation (THEORY §1, Eqs. 4-6 and §1.8), with ``s = +1`` on the positive side and
+    Derivation (theory §1, Eqs. 4-6 and §1.8), with ``s = +1`` on the positive side and
     ``s = -1`` on the negative side::
 
         p_eq = sqrt(K / I0)
@@ -276,7 +276,7 @@ def _derive_side(side: SideConstants, which: str) -> SideConstants:
         return side
     assert side.I0 is not None and side.K is not None
     assert side.Q is not None and side.phi_cr is not None
-    # THEORY §1.8: M_F keeps its sign (positive drives positive rotation), so it helps the
+    # theory §1.8: M_F keeps its sign (positive drives positive rotation), so it helps the
     # positive side overturn and resists the negative side.
     s = 1.0 if which == "positive" else -1.0
     m_f = 0.0 if side.M_F is None else side.M_F
@@ -313,7 +313,7 @@ def _derive_side(side: SideConstants, which: str) -> SideConstants:
 
 
 class Amplification(BaseModel):
-    """Data for amplifying the ground motion up the structure (THEORY §7, Eqs. 27-28).
+    """Data for amplifying the ground motion up the structure (theory §7, Eqs. 27-28).
 
     Attributes
     ----------
@@ -330,7 +330,7 @@ class Amplification(BaseModel):
         extra="forbid",
         allow_inf_nan=False,
         json_schema_extra={
-            "description": "Data for amplifying the ground motion up the structure (THEORY §7)."
+            "description": "Data for amplifying the ground motion up the structure (theory §7)."
         },
     )
 
@@ -453,7 +453,7 @@ class Mechanism(BaseModel):
         None, description="Where eta comes from; 'user' when eta is given without it."
     )
     amplification: Optional[Amplification] = Field(
-        None, description="Data for amplifying the ground motion up the structure (THEORY §7)."
+        None, description="Data for amplifying the ground motion up the structure (theory §7)."
     )
     geometry: Optional[Dict[str, JsonValue]] = Field(
         None, description="Free-form JSON summary of the geometry (lengths in m, masses in kg)."

@@ -179,7 +179,7 @@ Hinge = Union[Point3, Selector]
 
 
 class Hinges(BaseModel):
-    """The four hinges of a three-block mechanism (THEORY §2.4).
+    """The four hinges of a three-block mechanism (theory §2.4).
 
     A and D are on the ground; block 1 joins A and B, block 2 B and C, block 3 D and C.
     """

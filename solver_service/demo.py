@@ -56,7 +56,7 @@ DEMO_SCALES = (0.5, 1.0, 1.5, 2.0, 3.0)
 def rectangular_block(
     b: float, h: float, *, density: float = 1800.0, length: float = 1.0, one_sided: bool = False
 ) -> dict[str, Any]:
-    """Kinematic constants of a rectangular block rocking about a base edge (THEORY §2.1).
+    """Kinematic constants of a rectangular block rocking about a base edge (theory §2.1).
 
     Parameters
     ----------

@@ -23,7 +23,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 def test_pulse_json_reproduces_zhang_makris_onset() -> None:
-    # Omega = 5: first overturning at A = 3.0186 (THEORY §6.5); f_p = 5 p / 2 pi.
+    # Omega = 5: first overturning at A = 3.0186 (theory §6.5); f_p = 5 p / 2 pi.
     f_p = 5 * 2.0 / (2 * math.pi)
     common = ["pulse", "--p-eq", "2", "--lam", "0.2", "--eta", "0.9", "--f-p", str(f_p), "--json"]
     below = runner.invoke(app, [*common, "--a-p-g", str(-0.2 * 3.015)])

@@ -52,9 +52,9 @@ ROCKING = {"TwoSided": "two_sided", "OneSided": "one_sided"}
 KEEP = {"AxisSide": "axis_side", "Positive": "positive", "Negative": "negative"}
 #: Added elements offered by the loaded-wall checkbox dialog.
 ADDED_ELEMENTS = ("Floors", "Roof", "Vaults", "Tie-bars")
-#: Vault construction classes (THEORY §5, the thrust table).
+#: Vault construction classes (theory §5, the thrust table).
 VAULT_CLASSES = ("a", "b", "c", "d", "e")
-#: The three blocks of a multi-block mechanism, in spec order (THEORY §2.4).
+#: The three blocks of a multi-block mechanism, in spec order (theory §2.4).
 BLOCK_LABELS = ("block 1 (AB, turning about A)", "block 2 (BC)", "block 3 (DC, turning about D)")
 HINGE_NAMES = ("A", "B", "C", "D")
 

@@ -360,7 +360,7 @@ def find_contact(
     Notes
     -----
     Used to tell a floor bearing on a wall top (vertical normal) from one abutting its
-    face (horizontal normal), THEORY.md §2.2. Solids that interpenetrate without sharing a
+    face (horizontal normal), docs/theory.md §2.2. Solids that interpenetrate without sharing a
     face plane are not in contact in this sense; see :func:`contact_area` for a section.
 
     Examples

@@ -1,6 +1,6 @@
 """Exact mass properties of polyhedral solids and of assemblies of them.
 
-Notation (THEORY.md §2.1)
+Notation (docs/theory.md §2.1)
 -------------------------
 V : volume [m³]
 M : mass [kg], M = ρ V
@@ -90,7 +90,7 @@ class MassProps:
 
         Notes
         -----
-        Parallel-axis theorem; gives I_O of THEORY.md Eq. (7) for a rocking axis.
+        Parallel-axis theorem; gives I_O of docs/theory.md Eq. (7) for a rocking axis.
 
         Examples
         --------
@@ -172,7 +172,7 @@ def mass_properties(mesh: TriMesh, density: float, *, repair: bool = True) -> Ma
     Divergence theorem over signed tetrahedra (see ``_integrals``), exact for a
     polyhedron up to rounding. Coordinates are shifted to the bounding-box centre first,
     so a scene 100 km from the origin loses no accuracy. Then
-    I_G = tr(C_G) 1 - C_G with C_G = ρ ∫(x - r_G)(x - r_G)ᵀ dV (THEORY.md §2.1).
+    I_G = tr(C_G) 1 - C_G with C_G = ρ ∫(x - r_G)(x - r_G)ᵀ dV (docs/theory.md §2.1).
 
     Examples
     --------
@@ -229,7 +229,7 @@ def combine(parts: Sequence[MassProps], name: str = "assembly") -> MassProps:
 
     Notes
     -----
-    THEORY.md §2.1: M = Σ ρ_j V_j, r_G = Σ ρ_j V_j r_Gj / M, inertia summed over the
+    docs/theory.md §2.1: M = Σ ρ_j V_j, r_G = Σ ρ_j V_j r_Gj / M, inertia summed over the
     density groups after the parallel-axis shift.
 
     Examples

@@ -673,7 +673,7 @@ def check_solid(mesh: TriMesh, *, repair: bool = True) -> Tuple[TriMesh, List[st
     Notes
     -----
     Closed and oriented means every edge is used by exactly two faces, in opposite
-    directions; outward means a positive divergence-theorem volume (THEORY.md §2.1 uses
+    directions; outward means a positive divergence-theorem volume (docs/theory.md §2.1 uses
     it for M and I_O). Cost is dominated by one sort of the 3m half-edges, O(m log m).
     A mesh this function returned (or accepted) is remembered, with a CRC of its arrays, so
     checking it again (as ``mass_properties`` does) costs only the CRC.

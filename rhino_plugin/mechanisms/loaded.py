@@ -1,4 +1,4 @@
-"""Wall with added masses and static forces (A2, THEORY §2.2, Eqs. 11-16).
+"""Wall with added masses and static forces (A2, theory §2.2, Eqs. 11-16).
 
 Added elements and how they enter:
 

@@ -1,9 +1,9 @@
-"""Three blocks and four hinges: the planar four-bar linkage (THEORY §2.4, Eq. 24; §3.4).
+"""Three blocks and four hinges: the planar four-bar linkage (theory §2.4, Eq. 24; §3.4).
 
 Pure planar maths in the rocking plane: ``x`` horizontal, ``z`` up [m]. No CAD here; the
 pipeline supplies the blocks' mass properties and the hinge points.
 
-Notation (THEORY §0, §2.4)
+Notation (theory §0, §2.4)
 --------------------------
 A, D : ground hinges; B, C : internal hinges [m]
 block 1 = AB (turns about A), block 2 = BC (the coupler), block 3 = DC (turns about D)
@@ -32,7 +32,7 @@ For a given ``theta``, C is where the circle of radius L2 about B meets the circ
 L3 about D, on the side of line BD where it lies at rest (the branch can only change
 through tangency, which is where the linkage locks). The velocity ratios and their
 derivatives are solved from the closure ``r + u - w = const`` with ``r = B - A``,
-``u = C - B``, ``w = C - D``, which is THEORY §2.4's angle form written with vectors::
+``u = C - B``, ``w = C - D``, which is theory §2.4's angle form written with vectors::
 
     omega2 u - omega3 w = -r
     omega2' u - omega3' w = -J (r + omega2² u - omega3² w)       (J: +90° rotation)
@@ -81,7 +81,7 @@ HINGE_NAMES = ("A", "B", "C", "D")
 
 @dataclass(frozen=True)
 class FourBarResult(LinkageResult):
-    """Kinematic constants of one hinge set (THEORY §2.4, Eqs. 1-6).
+    """Kinematic constants of one hinge set (theory §2.4, Eqs. 1-6).
 
     Attributes
     ----------
@@ -216,7 +216,7 @@ def _check_hinges(points: Sequence[Sequence[float]], prefix: str = "hinge ") -> 
 
 
 class FourBar:
-    """A planar four-bar linkage A-B-C-D carrying three rigid blocks (THEORY §2.4).
+    """A planar four-bar linkage A-B-C-D carrying three rigid blocks (theory §2.4).
 
     Parameters
     ----------
@@ -363,7 +363,7 @@ class FourBar:
             (b[0] + g2[0], b[1] + g2[1]),
             (self.D[0] + g3[0], self.D[1] + g3[1]),
         ]
-        # d r_G / dt and d² r_G / dt² (THEORY §2.4, vector form).
+        # d r_G / dt and d² r_G / dt² (theory §2.4, vector form).
         jr, jg1, jg2, jg3 = _perp(r), _perp(g1), _perp(g2), _perp(g3)
         vel = [
             jg1,
@@ -494,7 +494,7 @@ def four_bar_constants(
     direction: int = 1,
     theta_max: float = 0.5 * math.pi,
 ) -> FourBarResult:
-    """Kinematic constants of a three-block, four-hinge mechanism (Eq. 24, THEORY §2.4).
+    """Kinematic constants of a three-block, four-hinge mechanism (Eq. 24, theory §2.4).
 
     Parameters
     ----------
@@ -603,7 +603,7 @@ def four_bar_restitution(
     hinges_old: Sequence[Sequence[float]],
     hinges_new: Sequence[Sequence[float]],
 ) -> float:
-    """Coefficient of restitution by momentum projection (THEORY §3.4).
+    """Coefficient of restitution by momentum projection (theory §3.4).
 
     Parameters
     ----------
@@ -621,7 +621,7 @@ def four_bar_restitution(
 
     Notes
     -----
-    THEORY §3.4: the impulses act only at the new ground hinges and at internal hinges, which
+    theory §3.4: the impulses act only at the new ground hinges and at internal hinges, which
     do no work in the new mode, so the generalised momentum along the new mode is conserved::
 
         eta = sum[m_k u_k⁻ . u_k⁺ + I_Gk w_k⁻ w_k⁺] / sum[m_k |u_k⁺|² + I_Gk (w_k⁺)²]
@@ -656,7 +656,7 @@ def portal_frame(
     length: float = 1.0,
     asymmetric: Optional[Tuple[float, float]] = None,
 ) -> Tuple[Tuple[PlanarBody, PlanarBody, PlanarBody], Hinges, Hinges]:
-    """Blocks and hinge sets of a rocking portal frame (THEORY §2.4; Makris & Vassiliou 2013).
+    """Blocks and hinge sets of a rocking portal frame (theory §2.4; Makris & Vassiliou 2013).
 
     Two rectangular columns stand on the ground and carry a beam pinned on their tops. In
     the positive set (sway towards +x) both columns rock about their +x base corners (the

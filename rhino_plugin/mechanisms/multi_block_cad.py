@@ -7,7 +7,7 @@ the horizontal axis normal to that plane.
 
 For each hinge set the sense of motion is the one in which the weight resists at rest
 (the hinges open; the other sense is not kinematically admissible for unilateral
-contacts). The constants follow THEORY §2.4 (``multi_block.four_bar_constants``); the
+contacts). The constants follow theory §2.4 (``multi_block.four_bar_constants``); the
 restitution is the momentum projection of §3.4 from the positive to the negative mode.
 """
 

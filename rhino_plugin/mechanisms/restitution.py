@@ -1,4 +1,4 @@
-"""Coefficients of restitution (THEORY §3).
+"""Coefficients of restitution (theory §3).
 
 Two-sided rocking uses Housner's momentum balance about the new pivot in its general form
 (Eq. 25 generalised, §3.1)::
@@ -10,7 +10,7 @@ rocking plane) and ``I_O'`` the inertia about the new pivot. For a body whose tw
 symmetric this is ``1 - 2 M R² sin²(alpha) / I_O``.
 
 One-sided rocking (rebound off a restraint) has three candidate rules that the published
-tables cannot tell apart (THEORY §3.2, §8); ``one_sided_eq26`` is the default:
+tables cannot tell apart (theory §3.2, §8); ``one_sided_eq26`` is the default:
 
 * ``one_sided_eq26``: ``1 - 2 M R² cos²(alpha) / I_O`` (Eq. 26);
 * ``one_sided_alt``: ``1 - 2 M R² / I_O``;
@@ -52,7 +52,7 @@ def housner_general(mass: float, i_g: float, r_og: Any, r_o2g: Any, i_o2: float)
 
     Notes
     -----
-    THEORY §3.1 (Housner 1963, angular momentum about the new pivot conserved).
+    theory §3.1 (Housner 1963, angular momentum about the new pivot conserved).
 
     Examples
     --------

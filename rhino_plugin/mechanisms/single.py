@@ -1,6 +1,6 @@
 """Single rocking block (A1): objects and densities -> M, G, I_O, R, alpha -> constants.
 
-Notation (THEORY §0, §2.1)
+Notation (theory §0, §2.1)
 --------------------------
 O : rotation axis (a line through ``point`` along unit ``direction``)
 G : centre of mass [m]; M : mass [kg]

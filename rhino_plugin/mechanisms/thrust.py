@@ -1,4 +1,4 @@
-"""Vault and roof thrusts (THEORY §5).
+"""Vault and roof thrusts (theory §5).
 
 Vault thrusts come from a **thrust table held as data** (``data/vault_thrust.json``): for each
 construction class a-e and rise/span ratio it gives the vertical load ``v`` and horizontal
@@ -7,7 +7,7 @@ bay's plan area [N/m²]. Users may load their own table (for example Ungewitter'
 in the same format. Between tabulated rise/span ratios the values are interpolated
 linearly; outside the table's range is an error.
 
-The shipped table is the documented engineering estimate of THEORY §5 (not Ungewitter's
+The shipped table is the documented engineering estimate of theory §5 (not Ungewitter's
 table, which could not be found): each diagonal rib band is a parabolic arch carrying a
 quarter of the vault's weight per springing, its thrust resolved onto the wall normal. For a
 bay of plan area ``A = s_n s_p`` (``s_n`` normal to the wall), rise ``f`` and weight
@@ -118,7 +118,7 @@ class ThrustTable:
 
 
 def roof_thrust(weight: float, span: float, rise: float, tied: bool) -> float:
-    """Horizontal thrust [N] of a pitched roof of weight [N], span and rise [m] (THEORY §5)."""
+    """Horizontal thrust [N] of a pitched roof of weight [N], span and rise [m] (theory §5)."""
     if tied:
         return 0.0
     if rise <= 0.0 or span <= 0.0:
@@ -128,7 +128,7 @@ def roof_thrust(weight: float, span: float, rise: float, tied: bool) -> float:
 
 if __name__ == "__main__":  # pragma: no cover - regenerates the shipped table
     doc = {
-        "source": "rockmech estimate of THEORY §5 (parabolic diagonal arches; not Ungewitter)",
+        "source": "rockmech estimate of theory §5 (parabolic diagonal arches; not Ungewitter)",
         "units": {"v_N_m2": "N per m^2 of bay plan area", "h_N_m2": "N per m^2 of bay plan area"},
         "rows": estimate_rows(),
     }

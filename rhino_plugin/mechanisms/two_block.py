@@ -1,10 +1,10 @@
-"""Two-block (vertical spanning strip) mechanism as planar rigid-body maths (THEORY §2.3, §3.4, §4).
+"""Two-block (vertical spanning strip) mechanism as planar rigid-body maths (theory §2.3, §3.4, §4).
 
 Everything here lives in the rocking plane: x horizontal, positive in the direction of
 collapse (outward), z up [m]. There is no CAD here; the pipeline passes planar bodies and
 hinge points.
 
-Notation (THEORY §0, §2.3)
+Notation (theory §0, §2.3)
 --------------------------
 O : base hinge of block 1 (fixed) [m]
 C : hinge between block 1 (lower) and block 2 (upper) [m]
@@ -12,7 +12,7 @@ H : top hinge of block 2, restrained horizontally and free vertically [m]
 P : point of block 2 where the overburden N acts, vertically downwards (default: H) [m]
 phi : rotation of block 1 about O, positive when C moves outward (+x) [rad]
 phi2 : rotation of block 2, positive in the sense opposite to phi, so that the bulging
-    mode has ``omega2 = dphi2/dphi > 0`` (THEORY's convention) [rad]
+    mode has ``omega2 = dphi2/dphi > 0`` (theory's convention) [rad]
 m_k, I_Gk : mass [kg] and centroidal moment of inertia [kg m²] of block k
 R1, alpha1 : distance O-G1 and its angle from the vertical [m, rad]
 R2, alpha2 : distance H-G2 and its angle from the vertical [m, rad]
@@ -23,7 +23,7 @@ Kinematics. Block 1 turns about O by phi. Block 2 is pinned to block 1 at C and 
 its own angle so that x_H stays at its rest value. The constraint is solved in closed form
 (one arcsine) on the branch that is continuous from rest; the velocity ratio
 ``omega2 = dphi2/dphi`` and its derivative follow by implicit differentiation, as for the
-four-bar of THEORY §2.4. Then (THEORY §1.1)::
+four-bar of theory §2.4. Then (theory §1.1)::
 
     M(phi) = sum_k I_Gk (dphi_k/dphi)² + m_k |dr_Gk/dphi|²,    Q(phi) = sum_k m_k dx_Gk/dphi
 
@@ -34,14 +34,14 @@ bisection). For rectangles with N at H it is the collinear configuration of O, C
 Eccentric overburden. When N acts at a point P other than H, two documented treatments are
 offered (``ECCENTRICITY_OPTIONS``):
 
-* ``"static_moment"`` (default, THEORY Eq. 23): V holds N at H; the eccentric part of N,
+* ``"static_moment"`` (default, theory Eq. 23): V holds N at H; the eccentric part of N,
   ``N (z_P - z_H)``, enters as the static moment
   ``M_F = -N d(z_P - z_H)/dphi`` at phi_cr, which for a rectangle is
   ``N xi b cos(alpha2) R1/R2``;
 * ``"potential"`` (exact linearisation): V holds N at P, phi_cr is the maximum of that V,
   and ``M_F = 0``.
 
-THEORY reports the two within about 1 % of each other for ``xi`` from 0.5 to 1.
+docs/theory.md reports the two within about 1 % of each other for ``xi`` from 0.5 to 1.
 """
 
 import math
@@ -109,7 +109,7 @@ class PlanarBody:
 
 @dataclass(frozen=True)
 class LinkageResult:
-    """Kinematic constants of a linkage mechanism about ``phi = phi_cr`` (THEORY §1.2).
+    """Kinematic constants of a linkage mechanism about ``phi = phi_cr`` (theory §1.2).
 
     Attributes
     ----------
@@ -138,7 +138,7 @@ class LinkageResult:
 
 @dataclass(frozen=True)
 class TwoBlockResult(LinkageResult):
-    """Kinematic constants of a two-block mechanism about ``phi = phi_cr`` (THEORY §1.2).
+    """Kinematic constants of a two-block mechanism about ``phi = phi_cr`` (theory §1.2).
 
     Attributes
     ----------
@@ -156,11 +156,11 @@ class TwoBlockResult(LinkageResult):
         Eqs. 4-6 [1/s], [-], [rad].
     details : dict of str to float
         ``R1``, ``alpha1``, ``R2``, ``alpha2`` (rest geometry); ``L_OC``, ``L_CH`` (hinge
-        distances) [m]; ``I_O1`` (block 1 about O), ``I_O2`` (block 2 about H, THEORY's
+        distances) [m]; ``I_O1`` (block 1 about O), ``I_O2`` (block 2 about H, theory's
         name) [kg m²];
         ``phi2_cr`` [rad], ``omega2`` (dphi2/dphi) and ``domega2`` (its derivative) at
         phi_cr; ``lam_static_exact``, the exact static multiplier ``V'(0)/(g Q(0))`` with N
-        at its own point (THEORY §1.6).
+        at its own point (theory §1.6).
     eccentricity : str
         The treatment of an eccentric overburden that was used (``ECCENTRICITY_OPTIONS``).
     """
@@ -206,7 +206,7 @@ def hinge_height(h: float, weight: float, overburden: float, f_mt: float, area: 
 
     Notes
     -----
-    THEORY §4, Eq. 17: the crack forms at the height z that minimises the lateral load
+    theory §4, Eq. 17: the crack forms at the height z that minimises the lateral load
     ``w(z) ∝ (f_mt A + N + W (h - z)/h) / (z (h - z))``, which gives::
 
         h_c = h / (1 + sqrt((N + f_mt A) / (N + W + f_mt A)))
@@ -421,14 +421,14 @@ def _check_chain(points: List[Tuple[str, Point2]], bodies: Sequence[PlanarBody])
 def two_block_constants(
     lower: PlanarBody,
     upper: PlanarBody,
-    O: Sequence[float],  # noqa: E741 (THEORY's name of the base hinge)
+    O: Sequence[float],  # noqa: E741 (theory's name of the base hinge)
     C: Sequence[float],
     H: Sequence[float],
     overburden: float = 0.0,
     overburden_point: Optional[Sequence[float]] = None,
     eccentricity: str = "static_moment",
 ) -> TwoBlockResult:
-    """Kinematic constants of the two-block mechanism O-C-H (THEORY §2.3, Eqs. 1-6).
+    """Kinematic constants of the two-block mechanism O-C-H (theory §2.3, Eqs. 1-6).
 
     Parameters
     ----------
@@ -440,7 +440,7 @@ def two_block_constants(
     overburden : float
         Vertical load N on block 2, downward [N], >= 0.
     overburden_point : (float, float), optional
-        Point of block 2 where N acts [m]; default H. THEORY's eccentric N sits at ``xi b``
+        Point of block 2 where N acts [m]; default H. theory's eccentric N sits at ``xi b``
         from H on the top face.
     eccentricity : {"static_moment", "potential"}
         Treatment of an eccentric N (module docstring, ``ECCENTRICITY_OPTIONS``). Equal
@@ -460,7 +460,7 @@ def two_block_constants(
 
     Notes
     -----
-    THEORY §1.1-1.7 with the general kinematics of the module docstring:
+    theory §1.1-1.7 with the general kinematics of the module docstring:
     ``I0 = M(phi_cr)``, ``K = -V''(phi_cr)``, ``Q = Q(phi_cr)``, ``p_eq = sqrt(K/I0)``,
     ``lam = (K phi_cr - M_F)/(g Q)``, ``phi_ov = phi_cr - M_F/K``. For rectangles with N at
     H these equal Eqs. 18-22 (``phi_cr = alpha1``, ``I0 = I_O1 + (R1/R2)² I_O2``, ...).
@@ -468,7 +468,7 @@ def two_block_constants(
     Examples
     --------
     A 0.3 m x 4 m strip with the hinge at mid-height and no overburden has ``lam = 2 alpha1``
-    (THEORY §2.3):
+    (theory §2.3):
 
     >>> res = rectangular_two_block(0.3, 4.0, 2.0, length=1.0, density=1800.0)
     >>> round(res.lam / (2.0 * math.atan(0.3 / 2.0)), 12)
@@ -535,14 +535,14 @@ def two_block_constants(
 def two_block_restitution(
     lower: PlanarBody,
     upper: PlanarBody,
-    O: Sequence[float],  # noqa: E741 (THEORY's name of the base hinge)
+    O: Sequence[float],  # noqa: E741 (theory's name of the base hinge)
     C: Sequence[float],
     H: Sequence[float],
     O2: Sequence[float],
     C2: Sequence[float],
     H2: Sequence[float],
 ) -> float:
-    """Restitution of the two-block mechanism when the hinges switch at rest (THEORY §3.4).
+    """Restitution of the two-block mechanism when the hinges switch at rest (theory §3.4).
 
     Parameters
     ----------
@@ -562,18 +562,18 @@ def two_block_restitution(
 
     Notes
     -----
-    THEORY §3.4: the impulses act only at the new hinges and at H' horizontally, which do
+    theory §3.4: the impulses act only at the new hinges and at H' horizontally, which do
     no work in the new mode, so the generalised momentum along that mode is conserved::
 
         eta = sum_k [m_k u_k- . u_k+ + I_Gk w_k- w_k+] / sum_k [m_k |u_k+|² + I_Gk (w_k+)²]
 
     with ``u = dr_G/dphi`` and ``w = dphi_k/dphi`` at rest, both modes parametrised by block
     1's rotation in the same absolute sense. The overburden is a force without inertia
-    here. For rectangles with N = 0 this equals THEORY §3.3's closed form.
+    here. For rectangles with N = 0 this equals theory §3.3's closed form.
 
     Examples
     --------
-    THEORY §3.3: two 0.30 m x 2 m blocks.
+    theory §3.3: two 0.30 m x 2 m blocks.
 
     >>> lo, up = rectangular_bodies(0.3, 4.0, 2.0, length=1.0, density=1800.0)
     >>> before = rectangular_hinges(0.3, 4.0, 2.0)
@@ -644,7 +644,7 @@ def rectangular_hinges(
 ) -> Tuple[Point2, Point2, Point2]:
     """Hinges O, C, H of a rectangular wall with inner face x = 0 and outer face x = b.
 
-    The outward mode (THEORY §2.3) has O at the base outer face, C at h_c on the inner face
+    The outward mode (theory §2.3) has O at the base outer face, C at h_c on the inner face
     and H at the top outer face; ``mirrored=True`` gives the inward mode O', C', H' (base
     inner face, h_c outer face, top inner face) [m].
     """
@@ -663,7 +663,7 @@ def rectangular_two_block(
     xi: float = 0.0,
     eccentricity: str = "static_moment",
 ) -> TwoBlockResult:
-    """Constants of a rectangular vertically spanning strip (THEORY §2.3).
+    """Constants of a rectangular vertically spanning strip (theory §2.3).
 
     Parameters
     ----------

@@ -10,8 +10,8 @@ The wall (the spec's groups) is restrained at top and bottom. In its rocking pla
 * the intermediate hinge height follows Eq. 17, ``h_c = h / (1 + sqrt((N + f_mt l b) /
   (N + W + f_mt l b)))``, and the wall is cut by the horizontal plane at ``h_c``;
 * hinges: O at the base outer edge, C at ``h_c`` on the inner face, H at the top outer edge
-  (THEORY §2.3); the negative side mirrors them about the wall's mid-plane;
-* restitution: the momentum projection of THEORY §3.4 between the two hinge sets, unless
+  (theory §2.3); the negative side mirrors them about the wall's mid-plane;
+* restitution: the momentum projection of theory §3.4 between the two hinge sets, unless
   the spec gives ``eta``.
 
 The maths of the linkage is in ``two_block``.

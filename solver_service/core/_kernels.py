@@ -7,7 +7,7 @@ the cell. Between events the linearised equation (model.py)::
 
     x'' = p_s**2 (x - s - q(t)),     q = scale * a / (G lam_s)
 
-is solved in closed form from an anchor state (THEORY §10: written about the anchor, so
+is solved in closed form from an anchor state (theory §10: written about the anchor, so
 no O(lam) terms cancel while the body chatters). Closed-form segments are at most
 ``MAX_PH / p`` long.
 
@@ -327,7 +327,7 @@ def _uplift_time(kind, c0, c1, c2, cs, ks, s, t, tb):
     """First time in ``[t, tb]`` at which the drive ``g = -s ks a`` exceeds 1, or ``-1``.
 
     The returned time is the bracket end at which ``g >= 1`` holds in floating point, so the
-    closed form started there moves outward (THEORY §10, sub-resolution uplift).
+    closed form started there moves outward (theory §10, sub-resolution uplift).
     """
     a_t, _ad_t = _accel(kind, c0, c1, c2, cs, t)
     g_t = -s * ks * a_t
@@ -687,7 +687,7 @@ def _simulate(
                             done = True
                     if ends_in_rest:
                         n_rest += 1
-                        # Rest rule (ends Zeno sequences, THEORY §10). A null excursion right
+                        # Rest rule (ends Zeno sequences, theory §10). A null excursion right
                         # after uplift in this segment holds the body until the segment ends.
                         if uplift_t >= t_sub0 and abs(vi) < v_rest_rel * p:
                             hold_until = tb
@@ -738,7 +738,7 @@ def _simulate(
 
     err_var = var_peak
     if status == 0 and mode == FLIGHT:
-        # Free rocking after the excitation: exact outcome (THEORY §1.8).
+        # Free rocking after the excitation: exact outcome (theory §1.8).
         if s > 0.0:
             p_s = p_pos
             p_o = p_neg

@@ -1,4 +1,4 @@
-"""Amplification of ground motion up the structure (THEORY.md §7).
+"""Amplification of ground motion up the structure (docs/theory.md §7).
 
 The exact pulse response spectrum of a damped linear oscillator (§7.1) and the
 square-root-sum-of-squares scale factor of Eqs. 27–28 (§7.2–7.3).
@@ -8,7 +8,7 @@ Notation
 f_n, omega_n : natural frequency of the oscillator [Hz], [rad/s]
 zeta : damping ratio [-], ``0 <= zeta < 1``
 omega_d : damped natural frequency divided by ``omega_n``, ``sqrt(1 - zeta**2)`` [-]
-f_p, omega_p, a_p : pulse frequency [Hz], [rad/s] and amplitude [m/s²] (THEORY §6.1)
+f_p, omega_p, a_p : pulse frequency [Hz], [rad/s] and amplitude [m/s²] (theory §6.1)
 r : frequency ratio ``f_p / f_n`` [-] (also the ratio of circular frequencies)
 u : displacement of the oscillator relative to the ground [m]
 R : pulse response spectrum, the peak response divided by ``a_p`` [-]
@@ -287,7 +287,7 @@ def pulse_response_spectrum(
 
     Notes
     -----
-    THEORY §7.1. The response is evaluated in closed form: during the pulse the forced
+    theory §7.1. The response is evaluated in closed form: during the pulse the forced
     damped harmonic response (particular solution plus the homogeneous part matching rest
     at ``t = 0``), grouped so that the undamped resonant case ``zeta = 0, r = 1`` is the exact
     secular limit; after the pulse the free damped vibration from the end state. Interior
@@ -382,7 +382,7 @@ def pulse_scale_factor(
 
     Notes
     -----
-    THEORY §7.3: ``SF(f_p) = sqrt(1 + (R(f_p/f_n) h/h_e)**2)``; the local pulse amplitude is
+    theory §7.3: ``SF(f_p) = sqrt(1 + (R(f_p/f_n) h/h_e)**2)``; the local pulse amplitude is
     ``SF(f_p) a_p``.
 
     Examples
@@ -419,7 +419,7 @@ def scale_factor(sa_g: float, pga_g: float, h: float, h_e: float) -> float:
 
     Notes
     -----
-    THEORY Eq. 28 (§7.3): square-root-sum-of-squares of the ground acceleration and the
+    theory Eq. 28 (§7.3): square-root-sum-of-squares of the ground acceleration and the
     response acceleration scaled linearly from ``h_e`` to ``h``.
 
     Examples
@@ -451,7 +451,7 @@ def effective_height(masses: ArrayLike, heights: ArrayLike) -> float:
 
     Notes
     -----
-    THEORY §7.2. A uniform cantilever gives ``2H/3``; a dominant tip mass gives ``H``.
+    theory §7.2. A uniform cantilever gives ``2H/3``; a dominant tip mass gives ``H``.
 
     Examples
     --------

@@ -1,4 +1,4 @@
-"""Code and paper scale factors for the acceleration at a height in a structure (THEORY §7.3–7.4).
+"""Code and paper scale factors for the acceleration at a height in a structure (theory §7.3–7.4).
 
 Each function returns a record of the value, the method, the formula and the inputs, so a
 report can show how the factor was obtained::
@@ -53,7 +53,7 @@ def sf_eq28(sa_g: float, pga_g: float, h: float, h_e: float) -> dict[str, Any]:
 
     Notes
     -----
-    THEORY Eq. 28: ``SF = sqrt(1 + (S_a/a_g · h/h_e)**2)`` (``amplification.scale_factor``).
+    theory Eq. 28: ``SF = sqrt(1 + (S_a/a_g · h/h_e)**2)`` (``amplification.scale_factor``).
 
     Examples
     --------
@@ -68,7 +68,7 @@ def sf_eq28(sa_g: float, pga_g: float, h: float, h_e: float) -> dict[str, Any]:
     }
     return {
         "value": scale_factor(**inputs),
-        "method": "Eq. 28 (SRSS of ground and modal response, THEORY §7.3)",
+        "method": "Eq. 28 (SRSS of ground and modal response, theory §7.3)",
         "formula": "sqrt(1 + (S_a/a_g * h/h_e)^2)",
         "inputs": inputs,
     }
@@ -100,7 +100,7 @@ def sf_ec8(z: float, H: float, T_a: float, T_1: float, S: float = 1.0) -> dict[s
 
     Notes
     -----
-    THEORY §7.4: ``S_a = alpha S [3(1 + z/H)/(1 + (1 - T_a/T_1)**2) - 0.5] >= alpha S``. The
+    theory §7.4: ``S_a = alpha S [3(1 + z/H)/(1 + (1 - T_a/T_1)**2) - 0.5] >= alpha S``. The
     floor means the element is never taken to accelerate less than the ground, i.e. the
     bracket is at least 1. Top of the building, rigid element: 2.5; with ``S = 1.15``: 2.875;
     with ``S = 1``, ``T_a/T_1 = 0.125``: 2.90.
@@ -142,7 +142,7 @@ def sf_nzs(h_i: float, h_n: float) -> dict[str, Any]:
 
     Notes
     -----
-    THEORY §7.4 (quoted from memory there): ``1 + h_i/6`` applies for ``h_i < 12 m``,
+    theory §7.4 (quoted from memory there): ``1 + h_i/6`` applies for ``h_i < 12 m``,
     ``1 + 10 h_i/h_n`` for ``h_i < 0.2 h_n``, and ``3.0`` always; the result is the lesser of
     the applicable values. Read this way ``C_Hi <= 3`` everywhere and ``C_Hi = 3`` where
     neither condition holds. Basantapur: ``1 + 4.6/6 = 1.77``.

@@ -1,6 +1,6 @@
 """Overturning boundaries of one-cycle pulses, their library, and mechanism envelopes.
 
-Notation (THEORY §6.2)
+Notation (theory §6.2)
 ----------------------
 Omega : pulse frequency over the frequency parameter, ``omega_p / p_eq`` [-]
 A : pulse amplitude over the uplift acceleration, ``a_p / (g lam)`` [-]
@@ -27,7 +27,7 @@ curves jump where the overturning mode changes (impact / no impact); across such
 the interpolation errs on the safe side there. Use ``exact=True`` to compute a mechanism's
 envelope directly where the exact jump position matters.
 
-One-sided rocking: the envelope is eta-independent (THEORY §6.4): the pulse is applied in
+One-sided rocking: the envelope is eta-independent (theory §6.4): the pulse is applied in
 both directions with no rebound (eta = 0) and the lower curve governs; in practice this is
 the pulse that first pushes against the restraint (closed form (b) of §6.3).
 """
@@ -567,7 +567,7 @@ def mechanism_envelope(
     Parameters
     ----------
     model : RockingModel
-        The mechanism. Two-sided needs ``eta``; one-sided does not (THEORY §6.4).
+        The mechanism. Two-sided needs ``eta``; one-sided does not (theory §6.4).
     f_p : array_like
         Pulse frequencies [Hz], > 0.
     library : OverturningLibrary, optional

@@ -3,9 +3,9 @@
 Between impacts the motion is solved in closed form: exactly for one-sine and one-cosine
 pulses, and exactly for sampled records taken as piecewise-linear acceleration. Impact,
 uplift, turning-point and ``|phi|/phi_ov = 1`` times are found to machine precision
-(THEORY §1.8, §6.3, §10; the argument that no event is missed is in ``_kernels``).
+(theory §1.8, §6.3, §10; the argument that no event is missed is in ``_kernels``).
 
-Rules (all documented in THEORY §1.8 and §10):
+Rules (all documented in theory §1.8 and §10):
 
 * uplift from rest when the drive exceeds the static multiplier, ``-a_g > g lam+`` or
   ``a_g > g lam-``; the crossing time is exact;
@@ -248,7 +248,7 @@ def simulate(
         Factor applied to the acceleration [-], > 0.
     criterion : {"ratio", "exact"}, optional
         Overturning verdict reported as ``overturned``; defaults to ``"exact"`` for pulses
-        and ``"ratio"`` for records (THEORY decisions).
+        and ``"ratio"`` for records (theory §0.3).
     dense : bool
         Return the time series (``t``, ``ratio``): every segment end and event.
     x0 : float

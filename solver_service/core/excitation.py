@@ -1,10 +1,10 @@
 """Ground excitations the solvers accept: one-cycle pulses and sampled records.
 
-Sign convention (Housner, THEORY §0): a positive ground acceleration opposes positive
+Sign convention (Housner, theory §0): a positive ground acceleration opposes positive
 rotation. A pulse with ``a_p > 0`` therefore first drives a body towards *negative*
 rotation; ``a_p < 0`` first drives it open (positive rotation).
 
-Pulse convention A (Zhang & Makris 2001, THEORY §10): the pulse starts at ``t = 0``
+Pulse convention A (Zhang & Makris 2001, theory §10): the pulse starts at ``t = 0``
 and ends at ``t = 1/f_p``; the body uplifts when the acceleration first exceeds the
 uplift threshold, and the pulse ends at phase 2π regardless of when uplift happened.
 """

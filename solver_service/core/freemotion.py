@@ -1,4 +1,4 @@
-"""Exact outcome of free rocking once the excitation has ended (THEORY §1.8, §6.3).
+"""Exact outcome of free rocking once the excitation has ended (theory §1.8, §6.3).
 
 Between impacts the free linearised motion on side ``s`` conserves
 ``E = (x'/p)**2 - (s*x - 1)**2``. From a state ``(x, v)`` the body overturns on the current
@@ -64,7 +64,7 @@ def free_rocking(
 
     Notes
     -----
-    THEORY §1.8 (invariant and overturning test) and §6.3 ("after the pulse").
+    theory §1.8 (invariant and overturning test) and §6.3 ("after the pulse").
 
     Examples
     --------

@@ -1,4 +1,4 @@
-"""The linearised rocking model of one mechanism (THEORY.md §1).
+"""The linearised rocking model of one mechanism (docs/theory.md §1).
 
 Notation
 --------
@@ -11,13 +11,13 @@ phi_ov : overturning rotation of a side [rad]
 eta : coefficient of restitution on the angular velocity at impact [-];
     ``0 <= eta <= 1`` for two-sided rocking, ``-1 <= eta <= 0`` for one-sided rebound.
 
-Equation of motion in ``x`` (Eq. 3 of THEORY.md divided by ``lam``), on side ``s = ±1``::
+Equation of motion in ``x`` (Eq. 3 of docs/theory.md divided by ``lam``), on side ``s = ±1``::
 
     x'' = p_s**2 * (x - s - a_g(t) / (g * lam_s))
 
 with Housner's sign convention: a positive ground acceleration ``a_g`` opposes positive
 rotation. At an impact on ``x = 0`` the angular velocity is scaled by ``eta``; in ``x`` this
-becomes ``x' -> eta * (phi_ov_old / phi_ov_new) * x'`` (THEORY §1.8).
+becomes ``x' -> eta * (phi_ov_old / phi_ov_new) * x'`` (theory §1.8).
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """Housner's nonlinear rocking block, integrated with ``scipy.integrate.solve_ivp``.
 
-The linearised model of THEORY §1 replaces ``sin``/``cos`` of Housner's equation by their
+The linearised model of theory §1 replaces ``sin``/``cos`` of Housner's equation by their
 values near ``phi = alpha``. This module integrates the full equation for one rigid block on a
-rigid base, so that the linearisation error of a case can be measured (THEORY §6.5 caveat).
+rigid base, so that the linearisation error of a case can be measured (theory §6.5 caveat).
 
 Notation
 --------
@@ -18,7 +18,7 @@ x : ``phi/alpha`` [-], the ratio reported (comparable with ``phi/phi_ov`` of the
 s : side in motion, +1 or -1
 G : standard gravity [m/s²]
 
-Equation of motion (THEORY §2.1, mirrored for ``phi < 0``)::
+Equation of motion (theory §2.1, mirrored for ``phi < 0``)::
 
     phi'' = -p**2 * (s sin(alpha - s phi) + a_g/G cos(alpha - s phi)),   s = sgn(phi)
 
@@ -145,7 +145,7 @@ class HousnerBlock:
         Notes
         -----
         ``R = sqrt(b² + h²)/2``, ``I_O = 4/3 M R²`` so ``p = sqrt(3 G / (4 R))``,
-        ``alpha = atan(b/h)`` (THEORY §2.1); ``eta`` from Eq. 25 (THEORY §3.1).
+        ``alpha = atan(b/h)`` (theory §2.1); ``eta`` from Eq. 25 (theory §3.1).
 
         Examples
         --------
@@ -161,14 +161,14 @@ class HousnerBlock:
         return cls(p=math.sqrt(3.0 * G / (4.0 * r)), alpha=alpha, eta=eta_f)
 
     def linearised(self) -> RockingModel:
-        """Return the linearised model: ``p_eq = p``, ``lam = phi_ov = alpha`` (THEORY §2.1)."""
+        """Return the linearised model: ``p_eq = p``, ``lam = phi_ov = alpha`` (theory §2.1)."""
         return RockingModel.symmetric(
             p_eq=self.p, lam=self.alpha, eta=self.eta, one_sided=self.one_sided, name=self.name
         )
 
 
 class _HousnerPhysics(_Physics):
-    """Housner's equation in ``x = phi/alpha`` for the shared engine (THEORY §2.1)."""
+    """Housner's equation in ``x = phi/alpha`` for the shared engine (theory §2.1)."""
 
     def __init__(self, block: HousnerBlock, method: str, rtol: float, atol: float) -> None:
         self.block = block
@@ -181,7 +181,7 @@ class _HousnerPhysics(_Physics):
         return self.block.p
 
     def uplift_accel(self, s: int) -> float:
-        """``G tan(alpha)`` [m/s²] (THEORY §1.8)."""
+        """``G tan(alpha)`` [m/s²] (theory §1.8)."""
         return G * math.tan(self.block.alpha)
 
     def rhs(self, s: int, accel: Accel) -> Rhs:
@@ -197,12 +197,12 @@ class _HousnerPhysics(_Physics):
         return fun
 
     def collapse_level(self, s: int, amax: float) -> float:
-        """``min(alpha + atan(amax/G), pi/2) / alpha`` (THEORY §10)."""
+        """``min(alpha + atan(amax/G), pi/2) / alpha`` (theory §10)."""
         alpha = self.block.alpha
         return min(alpha + math.atan(amax / G), 0.5 * math.pi) / alpha
 
     def impact(self, s: int, v: float) -> tuple[int, float]:
-        """Return the new side and ``v`` [1/s]: ``phi' -> eta phi'`` (THEORY §1.8)."""
+        """Return the new side and ``v`` [1/s]: ``phi' -> eta phi'`` (theory §1.8)."""
         return (1 if self.one_sided else -s), self.eta * v
 
     def energy(self, s: int, x: float, v: float) -> float:
@@ -247,7 +247,7 @@ class _HousnerPhysics(_Physics):
         and the top of the potential is ``E = 1`` at ``|phi| = alpha``. Outward motion with
         ``E > 1`` overturns; past the top, the body overturns unless it moves back inward with
         ``E > 1``. An impact multiplies the kinetic energy by ``eta²``, so the excursion after
-        the next impact is the last one that can be larger (THEORY §1.8, nonlinear analogue).
+        the next impact is the last one that can be larger (theory §1.8, nonlinear analogue).
         """
         nfev = 0
         y, w = s * x, s * v
@@ -304,7 +304,7 @@ def simulate_nonlinear(
         Factor on the acceleration [-], > 0.
     method : str
         ``solve_ivp`` method (``reference.IVP_METHODS``). Never use scipy's default
-        tolerances here (THEORY §10).
+        tolerances here (theory §10).
     rtol, atol : float
         ``solve_ivp`` tolerances [-] on ``x = phi/alpha`` and [1/s] on ``dx/dt``. The
         defaults are the setting ``benchmarks/stiff.py`` recommends (docs/numerics.md): on
@@ -341,7 +341,7 @@ def simulate_nonlinear(
 
     Notes
     -----
-    Equation of THEORY §2.1 mirrored for ``phi < 0``. Uplift from rest when
+    Equation of theory §2.1 mirrored for ``phi < 0``. Uplift from rest when
     ``|a_g| > G tan(alpha)`` in the opening direction (§1.8). Impact ``phi' -> eta phi'``
     (§1.8). During the excitation the block has certainly collapsed once it moves outward
     past ``alpha + atan(max|a_g|/G)``, capped at ``pi/2`` (§10); after it, the energy of the
@@ -431,7 +431,7 @@ def linearisation_error(
     The linear run uses the exact integrator (``exact.simulate``) when it is importable;
     otherwise ``simulate_ivp`` at ``rtol = LINEAR_RTOL``. Both models share
     ``p`` and ``phi_ov = alpha`` but not the uplift threshold (``G alpha`` linear,
-    ``G tan alpha`` nonlinear, THEORY §1.8), which is part of the linearisation error.
+    ``G tan alpha`` nonlinear, theory §1.8), which is part of the linearisation error.
     """
     nl = simulate_nonlinear(block, excitation, scale=scale, **kw)
     lin = _simulate_linear(block.linearised(), excitation, scale, kw)
@@ -488,7 +488,7 @@ def linearisation_estimate(alpha: float, omega: Optional[float] = None) -> float
     Parameters
     ----------
     alpha : float
-        Slenderness [rad]; for a mechanism, its ``lam`` (the equivalent block of THEORY §1.4).
+        Slenderness [rad]; for a mechanism, its ``lam`` (the equivalent block of theory §1.4).
     omega : float, optional
         Pulse frequency ratio ``omega_p / p`` [-]. Given: the error of the minimum
         overturning amplitude of a one-sine pulse. None: the error of the peak rotation on
@@ -538,7 +538,7 @@ def linearisation_warnings(model: RockingModel, omega_p: Optional[float] = None)
     ----------
     model : RockingModel
         The mechanism; ``alpha`` is taken as ``lam`` of each side (for a single block
-        ``lam = alpha``, THEORY §2.1; for other mechanisms the equivalent block of §1.4).
+        ``lam = alpha``, theory §2.1; for other mechanisms the equivalent block of §1.4).
     omega_p : float, optional
         Circular pulse frequency [rad/s]; each side is looked up at ``omega_p / p_eq``.
         None for records.

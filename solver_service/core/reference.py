@@ -62,7 +62,7 @@ __all__ = ["IVP_METHODS", "MAX_IMPACTS", "ZENO_VREL", "simulate_ivp"]
 #: Methods of ``scipy.integrate.solve_ivp`` the references accept.
 IVP_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
 
-#: Rest rule: after an impact the body rests when ``|v| < ZENO_VREL * p`` [-] (THEORY §10).
+#: Rest rule: after an impact the body rests when ``|v| < ZENO_VREL * p`` [-] (theory §10).
 ZENO_VREL = 1e-9
 
 #: Default hard cap on the number of impacts; the run stops with status -1 beyond it.
@@ -385,7 +385,7 @@ class _Physics:
 
 
 class _LinearPhysics(_Physics):
-    """Linearised rocking (THEORY §1.4, §1.8), ``x'' = p_s²(x - s - a_g/(G lam_s))``."""
+    """Linearised rocking (theory §1.4, §1.8), ``x'' = p_s²(x - s - a_g/(G lam_s))``."""
 
     def __init__(self, model: RockingModel) -> None:
         self.model = model
@@ -398,11 +398,11 @@ class _LinearPhysics(_Physics):
         return self._sides[s].p_eq
 
     def uplift_accel(self, s: int) -> float:
-        """``G * lam_s`` [m/s²] (THEORY §1.8)."""
+        """``G * lam_s`` [m/s²] (theory §1.8)."""
         return G * self._sides[s].lam
 
     def rhs(self, s: int, accel: Accel) -> Rhs:
-        """Eq. 3 of THEORY §1.4 divided by ``lam``."""
+        """Eq. 3 of theory §1.4 divided by ``lam``."""
         side = self._sides[s]
         p2 = side.p_eq**2
         k = 1.0 / (G * side.lam)
@@ -414,17 +414,17 @@ class _LinearPhysics(_Physics):
         return fun
 
     def collapse_level(self, s: int, amax: float) -> float:
-        """``1 + amax/(G lam_s)`` (THEORY §10)."""
+        """``1 + amax/(G lam_s)`` (theory §10)."""
         return 1.0 + amax / (G * self._sides[s].lam)
 
     def impact(self, s: int, v: float) -> tuple[int, float]:
-        """THEORY §1.8: ``v -> eta (phi_ov_s/phi_ov_new) v`` two-sided, ``eta v`` one-sided."""
+        """Theory §1.8: ``v -> eta (phi_ov_s/phi_ov_new) v`` two-sided, ``eta v`` one-sided."""
         if self.one_sided:
             return 1, self.eta * v
         return -s, self.eta * (self._sides[s].phi_ov / self._sides[-s].phi_ov) * v
 
     def free(self, s: int, x: float, v: float, zeno_vrel: float) -> _FreeOutcome:
-        """Exact free rocking (``freemotion.free_rocking``, THEORY §1.8)."""
+        """Exact free rocking (``freemotion.free_rocking``, theory §1.8)."""
         o = s if self.one_sided else -s
         r_so = self._sides[s].phi_ov / self._sides[o].phi_ov
         c, dt_cross, peak, dt_peak = free_rocking(
@@ -561,7 +561,7 @@ def _run(
 
     Notes
     -----
-    Rules of THEORY §1.8 (uplift, impact, one-sided rebound), §10 (rest rule, collapse
+    Rules of theory §1.8 (uplift, impact, one-sided rebound), §10 (rest rule, collapse
     criterion during the excitation) and §6.3 (free motion after it).
     """
     wall0 = time.perf_counter()
@@ -818,7 +818,7 @@ def simulate_ivp(
 
     Notes
     -----
-    Equation of motion ``x'' = p_s²(x - s - a_g/(G lam_s))`` (THEORY §1.4, §1.8). Uplift from
+    Equation of motion ``x'' = p_s²(x - s - a_g/(G lam_s))`` (theory §1.4, §1.8). Uplift from
     rest when ``a_g < -G lam_pos`` or ``a_g > G lam_neg`` (§1.8), located in closed form (sine
     pulse) or by linear interpolation between samples (records are piecewise linear).
     Impacts (§1.8) and the rest rule (§10) as in the exact integrator. During the excitation

@@ -7,10 +7,10 @@ Two overturning verdicts are reported, because the method and the physics differ
 ``collapsed``
     The exact outcome: the body can no longer come back. During the excitation this is
     certain once it moves outward past ``1 + max|a_g|/(g lam)`` (in ``x``); after the
-    excitation the free-rocking invariant of THEORY §1.8 decides exactly.
+    excitation the free-rocking invariant of theory §1.8 decides exactly.
 
 ``overturned`` follows ``criterion``: ``"ratio"`` (the default for records) or ``"exact"``
-(the default for pulses, THEORY §10, since a decelerating pulse can pull a body back).
+(the default for pulses, theory §10, since a decelerating pulse can pull a body back).
 """
 
 from __future__ import annotations

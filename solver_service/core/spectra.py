@@ -1,4 +1,4 @@
-"""Elastic response spectra of ground-motion records (the ``S_a(T_n)`` of Eq. 28, THEORY §7.3).
+"""Elastic response spectra of ground-motion records (the ``S_a(T_n)`` of Eq. 28, theory §7.3).
 
 The oscillator is ``ü + 2 zeta omega_n u̇ + omega_n**2 u = -a_g(t)`` (§7.1), at rest at the
 first sample, with ``a_g`` linear between samples. It is integrated exactly with the

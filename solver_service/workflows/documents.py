@@ -244,7 +244,7 @@ def envelope_doc(
 ) -> tuple[dict[str, Any], list[Envelope]]:
     """Ground-level envelopes of every mechanism and the critical bands.
 
-    Mechanisms with ``amplification`` are corrected by ``SF(f_p)`` (THEORY §7); the others
+    Mechanisms with ``amplification`` are corrected by ``SF(f_p)`` (theory §7); the others
     skip that work entirely.
 
     Returns

@@ -3,7 +3,7 @@
 The benchmark measures the exact integrator against this reference, so the reference itself
 is verified here, independently of the project's solvers: free-rocking times in closed form,
 the Zhang & Makris (2001) mode-1 overturning onset and the closed-form mode-2 onset
-(THEORY §6.3, §6.5).
+(theory §6.3, §6.5).
 """
 
 from __future__ import annotations
@@ -75,7 +75,7 @@ def test_no_motion_below_the_uplift_threshold() -> None:
 
 
 def test_zhang_makris_mode1_onset_at_eta_09_omega_5() -> None:
-    # THEORY §6.5: first overturning (one impact) at A = 3.019 (Zhang & Makris: 3.01);
+    # theory §6.5: first overturning (one impact) at A = 3.019 (Zhang & Makris: 3.01);
     # bisection on the collapse verdict to a bracket of 1e-4.
     model = mpref.MPModel.symmetric(P_EQ, 0.2, 0.9)
 
@@ -97,9 +97,9 @@ def test_zhang_makris_mode1_onset_at_eta_09_omega_5() -> None:
 
 
 def test_mode2_onset_matches_closed_form_to_1e10() -> None:
-    # THEORY §6.3(a) (Zhang & Makris 2001 Eq. 47): overturning without impact starts at
+    # theory §6.3(a) (Zhang & Makris 2001 Eq. 47): overturning without impact starts at
     # A = 1/sin(psi), Omega sin(psi) - cos(psi) = -exp(-(2 pi - psi)/Omega). Just below it
-    # lies the "safe cape" (THEORY §6.5), so the verdict flips across the closed form.
+    # lies the "safe cape" (theory §6.5), so the verdict flips across the closed form.
     omega = 5.0
     with mp.workdps(30):
         om = mpf(omega)

@@ -1,4 +1,4 @@
-"""Spec + real .3dm scene -> kinematic constants, against hand formulas (THEORY §2.1, §2.2, §3)."""
+"""Spec + real .3dm scene -> kinematic constants, against hand formulas (theory §2.1, §2.2, §3)."""
 
 from __future__ import annotations
 
@@ -272,7 +272,7 @@ def test_loaded_wall_lambda_matches_the_exact_static_multiplier(tmp_path: Path) 
         "F.tie_bars[0]": None,
     }
     lam = f["positive"]["lam"]
-    # THEORY §2.2's check (a façade with a moderate thrust and a tie); measured 0.68 %. The
+    # theory §2.2's check (a façade with a moderate thrust and a tie); measured 0.68 %. The
     # linearisation difference grows with the thrust: 1.4 % with a class-c vault here.
     assert lam == pytest.approx(summary["static_multiplier_exact"], rel=0.01)
     # Masses: wall + bearing half-slab + vault V/g; M_c* adds the abutting half-slab.

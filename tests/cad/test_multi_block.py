@@ -1,8 +1,8 @@
-"""Three blocks, four hinges (THEORY §2.4, Eq. 24; restitution §3.4) against exact references.
+"""Three blocks, four hinges (theory §2.4, Eq. 24; restitution §3.4) against exact references.
 
 References: Makris & Vassiliou's exact equivalence for the symmetric rocking frame, an
 independent brute-force closure (written here) differentiated by Richardson-extrapolated
-finite differences, THEORY §2.4's closed forms in angle notation, and Housner's Eq. 25.
+finite differences, theory §2.4's closed forms in angle notation, and Housner's Eq. 25.
 """
 
 from __future__ import annotations
@@ -50,7 +50,7 @@ def mv_frame(b: float, h: float, gamma: float, span: float = 2.5) -> tuple[Any, 
 
 
 def mv_reference(b: float, h: float, gamma: float) -> dict[str, float]:
-    """Makris & Vassiliou (2013): the frame is Housner's block with p scaled (THEORY §2.4)."""
+    """Makris & Vassiliou (2013): the frame is Housner's block with p scaled (theory §2.4)."""
     alpha = math.atan(b / h)
     big_r = 0.5 * math.hypot(b, h)
     p = math.sqrt(3 * G / (4 * big_r))
@@ -251,7 +251,7 @@ def test_energy_derivatives_match_finite_differences_of_brute_force_closure(
 
 @pytest.mark.parametrize(("name", "blocks", "hinges", "direction"), linkages())
 def test_constants_match_theory_closed_forms_in_angle_notation(name, blocks, hinges, direction):
-    """THEORY §2.4's formulas (theta anticlockwise) evaluated on the brute-force geometry."""
+    """Theory §2.4's formulas (theta anticlockwise) evaluated on the brute-force geometry."""
     res = four_bar_constants(blocks, *hinges, direction=direction)
     sense = expected_sense(hinges, direction)
     t = sense * res.phi_cr
@@ -391,7 +391,7 @@ def test_portal_frame_mass_properties_match_polygon_integration():
 def impulse_restitution(
     blocks: Sequence[PlanarBody], old: Sequence[Any], new: Sequence[Any]
 ) -> float:
-    """Newton impact of three rigid bodies: impulses at the new hinges only (THEORY §3.4).
+    """Newton impact of three rigid bodies: impulses at the new hinges only (theory §3.4).
 
     Unknowns: post-impact (vx, vz, omega) of each block and the impulses at A', B', C', D'.
     The pre-impact state is the old hinge set's mode with block 1 turning at 1 rad/s.

@@ -1,5 +1,5 @@
 """Two-block mechanism: general planar maths against an independent brute-force model,
-THEORY §2.3 closed forms (Eqs. 18-23), §3.3-3.4 restitution and §4 hinge height (Eq. 17).
+theory §2.3 closed forms (Eqs. 18-23), §3.3-3.4 restitution and §4 hinge height (Eq. 17).
 
 The brute-force model here shares nothing with the module: polygon corners are moved as
 complex numbers, the top-hinge constraint is solved with scipy's brentq, V and the centres of
@@ -34,7 +34,7 @@ from shared_schema.errors import GeometryError, InputError
 G = 9.80665
 RHO = 1800.0
 LENGTH = 1.2
-#: Claimed agreement of the general solution with the exact model (THEORY §2.3: "machine
+#: Claimed agreement of the general solution with the exact model (theory §2.3: "machine
 #: precision"; the finite differences below resolve about 1e-10).
 RTOL_EXACT = 1e-8
 
@@ -79,7 +79,7 @@ class BruteForce:
 
     block1: list[complex]
     block2: list[complex]
-    O: complex  # noqa: E741 (THEORY's hinge names)
+    O: complex  # noqa: E741 (theory's hinge names)
     C: complex
     H: complex
     N: float = 0.0
@@ -189,7 +189,7 @@ def module_result(model: BruteForce, eccentricity: str = "potential") -> tb.TwoB
 
 
 def closed_forms(b: float, h: float, h_c: float, N: float) -> dict[str, float]:
-    """THEORY Eqs. 18-22 for a rectangular strip with N at H."""
+    """Theory Eqs. 18-22 for a rectangular strip with N at H."""
     h1, h2 = h_c, h - h_c
     m1, m2 = RHO * LENGTH * b * h1, RHO * LENGTH * b * h2
     r1, r2 = 0.5 * math.hypot(b, h1), 0.5 * math.hypot(b, h2)
@@ -302,7 +302,7 @@ def eccentric_pair(b, h, n_over_w, f_mt, xi):
     return static, exact
 
 
-# THEORY §2.3: "for xi = 0.5-1 the M_F treatment is within about 1 % of the exact
+# theory §2.3: "for xi = 0.5-1 the M_F treatment is within about 1 % of the exact
 # linearisation". h_c from Eq. 17. This holds for slender strips (b/h = 1/30 for any N up to
 # W, and b/h = 0.075 with f_mt = 0.1 MPa at xi = 0.5); see the next test for where it fails.
 @pytest.mark.parametrize("xi", [0.5, 1.0])
@@ -324,7 +324,7 @@ def test_static_moment_within_one_percent_of_exact_linearisation(b, h, n_over_w,
 def test_static_moment_overestimates_lam_by_more_than_one_percent_for_thicker_walls(
     b, h, n_over_w, xi, lam_excess
 ):
-    # Recorded limit of THEORY's 1 % claim (f_mt = 0, h_c from Eq. 17): the static-moment
+    # Recorded limit of theory's 1 % claim (f_mt = 0, h_c from Eq. 17): the static-moment
     # treatment is unconservative, lam too high by 1.8-7.5 % for b/h = 0.075-0.15.
     static, exact = eccentric_pair(b, h, n_over_w, 0.0, xi)
     assert static.lam / exact.lam - 1 == pytest.approx(lam_excess, abs=5e-4)
@@ -337,7 +337,7 @@ def test_overburden_at_h_makes_both_eccentricity_options_equal():
 
 
 def test_equal_blocks_reproduce_theory_table_lam_and_exact_static_multiplier():
-    # THEORY §1.6 table, "two-block wall": lam = 0.2978 against the exact 0.3000. Virtual
+    # theory §1.6 table, "two-block wall": lam = 0.2978 against the exact 0.3000. Virtual
     # work at rest for h1 = h2 without N gives the exact multiplier 2 b / h1 = 0.3.
     res = rectangular_two_block(0.3, 4.0, 2.0, LENGTH, RHO)
     assert round(res.lam, 4) == 0.2978
@@ -392,7 +392,7 @@ def eta_rect(b: float, h1: float, h2: float) -> float:
 
 
 def eta_theory_closed_form(b: float, h1: float, h2: float) -> float:
-    """THEORY §3.3 closed form for rectangles, N = 0, at theta = 0."""
+    """Theory §3.3 closed form for rectangles, N = 0, at theta = 0."""
     m1, m2 = b * h1, b * h2
     i1, i2 = m1 * (b * b + h1 * h1) / 12, m2 * (b * b + h2 * h2) / 12
     w = h1 / h2

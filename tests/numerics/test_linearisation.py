@@ -2,7 +2,7 @@
 
 The shipped table (``solver_service/data/linearisation_map.npz``) is written by
 ``benchmarks/linearisation_map.py``; these tests recompute points of it with the solvers,
-check its trends against the uplift-threshold argument of THEORY §8.5, and check that the
+check its trends against the uplift-threshold argument of theory §8.5, and check that the
 API and the CLI warn where the linear model is off by more than 10 %.
 """
 
@@ -56,7 +56,7 @@ def test_slender_blocks_are_linear_and_stocky_ones_are_not() -> None:
     assert np.all(err[tab["alpha"] <= 0.03] < 0.01)
     assert np.all(err[tab["alpha"] >= 1.0] > WARN_LINEARISATION)
     # At low Omega the error is the uplift-threshold mismatch: the linear model uplifts at
-    # g alpha, the block at g tan(alpha) (THEORY §8.5), so a_lin/a_nl ~ alpha/tan(alpha).
+    # g alpha, the block at g tan(alpha) (theory §8.5), so a_lin/a_nl ~ alpha/tan(alpha).
     j = 0
     for i, alpha in enumerate(tab["alpha"]):
         ratio = alpha / math.tan(alpha)

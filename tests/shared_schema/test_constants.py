@@ -18,7 +18,7 @@ from shared_schema.constants import (
 )
 from shared_schema.errors import InputError, RockmechError
 
-# Published-table form, as in the brief (THEORY §8 style wall mechanism).
+# Published-table form, as in the brief (theory §8 style wall mechanism).
 W1 = {
     "id": "W1",
     "rocking": "two_sided",
@@ -30,7 +30,7 @@ W1 = {
 
 
 def rectangular_block(b=0.5, h=3.0, density=2000.0, length=1.0):
-    """Physical constants of a rectangular block rocking about a base corner (THEORY §2.1)."""
+    """Physical constants of a rectangular block rocking about a base corner (theory §2.1)."""
     mass = density * b * h * length
     r = 0.5 * math.hypot(b, h)
     alpha = math.atan(b / h)

@@ -35,7 +35,7 @@ def test_asymmetric_loaded_mechanism_keeps_side_specific_constants():
         {"id": "L1", "positive": LOADED_SIDE, "negative": LOADED_SIDE, "eta": 0.8}
     )
     model = to_rocking_model(mech)
-    # THEORY Eqs. 4-6 and §1.8 with K phi_cr = 4000 N m, M_F = 1000 N m, g Q = 19613.3 N.
+    # theory Eqs. 4-6 and §1.8 with K phi_cr = 4000 N m, M_F = 1000 N m, g Q = 19613.3 N.
     assert model.positive.p_eq == pytest.approx(2.0, rel=1e-15)
     assert model.positive.lam == pytest.approx(3000.0 / 19613.3, rel=1e-12)
     assert model.positive.phi_ov == pytest.approx(0.075, rel=1e-12)

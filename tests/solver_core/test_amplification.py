@@ -1,4 +1,4 @@
-"""Verification of the pulse response spectrum and the Eq. 28 scale factor (THEORY §7)."""
+"""Verification of the pulse response spectrum and the Eq. 28 scale factor (theory §7)."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from solver_service.core.amplification import (
     sdof_pulse_peak,
 )
 
-# THEORY §7.1 table, zeta = 0.05, one-cycle sine pulse (computed by another author).
+# theory §7.1 table, zeta = 0.05, one-cycle sine pulse (computed by another author).
 TABLE_RATIOS = [0.1, 0.2, 0.3, 0.5, 0.7, 0.8, 0.9, 1.0, 1.2, 1.5, 2.0, 3.0, 5.0]
 TABLE_PSEUDO = [1.04, 1.04, 1.35, 1.62, 2.58, 2.77, 2.79, 2.70, 2.34, 1.79, 1.15, 0.56, 0.21]
 TABLE_RELATIVE = [0.09, 0.20, 0.36, 0.79, 1.99, 2.32, 2.54, 2.69, 2.35, 1.82, 1.73, 1.47, 1.21]
@@ -89,7 +89,7 @@ def reference_peaks(
     return peaks
 
 
-# --- THEORY §7.1 table ----------------------------------------------------------------------
+# --- theory §7.1 table ----------------------------------------------------------------------
 
 
 @pytest.mark.parametrize(("ratio", "expected"), list(zip(TABLE_RATIOS, TABLE_PSEUDO)))

@@ -1,4 +1,4 @@
-"""Scale factors of Eq. 28, EN 1998-1 §4.3.5.2 and NZS 1170.5 §8.3 (THEORY §7.3–7.4)."""
+"""Scale factors of Eq. 28, EN 1998-1 §4.3.5.2 and NZS 1170.5 §8.3 (theory §7.3–7.4)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from solver_service.core.codes import sf_ec8, sf_eq28, sf_nzs
 
 @pytest.mark.parametrize(("pga_g", "expected"), [(0.155, 1.595), (0.158, 1.576)])
 def test_eq28_reproduces_basantapur_check(pga_g: float, expected: float) -> None:
-    # THEORY §7.3: S_a = 0.19 g, h = 4.60 m, h_e = 4.54 m.
+    # theory §7.3: S_a = 0.19 g, h = 4.60 m, h_e = 4.54 m.
     out = sf_eq28(0.19, pga_g, 4.60, 4.54)
     assert round(out["value"], 3) == expected
     assert out["inputs"] == {"sa_g": 0.19, "pga_g": pga_g, "h": 4.60, "h_e": 4.54}
@@ -51,7 +51,7 @@ def test_nzs_takes_the_lesser_of_the_applicable_values(
 def test_ec8_top_of_building_values_of_theory_7_4(
     T_a: float, T_1: float, S: float, expected: float
 ) -> None:
-    # THEORY §7.4 quotes the last as 2.90 (two decimals): 6/1.765625 - 0.5 = 2.8982.
+    # theory §7.4 quotes the last as 2.90 (two decimals): 6/1.765625 - 0.5 = 2.8982.
     out = sf_ec8(z=8.0, H=8.0, T_a=T_a, T_1=T_1, S=S)
     assert round(out["value"], 3) == expected
     assert out["inputs"]["S"] == S and out["inputs"]["z"] == 8.0

@@ -1,4 +1,4 @@
-"""Overturning boundaries, the library, envelopes and the critical mechanism (THEORY §6-§7)."""
+"""Overturning boundaries, the library, envelopes and the critical mechanism (theory §6-§7)."""
 
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ from solver_service.core.reference import simulate_ivp
 from solver_service.workflows.documents import envelope_doc, frequency_grid
 
 OMEGA = np.array([0.25, 0.5, 1, 2, 3, 4, 5, 6, 8, 10], dtype=float)
-# THEORY §6.5, minimum overturning A = a_p/(g lam) (3 decimals printed).
+# theory §6.5, minimum overturning A = a_p/(g lam) (3 decimals printed).
 TABLE = {
     0.7: [1.029, 1.076, 1.142, 1.256, 1.552, 5.239, 7.168, 9.417, 14.871, 21.600],
     0.8: [1.028, 1.071, 1.137, 1.239, 1.457, 2.398, 7.168, 9.417, 14.871, 21.600],
@@ -42,7 +42,7 @@ LOW_OMEGA_DISAGREEMENTS = {(0.7, 0.5), (0.8, 0.5), (0.9, 0.25), (1.0, 0.5)}
 
 
 def closed_form(omega: float, case: str) -> float:
-    """Mode-2 (no impact) overturning amplitude, THEORY §6.3 (a) and (b)."""
+    """Mode-2 (no impact) overturning amplitude, theory §6.3 (a) and (b)."""
     sign, span = (1.0, 2 * math.pi) if case == "a" else (-1.0, math.pi)
 
     def f(psi: float) -> float:
@@ -103,7 +103,7 @@ def test_low_omega_entries_are_confirmed_by_an_independent_integrator(
         pulse = Pulse(a_p=-a_min * factor, f_p=omega / (2 * math.pi))
         ref = simulate_ivp(model, pulse, rtol=1e-12, atol=1e-14)
         if factor < 1 and ref.collapsed:
-            # Close to the threshold the outcome alternates on 1e-4 scales (THEORY §10): the
+            # Close to the threshold the outcome alternates on 1e-4 scales (theory §10): the
             # scan resolves the first edge only to its step; the edge itself must be real.
             continue
         assert ref.collapsed is expected

@@ -47,7 +47,7 @@ def zeros(duration: float = 8.0, dt: float = 0.01) -> SampledAccel:
     return SampledAccel(np.zeros(round(duration / dt) + 1), dt)
 
 
-# --- Zhang & Makris (2001), THEORY §6.5: eta = 0.9, Omega = 5 -------------------------------
+# --- Zhang & Makris (2001), theory §6.5: eta = 0.9, Omega = 5 -------------------------------
 
 
 def test_zhang_makris_first_overturning_amplitude() -> None:
@@ -65,7 +65,7 @@ def test_zhang_makris_safe_band_edges() -> None:
 
 
 def _closed_form(omega: float, case: str) -> float:
-    """Mode-2 (no impact) overturning amplitude, THEORY §6.3 (a) and (b)."""
+    """Mode-2 (no impact) overturning amplitude, theory §6.3 (a) and (b)."""
     if case == "a":
         f = lambda s: omega * math.sin(s) - math.cos(s) + math.exp(-(2 * math.pi - s) / omega)  # noqa: E731
     else:
@@ -84,7 +84,7 @@ def test_mode2_closed_forms_bound_overturning(omega: float, case: str, sign: flo
 
 
 def test_mode2_table_values() -> None:
-    # THEORY §6.5 table: one-sided (b) and no-impact (a) columns.
+    # theory §6.5 table: one-sided (b) and no-impact (a) columns.
     assert _closed_form(2.0, "b") == pytest.approx(1.801, abs=5e-4)
     assert _closed_form(2.0, "a") == pytest.approx(2.350, abs=5e-4)
     assert _closed_form(10.0, "a") == pytest.approx(21.600, abs=5e-4)
@@ -385,7 +385,7 @@ def test_impact_log_follows_the_impact_rule_and_loses_energy(elcentro_path) -> N
     np.testing.assert_allclose(v_out[moving], 0.9 * v_in[moving], rtol=1e-15)
     assert np.all(side * v_in <= 0.0)  # arrives moving towards phi = 0
     assert np.all(np.diff(t) > 0.0)
-    # THEORY §1.8 at x = 0: E = (x'/p)^2 - 1 never increases at an impact.
+    # theory §1.8 at x = 0: E = (x'/p)^2 - 1 never increases at an impact.
     assert np.all((v_out / 2.0) ** 2 <= (v_in / 2.0) ** 2)
 
 

@@ -73,7 +73,7 @@ def test_response_is_antisymmetric_for_symmetric_mechanism(amp: float, omega_rat
     assert a.ratio.min() < 0.0 < a.ratio.max()
 
 
-# -- Zhang & Makris (2001), THEORY §6.5 --------------------------------------------------------
+# -- Zhang & Makris (2001), theory §6.5 --------------------------------------------------------
 
 
 @pytest.mark.parametrize(
@@ -84,7 +84,7 @@ def test_response_is_antisymmetric_for_symmetric_mechanism(amp: float, omega_rat
 def test_zhang_makris_overturning_band_at_eta_09_omega_5(
     amp: float, collapses: bool, sign: float
 ) -> None:
-    # First overturning at A = 3.0186, safe band 6.3181-7.1681 (THEORY §6.5).
+    # First overturning at A = 3.0186, safe band 6.3181-7.1681 (theory §6.5).
     r = simulate_ivp(MODEL, pulse(sign * amp, 5.0), rtol=1e-12)
     assert r.criterion == "exact"
     assert r.overturned is collapses
@@ -96,7 +96,7 @@ def test_zhang_makris_overturning_band_at_eta_09_omega_5(
 
 
 def test_safe_island_exceeds_ratio_without_collapse() -> None:
-    # In the safe band the method's criterion and the exact outcome differ (THEORY §10).
+    # In the safe band the method's criterion and the exact outcome differ (theory §10).
     exc = pulse(6.5, 5.0)
     r = simulate_ivp(MODEL, exc)
     assert r.ratio_exceeded and not r.collapsed

@@ -37,7 +37,7 @@ def test_box_volume_mass_com_and_inertia_tensor_are_exact():
 def test_box_inertia_about_base_edge_is_m_b2_plus_h2_over_3():
     b, length, h, rho = 0.6, 4.0, 3.0, 1900.0
     p = mass_properties(box([0, 0, 0], [b, length, h]), rho)
-    # Rocking axis along y through the bottom edge x = b, z = 0 (THEORY §2.1, I_O = 4/3 M R²).
+    # Rocking axis along y through the bottom edge x = b, z = 0 (theory §2.1, I_O = 4/3 M R²).
     i_o = p.inertia_about_axis([b, 0.0, 0.0], [0.0, 1.0, 0.0])
     assert rel(i_o, p.mass * (b**2 + h**2) / 3) < RTOL
     assert rel(i_o, 4 / 3 * p.mass * (b**2 + h**2) / 4) < RTOL
