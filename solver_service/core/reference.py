@@ -564,6 +564,9 @@ def _run(
     Rules of theory §1.8 (uplift, impact, one-sided rebound), §10 (rest rule, collapse
     criterion during the excitation) and §6.3 (free motion after it).
     """
+    # long: one event loop over uplift, flight, impact and rest; its state (side, phase,
+    # stall count, dense log) is shared by every branch, and the reference is meant to be
+    # read top to bottom beside the exact kernel rather than split across helpers.
     wall0 = time.perf_counter()
     trk = _Track()
     t = forcing.t_start
