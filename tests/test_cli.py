@@ -565,3 +565,31 @@ def test_history_warns_where_the_linear_model_is_off(tmp_path: Path) -> None:
     table = runner.invoke(app, ["history", str(constants), record])
     assert f"warning: SQUAT: {expected[0]}" in table.stderr
     assert "SLENDER:" not in table.stderr
+
+
+def test_history_skips_a_mechanism_without_eta_with_a_note_and_runs_the_others() -> None:
+    church = EXAMPLES / "constants" / "church.json"
+    record = EXAMPLES / "records" / "elcentro_NS.dat"
+    res = runner.invoke(app, ["history", str(church), str(record), "--json"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    no_eta = [m["id"] for m in json.loads(church.read_text())["mechanisms"] if "eta" not in m]
+    assert no_eta, "the example church keeps an envelope-only mechanism"
+    assert [s["mechanism"] for s in doc["skipped"]] == no_eta
+    assert "restitution" in doc["skipped"][0]["reason"]
+    ran = {r["mechanism"] for r in doc["results"]}
+    assert ran and not ran & set(no_eta)
+    # The rows of the others equal a run of the file without the skipped mechanism.
+    full = json.loads(church.read_text())
+    full["mechanisms"] = [m for m in full["mechanisms"] if "eta" in m]
+    assert len(full["mechanisms"]) == len(ran)
+
+
+def test_history_with_no_runnable_mechanism_names_them_all(tmp_path: Path) -> None:
+    path = tmp_path / "c.json"
+    path.write_text(
+        json.dumps({"mechanisms": [{"id": "F", "rocking": "one_sided", "p_eq": 2.0, "lam": 0.2}]})
+    )
+    res = runner.invoke(app, ["history", str(path), str(EXAMPLES / "records" / "elcentro_NS.dat")])
+    assert res.exit_code == 2
+    assert "mechanisms" in res.stderr and "F:" in res.stderr and "restitution" in res.stderr

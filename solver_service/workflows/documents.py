@@ -47,6 +47,7 @@ __all__ = [
     "record_analysis",
     "record_doc",
     "record_pulse_doc",
+    "time_domain_mechanisms",
 ]
 
 
@@ -430,9 +431,8 @@ def history_doc(
     """
     if at_height is not None:
         at_height = check_positive(at_height, "at_height")
+    cf, skipped = time_domain_mechanisms(cf)
     models = [to_rocking_model(m) for m in cf.mechanisms]
-    for model in models:
-        model.require_eta()
     factors, batches = run_scaled(cf, models, motion, scales, sf, building, criterion)
     per_mech: list[list[dict[str, Any]]] = [[] for _ in models]
     for members, batch in batches:
@@ -471,10 +471,49 @@ def history_doc(
         doc["scale_factors"] = factors
     if at_height is not None:
         doc["displacement"] = {"height_m": at_height, "formula": "u = z * max|phi| [m]"}
+    if skipped:
+        doc["skipped"] = skipped
     notes = linearisation_notes(cf, models)
     if notes:
         doc["warnings"] = notes
     return doc
+
+
+def time_domain_mechanisms(cf: ConstantsFile) -> tuple[ConstantsFile, list[dict[str, str]]]:
+    """Split a constants file into the mechanisms a time history can run and the others.
+
+    A time-domain analysis needs a coefficient of restitution; a mechanism without one
+    (envelope-only data) is skipped with a note rather than stopping the others.
+
+    Returns
+    -------
+    runnable : ConstantsFile
+        The mechanisms with ``eta``.
+    skipped : list of dict
+        ``{"mechanism": id, "reason": ...}`` for each mechanism left out.
+
+    Raises
+    ------
+    InputError
+        If no mechanism can run (``mechanisms``).
+    """
+    keep, skipped = [], []
+    for mech in cf.mechanisms:
+        if mech.eta is None:
+            kind = mech.rocking.replace("_", "-")
+            skipped.append(
+                {
+                    "mechanism": mech.id,
+                    "reason": f"a time history of a {kind} mechanism needs a coefficient of "
+                    "restitution (eta), which the constants file does not give",
+                }
+            )
+        else:
+            keep.append(mech)
+    if not keep:
+        reasons = "; ".join(f"{s['mechanism']}: {s['reason']}" for s in skipped)
+        raise InputError(f"no mechanism can run a time history ({reasons})", "mechanisms")
+    return cf.model_copy(update={"mechanisms": keep}), skipped
 
 
 def linearisation_notes(cf: ConstantsFile, models: list[Any]) -> dict[str, list[str]]:

@@ -135,7 +135,7 @@ def dense_runs(
     """Time series of every mechanism at one user scale, as a history document ran it.
 
     Each mechanism gets the document's scale factor up the structure on top of ``scale``
-    and the document's overturning criterion.
+    and the document's overturning criterion; those the document skipped are left out.
 
     Returns
     -------
@@ -143,8 +143,11 @@ def dense_runs(
         The results carry ``t`` and ``ratio`` (``dense=True``).
     """
     factors = {k: v["value"] for k, v in doc.get("scale_factors", {}).items()}
+    skipped = {s["mechanism"] for s in doc.get("skipped", [])}
     runs = []
     for mech in cf.mechanisms:
+        if mech.id in skipped:
+            continue
         effective = scale * factors.get(mech.id, 1.0)
         res = simulate(
             to_rocking_model(mech),
