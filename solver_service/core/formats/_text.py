@@ -183,7 +183,7 @@ def check_peak(
     got = float(np.max(np.abs(values)))
     if abs(got - peak) > tol:
         raise InputError(
-            f"{name}: header states peak {peak:g} {units}, but the samples give {got:.6g} "
+            f"{name}: header states peak {peak:.10g} {units}, but the samples give {got:.6g} "
             f"{units}; the file is damaged or not what its header says",
             "record",
         )
