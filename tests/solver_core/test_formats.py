@@ -205,6 +205,14 @@ def test_a_lost_sample_is_refused(formats_dir: Path, tmp_path: Path) -> None:
         GroundMotion.from_file(path)
 
 
+def test_a_surplus_sample_is_refused(formats_dir: Path, tmp_path: Path) -> None:
+    # One more line of DMG acceleration before the velocity block.
+    extra = "     1.000     2.000\r\n 3251 POINTS OF VELOC"
+    path = _tampered(formats_dir, tmp_path, DMG, " 3251 POINTS OF VELOC", extra)
+    with pytest.raises(InputError, match="header says 3251 samples, but the file has 3253"):
+        GroundMotion.from_file(path, channel=1)
+
+
 def test_fixed_width_fields_read_numbers_that_touch() -> None:
     rows = [(1, " -1000.000-10000.500     2.250"), (2, "     4.000")]
     np.testing.assert_array_equal(

@@ -119,7 +119,8 @@ def fixed_width_values(
     Parameters
     ----------
     lines : sequence of (line number, text)
-        The data lines, in order; numbers are read until ``count`` are found.
+        The data lines, in order; every number on them is read, so a surplus is an error
+        too (never a silently dropped sample).
     width : int
         Field width [characters]; fixed fields also read numbers that touch (``-1.5-2.5``).
     count : int
@@ -134,8 +135,6 @@ def fixed_width_values(
             cell = line[start : start + width]
             if cell.strip():
                 out.append(number(cell, f"{name} line {lineno}"))
-        if len(out) >= count:
-            break
     if len(out) != count:
         raise InputError(
             f"{name}: header says {count} samples, but the file has {len(out)}", "record"
