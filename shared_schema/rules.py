@@ -48,11 +48,31 @@ TYPOLOGIES: Tuple[str, ...] = ("single_block", "single_block_loaded", "two_block
 #: Rocking kinds: two-sided (rocks about both edges) or one-sided (rebounds off a restraint).
 ROCKING_KINDS: Tuple[str, ...] = ("two_sided", "one_sided")
 
-#: Ground-motion file formats the readers take (``solver_service.core.records``).
-RECORD_FORMATS: Tuple[str, ...] = ("at2", "two_column", "one_column", "csv")
+#: Ground-motion file formats the readers take (``solver_service.core.records``): PEER AT2,
+#: plain columns and CSV, then the strong-motion databases' own (``solver_service.core.formats``):
+#: ESM/ITACA ASCII, NIED K-NET/KiK-net, COSMOS V2, CSMIP/DMG V2 and GeoNet V2A.
+RECORD_FORMATS: Tuple[str, ...] = (
+    "at2",
+    "two_column",
+    "one_column",
+    "csv",
+    "esm",
+    "knet",
+    "cosmos",
+    "dmg",
+    "geonet",
+)
 
-#: Acceleration units of records, with the factor that turns each into m/s².
-RECORD_UNITS: Dict[str, float] = {"g": G, "m/s2": 1.0, "cm/s2": 0.01}
+#: Acceleration units of records, with the factor that turns each into m/s² (cm/s² is the
+#: gal; mg is a thousandth of g; in/s² is the inch per second squared of COSMOS files).
+RECORD_UNITS: Dict[str, float] = {
+    "g": G,
+    "m/s2": 1.0,
+    "cm/s2": 0.01,
+    "mm/s2": 0.001,
+    "mg": G / 1000.0,
+    "in/s2": 0.0254,
+}
 
 #: Scale-factor methods of time histories up the structure: none, Eq. 28 from the record's
 #: spectrum, or the EN 1998-1 and NZS 1170.5 code factors (docs/theory.md §7.3-7.4).

@@ -34,9 +34,15 @@ from .workflows.documents import (
     record_analysis,
     record_pulse_doc,
 )
-from .workflows.inputs import constants_from_files, read_constants, read_record
+from .workflows.inputs import (
+    constants_from_files,
+    read_constants,
+    read_record,
+    read_record_spec,
+)
 from .workflows.outputs import finite_json, write_envelope, write_history, write_record
 from .workflows.scaling import Building
+from .workflows.tables import constants_from_table
 
 app = typer.Typer(
     name="rockmech",
@@ -133,16 +139,28 @@ def pulse(
 
 # Options shared by every command that reads a ground-motion record.
 _RECORD_ARG = typer.Argument(
-    ..., help="Record file: PEER AT2, two columns (t, a), one column (with --dt) or CSV."
+    ...,
+    help="Record file: PEER AT2, ESM/ITACA, K-NET/KiK-net, COSMOS V2, CSMIP/DMG V2, GeoNet "
+    "V2A, two columns (t, a), one column (with --dt) or CSV.",
 )
 _UNITS_OPT = typer.Option(
     None,
     "--units",
-    help="Acceleration units: g, m/s2 or cm/s2; AT2 files state their own, two-column "
-    "files default to g, other formats need it.",
+    help="Acceleration units: g, m/s2, cm/s2, mm/s2, mg or in/s2; files that state their own "
+    "(AT2, the strong-motion formats, a CSV column 'acc [g]') are read in them, two-column "
+    "files default to g, other files need it.",
 )
 _FORMAT_OPT = typer.Option(
-    None, "--format", help="at2, two_column, one_column or csv (default: detected)."
+    None,
+    "--format",
+    help="at2, esm, knet, cosmos, dmg, geonet, two_column, one_column or csv (default: "
+    "detected from the content).",
+)
+_CHANNEL_OPT = typer.Option(
+    None, "--channel", help="Channel number in a file with several (DMG V2, GeoNet V2A)."
+)
+_COMPONENT_OPT = typer.Option(
+    None, "--component", help="Component of a file with several, as its header names it."
 )
 _DT_OPT = typer.Option(None, "--dt", help="Time step [s] of a record without a time column.")
 # Options of the scale factor up the structure (history, ida, report).
@@ -177,7 +195,9 @@ def _scales(first: list[float], extra: list[str]) -> list[float]:
 @_user_errors
 def history(
     ctx: typer.Context,
-    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    constants: Path = typer.Argument(
+        ..., help="Kinematic-constants JSON file or constants table (.csv, .xlsx)."
+    ),
     record: Path = _RECORD_ARG,
     scale: list[float] = typer.Option(
         [1.0], "--scale", help="Scale factors on the record, e.g. --scale 0.5 1 2."
@@ -185,6 +205,8 @@ def history(
     units: Optional[str] = _UNITS_OPT,
     record_format: Optional[str] = _FORMAT_OPT,
     dt: Optional[float] = _DT_OPT,
+    channel: Optional[str] = _CHANNEL_OPT,
+    component: Optional[str] = _COMPONENT_OPT,
     sf: str = _SF_OPT,
     building_height: Optional[float] = _BUILDING_HEIGHT_OPT,
     soil_factor: float = _SOIL_FACTOR_OPT,
@@ -209,7 +231,7 @@ def history(
     """Time history of every mechanism in CONSTANTS under RECORD at each scale factor."""
     scales = _scales(scale, ctx.args)
     cf = read_constants(constants)
-    motion = read_record(record, record_format, units, dt)
+    motion = read_record(record, record_format, units, dt, channel, component)
     options: dict[str, Any] = {
         "sf": sf,
         "building": Building(building_height, soil_factor, element_period),
@@ -258,6 +280,8 @@ def record_info(
     units: Optional[str] = _UNITS_OPT,
     record_format: Optional[str] = _FORMAT_OPT,
     dt: Optional[float] = _DT_OPT,
+    channel: Optional[str] = _CHANNEL_OPT,
+    component: Optional[str] = _COMPONENT_OPT,
     zeta: float = typer.Option(0.05, "--damping", help="Damping ratio of the spectrum [-]."),
     t_min: float = typer.Option(0.02, "--t-min", help="Shortest period of the spectrum [s]."),
     t_max: float = typer.Option(10.0, "--t-max", help="Longest period of the spectrum [s]."),
@@ -271,7 +295,7 @@ def record_info(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Describe a record: metadata, largest sine pulses and exact response spectrum."""
-    motion = read_record(record, record_format, units, dt)
+    motion = read_record(record, record_format, units, dt, channel, component)
     periods = log_grid(t_min, t_max, n, names=("t_min", "t_max"))
     doc, spectrum, found = record_analysis(
         motion, periods, zeta, n_pulses=pulses, f_min=f_min, f_max=f_max
@@ -284,6 +308,15 @@ def record_info(
     typer.echo(
         f"{motion.name}: {len(motion.accel.acc)} samples, dt {motion.dt:g} s, "
         f"{motion.duration:.2f} s, PGA {motion.pga_g:.4f} g"
+    )
+    meta = motion.metadata
+    typer.echo(
+        "  "
+        + ", ".join(
+            f"{key} {meta[key]}"
+            for key in ("format", "units", "station", "component", "channels")
+            if meta.get(key) not in (None, "")
+        )
     )
     typer.echo("largest one-cycle sine pulses (a_p signed: > 0 first accelerates positively):")
     for p in doc["pulses"]:
@@ -304,7 +337,15 @@ def record_info(
 @_user_errors
 def ida(
     constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
-    records: list[Path] = typer.Argument(..., help="Record files (any supported format)."),
+    records: Optional[list[Path]] = typer.Argument(
+        None, help="Record files (any supported format); or --record-spec."
+    ),
+    record_spec: Optional[Path] = typer.Option(
+        None,
+        "--record-spec",
+        help="CSV (columns file, format, units, dt, channel, component) or JSON list of "
+        "records, each with its own options; file names relative to the spec.",
+    ),
     scales: str = typer.Option(
         ...,
         "--scales",
@@ -316,6 +357,8 @@ def ida(
     units: Optional[str] = _UNITS_OPT,
     record_format: Optional[str] = _FORMAT_OPT,
     dt: Optional[float] = _DT_OPT,
+    channel: Optional[str] = _CHANNEL_OPT,
+    component: Optional[str] = _COMPONENT_OPT,
     sf: str = _SF_OPT,
     building_height: Optional[float] = _BUILDING_HEIGHT_OPT,
     soil_factor: float = _SOIL_FACTOR_OPT,
@@ -345,7 +388,10 @@ def ida(
 
     levels = parse_levels(scales)
     cf = read_constants(constants)
-    motions = [read_record(path, record_format, units, dt) for path in records]
+    motions = [read_record(p, record_format, units, dt, channel, component) for p in records or []]
+    motions += [spec.read() for spec in (read_record_spec(record_spec) if record_spec else [])]
+    if not motions:
+        _fail("records: give record files or --record-spec")
     console = Console(stderr=True)
     show = console.is_terminal if progress is None else progress
     bar = Progress(
@@ -425,11 +471,25 @@ def constants(
             typer.echo(f"    warning: {note}")
 
 
+@app.command("constants-table")
+@_user_errors
+def constants_table(
+    table: Path = typer.Argument(..., help="Table, one mechanism per row (.csv or .xlsx)."),
+    output: Path = typer.Option(..., "-o", "--output", help="Kinematic-constants JSON to write."),
+) -> None:
+    """Turn a table of mechanisms (id, p_eq, lam, eta, f_n, h_e, h...) into a constants file."""
+    cf = constants_from_table(table)
+    save_constants(output, cf)
+    typer.echo(f"wrote {output}: {len(cf.mechanisms)} mechanism(s) from {table.name}")
+
+
 @app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
 @_user_errors
 def envelope(
     ctx: typer.Context,
-    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    constants: Path = typer.Argument(
+        ..., help="Kinematic-constants JSON file or constants table (.csv, .xlsx)."
+    ),
     out: Path = typer.Option(..., "--out", help="Folder for envelope.json, .csv and .png."),
     f_min: float = typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
     f_max: float = typer.Option(10.0, "--f-max", help="Highest pulse frequency [Hz]."),
@@ -448,6 +508,8 @@ def envelope(
     units: Optional[str] = _UNITS_OPT,
     record_format: Optional[str] = _FORMAT_OPT,
     dt: Optional[float] = _DT_OPT,
+    channel: Optional[str] = _CHANNEL_OPT,
+    component: Optional[str] = _COMPONENT_OPT,
     as_json: bool = typer.Option(False, "--json", help="Also print the JSON document."),
 ) -> None:
     """Minimum overturning sine-pulse amplitude of every mechanism, and the critical bands."""
@@ -455,7 +517,7 @@ def envelope(
     cf = read_constants(constants)
     pulse = None
     if record is not None:
-        motion = read_record(record, record_format, units, dt)
+        motion = read_record(record, record_format, units, dt, channel, component)
         pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), exact=exact)
     elif ctx.args:
         _fail(f"unexpected argument {ctx.args[0]!r}")
@@ -585,6 +647,8 @@ def report(
     units: Optional[str] = _UNITS_OPT,
     record_format: Optional[str] = _FORMAT_OPT,
     dt: Optional[float] = _DT_OPT,
+    channel: Optional[str] = _CHANNEL_OPT,
+    component: Optional[str] = _COMPONENT_OPT,
     sf: str = _SF_OPT,
     building_height: Optional[float] = _BUILDING_HEIGHT_OPT,
     soil_factor: float = _SOIL_FACTOR_OPT,
@@ -608,7 +672,7 @@ def report(
     sources = [input_source("constants", constants.name, constants.read_bytes())]
     motion = None
     if record is not None:
-        motion = read_record(record, record_format, units, dt)
+        motion = read_record(record, record_format, units, dt, channel, component)
         sources.append(input_source("record", record.name, record.read_bytes()))
     options = {"scales": scales, "sf": sf, "building_height": building_height}
     options.update(soil_factor=soil_factor, element_period=element_period, at_height=at_height)

@@ -12,9 +12,21 @@ Formats read here (``GroundMotion.from_file`` picks one by name or by the file):
 * ``"csv"``: comma-separated with a header row; a time column or a given time step
   (``GroundMotion.from_csv``).
 
-Units of acceleration are named explicitly: ``"g"``, ``"m/s2"`` or ``"cm/s2"``; only AT2
-files state their own. Inside, everything is SI (m/s²). Every sample of a file is kept,
-including a short last line.
+The strong-motion databases' own formats, detected from their content and read by
+``solver_service.core.formats`` (``GroundMotion.from_strong_motion``):
+
+* ``"esm"``: ESM / ITACA ASCII (DYNA 1.2 header);
+* ``"knet"``: NIED K-NET and KiK-net ASCII (scale factor applied, mean removed as NIED does);
+* ``"cosmos"``: COSMOS V2 corrected acceleration;
+* ``"dmg"``: CSMIP / DMG V2, several channels per file;
+* ``"geonet"``: GeoNet V2A, three components per file.
+
+Units of acceleration are a key of ``UNITS`` (``"g"``, ``"m/s2"``, ``"cm/s2"``, ``"mm/s2"``,
+``"mg"``, ``"in/s2"``). Files that state their units (AT2, the strong-motion formats, a CSV
+whose acceleration column names them: ``acc [g]``, ``a (m/s2)``, ``accel_cm/s2``) are read in
+them; a given ``units`` must then agree. Files that do not state them need ``units``. Inside,
+everything is SI (m/s²). Every sample of a file is kept, including a short last line; the
+strong-motion readers also check the header's sample count and peak.
 """
 
 from __future__ import annotations
@@ -33,6 +45,9 @@ from shared_schema.errors import InputError
 from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, G
 
 from .excitation import SampledAccel
+from .formats import READERS, Channel, channel_list, select_channel
+from .formats import detect as detect_strong_motion
+from .formats._text import units_or_none
 
 __all__ = ["DT_RTOL", "FORMATS", "UNITS", "GroundMotion", "detect_format"]
 
@@ -56,12 +71,36 @@ _AT2_UNITS = {
     "M/SEC/SEC": "m/s2",
     "M/S2": "m/s2",
 }
-_UNITS_HINT = "give units: g, m/s2 or cm/s2"
+_UNITS_HINT = "give units: " + ", ".join(list(RECORD_UNITS)[:-1]) + f" or {list(RECORD_UNITS)[-1]}"
+#: Units of a time column a CSV header may name; only seconds are read.
+_SECONDS = {"s", "sec", "secs", "second", "seconds"}
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?"
 _DATE = re.compile(r"\d{1,2}/\d{1,2}/\d{2,4}")
 
 PathLike = Union[str, Path]
 Column = Union[str, int, None]
+ChannelKey = Union[int, str, None]
+
+
+def _units_in_name(name: str) -> Optional[str]:
+    """Units a column name states: ``acc [g]``, ``a (m/s2)``, ``accel_cm/s2`` -> key, else None."""
+    bracket = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]\s*$", name)
+    if bracket:
+        return units_or_none(bracket.group(1))
+    for sep in ("_", " "):
+        if sep in name.strip():
+            return units_or_none(name.strip().rsplit(sep, 1)[1])
+    return None
+
+
+def _check_time_units(name: str, where: str) -> None:
+    """Refuse a time column that names units other than seconds (``t [ms]``)."""
+    bracket = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]\s*$", name)
+    if bracket and bracket.group(1).strip().lower() not in _SECONDS:
+        raise InputError(
+            f"{where}: time column {name!r} is in {bracket.group(1)!r}; give time in seconds",
+            "time_column",
+        )
 
 
 def _unit_factor(units: str) -> float:
@@ -192,6 +231,31 @@ def _resolve_column(col: Column, header: list[str], arg: str, name: str) -> int:
     raise InputError(f"{name} has no column {col!r}; columns are {header}", arg)
 
 
+def _check_stated_units(motion: GroundMotion, units: Optional[str], name: str) -> None:
+    """Refuse ``units`` other than those the file states."""
+    stated = motion.metadata["units"]
+    if units is not None and units != stated:
+        raise InputError(f"{name} states units {stated!r}, got {units!r}", "units")
+
+
+def _check_one_channel(
+    motion: GroundMotion, channel: ChannelKey, component: Optional[str], name: str
+) -> None:
+    """Refuse a channel or component other than the one a single-channel file holds."""
+    if channel is not None and str(channel).strip() != "1":
+        raise InputError(f"{name} holds one channel (1), got channel {channel!r}", "channel")
+    own = str(motion.metadata.get("component", ""))
+    if (
+        component is not None
+        and "".join(component.split()).casefold() != "".join(own.split()).casefold()
+    ):
+        raise InputError(
+            f"{name} holds one channel (component {own or 'not stated'}), "
+            f"got component {component!r}",
+            "component",
+        )
+
+
 @dataclass(frozen=True)
 class GroundMotion:
     """A uniformly sampled ground-acceleration record with its metadata.
@@ -253,6 +317,8 @@ class GroundMotion:
         format: Optional[str] = None,
         units: Optional[str] = None,
         dt: Optional[float] = None,
+        channel: ChannelKey = None,
+        component: Optional[str] = None,
     ) -> GroundMotion:
         """Read a record in any of ``FORMATS``, named or detected.
 
@@ -260,21 +326,29 @@ class GroundMotion:
         ----------
         path : str or Path
             The record file.
-        format : {"at2", "two_column", "one_column", "csv"}, optional
-            By default from the extension (``.AT2``, ``.csv``), else from the first data
-            line: two numbers are ``two_column``, one is ``one_column``.
-        units : {"g", "m/s2", "cm/s2"}, optional
-            Units of acceleration; required for every format but AT2, which states its own
-            (if given for AT2 it must agree).
+        format : str, optional
+            One of ``FORMATS``. By default from the extension (``.AT2``, ``.csv``), else
+            from the content: a strong-motion header (ESM, K-NET, COSMOS, DMG, GeoNet), else
+            the first data line: two numbers are ``two_column``, one is ``one_column``.
+        units : str, optional
+            Units of acceleration, a key of ``UNITS``. Required where the file does not
+            state them; where it does (AT2, strong-motion formats, a CSV header naming
+            them) a given value must agree.
         dt : float, optional
             Time step [s] for files without a time column (``one_column``, ``csv``);
             refused where the file has its own.
+        channel : int or str, optional
+            Channel number as the file gives it (1-based), for files with several.
+        component : str, optional
+            Component as the header names it (``S16W``, ``Up``, ``90 DEG``).
 
         Raises
         ------
         InputError
-            Unknown or undetectable format (field ``format``), missing units (``units``),
-            missing or superfluous ``dt`` (``dt``), or a bad file (``record``).
+            Unknown or undetectable format (field ``format``), missing or contradicting
+            units (``units``), missing or superfluous ``dt`` (``dt``), several channels and
+            none chosen or no such channel (``channel``, ``component``), or a bad file
+            (``record``).
         """
         p = Path(path)
         if format is None:
@@ -286,27 +360,85 @@ class GroundMotion:
                 f"unknown record format {format!r} for {p.name}; formats are {list(FORMATS)}",
                 "format",
             )
+        if fmt in READERS:
+            if dt is not None:
+                raise InputError(f"{p.name} is {fmt} and states its own time step", "dt")
+            motion = cls.from_strong_motion(p, fmt, channel=channel, component=component)
+            _check_stated_units(motion, units, p.name)
+            return motion
         if fmt == "at2":
             if dt is not None:
                 raise InputError(f"{p.name} is AT2 and states its own time step", "dt")
             motion = cls.from_at2(p)
-            if units is not None and units != motion.metadata["units"]:
-                raise InputError(
-                    f"{p.name} states units {motion.metadata['units']!r}, got {units!r}",
-                    "units",
-                )
-            return motion
-        if units is None:
+            _check_stated_units(motion, units, p.name)
+        elif fmt == "csv":
+            motion = cls.from_csv(p, units, dt=dt)
+        elif units is None:
             raise InputError(f"{_UNITS_HINT} ({fmt} file {p.name} does not state them)", "units")
-        if fmt == "two_column":
+        elif fmt == "two_column":
             if dt is not None:
                 raise InputError(f"{p.name} has a time column; do not give dt", "dt")
-            return cls.from_two_column(p, units=units)
-        if fmt == "one_column":
+            motion = cls.from_two_column(p, units=units)
+        else:
             if dt is None:
                 raise InputError(f"one_column file {p.name} needs a time step dt [s]", "dt")
-            return cls.from_one_column(p, dt, units)
-        return cls.from_csv(p, units, dt=dt)
+            motion = cls.from_one_column(p, dt, units)
+        _check_one_channel(motion, channel, component, p.name)
+        return motion
+
+    @classmethod
+    def from_strong_motion(
+        cls,
+        path: PathLike,
+        format: Optional[str] = None,
+        *,
+        channel: ChannelKey = None,
+        component: Optional[str] = None,
+    ) -> GroundMotion:
+        """Read one acceleration channel of an ESM, K-NET, COSMOS, DMG or GeoNet file.
+
+        Parameters
+        ----------
+        path : str or Path
+            The file.
+        format : {"esm", "knet", "cosmos", "dmg", "geonet"}, optional
+            By default detected from the header.
+        channel, component : optional
+            Which channel of a file with several (see ``from_file``); required there.
+
+        Raises
+        ------
+        InputError
+            Not one of these formats, a bad header, a sample count or peak other than the
+            header states (``record``), or no channel chosen among several (``channel``).
+
+        Notes
+        -----
+        ``metadata`` holds ``station``, ``component``, ``channel``, ``event``, ``units``
+        (the file's), ``dt`` [s], ``npts``, ``peak`` (the header's, in the file's units),
+        ``pga_g``, ``source``, ``format`` and ``channels`` (every channel of the file,
+        ``"1: 90 DEG, 2: UP, ..."``), plus the fields each format adds.
+        """
+        p, text = _read_text(path)
+        fmt = format if format is not None else detect_strong_motion(text)
+        if fmt is None or fmt not in READERS:
+            raise InputError(
+                f"{p.name} is not one of the strong-motion formats {list(READERS)}", "format"
+            )
+        channels = READERS[fmt][1](text, p.name)
+        chosen: Channel = select_channel(channels, p.name, channel, component)
+        meta: dict[str, Any] = {
+            **chosen.metadata,
+            "source": p.name,
+            "format": fmt,
+            "units": chosen.units,
+            "channels": channel_list(channels),
+        }
+        name = p.stem if len(channels) == 1 else f"{p.stem}_{chosen.metadata['channel']}"
+        accel = SampledAccel(chosen.values * UNITS[chosen.units], chosen.dt)
+        motion = cls(accel, name, meta)
+        meta["pga_g"] = motion.pga_g
+        return motion
 
     @classmethod
     def from_at2(cls, path: PathLike) -> GroundMotion:
@@ -452,7 +584,7 @@ class GroundMotion:
     def from_csv(
         cls,
         path: PathLike,
-        units: str,
+        units: Optional[str] = None,
         time_column: Column = None,
         accel_column: Column = None,
         dt: Optional[float] = None,
@@ -464,8 +596,10 @@ class GroundMotion:
         path : str or Path
             The file; ``#`` comment lines and blank lines are skipped. If the first row is
             all numbers it is data (no header) and columns can only be given by index.
-        units : {"g", "m/s2", "cm/s2"}
-            Units of the acceleration column.
+        units : str, optional
+            Units of the acceleration column, a key of ``UNITS``. By default read from the
+            column's name (``acc [g]``, ``a (m/s2)``, ``accel_cm/s2``); required where the
+            name states none, and must agree where it does.
         time_column, accel_column : str or int, optional
             Columns by header name (exact, else case-insensitive) or 0-based index. By
             default time is column 0 and acceleration the first other column.
@@ -479,7 +613,8 @@ class GroundMotion:
             Bad ``units``/``dt``/columns, missing file, unparsable cells, fewer than 2
             samples, non-finite values, or time not strictly increasing and uniform.
         """
-        factor = _unit_factor(units)
+        if units is not None:
+            _unit_factor(units)
         if dt is not None:
             dt = _check_dt(dt)
             if time_column is not None:
@@ -515,6 +650,20 @@ class GroundMotion:
         )
         if ia == it:
             raise InputError(f"{p.name}: time and acceleration are the same column", "accel_column")
+        stated = _units_in_name(header[ia]) if names else None
+        if stated is None and units is None:
+            raise InputError(
+                f"{_UNITS_HINT} (column {header[ia]!r} of {p.name} does not state them)", "units"
+            )
+        if stated is not None and units is not None and stated != units:
+            raise InputError(
+                f"{p.name}: column {header[ia]!r} states units {stated!r}, got {units!r}", "units"
+            )
+        units = stated or units
+        assert units is not None
+        factor = UNITS[units]
+        if it is not None and names:
+            _check_time_units(header[it], p.name)
         need = max(ia, -1 if it is None else it) + 1
         t_list: list[float] = []
         a_list: list[float] = []
@@ -541,18 +690,27 @@ class GroundMotion:
             "npts": int(a.size),
             "time_column": header[it] if (it is not None and names) else it,
             "accel_column": header[ia] if names else ia,
+            "units_from": "header" if stated is not None else "given",
         }
         return cls(SampledAccel(a * factor, dt, t0=t0), p.stem, meta)
 
 
 def detect_format(p: Path) -> str:
-    """Return the format of a record file: from its extension, else its first data line."""
+    """Return the format of a record file.
+
+    From its extension (``.AT2``, ``.csv``), else its content: a PEER title, a strong-motion
+    header (``solver_service.core.formats.detect``), else the count of numbers on the first
+    data line (2: ``two_column``, 1: ``one_column``).
+    """
     fmt = _EXTENSIONS.get(p.suffix.lower())
     if fmt is not None:
         return fmt
     _, text = _read_text(p)
     if text.lstrip().upper().startswith("PEER NGA"):
         return "at2"
+    strong = detect_strong_motion(text)
+    if strong is not None:
+        return strong
     lines = _data_lines(text)
     if not lines:
         raise InputError(f"{p.name} is empty: no data lines to read", "record")

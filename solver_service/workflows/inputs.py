@@ -2,19 +2,34 @@
 
 from __future__ import annotations
 
+import csv
+import io
+import json
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional, Union
 
 from rhino_plugin.mechanisms.build import constants_from_spec
 from rhino_plugin.scene_3dm import Scene
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 from shared_schema.io import load_constants
+from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, check_positive
 from shared_schema.spec import parse_spec
 
 from ..core.records import GroundMotion, detect_format
+from .tables import constants_from_table, is_table
 
-__all__ = ["constants_from_files", "read_constants", "read_record"]
+__all__ = [
+    "RecordSpec",
+    "constants_from_files",
+    "read_constants",
+    "read_record",
+    "read_record_spec",
+]
+
+#: Columns (CSV) or keys (JSON) of a record-spec file; only ``file`` is required.
+SPEC_FIELDS = ("file", "format", "units", "dt", "channel", "component")
 
 
 def _require_file(path: Path, label: str) -> None:
@@ -29,6 +44,8 @@ def read_record(
     fmt: Optional[str] = None,
     units: Optional[str] = None,
     dt: Optional[float] = None,
+    channel: Union[int, str, None] = None,
+    component: Optional[str] = None,
 ) -> GroundMotion:
     """Read a record as ``rockmech`` does: format detected, a two-column file in g by default.
 
@@ -36,19 +53,132 @@ def read_record(
     ----------
     path : Path
         The record file.
-    fmt, units, dt
+    fmt, units, dt, channel, component
         As ``GroundMotion.from_file``; ``units`` defaults to g for a two-column file (the
-        t [s], a [g] convention of the bundled record).
+        t [s], a [g] convention of the bundled record); ``channel`` or ``component`` choose
+        one channel of a file with several (DMG V2, GeoNet V2A).
     """
     fmt = fmt or detect_format(path)
     if units is None and fmt == "two_column":
         units = "g"
-    return GroundMotion.from_file(path, format=fmt, units=units, dt=dt)
+    return GroundMotion.from_file(
+        path, format=fmt, units=units, dt=dt, channel=channel, component=component
+    )
+
+
+@dataclass(frozen=True)
+class RecordSpec:
+    """How to read one record of a list: the file and its ``read_record`` options."""
+
+    file: Path
+    format: Optional[str] = None
+    units: Optional[str] = None
+    dt: Optional[float] = None
+    channel: Optional[str] = None
+    component: Optional[str] = None
+
+    def read(self) -> GroundMotion:
+        """Read the record (``read_record``)."""
+        return read_record(
+            self.file, self.format, self.units, self.dt, self.channel, self.component
+        )
+
+
+def _spec_rows(path: Path, text: str) -> list[tuple[str, dict[str, Any]]]:
+    """``(row label, fields)`` of a record-spec file: JSON list of objects or CSV with header."""
+    if path.suffix.lower() == ".json":
+        try:
+            doc = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InputError(f"{path.name} is not valid JSON: {exc}", "record_spec") from None
+        if not isinstance(doc, list) or not all(isinstance(r, dict) for r in doc):
+            raise InputError(f"{path.name}: expected a JSON list of objects", "record_spec")
+        return [(f"record_spec[{i}]", dict(r)) for i, r in enumerate(doc)]
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    rows = list(csv.reader(io.StringIO("\n".join(lines))))
+    if not rows:
+        raise InputError(f"{path.name} is empty", "record_spec")
+    header = [h.strip().lower() for h in rows[0]]
+    out = []
+    for n, cells in enumerate(rows[1:], start=2):
+        if len(cells) > len(header):
+            raise InputError(
+                f"row {n} has {len(cells)} cells, the header {len(header)}", "record_spec"
+            )
+        fields = {h: c.strip() for h, c in zip(header, cells) if c.strip()}
+        out.append((f"record_spec row {n}", fields))
+    return out
+
+
+def read_record_spec(path: Path) -> list[RecordSpec]:
+    """Read a list of records, each with its own format, units, dt, channel or component.
+
+    Parameters
+    ----------
+    path : Path
+        A CSV file with a header row naming some of ``SPEC_FIELDS`` (``file`` required;
+        empty cells mean "detect" or "not given"), or a JSON list of objects with those
+        keys. Relative file names are taken from the spec's folder.
+
+    Raises
+    ------
+    InputError
+        An unknown column or key, a row without ``file``, a ``dt`` that is not a positive
+        number, or an unknown format or units; the message names the row and the column.
+    """
+    _require_file(path, "record_spec")
+    rows = _spec_rows(path, path.read_text(encoding="utf-8"))
+    if not rows:
+        raise InputError(f"{path.name} lists no records", "record_spec")
+    specs = []
+    for label, fields in rows:
+        unknown = sorted(set(fields) - set(SPEC_FIELDS))
+        if unknown:
+            raise InputError(
+                f"{label}: unknown column {unknown[0]!r}; columns are {list(SPEC_FIELDS)}",
+                "record_spec",
+            )
+        if not fields.get("file"):
+            raise InputError(f"{label}, column 'file': missing", "record_spec")
+        values: dict[str, Any] = {}
+        for key in SPEC_FIELDS[1:]:
+            value = fields.get(key)
+            if value is None or value == "":
+                continue
+            if key == "dt":
+                try:
+                    values[key] = check_positive(float(value), "dt")
+                except (TypeError, ValueError, InputError):
+                    raise InputError(
+                        f"{label}, column 'dt': must be a number > 0 [s], got {value!r}",
+                        "record_spec",
+                    ) from None
+                continue
+            if key == "format" and value not in RECORD_FORMATS:
+                raise InputError(
+                    f"{label}, column 'format': must be one of {list(RECORD_FORMATS)}, "
+                    f"got {value!r}",
+                    "record_spec",
+                )
+            if key == "units" and value not in RECORD_UNITS:
+                raise InputError(
+                    f"{label}, column 'units': must be one of {list(RECORD_UNITS)}, got {value!r}",
+                    "record_spec",
+                )
+            values[key] = str(value)
+        specs.append(RecordSpec(path.parent / str(fields["file"]), **values))
+    return specs
 
 
 def read_constants(path: Path) -> ConstantsFile:
-    """Read and validate a kinematic-constants file; errors name ``constants``."""
+    """Read and validate a kinematic-constants file, or a constants table (``.csv``, ``.xlsx``).
+
+    Errors name ``constants`` (a JSON file) or ``table`` with the row and column (a table,
+    ``solver_service.workflows.tables``).
+    """
     _require_file(path, "constants")
+    if is_table(path):
+        return constants_from_table(path)
     return load_constants(path)
 
 

@@ -299,7 +299,7 @@ def test_from_file_detects_two_and_one_column(tmp_path: Path, elcentro_path: Pat
 
 
 def test_from_file_errors_name_the_file_and_field(tmp_path: Path, elcentro_path: Path) -> None:
-    with pytest.raises(InputError, match="give units: g, m/s2 or cm/s2") as err:
+    with pytest.raises(InputError, match="give units: g, m/s2, cm/s2") as err:
         GroundMotion.from_file(elcentro_path)
     assert err.value.field == "units" and "elcentro_NS.dat" in str(err.value)
     with pytest.raises(InputError, match="has a time column") as err:

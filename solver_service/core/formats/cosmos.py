@@ -1,0 +1,143 @@
+"""COSMOS Strong-Motion Data Format V2 (corrected acceleration), e.g. CESMD ``.V2c`` files.
+
+Each channel: a text header (its line count is on line 1, ``with 13 text lines``), an integer
+header (``100 Integer-header values follow on 10 lines, Format= (10I8)``), a real header
+(``Format= (5F15.6)``), comment lines, then ``42000 acceleration pts, approx 210 secs,
+units=cm/sec2(04),Format=(1E15.6)`` and the samples; ``End-of-data for Chan...`` closes it.
+Velocity or displacement channels in the same file are skipped.
+
+Notes
+-----
+Fields used (1-based as in the COSMOS format document, v1.20): integer 1 processing stage
+(2 = corrected), 2 data type (1 = acceleration), 3 units code (2 g, 4 cm/s², 10 gal,
+11 mg, 7 in/s²); real 62 sampling interval [ms], 64 peak value and 65 its time [s]; -999 is
+"unknown". Reference: COSMOS Strong Motion Data Format, v1.20 (2001); ``gmprocess.io.cosmos``.
+"""
+
+from __future__ import annotations
+
+import re
+
+from shared_schema.errors import InputError
+
+from ._text import Channel, check_count, check_peak, fixed_width_values, units_from_text
+
+__all__ = ["read", "sniff"]
+
+#: COSMOS physical-units codes of acceleration -> ``RECORD_UNITS`` keys.
+UNITS_CODES = {2: "g", 4: "cm/s2", 7: "in/s2", 10: "cm/s2", 11: "mg"}
+#: COSMOS "unknown" marker of the real header.
+UNKNOWN = -999.0
+_FIRST = re.compile(r"\(Format v\d+\.\d+ with\s+(\d+) text lines\)", re.IGNORECASE)
+_BLOCK = re.compile(
+    r"^\s*(\d+)\s+(Integer|Real)-header values follow on\s+(\d+)\s+lines,\s*"
+    r"Format\s*=\s*\((\d+)[IFE](\d+)(?:\.(\d+))?",
+    re.IGNORECASE,
+)
+_COMMENTS = re.compile(r"^\s*(\d+)\s+Comment line\(s\) follow", re.IGNORECASE)
+_DATA = re.compile(
+    r"^\s*(\d+)\s+(\w+)\s+pts,.*units\s*=\s*([^(,]*)\((\d+)\)\s*,\s*"
+    r"Format\s*=\s*\((\d+)[EFG](\d+)",
+    re.IGNORECASE,
+)
+
+
+def sniff(head: str) -> bool:
+    """Tell the start of a COSMOS file (``(Format v01.20 with 13 text lines)``)."""
+    first = head.split("\n", 1)[0]
+    return _FIRST.search(first) is not None
+
+
+def _block(lines: list[str], i: int, name: str, kind: str) -> tuple[list[float], int, int]:
+    """Read an integer or real header block at line index ``i``: values, next index, decimals."""
+    match = _BLOCK.match(lines[i]) if i < len(lines) else None
+    if match is None or match.group(2).lower() != kind:
+        raise InputError(f"{name} line {i + 1}: expected the COSMOS {kind}-header line", "record")
+    count, nlines, width = int(match.group(1)), int(match.group(3)), int(match.group(5))
+    rows = [(k + 1, lines[k]) for k in range(i + 1, i + 1 + nlines)]
+    values = fixed_width_values(rows, width, count, f"{name} {kind} header")
+    return [float(v) for v in values], i + 1 + nlines, int(match.group(6) or 0)
+
+
+def read(text: str, name: str) -> list[Channel]:
+    """Read every acceleration channel of a COSMOS V2 file (usually one).
+
+    Raises
+    ------
+    InputError
+        A malformed header, a file that is not corrected (V2) acceleration, unknown units,
+        a sample count other than the data line's or a peak other than real header 64.
+    """
+    lines = text.splitlines()
+    channels: list[Channel] = []
+    i, number_in_file = 0, 0
+    while i < len(lines):
+        if not lines[i].strip():
+            i += 1
+            continue
+        first = _FIRST.search(lines[i])
+        if first is None:
+            raise InputError(f"{name} line {i + 1}: expected a COSMOS channel header", "record")
+        text_header = lines[i : i + int(first.group(1))]
+        i += int(first.group(1))
+        ints, i, _ = _block(lines, i, name, "integer")
+        reals, i, digits = _block(lines, i, name, "real")
+        comments = _COMMENTS.match(lines[i]) if i < len(lines) else None
+        if comments is None:
+            raise InputError(f"{name} line {i + 1}: expected the comment-count line", "record")
+        notes = lines[i + 1 : i + 1 + int(comments.group(1))]
+        i += 1 + int(comments.group(1))
+        data = _DATA.match(lines[i]) if i < len(lines) else None
+        if data is None:
+            raise InputError(f"{name} line {i + 1}: expected the data line", "record")
+        npts, width = int(data.group(1)), int(data.group(6))
+        per_line = int(data.group(5))
+        nrows = -(-npts // per_line)
+        rows = [(k + 1, lines[k]) for k in range(i + 1, min(i + 1 + nrows, len(lines)))]
+        i += 1 + nrows
+        if i < len(lines) and lines[i].lstrip().lower().startswith("end-of-data"):
+            i += 1
+        number_in_file += 1
+        if int(ints[1]) != 1 or data.group(2).lower() != "acceleration":
+            continue  # velocity or displacement channel
+        where = f"{name} channel {number_in_file}"
+        if int(ints[0]) != 2:
+            raise InputError(
+                f"{where}: processing stage {int(ints[0])}, not corrected acceleration (V2)",
+                "record",
+            )
+        code = int(data.group(4))
+        if code not in UNITS_CODES:
+            raise InputError(f"{where}: unknown COSMOS units code {code}", "record")
+        units = UNITS_CODES[code]
+        if data.group(3).strip() and units_from_text(data.group(3), where) != units:
+            raise InputError(
+                f"{where}: units {data.group(3).strip()!r} disagree with code {code}", "record"
+            )
+        if reals[61] == UNKNOWN or reals[61] <= 0:
+            raise InputError(f"{where}: real header 62 (sampling interval) is unknown", "record")
+        dt = reals[61] / 1000.0
+        values = fixed_width_values(rows, width, npts, where)
+        check_count(values, npts, where)
+        stated = None if reals[63] == UNKNOWN else f"{reals[63]:.{digits}f}"
+        peak = check_peak(values, stated, units, where)
+        scnl = next((c.split(">", 1)[1].split()[0] for c in notes if "<SCNL>" in c), "")
+        found = (
+            re.search(r"Code:\s*(\S+)\s+(.*)$", text_header[4]) if len(text_header) > 4 else None
+        )
+        station = f"{found.group(1)} {found.group(2).strip()}" if found else ""
+        meta = {
+            "event": text_header[1].strip() if len(text_header) > 1 else "",
+            "station": station,
+            "component": scnl.split(".")[1] if scnl.count(".") >= 1 else scnl,
+            "scnl": scnl,
+            "channel": number_in_file,
+            "npts": npts,
+            "dt": dt,
+            "peak": peak,
+            "peak_time_s": None if reals[64] == UNKNOWN else reals[64],
+        }
+        channels.append(Channel(values, dt, units, meta))
+    if not channels:
+        raise InputError(f"{name}: no acceleration channel in this COSMOS file", "record")
+    return channels

@@ -1,0 +1,263 @@
+"""Constants tables: one mechanism per row, as papers print them, into a constants file.
+
+A table is a ``.csv`` file or the first sheet of an ``.xlsx`` workbook (read with openpyxl,
+the ``tables`` extra). The first non-blank row names the columns; each further row is one
+mechanism. Column names are matched without case, spaces or a trailing unit in brackets
+(``p_eq [rad/s]``, ``f_n (Hz)``); a unit in brackets must be the column's SI unit, or ``deg``
+for the angles ``phi_ov``/``phi_cr`` (converted to rad).
+
+Columns (``COLUMNS``): ``id`` (required), ``name``, ``typology``, ``rocking``, ``eta``,
+``eta_source``, ``source`` (into ``provenance.source``); the positive side in the short form
+``p_eq``, ``lam``, ``phi_ov`` or the physical form ``I0``, ``K``, ``Q``, ``phi_cr``, ``M_F``;
+the negative side as ``p_eq_neg``, ``lam_neg``, ``phi_ov_neg``; the amplification data
+``f_n``, ``h_e``, ``h`` (all three or none). Empty cells mean "not given". Every row is
+validated as the constants file validates a mechanism (``shared_schema.constants``), and
+errors name the row (as the spreadsheet numbers it) and the column.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import re
+from pathlib import Path
+from typing import Any, Optional
+
+from shared_schema.constants import ConstantsFile, parse_constants
+from shared_schema.errors import InputError
+
+__all__ = ["COLUMNS", "TABLE_SUFFIXES", "XLSX_HINT", "constants_from_table", "is_table"]
+
+#: Column -> (where it goes in a mechanism, SI unit or None for text, dimensionless "-").
+COLUMNS: dict[str, tuple[tuple[str, ...], Optional[str]]] = {
+    "id": (("id",), None),
+    "name": (("name",), None),
+    "typology": (("typology",), None),
+    "rocking": (("rocking",), None),
+    "eta": (("eta",), "-"),
+    "eta_source": (("eta_source",), None),
+    "source": (("provenance", "source"), None),
+    "p_eq": (("positive", "p_eq"), "rad/s"),
+    "lam": (("positive", "lam"), "-"),
+    "phi_ov": (("positive", "phi_ov"), "rad"),
+    "I0": (("positive", "I0"), "kg m^2"),
+    "K": (("positive", "K"), "N m/rad"),
+    "Q": (("positive", "Q"), "kg m"),
+    "phi_cr": (("positive", "phi_cr"), "rad"),
+    "M_F": (("positive", "M_F"), "N m"),
+    "p_eq_neg": (("negative", "p_eq"), "rad/s"),
+    "lam_neg": (("negative", "lam"), "-"),
+    "phi_ov_neg": (("negative", "phi_ov"), "rad"),
+    "f_n": (("amplification", "f_n"), "Hz"),
+    "h_e": (("amplification", "h_e"), "m"),
+    "h": (("amplification", "h"), "m"),
+}
+#: Other spellings papers use for a column (folded: lower case, no spaces).
+ALIASES = {"lambda": "lam", "λ": "lam", "η": "eta", "p": "p_eq", "i0": "I0", "k": "K"}
+#: Table file suffixes (lower case) that commands take where a constants JSON is expected.
+TABLE_SUFFIXES = (".csv", ".xlsx")
+#: What to run when openpyxl is missing.
+XLSX_HINT = "pip install 'rockmech[tables]'  (or: pip install openpyxl)"
+#: Unit spellings accepted in brackets, folded, per SI unit.
+_UNIT_SPELLINGS = {
+    "-": {"-", "", "g"},
+    "rad/s": {"rad/s", "1/s", "s^-1", "s-1"},
+    "rad": {"rad"},
+    "Hz": {"hz"},
+    "m": {"m"},
+    "kg m^2": {"kgm^2", "kgm2", "kg·m^2", "kg·m²", "kgm²"},
+    "N m/rad": {"nm/rad", "n·m/rad"},
+    "kg m": {"kgm", "kg·m"},
+    "N m": {"nm", "n·m"},
+}
+_UNIT = re.compile(r"^(.*?)\s*[\[(]\s*([^\])]*)\s*[\])]\s*$")
+_FOLDED = {k.casefold(): k for k in COLUMNS}
+
+
+def is_table(path: Path) -> bool:
+    """Tell a constants table (``.csv``, ``.xlsx``) from a constants JSON by its suffix."""
+    return path.suffix.lower() in TABLE_SUFFIXES
+
+
+def _column(title: str, col: int) -> tuple[str, float]:
+    """Return the canonical column of a header cell and the factor to SI of its unit."""
+    text = title.strip()
+    match = _UNIT.match(text)
+    base, unit = (match.group(1), match.group(2).strip()) if match else (text, None)
+    key = "".join(base.split()).casefold()
+    key = ALIASES.get(key, key)
+    name = _FOLDED.get(key.casefold())
+    if name is None:
+        raise InputError(f"column {col} {title!r}: unknown; columns are {list(COLUMNS)}", "table")
+    si = COLUMNS[name][1]
+    if unit is None:
+        return name, 1.0
+    folded = "".join(unit.split()).casefold()
+    if si is None:
+        raise InputError(f"column {title!r}: {name} is text and takes no unit", "table")
+    if si == "rad" and folded in ("deg", "°", "degrees"):
+        return name, math.pi / 180.0
+    if folded not in _UNIT_SPELLINGS[si]:
+        raise InputError(f"column {title!r}: unit {unit!r}, expected {si!r}", "table")
+    return name, 1.0
+
+
+def _read_csv(path: Path) -> list[tuple[int, list[Any]]]:
+    text = path.read_text(encoding="utf-8-sig")
+    rows = list(csv.reader(io.StringIO(text)))
+    return [(n, cells) for n, cells in enumerate(rows, start=1)]
+
+
+def _read_xlsx(path: Path) -> list[tuple[int, list[Any]]]:
+    try:
+        # openpyxl is optional (the "tables" extra): only .xlsx tables need it.
+        import openpyxl  # type: ignore[import-untyped]
+    except ImportError:
+        raise InputError(f"reading {path.name} needs openpyxl: {XLSX_HINT}", "table") from None
+    try:
+        book = openpyxl.load_workbook(path, read_only=True, data_only=True)
+    except Exception as exc:  # openpyxl raises many kinds for a damaged workbook
+        raise InputError(f"cannot read {path.name} as .xlsx: {exc}", "table") from None
+    sheet = book.worksheets[0]
+    rows = [(n, list(r)) for n, r in enumerate(sheet.iter_rows(values_only=True), start=1)]
+    book.close()
+    return rows
+
+
+def _blank(cell: Any) -> bool:
+    return cell is None or (isinstance(cell, str) and not cell.strip())
+
+
+def _number(cell: Any, where: str) -> float:
+    if isinstance(cell, bool):
+        raise InputError(f"{where}: must be a number, got {cell!r}", "table")
+    if isinstance(cell, (int, float)):
+        value = float(cell)
+    else:
+        try:
+            value = float(str(cell).strip())
+        except ValueError:
+            raise InputError(f"{where}: not a number: {str(cell).strip()!r}", "table") from None
+    if not math.isfinite(value):
+        raise InputError(f"{where}: must be finite, got {cell!r}", "table")
+    return value
+
+
+#: Mechanism field path (as constants-file errors give it) -> column.
+_PATHS = {".".join(where): name for name, (where, _) in COLUMNS.items()}
+
+
+#: Errors on a whole part of a mechanism -> the columns that make it.
+_WHOLE = {
+    "": "id",
+    "positive": "p_eq, lam",
+    "negative": "p_eq_neg, lam_neg",
+    "amplification": "f_n, h_e, h",
+}
+
+
+def _row_error(exc: InputError, row: int, titles: dict[str, str], name: str) -> InputError:
+    """Re-word a constants-file error on one mechanism as row ``row`` and its column."""
+    path = re.sub(r"^mechanisms\[\d+\](?: \(id [^)]*\))?\.?", "", exc.field or "")
+    column = _PATHS.get(path) or _WHOLE.get(path.split(".", 1)[0])
+    label = f"row {row}" + (f", column {titles.get(column, column)!r}" if column else "")
+    return InputError(f"{name} {label}: {exc.reason}", "table")
+
+
+def constants_from_table(path: Path) -> ConstantsFile:
+    """Read a constants table (``.csv`` or ``.xlsx``) into a validated constants file.
+
+    Parameters
+    ----------
+    path : Path
+        The table; see the module docstring for its columns.
+
+    Returns
+    -------
+    ConstantsFile
+        The same model ``load_constants`` gives for the equivalent JSON file (short-form
+        mechanisms written flat, ``phi_ov`` defaulting to ``lam``).
+
+    Raises
+    ------
+    InputError
+        Missing file, unknown suffix, openpyxl missing for ``.xlsx`` (with the ``pip
+        install`` line), an unknown column or unit, or a bad cell; every message names the
+        row (as the spreadsheet numbers it) and the column. Field ``table``.
+    """
+    if not path.is_file():
+        raise InputError(f"table file not found: {path}", "table")
+    suffix = path.suffix.lower()
+    if suffix not in TABLE_SUFFIXES:
+        raise InputError(f"{path.name}: a table is .csv or .xlsx, got {suffix!r}", "table")
+    rows = _read_csv(path) if suffix == ".csv" else _read_xlsx(path)
+    rows = [(n, cells) for n, cells in rows if not all(_blank(c) for c in cells)]
+    if not rows:
+        raise InputError(f"{path.name} is empty", "table")
+    head_row, head = rows[0]
+    columns: list[Optional[tuple[str, float]]] = []
+    titles: dict[str, str] = {}
+    for col, title in enumerate(head, start=1):
+        if _blank(title):
+            columns.append(None)
+            continue
+        try:
+            name, factor = _column(str(title), col)
+        except InputError as exc:
+            raise InputError(f"{path.name} row {head_row}, {exc.reason}", "table") from None
+        if name in titles:
+            raise InputError(
+                f"{path.name} row {head_row}: columns {titles[name]!r} and {title!r} are "
+                f"both {name}",
+                "table",
+            )
+        titles[name] = str(title).strip()
+        columns.append((name, factor))
+    if "id" not in titles:
+        raise InputError(f"{path.name} row {head_row}: no 'id' column", "table")
+    mechanisms: list[dict[str, Any]] = []
+    row_numbers: list[int] = []
+    for n, cells in rows[1:]:
+        mech: dict[str, Any] = {}
+        for col, cell in enumerate(cells):
+            if _blank(cell):
+                continue
+            spec = columns[col] if col < len(columns) else None
+            if spec is None:
+                raise InputError(
+                    f"{path.name} row {n}, column {col + 1}: a value under no column name",
+                    "table",
+                )
+            name, factor = spec
+            where, unit = COLUMNS[name]
+            cell_where = f"{path.name} row {n}, column {titles[name]!r}"
+            if unit is None:
+                value: Any = str(cell).strip()
+            else:
+                value = _number(cell, cell_where) * factor
+            target = mech
+            for key in where[:-1]:
+                target = target.setdefault(key, {})
+            target[where[-1]] = value
+        if "id" not in mech:
+            raise InputError(f"{path.name} row {n}, column {titles['id']!r}: missing", "table")
+        # The short form of the positive side is written flat, as in the JSON files.
+        positive = mech.get("positive", {})
+        if positive and not {"I0", "K", "Q", "phi_cr", "M_F"} & set(positive):
+            mech.update(mech.pop("positive"))
+        try:
+            parse_constants(json.dumps({"mechanisms": [mech]}))
+        except InputError as exc:
+            raise _row_error(exc, n, titles, path.name) from None
+        mechanisms.append(mech)
+        row_numbers.append(n)
+    if not mechanisms:
+        raise InputError(f"{path.name}: the table has a header but no mechanism rows", "table")
+    try:
+        return parse_constants(json.dumps({"mechanisms": mechanisms}))
+    except InputError as exc:
+        index = re.match(r"mechanisms\[(\d+)\]", exc.field or "")
+        row = row_numbers[int(index.group(1))] if index else head_row
+        raise _row_error(exc, row, titles, path.name) from None
