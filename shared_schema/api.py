@@ -15,9 +15,17 @@ Python 3.9-clean: no ``X | Y`` annotations.
 
 from typing import Annotated, Any, Dict, List, Literal, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from shared_schema.constants import Amplification, ConstantsFile
+from shared_schema.rules import (
+    CRITERIA,
+    PULSE_SHAPES,
+    RECORD_FORMATS,
+    RECORD_UNITS,
+    SF_METHODS,
+    check_choice,
+)
 
 __all__ = [
     "RECORD_UNITS",
@@ -52,8 +60,6 @@ __all__ = [
     "SpectrumResponse",
 ]
 
-#: Acceleration units a record may be given in.
-RECORD_UNITS = ("g", "m/s2", "cm/s2")
 
 _REQUEST = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
 _RESPONSE = ConfigDict(extra="allow")
@@ -91,12 +97,12 @@ class PulseRequest(BaseModel):
         json_schema_extra={"exclusiveMinimum": 0},
     )
     shape: str = Field(
-        "sine", description="Pulse shape.", json_schema_extra={"enum": ["sine", "cosine"]}
+        "sine", description="Pulse shape.", json_schema_extra={"enum": list(PULSE_SHAPES)}
     )
     criterion: Optional[str] = Field(
         None,
         description="Overturning verdict: exact (default for pulses) or ratio.",
-        json_schema_extra={"enum": ["exact", "ratio", None]},
+        json_schema_extra={"enum": [*CRITERIA, None]},
     )
 
 
@@ -109,10 +115,17 @@ class RecordSamples(BaseModel):
         min_length=2, description="Acceleration samples, in `units`, at a uniform step `dt`."
     )
     dt: float = _gt0("Time step [s], > 0.")
-    units: Literal["g", "m/s2", "cm/s2"] = Field(description="Units of `accel`.")
+    units: str = Field(
+        description="Units of `accel`.", json_schema_extra={"enum": list(RECORD_UNITS)}
+    )
     name: str = Field(
         "record", min_length=1, max_length=200, description="Name used in results and reports."
     )
+
+    @field_validator("units")
+    @classmethod
+    def _known_units(cls, units: str) -> str:
+        return check_choice(units, tuple(RECORD_UNITS), "units")
 
 
 class EnvelopeRequest(BaseModel):
@@ -155,12 +168,12 @@ class _HistoryOptions(_BuildingOptions):
         description="Scale factor up the structure for mechanisms with amplification data: "
         "none; eq28 (from the record's 5 % spectrum at T_n = 1/f_n); ec8 (EN 1998-1 "
         "§4.3.5.2) or nzs (NZS 1170.5 C_Hi), both with building_height.",
-        json_schema_extra={"enum": ["none", "eq28", "ec8", "nzs"]},
+        json_schema_extra={"enum": list(SF_METHODS)},
     )
     criterion: Optional[str] = Field(
         None,
         description="Overturning verdict: ratio (default for records) or exact.",
-        json_schema_extra={"enum": ["ratio", "exact", None]},
+        json_schema_extra={"enum": [*CRITERIA, None]},
     )
 
 
@@ -275,13 +288,13 @@ class RecordFileOptions(BaseModel):
 
     format: Optional[str] = Field(
         None,
-        description="at2, two_column, one_column or csv (default: detected).",
-        json_schema_extra={"enum": ["at2", "two_column", "one_column", "csv"]},
+        description=f"One of {', '.join(RECORD_FORMATS)} (default: detected from the content).",
+        json_schema_extra={"enum": list(RECORD_FORMATS)},
     )
     units: Optional[str] = Field(
         None,
-        description="Acceleration units: g, m/s2 or cm/s2; AT2 files state their own, "
-        "two-column files default to g, other formats need it.",
+        description=f"Acceleration units: {', '.join(RECORD_UNITS)}; files that state their "
+        "units use them, two-column files default to g, other formats need it.",
         json_schema_extra={"enum": list(RECORD_UNITS)},
     )
     dt: Optional[float] = Field(
