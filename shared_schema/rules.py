@@ -16,7 +16,9 @@ What lives here
 
 import math
 import numbers
-from typing import Dict, Optional, Tuple
+import os
+from pathlib import Path
+from typing import Dict, Optional, Tuple, Union
 
 from shared_schema.errors import InputError
 
@@ -31,6 +33,7 @@ __all__ = [
     "G",
     "check_choice",
     "check_eta",
+    "check_file",
     "check_non_negative",
     "check_number",
     "check_positive",
@@ -131,6 +134,19 @@ def check_positive(value: object, name: str) -> float:
 def check_non_negative(value: object, name: str) -> float:
     """Return ``value`` as a float; raise ``InputError`` naming ``name`` unless finite and >= 0."""
     return check_number(value, name, at_least=0.0)
+
+
+def check_file(path: Union[str, "os.PathLike[str]"], label: str) -> Path:
+    """Return ``path`` as a Path if it names a readable file; raise ``InputError`` naming ``label``.
+
+    A folder is reported as a folder, not as a missing file.
+    """
+    p = Path(path)
+    if p.is_dir():
+        raise InputError(f"is a folder, not a file: {p}", label)
+    if not p.is_file():
+        raise InputError(f"file not found: {p}", label)
+    return p
 
 
 def check_choice(value: object, choices: Tuple[str, ...], name: str) -> str:

@@ -21,6 +21,7 @@ from shared_schema.io import save_constants, write_atomic
 
 from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
 from .core.model import check_positive
+from .core.records import GroundMotion
 from .demo import run_demo
 from .ida import ida_csv, parse_levels, run_ida
 from .report.html import build_report, input_source, write_report
@@ -71,6 +72,14 @@ def _user_errors(fn: F) -> F:
             _fail(str(exc))
 
     return wrapper  # type: ignore[return-value]
+
+
+def _read_record(path: Path, *args: Any) -> GroundMotion:
+    """Read a record as every command does, with its warnings on stderr."""
+    motion = read_record(path, *args)
+    for note in motion.warnings:
+        typer.echo(f"warning: record: {note}", err=True)
+    return motion
 
 
 def _print_json(doc: Any) -> None:
@@ -231,7 +240,7 @@ def history(
     """Time history of every mechanism in CONSTANTS under RECORD at each scale factor."""
     scales = _scales(scale, ctx.args)
     cf = read_constants(constants)
-    motion = read_record(record, record_format, units, dt, channel, component)
+    motion = _read_record(record, record_format, units, dt, channel, component)
     options: dict[str, Any] = {
         "sf": sf,
         "building": Building(building_height, soil_factor, element_period),
@@ -295,7 +304,7 @@ def record_info(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Describe a record: metadata, largest sine pulses and exact response spectrum."""
-    motion = read_record(record, record_format, units, dt, channel, component)
+    motion = _read_record(record, record_format, units, dt, channel, component)
     periods = log_grid(t_min, t_max, n, names=("t_min", "t_max"))
     doc, spectrum, found = record_analysis(
         motion, periods, zeta, n_pulses=pulses, f_min=f_min, f_max=f_max
@@ -388,7 +397,7 @@ def ida(
 
     levels = parse_levels(scales)
     cf = read_constants(constants)
-    motions = [read_record(p, record_format, units, dt, channel, component) for p in records or []]
+    motions = [_read_record(p, record_format, units, dt, channel, component) for p in records or []]
     motions += [spec.read() for spec in (read_record_spec(record_spec) if record_spec else [])]
     if not motions:
         _fail("records: give record files or --record-spec")
@@ -517,7 +526,7 @@ def envelope(
     cf = read_constants(constants)
     pulse = None
     if record is not None:
-        motion = read_record(record, record_format, units, dt, channel, component)
+        motion = _read_record(record, record_format, units, dt, channel, component)
         pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), exact=exact)
     elif ctx.args:
         _fail(f"unexpected argument {ctx.args[0]!r}")
@@ -672,7 +681,7 @@ def report(
     sources = [input_source("constants", constants.name, constants.read_bytes())]
     motion = None
     if record is not None:
-        motion = read_record(record, record_format, units, dt, channel, component)
+        motion = _read_record(record, record_format, units, dt, channel, component)
         sources.append(input_source("record", record.name, record.read_bytes()))
     options = {"scales": scales, "sf": sf, "building_height": building_height}
     options.update(soil_factor=soil_factor, element_period=element_period, at_height=at_height)

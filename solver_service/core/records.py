@@ -42,17 +42,30 @@ import numpy as np
 from numpy.typing import NDArray
 
 from shared_schema.errors import InputError
-from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, G
+from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, G, check_file
 
 from .excitation import SampledAccel
 from .formats import READERS, Channel, channel_list, select_channel
 from .formats import detect as detect_strong_motion
 from .formats._text import units_or_none
 
-__all__ = ["DT_RTOL", "FORMATS", "UNITS", "GroundMotion", "detect_format"]
+__all__ = [
+    "DT_PLAUSIBLE_S",
+    "DT_RTOL",
+    "FORMATS",
+    "PGA_PLAUSIBLE_G",
+    "UNITS",
+    "GroundMotion",
+    "detect_format",
+    "plausibility_warnings",
+]
 
 #: Acceleration units and their factor to m/s² (``shared_schema.rules``).
 UNITS = RECORD_UNITS
+#: PGA [g] outside which a record gets a plausibility warning (issue #14: wrong units).
+PGA_PLAUSIBLE_G = (0.001, 5.0)
+#: Time step [s] outside which a record gets a plausibility warning.
+DT_PLAUSIBLE_S = (1e-4, 0.1)
 #: Relative tolerance on the spacing of time stamps read from a file.
 DT_RTOL = 1e-6
 #: Record formats ``GroundMotion.from_file`` reads (``shared_schema.rules``).
@@ -118,9 +131,7 @@ def _check_dt(dt: Any) -> float:
 
 
 def _read_text(path: PathLike) -> tuple[Path, str]:
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"record file not found: {p}", "record")
+    p = check_file(path, "record")
     try:
         return p, p.read_text(encoding="utf-8", errors="strict")
     except (OSError, UnicodeDecodeError) as exc:
@@ -273,6 +284,16 @@ class GroundMotion:
     accel: SampledAccel
     name: str = "record"
     metadata: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        notes = plausibility_warnings(self)
+        if notes:
+            self.metadata["warnings"] = [*self.metadata.get("warnings", []), *notes]
+
+    @property
+    def warnings(self) -> list[str]:
+        """Notes on how the record was read or why its values look implausible."""
+        return list(self.metadata.get("warnings", []))
 
     @property
     def dt(self) -> float:
@@ -544,7 +565,8 @@ class GroundMotion:
         _check_samples(a, p.name)
         dt = _uniform_step(t, p.name)
         meta = {"source": p.name, "format": "two_column", "units": units, "npts": int(t.size)}
-        return cls(SampledAccel(a * factor, dt, t0=float(t[0])), p.stem, meta)
+        meta.update(_time_origin(float(t[0]), p.name))
+        return cls(SampledAccel(a * factor, dt), p.stem, meta)
 
     @classmethod
     def from_one_column(cls, path: PathLike, dt: float, units: str) -> GroundMotion:
@@ -692,7 +714,50 @@ class GroundMotion:
             "accel_column": header[ia] if names else ia,
             "units_from": "header" if stated is not None else "given",
         }
-        return cls(SampledAccel(a * factor, dt, t0=t0), p.stem, meta)
+        meta.update(_time_origin(t0, p.name))
+        return cls(SampledAccel(a * factor, dt), p.stem, meta)
+
+
+def _time_origin(t0: float, name: str) -> dict[str, Any]:
+    """Metadata for a time column that does not start at 0: the record is shifted to 0.
+
+    Every sample is used, from the first; the analyses take t = 0 at the first sample, so a
+    time column starting at ``t0`` is shifted by ``-t0`` and the shift is reported.
+    """
+    if t0 == 0.0:
+        return {}
+    return {
+        "time_shift_s": -t0,
+        "warnings": [
+            f"{name}: the time column starts at t = {t0:g} s; every sample is used and the "
+            f"time axis is shifted by {-t0:g} s so that the record starts at t = 0"
+        ],
+    }
+
+
+def plausibility_warnings(motion: GroundMotion) -> list[str]:
+    """Warnings for a record whose PGA or time step is implausible (often wrong units).
+
+    A PGA below ``PGA_PLAUSIBLE_G[0]`` or above ``PGA_PLAUSIBLE_G[1]`` [g], or a time step
+    outside ``DT_PLAUSIBLE_S`` [s], gets a warning naming the units the file was read in.
+    """
+    units = motion.metadata.get("units")
+    read_in = f"read in {units}" if units else "units not stated"
+    notes = []
+    pga_g = motion.pga_g
+    lo, hi = PGA_PLAUSIBLE_G
+    if not lo <= pga_g <= hi:
+        notes.append(
+            f"PGA {pga_g:.3g} g is outside the plausible range [{lo:g}, {hi:g}] g "
+            f"({read_in}); check the units"
+        )
+    dt_lo, dt_hi = DT_PLAUSIBLE_S
+    if not dt_lo <= motion.dt <= dt_hi:
+        notes.append(
+            f"time step dt = {motion.dt:.3g} s is outside the plausible range "
+            f"[{dt_lo:g}, {dt_hi:g}] s ({read_in}); check the time units or --dt"
+        )
+    return notes
 
 
 def detect_format(p: Path) -> str:

@@ -14,7 +14,7 @@ from rhino_plugin.scene_3dm import Scene
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 from shared_schema.io import load_constants
-from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, check_positive
+from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, check_file, check_positive
 from shared_schema.spec import parse_spec
 
 from ..core.records import GroundMotion, detect_format
@@ -30,13 +30,6 @@ __all__ = [
 
 #: Columns (CSV) or keys (JSON) of a record-spec file; only ``file`` is required.
 SPEC_FIELDS = ("file", "format", "units", "dt", "channel", "component")
-
-
-def _require_file(path: Path, label: str) -> None:
-    if path.is_dir():
-        raise InputError(f"is a folder, not a file: {path}", label)
-    if not path.is_file():
-        raise InputError(f"file not found: {path}", label)
 
 
 def read_record(
@@ -126,7 +119,7 @@ def read_record_spec(path: Path) -> list[RecordSpec]:
         An unknown column or key, a row without ``file``, a ``dt`` that is not a positive
         number, or an unknown format or units; the message names the row and the column.
     """
-    _require_file(path, "record_spec")
+    check_file(path, "record_spec")
     rows = _spec_rows(path, path.read_text(encoding="utf-8"))
     if not rows:
         raise InputError(f"{path.name} lists no records", "record_spec")
@@ -176,7 +169,7 @@ def read_constants(path: Path) -> ConstantsFile:
     Errors name ``constants`` (a JSON file) or ``table`` with the row and column (a table,
     ``solver_service.workflows.tables``).
     """
-    _require_file(path, "constants")
+    check_file(path, "constants")
     if is_table(path):
         return constants_from_table(path)
     return load_constants(path)
@@ -193,7 +186,7 @@ def constants_from_files(scene: Path, spec: Path) -> ConstantsFile:
         Mechanism spec (JSON); relative paths inside it are taken from its folder.
     """
     for label, path in (("scene", scene), ("spec", spec)):
-        _require_file(path, label)
+        check_file(path, label)
     spec_file = parse_spec(spec.read_bytes(), spec.name)
     return constants_from_spec(
         spec_file,

@@ -266,10 +266,8 @@ def _cases() -> list[Case]:
         expect, fld, problem, xf = "error", "", ".", ""
         if name in ("tiny_g.dat", "huge_g.dat", "coarse_dt.dat"):
             expect, problem = "warn", r"PGA|dt|implausible|units"
-            xf = "#14 units: no plausibility warning on records yet"
         if name in ("negative_start.dat", "late_start.dat"):
             expect, problem = "warn", r"start|shift|t\[0\]|time"
-            xf = "#14 records: a time column not starting at 0 is used without a note"
         if name == "one_column.txt":
             fld, problem = "", r"dt|--dt|format|column"
         cases.append(
@@ -309,7 +307,6 @@ def _cases() -> list[Case]:
             "error",
             "record|path",
             "folder|directory|not a file",
-            xfail="#14 messages: a folder reported as file not found",
         ),
         Case(
             "history-missing-constants",

@@ -333,3 +333,43 @@ def test_from_file_errors_name_the_file_and_field(tmp_path: Path, elcentro_path:
         GroundMotion.from_file(tmp_path / "nope.dat", units="g")
     with pytest.raises(InputError, match="not found"):
         GroundMotion.from_file(tmp_path / "nope.AT2")
+
+
+def test_a_time_column_starting_before_zero_is_shifted_with_a_note(tmp_path: Path) -> None:
+    t = np.arange(-2.0, 2.0, 0.01)
+    a = 0.2 * np.sin(2 * np.pi * t)
+    shifted, plain = tmp_path / "neg.dat", tmp_path / "zero.dat"
+    np.savetxt(shifted, np.column_stack([t, a]))
+    np.savetxt(plain, np.column_stack([t + 2.0, a]))
+    m1 = GroundMotion.from_file(shifted, units="g")
+    m0 = GroundMotion.from_file(plain, units="g")
+    assert m1.accel.n == t.size  # every sample kept
+    assert np.array_equal(m1.accel.acc, m0.accel.acc)
+    assert m1.accel.t0 == 0.0 and m1.metadata["time_shift_s"] == 2.0
+    assert any("shifted by 2 s" in w for w in m1.warnings)
+    assert not m0.warnings
+
+
+@pytest.mark.parametrize(
+    ("amplitude", "units", "dt", "expect"),
+    [
+        (0.3, "g", 0.01, None),
+        (0.3, "cm/s2", 0.01, "PGA"),  # a record in g read as cm/s2: PGA 0.0003 g
+        (30.0, "g", 0.01, "PGA"),
+        (0.3, "g", 0.5, "dt"),
+        (0.3, "g", 5e-5, "dt"),
+    ],
+)
+def test_an_implausible_record_gets_a_warning_naming_its_units(
+    tmp_path: Path, amplitude: float, units: str, dt: float, expect: Any
+) -> None:
+    t = dt * np.arange(2000)
+    path = tmp_path / "rec.dat"
+    np.savetxt(path, np.column_stack([t, amplitude * np.sin(t)]))
+    motion = GroundMotion.from_file(path, units=units)
+    if expect is None:
+        assert motion.warnings == []
+    else:
+        assert any(expect in w and f"read in {units}" in w for w in motion.warnings), (
+            motion.warnings
+        )
