@@ -276,6 +276,8 @@ def history(
     for mech_id, notes in doc.get("warnings", {}).items():
         for note in notes:
             typer.echo(f"warning: {mech_id}: {note}", err=True)
+    for note in doc.get("option_warnings", []):
+        typer.echo(f"warning: {note}", err=True)
     for skip in doc.get("skipped", []):
         typer.echo(f"warning: {skip['mechanism']} skipped: {skip['reason']}", err=True)
     if out is not None:

@@ -156,7 +156,12 @@ def test_history_bad_inputs(tmp_path: Path) -> None:
     one_sided.write_text(
         json.dumps({"mechanisms": [{"id": "F9", "rocking": "one_sided", "p_eq": 2.0, "lam": 0.1}]})
     )
-    cases.append(([str(one_sided), str(EXAMPLES / "records" / "elcentro_NS.dat")], "F9.eta"))
+    cases.append(
+        (
+            [str(one_sided), str(EXAMPLES / "records" / "elcentro_NS.dat")],
+            "F9: a time history of a one-sided mechanism needs a coefficient of restitution",
+        )
+    )
     for args, message in cases:
         res = runner.invoke(app, ["history", *args])
         assert res.exit_code == 2, (args, res.output)
@@ -593,3 +598,24 @@ def test_history_with_no_runnable_mechanism_names_them_all(tmp_path: Path) -> No
     res = runner.invoke(app, ["history", str(path), str(EXAMPLES / "records" / "elcentro_NS.dat")])
     assert res.exit_code == 2
     assert "mechanisms" in res.stderr and "F:" in res.stderr and "restitution" in res.stderr
+
+
+def test_options_that_cannot_apply_warn_and_impossible_values_fail() -> None:
+    constants = EXAMPLES / "constants" / "rect_walls.json"  # no amplification data
+    record = EXAMPLES / "records" / "elcentro_NS.dat"
+    res = runner.invoke(app, ["history", str(constants), str(record), "--sf", "ec8", "--json"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    assert any("sf ec8 has no effect" in n for n in doc["option_warnings"])
+    text = runner.invoke(app, ["history", str(constants), str(record), "--sf", "ec8"])
+    assert "warning: sf ec8 has no effect" in text.stderr
+    plain = runner.invoke(app, ["history", str(constants), str(record), "--json"])
+    assert [r["peak_ratio"] for r in doc["results"]] == [
+        r["peak_ratio"] for r in json.loads(plain.stdout)["results"]
+    ]
+    res = runner.invoke(app, ["history", str(constants), str(record), "--building-height", "12"])
+    assert "building_height has no effect with sf none" in res.stderr
+    res = runner.invoke(
+        app, ["history", str(constants), str(record), "--sf", "ec8", "--building-height", "-5"]
+    )
+    assert res.exit_code == 2 and "building_height: must be finite and > 0" in res.stderr

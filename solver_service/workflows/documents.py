@@ -32,7 +32,7 @@ from ..core.pulses import extract_pulses, largest_pulse
 from ..core.records import GroundMotion
 from ..core.spectra import Spectrum, response_spectrum
 from .adapter import to_rocking_model
-from .scaling import Building, run_scaled
+from .scaling import Building, option_notes, run_scaled
 
 __all__ = [
     "PULSE_METHOD",
@@ -473,6 +473,9 @@ def history_doc(
         doc["displacement"] = {"height_m": at_height, "formula": "u = z * max|phi| [m]"}
     if skipped:
         doc["skipped"] = skipped
+    options = option_notes(cf, sf, building)
+    if options:
+        doc["option_warnings"] = options
     notes = linearisation_notes(cf, models)
     if notes:
         doc["warnings"] = notes

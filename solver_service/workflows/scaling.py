@@ -12,14 +12,21 @@ from typing import Any, Optional
 
 from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError
-from shared_schema.rules import SF_METHODS, G
+from shared_schema.rules import SF_METHODS, G, check_choice, check_non_negative, check_positive
 
 from ..core.codes import sf_ec8, sf_eq28, sf_nzs
 from ..core.exact import simulate, simulate_batch
 from ..core.spectra import response_spectrum
 from .adapter import to_rocking_model
 
-__all__ = ["SF_METHODS", "Building", "dense_runs", "mechanism_scale_factor", "run_scaled"]
+__all__ = [
+    "SF_METHODS",
+    "Building",
+    "dense_runs",
+    "mechanism_scale_factor",
+    "option_notes",
+    "run_scaled",
+]
 
 
 @dataclass(frozen=True)
@@ -40,6 +47,40 @@ class Building:
     height: Optional[float] = None
     soil_factor: float = 1.0
     element_period: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.height is not None:
+            check_positive(self.height, "building_height")
+        check_positive(self.soil_factor, "soil_factor")
+        check_non_negative(self.element_period, "element_period")
+
+
+def option_notes(cf: ConstantsFile, sf: str, building: Building) -> list[str]:
+    """Warnings for scale-factor options that cannot apply to these mechanisms.
+
+    ``sf`` other than ``none`` acts only on mechanisms with ``amplification`` data; the
+    building options act only with ``sf`` ``ec8`` (all three) or ``nzs`` (the height).
+    """
+    check_choice(sf, SF_METHODS, "sf")
+    notes = []
+    if sf != "none" and not any(m.amplification is not None for m in cf.mechanisms):
+        notes.append(
+            f"sf {sf} has no effect: no mechanism has amplification data (f_n, h_e, h), so "
+            "every mechanism takes the record as given (ground level)"
+        )
+    used = {
+        "ec8": ("building_height", "soil_factor", "element_period"),
+        "nzs": ("building_height",),
+    }
+    given = {
+        "building_height": building.height is not None,
+        "soil_factor": building.soil_factor != Building.soil_factor,
+        "element_period": building.element_period != Building.element_period,
+    }
+    for name, is_given in given.items():
+        if is_given and name not in used.get(sf, ()):
+            notes.append(f"{name} has no effect with sf {sf}")
+    return notes
 
 
 def mechanism_scale_factor(
@@ -63,8 +104,7 @@ def mechanism_scale_factor(
     dict or None
         ``{"value", "method", "formula", "inputs"}`` (``solver_service.core.codes``).
     """
-    if sf not in SF_METHODS:
-        raise InputError(f"must be one of {list(SF_METHODS)}, got {sf!r}", "sf")
+    check_choice(sf, SF_METHODS, "sf")
     amp = mech.amplification
     if sf == "none" or amp is None:
         return None

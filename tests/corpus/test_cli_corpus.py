@@ -351,7 +351,6 @@ def _cases() -> list[Case]:
             "warn",
             "",
             "amplification|no effect|building",
-            xfail="#14 options that do nothing",
         ),
         Case(
             "history-building-height-neg",
@@ -359,7 +358,6 @@ def _cases() -> list[Case]:
             "error",
             "building_height",
             r"> 0",
-            xfail="#14 options that do nothing",
         ),
         Case("history-at-height-neg", [*hist, "--at-height", "-1"], "error", "at_height", r"> 0"),
         Case(
