@@ -22,21 +22,51 @@ from typing import TYPE_CHECKING, Any
 
 from rockmech._version import __version__
 
-if TYPE_CHECKING:
-    from shared_schema.constants import ConstantsFile
-    from shared_schema.errors import GeometryError, InputError, RockmechError, SolverError
-    from shared_schema.extras import MissingExtra
-    from shared_schema.io import load_constants, save_constants
-    from solver_service.core.envelope import critical_bands, mechanism_envelope
-    from solver_service.core.exact import simulate, simulate_batch
-    from solver_service.core.excitation import Pulse, SampledAccel
-    from solver_service.core.model import G, RockingModel
-    from solver_service.core.pulses import extract_pulses, largest_pulse
-    from solver_service.core.records import GroundMotion
-    from solver_service.core.spectra import response_spectrum
-    from solver_service.demo import examples_dir
-    from solver_service.report.html import build_report, write_report
-    from solver_service.workflows.inputs import constants_from_files
+if TYPE_CHECKING:  # the real types for type checkers and editors
+    from shared_schema.constants import ConstantsFile as ConstantsFile
+    from shared_schema.errors import (
+        GeometryError as GeometryError,
+    )
+    from shared_schema.errors import (
+        InputError as InputError,
+    )
+    from shared_schema.errors import (
+        RockmechError as RockmechError,
+    )
+    from shared_schema.errors import (
+        SolverError as SolverError,
+    )
+    from shared_schema.extras import MissingExtra as MissingExtra
+    from shared_schema.io import load_constants as load_constants
+    from shared_schema.io import save_constants as save_constants
+    from solver_service.core.envelope import (
+        critical_bands as critical_bands,
+    )
+    from solver_service.core.envelope import (
+        mechanism_envelope as mechanism_envelope,
+    )
+    from solver_service.core.exact import simulate as simulate
+    from solver_service.core.exact import simulate_batch as simulate_batch
+    from solver_service.core.excitation import Pulse as Pulse
+    from solver_service.core.excitation import SampledAccel as SampledAccel
+    from solver_service.core.model import G as G
+    from solver_service.core.model import RockingModel as RockingModel
+    from solver_service.core.pulses import (
+        extract_pulses as extract_pulses,
+    )
+    from solver_service.core.pulses import (
+        largest_pulse as largest_pulse,
+    )
+    from solver_service.core.records import GroundMotion as GroundMotion
+    from solver_service.core.spectra import response_spectrum as response_spectrum
+    from solver_service.demo import examples_dir as examples_dir
+    from solver_service.report.html import (
+        build_report as build_report,
+    )
+    from solver_service.report.html import (
+        write_report as write_report,
+    )
+    from solver_service.workflows.inputs import constants_from_files as constants_from_files
 
 #: Each public name and the module it comes from (imported on first access).
 _SOURCES = {
