@@ -754,7 +754,7 @@ def serve(
     ),
 ) -> None:
     """Run the REST service (FastAPI + uvicorn); settings also from ROCKMECH_* variables."""
-    for module in ("fastapi", "uvicorn", "pydantic_settings", "multipart"):
+    for module in ("fastapi", "uvicorn", "pydantic_settings"):
         require(module, "service", "for rockmech serve")
     # The service extra is loaded only by the command that needs it.
     from .api.server import run, settings_with
