@@ -378,10 +378,9 @@ def record_info(
         f"{motion.duration:.2f} s, PGA {motion.pga_g:.4f} g"
     )
     typer.echo("largest one-cycle sine pulses (a_p signed: > 0 first accelerates positively):")
-    for p in doc["pulses"]:
-        typer.echo(
-            f"  a_p = {p['a_p_g']:+.4f} g  f_p = {p['f_p_hz']:.3f} Hz  t = {p['t_start_s']:.3f} s"
-        )
+    rows = [[f"{p['a_p_g']:+.4g}", _g4(p["f_p_hz"]), _g4(p["t_start_s"])] for p in doc["pulses"]]
+    for line in _table(["a_p [g]", "f_p [Hz]", "t_start [s]"], rows):
+        typer.echo(line)
     spec = doc["spectrum"]
     k = max(range(len(spec["psa_g"])), key=lambda i: spec["psa_g"][i])
     typer.echo(
@@ -485,14 +484,14 @@ def ida(
         f"largest error estimate {doc['max_error_estimate']:.1e}"
     )
     unit = doc["intensity"]["units"]
+    rows, notes = [], []
     for mech in doc["mechanisms"]:
         fit = mech["fragility"]
-        if "median" in fit:
-            text = f"median {fit['median']:.4g} {unit}, beta {fit['beta']:.3f}"
-        else:
-            text = "no fit"
-        note = f" ({fit['note']})" if "note" in fit else ""
-        typer.echo(f"  {mech['id']:<12} {text}{note}")
+        rows.append([str(mech["id"]), _g4(fit.get("median")), _g4(fit.get("beta"))])
+        if "note" in fit:
+            notes.append(f"  {mech['id']}: {fit['note']}")
+    for line in _table(["mechanism", f"median [{unit}]", "beta [-]"], rows) + notes:
+        typer.echo(line)
     if out is not None:
         typer.echo(f"wrote {out / 'ida.json'}, ida.csv, ida.png")
 
@@ -571,8 +570,9 @@ def envelope(
         return
     typer.echo(f"wrote {out / 'envelope.json'}, envelope.csv, envelope.png")
     typer.echo("critical mechanism by pulse frequency:")
-    for band in doc["critical"]:
-        typer.echo(f"  {band['f_min']:8.3f} - {band['f_max']:8.3f} Hz: {band['mechanism']}")
+    rows = [[str(b["mechanism"]), _g4(b["f_min"]), _g4(b["f_max"])] for b in doc["critical"]]
+    for line in _table(["mechanism", "f_min [Hz]", "f_max [Hz]"], rows):
+        typer.echo(line)
     if pulse is not None:
         p = pulse["pulse"]
         typer.echo(
