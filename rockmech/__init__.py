@@ -11,8 +11,8 @@ Examples
 >>> import rockmech
 >>> wall = rockmech.RockingModel.symmetric(p_eq=2.2, lam=0.165, eta=0.96, name="W2")
 >>> res = rockmech.simulate(wall, rockmech.Pulse(a_p=-3.0, f_p=1.0))  # a_p [m/s²], f_p [Hz]
->>> bool(res.overturned)
-False
+>>> bool(res.overturned), res.peak_ratio
+(True, 1.0)
 """
 
 from __future__ import annotations

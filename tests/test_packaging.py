@@ -378,3 +378,10 @@ def test_sdist_holds_every_tracked_file(dists: dict[str, Path]) -> None:
         names = {m.name.removeprefix(top) for m in tar.getmembers() if m.isfile()}
     missing = sorted(set(_tracked()) - names)
     assert not missing, missing
+
+
+def test_rockmech_docstring_example_runs() -> None:
+    import doctest
+
+    result = doctest.testmod(rockmech, verbose=False)
+    assert result.attempted >= 3 and result.failed == 0
