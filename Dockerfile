@@ -1,9 +1,10 @@
-# rockmech REST solver service (FastAPI + uvicorn). Service only: no Rhino libraries. The
-# /api/v1/constants endpoint reads .3dm scenes and answers 501 in this image unless it is
-# built with --build-arg EXTRAS=service,geometry (adds rhino3dm, trimesh, manifold3d).
+# rockmech REST solver service (FastAPI + uvicorn). The default image serves every endpoint,
+# /api/v1/constants (.3dm scenes: rhino3dm, trimesh, manifold3d, shapely) included. Build
+# with --build-arg EXTRAS=service for a slimmer image without the geometry libraries: there
+# /api/v1/constants answers 501 with the install line of the missing extra.
 FROM python:3.11-slim
 
-ARG EXTRAS=service
+ARG EXTRAS=service,geometry
 ENV PYTHONDONTWRITEBYTECODE=1 \
     PYTHONUNBUFFERED=1 \
     PIP_NO_CACHE_DIR=1 \
@@ -16,19 +17,22 @@ ENV PYTHONDONTWRITEBYTECODE=1 \
 WORKDIR /app
 
 # Dependencies in their own layer: only the project metadata is needed to resolve them, so a
-# change to the sources does not reinstall them. Versions come from pyproject.toml's ranges
-# (ghhops-server is pinned there), hence no pins on this line.
-COPY pyproject.toml README.md ./
+# change to the sources does not reinstall them. The package folders pyproject.toml lists are
+# created empty for that install and removed after it. Versions come from pyproject.toml's
+# ranges (ghhops-server is pinned there), hence no pins on this line.
+COPY pyproject.toml README.md LICENSE ./
+COPY rockmech/_version.py ./rockmech/_version.py
 # hadolint ignore=DL3013
-RUN mkdir -p shared_schema solver_service rhino_plugin \
-    && touch shared_schema/__init__.py solver_service/__init__.py rhino_plugin/__init__.py \
+RUN python -c "import pathlib, tomllib; t = tomllib.load(open('pyproject.toml', 'rb'))['tool']['setuptools']; [pathlib.Path(t['package-dir'].get(p, p.replace('.', '/'))).mkdir(parents=True, exist_ok=True) for p in t['packages']]" \
     && pip install ".[${EXTRAS}]" \
     && pip uninstall -y rockmech \
-    && rm -rf shared_schema solver_service rhino_plugin build ./*.egg-info
+    && rm -rf rockmech shared_schema solver_service rhino_plugin examples build ./*.egg-info
 
+COPY rockmech ./rockmech
 COPY shared_schema ./shared_schema
 COPY solver_service ./solver_service
 COPY rhino_plugin ./rhino_plugin
+COPY examples ./examples
 RUN pip install --no-deps . \
     && rm -rf build ./*.egg-info \
     && useradd --create-home --uid 10001 --user-group rockmech

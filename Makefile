@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 
-.PHONY: install demo test lint typecheck pyright schema bench numerics serve clean
+.PHONY: install demo test lint typecheck pyright schema bench numerics serve dist install-check clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -29,6 +29,17 @@ lint: $(STAMP)
 typecheck: $(STAMP)
 	$(BIN)/mypy
 	$(BIN)/mypy --config-file mypy-py39.ini
+
+## The wheel and the sdist, in dist/.
+dist: $(STAMP)
+	rm -rf dist
+	$(BIN)/python -m build --outdir dist .
+
+## The wheel installed as a user would, in a fresh virtual environment: with no extras
+## (--version, --help, demo, import rockmech), then with geometry,service (constants and
+## one request to rockmech serve). .ci/run runs it after `make test`.
+install-check: dist
+	.ci/install_check dist
 
 ## The Rhino glue against RhinoCommon (pyright + rhino-stubs-typed; needs node on PATH).
 ## `make test` runs the same check in tests/rhino_glue/test_static.py.
@@ -59,4 +70,4 @@ serve: $(STAMP)
 	$(BIN)/rockmech serve
 
 clean:
-	rm -rf $(VENV) out .mypy_cache .ruff_cache .pytest_cache
+	rm -rf $(VENV) out dist build .mypy_cache .ruff_cache .pytest_cache

@@ -28,6 +28,7 @@ import numpy as np
 
 from rhino_plugin.geometry.mesh import TriMesh
 from shared_schema.errors import GeometryError, InputError
+from shared_schema.extras import require
 
 __all__ = ["Scene", "SceneObject", "solid_mesh", "triangulate_polygon"]
 
@@ -72,9 +73,7 @@ _CURVE_KINDS = {"LineCurve": "line", "PolylineCurve": "polyline"}
 
 def _rhino3dm() -> Any:
     """Import rhino3dm lazily (heavy, and its bundled type stubs are incomplete)."""
-    import rhino3dm
-
-    return rhino3dm
+    return require("rhino3dm", "geometry", "to read .3dm scenes")
 
 
 @dataclass(frozen=True)

@@ -1,29 +1,34 @@
 """The ``rockmech`` command line.
 
 Every command validates its inputs up front; a bad argument exits with status 2 and a
-one-line reason on stderr (``error: <field>: <what is wrong>``). With ``--json`` a command
-prints exactly one JSON document to stdout. SI units throughout, except where an option
-name says otherwise (``--a-p-g`` is in g).
+one-line reason on stderr (``error: <field>: <what is wrong>``), and so does a missing
+optional extra (the message gives its ``pip install 'rockmech[<extra>]'`` line). Results go
+to stdout, warnings, notes and progress to stderr. With ``--json`` a command prints exactly
+one JSON document to stdout. SI units throughout, except where an option name says
+otherwise (``--a-p-g`` is in g); every ``--help`` shows the units in brackets.
 """
 
 from __future__ import annotations
 
 import functools
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn, Optional, TypeVar
 
 import typer
 
+from rockmech._version import __version__
 from shared_schema.errors import RockmechError
+from shared_schema.extras import MissingExtra, extra_for, require
 from shared_schema.io import save_constants, write_atomic
+from shared_schema.rules import CRITERIA, PULSE_SHAPES, RECORD_FORMATS, RECORD_UNITS, SF_METHODS
 
 from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
 from .core.model import check_positive
 from .core.records import GroundMotion
 from .demo import run_demo
-from .ida import ida_csv, parse_levels, run_ida
+from .ida import IM_MEASURES, ida_csv, parse_levels, run_ida
 from .report.html import build_report, input_source, write_report
 from .report.plots import plot_fragility
 from .workflows.documents import (
@@ -51,9 +56,13 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    # Plain help: rich markup would read the units in brackets ("[rad/s]") as tags and drop them.
+    rich_markup_mode=None,
 )
 
 F = TypeVar("F", bound=Callable[..., Any])
+#: Widest terminal table [characters].
+TABLE_WIDTH = 100
 
 
 def _fail(message: str) -> NoReturn:
@@ -61,8 +70,13 @@ def _fail(message: str) -> NoReturn:
     raise typer.Exit(code=2)
 
 
+def _note(message: str) -> None:
+    """Print a warning or note on stderr, so that stdout holds only results."""
+    typer.echo(message, err=True)
+
+
 def _user_errors(fn: F) -> F:
-    """Turn rockmech's own errors into a one-line message and exit status 2."""
+    """Turn rockmech's own errors, and missing extras, into a one-line message and exit 2."""
 
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -70,6 +84,13 @@ def _user_errors(fn: F) -> F:
             return fn(*args, **kwargs)
         except RockmechError as exc:
             _fail(str(exc))
+        except ModuleNotFoundError as exc:
+            # A heavy module imported without ``require``: still name the extra.
+            name = exc.name or "a module"
+            extra = extra_for(name)
+            if extra is not None:
+                _fail(str(MissingExtra(name, extra)))
+            _fail(f"{name} is not installed; reinstall rockmech (pip install rockmech)")
 
     return wrapper  # type: ignore[return-value]
 
@@ -78,8 +99,64 @@ def _read_record(path: Path, *args: Any) -> GroundMotion:
     """Read a record as every command does, with its warnings on stderr."""
     motion = read_record(path, *args)
     for note in motion.warnings:
-        typer.echo(f"warning: record: {note}", err=True)
+        _note(f"warning: record: {note}")
     return motion
+
+
+def _choices(values: Iterable[str]) -> str:
+    """Return the ``--help`` placeholder of a word from a vocabulary: ``[sine|cosine]``.
+
+    The vocabularies live in ``shared_schema.rules``. A value outside one reaches the domain
+    check, so the command line and the REST service give the same one-line message
+    (``error: shape: must be one of [...]``); a test pins that.
+    """
+    return "[" + "|".join(values) + "]"
+
+
+def _table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
+    """Lines of an aligned text table at most ``TABLE_WIDTH`` wide.
+
+    The first column (names) is left-aligned and, only if the table would be too wide,
+    shortened with ``...``; the other columns are right-aligned.
+    """
+    widths = [max([len(h)] + [len(r[i]) for r in rows]) for i, h in enumerate(headers)]
+    spare = TABLE_WIDTH - (sum(widths) + 2 * (len(widths) - 1))
+    if spare < 0:
+        widths[0] = max(len(headers[0]), widths[0] + spare)
+
+    def fit(text: str, width: int) -> str:
+        return text if len(text) <= width else text[: max(width - 3, 1)] + "..."
+
+    def line(cells: Sequence[str]) -> str:
+        out = [fit(cells[0], widths[0]).ljust(widths[0])]
+        out += [c.rjust(w) for c, w in zip(cells[1:], widths[1:])]
+        return "  ".join(out).rstrip()
+
+    return [line(headers)] + [line(r) for r in rows]
+
+
+def _g4(value: Optional[float]) -> str:
+    """Format a number to 4 significant figures (``-`` for none)."""
+    return "-" if value is None else f"{value:.4g}"
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        typer.echo(f"rockmech {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(
+    version: bool = typer.Option(
+        False,
+        "--version",
+        callback=_print_version,
+        is_eager=True,
+        help="Print the version and exit.",
+    ),
+) -> None:
+    """Rocking collapse mechanisms of masonry: exact rocking solver and tools (SI units)."""
 
 
 def _print_json(doc: Any) -> None:
@@ -89,6 +166,11 @@ def _print_json(doc: Any) -> None:
 
 def _fmt_time(value: Optional[float]) -> str:
     return "-" if value is None else f"{value:.4f} s"
+
+
+# Vocabularies of the choice options: one home, shared_schema.rules.
+_SHAPES = _choices(PULSE_SHAPES)
+_CRITERIA = _choices(CRITERIA)
 
 
 @app.command()
@@ -110,9 +192,12 @@ def pulse(
     phi_ov: Optional[float] = typer.Option(
         None, "--phi-ov", help="Overturning rotation [rad]; defaults to lambda."
     ),
-    shape: str = typer.Option("sine", "--shape", help="Pulse shape: sine or cosine."),
+    shape: str = typer.Option("sine", "--shape", metavar=_SHAPES, help="Pulse shape."),
     criterion: Optional[str] = typer.Option(
-        None, "--criterion", help="Overturning verdict: exact (default for pulses) or ratio."
+        None,
+        "--criterion",
+        metavar=_CRITERIA,
+        help="Overturning verdict: exact (default for pulses) or ratio.",
     ),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
@@ -143,7 +228,7 @@ def pulse(
         f"t_overturn: {_fmt_time(doc['t_overturn'])}"
     )
     for note in doc["warnings"]:
-        typer.echo(f"warning: {note}", err=True)
+        _note(f"warning: {note}")
 
 
 # Options shared by every command that reads a ground-motion record.
@@ -155,15 +240,16 @@ _RECORD_ARG = typer.Argument(
 _UNITS_OPT = typer.Option(
     None,
     "--units",
-    help="Acceleration units: g, m/s2, cm/s2, mm/s2, mg or in/s2; files that state their own "
-    "(AT2, the strong-motion formats, a CSV column 'acc [g]') are read in them, two-column "
-    "files default to g, other files need it.",
+    metavar=_choices(RECORD_UNITS),
+    help="Acceleration units; files that state their own (AT2, the strong-motion formats, a "
+    "CSV column 'acc [g]') are read in them, two-column files default to g, other files need "
+    "it.",
 )
 _FORMAT_OPT = typer.Option(
     None,
     "--format",
-    help="at2, esm, knet, cosmos, dmg, geonet, two_column, one_column or csv (default: "
-    "detected from the content).",
+    metavar=_choices(RECORD_FORMATS),
+    help="Record format (default: detected from the content).",
 )
 _CHANNEL_OPT = typer.Option(
     None, "--channel", help="Channel number in a file with several (DMG V2, GeoNet V2A)."
@@ -176,6 +262,7 @@ _DT_OPT = typer.Option(None, "--dt", help="Time step [s] of a record without a t
 _SF_OPT = typer.Option(
     "none",
     "--sf",
+    metavar=_choices(SF_METHODS),
     help="Scale factor up the structure for mechanisms with amplification data: none; "
     "eq28 (from the record's 5 % spectrum at T_n = 1/f_n); ec8 (EN 1998-1 §4.3.5.2, "
     "needs --building-height); nzs (NZS 1170.5 C_Hi, needs --building-height).",
@@ -227,7 +314,10 @@ def history(
         "mechanism's rotation axis (to compare with shake-table tests).",
     ),
     criterion: Optional[str] = typer.Option(
-        None, "--criterion", help="Overturning verdict: ratio (default for records) or exact."
+        None,
+        "--criterion",
+        metavar=_CRITERIA,
+        help="Overturning verdict: ratio (default for records) or exact.",
     ),
     out: Optional[Path] = typer.Option(
         None,
@@ -261,25 +351,29 @@ def history(
     for mech_id, info in doc.get("scale_factors", {}).items():
         typer.echo(f"  SF {mech_id}: {info['value']:.4f} = {info['formula']}")
     disp = at_height is not None
-    typer.echo(
-        f"{'mechanism':<16}{'scale':>8}{'peak':>10}{'overturned':>12}"
-        f"{'t_ov [s]':>10}{'impacts':>9}{'error':>10}" + (f"{'u_peak [m]':>12}" if disp else "")
-    )
+    headers = ["mechanism", "scale", "peak |phi|/phi_ov", "overturned", "t_ov [s]", "impacts"]
+    headers += ["error"] + (["u_peak [m]"] if disp else [])
+    rows = []
     for row in doc["results"]:
-        t_ov = "-" if row["t_overturn"] is None else f"{row['t_overturn']:.3f}"
-        typer.echo(
-            f"{row['mechanism']:<16}{row['scale']:>8g}{row['peak_ratio']:>10.4f}"
-            f"{'yes' if row['overturned'] else 'no':>12}{t_ov:>10}{row['n_impacts']:>9}"
-            f"{row['error_estimate']:>10.1e}"
-            + (f"{row['peak_displacement_m']:>12.4g}" if disp else "")
-        )
+        cells = [
+            str(row["mechanism"]),
+            _g4(row["scale"]),
+            _g4(row["peak_ratio"]),
+            "yes" if row["overturned"] else "no",
+            _g4(row["t_overturn"]),
+            str(row["n_impacts"]),
+            f"{row['error_estimate']:.1e}",
+        ]
+        rows.append(cells + ([_g4(row["peak_displacement_m"])] if disp else []))
+    for line in _table(headers, rows):
+        typer.echo(line)
     for mech_id, notes in doc.get("warnings", {}).items():
         for note in notes:
-            typer.echo(f"warning: {mech_id}: {note}", err=True)
+            _note(f"warning: {mech_id}: {note}")
     for note in doc.get("option_warnings", []):
-        typer.echo(f"warning: {note}", err=True)
+        _note(f"warning: {note}")
     for skip in doc.get("skipped", []):
-        typer.echo(f"warning: {skip['mechanism']} skipped: {skip['reason']}", err=True)
+        _note(f"warning: {skip['mechanism']} skipped: {skip['reason']}")
     if out is not None:
         typer.echo(f"wrote {out / 'history.json'}, history.png, history_record.png")
 
@@ -330,10 +424,9 @@ def record_info(
         )
     )
     typer.echo("largest one-cycle sine pulses (a_p signed: > 0 first accelerates positively):")
-    for p in doc["pulses"]:
-        typer.echo(
-            f"  a_p = {p['a_p_g']:+.4f} g  f_p = {p['f_p_hz']:.3f} Hz  t = {p['t_start_s']:.3f} s"
-        )
+    rows = [[f"{p['a_p_g']:+.4g}", _g4(p["f_p_hz"]), _g4(p["t_start_s"])] for p in doc["pulses"]]
+    for line in _table(["a_p [g]", "f_p [Hz]", "t_start [s]"], rows):
+        typer.echo(line)
     spec = doc["spectrum"]
     k = max(range(len(spec["psa_g"])), key=lambda i: spec["psa_g"][i])
     typer.echo(
@@ -363,7 +456,10 @@ def ida(
         help="Intensity levels: a list 0.25,0.5,1,2 or a log range start:stop:n (0.1:3:20).",
     ),
     im: str = typer.Option(
-        "scale", "--im", help="Intensity measure: scale (factor on each record) or pga [g]."
+        "scale",
+        "--im",
+        metavar=_choices(IM_MEASURES),
+        help="Intensity measure: scale (factor on each record) or pga [g].",
     ),
     units: Optional[str] = _UNITS_OPT,
     record_format: Optional[str] = _FORMAT_OPT,
@@ -375,7 +471,10 @@ def ida(
     soil_factor: float = _SOIL_FACTOR_OPT,
     element_period: float = _ELEMENT_PERIOD_OPT,
     criterion: Optional[str] = typer.Option(
-        None, "--criterion", help="Overturning verdict: ratio (default) or exact."
+        None,
+        "--criterion",
+        metavar=_CRITERIA,
+        help="Overturning verdict: ratio (default) or exact.",
     ),
     scheduler: Optional[str] = typer.Option(
         None,
@@ -444,14 +543,14 @@ def ida(
         f"largest error estimate {doc['max_error_estimate']:.1e}"
     )
     unit = doc["intensity"]["units"]
+    rows, notes = [], []
     for mech in doc["mechanisms"]:
         fit = mech["fragility"]
-        if "median" in fit:
-            text = f"median {fit['median']:.4g} {unit}, beta {fit['beta']:.3f}"
-        else:
-            text = "no fit"
-        note = f" ({fit['note']})" if "note" in fit else ""
-        typer.echo(f"  {mech['id']:<12} {text}{note}")
+        rows.append([str(mech["id"]), _g4(fit.get("median")), _g4(fit.get("beta"))])
+        if "note" in fit:
+            notes.append(f"  {mech['id']}: {fit['note']}")
+    for line in _table(["mechanism", f"median [{unit}]", "beta [-]"], rows) + notes:
+        typer.echo(line)
     if out is not None:
         typer.echo(f"wrote {out / 'ida.json'}, ida.csv, ida.png")
 
@@ -471,15 +570,16 @@ def constants(
         _print_json(json.loads(cf.model_dump_json(exclude_none=True)))
         return
     typer.echo(f"wrote {output}")
+    rows = []
     for m in cf.mechanisms:
         side = m.positive
-        typer.echo(
-            f"  {m.id:<8} p_eq = {side.p_eq:.4f} rad/s  lam = {side.lam:.4f}  "
-            f"phi_ov = {side.phi_ov:.4f} rad  eta = {m.eta if m.eta is not None else '-'}"
-        )
+        rows.append([m.id, _g4(side.p_eq), _g4(side.lam), _g4(side.phi_ov), _g4(m.eta)])
         notes = (m.provenance or {}).get("warnings") or []
         for note in notes if isinstance(notes, list) else []:
-            typer.echo(f"    warning: {note}")
+            _note(f"warning: {m.id}: {note}")
+    headers = ["mechanism", "p_eq [rad/s]", "lam [-]", "phi_ov [rad]", "eta [-]"]
+    for line in _table(headers, rows):
+        typer.echo(line)
 
 
 @app.command("constants-table")
@@ -545,8 +645,9 @@ def envelope(
         return
     typer.echo(f"wrote {out / 'envelope.json'}, envelope.csv, envelope.png")
     typer.echo("critical mechanism by pulse frequency:")
-    for band in doc["critical"]:
-        typer.echo(f"  {band['f_min']:8.3f} - {band['f_max']:8.3f} Hz: {band['mechanism']}")
+    rows = [[str(b["mechanism"]), _g4(b["f_min"]), _g4(b["f_max"])] for b in doc["critical"]]
+    for line in _table(["mechanism", "f_min [Hz]", "f_max [Hz]"], rows):
+        typer.echo(line)
     if pulse is not None:
         p = pulse["pulse"]
         typer.echo(
@@ -566,7 +667,7 @@ def boundary(
         None, "--eta", help="Coefficient of restitution [-] (one-sided: default 0)."
     ),
     one_sided: bool = typer.Option(False, "--one-sided", help="One-sided rocking."),
-    shape: str = typer.Option("sine", "--shape", help="Pulse shape: sine or cosine."),
+    shape: str = typer.Option("sine", "--shape", metavar=_SHAPES, help="Pulse shape."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Every overturning interval in A = a_p/(g lam) at one frequency ratio (exact)."""
@@ -634,15 +735,21 @@ def demo(
     ),
 ) -> None:
     """Run the bundled example: rectangular walls on El Centro 1940, exact integration."""
-    paths = run_demo(out, record)
+    paths = run_demo(out, record, on_skip=lambda note: _note(f"note: {note}"))
     for kind, path in paths.items():
         typer.echo(f"wrote {kind}: {path}")
     summary = json.loads(paths["history"].read_text())
-    for row in summary["results"]:
-        typer.echo(
-            f"  {row['mechanism']:<8} x{row['scale']:<4g} peak |phi|/phi_ov = "
-            f"{row['peak_ratio']:.4f}  {'OVERTURNS' if row['overturned'] else 'survives'}"
-        )
+    rows = [
+        [
+            str(row["mechanism"]),
+            _g4(row["scale"]),
+            _g4(row["peak_ratio"]),
+            "OVERTURNS" if row["overturned"] else "survives",
+        ]
+        for row in summary["results"]
+    ]
+    for line in _table(["mechanism", "scale", "peak |phi|/phi_ov", "verdict"], rows):
+        typer.echo(line)
 
 
 @app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
@@ -668,7 +775,10 @@ def report(
         None, "--at-height", help="Also tabulate the peak displacement [m] this far [m] up."
     ),
     criterion: Optional[str] = typer.Option(
-        None, "--criterion", help="Verdict of the time histories: ratio (default) or exact."
+        None,
+        "--criterion",
+        metavar=_CRITERIA,
+        help="Verdict of the time histories: ratio (default) or exact.",
     ),
     f_min: float = typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
     f_max: float = typer.Option(10.0, "--f-max", help="Highest pulse frequency [Hz]."),
@@ -721,10 +831,18 @@ def serve(
     ),
 ) -> None:
     """Run the REST service (FastAPI + uvicorn); settings also from ROCKMECH_* variables."""
-    # fastapi and uvicorn (the service extra) are loaded only by the command that needs them.
+    for module in ("fastapi", "uvicorn", "pydantic_settings"):
+        require(module, "service", "for rockmech serve")
+    # The service extra is loaded only by the command that needs it.
     from .api.server import run, settings_with
 
-    run(settings_with(host=host, port=port, compute_workers=workers, compute_timeout_s=timeout))
+    settings = settings_with(
+        host=host, port=port, compute_workers=workers, compute_timeout_s=timeout
+    )
+    host_part = f"[{settings.host}]" if ":" in settings.host else settings.host
+    typer.echo(f"rockmech {__version__} serving on http://{host_part}:{settings.port}")
+    typer.echo(f"  docs: http://{host_part}:{settings.port}/api/v1/docs (Ctrl+C to stop)")
+    run(settings)
 
 
 def main() -> None:  # pragma: no cover - console entry point

@@ -21,10 +21,14 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, Optional
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.errors import InputError
+from shared_schema.extras import MissingExtra
 from shared_schema.io import load_constants, save_constants
 
 from .core.model import G
@@ -33,10 +37,36 @@ from .workflows.documents import frequency_grid
 from .workflows.inputs import constants_from_files
 from .workflows.outputs import write_envelope, write_history
 
-__all__ = ["DEMO_WALLS", "EXAMPLES_DIR", "rectangular_block", "run_demo"]
+__all__ = ["DEMO_WALLS", "EXAMPLES_DIR", "examples_dir", "rectangular_block", "run_demo"]
 
-#: The repository's examples folder (bundled scenes, records and constants).
-EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "examples"
+
+def examples_dir() -> Path:
+    """Return the folder of the bundled examples (scenes, specs, constants, El Centro 1940).
+
+    An installed wheel holds them as package data (``solver_service/data/examples``, which
+    pyproject.toml maps from the repository's ``examples/``); a source tree has the
+    repository's ``examples/`` folder.
+
+    Raises
+    ------
+    InputError
+        If neither exists (a broken installation).
+    """
+    bundled = resources.files(__package__ or "solver_service") / "data" / "examples"
+    if isinstance(bundled, Path) and bundled.is_dir():
+        return bundled
+    source_tree = Path(__file__).resolve().parents[1] / "examples"
+    if source_tree.is_dir():
+        return source_tree
+    raise InputError(
+        f"the bundled examples are missing (looked in {bundled} and {source_tree}); "
+        "reinstall rockmech",
+        "examples",
+    )
+
+
+#: The bundled examples folder (see ``examples_dir``).
+EXAMPLES_DIR = examples_dir()
 #: Demo walls: id, description, thickness b [m], height h [m], rocking kind.
 DEMO_WALLS = (
     ("W1", "free-standing brick wall 0.25 m x 3.0 m", 0.25, 3.0, "two_sided"),
@@ -124,7 +154,12 @@ def demo_constants() -> ConstantsFile:
     return ConstantsFile.model_validate({"mechanisms": mechanisms})
 
 
-def run_demo(out_dir: Path, record_path: Path | None = None) -> dict[str, Path]:
+def run_demo(
+    out_dir: Path,
+    record_path: Path | None = None,
+    *,
+    on_skip: Optional[Callable[[str], None]] = None,
+) -> dict[str, Path]:
     """Run the demonstration and write its files to ``out_dir``.
 
     Parameters
@@ -133,6 +168,9 @@ def run_demo(out_dir: Path, record_path: Path | None = None) -> dict[str, Path]:
         Output folder (created if missing).
     record_path : Path, optional
         Two-column record in g; defaults to the bundled El Centro 1940 N-S.
+    on_skip : callable, optional
+        Called with a one-line note when the CAD part is skipped because the ``geometry``
+        extra is missing. Without it, ``MissingExtra`` is raised instead.
 
     Returns
     -------
@@ -154,7 +192,13 @@ def run_demo(out_dir: Path, record_path: Path | None = None) -> dict[str, Path]:
     )
     env_paths = church_envelope(out_dir)
     env_paths["church_history"] = church_history(out_dir, record)
-    cad_paths = facade_from_scene(out_dir)
+    try:
+        cad_paths = facade_from_scene(out_dir)
+    except MissingExtra as exc:
+        if on_skip is None:
+            raise
+        on_skip(f"skipped the CAD example (facade.3dm -> constants -> envelopes): {exc}")
+        cad_paths = {}
     return {
         "constants": constants_path,
         "history": out_dir / "history.json",

@@ -24,6 +24,7 @@ import numpy as np
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
+from shared_schema.extras import require
 
 from .core.fragility import fit_lognormal
 from .core.model import check_positive
@@ -124,15 +125,9 @@ def _levels(levels: Sequence[float]) -> list[float]:
     return sorted(out)
 
 
-def _dask_client(address: str, timeout: float) -> Any:
+def _dask_client(distributed: Any, address: str, timeout: float) -> Any:
     try:
-        from dask.distributed import Client
-    except ImportError as exc:  # pragma: no cover - dask is in the dev extra
-        raise InputError(
-            f"needs dask.distributed: pip install 'rockmech[dask]' ({exc})", "scheduler"
-        ) from exc
-    try:
-        return Client(address, timeout=timeout, set_as_default=False)  # type: ignore[no-untyped-call]
+        return distributed.Client(address, timeout=timeout, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
         raise InputError(
             f"cannot reach the Dask scheduler at {address} within {timeout:g} s ({exc})",
@@ -154,15 +149,15 @@ def _collect(
             if progress is not None:
                 progress(i + 1, len(payloads))
         return results, {"kind": "local"}
-    from dask.distributed import as_completed
-
-    client = _dask_client(scheduler, timeout)
+    # Checked before anything else touches dask: a missing extra names its install line.
+    distributed = require("dask.distributed", "dask", "for ida --scheduler")
+    client = _dask_client(distributed, scheduler, timeout)
     try:
         n_workers = len(client.scheduler_info().get("workers", {}))
         futures = [client.submit(run_record, **p, pure=False) for p in payloads]
         index = {f.key: i for i, f in enumerate(futures)}
         with client.as_current():
-            for done, future in enumerate(as_completed(futures), start=1):  # type: ignore[no-untyped-call]
+            for done, future in enumerate(distributed.as_completed(futures), start=1):
                 results[index[future.key]] = future.result()
                 if progress is not None:
                     progress(done, len(payloads))

@@ -7,6 +7,7 @@ import math
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -619,3 +620,103 @@ def test_options_that_cannot_apply_warn_and_impossible_values_fail() -> None:
         app, ["history", str(constants), str(record), "--sf", "ec8", "--building-height", "-5"]
     )
     assert res.exit_code == 2 and "building_height: must be finite and > 0" in res.stderr
+
+
+# --- Conventions: help, choices, streams, tables ---------------------------------------------
+
+
+def _commands() -> list[tuple[list[str], Any]]:
+    import typer.main
+
+    out: list[tuple[list[str], Any]] = []
+
+    def walk(cmd: Any, path: list[str]) -> None:
+        if hasattr(cmd, "commands"):  # a group
+            for name, sub in cmd.commands.items():
+                walk(sub, [*path, name])
+        else:
+            out.append((path, cmd))
+
+    walk(typer.main.get_command(app), [])
+    return out
+
+
+def test_every_help_shows_the_units_and_bracketed_text_of_its_options() -> None:
+    import re
+
+    commands = _commands()
+    assert len(commands) >= 11
+    seen = 0
+    for path, cmd in commands:
+        res = runner.invoke(app, [*path, "--help"])
+        assert res.exit_code == 0, (path, res.output)
+        shown = " ".join(res.stdout.split())
+        texts = [p.help or "" for p in cmd.params] + [cmd.help or ""]
+        for text in texts:
+            for token in re.findall(r"\[[^\]\[]+\]", text):
+                assert " ".join(token.split()) in shown, (path, token)
+                seen += 1
+    assert seen >= 40  # [rad/s], [g], [s], [m], [Hz], [-] ... across the commands
+
+
+def test_choice_options_list_the_vocabularies_of_shared_schema_rules() -> None:
+    from shared_schema.rules import CRITERIA, PULSE_SHAPES, RECORD_FORMATS, RECORD_UNITS, SF_METHODS
+
+    expected = {
+        ("pulse", "--shape"): PULSE_SHAPES,
+        ("pulse", "--criterion"): CRITERIA,
+        ("history", "--sf"): SF_METHODS,
+        ("history", "--units"): tuple(RECORD_UNITS),
+        ("history", "--format"): RECORD_FORMATS,
+        ("ida", "--im"): ("scale", "pga"),
+        ("boundary", "--shape"): PULSE_SHAPES,
+    }
+    for (command, option), values in expected.items():
+        res = runner.invoke(app, [command, "--help"])
+        assert f"{option} [{'|'.join(values)}]" in res.stdout, (command, option)
+
+
+def test_version_option() -> None:
+    from rockmech import __version__
+
+    res = runner.invoke(app, ["--version"])
+    assert res.exit_code == 0 and res.stdout == f"rockmech {__version__}\n"
+
+
+def test_history_table_is_aligned_within_100_columns_at_4_significant_figures(
+    tmp_path: Path,
+) -> None:
+    long_id = "NORTH_FACADE_GABLE_OVERTURNING_ABOUT_THE_BASE_WITH_RETURN_WALLS"
+    doc = json.loads((EXAMPLES / "constants" / "rect_walls.json").read_text())
+    doc["mechanisms"][0]["id"] = long_id
+    path = tmp_path / "walls.json"
+    path.write_text(json.dumps(doc))
+    record = str(EXAMPLES / "records" / "elcentro_NS.dat")
+    args = ["history", str(path), record, "--scale", "0.5", "1", "--at-height", "2.5"]
+    res = runner.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    as_json = json.loads(runner.invoke(app, [*args, "--json"]).stdout)
+    lines = res.stdout.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("mechanism"))
+    table = lines[start : start + 1 + len(as_json["results"])]
+    assert all(len(line) <= 100 for line in res.stdout.splitlines()), max(map(len, lines))
+    # Right-aligned columns end at the same place on every row.
+    assert len({len(line) for line in table}) == 1, table
+    for line, row in zip(table[1:], as_json["results"]):
+        cells = line.split()
+        assert cells[-1] == f"{row['peak_displacement_m']:.4g}"
+        assert f"{row['peak_ratio']:.4g}" in cells
+    first = table[1].split()[0]
+    assert first.endswith("...") and long_id.startswith(first[:-3]), first
+    assert "warning" not in res.stdout
+
+
+def test_serve_prints_the_address_it_listens_on(monkeypatch: pytest.MonkeyPatch) -> None:
+    from solver_service.api import server
+
+    calls: list[Any] = []
+    monkeypatch.setattr(server, "run", calls.append)
+    res = runner.invoke(app, ["serve", "--host", "127.0.0.1", "--port", "8765"])
+    assert res.exit_code == 0, res.output
+    assert res.stdout.splitlines()[0].endswith("serving on http://127.0.0.1:8765")
+    assert calls and calls[0].port == 8765

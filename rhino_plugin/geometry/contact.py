@@ -16,6 +16,7 @@ from typing import Any, Dict, List, Optional, Tuple
 import numpy as np
 
 from shared_schema.errors import GeometryError, InputError
+from shared_schema.extras import require
 
 from .frames import plane_basis
 from .mesh import TriMesh
@@ -89,7 +90,7 @@ def _patch_region(faces: np.ndarray, xy: np.ndarray) -> Any:
     xy : (n, 2) float
         Plane coordinates of the vertices [m].
     """
-    import shapely
+    shapely = require("shapely", "geometry", "for contact polygons")
 
     tri = xy[faces]
     e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
@@ -112,7 +113,7 @@ def _patch_region(faces: np.ndarray, xy: np.ndarray) -> Any:
 
 def _triangles_union(tri2d: np.ndarray) -> Any:
     """Union of 2D triangles (k, 3, 2) as a shapely geometry (degenerate ones skipped)."""
-    import shapely
+    shapely = require("shapely", "geometry", "for contact polygons")
 
     e1 = tri2d[:, 1] - tri2d[:, 0]
     e2 = tri2d[:, 2] - tri2d[:, 0]
@@ -127,7 +128,7 @@ def _triangles_union(tri2d: np.ndarray) -> Any:
 
 def _rings_xor(rings: List[np.ndarray]) -> Any:
     """Even-odd composition of closed 2D rings (outer boundaries and holes alike)."""
-    import shapely
+    shapely = require("shapely", "geometry", "for contact polygons")
 
     result = shapely.Polygon()
     for ring in rings:
@@ -180,7 +181,7 @@ def section_polygon(
     chained through shared mesh edges (no coordinate matching) and the loops combined by
     the even-odd rule.
     """
-    import shapely
+    shapely = require("shapely", "geometry", "for contact polygons")
 
     rel = mesh.vertices - origin
     d = rel @ n

@@ -16,6 +16,7 @@ from typing import Tuple
 import numpy as np
 
 from shared_schema.errors import GeometryError, InputError
+from shared_schema.extras import require
 
 from .mesh import TriMesh
 from .validate import check_solid
@@ -75,7 +76,7 @@ def split_by_plane(mesh: TriMesh, point: np.ndarray, normal: np.ndarray) -> Tupl
     ``manifold3d.Manifold.split_by_plane`` in double precision; the caps are exact
     polygons of the section, so V(positive) + V(negative) = V to rounding.
     """
-    import manifold3d
+    manifold3d = require("manifold3d", "geometry", "to cut solids")
 
     p, n = _plane(point, normal)
     check_solid(mesh, repair=False)

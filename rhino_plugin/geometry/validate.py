@@ -48,6 +48,7 @@ from typing import Any, Dict, List, Optional, Tuple
 import numpy as np
 
 from shared_schema.errors import GeometryError
+from shared_schema.extras import require
 
 from .frames import plane_basis
 from .mesh import TriMesh
@@ -362,8 +363,8 @@ def _fill_holes(vertices: np.ndarray, faces: np.ndarray) -> Tuple[np.ndarray, in
 
     Returns the faces, the number of holes filled and the number left open.
     """
-    import manifold3d
-    import shapely
+    manifold3d = require("manifold3d", "geometry", "to close holes in meshes")
+    shapely = require("shapely", "geometry", "to close holes in meshes")
 
     loops = _boundary_loops(faces, len(vertices))
     if loops is None:
@@ -495,7 +496,7 @@ def _check_overlaps(
     involved = pos[np.any(overlap, axis=1)]
     if len(involved) < 2:
         return
-    import manifold3d
+    manifold3d = require("manifold3d", "geometry", "to check solids for overlaps")
 
     solids = []
     for s in involved:

@@ -29,6 +29,7 @@ from rhino_plugin.mechanisms.build import constants_from_spec
 from rhino_plugin.scene_3dm import Scene
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError, RockmechError
+from shared_schema.extras import MissingExtra
 from shared_schema.spec import parse_spec
 
 from ..core import codes
@@ -503,7 +504,7 @@ def run_job(
     media_type, fn = JOBS[kind]
     try:
         return JobOutput(200, media_type, fn(params, blobs, limits))
-    except ServiceUnavailable as exc:
+    except (ServiceUnavailable, MissingExtra) as exc:
         return JobOutput(501, "application/json", error_body("NotAvailable", str(exc)))
     except RockmechError as exc:
         field = exc.field if isinstance(exc, InputError) else None

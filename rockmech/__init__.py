@@ -1,0 +1,118 @@
+"""rockmech: rocking collapse mechanisms of masonry, from CAD solids to exact rocking responses.
+
+The stable Python API in one place. The code lives in three packages: ``shared_schema``
+(file formats and errors), ``solver_service`` (the solver, workflows, command line and
+service) and ``rhino_plugin`` (geometry and Rhino); this package re-exports what scripts
+need. Importing it is cheap: each name is imported on first use, so ``import rockmech``
+loads neither numpy, scipy, matplotlib nor rhino3dm.
+
+Examples
+--------
+>>> import rockmech
+>>> wall = rockmech.RockingModel.symmetric(p_eq=2.2, lam=0.165, eta=0.96, name="W2")
+>>> res = rockmech.simulate(wall, rockmech.Pulse(a_p=-3.0, f_p=1.0))  # a_p [m/s²], f_p [Hz]
+>>> bool(res.overturned), res.peak_ratio
+(True, 1.0)
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+from rockmech._version import __version__
+
+if TYPE_CHECKING:  # the real types for type checkers and editors
+    from shared_schema.constants import ConstantsFile as ConstantsFile
+    from shared_schema.errors import (
+        GeometryError as GeometryError,
+    )
+    from shared_schema.errors import (
+        InputError as InputError,
+    )
+    from shared_schema.errors import (
+        RockmechError as RockmechError,
+    )
+    from shared_schema.errors import (
+        SolverError as SolverError,
+    )
+    from shared_schema.extras import MissingExtra as MissingExtra
+    from shared_schema.io import load_constants as load_constants
+    from shared_schema.io import save_constants as save_constants
+    from solver_service.core.envelope import (
+        critical_bands as critical_bands,
+    )
+    from solver_service.core.envelope import (
+        mechanism_envelope as mechanism_envelope,
+    )
+    from solver_service.core.exact import simulate as simulate
+    from solver_service.core.exact import simulate_batch as simulate_batch
+    from solver_service.core.excitation import Pulse as Pulse
+    from solver_service.core.excitation import SampledAccel as SampledAccel
+    from solver_service.core.model import G as G
+    from solver_service.core.model import RockingModel as RockingModel
+    from solver_service.core.pulses import (
+        extract_pulses as extract_pulses,
+    )
+    from solver_service.core.pulses import (
+        largest_pulse as largest_pulse,
+    )
+    from solver_service.core.records import GroundMotion as GroundMotion
+    from solver_service.core.spectra import response_spectrum as response_spectrum
+    from solver_service.demo import examples_dir as examples_dir
+    from solver_service.report.html import (
+        build_report as build_report,
+    )
+    from solver_service.report.html import (
+        write_report as write_report,
+    )
+    from solver_service.workflows.inputs import constants_from_files as constants_from_files
+
+#: Each public name and the module it comes from (imported on first access).
+_SOURCES = {
+    # Errors: every error rockmech raises on purpose is a RockmechError.
+    "RockmechError": "shared_schema.errors",
+    "InputError": "shared_schema.errors",
+    "GeometryError": "shared_schema.errors",
+    "SolverError": "shared_schema.errors",
+    "MissingExtra": "shared_schema.extras",
+    # The kinematic-constants file.
+    "ConstantsFile": "shared_schema.constants",
+    "load_constants": "shared_schema.io",
+    "save_constants": "shared_schema.io",
+    "constants_from_files": "solver_service.workflows.inputs",
+    # Models, excitations and the exact solver.
+    "G": "solver_service.core.model",
+    "RockingModel": "solver_service.core.model",
+    "Pulse": "solver_service.core.excitation",
+    "SampledAccel": "solver_service.core.excitation",
+    "GroundMotion": "solver_service.core.records",
+    "simulate": "solver_service.core.exact",
+    "simulate_batch": "solver_service.core.exact",
+    # Envelopes, pulses in records, spectra.
+    "mechanism_envelope": "solver_service.core.envelope",
+    "critical_bands": "solver_service.core.envelope",
+    "extract_pulses": "solver_service.core.pulses",
+    "largest_pulse": "solver_service.core.pulses",
+    "response_spectrum": "solver_service.core.spectra",
+    # Reports and the bundled examples.
+    "build_report": "solver_service.report.html",
+    "write_report": "solver_service.report.html",
+    "examples_dir": "solver_service.demo",
+}
+
+__all__ = ["__version__", *_SOURCES]
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name on first access (PEP 562)."""
+    source = _SOURCES.get(name)
+    if source is None:
+        raise AttributeError(f"module 'rockmech' has no attribute {name!r}")
+    value = getattr(importlib.import_module(source), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_SOURCES))
