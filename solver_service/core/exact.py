@@ -46,8 +46,8 @@ from shared_schema.errors import InputError
 
 from . import _kernels as _k
 from .excitation import Pulse, SampledAccel
+from .linearisation import linearisation_warnings
 from .model import RockingModel, check_positive
-from .nonlinear import linearisation_warnings
 from .result import CRITERIA, STATUS_MESSAGES, RockingResult
 
 __all__ = [
@@ -269,7 +269,7 @@ def simulate(
     RockingResult
         ``warnings`` says when the peak is not resolved (``error_estimate >=
         UNRESOLVED_ERROR``) and when the case lies where the linearised model is more than
-        10 % off Housner's nonlinear block (``nonlinear.linearisation_warnings``).
+        10 % off Housner's nonlinear block (``linearisation.linearisation_warnings``).
 
     Examples
     --------
