@@ -95,6 +95,57 @@ REST = 0
 FLIGHT = 1
 
 
+# Side constants: the (2, NSIDE) array ``sides``, row 0 for side s = +1, row 1 for s = -1.
+#: Frequency parameter p [rad/s].
+SIDE_P = 0
+#: ``ks = scale / (G lam)``: turns the ground acceleration [m/s²] into ``q`` [-].
+SIDE_KS = 1
+#: Overturning rotation phi_ov [rad].
+SIDE_PHIOV = 2
+NSIDE = 3
+
+# Rules of one run: the (NRULE,) array ``rules``.
+RULE_ETA = 0
+RULE_ONE_SIDED = 1
+RULE_V_REST = 2
+RULE_MAX_IMPACTS = 3
+RULE_P_MAX = 4
+NRULE = 5
+
+# A closed-form flight: the (NFL,) array ``fl`` holds the cell and the anchor state.
+FL_KIND = 0
+FL_C0 = 1
+FL_C1 = 2
+FL_C2 = 3
+FL_CS = 4
+FL_KS = 5
+FL_S = 6
+FL_P = 7
+FL_TA = 8
+FL_XA = 9
+FL_VA = 10
+NFL = 11
+
+# Run state: the (NST,) array ``st``; its first NOUT entries are the output vector.
+ST_MODE = NOUT
+ST_S = NOUT + 1
+ST_X = NOUT + 2
+ST_V = NOUT + 3
+ST_T = NOUT + 4
+ST_PXX = NOUT + 5
+ST_PXV = NOUT + 6
+ST_PVV = NOUT + 7
+#: Variance of x at the anchor of the flight that holds the peak.
+ST_VAR_PEAK = NOUT + 8
+#: When |x| reached 1 on the current excursion (NaN: not yet).
+ST_T_CROSS = NOUT + 9
+#: Rest is held until this time (sub-resolution uplift).
+ST_HOLD = NOUT + 10
+#: Time of the last uplift (NaN after an impact).
+ST_UPLIFT_T = NOUT + 11
+NST = NOUT + 12
+
+
 @_jit
 def _sinh_minus(u):
     """Return ``sinh(u) - u`` without cancellation for small ``u``."""
@@ -115,35 +166,59 @@ def _sinh_minus(u):
 
 
 @_jit
-def _accel(kind, c0, c1, c2, cs, t):
-    """Ground acceleration of a cell and its rate at absolute time ``t``."""
-    if kind == 0:
-        return c0 + c1 * (t - cs), c1
-    return c0 * math.sin(c1 * t + c2), c0 * c1 * math.cos(c1 * t + c2)
+def _accel(cell, t):
+    """Ground acceleration of a cell (rows ``CELL_ROWS``) and its rate at absolute time ``t``."""
+    if cell[0] == 0:
+        return cell[1] + cell[2] * (t - cell[4]), cell[2]
+    arg = cell[2] * t + cell[3]
+    return cell[1] * math.sin(arg), cell[1] * cell[2] * math.cos(arg)
 
 
 @_jit
-def _state(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, tau):
-    """State ``(x, x', x'', x''')`` at ``ta + tau`` from the anchor ``(ta, xa, va)`` on side ``s``.
+def _side(s):
+    """Row of the ``sides`` array for side ``s`` (+1: 0, -1: 1)."""
+    return 0 if s > 0.0 else 1
 
-    ``ks = scale / (G lam_s)`` turns the ground acceleration into ``q``.
-    """
+
+@_jit
+def _anchor(fl, cell, sides, s, ta, xa, va):
+    """Fill the flight array ``fl``: cell, side constants of side ``s`` and anchor state."""
+    for r in range(5):
+        fl[r] = cell[r]
+    row = _side(s)
+    fl[FL_KS] = sides[row, SIDE_KS]
+    fl[FL_S] = s
+    fl[FL_P] = sides[row, SIDE_P]
+    fl[FL_TA] = ta
+    fl[FL_XA] = xa
+    fl[FL_VA] = va
+
+
+@_jit
+def _state(fl, tau):
+    """State ``(x, x', x'', x''')`` at ``ta + tau`` from the anchor of the flight ``fl``."""
+    ks = fl[FL_KS]
+    s = fl[FL_S]
+    p = fl[FL_P]
+    ta = fl[FL_TA]
+    xa = fl[FL_XA]
+    va = fl[FL_VA]
     u = p * tau
     sh = math.sinh(u)
     h = math.sinh(0.5 * u)
     chm1 = 2.0 * h * h  # cosh(u) - 1 without cancellation
-    if kind == 0:
-        q0 = ks * (c0 + c1 * (ta - cs))
-        q1 = ks * c1
+    if fl[FL_KIND] == 0:
+        q0 = ks * (fl[FL_C0] + fl[FL_C1] * (ta - fl[FL_CS]))
+        q1 = ks * fl[FL_C1]
         a = xa - s - q0
         x = xa + a * chm1 + va * sh / p - q1 * _sinh_minus(u) / p
         v = va + (va - q1) * chm1 + a * p * sh
         q = q0 + q1 * tau
         qd = q1
     else:
-        kk = ks * c0
-        w = c1
-        th = w * ta + c2
+        kk = ks * fl[FL_C0]
+        w = fl[FL_C1]
+        th = w * ta + fl[FL_C2]
         kap = p * p * kk / (p * p + w * w)
         y = xa - s - kap * math.sin(th)
         yp = va - kap * w * math.cos(th)
@@ -168,36 +243,38 @@ def _sgn(z):
 
 
 @_jit
-def _root(which, target, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, lo, hi, sig_lo, f_lo, f_hi):
-    """Zero of component ``which`` (0: x - target, 1: x', 2: x'') in ``[lo, hi]``.
+def _component(which, target, fl, t):
+    """Return function ``which`` (0: x - target, 1: x', 2: x'') at ``t`` and two derivatives.
+
+    The second derivative is returned as 0 for ``which == 2`` (Newton's step, not Halley's).
+    """
+    x, v, acc, jerk = _state(fl, t)
+    if which == 0:
+        return x - target, v, acc
+    if which == 1:
+        return v, acc, jerk
+    return acc, jerk, 0.0
+
+
+@_jit
+def _root(which, target, fl, lo, hi, sig_lo, f_lo, f_hi):
+    """Zero of component ``which`` (0: x - target, 1: x', 2: x'') of flight ``fl`` in ``[lo, hi]``.
 
     ``sig_lo`` is the sign of the function just right of ``lo``; the function is assumed to
     change sign once in the bracket. ``f_lo``, ``f_hi`` are its values at the ends when known
     (NaN otherwise) and give a regula-falsi start. Safeguarded Halley iteration (Newton for
     ``x''``): a step is taken when it stays inside the bracket and shrinks fast enough,
     otherwise bisection.
-    Returns the root (time offset from ``ta``).
+    Returns the root (time offset from the anchor).
     """
     t = 0.5 * (lo + hi)
     if f_lo - f_hi != 0.0 and math.isfinite(f_lo - f_hi):
         t = lo + (hi - lo) * min(max(f_lo / (f_lo - f_hi), 0.01), 0.99)
     width = hi - lo
     # Absolute time cannot be resolved finer than a few ulps of ta + t.
-    tol = 4.0 * EPS * (abs(ta) + abs(hi))
+    tol = 4.0 * EPS * (abs(fl[FL_TA]) + abs(hi))
     for _ in range(ROOT_MAXITER):
-        x, v, acc, jerk = _state(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, t)
-        fpp = 0.0
-        if which == 0:
-            f = x - target
-            fp = v
-            fpp = acc
-        elif which == 1:
-            f = v
-            fp = acc
-            fpp = jerk
-        else:
-            f = acc
-            fp = jerk
+        f, fp, fpp = _component(which, target, fl, t)
         if f == 0.0:
             return t
         if _sgn(f) == sig_lo:
@@ -241,13 +318,14 @@ def _side_sign_left(v, acc, jerk):
 
 
 @_jit
-def _velocity_zeros(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, aa, ja, big_h, sig_a, qd_sign):
+def _velocity_zeros(fl, aa, big_h, sig_a, qd_sign):
     """Interior zeros of x' on ``(0, big_h)``: returns ``(n, z1, z2, x(big_h), x'(big_h))``.
 
-    ``sig_a`` is the sign of x' just after 0; ``qd_sign`` the constant sign of q' on the
-    stretch (0 when q is constant). See the module docstring for the argument.
+    ``aa`` is x'' at the anchor and ``sig_a`` the sign of x' just after it; ``qd_sign`` the
+    constant sign of q' on the stretch (0 when q is constant). See the module docstring.
     """
-    xb, vb, ab, jb = _state(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, big_h)
+    va = fl[FL_VA]
+    xb, vb, ab, jb = _state(fl, big_h)
     sig_b = _side_sign_left(vb, ab, jb)
     n = 0
     z1 = 0.0
@@ -259,15 +337,15 @@ def _velocity_zeros(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, aa, ja, big_h, s
         n = 0
     elif sig_a != sig_b:
         n = 1
-        z1 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, big_h, sig_a, va, vb)
+        z1 = _root(1, 0.0, fl, 0.0, big_h, sig_a, va, vb)
     elif sig_a != hump and _sgn(aa) == hump and _sgn(ab) == -hump:
         # x' has sign -hump at both ends and x'' turns from hump to -hump: it may dip.
-        m = _root(2, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, big_h, hump, aa, ab)
-        vm = _state(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, m)[1]
+        m = _root(2, 0.0, fl, 0.0, big_h, hump, aa, ab)
+        vm = _state(fl, m)[1]
         if _sgn(vm) == hump:
             n = 2
-            z1 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, m, sig_a, va, vm)
-            z2 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, m, big_h, hump, vm, vb)
+            z1 = _root(1, 0.0, fl, 0.0, m, sig_a, va, vm)
+            z2 = _root(1, 0.0, fl, m, big_h, hump, vm, vb)
     return n, z1, z2, xb, vb
 
 
@@ -323,18 +401,16 @@ def _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest):
 
 
 @_jit
-def _uplift_time(kind, c0, c1, c2, cs, ks, s, t, tb):
+def _uplift_time(cell, ks, s, t, tb):
     """First time in ``[t, tb]`` at which the drive ``g = -s ks a`` exceeds 1, or ``-1``.
 
     The returned time is the bracket end at which ``g >= 1`` holds in floating point, so the
     closed form started there moves outward (THEORY §10, sub-resolution uplift).
     """
-    a_t, _ad_t = _accel(kind, c0, c1, c2, cs, t)
-    g_t = -s * ks * a_t
+    g_t = -s * ks * _accel(cell, t)[0]
     if g_t > 1.0:
         return t
-    a_b, _ad_b = _accel(kind, c0, c1, c2, cs, tb)
-    g_b = -s * ks * a_b
+    g_b = -s * ks * _accel(cell, tb)[0]
     if g_b <= 1.0:
         return -1.0
     # g is monotone in the cell: safeguarded Newton from the regula-falsi point, then the
@@ -344,7 +420,7 @@ def _uplift_time(kind, c0, c1, c2, cs, ks, s, t, tb):
     x = lo + (hi - lo) * min(max((1.0 - g_t) / (g_b - g_t), 0.0), 1.0)
     tol = 4.0 * EPS * (abs(t) + abs(tb))
     for _ in range(ROOT_MAXITER):
-        a_x, ad_x = _accel(kind, c0, c1, c2, cs, x)
+        a_x, ad_x = _accel(cell, x)
         g = -s * ks * a_x
         if g >= 1.0:
             hi = x
@@ -362,15 +438,40 @@ def _uplift_time(kind, c0, c1, c2, cs, ks, s, t, tb):
         x = xn
     # Step up from the converged point to the first time where g >= 1 (bounded by hi).
     for _ in range(8):
-        if x >= hi or -s * ks * _accel(kind, c0, c1, c2, cs, x)[0] >= 1.0:
+        if x >= hi or -s * ks * _accel(cell, x)[0] >= 1.0:
             break
         x = min(x + tol, hi)
     return min(x, hi)
 
 
 @_jit
-def _propagate_cov(pxx, pxv, pvv, p, tau, ex, ev):
-    """Covariance of the rounding error carried through a homogeneous flight of ``tau``."""
+def _set_cov(st, pxx, pxv, pvv, p):
+    """Store the error covariance, clipped to the physical span of the motion (``ERR_CAP``)."""
+    xcap = ERR_CAP * ERR_CAP
+    vcap = xcap * p * p
+    if not pxx <= xcap:  # also catches NaN
+        pxx = xcap
+    if not pvv <= vcap:
+        pvv = vcap
+    lim = math.sqrt(pxx * pvv)
+    if not abs(pxv) <= lim:
+        pxv = lim if pxv > 0.0 else -lim
+    st[ST_PXX] = pxx
+    st[ST_PXV] = pxv
+    st[ST_PVV] = pvv
+
+
+@_jit
+def _propagate_cov(st, p, tau, ex):
+    """Carry the error covariance through a homogeneous flight of ``tau`` [s].
+
+    ``ex`` is the rounding error added to x on the way (``ex * p`` to x'); the result is
+    capped (``_set_cov``).
+    """
+    pxx = st[ST_PXX]
+    pxv = st[ST_PXV]
+    pvv = st[ST_PVV]
+    ev = ex * p
     u = p * tau
     ch = math.cosh(u)
     sh = math.sinh(u)
@@ -381,83 +482,321 @@ def _propagate_cov(pxx, pxv, pvv, p, tau, ex, ev):
     nxx = a * a * pxx + 2.0 * a * b * pxv + b * b * pvv + ex * ex
     nxv = a * c * pxx + (a * d + b * c) * pxv + b * d * pvv
     nvv = c * c * pxx + 2.0 * c * d * pxv + d * d * pvv + ev * ev
-    return nxx, nxv, nvv
+    _set_cov(st, nxx, nxv, nvv, p)
 
 
 @_jit
-def _record(trace_t, trace_x, ntr, t, x):
-    """Append ``(t, x)`` to the time-series buffers if there is room; return the new length."""
-    if ntr < trace_t.shape[0]:
-        trace_t[ntr] = t
-        trace_x[ntr] = x
-        return ntr + 1
-    return ntr
+def _record(st, trace, t, x):
+    """Append ``(t, x)`` to the time-series buffer ``trace`` (2, m) if there is room."""
+    ntr = int(st[OUT_N_TRACE])
+    if ntr < trace.shape[1]:
+        trace[0, ntr] = t
+        trace[1, ntr] = x
+        st[OUT_N_TRACE] = ntr + 1
 
 
 @_jit
-def _cap_cov(pxx, pxv, pvv, p):
-    """Clip the error covariance to the physical span of the motion (``ERR_CAP``)."""
-    xcap = ERR_CAP * ERR_CAP
-    vcap = xcap * p * p
-    if not pxx <= xcap:  # also catches NaN
-        pxx = xcap
-    if not pvv <= vcap:
-        pvv = vcap
-    lim = math.sqrt(pxx * pvv)
-    if not abs(pxv) <= lim:
-        pxv = lim if pxv > 0.0 else -lim
-    return pxx, pxv, pvv
+def _log_impact(st, log, t, s, vi, v_out):
+    """Append an impact to the impact log ``log`` (4, k) if there is room."""
+    nlog = int(st[OUT_N_LOG])
+    if nlog < log.shape[1]:
+        log[0, nlog] = t
+        log[1, nlog] = s
+        log[2, nlog] = vi
+        log[3, nlog] = v_out
+        st[OUT_N_LOG] = nlog + 1
 
 
 @_jit
-def _simulate(
-    kind,
-    c0,
-    c1,
-    c2,
-    tstart,
-    tend,
-    amax_after,
-    scale,
-    p_pos,
-    p_neg,
-    lam_pos,
-    lam_neg,
-    phiov_pos,
-    phiov_neg,
-    eta,
-    one_sided,
-    x0,
-    v_rest_rel,
-    max_impacts,
-    trace_t,
-    trace_x,
-    log,
-):
-    """Integrate one mechanism through a cell sequence (unpacked arguments; see ``simulate_cells``).
+def _init_state(t0, x0):
+    """Run state at ``t0``: at rest, or released from rest at ``x0`` (normalised rotation)."""
+    st = np.zeros(NST)
+    st[ST_MODE] = REST
+    st[ST_T] = t0
+    if x0 != 0.0:
+        st[ST_MODE] = FLIGHT
+        st[ST_S] = _sgn(x0)
+        st[ST_X] = x0
+    st[OUT_PEAK] = abs(x0)
+    st[OUT_T_PEAK] = t0
+    st[OUT_T_EXCEED] = math.nan
+    st[ST_T_CROSS] = math.nan
+    if abs(x0) >= 1.0:
+        st[OUT_T_EXCEED] = t0
+        st[ST_T_CROSS] = t0
+    st[OUT_T_COLLAPSE] = math.nan
+    st[ST_HOLD] = -math.inf
+    st[ST_UPLIFT_T] = math.nan
+    return st
+
+
+@_jit
+def _set_rest(st):
+    """Come to rest on the base (no error is carried at rest)."""
+    st[ST_MODE] = REST
+    st[ST_S] = 0.0
+    st[ST_X] = 0.0
+    st[ST_V] = 0.0
+    st[ST_PXX] = 0.0
+    st[ST_PXV] = 0.0
+    st[ST_PVV] = 0.0
+    st[ST_T_CROSS] = math.nan
+
+
+@_jit
+def _rest_step(st, cell, sides, rules, tb, trace):
+    """At rest until ``tb`` or until uplift; returns True when the segment is done."""
+    t = st[ST_T]
+    if t < st[ST_HOLD]:
+        st[ST_T] = tb
+        _record(st, trace, tb, 0.0)
+        return True
+    tu = -1.0
+    su = 0.0
+    t1 = _uplift_time(cell, sides[0, SIDE_KS], 1.0, t, tb)
+    if t1 >= 0.0:
+        tu = t1
+        su = 1.0
+    if rules[RULE_ONE_SIDED] == 0.0:
+        t2 = _uplift_time(cell, sides[1, SIDE_KS], -1.0, t, tb)
+        if t2 >= 0.0 and (tu < 0.0 or t2 < tu):
+            tu = t2
+            su = -1.0
+    if tu < 0.0 or tu >= tb:
+        st[ST_T] = tb
+        _record(st, trace, tb, 0.0)
+        return True
+    st[ST_MODE] = FLIGHT
+    st[ST_S] = su
+    st[ST_X] = 0.0
+    st[ST_V] = 0.0
+    st[ST_T] = tu
+    st[ST_UPLIFT_T] = tu
+    st[OUT_N_UPLIFTS] += 1
+    _record(st, trace, tu, 0.0)
+    return False
+
+
+@_jit
+def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace):
+    """Walk the monotone pieces ``[0, z1], [z1, z2], [z2, H]`` of x in the flight ``fl``.
+
+    Records turning points, the first ``|x| = 1`` crossing and the peak. Returns the time
+    offset of the impact (``x = 0``) from the anchor, or -1 when there is none.
+    """
+    s = fl[FL_S]
+    ta = fl[FL_TA]
+    tau_l = 0.0
+    sx_l = s * fl[FL_XA]
+    for piece in range(nz + 1):
+        if piece < nz:
+            tau_r = z1 if piece == 0 else z2
+            xr = _state(fl, tau_r)[0]
+            if s * xr >= 0.0:  # turning point
+                _record(st, trace, ta + tau_r, xr)
+        else:
+            tau_r = big_h
+            xr = xb
+        sx_r = s * xr
+        if sx_r < 0.0:
+            # Impact in (tau_l, tau_r]: s*x falls through 0 on a monotone piece.
+            if sx_l <= 0.0:
+                return tau_l
+            return _root(0, 0.0, fl, tau_l, tau_r, s, s * sx_l, xr)
+        if sx_r >= 1.0 and sx_l < 1.0 and math.isnan(st[ST_T_CROSS]):
+            tc = _root(0, s, fl, tau_l, tau_r, -s, s * sx_l - s, xr - s)
+            st[ST_T_CROSS] = ta + tc
+            if math.isnan(st[OUT_T_EXCEED]):
+                st[OUT_T_EXCEED] = ta + tc
+        if sx_r > st[OUT_PEAK]:
+            st[OUT_PEAK] = sx_r
+            st[OUT_T_PEAK] = ta + tau_r
+            st[ST_VAR_PEAK] = st[ST_PXX]
+        tau_l = tau_r
+        sx_l = sx_r
+    return -1.0
+
+
+@_jit
+def _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log):
+    """Impact at ``ta + tau_imp``: restitution, side change, rest rule, error saltation."""
+    s = fl[FL_S]
+    p = fl[FL_P]
+    eta = rules[RULE_ETA]
+    v_rest_rel = rules[RULE_V_REST]
+    _xi, vi, ai, _ji = _state(fl, tau_imp)
+    ex = EPS * (abs(fl[FL_XA]) + 1.0 + abs(fl[FL_KS] * fl[FL_C0]))
+    _propagate_cov(st, p, tau_imp, ex)
+    t = fl[FL_TA] + tau_imp
+    st[ST_T] = t
+    row = _side(s)
+    if rules[RULE_ONE_SIDED] != 0.0:
+        s_new = s
+        row_new = row
+        c_imp = eta
+    else:
+        s_new = -s
+        row_new = 1 - row
+        c_imp = eta * (sides[row, SIDE_PHIOV] / sides[row_new, SIDE_PHIOV])
+    p_new = sides[row_new, SIDE_P]
+    v_new = c_imp * vi
+    acc_new = p_new * p_new * (-s_new - sides[row_new, SIDE_KS] * _accel(cell, t)[0])
+    _record(st, trace, t, 0.0)
+    ends_in_rest = abs(v_new) < v_rest_rel * p_new or vi == 0.0
+    _log_impact(st, log, t, s, vi, 0.0 if ends_in_rest else v_new)
+    if abs(vi) >= v_rest_rel * p:
+        st[OUT_N_IMPACTS] += 1
+        if st[OUT_N_IMPACTS] >= rules[RULE_MAX_IMPACTS]:
+            st[OUT_STATUS] = -1
+    if ends_in_rest:
+        st[OUT_N_RESTS] += 1
+        # Rest rule (ends Zeno sequences, THEORY §10). A null excursion right after uplift
+        # in this segment holds the body until the segment ends.
+        if st[ST_UPLIFT_T] >= t_sub0 and abs(vi) < v_rest_rel * p:
+            st[ST_HOLD] = tb
+        _set_rest(st)
+        return
+    # Saltation of the error covariance: the impact time moves with the state.
+    pxx = st[ST_PXX]
+    pxv = st[ST_PXV]
+    pvv = st[ST_PVV]
+    m_s = (acc_new - c_imp * ai) / vi
+    nxx = c_imp * c_imp * pxx
+    nxv = c_imp * (m_s * pxx + c_imp * pxv)
+    nvv = m_s * m_s * pxx + 2.0 * m_s * c_imp * pxv + c_imp * c_imp * pvv
+    dtau = 4.0 * EPS * max(abs(t), 1.0)
+    _set_cov(st, nxx, nxv, nvv + (c_imp * ai * dtau) ** 2, p_new)
+    st[ST_S] = s_new
+    st[ST_X] = 0.0
+    st[ST_V] = v_new
+    st[ST_T_CROSS] = math.nan
+    st[ST_UPLIFT_T] = math.nan
+
+
+@_jit
+def _advance(st, fl, xb, vb, tb, amax_after, trace):
+    """No impact in the flight: move to its end ``tb``; check for certain collapse."""
+    s = fl[FL_S]
+    ks = fl[FL_KS]
+    ex = EPS * (abs(fl[FL_XA]) + abs(xb) + 1.0 + abs(ks * fl[FL_C0]))
+    _propagate_cov(st, fl[FL_P], tb - fl[FL_TA], ex)
+    st[ST_X] = xb
+    st[ST_V] = vb
+    st[ST_T] = tb
+    if not (math.isfinite(xb) and math.isfinite(vb)):
+        st[OUT_STATUS] = -2
+        return
+    _record(st, trace, tb, xb)
+    # Certain collapse: moving outward beyond 1 + max future drive.
+    if s * vb > 0.0 and s * xb > 1.0 + ks * amax_after:
+        st[OUT_COLLAPSED] = 1.0
+        t_cross = st[ST_T_CROSS]
+        st[OUT_T_COLLAPSE] = t_cross if not math.isnan(t_cross) else tb
+        st[OUT_STATUS] = 1
+
+
+@_jit
+def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
+    """Closed-form flight from the current state to ``tb`` or to the first impact.
+
+    Returns True when the segment is done (``tb`` reached, or the run ended there).
+    """
+    s = st[ST_S]
+    ta = st[ST_T]
+    big_h = tb - ta
+    if big_h <= 0.0:
+        return True
+    st[OUT_N_STEPS] += 1
+    xa = st[ST_X]
+    va = st[ST_V]
+    _anchor(fl, cell, sides, s, ta, xa, va)
+    p = fl[FL_P]
+    ks = fl[FL_KS]
+    a_a, ad_a = _accel(cell, ta)
+    # Sign of q' on the stretch: constant for linear cells; for sinusoidal quarter cells
+    # taken at the midpoint, clear of the zeros on the cell boundaries.
+    qd_sign = _sgn(ad_a) if cell[0] == 0 else _sgn(_accel(cell, 0.5 * (ta + tb))[1])
+    acc_a = p * p * (xa - s - ks * a_a)
+    jerk_a = p * p * (va - ks * ad_a)
+    sig_a = _side_sign_right(va, acc_a, jerk_a)
+    if xa == 0.0 and va == 0.0:
+        sig_a = s  # uplift: the drive exceeds the threshold, motion is outward
+    nz, z1, z2, xb, vb = _velocity_zeros(fl, acc_a, big_h, sig_a, qd_sign)
+    tau_imp = _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace)
+    if tau_imp >= 0.0:
+        _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log)
+        return False
+    _advance(st, fl, xb, vb, tb, cell[6], trace)
+    return True
+
+
+@_jit
+def _free_tail(st, sides, rules):
+    """After the excitation: the exact free-rocking outcome (THEORY §1.8) and its error."""
+    s = st[ST_S]
+    x = st[ST_X]
+    v = st[ST_V]
+    t = st[ST_T]
+    row = _side(s)
+    p_s = sides[row, SIDE_P]
+    p_o = sides[1 - row, SIDE_P]
+    r_so = sides[row, SIDE_PHIOV] / sides[1 - row, SIDE_PHIOV]
+    eta = rules[RULE_ETA]
+    one_sided = rules[RULE_ONE_SIDED] != 0.0
+    v_rest = rules[RULE_V_REST] * (p_s if one_sided else p_o)
+    col, dt_cross, pk, dt_pk = _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest)
+    if col:
+        st[OUT_COLLAPSED] = 1.0
+        t_cross = st[ST_T_CROSS]
+        st[OUT_T_COLLAPSE] = t + dt_cross if math.isnan(t_cross) else t_cross
+        if math.isnan(st[OUT_T_EXCEED]):
+            st[OUT_T_EXCEED] = st[OUT_T_COLLAPSE]
+        st[OUT_STATUS] = 1
+    elif pk > st[OUT_PEAK]:
+        # Sensitivity of the analytic tail to the propagated state error.
+        dx = math.sqrt(st[ST_PXX]) + EPS
+        dv = math.sqrt(st[ST_PVV]) + EPS * p_s
+        pk_x = _free_rocking(s, x + s * dx, v, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
+        pk_v = _free_rocking(s, x, v + s * dv, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
+        st[ST_VAR_PEAK] = (pk_x - pk) ** 2 + (pk_v - pk) ** 2
+        st[OUT_PEAK] = pk
+        st[OUT_T_PEAK] = t + dt_pk
+        if pk >= 1.0 and math.isnan(st[OUT_T_EXCEED]):
+            st[OUT_T_EXCEED] = t + dt_pk
+
+
+@_jit
+def _finish(st, ntr_cap):
+    """Return the output vector (``OUT_*``) of the final run state."""
+    if st[OUT_COLLAPSED] != 0.0:
+        st[OUT_PEAK] = 1.0
+        st[OUT_T_PEAK] = st[OUT_T_COLLAPSE]
+    peak = st[OUT_PEAK]
+    st[OUT_ERROR] = ERR_SAFETY * (math.sqrt(st[ST_VAR_PEAK]) + EPS * max(peak, 1.0))
+    st[OUT_TRACE_FULL] = 1.0 if ntr_cap > 0 and st[OUT_N_TRACE] == ntr_cap else 0.0
+    return st[:NOUT].copy()
+
+
+@_jit
+def _simulate(cells, sides, rules, x0, trace, log):
+    """Integrate one mechanism through a cell sequence (see ``simulate_cells``).
 
     Parameters
     ----------
-    kind, c0, c1, c2, tstart, tend, amax_after : (n,) arrays
-        Cells (see module docstring); ``amax_after[i]`` bounds ``|a|`` from ``tstart[i]`` on
-        [m/s²].
-    scale : float
-        Factor on the ground acceleration [-].
-    p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg : float
-        Side constants [rad/s], [-], [rad].
-    eta : float
-        Coefficient of restitution [-].
-    one_sided : bool
-        One-sided rocking.
+    cells : (7, n) float
+        Rows ``CELL_ROWS``; ``amax_after[i]`` bounds ``|a|`` from ``t_start[i]`` on [m/s²].
+    sides : (2, NSIDE) float
+        ``SIDE_*`` constants of side +1 (row 0) and side -1 (row 1): p [rad/s],
+        ks [s²/m], phi_ov [rad].
+    rules : (NRULE,) float
+        ``RULE_*``: restitution [-], one-sided (1 or 0), rest rule [-] (an impact whose
+        outgoing speed is below ``v_rest_rel * p`` ends in rest), impact cap, largest p
+        [rad/s].
     x0 : float
         Initial normalised rotation, released from rest [-].
-    v_rest_rel : float
-        Rest rule: an impact whose outgoing speed is below ``v_rest_rel * p`` ends in rest.
-    max_impacts : int
-        Impact cap.
-    trace_t, trace_x : (m,) arrays
-        Output buffers for the time series (size 0: no trace).
-    log : (4, k) array
+    trace : (2, m) float
+        Output buffer for the time series (``m = 0``: no trace).
+    log : (4, k) float
         Output buffer for the impact log (rows ``LOG_ROWS``; ``k = 0``: no log). Every
         impact is logged, also those below the rest speed that end in rest.
 
@@ -465,327 +804,51 @@ def _simulate(
     -------
     (NOUT,) float array, indexed by the ``OUT_*`` constants.
     """
-    out = np.zeros(NOUT)
-    ntr_cap = trace_t.shape[0]
-    ntr = 0
-    nlog_cap = log.shape[1]
-    nlog = 0
-    n_up = 0
-    n_rest = 0
-    n = kind.shape[0]
-    p_max = max(p_pos, p_neg)
-    ks_pos = scale / (G * lam_pos)
-    ks_neg = scale / (G * lam_neg)
-
-    mode = REST
-    s = 0.0
-    x = 0.0
-    v = 0.0
-    t = tstart[0]
-    if x0 != 0.0:
-        mode = FLIGHT
-        s = _sgn(x0)
-        x = x0
-    peak = abs(x0)
-    t_peak = t
-    var_peak = 0.0
-    t_exceed = math.nan
-    t_cross = math.nan  # when |x| reached 1 on the current excursion
-    if abs(x0) >= 1.0:
-        t_exceed = t
-        t_cross = t
-    collapsed = False
-    t_collapse = math.nan
-    n_imp = 0
-    n_steps = 0
-    status = 0
-    pxx = 0.0
-    pxv = 0.0
-    pvv = 0.0
-    hold_until = -math.inf
-    uplift_t = math.nan
-    done = False
-    ntr = _record(trace_t, trace_x, ntr, t, x)
-
-    for i in range(n):
-        if done:
+    st = _init_state(cells[4, 0], x0)
+    fl = np.empty(NFL)
+    p_max = rules[RULE_P_MAX]
+    _record(st, trace, st[ST_T], st[ST_X])
+    for i in range(cells.shape[1]):
+        if st[OUT_STATUS] != 0.0:
             break
-        k = kind[i]
-        a0 = c0[i]
-        a1 = c1[i]
-        a2 = c2[i]
-        cs = tstart[i]
-        ce = tend[i]
+        cell = cells[:, i]
+        cs = cell[4]
+        ce = cell[5]
         nsub = max(1, math.ceil(p_max * (ce - cs) / MAX_PH))
         hsub = (ce - cs) / nsub
         for j in range(nsub):
-            if done:
+            if st[OUT_STATUS] != 0.0:
                 break
             tb = ce if j == nsub - 1 else cs + (j + 1) * hsub
-            t_sub0 = t
-            while not done:
-                if mode == REST:
-                    if t < hold_until:
-                        t = tb
-                        ntr = _record(trace_t, trace_x, ntr, t, 0.0)
+            t_sub0 = st[ST_T]
+            while st[OUT_STATUS] == 0.0:
+                if st[ST_MODE] == REST:
+                    if _rest_step(st, cell, sides, rules, tb, trace):
                         break
-                    tu = -1.0
-                    su = 0.0
-                    t1 = _uplift_time(k, a0, a1, a2, cs, ks_pos, 1.0, t, tb)
-                    if t1 >= 0.0:
-                        tu = t1
-                        su = 1.0
-                    if not one_sided:
-                        t2 = _uplift_time(k, a0, a1, a2, cs, ks_neg, -1.0, t, tb)
-                        if t2 >= 0.0 and (tu < 0.0 or t2 < tu):
-                            tu = t2
-                            su = -1.0
-                    if tu < 0.0 or tu >= tb:
-                        t = tb
-                        ntr = _record(trace_t, trace_x, ntr, t, 0.0)
-                        break
-                    mode = FLIGHT
-                    s = su
-                    x = 0.0
-                    v = 0.0
-                    t = tu
-                    uplift_t = tu
-                    n_up += 1
-                    ntr = _record(trace_t, trace_x, ntr, t, 0.0)
-                    continue
-
-                # Flight on side s from the anchor (t, x, v) to tb or to the first impact.
-                if s > 0.0:
-                    p = p_pos
-                    ks = ks_pos
-                else:
-                    p = p_neg
-                    ks = ks_neg
-                big_h = tb - t
-                if big_h <= 0.0:
+                elif _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
                     break
-                n_steps += 1
-                ta = t
-                xa = x
-                va = v
-                ad_a = _accel(k, a0, a1, a2, cs, ta)[1]
-                # Sign of q' on the stretch: constant for linear cells; for sinusoidal quarter
-                # cells taken at the midpoint, clear of the zeros on the cell boundaries.
-                qd_sign = (
-                    _sgn(ad_a) if k == 0 else _sgn(_accel(k, a0, a1, a2, cs, 0.5 * (ta + tb))[1])
-                )
-                acc_a = p * p * (xa - s - ks * _accel(k, a0, a1, a2, cs, ta)[0])
-                jerk_a = p * p * (va - ks * ad_a)
-                sig_a = _side_sign_right(va, acc_a, jerk_a)
-                if xa == 0.0 and va == 0.0:
-                    sig_a = s  # uplift: the drive exceeds the threshold, motion is outward
-                nz, z1, z2, xb, vb = _velocity_zeros(
-                    k, a0, a1, a2, cs, ks, s, p, ta, xa, va, acc_a, jerk_a, big_h, sig_a, qd_sign
-                )
-                # Monotone pieces of x: [0, z1], [z1, z2], [z2, H].
-                tau_l = 0.0
-                sx_l = s * xa
-                tau_imp = -1.0
-                for piece in range(nz + 1):
-                    if piece < nz:
-                        tau_r = z1 if piece == 0 else z2
-                        xr = _state(k, a0, a1, a2, cs, ks, s, p, ta, xa, va, tau_r)[0]
-                        if s * xr >= 0.0:  # turning point
-                            ntr = _record(trace_t, trace_x, ntr, ta + tau_r, xr)
-                    else:
-                        tau_r = big_h
-                        xr = xb
-                    sx_r = s * xr
-                    if sx_r < 0.0:
-                        # Impact in (tau_l, tau_r]: s*x falls through 0 on a monotone piece.
-                        if sx_l <= 0.0:
-                            tau_imp = tau_l
-                        else:
-                            tau_imp = _root(
-                                0,
-                                0.0,
-                                k,
-                                a0,
-                                a1,
-                                a2,
-                                cs,
-                                ks,
-                                s,
-                                p,
-                                ta,
-                                xa,
-                                va,
-                                tau_l,
-                                tau_r,
-                                s,
-                                s * sx_l,
-                                xr,
-                            )
-                        break
-                    if sx_r >= 1.0 and sx_l < 1.0 and math.isnan(t_cross):
-                        tc = _root(
-                            0,
-                            s,
-                            k,
-                            a0,
-                            a1,
-                            a2,
-                            cs,
-                            ks,
-                            s,
-                            p,
-                            ta,
-                            xa,
-                            va,
-                            tau_l,
-                            tau_r,
-                            -s,
-                            s * sx_l - s,
-                            xr - s,
-                        )
-                        t_cross = ta + tc
-                        if math.isnan(t_exceed):
-                            t_exceed = t_cross
-                    if sx_r > peak:
-                        peak = sx_r
-                        t_peak = ta + tau_r
-                        var_peak = pxx
-                    tau_l = tau_r
-                    sx_l = sx_r
+    if st[OUT_STATUS] == 0.0 and st[ST_MODE] == FLIGHT:
+        _free_tail(st, sides, rules)
+    return _finish(st, trace.shape[1])
 
-                if tau_imp >= 0.0:
-                    _xi, vi, ai, _ji = _state(k, a0, a1, a2, cs, ks, s, p, ta, xa, va, tau_imp)
-                    ex = EPS * (abs(xa) + 1.0 + abs(ks * a0))
-                    pxx, pxv, pvv = _propagate_cov(pxx, pxv, pvv, p, tau_imp, ex, ex * p)
-                    pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p)
-                    t = ta + tau_imp
-                    if one_sided:
-                        s_new = s
-                        c_imp = eta
-                        p_new = p
-                        ks_new = ks
-                    else:
-                        s_new = -s
-                        c_imp = eta * (phiov_pos / phiov_neg if s > 0.0 else phiov_neg / phiov_pos)
-                        p_new = p_neg if s > 0.0 else p_pos
-                        ks_new = ks_neg if s > 0.0 else ks_pos
-                    v_new = c_imp * vi
-                    a_now = _accel(k, a0, a1, a2, cs, t)[0]
-                    acc_new = p_new * p_new * (-s_new - ks_new * a_now)
-                    ntr = _record(trace_t, trace_x, ntr, t, 0.0)
-                    ends_in_rest = abs(v_new) < v_rest_rel * p_new or vi == 0.0
-                    if nlog < nlog_cap:
-                        log[0, nlog] = t
-                        log[1, nlog] = s
-                        log[2, nlog] = vi
-                        log[3, nlog] = 0.0 if ends_in_rest else v_new
-                        nlog += 1
-                    if abs(vi) >= v_rest_rel * p:
-                        n_imp += 1
-                        if n_imp >= max_impacts:
-                            status = -1
-                            done = True
-                    if ends_in_rest:
-                        n_rest += 1
-                        # Rest rule (ends Zeno sequences, THEORY §10). A null excursion right
-                        # after uplift in this segment holds the body until the segment ends.
-                        if uplift_t >= t_sub0 and abs(vi) < v_rest_rel * p:
-                            hold_until = tb
-                        mode = REST
-                        s = 0.0
-                        x = 0.0
-                        v = 0.0
-                        pxx = 0.0
-                        pxv = 0.0
-                        pvv = 0.0
-                        t_cross = math.nan
-                        continue
-                    m_s = (acc_new - c_imp * ai) / vi
-                    nxx = c_imp * c_imp * pxx
-                    nxv = c_imp * (m_s * pxx + c_imp * pxv)
-                    nvv = m_s * m_s * pxx + 2.0 * m_s * c_imp * pxv + c_imp * c_imp * pvv
-                    dtau = 4.0 * EPS * max(abs(t), 1.0)
-                    pxx = nxx
-                    pxv = nxv
-                    pvv = nvv + (c_imp * ai * dtau) ** 2
-                    pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p_new)
-                    s = s_new
-                    x = 0.0
-                    v = v_new
-                    t_cross = math.nan
-                    uplift_t = math.nan
-                    continue
 
-                # No impact: advance to the segment end.
-                ex = EPS * (abs(xa) + abs(xb) + 1.0 + abs(ks * a0))
-                pxx, pxv, pvv = _propagate_cov(pxx, pxv, pvv, p, big_h, ex, ex * p)
-                pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p)
-                x = xb
-                v = vb
-                t = tb
-                if not (math.isfinite(x) and math.isfinite(v)):
-                    status = -2
-                    done = True
-                    break
-                ntr = _record(trace_t, trace_x, ntr, t, x)
-                # Certain collapse: moving outward beyond 1 + max future drive.
-                if s * v > 0.0 and s * x > 1.0 + ks * amax_after[i]:
-                    collapsed = True
-                    t_collapse = t_cross if not math.isnan(t_cross) else t
-                    status = 1
-                    done = True
-                break
-
-    err_var = var_peak
-    if status == 0 and mode == FLIGHT:
-        # Free rocking after the excitation: exact outcome (THEORY §1.8).
-        if s > 0.0:
-            p_s = p_pos
-            p_o = p_neg
-            r_so = phiov_pos / phiov_neg
-        else:
-            p_s = p_neg
-            p_o = p_pos
-            r_so = phiov_neg / phiov_pos
-        col, dt_cross, pk, dt_pk = _free_rocking(
-            s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest_rel * (p_s if one_sided else p_o)
-        )
-        if col:
-            collapsed = True
-            t_collapse = t + dt_cross if math.isnan(t_cross) else t_cross
-            if math.isnan(t_exceed):
-                t_exceed = t_collapse
-            status = 1
-        elif pk > peak:
-            # Sensitivity of the analytic tail to the propagated state error.
-            dx = math.sqrt(pxx) + EPS
-            dv = math.sqrt(pvv) + EPS * p_s
-            pk_x = _free_rocking(s, x + s * dx, v, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
-            pk_v = _free_rocking(s, x, v + s * dv, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
-            err_var = (pk_x - pk) ** 2 + (pk_v - pk) ** 2
-            peak = pk
-            t_peak = t + dt_pk
-            if peak >= 1.0 and math.isnan(t_exceed):
-                t_exceed = t_peak
-    if collapsed:
-        peak = 1.0
-        t_peak = t_collapse
-
-    out[OUT_STATUS] = status
-    out[OUT_PEAK] = peak
-    out[OUT_T_PEAK] = t_peak
-    out[OUT_T_EXCEED] = t_exceed
-    out[OUT_COLLAPSED] = 1.0 if collapsed else 0.0
-    out[OUT_T_COLLAPSE] = t_collapse
-    out[OUT_N_IMPACTS] = n_imp
-    out[OUT_N_STEPS] = n_steps
-    out[OUT_ERROR] = ERR_SAFETY * (math.sqrt(err_var) + EPS * max(peak, 1.0))
-    out[OUT_N_TRACE] = ntr
-    out[OUT_TRACE_FULL] = 1.0 if ntr_cap > 0 and ntr == ntr_cap else 0.0
-    out[OUT_N_UPLIFTS] = n_up
-    out[OUT_N_RESTS] = n_rest
-    out[OUT_N_LOG] = nlog
-    return out
+@_jit
+def _run_constants(params, scale, v_rest_rel, max_impacts):
+    """Return ``sides`` and ``rules`` of one run (``params`` as in ``simulate_cells``)."""
+    sides = np.empty((2, NSIDE))
+    sides[0, SIDE_P] = params[0]
+    sides[1, SIDE_P] = params[1]
+    sides[0, SIDE_KS] = scale / (G * params[2])
+    sides[1, SIDE_KS] = scale / (G * params[3])
+    sides[0, SIDE_PHIOV] = params[4]
+    sides[1, SIDE_PHIOV] = params[5]
+    rules = np.empty(NRULE)
+    rules[RULE_ETA] = params[6]
+    rules[RULE_ONE_SIDED] = 1.0 if params[7] != 0.0 else 0.0
+    rules[RULE_V_REST] = v_rest_rel
+    rules[RULE_MAX_IMPACTS] = max_impacts
+    rules[RULE_P_MAX] = max(params[0], params[1])
+    return sides, rules
 
 
 @_jit
@@ -799,7 +862,7 @@ def simulate_cells(cells, params, scale, x0, v_rest_rel, max_impacts, trace):
     params : (8,) float
         ``p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided``.
     scale, x0, v_rest_rel, max_impacts
-        Scale factor, initial ratio, rest rule, impact cap (see ``_simulate``).
+        Scale factor [-], initial ratio [-], rest rule [-], impact cap (see ``_simulate``).
     trace : (2, m) float
         Time-series buffer (times, ratios); ``m = 0`` for none.
 
@@ -818,30 +881,8 @@ def simulate_cells_logged(cells, params, scale, x0, v_rest_rel, max_impacts, tra
 
     The log holds the first ``k`` impacts; ``out[OUT_N_LOG]`` says how many were written.
     """
-    return _simulate(
-        cells[0],
-        cells[1],
-        cells[2],
-        cells[3],
-        cells[4],
-        cells[5],
-        cells[6],
-        scale,
-        params[0],
-        params[1],
-        params[2],
-        params[3],
-        params[4],
-        params[5],
-        params[6],
-        params[7] != 0.0,
-        x0,
-        v_rest_rel,
-        max_impacts,
-        trace[0],
-        trace[1],
-        log,
-    )
+    sides, rules = _run_constants(params, scale, v_rest_rel, max_impacts)
+    return _simulate(cells, sides, rules, x0, trace, log)
 
 
 @_jit_parallel
