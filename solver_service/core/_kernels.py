@@ -41,6 +41,12 @@ try:  # numba is optional: without it the same code runs as plain Python.
     def _jit_parallel(fn):
         return _numba.njit(cache=True, nogil=True, parallel=True)(fn)
 
+    def _leaf(fn):
+        # Helpers that allocate nothing run without the reference counting of their array
+        # arguments, which would otherwise cost more than the arithmetic of a step.
+        options: dict[str, Any] = {"_nrt": False}  # not in numba's type stubs
+        return _numba.njit(cache=True, nogil=True, **options)(fn)
+
     _prange: Any = _numba.prange
     JIT = True
 except ImportError:  # pragma: no cover - exercised through the python backend
@@ -49,6 +55,7 @@ except ImportError:  # pragma: no cover - exercised through the python backend
         return fn
 
     _jit_parallel = _jit
+    _leaf = _jit
     _prange = range
     JIT = False
 
@@ -146,7 +153,7 @@ ST_UPLIFT_T = NOUT + 11
 NST = NOUT + 12
 
 
-@_jit
+@_leaf
 def _sinh_minus(u):
     """Return ``sinh(u) - u`` without cancellation for small ``u``."""
     if abs(u) < SERIES_U:
@@ -165,7 +172,7 @@ def _sinh_minus(u):
     return math.sinh(u) - u
 
 
-@_jit
+@_leaf
 def _accel(cell, t):
     """Ground acceleration of a cell (rows ``CELL_ROWS``) and its rate at absolute time ``t``."""
     if cell[0] == 0:
@@ -174,13 +181,13 @@ def _accel(cell, t):
     return cell[1] * math.sin(arg), cell[1] * cell[2] * math.cos(arg)
 
 
-@_jit
+@_leaf
 def _side(s):
     """Row of the ``sides`` array for side ``s`` (+1: 0, -1: 1)."""
     return 0 if s > 0.0 else 1
 
 
-@_jit
+@_leaf
 def _anchor(fl, cell, sides, s, ta, xa, va):
     """Fill the flight array ``fl``: cell, side constants of side ``s`` and anchor state."""
     for r in range(5):
@@ -194,7 +201,59 @@ def _anchor(fl, cell, sides, s, ta, xa, va):
     fl[FL_VA] = va
 
 
-@_jit
+@_leaf
+def _cosh_minus(u):
+    """Return ``cosh(u) - 1`` without cancellation (Taylor series for small ``u``)."""
+    if abs(u) < SERIES_U:
+        u2 = u * u
+        # Series to u**16: truncation below 1e-20 relative for |u| < 0.5.
+        poly = 1.0 / 20922789888000.0
+        poly = 1.0 / 87178291200.0 + u2 * poly
+        poly = 1.0 / 479001600.0 + u2 * poly
+        poly = 1.0 / 3628800.0 + u2 * poly
+        poly = 1.0 / 40320.0 + u2 * poly
+        poly = 1.0 / 720.0 + u2 * poly
+        poly = 1.0 / 24.0 + u2 * poly
+        poly = 0.5 + u2 * poly
+        return u2 * poly
+    h = math.sinh(0.5 * u)
+    return 2.0 * h * h
+
+
+@_leaf
+def _flow_coeffs(p, tau):
+    """Coefficients of the closed-form flow over ``tau`` [s] on a side of frequency ``p``.
+
+    Returns ``(cosh(u) - 1, sinh(u)/p, (sinh(u) - u)/p, p sinh(u))`` with ``u = p tau``:
+    from the anchor, ``x = xa + a chm1 + va shp - q1 smp`` and ``x' = va + (va - q1) chm1 +
+    a psh`` for a linear drive (``a = xa - s - q0``). Below ``SERIES_U`` only polynomials
+    are evaluated. The batch path computes them once per side and sample interval, the
+    event path per call: the same numbers either way.
+    """
+    u = p * tau
+    sm = _sinh_minus(u)
+    sh = u + sm if abs(u) < SERIES_U else math.sinh(u)
+    return _cosh_minus(u), sh / p, sm / p, p * sh
+
+
+@_leaf
+def _cov_coeffs(p, tau):
+    """Coefficients of the covariance map of the homogeneous flow over ``tau`` [s].
+
+    With the flow matrix ``[[a, b], [c, d]] = [[cosh u, sinh(u)/p], [p sinh u, cosh u]]``:
+    ``(a a, 2 a b, b b, a c, a d + b c, b d, c c, 2 c d, d d)``.
+    """
+    u = p * tau
+    ch = 1.0 + _cosh_minus(u)
+    sh = u + _sinh_minus(u) if abs(u) < SERIES_U else math.sinh(u)
+    a = ch
+    b = sh / p
+    c = p * sh
+    d = ch
+    return a * a, 2.0 * a * b, b * b, a * c, a * d + b * c, b * d, c * c, 2.0 * c * d, d * d
+
+
+@_leaf
 def _state(fl, tau):
     """State ``(x, x', x'', x''')`` at ``ta + tau`` from the anchor of the flight ``fl``."""
     ks = fl[FL_KS]
@@ -203,19 +262,20 @@ def _state(fl, tau):
     ta = fl[FL_TA]
     xa = fl[FL_XA]
     va = fl[FL_VA]
-    u = p * tau
-    sh = math.sinh(u)
-    h = math.sinh(0.5 * u)
-    chm1 = 2.0 * h * h  # cosh(u) - 1 without cancellation
     if fl[FL_KIND] == 0:
+        chm1, shp, smp, psh = _flow_coeffs(p, tau)
         q0 = ks * (fl[FL_C0] + fl[FL_C1] * (ta - fl[FL_CS]))
         q1 = ks * fl[FL_C1]
         a = xa - s - q0
-        x = xa + a * chm1 + va * sh / p - q1 * _sinh_minus(u) / p
-        v = va + (va - q1) * chm1 + a * p * sh
+        x = xa + a * chm1 + va * shp - q1 * smp
+        v = va + (va - q1) * chm1 + a * psh
         q = q0 + q1 * tau
         qd = q1
     else:
+        u = p * tau
+        sh = math.sinh(u)
+        h = math.sinh(0.5 * u)
+        chm1 = 2.0 * h * h  # cosh(u) - 1 without cancellation
         kk = ks * fl[FL_C0]
         w = fl[FL_C1]
         th = w * ta + fl[FL_C2]
@@ -233,7 +293,7 @@ def _state(fl, tau):
     return x, v, acc, jerk
 
 
-@_jit
+@_leaf
 def _sgn(z):
     if z > 0.0:
         return 1.0
@@ -242,7 +302,7 @@ def _sgn(z):
     return 0.0
 
 
-@_jit
+@_leaf
 def _component(which, target, fl, t):
     """Return function ``which`` (0: x - target, 1: x', 2: x'') at ``t`` and two derivatives.
 
@@ -256,7 +316,7 @@ def _component(which, target, fl, t):
     return acc, jerk, 0.0
 
 
-@_jit
+@_leaf
 def _root(which, target, fl, lo, hi, sig_lo, f_lo, f_hi):
     """Zero of component ``which`` (0: x - target, 1: x', 2: x'') of flight ``fl`` in ``[lo, hi]``.
 
@@ -297,7 +357,7 @@ def _root(which, target, fl, lo, hi, sig_lo, f_lo, f_hi):
     return t
 
 
-@_jit
+@_leaf
 def _side_sign_right(v, acc, jerk):
     """Sign of x' just after a point, from x', x'' and x''' there."""
     if v != 0.0:
@@ -307,7 +367,7 @@ def _side_sign_right(v, acc, jerk):
     return _sgn(jerk)
 
 
-@_jit
+@_leaf
 def _side_sign_left(v, acc, jerk):
     """Sign of x' just before a point, from x', x'' and x''' there."""
     if v != 0.0:
@@ -317,7 +377,7 @@ def _side_sign_left(v, acc, jerk):
     return _sgn(jerk)
 
 
-@_jit
+@_leaf
 def _velocity_zeros(fl, aa, big_h, sig_a, qd_sign):
     """Interior zeros of x' on ``(0, big_h)``: returns ``(n, z1, z2, x(big_h), x'(big_h))``.
 
@@ -349,7 +409,7 @@ def _velocity_zeros(fl, aa, big_h, sig_a, qd_sign):
     return n, z1, z2, xb, vb
 
 
-@_jit
+@_leaf
 def _free_time_to_zero(y, w, p):
     """Time for free motion ``y'' = p**2 y`` to go from ``(y, w)`` to ``y = -1``."""
     wp = w / p
@@ -366,7 +426,7 @@ def _free_time_to_zero(y, w, p):
     return max(math.asinh(1.0 / c) - math.asinh(-y / c), 0.0) / p
 
 
-@_jit
+@_leaf
 def _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest):
     """Free-rocking outcome; documented in ``freemotion.free_rocking``, which wraps it."""
     y = s * x - 1.0
@@ -400,7 +460,7 @@ def _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest):
     return False, math.nan, peak, dt_peak
 
 
-@_jit
+@_leaf
 def _uplift_time(cell, ks, s, t, tb):
     """First time in ``[t, tb]`` at which the drive ``g = -s ks a`` exceeds 1, or ``-1``.
 
@@ -444,9 +504,9 @@ def _uplift_time(cell, ks, s, t, tb):
     return min(x, hi)
 
 
-@_jit
-def _set_cov(st, pxx, pxv, pvv, p):
-    """Store the error covariance, clipped to the physical span of the motion (``ERR_CAP``)."""
+@_leaf
+def _cap_cov(pxx, pxv, pvv, p):
+    """Clip the error covariance to the physical span of the motion (``ERR_CAP``)."""
     xcap = ERR_CAP * ERR_CAP
     vcap = xcap * p * p
     if not pxx <= xcap:  # also catches NaN
@@ -456,36 +516,37 @@ def _set_cov(st, pxx, pxv, pvv, p):
     lim = math.sqrt(pxx * pvv)
     if not abs(pxv) <= lim:
         pxv = lim if pxv > 0.0 else -lim
+    return pxx, pxv, pvv
+
+
+@_leaf
+def _set_cov(st, pxx, pxv, pvv, p):
+    """Store the error covariance, clipped (``_cap_cov``)."""
+    pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p)
     st[ST_PXX] = pxx
     st[ST_PXV] = pxv
     st[ST_PVV] = pvv
 
 
-@_jit
+@_leaf
 def _propagate_cov(st, p, tau, ex):
     """Carry the error covariance through a homogeneous flight of ``tau`` [s].
 
     ``ex`` is the rounding error added to x on the way (``ex * p`` to x'); the result is
     capped (``_set_cov``).
     """
+    aa, ab2, bb, ac, adbc, bd, cc, cd2, dd = _cov_coeffs(p, tau)
     pxx = st[ST_PXX]
     pxv = st[ST_PXV]
     pvv = st[ST_PVV]
     ev = ex * p
-    u = p * tau
-    ch = math.cosh(u)
-    sh = math.sinh(u)
-    a = ch
-    b = sh / p
-    c = p * sh
-    d = ch
-    nxx = a * a * pxx + 2.0 * a * b * pxv + b * b * pvv + ex * ex
-    nxv = a * c * pxx + (a * d + b * c) * pxv + b * d * pvv
-    nvv = c * c * pxx + 2.0 * c * d * pxv + d * d * pvv + ev * ev
+    nxx = aa * pxx + ab2 * pxv + bb * pvv + ex * ex
+    nxv = ac * pxx + adbc * pxv + bd * pvv
+    nvv = cc * pxx + cd2 * pxv + dd * pvv + ev * ev
     _set_cov(st, nxx, nxv, nvv, p)
 
 
-@_jit
+@_leaf
 def _record(st, trace, t, x):
     """Append ``(t, x)`` to the time-series buffer ``trace`` (2, m) if there is room."""
     ntr = int(st[OUT_N_TRACE])
@@ -495,7 +556,7 @@ def _record(st, trace, t, x):
         st[OUT_N_TRACE] = ntr + 1
 
 
-@_jit
+@_leaf
 def _log_impact(st, log, t, s, vi, v_out):
     """Append an impact to the impact log ``log`` (4, k) if there is room."""
     nlog = int(st[OUT_N_LOG])
@@ -530,7 +591,7 @@ def _init_state(t0, x0):
     return st
 
 
-@_jit
+@_leaf
 def _set_rest(st):
     """Come to rest on the base (no error is carried at rest)."""
     st[ST_MODE] = REST
@@ -543,7 +604,7 @@ def _set_rest(st):
     st[ST_T_CROSS] = math.nan
 
 
-@_jit
+@_leaf
 def _rest_step(st, cell, sides, rules, tb, trace):
     """At rest until ``tb`` or until uplift; returns True when the segment is done."""
     t = st[ST_T]
@@ -577,7 +638,7 @@ def _rest_step(st, cell, sides, rules, tb, trace):
     return False
 
 
-@_jit
+@_leaf
 def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace):
     """Walk the monotone pieces ``[0, z1], [z1, z2], [z2, H]`` of x in the flight ``fl``.
 
@@ -617,7 +678,7 @@ def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace):
     return -1.0
 
 
-@_jit
+@_leaf
 def _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log):
     """Impact at ``ta + tau_imp``: restitution, side change, rest rule, error saltation."""
     s = fl[FL_S]
@@ -673,7 +734,7 @@ def _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log):
     st[ST_UPLIFT_T] = math.nan
 
 
-@_jit
+@_leaf
 def _advance(st, fl, xb, vb, tb, amax_after, trace):
     """No impact in the flight: move to its end ``tb``; check for certain collapse."""
     s = fl[FL_S]
@@ -695,7 +756,7 @@ def _advance(st, fl, xb, vb, tb, amax_after, trace):
         st[OUT_STATUS] = 1
 
 
-@_jit
+@_leaf
 def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
     """Closed-form flight from the current state to ``tb`` or to the first impact.
 
@@ -730,7 +791,7 @@ def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
     return True
 
 
-@_jit
+@_leaf
 def _free_tail(st, sides, rules):
     """After the excitation: the exact free-rocking outcome (THEORY §1.8) and its error."""
     s = st[ST_S]
@@ -777,6 +838,32 @@ def _finish(st, ntr_cap):
     return st[:NOUT].copy()
 
 
+@_leaf
+def _n_segments(cell, rules):
+    """Closed-form segments of a cell: each at most ``MAX_PH / p`` long."""
+    return max(1, math.ceil(rules[RULE_P_MAX] * (cell[5] - cell[4]) / MAX_PH))
+
+
+@_leaf
+def _run_cell(st, fl, cell, sides, rules, trace, log):
+    """Integrate one cell, event by event, from its start (where the run state is)."""
+    cs = cell[4]
+    ce = cell[5]
+    nsub = _n_segments(cell, rules)
+    hsub = (ce - cs) / nsub
+    for j in range(nsub):
+        if st[OUT_STATUS] != 0.0:
+            break
+        tb = ce if j == nsub - 1 else cs + (j + 1) * hsub
+        t_sub0 = st[ST_T]
+        while st[OUT_STATUS] == 0.0:
+            if st[ST_MODE] == REST:
+                if _rest_step(st, cell, sides, rules, tb, trace):
+                    break
+            elif _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
+                break
+
+
 @_jit
 def _simulate(cells, sides, rules, x0, trace, log):
     """Integrate one mechanism through a cell sequence (see ``simulate_cells``).
@@ -806,27 +893,11 @@ def _simulate(cells, sides, rules, x0, trace, log):
     """
     st = _init_state(cells[4, 0], x0)
     fl = np.empty(NFL)
-    p_max = rules[RULE_P_MAX]
     _record(st, trace, st[ST_T], st[ST_X])
     for i in range(cells.shape[1]):
         if st[OUT_STATUS] != 0.0:
             break
-        cell = cells[:, i]
-        cs = cell[4]
-        ce = cell[5]
-        nsub = max(1, math.ceil(p_max * (ce - cs) / MAX_PH))
-        hsub = (ce - cs) / nsub
-        for j in range(nsub):
-            if st[OUT_STATUS] != 0.0:
-                break
-            tb = ce if j == nsub - 1 else cs + (j + 1) * hsub
-            t_sub0 = st[ST_T]
-            while st[OUT_STATUS] == 0.0:
-                if st[ST_MODE] == REST:
-                    if _rest_step(st, cell, sides, rules, tb, trace):
-                        break
-                elif _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
-                    break
+        _run_cell(st, fl, cells[:, i], sides, rules, trace, log)
     if st[OUT_STATUS] == 0.0 and st[ST_MODE] == FLIGHT:
         _free_tail(st, sides, rules)
     return _finish(st, trace.shape[1])
@@ -849,6 +920,212 @@ def _run_constants(params, scale, v_rest_rel, max_impacts):
     rules[RULE_MAX_IMPACTS] = max_impacts
     rules[RULE_P_MAX] = max(params[0], params[1])
     return sides, rules
+
+
+# Propagator of one side over one sample interval: the (2, NPROP) array ``prop``.
+PROP_CHM1 = 0
+PROP_SHP = 1
+PROP_SMP = 2
+PROP_PSH = 3
+PROP_P = 4
+#: Then the nine covariance coefficients of ``_cov_coeffs``.
+PROP_COV = 5
+NPROP = 14
+#: Scale factors integrated together by one batch task (structure of arrays).
+BLOCK = 32
+
+
+@_leaf
+def _propagator(prop, sides, h):
+    """Fill ``prop`` with the closed-form flow over ``h`` [s] on both sides (``_flow_coeffs``)."""
+    for row in range(2):
+        p = sides[row, SIDE_P]
+        chm1, shp, smp, psh = _flow_coeffs(p, h)
+        prop[row, PROP_CHM1] = chm1
+        prop[row, PROP_SHP] = shp
+        prop[row, PROP_SMP] = smp
+        prop[row, PROP_PSH] = psh
+        prop[row, PROP_P] = p
+        cov = _cov_coeffs(p, h)
+        for r in range(9):
+            prop[row, PROP_COV + r] = cov[r]
+
+
+@_leaf
+def _fast_rest(st, ksp, ksn, j, cell, one_sided):
+    """Return True when run ``j`` at rest stays at rest through a linear cell (no uplift).
+
+    The drive is linear in the cell, so ``g = -s ks a`` stays at or below 1 when it does at
+    both ends (``_uplift_time``); a held rest needs no test.
+    """
+    if st[ST_T, j] < st[ST_HOLD, j]:
+        return True
+    a_t = cell[1] + cell[2] * (cell[4] - cell[4])
+    a_b = cell[1] + cell[2] * (cell[5] - cell[4])
+    if -ksp[j] * a_t > 1.0 or -ksp[j] * a_b > 1.0:
+        return False
+    return one_sided or (ksn[j] * a_t <= 1.0 and ksn[j] * a_b <= 1.0)
+
+
+#: Margin [-] by which a bound on a turning point must clear the peak (and 1) for the batch
+#: path to skip locating it: far above the rounding of the bound and of the located value.
+BOUND_MARGIN = 1e-12
+
+
+@_leaf
+def _no_event(s, xa, va, xb, vb, q0, q1, h, p, peak):
+    """Return True when a flight of ``h`` [s] from ``(xa, va)`` to ``(xb, vb)`` has no event.
+
+    No impact, no ``|x| = 1`` crossing, no new peak inside, and no zero of ``x'`` whose
+    value the event path would use. With ``x~ = s x`` and ``w~ = s x'``, and ``q~' = s q1``
+    of one sign on the cell (maximum principle, module docstring):
+
+    * ``x'`` of one sign at both ends and no hump allowed: ``x`` is monotone;
+    * one zero of ``x'``, a maximum of ``x~``: ``x~ <= x~a + w~a h`` when ``q~' <= 0``, else
+      ``x~ <= x~b - w~b h``; the bound must stay below the peak and 1 (then the event path
+      would find the same state at the end and change nothing on the way);
+    * one zero of ``x'``, a minimum of ``x~``: ``x~ >= x~a + w~a h`` when ``q~' >= 0``, else
+      ``x~ >= x~b - w~b h``; the bound must stay above 0 (no impact).
+    """
+    sx = s * xb
+    if not (va != 0.0 and vb != 0.0 and 0.0 <= sx < 1.0 and abs(vb) <= 1.7976931348623157e308):
+        return False
+    wa = s * va
+    wb = s * vb
+    sq = s * q1
+    if (wa > 0.0) == (wb > 0.0):
+        hump = -1.0 if q1 <= 0.0 else 1.0
+        if _sgn(va) != hump and _sgn(p * p * (xa - s - q0)) == hump:
+            # x' may dip to zero inside: the event path decides.
+            return _sgn(p * p * (xb - s - (q0 + q1 * h))) != -hump
+        return True
+    if wa > 0.0:
+        top = s * xa + wa * h if sq <= 0.0 else sx - wb * h
+        return top + BOUND_MARGIN < min(peak, 1.0)
+    low = s * xa + wa * h if sq >= 0.0 else sx - wb * h
+    return low > BOUND_MARGIN
+
+
+@_leaf
+def _fast_flight(st, ksp, ksn, j, cell, prop):
+    """Advance run ``j`` in flight through a linear cell when no event can lie inside it.
+
+    The cheap bound (``_no_event``) decides from the two ends of the step, computed with
+    the precomputed propagator, bit for bit the arithmetic of ``_flight_step``. Returns
+    False (nothing changed) when an event may lie in the cell.
+    """
+    s = st[ST_S, j]
+    row = 0 if s > 0.0 else 1
+    ks = ksp[j] if s > 0.0 else ksn[j]
+    c0 = cell[1]
+    c1 = cell[2]
+    h = cell[5] - cell[4]
+    xa = st[ST_X, j]
+    va = st[ST_V, j]
+    q0 = ks * (c0 + c1 * (cell[4] - cell[4]))
+    q1 = ks * c1
+    a = xa - s - q0
+    xb = xa + a * prop[row, PROP_CHM1] + va * prop[row, PROP_SHP] - q1 * prop[row, PROP_SMP]
+    vb = va + (va - q1) * prop[row, PROP_CHM1] + a * prop[row, PROP_PSH]
+    p = prop[row, PROP_P]
+    if not _no_event(s, xa, va, xb, vb, q0, q1, h, p, st[OUT_PEAK, j]):
+        return False
+    st[OUT_N_STEPS, j] += 1
+    pxx = st[ST_PXX, j]
+    sx = s * xb
+    if sx > st[OUT_PEAK, j]:
+        st[OUT_PEAK, j] = sx
+        st[OUT_T_PEAK, j] = cell[4] + h
+        st[ST_VAR_PEAK, j] = pxx
+    pxv = st[ST_PXV, j]
+    pvv = st[ST_PVV, j]
+    ex = EPS * (abs(xa) + abs(xb) + 1.0 + abs(ks * c0))
+    ev = ex * p
+    k = PROP_COV
+    nxx = prop[row, k] * pxx + prop[row, k + 1] * pxv + prop[row, k + 2] * pvv + ex * ex
+    nxv = prop[row, k + 3] * pxx + prop[row, k + 4] * pxv + prop[row, k + 5] * pvv
+    nvv = prop[row, k + 6] * pxx + prop[row, k + 7] * pxv + prop[row, k + 8] * pvv + ev * ev
+    pxx, pxv, pvv = _cap_cov(nxx, nxv, nvv, p)
+    st[ST_PXX, j] = pxx
+    st[ST_PXV, j] = pxv
+    st[ST_PVV, j] = pvv
+    st[ST_X, j] = xb
+    st[ST_V, j] = vb
+    return True
+
+
+@_leaf
+def _fast_cell(st, ksp, ksn, cell, prop, one_sided, slow):
+    """One sample interval for every run of a block; mark in ``slow`` the runs it cannot do.
+
+    Returns the number of runs left to the event path. Runs that end (status != 0) are
+    skipped.
+    """
+    n_slow = 0
+    ce = cell[5]
+    for j in range(st.shape[1]):
+        slow[j] = False
+        if st[OUT_STATUS, j] != 0.0:
+            continue
+        if st[ST_MODE, j] == REST:
+            done = _fast_rest(st, ksp, ksn, j, cell, one_sided)
+        else:
+            done = _fast_flight(st, ksp, ksn, j, cell, prop)
+        if done:
+            st[ST_T, j] = ce
+        else:
+            slow[j] = True
+            n_slow += 1
+    return n_slow
+
+
+@_jit
+def _simulate_block(cells, params, scales, v_rest_rel, max_impacts):
+    """Run one mechanism at every scale of ``scales`` together; return (k, NOUT).
+
+    Structure of arrays: ``st[:, j]`` is the run state of scale ``j``. Each linear cell
+    short enough for one closed-form segment goes through ``_fast_cell`` (the per-interval
+    propagator is computed once per side and interval width, not per run); the runs in which
+    an event may lie, and every other cell, take the event path (``_run_cell``) with the
+    same arithmetic, so the results are those of ``simulate_cells`` bit for bit.
+    """
+    k = scales.shape[0]
+    st = np.empty((NST, k))
+    sides = np.empty((k, 2, NSIDE))
+    rules = np.empty(NRULE)
+    for j in range(k):
+        sides[j], rules = _run_constants(params, scales[j], v_rest_rel, max_impacts)
+        st[:, j] = _init_state(cells[4, 0], 0.0)
+    ksp = sides[:, 0, SIDE_KS].copy()
+    ksn = sides[:, 1, SIDE_KS].copy()
+    one_sided = rules[RULE_ONE_SIDED] != 0.0
+    prop = np.empty((2, NPROP))
+    h_prop = math.nan
+    slow = np.zeros(k, dtype=np.bool_)
+    fl = np.empty(NFL)
+    trace = np.empty((2, 0))
+    log = np.empty((4, 0))
+    for i in range(cells.shape[1]):
+        cell = cells[:, i]
+        n_slow = k
+        if cell[0] == 0 and _n_segments(cell, rules) == 1:
+            h = cell[5] - cell[4]
+            if h != h_prop:
+                _propagator(prop, sides[0], h)
+                h_prop = h
+            n_slow = _fast_cell(st, ksp, ksn, cell, prop, one_sided, slow)
+        else:
+            slow[:] = True
+        if n_slow > 0:
+            for j in range(k):
+                if slow[j] and st[OUT_STATUS, j] == 0.0:
+                    _run_cell(st[:, j], fl, cell, sides[j], rules, trace, log)
+    out = np.empty((k, NOUT))
+    for j in range(k):
+        if st[OUT_STATUS, j] == 0.0 and st[ST_MODE, j] == FLIGHT:
+            _free_tail(st[:, j], sides[j], rules)
+        out[j] = _finish(st[:, j], 0)
+    return out
 
 
 @_jit
@@ -890,16 +1167,18 @@ def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
     """Run every mechanism (rows of ``params``) at every scale; return (m, k, NOUT).
 
     ``params[i] = (p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided)``.
+    The work is split in tasks of one mechanism × up to ``BLOCK`` scales
+    (``_simulate_block``), run in parallel.
     """
     m = params.shape[0]
     nk = scales.shape[0]
+    nb = (nk + BLOCK - 1) // BLOCK
     out = np.empty((m, nk, NOUT))
-    for ij in _prange(m * nk):
-        i = ij // nk
-        j = ij % nk
-        out[i, j, :] = simulate_cells(
-            cells, params[i], scales[j], 0.0, v_rest_rel, max_impacts, np.empty((2, 0))
-        )
+    for ib in _prange(m * nb):
+        i = ib // nb
+        lo = (ib % nb) * BLOCK
+        hi = min(lo + BLOCK, nk)
+        out[i, lo:hi, :] = _simulate_block(cells, params[i], scales[lo:hi], v_rest_rel, max_impacts)
     return out
 
 
