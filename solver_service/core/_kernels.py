@@ -1007,7 +1007,7 @@ def _no_event(s, xa, va, xb, vb, q0, q1, h, p, peak):
 
 
 @_leaf
-def _fast_flight(st, ksp, ksn, j, cell, prop):
+def _fast_flight(st, ksp, ksn, j, cell, props, w):
     """Advance run ``j`` in flight through a linear cell when no event can lie inside it.
 
     The cheap bound (``_no_event``) decides from the two ends of the step, computed with
@@ -1025,9 +1025,14 @@ def _fast_flight(st, ksp, ksn, j, cell, prop):
     q0 = ks * (c0 + c1 * (cell[4] - cell[4]))
     q1 = ks * c1
     a = xa - s - q0
-    xb = xa + a * prop[row, PROP_CHM1] + va * prop[row, PROP_SHP] - q1 * prop[row, PROP_SMP]
-    vb = va + (va - q1) * prop[row, PROP_CHM1] + a * prop[row, PROP_PSH]
-    p = prop[row, PROP_P]
+    xb = (
+        xa
+        + a * props[w, row, PROP_CHM1]
+        + va * props[w, row, PROP_SHP]
+        - q1 * props[w, row, PROP_SMP]
+    )
+    vb = va + (va - q1) * props[w, row, PROP_CHM1] + a * props[w, row, PROP_PSH]
+    p = props[w, row, PROP_P]
     if not _no_event(s, xa, va, xb, vb, q0, q1, h, p, st[OUT_PEAK, j]):
         return False
     st[OUT_N_STEPS, j] += 1
@@ -1042,9 +1047,14 @@ def _fast_flight(st, ksp, ksn, j, cell, prop):
     ex = EPS * (abs(xa) + abs(xb) + 1.0 + abs(ks * c0))
     ev = ex * p
     k = PROP_COV
-    nxx = prop[row, k] * pxx + prop[row, k + 1] * pxv + prop[row, k + 2] * pvv + ex * ex
-    nxv = prop[row, k + 3] * pxx + prop[row, k + 4] * pxv + prop[row, k + 5] * pvv
-    nvv = prop[row, k + 6] * pxx + prop[row, k + 7] * pxv + prop[row, k + 8] * pvv + ev * ev
+    nxx = props[w, row, k] * pxx + props[w, row, k + 1] * pxv + props[w, row, k + 2] * pvv + ex * ex
+    nxv = props[w, row, k + 3] * pxx + props[w, row, k + 4] * pxv + props[w, row, k + 5] * pvv
+    nvv = (
+        props[w, row, k + 6] * pxx
+        + props[w, row, k + 7] * pxv
+        + props[w, row, k + 8] * pvv
+        + ev * ev
+    )
     pxx, pxv, pvv = _cap_cov(nxx, nxv, nvv, p)
     st[ST_PXX, j] = pxx
     st[ST_PXV, j] = pxv
@@ -1055,7 +1065,7 @@ def _fast_flight(st, ksp, ksn, j, cell, prop):
 
 
 @_leaf
-def _fast_cell(st, ksp, ksn, cell, prop, one_sided, slow):
+def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow):
     """One sample interval for every run of a block; mark in ``slow`` the runs it cannot do.
 
     Returns the number of runs left to the event path. Runs that end (status != 0) are
@@ -1070,7 +1080,7 @@ def _fast_cell(st, ksp, ksn, cell, prop, one_sided, slow):
         if st[ST_MODE, j] == REST:
             done = _fast_rest(st, ksp, ksn, j, cell, one_sided)
         else:
-            done = _fast_flight(st, ksp, ksn, j, cell, prop)
+            done = _fast_flight(st, ksp, ksn, j, cell, props, w)
         if done:
             st[ST_T, j] = ce
         else:
@@ -1079,15 +1089,44 @@ def _fast_cell(st, ksp, ksn, cell, prop, one_sided, slow):
     return n_slow
 
 
+@_leaf
+def _load_run(st1, sides1, st, sides, j):
+    """Copy run ``j`` of a block into the contiguous scratch arrays of the event path."""
+    for r in range(NST):
+        st1[r] = st[r, j]
+    for row in range(2):
+        for c in range(NSIDE):
+            sides1[row, c] = sides[j, row, c]
+
+
+@_leaf
+def _store_run(st, st1, j):
+    """Copy the scratch run state back into column ``j`` of the block."""
+    for r in range(NST):
+        st[r, j] = st1[r]
+
+
+@_leaf
+def _event_path(st, sides, slow, cell, rules, st1, sides1, fl, trace, log):
+    """Integrate through ``cell`` the runs of a block marked in ``slow`` (``_run_cell``)."""
+    for j in range(st.shape[1]):
+        if slow[j] and st[OUT_STATUS, j] == 0.0:
+            _load_run(st1, sides1, st, sides, j)
+            _run_cell(st1, fl, cell, sides1, rules, trace, log)
+            _store_run(st, st1, j)
+
+
 @_jit
-def _simulate_block(cells, params, scales, v_rest_rel, max_impacts):
+def _simulate_block(cells, width_of, widths, params, scales, v_rest_rel, max_impacts):
     """Run one mechanism at every scale of ``scales`` together; return (k, NOUT).
 
-    Structure of arrays: ``st[:, j]`` is the run state of scale ``j``. Each linear cell
-    short enough for one closed-form segment goes through ``_fast_cell`` (the per-interval
-    propagator is computed once per side and interval width, not per run); the runs in which
-    an event may lie, and every other cell, take the event path (``_run_cell``) with the
-    same arithmetic, so the results are those of ``simulate_cells`` bit for bit.
+    Structure of arrays: ``st[:, j]`` is the run state of scale ``j``. ``widths`` are the
+    distinct cell widths [s] and ``width_of[i]`` the one of cell ``i``. Each linear cell
+    short enough for one closed-form segment goes through ``_fast_cell`` with the
+    propagator of its width (computed once per side and width, not per sample or run); the
+    runs in which an event may lie, and every other cell, take the event path
+    (``_run_cell``) with the same arithmetic, so the results are those of
+    ``simulate_cells`` bit for bit.
     """
     k = scales.shape[0]
     st = np.empty((NST, k))
@@ -1099,32 +1138,35 @@ def _simulate_block(cells, params, scales, v_rest_rel, max_impacts):
     ksp = sides[:, 0, SIDE_KS].copy()
     ksn = sides[:, 1, SIDE_KS].copy()
     one_sided = rules[RULE_ONE_SIDED] != 0.0
-    prop = np.empty((2, NPROP))
-    h_prop = math.nan
-    slow = np.zeros(k, dtype=np.bool_)
+    props = np.empty((widths.shape[0], 2, NPROP))
+    have = np.zeros(widths.shape[0], dtype=np.bool_)
+    slow = np.ones(k, dtype=np.bool_)
+    cell = np.empty(len(CELL_ROWS))
+    st1 = np.empty(NST)
+    sides1 = np.empty((2, NSIDE))
     fl = np.empty(NFL)
     trace = np.empty((2, 0))
     log = np.empty((4, 0))
     for i in range(cells.shape[1]):
-        cell = cells[:, i]
+        for r in range(len(CELL_ROWS)):
+            cell[r] = cells[r, i]
         n_slow = k
         if cell[0] == 0 and _n_segments(cell, rules) == 1:
-            h = cell[5] - cell[4]
-            if h != h_prop:
-                _propagator(prop, sides[0], h)
-                h_prop = h
-            n_slow = _fast_cell(st, ksp, ksn, cell, prop, one_sided, slow)
+            w = width_of[i]
+            if not have[w]:
+                _propagator(props[w], sides[0], widths[w])
+                have[w] = True
+            n_slow = _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow)
         else:
             slow[:] = True
         if n_slow > 0:
-            for j in range(k):
-                if slow[j] and st[OUT_STATUS, j] == 0.0:
-                    _run_cell(st[:, j], fl, cell, sides[j], rules, trace, log)
+            _event_path(st, sides, slow, cell, rules, st1, sides1, fl, trace, log)
     out = np.empty((k, NOUT))
     for j in range(k):
-        if st[OUT_STATUS, j] == 0.0 and st[ST_MODE, j] == FLIGHT:
-            _free_tail(st[:, j], sides[j], rules)
-        out[j] = _finish(st[:, j], 0)
+        _load_run(st1, sides1, st, sides, j)
+        if st1[OUT_STATUS] == 0.0 and st1[ST_MODE] == FLIGHT:
+            _free_tail(st1, sides1, rules)
+        out[j] = _finish(st1, 0)
     return out
 
 
@@ -1168,17 +1210,22 @@ def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
 
     ``params[i] = (p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided)``.
     The work is split in tasks of one mechanism × up to ``BLOCK`` scales
-    (``_simulate_block``), run in parallel.
+    (``_simulate_block``), run in parallel; the distinct cell widths are found once.
     """
     m = params.shape[0]
     nk = scales.shape[0]
     nb = (nk + BLOCK - 1) // BLOCK
+    cell_widths = cells[5] - cells[4]
+    widths = np.unique(cell_widths)
+    width_of = np.searchsorted(widths, cell_widths)
     out = np.empty((m, nk, NOUT))
     for ib in _prange(m * nb):
         i = ib // nb
         lo = (ib % nb) * BLOCK
         hi = min(lo + BLOCK, nk)
-        out[i, lo:hi, :] = _simulate_block(cells, params[i], scales[lo:hi], v_rest_rel, max_impacts)
+        out[i, lo:hi, :] = _simulate_block(
+            cells, width_of, widths, params[i], scales[lo:hi], v_rest_rel, max_impacts
+        )
     return out
 
 
