@@ -1230,6 +1230,31 @@ def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
 
 
 @_jit
+def pulse_cells(a_p, omega, phase, duration, per_quarter, t_extra):
+    """Cells (``CELL_ROWS``) of a one-cycle pulse ``a = a_p sin(omega t + phase)``.
+
+    ``4 per_quarter`` sinusoidal cells over ``duration`` [s] (quarter periods hold every
+    extremum on a boundary, so the acceleration is monotone in each cell), then, when
+    ``t_extra > 0``, one cell of zero acceleration ``t_extra`` [s] long.
+    """
+    n = 4 * per_quarter
+    n_all = n + 1 if t_extra > 0.0 else n
+    cells = np.zeros((len(CELL_ROWS), n_all))
+    for i in range(n):
+        cells[0, i] = 1.0
+        cells[1, i] = a_p
+        cells[2, i] = omega
+        cells[3, i] = phase
+        cells[4, i] = duration * i / n
+        cells[5, i] = duration * (i + 1) / n
+        cells[6, i] = abs(a_p)
+    if t_extra > 0.0:
+        cells[4, n] = cells[5, n - 1]
+        cells[5, n] = cells[5, n - 1] + t_extra
+    return cells
+
+
+@_jit
 def pulse_collapses(amp, omega, phase, eta, one_sided, v_rest_rel, quarter_cells, cells):
     """Exact outcome of a dimensionless one-cycle pulse (p = 1, g lam = 1).
 

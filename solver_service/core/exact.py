@@ -78,6 +78,11 @@ UNRESOLVED_ERROR = 0.1
 IMPACT_LOG_CAP = 1_000_000
 
 _KERNEL_CACHE: dict[str, ModuleType] = {}
+#: Empty time-series and impact-log buffers (the kernels write nothing into them).
+_NO_TRACE = np.empty((2, 0))
+_NO_LOG = np.empty((4, 0))
+#: ``RockingResult.method`` by back end (compiled or not).
+_METHOD = {True: "exact:numba", False: "exact:python"}
 
 
 def kernels(backend: str = "auto") -> ModuleType:
@@ -153,18 +158,12 @@ def _record_cells(rec: SampledAccel, t_extra: float) -> Cells:
 
 def _pulse_cells(pulse: Pulse, per_quarter: int, t_extra: float) -> Cells:
     # Quarter periods hold every extremum of both shapes on a boundary, so the
-    # acceleration is monotone in each cell.
-    n = 4 * per_quarter
-    edges = pulse.duration * np.arange(n + 1) / n
-    data = np.empty((7, n))
-    data[0] = 1.0
-    data[1] = pulse.a_p
-    data[2] = pulse.omega_p
-    data[3] = pulse.phase
-    data[4] = edges[:-1]
-    data[5] = edges[1:]
-    data[6] = abs(pulse.a_p)
-    return _append_rest(Cells(data), t_extra)
+    # acceleration is monotone in each cell (built in the kernels: a few microseconds
+    # less per call than numpy on arrays this small).
+    data = _k.pulse_cells(
+        pulse.a_p, pulse.omega_p, pulse.phase, pulse.duration, per_quarter, float(t_extra)
+    )
+    return Cells(data)
 
 
 def _append_rest(cells: Cells, t_extra: float) -> Cells:
@@ -298,16 +297,17 @@ def simulate(
         p_max = max(model.positive.p_eq, model.neg.p_eq)
         n_seg = np.ceil(p_max * cells.widths / kern.MAX_PH).clip(min=1).sum()
         cap = int(n_seg) + 3 * min(int(max_impacts), 100_000) + 8
-    trace = np.empty((2, cap))
+    trace = np.empty((2, cap)) if cap else _NO_TRACE
     n_log = min(int(max_impacts), IMPACT_LOG_CAP) + 2 if impact_log else 0
-    log = np.empty((4, n_log))
+    log = np.empty((4, n_log)) if n_log else _NO_LOG
+    # One conversion of the output vector to Python floats (cheaper than one per field).
     out = kern.simulate_cells_logged(
         cells.data, params, scale, float(x0), V_REST_REL, int(max_impacts), trace, log
-    )
+    ).tolist()
     runtime = time.perf_counter() - t_start
     n_tr = int(out[_k.OUT_N_TRACE])
     notes = []
-    err = float(out[_k.OUT_ERROR])
+    err = out[_k.OUT_ERROR]
     if err >= UNRESOLVED_ERROR:
         notes.append(_unresolved(err))
     notes += linearisation_warnings(
@@ -320,20 +320,21 @@ def simulate(
             RuntimeWarning,
             stacklevel=2,
         )
+    t_exceed = out[_k.OUT_T_EXCEED]
     return RockingResult(
         status=int(out[_k.OUT_STATUS]),
-        peak_ratio=float(out[_k.OUT_PEAK]),
-        t_peak=float(out[_k.OUT_T_PEAK]),
+        peak_ratio=out[_k.OUT_PEAK],
+        t_peak=out[_k.OUT_T_PEAK],
         criterion=crit,
-        ratio_exceeded=not math.isnan(out[_k.OUT_T_EXCEED]),
-        t_ratio_exceeded=_nan_to_none(out[_k.OUT_T_EXCEED]),
+        ratio_exceeded=not math.isnan(t_exceed),
+        t_ratio_exceeded=_nan_to_none(t_exceed),
         collapsed=bool(out[_k.OUT_COLLAPSED]),
         t_collapse=_nan_to_none(out[_k.OUT_T_COLLAPSE]),
         n_impacts=int(out[_k.OUT_N_IMPACTS]),
         n_steps=int(out[_k.OUT_N_STEPS]),
         error_estimate=err,
         runtime_s=runtime,
-        method=f"exact:{'numba' if kern.JIT else 'python'}",
+        method=_METHOD[kern.JIT],
         t=trace[0, :n_tr].copy() if dense else None,
         ratio=trace[1, :n_tr].copy() if dense else None,
         n_uplifts=int(out[_k.OUT_N_UPLIFTS]),
@@ -479,5 +480,5 @@ def simulate_batch(
         status=out[..., _k.OUT_STATUS].astype(np.int64),
         criterion=crit,
         runtime_s=time.perf_counter() - t_start,
-        method=f"exact:{'numba' if kern.JIT else 'python'}",
+        method=_METHOD[kern.JIT],
     )

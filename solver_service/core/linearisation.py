@@ -140,6 +140,11 @@ def linearisation_warnings(model: RockingModel, omega_p: Optional[float] = None)
     >>> linearisation_warnings(RockingModel.symmetric(2.0, 0.05, 0.9), omega_p=4.0)
     []
     """
+    # The common case (every side below the map's first warning) costs no hashing.
+    table = _linearisation_map()
+    lam_max = model.positive.lam if model.one_sided else max(model.positive.lam, model.neg.lam)
+    if table is None or lam_max < table["alpha_warn"]:
+        return []
     return list(_warnings_cached(model, omega_p))
 
 

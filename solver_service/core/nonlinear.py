@@ -83,6 +83,7 @@ DEFAULT_METHOD = "DOP853"
 DEFAULT_RTOL = 1e-12
 DEFAULT_ATOL = 1e-14
 
+
 @dataclass(frozen=True)
 class HousnerBlock:
     """A rigid block rocking on a rigid base (Housner 1963).
