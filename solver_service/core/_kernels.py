@@ -1230,6 +1230,26 @@ def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
 
 
 @_jit
+def simulate_grid_serial(cells, params, scales, v_rest_rel, max_impacts):
+    """``simulate_grid`` on the calling thread only (for callers that run many in threads)."""
+    m = params.shape[0]
+    nk = scales.shape[0]
+    nb = (nk + BLOCK - 1) // BLOCK
+    cell_widths = cells[5] - cells[4]
+    widths = np.unique(cell_widths)
+    width_of = np.searchsorted(widths, cell_widths)
+    out = np.empty((m, nk, NOUT))
+    for ib in range(m * nb):
+        i = ib // nb
+        lo = (ib % nb) * BLOCK
+        hi = min(lo + BLOCK, nk)
+        out[i, lo:hi, :] = _simulate_block(
+            cells, width_of, widths, params[i], scales[lo:hi], v_rest_rel, max_impacts
+        )
+    return out
+
+
+@_jit
 def pulse_cells(a_p, omega, phase, duration, per_quarter, t_extra):
     """Cells (``CELL_ROWS``) of a one-cycle pulse ``a = a_p sin(omega t + phase)``.
 

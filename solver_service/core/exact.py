@@ -29,12 +29,14 @@ resolved: the trajectory is too sensitive for any double-precision integrator.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import math
 import sys
+import threading
 import time
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, Optional, Union
@@ -59,6 +61,7 @@ __all__ = [
     "kernels",
     "simulate",
     "simulate_batch",
+    "single_threaded",
 ]
 
 Excitation = Union[Pulse, SampledAccel]
@@ -78,6 +81,8 @@ UNRESOLVED_ERROR = 0.1
 IMPACT_LOG_CAP = 1_000_000
 
 _KERNEL_CACHE: dict[str, ModuleType] = {}
+#: Per-thread switch of ``simulate_batch`` to the single-threaded grid (``single_threaded``).
+_THREAD = threading.local()
 #: Empty time-series and impact-log buffers (the kernels write nothing into them).
 _NO_TRACE = np.empty((2, 0))
 _NO_LOG = np.empty((4, 0))
@@ -425,6 +430,22 @@ class BatchResult:
         return rows
 
 
+@contextlib.contextmanager
+def single_threaded() -> Iterator[None]:
+    """Within this block, ``simulate_batch`` on this thread runs on this thread only.
+
+    For callers that run many batches at once in their own threads (``ida.run_ida``): the
+    kernels release the GIL, so the threads run in parallel without the compiled kernels
+    starting threads of their own.
+    """
+    before = getattr(_THREAD, "serial", False)
+    _THREAD.serial = True
+    try:
+        yield
+    finally:
+        _THREAD.serial = before
+
+
 def simulate_batch(
     models: Sequence[RockingModel],
     excitation: Excitation,
@@ -463,7 +484,8 @@ def simulate_batch(
     crit = _criterion(criterion, excitation)
     cells = cells_for(excitation)
     kern = kernels(backend)
-    out = kern.simulate_grid(cells.data, params, sc, V_REST_REL, int(max_impacts))
+    grid = kern.simulate_grid_serial if getattr(_THREAD, "serial", False) else kern.simulate_grid
+    out = grid(cells.data, params, sc, V_REST_REL, int(max_impacts))
     t_exc = out[..., _k.OUT_T_EXCEED]
     return BatchResult(
         names=[m.name for m in models],
