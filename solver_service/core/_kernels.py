@@ -65,7 +65,7 @@ G = 9.80665
 EPS = 2.220446049250313e-16
 #: Longest closed-form segment, as p*h; bounds cosh/sinh growth inside one evaluation.
 MAX_PH = 1.0
-#: Below this p*tau, sinh(u) - u is evaluated by its Taylor series (no cancellation).
+#: Below this p*tau, sinh and cosh are evaluated by their Taylor series (no cancellation).
 SERIES_U = 0.5
 #: Iteration cap of the safeguarded Newton root finder (bisection alone needs < 1100).
 ROOT_MAXITER = 200
@@ -154,25 +154,6 @@ NST = NOUT + 12
 
 
 @_leaf
-def _sinh_minus(u):
-    """Return ``sinh(u) - u`` without cancellation for small ``u``."""
-    if abs(u) < SERIES_U:
-        u2 = u * u
-        # Taylor series to u**19: truncation below 1e-17 relative for |u| < 0.5.
-        poly = 1.0 / 121645100408832000.0
-        poly = 1.0 / 355687428096000.0 + u2 * poly
-        poly = 1.0 / 1307674368000.0 + u2 * poly
-        poly = 1.0 / 6227020800.0 + u2 * poly
-        poly = 1.0 / 39916800.0 + u2 * poly
-        poly = 1.0 / 362880.0 + u2 * poly
-        poly = 1.0 / 5040.0 + u2 * poly
-        poly = 1.0 / 120.0 + u2 * poly
-        poly = 1.0 / 6.0 + u2 * poly
-        return u * u2 * poly
-    return math.sinh(u) - u
-
-
-@_leaf
 def _accel(cell, t):
     """Ground acceleration of a cell (rows ``CELL_ROWS``) and its rate at absolute time ``t``."""
     if cell[0] == 0:
@@ -201,23 +182,40 @@ def _anchor(fl, cell, sides, s, ta, xa, va):
     fl[FL_VA] = va
 
 
+#: Below this ``u**2`` four terms of each series reach full double precision.
+SHORT_U2 = 2.5e-3
+
+
 @_leaf
-def _cosh_minus(u):
-    """Return ``cosh(u) - 1`` without cancellation (Taylor series for small ``u``)."""
-    if abs(u) < SERIES_U:
-        u2 = u * u
-        # Series to u**16: truncation below 1e-20 relative for |u| < 0.5.
-        poly = 1.0 / 20922789888000.0
-        poly = 1.0 / 87178291200.0 + u2 * poly
-        poly = 1.0 / 479001600.0 + u2 * poly
-        poly = 1.0 / 3628800.0 + u2 * poly
-        poly = 1.0 / 40320.0 + u2 * poly
-        poly = 1.0 / 720.0 + u2 * poly
-        poly = 1.0 / 24.0 + u2 * poly
-        poly = 0.5 + u2 * poly
-        return u2 * poly
-    h = math.sinh(0.5 * u)
-    return 2.0 * h * h
+def _series(u2):
+    """Return ``(ps, pc)``: ``sinh(u) - u = u**3 ps`` and ``cosh(u) - 1 = u**2 pc``.
+
+    Taylor series in ``u2 = u**2`` for ``|u| < SERIES_U``: to ``u**19`` and ``u**16``
+    (truncation below 1e-17 relative), or four terms each when ``u2 < SHORT_U2`` (the
+    common case of one record sample, truncation below 3e-17 relative). No cancellation.
+    """
+    if u2 < SHORT_U2:
+        ps = 1.0 / 6.0 + u2 * (1.0 / 120.0 + u2 * (1.0 / 5040.0 + u2 * (1.0 / 362880.0)))
+        pc = 0.5 + u2 * (1.0 / 24.0 + u2 * (1.0 / 720.0 + u2 * (1.0 / 40320.0)))
+        return ps, pc
+    ps = 1.0 / 121645100408832000.0
+    ps = 1.0 / 355687428096000.0 + u2 * ps
+    ps = 1.0 / 1307674368000.0 + u2 * ps
+    ps = 1.0 / 6227020800.0 + u2 * ps
+    ps = 1.0 / 39916800.0 + u2 * ps
+    ps = 1.0 / 362880.0 + u2 * ps
+    ps = 1.0 / 5040.0 + u2 * ps
+    ps = 1.0 / 120.0 + u2 * ps
+    ps = 1.0 / 6.0 + u2 * ps
+    pc = 1.0 / 20922789888000.0
+    pc = 1.0 / 87178291200.0 + u2 * pc
+    pc = 1.0 / 479001600.0 + u2 * pc
+    pc = 1.0 / 3628800.0 + u2 * pc
+    pc = 1.0 / 40320.0 + u2 * pc
+    pc = 1.0 / 720.0 + u2 * pc
+    pc = 1.0 / 24.0 + u2 * pc
+    pc = 0.5 + u2 * pc
+    return ps, pc
 
 
 @_leaf
@@ -227,13 +225,19 @@ def _flow_coeffs(p, tau):
     Returns ``(cosh(u) - 1, sinh(u)/p, (sinh(u) - u)/p, p sinh(u))`` with ``u = p tau``:
     from the anchor, ``x = xa + a chm1 + va shp - q1 smp`` and ``x' = va + (va - q1) chm1 +
     a psh`` for a linear drive (``a = xa - s - q0``). Below ``SERIES_U`` only polynomials
-    are evaluated. The batch path computes them once per side and sample interval, the
-    event path per call: the same numbers either way.
+    in ``u**2`` are evaluated (no division, no cancellation). The batch path computes them
+    once per side and sample interval, the event path per call: the same numbers either
+    way.
     """
     u = p * tau
-    sm = _sinh_minus(u)
-    sh = u + sm if abs(u) < SERIES_U else math.sinh(u)
-    return _cosh_minus(u), sh / p, sm / p, p * sh
+    if abs(u) < SERIES_U:
+        u2 = u * u
+        ps, pc = _series(u2)
+        smp = tau * u2 * ps
+        return u2 * pc, tau + smp, smp, p * (u + u * u2 * ps)
+    h = math.sinh(0.5 * u)
+    sh = math.sinh(u)
+    return 2.0 * h * h, sh / p, (sh - u) / p, p * sh
 
 
 @_leaf
@@ -243,13 +247,9 @@ def _cov_coeffs(p, tau):
     With the flow matrix ``[[a, b], [c, d]] = [[cosh u, sinh(u)/p], [p sinh u, cosh u]]``:
     ``(a a, 2 a b, b b, a c, a d + b c, b d, c c, 2 c d, d d)``.
     """
-    u = p * tau
-    ch = 1.0 + _cosh_minus(u)
-    sh = u + _sinh_minus(u) if abs(u) < SERIES_U else math.sinh(u)
-    a = ch
-    b = sh / p
-    c = p * sh
-    d = ch
+    chm1, b, _smp, c = _flow_coeffs(p, tau)
+    a = 1.0 + chm1
+    d = a
     return a * a, 2.0 * a * b, b * b, a * c, a * d + b * c, b * d, c * c, 2.0 * c * d, d * d
 
 
