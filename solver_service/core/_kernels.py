@@ -59,6 +59,7 @@ except ImportError:  # pragma: no cover - exercised through the python backend
     _prange = range
     JIT = False
 
+
 #: Standard gravity [m/s²] (same value as model.G).
 G = 9.80665
 #: Unit roundoff of float64.
@@ -568,10 +569,10 @@ def _log_impact(st, log, t, s, vi, v_out):
         st[OUT_N_LOG] = nlog + 1
 
 
-@_jit
-def _init_state(t0, x0):
-    """Run state at ``t0``: at rest, or released from rest at ``x0`` (normalised rotation)."""
-    st = np.zeros(NST)
+@_leaf
+def _reset_state(st, t0, x0):
+    """Set ``st`` to the run state at ``t0``: at rest, or released from rest at ``x0``."""
+    st[:] = 0.0
     st[ST_MODE] = REST
     st[ST_T] = t0
     if x0 != 0.0:
@@ -588,6 +589,13 @@ def _init_state(t0, x0):
     st[OUT_T_COLLAPSE] = math.nan
     st[ST_HOLD] = -math.inf
     st[ST_UPLIFT_T] = math.nan
+
+
+@_jit
+def _init_state(t0, x0):
+    """Return a new run state at ``t0`` (``_reset_state``)."""
+    st = np.empty(NST)
+    _reset_state(st, t0, x0)
     return st
 
 
@@ -826,15 +834,21 @@ def _free_tail(st, sides, rules):
             st[OUT_T_EXCEED] = t + dt_pk
 
 
-@_jit
-def _finish(st, ntr_cap):
-    """Return the output vector (``OUT_*``) of the final run state."""
+@_leaf
+def _finalise(st, ntr_cap):
+    """Complete the output entries (``OUT_*``) of the final run state in place."""
     if st[OUT_COLLAPSED] != 0.0:
         st[OUT_PEAK] = 1.0
         st[OUT_T_PEAK] = st[OUT_T_COLLAPSE]
     peak = st[OUT_PEAK]
     st[OUT_ERROR] = ERR_SAFETY * (math.sqrt(st[ST_VAR_PEAK]) + EPS * max(peak, 1.0))
     st[OUT_TRACE_FULL] = 1.0 if ntr_cap > 0 and st[OUT_N_TRACE] == ntr_cap else 0.0
+
+
+@_jit
+def _finish(st, ntr_cap):
+    """Return the output vector (``OUT_*``) of the final run state."""
+    _finalise(st, ntr_cap)
     return st[:NOUT].copy()
 
 
@@ -891,8 +905,15 @@ def _simulate(cells, sides, rules, x0, trace, log):
     -------
     (NOUT,) float array, indexed by the ``OUT_*`` constants.
     """
-    st = _init_state(cells[4, 0], x0)
-    fl = np.empty(NFL)
+    st = np.empty(NST)
+    _simulate_into(st, np.empty(NFL), cells, sides, rules, x0, trace, log)
+    return st[:NOUT].copy()
+
+
+@_leaf
+def _simulate_into(st, fl, cells, sides, rules, x0, trace, log):
+    """``_simulate`` into the caller's run state ``st`` and flight scratch ``fl``."""
+    _reset_state(st, cells[4, 0], x0)
     _record(st, trace, st[ST_T], st[ST_X])
     for i in range(cells.shape[1]):
         if st[OUT_STATUS] != 0.0:
@@ -900,7 +921,7 @@ def _simulate(cells, sides, rules, x0, trace, log):
         _run_cell(st, fl, cells[:, i], sides, rules, trace, log)
     if st[OUT_STATUS] == 0.0 and st[ST_MODE] == FLIGHT:
         _free_tail(st, sides, rules)
-    return _finish(st, trace.shape[1])
+    _finalise(st, trace.shape[1])
 
 
 @_jit
@@ -1274,13 +1295,16 @@ def pulse_cells(a_p, omega, phase, duration, per_quarter, t_extra):
     return cells
 
 
-@_jit
-def pulse_collapses(amp, omega, phase, eta, one_sided, v_rest_rel, quarter_cells, cells):
+@_leaf
+def pulse_collapses(amp, omega, phase, quarter_cells, work):
     """Exact outcome of a dimensionless one-cycle pulse (p = 1, g lam = 1).
 
-    ``cells`` is a scratch (7, 4 * quarter_cells) array; ``amp`` is the signed amplitude
-    ``a_p / (g lam)`` and ``omega`` the ratio ``omega_p / p``.
+    ``amp`` is the signed amplitude ``a_p / (g lam)`` and ``omega`` the ratio
+    ``omega_p / p``. ``work`` is the scratch of ``pulse_work`` (its cells are overwritten);
+    nothing is allocated, so the scan and bisection of ``boundary_grid`` cost only the
+    integration.
     """
+    cells, sides, rules, st, fl, trace, log = work
     n = 4 * quarter_cells
     period = 2.0 * math.pi / omega
     for i in range(n):
@@ -1291,9 +1315,17 @@ def pulse_collapses(amp, omega, phase, eta, one_sided, v_rest_rel, quarter_cells
         cells[4, i] = period * i / n
         cells[5, i] = period * (i + 1) / n
         cells[6, i] = abs(amp)
+    _simulate_into(st, fl, cells, sides, rules, 0.0, trace, log)
+    return st[OUT_COLLAPSED] != 0.0
+
+
+@_jit
+def pulse_work(eta, one_sided, v_rest_rel, quarter_cells):
+    """Scratch of ``pulse_collapses`` for a restitution and rest rule (any amplitude, Omega)."""
     params = np.array([1.0, 1.0, 1.0 / G, 1.0 / G, 1.0, 1.0, eta, 1.0 if one_sided else 0.0])
-    out = simulate_cells(cells, params, 1.0, 0.0, v_rest_rel, 1_000_000, np.empty((2, 0)))
-    return out[OUT_COLLAPSED] != 0.0
+    sides, rules = _run_constants(params, 1.0, v_rest_rel, 1_000_000)
+    cells = np.empty((len(CELL_ROWS), 4 * quarter_cells))
+    return cells, sides, rules, np.empty(NST), np.empty(NFL), np.empty((2, 0)), np.empty((4, 0))
 
 
 @_jit_parallel
@@ -1308,23 +1340,24 @@ def boundary_grid(omegas, eta, one_sided, sign, phase, a_scan, rtol, max_edges, 
     edges = np.full((n_om, max_edges), np.nan)
     n_edges = np.zeros(n_om, dtype=np.int64)
     first = np.zeros(n_om, dtype=np.bool_)
-    for i in _prange(n_om):
-        cells = np.empty((7, 4))
+    # Static chunks of the parallel loop would give one thread the slow, low Omega: visit the
+    # Omega in golden-ratio order, so that every contiguous chunk samples the whole range.
+    order = np.argsort((np.arange(n_om) * 0.6180339887498949) % 1.0)
+    for c in _prange(n_om):
+        i = order[c]
+        work = pulse_work(eta, one_sided, v_rest_rel, 1)
         om = omegas[i]
-        prev = pulse_collapses(sign * a_scan[0], om, phase, eta, one_sided, v_rest_rel, 1, cells)
+        prev = pulse_collapses(sign * a_scan[0], om, phase, 1, work)
         first[i] = prev
         ne = 0
         for j in range(1, a_scan.shape[0]):
-            cur = pulse_collapses(sign * a_scan[j], om, phase, eta, one_sided, v_rest_rel, 1, cells)
+            cur = pulse_collapses(sign * a_scan[j], om, phase, 1, work)
             if cur != prev:
                 lo = a_scan[j - 1]
                 hi = a_scan[j]
                 while hi - lo > rtol * hi:
                     mid = 0.5 * (lo + hi)
-                    c_mid = pulse_collapses(
-                        sign * mid, om, phase, eta, one_sided, v_rest_rel, 1, cells
-                    )
-                    if c_mid == prev:
+                    if pulse_collapses(sign * mid, om, phase, 1, work) == prev:
                         lo = mid
                     else:
                         hi = mid
