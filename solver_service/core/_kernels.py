@@ -20,6 +20,23 @@ the cell ends, plus one bracketed search for a zero of ``x''`` in the ambiguous 
 point and ``|x| = 1`` crossing is bracketed and solved by safeguarded Newton iteration
 to machine precision. No grazing impact is missed.
 
+Layout. One run carries small arrays instead of long argument lists: ``sides`` (p, ks,
+phi_ov of each side, ``SIDE_*``), ``rules`` (restitution, one-sided, rest rule, impact cap,
+``RULE_*``), the closed-form flight ``fl`` (cell and anchor, ``FL_*``) and the run state
+``st`` (``ST_*``; its first ``NOUT`` entries are the output vector). The event path is
+``_run_cell`` -> ``_rest_step`` (uplift) / ``_flight_step`` (``_velocity_zeros``,
+``_scan_pieces``, then ``_impact`` or ``_advance``), and ``_free_tail`` after the
+excitation. Helpers that allocate nothing are compiled without reference counting
+(``_leaf``): passing arrays to them costs nothing.
+
+Batch path (``simulate_grid``). Scales are run in blocks as a structure of arrays
+(``_simulate_block``). For a linear cell of one closed-form segment, the flow over the
+cell width is computed once per side and width (``_propagator``: the record's few distinct
+widths, not per sample or run), and ``_no_event`` decides from the two ends of the step,
+with the maximum-principle bounds above, that no event lies inside; only the runs where
+one may lie take the event path, with the same arithmetic, so a batch gives the numbers
+of single runs bit for bit.
+
 The same source runs uncompiled (``exact.kernels("python")``) as the pure-numpy path.
 """
 
