@@ -219,6 +219,13 @@ def main(argv: Optional[list[str]] = None) -> int:
         f"{res['minimal_overturns']} of the {sc.size} runs.",
         "",
         md_table(headers, rows),
+        "",
+        "Reading: the kernel's steps without an event cost a few ns (the per-width propagator "
+        "and the no-event bound); what remains is the events. Here each run has about "
+        f"{res['impacts'] / sc.size:.0f} impacts, and every impact is located to machine "
+        "precision (a safeguarded Halley iteration on the closed form, the turning point "
+        "before it, the saltation of the error covariance), some ten closed-form "
+        "evaluations each, where the minimal stepper only flips a sign at the sample.",
     ]
     write_section(DOC_MD, "limit", "\n".join(lines))
     return 0
