@@ -484,6 +484,9 @@ def ida(
     timeout: float = typer.Option(
         10.0, "--timeout", help="Seconds to wait for the Dask scheduler to answer [s]."
     ),
+    jobs: Optional[int] = typer.Option(
+        None, "--jobs", help="Threads of a local run (default: all cores)."
+    ),
     progress: Optional[bool] = typer.Option(
         None, "--progress/--no-progress", help="Progress bar (default: on a terminal)."
     ),
@@ -526,6 +529,7 @@ def ida(
             scheduler=scheduler,
             progress=lambda done, total: bar.update(task, completed=done),
             timeout=check_positive(timeout, "timeout"),
+            jobs=jobs,
         )
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)

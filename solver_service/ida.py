@@ -1,10 +1,13 @@
 """Incremental dynamic analysis: many records × many intensities × many mechanisms.
 
-The unit of work is one record (``run_record``): every mechanism at every intensity level
-in one compiled, parallel batch (``exact.simulate_batch``). ``run_ida`` runs the records
-in-process by default, or maps the same function over the records on a dask.distributed
-cluster when a scheduler address is given (chunked by record; only plain data, arrays and
-the function's import path travel to the workers). The fraction of records that overturn
+The unit of work is one record at a block of intensity levels (``run_record``): every
+mechanism at every level of the block in one compiled batch (``exact.simulate_batch``).
+``run_ida`` cuts the work into tasks of (record × block of levels), enough for every worker
+to get several, and runs them in-process on ``jobs`` threads (all cores by default; the
+kernels release the GIL), or maps the same function over the tasks on a dask.distributed
+cluster when a scheduler address is given (only plain data, arrays and the function's import
+path travel to the workers). The results do not depend on the cutting: every run is
+independent. The fraction of records that overturn
 each mechanism at each level is then fitted with a lognormal fragility curve
 (``core.fragility``).
 
@@ -16,8 +19,10 @@ them).
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from typing import Any, Optional
 
 import numpy as np
@@ -26,6 +31,7 @@ from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 from shared_schema.extras import require
 
+from .core.exact import single_threaded
 from .core.fragility import fit_lognormal
 from .core.model import check_positive
 from .core.records import GroundMotion
@@ -39,6 +45,8 @@ IM_MEASURES = {"scale": "-", "pga": "g"}
 
 #: Seconds to wait for a Dask scheduler before giving up.
 CONNECT_TIMEOUT_S = 10.0
+#: Tasks per worker aimed at when records are cut into blocks of levels (load balance).
+TASKS_PER_WORKER = 4
 
 
 def run_record(
@@ -135,35 +143,126 @@ def _dask_client(distributed: Any, address: str, timeout: float) -> Any:
         ) from exc
 
 
+def level_blocks(n_records: int, n_levels: int, n_workers: int) -> list[tuple[int, int]]:
+    """Cut the levels into blocks ``[lo, hi)`` so that records × blocks >= 4 × workers.
+
+    One worker gets one block per record.
+
+    Parameters
+    ----------
+    n_records, n_levels, n_workers : int
+        Records, intensity levels and workers (threads or Dask worker threads), each >= 1.
+
+    Returns
+    -------
+    list of (int, int)
+        Contiguous blocks covering ``range(n_levels)``, sizes equal to within one level.
+
+    Examples
+    --------
+    >>> level_blocks(100, 50, 2)
+    [(0, 50)]
+    >>> level_blocks(1, 10, 2)
+    [(0, 1), (1, 2), (2, 3), (3, 5), (5, 6), (6, 7), (7, 8), (8, 10)]
+    """
+    if n_workers <= 1:
+        return [(0, n_levels)]  # one worker: nothing to balance
+    want = -(-TASKS_PER_WORKER * n_workers // max(n_records, 1))
+    n_blocks = max(1, min(n_levels, want))
+    bounds = [b * n_levels // n_blocks for b in range(n_blocks + 1)]
+    return list(zip(bounds[:-1], bounds[1:]))
+
+
+def _run_serial(payload: dict[str, Any]) -> dict[str, Any]:
+    """``run_record`` with the batch kernels confined to the calling thread."""
+    with single_threaded():
+        return run_record(**payload)
+
+
+def _merge(parts: list[dict[str, Any]]) -> dict[str, Any]:
+    """Join the results of one record's level blocks (in level order) into one result."""
+    out = dict(parts[0])
+    for key in ("overturned", "peak_ratio", "error_estimate", "status"):
+        out[key] = np.concatenate([p[key] for p in parts], axis=1)
+    out["runtime_s"] = sum(p["runtime_s"] for p in parts)
+    return out
+
+
+def _tasks(payloads: list[dict[str, Any]], n_workers: int) -> list[tuple[int, dict[str, Any]]]:
+    """(record index, payload for one block of levels) for every task."""
+    levels = payloads[0]["levels"]
+    blocks = level_blocks(len(payloads), len(levels), n_workers)
+    return [
+        (i, {**p, "levels": p["levels"][lo:hi]})
+        for i, p in enumerate(payloads)
+        for lo, hi in blocks
+    ]
+
+
+def _gather(
+    tasks: list[tuple[int, dict[str, Any]]],
+    n_records: int,
+    finished: Callable[[], Any],
+    progress: Optional[Callable[[int, int], None]],
+) -> list[dict[str, Any]]:
+    """Collect task results as ``finished()`` yields ``(task index, result)``; merge per record."""
+    parts: list[list[Any]] = [[] for _ in range(n_records)]
+    left = [0] * n_records
+    for rec, _ in tasks:
+        left[rec] += 1
+    done = 0
+    for k, result in finished():
+        rec = tasks[k][0]
+        parts[rec].append((k, result))
+        left[rec] -= 1
+        if left[rec] == 0:
+            done += 1
+            if progress is not None:
+                progress(done, n_records)
+    return [_merge([r for _, r in sorted(p, key=lambda kr: kr[0])]) for p in parts]
+
+
 def _collect(
     payloads: list[dict[str, Any]],
     scheduler: Optional[str],
     progress: Optional[Callable[[int, int], None]],
     timeout: float,
+    jobs: Optional[int],
 ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
-    """Run ``run_record`` over the payloads, locally or on Dask; results in input order."""
-    results: list[Any] = [None] * len(payloads)
+    """Run the (record × level block) tasks locally or on Dask; results in record order."""
     if scheduler is None:
-        for i, payload in enumerate(payloads):
-            results[i] = run_record(**payload)
-            if progress is not None:
-                progress(i + 1, len(payloads))
-        return results, {"kind": "local"}
+        n_jobs = jobs if jobs is not None else (os.cpu_count() or 1)
+        tasks = _tasks(payloads, n_jobs)
+        with ThreadPoolExecutor(max_workers=n_jobs) as pool:
+            pending = {pool.submit(_run_serial, p): k for k, (_, p) in enumerate(tasks)}
+
+            def finished_local() -> Any:
+                for future in as_completed(pending):
+                    yield pending[future], future.result()
+
+            results = _gather(tasks, len(payloads), finished_local, progress)
+        return results, {"kind": "local", "jobs": n_jobs, "tasks": len(tasks)}
     # Checked before anything else touches dask: a missing extra names its install line.
     distributed = require("dask.distributed", "dask", "for ida --scheduler")
     client = _dask_client(distributed, scheduler, timeout)
     try:
-        n_workers = len(client.scheduler_info().get("workers", {}))
-        futures = [client.submit(run_record, **p, pure=False) for p in payloads]
-        index = {f.key: i for i, f in enumerate(futures)}
-        with client.as_current():
-            for done, future in enumerate(distributed.as_completed(futures), start=1):
-                results[index[future.key]] = future.result()
-                if progress is not None:
-                    progress(done, len(payloads))
+        workers = client.scheduler_info().get("workers", {})
+        n_workers = len(workers)
+        n_threads = sum(int(w.get("nthreads", 1)) for w in workers.values()) or 1
+        tasks = _tasks(payloads, n_threads)
+        futures = [client.submit(run_record, **p, pure=False) for _, p in tasks]
+        index = {f.key: k for k, f in enumerate(futures)}
+
+        def finished_dask() -> Any:
+            with client.as_current():
+                for future in distributed.as_completed(futures):
+                    yield index[future.key], future.result()
+
+        results = _gather(tasks, len(payloads), finished_dask, progress)
     finally:
         client.close()
-    return results, {"kind": "dask", "scheduler": scheduler, "n_workers": n_workers}
+    backend = {"kind": "dask", "scheduler": scheduler, "n_workers": n_workers}
+    return results, {**backend, "tasks": len(tasks)}
 
 
 def run_ida(
@@ -178,6 +277,7 @@ def run_ida(
     scheduler: Optional[str] = None,
     progress: Optional[Callable[[int, int], None]] = None,
     timeout: float = CONNECT_TIMEOUT_S,
+    jobs: Optional[int] = None,
 ) -> dict[str, Any]:
     """Incremental dynamic analysis with lognormal fragility fits, as a JSON-ready document.
 
@@ -204,13 +304,16 @@ def run_ida(
         Called as ``progress(records_done, n_records)``.
     timeout : float
         Seconds to wait for the scheduler [s].
+    jobs : int, optional
+        Threads of the local run (default: all cores); ignored on Dask.
 
     Returns
     -------
     dict
         ``intensity``, ``records``, per mechanism ``n_overturned``, ``fraction``,
         ``first_overturning_level`` (per record) and ``fragility`` (median, beta), plus
-        ``runs``, ``runtime_s``, ``max_error_estimate`` and ``backend``.
+        ``runs``, ``runtime_s``, ``max_error_estimate`` and ``backend`` (``kind``, and
+        ``jobs`` or the Dask ``scheduler`` and ``n_workers``, and the number of ``tasks``).
 
     Raises
     ------
@@ -223,6 +326,8 @@ def run_ida(
     if len(motions) == 0:
         raise InputError("needs at least one record", "records")
     lv = _levels(levels)
+    if jobs is not None and (isinstance(jobs, bool) or int(jobs) != jobs or jobs < 1):
+        raise InputError(f"must be a whole number >= 1, got {jobs!r}", "jobs")
     building = building or Building()
     for mech in cf.mechanisms:
         to_rocking_model(mech).require_eta()
@@ -249,7 +354,7 @@ def run_ida(
         for m in motions
     ]
     start = time.perf_counter()
-    results, backend = _collect(payloads, scheduler, progress, timeout)
+    results, backend = _collect(payloads, scheduler, progress, timeout, jobs)
     wall = time.perf_counter() - start
     overturned = np.stack([r["overturned"] for r in results])  # (records, mechs, levels)
     counts = overturned.sum(axis=0)

@@ -16,7 +16,7 @@ from shared_schema.io import load_constants
 from solver_service.cli import app
 from solver_service.core.exact import simulate
 from solver_service.core.records import GroundMotion
-from solver_service.ida import parse_levels, run_ida
+from solver_service.ida import level_blocks, parse_levels, run_ida
 from solver_service.workflows.adapter import models_from_file
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -58,8 +58,35 @@ def test_local_ida_counts_equal_direct_simulations(motions: list[GroundMotion]) 
         assert mech["fraction"] == pytest.approx(verdicts.mean(axis=0).tolist())
         for row, first in zip(verdicts, mech["first_overturning_level"]):
             assert first == (LEVELS[int(np.argmax(row))] if row.any() else None)
-    assert doc["backend"] == {"kind": "local"}
+    assert doc["backend"]["kind"] == "local" and doc["backend"]["jobs"] >= 1
     assert "scale_factors" not in doc["mechanisms"][0]
+
+
+def test_level_blocks_cover_the_levels_and_spread_the_work() -> None:
+    assert level_blocks(1, 10, 1) == [(0, 10)]
+    for n_rec, n_lev, n_work in [(100, 50, 2), (1, 10, 2), (3, 5, 8), (2, 1, 16), (7, 13, 3)]:
+        blocks = level_blocks(n_rec, n_lev, n_work)
+        assert [lo for lo, _ in blocks] == sorted({lo for lo, _ in blocks})
+        assert blocks[0][0] == 0 and blocks[-1][1] == n_lev
+        assert all(b[1] == c[0] for b, c in zip(blocks, blocks[1:]))
+        sizes = [hi - lo for lo, hi in blocks]
+        assert min(sizes) >= 1 and max(sizes) - min(sizes) <= 1
+        assert n_rec * len(blocks) >= min(4 * n_work, n_rec * n_lev)
+    assert level_blocks(100, 50, 2) == [(0, 50)]  # enough records: one task per record
+
+
+def test_local_ida_is_the_same_on_any_number_of_threads(motions: list[GroundMotion]) -> None:
+    cf = load_constants(CONSTANTS)
+    one = run_ida(cf, motions[:1], LEVELS, jobs=1)
+    many = run_ida(cf, motions[:1], LEVELS, jobs=3)
+    assert one["backend"]["tasks"] == 1 and many["backend"]["tasks"] == len(LEVELS)
+    for key in ("intensity", "records", "mechanisms", "runs", "max_error_estimate"):
+        assert one[key] == many[key], key
+    model = models_from_file(cf)[1]
+    peaks = [simulate(model, motions[0].accel, scale=s).overturned for s in LEVELS]
+    assert many["mechanisms"][1]["n_overturned"] == [int(p) for p in peaks]
+    with pytest.raises(InputError, match="jobs"):
+        run_ida(cf, motions[:1], LEVELS, jobs=0)
 
 
 def test_pga_intensity_scales_each_record_to_the_level(motions: list[GroundMotion]) -> None:
@@ -83,10 +110,16 @@ def test_dask_local_cluster_gives_the_local_numbers(motions: list[GroundMotion])
         n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
     ) as cluster:
         remote = run_ida(cf, motions, LEVELS, scheduler=cluster.scheduler_address)
+        # One record: the levels are cut into blocks so both workers get work.
+        single = run_ida(cf, motions[:1], LEVELS, scheduler=cluster.scheduler_address)
     assert remote["backend"]["kind"] == "dask"
     assert remote["backend"]["n_workers"] == 2
     for key in ("intensity", "records", "mechanisms", "runs", "max_error_estimate", "criterion"):
         assert remote[key] == local[key], key
+    assert single["backend"]["tasks"] == len(LEVELS) > len(single["records"])
+    local_single = run_ida(cf, motions[:1], LEVELS, jobs=1)
+    for key in ("intensity", "records", "mechanisms", "runs", "max_error_estimate", "criterion"):
+        assert single[key] == local_single[key], key
 
 
 def test_unreachable_scheduler_is_a_clear_error_not_a_hang(motions: list[GroundMotion]) -> None:
@@ -130,6 +163,7 @@ def test_cli_ida_writes_json_csv_and_plot(tmp_path: Path, elcentro_path: Path) -
         (["--scales", "1,1"], "repeated"),
         (["--scales", "1", "--im", "pgv"], "im: must be one of"),
         (["--scales", "1", "--timeout", "0"], "timeout"),
+        (["--scales", "1", "--jobs", "0"], "jobs: must be a whole number >= 1"),
     ],
 )
 def test_cli_ida_bad_input(args: list[str], message: str) -> None:

@@ -20,6 +20,23 @@ the cell ends, plus one bracketed search for a zero of ``x''`` in the ambiguous 
 point and ``|x| = 1`` crossing is bracketed and solved by safeguarded Newton iteration
 to machine precision. No grazing impact is missed.
 
+Layout. One run carries small arrays instead of long argument lists: ``sides`` (p, ks,
+phi_ov of each side, ``SIDE_*``), ``rules`` (restitution, one-sided, rest rule, impact cap,
+``RULE_*``), the closed-form flight ``fl`` (cell and anchor, ``FL_*``) and the run state
+``st`` (``ST_*``; its first ``NOUT`` entries are the output vector). The event path is
+``_run_cell`` -> ``_rest_step`` (uplift) / ``_flight_step`` (``_velocity_zeros``,
+``_scan_pieces``, then ``_impact`` or ``_advance``), and ``_free_tail`` after the
+excitation. Helpers that allocate nothing are compiled without reference counting
+(``_leaf``): passing arrays to them costs nothing.
+
+Batch path (``simulate_grid``). Scales are run in blocks as a structure of arrays
+(``_simulate_block``). For a linear cell of one closed-form segment, the flow over the
+cell width is computed once per side and width (``_propagator``: the record's few distinct
+widths, not per sample or run), and ``_no_event`` decides from the two ends of the step,
+with the maximum-principle bounds above, that no event lies inside; only the runs where
+one may lie take the event path, with the same arithmetic, so a batch gives the numbers
+of single runs bit for bit.
+
 The same source runs uncompiled (``exact.kernels("python")``) as the pure-numpy path.
 """
 
@@ -27,6 +44,8 @@ import math
 from typing import Any
 
 import numpy as np
+
+from shared_schema.rules import G
 
 _NO_JIT = globals().get("_NO_JIT", False)
 
@@ -41,6 +60,12 @@ try:  # numba is optional: without it the same code runs as plain Python.
     def _jit_parallel(fn):
         return _numba.njit(cache=True, nogil=True, parallel=True)(fn)
 
+    def _leaf(fn):
+        # Helpers that allocate nothing run without the reference counting of their array
+        # arguments, which would otherwise cost more than the arithmetic of a step.
+        options: dict[str, Any] = {"_nrt": False}  # not in numba's type stubs
+        return _numba.njit(cache=True, nogil=True, **options)(fn)
+
     _prange: Any = _numba.prange
     JIT = True
 except ImportError:  # pragma: no cover - exercised through the python backend
@@ -49,16 +74,16 @@ except ImportError:  # pragma: no cover - exercised through the python backend
         return fn
 
     _jit_parallel = _jit
+    _leaf = _jit
     _prange = range
     JIT = False
 
-#: Standard gravity [m/s²] (same value as model.G).
-G = 9.80665
+
 #: Unit roundoff of float64.
 EPS = 2.220446049250313e-16
 #: Longest closed-form segment, as p*h; bounds cosh/sinh growth inside one evaluation.
 MAX_PH = 1.0
-#: Below this p*tau, sinh(u) - u is evaluated by its Taylor series (no cancellation).
+#: Below this p*tau, sinh and cosh are evaluated by their Taylor series (no cancellation).
 SERIES_U = 0.5
 #: Iteration cap of the safeguarded Newton root finder (bisection alone needs < 1100).
 ROOT_MAXITER = 200
@@ -95,55 +120,183 @@ REST = 0
 FLIGHT = 1
 
 
-@_jit
-def _sinh_minus(u):
-    """Return ``sinh(u) - u`` without cancellation for small ``u``."""
-    if abs(u) < SERIES_U:
-        u2 = u * u
-        # Taylor series to u**19: truncation below 1e-17 relative for |u| < 0.5.
-        poly = 1.0 / 121645100408832000.0
-        poly = 1.0 / 355687428096000.0 + u2 * poly
-        poly = 1.0 / 1307674368000.0 + u2 * poly
-        poly = 1.0 / 6227020800.0 + u2 * poly
-        poly = 1.0 / 39916800.0 + u2 * poly
-        poly = 1.0 / 362880.0 + u2 * poly
-        poly = 1.0 / 5040.0 + u2 * poly
-        poly = 1.0 / 120.0 + u2 * poly
-        poly = 1.0 / 6.0 + u2 * poly
-        return u * u2 * poly
-    return math.sinh(u) - u
+# Side constants: the (2, NSIDE) array ``sides``, row 0 for side s = +1, row 1 for s = -1.
+#: Frequency parameter p [rad/s].
+SIDE_P = 0
+#: ``ks = scale / (G lam)``: turns the ground acceleration [m/s²] into ``q`` [-].
+SIDE_KS = 1
+#: Overturning rotation phi_ov [rad].
+SIDE_PHIOV = 2
+NSIDE = 3
+
+# Rules of one run: the (NRULE,) array ``rules``.
+RULE_ETA = 0
+RULE_ONE_SIDED = 1
+RULE_V_REST = 2
+RULE_MAX_IMPACTS = 3
+RULE_P_MAX = 4
+NRULE = 5
+
+# A closed-form flight: the (NFL,) array ``fl`` holds the cell and the anchor state.
+FL_KIND = 0
+FL_C0 = 1
+FL_C1 = 2
+FL_C2 = 3
+FL_CS = 4
+FL_KS = 5
+FL_S = 6
+FL_P = 7
+FL_TA = 8
+FL_XA = 9
+FL_VA = 10
+NFL = 11
+
+# Run state: the (NST,) array ``st``; its first NOUT entries are the output vector.
+ST_MODE = NOUT
+ST_S = NOUT + 1
+ST_X = NOUT + 2
+ST_V = NOUT + 3
+ST_T = NOUT + 4
+ST_PXX = NOUT + 5
+ST_PXV = NOUT + 6
+ST_PVV = NOUT + 7
+#: Variance of x at the anchor of the flight that holds the peak.
+ST_VAR_PEAK = NOUT + 8
+#: When |x| reached 1 on the current excursion (NaN: not yet).
+ST_T_CROSS = NOUT + 9
+#: Rest is held until this time (sub-resolution uplift).
+ST_HOLD = NOUT + 10
+#: Time of the last uplift (NaN after an impact).
+ST_UPLIFT_T = NOUT + 11
+NST = NOUT + 12
 
 
-@_jit
-def _accel(kind, c0, c1, c2, cs, t):
-    """Ground acceleration of a cell and its rate at absolute time ``t``."""
-    if kind == 0:
-        return c0 + c1 * (t - cs), c1
-    return c0 * math.sin(c1 * t + c2), c0 * c1 * math.cos(c1 * t + c2)
+@_leaf
+def _accel(cell, t):
+    """Ground acceleration of a cell (rows ``CELL_ROWS``) and its rate at absolute time ``t``."""
+    if cell[0] == 0:
+        return cell[1] + cell[2] * (t - cell[4]), cell[2]
+    arg = cell[2] * t + cell[3]
+    return cell[1] * math.sin(arg), cell[1] * cell[2] * math.cos(arg)
 
 
-@_jit
-def _state(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, tau):
-    """State ``(x, x', x'', x''')`` at ``ta + tau`` from the anchor ``(ta, xa, va)`` on side ``s``.
+@_leaf
+def _side(s):
+    """Row of the ``sides`` array for side ``s`` (+1: 0, -1: 1)."""
+    return 0 if s > 0.0 else 1
 
-    ``ks = scale / (G lam_s)`` turns the ground acceleration into ``q``.
+
+@_leaf
+def _anchor(fl, cell, sides, s, ta, xa, va):
+    """Fill the flight array ``fl``: cell, side constants of side ``s`` and anchor state."""
+    for r in range(5):
+        fl[r] = cell[r]
+    row = _side(s)
+    fl[FL_KS] = sides[row, SIDE_KS]
+    fl[FL_S] = s
+    fl[FL_P] = sides[row, SIDE_P]
+    fl[FL_TA] = ta
+    fl[FL_XA] = xa
+    fl[FL_VA] = va
+
+
+#: Below this ``u**2`` four terms of each series reach full double precision.
+SHORT_U2 = 2.5e-3
+
+
+@_leaf
+def _series(u2):
+    """Return ``(ps, pc)``: ``sinh(u) - u = u**3 ps`` and ``cosh(u) - 1 = u**2 pc``.
+
+    Taylor series in ``u2 = u**2`` for ``|u| < SERIES_U``: to ``u**19`` and ``u**16``
+    (truncation below 1e-17 relative), or four terms each when ``u2 < SHORT_U2`` (the
+    common case of one record sample, truncation below 3e-17 relative). No cancellation.
+    """
+    if u2 < SHORT_U2:
+        ps = 1.0 / 6.0 + u2 * (1.0 / 120.0 + u2 * (1.0 / 5040.0 + u2 * (1.0 / 362880.0)))
+        pc = 0.5 + u2 * (1.0 / 24.0 + u2 * (1.0 / 720.0 + u2 * (1.0 / 40320.0)))
+        return ps, pc
+    ps = 1.0 / 121645100408832000.0
+    ps = 1.0 / 355687428096000.0 + u2 * ps
+    ps = 1.0 / 1307674368000.0 + u2 * ps
+    ps = 1.0 / 6227020800.0 + u2 * ps
+    ps = 1.0 / 39916800.0 + u2 * ps
+    ps = 1.0 / 362880.0 + u2 * ps
+    ps = 1.0 / 5040.0 + u2 * ps
+    ps = 1.0 / 120.0 + u2 * ps
+    ps = 1.0 / 6.0 + u2 * ps
+    pc = 1.0 / 20922789888000.0
+    pc = 1.0 / 87178291200.0 + u2 * pc
+    pc = 1.0 / 479001600.0 + u2 * pc
+    pc = 1.0 / 3628800.0 + u2 * pc
+    pc = 1.0 / 40320.0 + u2 * pc
+    pc = 1.0 / 720.0 + u2 * pc
+    pc = 1.0 / 24.0 + u2 * pc
+    pc = 0.5 + u2 * pc
+    return ps, pc
+
+
+@_leaf
+def _flow_coeffs(p, tau):
+    """Coefficients of the closed-form flow over ``tau`` [s] on a side of frequency ``p``.
+
+    Returns ``(cosh(u) - 1, sinh(u)/p, (sinh(u) - u)/p, p sinh(u))`` with ``u = p tau``:
+    from the anchor, ``x = xa + a chm1 + va shp - q1 smp`` and ``x' = va + (va - q1) chm1 +
+    a psh`` for a linear drive (``a = xa - s - q0``). Below ``SERIES_U`` only polynomials
+    in ``u**2`` are evaluated (no division, no cancellation). The batch path computes them
+    once per side and sample interval, the event path per call: the same numbers either
+    way.
     """
     u = p * tau
-    sh = math.sinh(u)
+    if abs(u) < SERIES_U:
+        u2 = u * u
+        ps, pc = _series(u2)
+        smp = tau * u2 * ps
+        return u2 * pc, tau + smp, smp, p * (u + u * u2 * ps)
     h = math.sinh(0.5 * u)
-    chm1 = 2.0 * h * h  # cosh(u) - 1 without cancellation
-    if kind == 0:
-        q0 = ks * (c0 + c1 * (ta - cs))
-        q1 = ks * c1
+    sh = math.sinh(u)
+    return 2.0 * h * h, sh / p, (sh - u) / p, p * sh
+
+
+@_leaf
+def _cov_coeffs(p, tau):
+    """Coefficients of the covariance map of the homogeneous flow over ``tau`` [s].
+
+    With the flow matrix ``[[a, b], [c, d]] = [[cosh u, sinh(u)/p], [p sinh u, cosh u]]``:
+    ``(a a, 2 a b, b b, a c, a d + b c, b d, c c, 2 c d, d d)``.
+    """
+    chm1, b, _smp, c = _flow_coeffs(p, tau)
+    a = 1.0 + chm1
+    d = a
+    return a * a, 2.0 * a * b, b * b, a * c, a * d + b * c, b * d, c * c, 2.0 * c * d, d * d
+
+
+@_leaf
+def _state(fl, tau):
+    """State ``(x, x', x'', x''')`` at ``ta + tau`` from the anchor of the flight ``fl``."""
+    ks = fl[FL_KS]
+    s = fl[FL_S]
+    p = fl[FL_P]
+    ta = fl[FL_TA]
+    xa = fl[FL_XA]
+    va = fl[FL_VA]
+    if fl[FL_KIND] == 0:
+        chm1, shp, smp, psh = _flow_coeffs(p, tau)
+        q0 = ks * (fl[FL_C0] + fl[FL_C1] * (ta - fl[FL_CS]))
+        q1 = ks * fl[FL_C1]
         a = xa - s - q0
-        x = xa + a * chm1 + va * sh / p - q1 * _sinh_minus(u) / p
-        v = va + (va - q1) * chm1 + a * p * sh
+        x = xa + a * chm1 + va * shp - q1 * smp
+        v = va + (va - q1) * chm1 + a * psh
         q = q0 + q1 * tau
         qd = q1
     else:
-        kk = ks * c0
-        w = c1
-        th = w * ta + c2
+        u = p * tau
+        sh = math.sinh(u)
+        h = math.sinh(0.5 * u)
+        chm1 = 2.0 * h * h  # cosh(u) - 1 without cancellation
+        kk = ks * fl[FL_C0]
+        w = fl[FL_C1]
+        th = w * ta + fl[FL_C2]
         kap = p * p * kk / (p * p + w * w)
         y = xa - s - kap * math.sin(th)
         yp = va - kap * w * math.cos(th)
@@ -158,7 +311,7 @@ def _state(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, tau):
     return x, v, acc, jerk
 
 
-@_jit
+@_leaf
 def _sgn(z):
     if z > 0.0:
         return 1.0
@@ -167,37 +320,39 @@ def _sgn(z):
     return 0.0
 
 
-@_jit
-def _root(which, target, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, lo, hi, sig_lo, f_lo, f_hi):
-    """Zero of component ``which`` (0: x - target, 1: x', 2: x'') in ``[lo, hi]``.
+@_leaf
+def _component(which, target, fl, t):
+    """Return function ``which`` (0: x - target, 1: x', 2: x'') at ``t`` and two derivatives.
+
+    The second derivative is returned as 0 for ``which == 2`` (Newton's step, not Halley's).
+    """
+    x, v, acc, jerk = _state(fl, t)
+    if which == 0:
+        return x - target, v, acc
+    if which == 1:
+        return v, acc, jerk
+    return acc, jerk, 0.0
+
+
+@_leaf
+def _root(which, target, fl, lo, hi, sig_lo, f_lo, f_hi):
+    """Zero of component ``which`` (0: x - target, 1: x', 2: x'') of flight ``fl`` in ``[lo, hi]``.
 
     ``sig_lo`` is the sign of the function just right of ``lo``; the function is assumed to
     change sign once in the bracket. ``f_lo``, ``f_hi`` are its values at the ends when known
     (NaN otherwise) and give a regula-falsi start. Safeguarded Halley iteration (Newton for
     ``x''``): a step is taken when it stays inside the bracket and shrinks fast enough,
     otherwise bisection.
-    Returns the root (time offset from ``ta``).
+    Returns the root (time offset from the anchor).
     """
     t = 0.5 * (lo + hi)
     if f_lo - f_hi != 0.0 and math.isfinite(f_lo - f_hi):
         t = lo + (hi - lo) * min(max(f_lo / (f_lo - f_hi), 0.01), 0.99)
     width = hi - lo
     # Absolute time cannot be resolved finer than a few ulps of ta + t.
-    tol = 4.0 * EPS * (abs(ta) + abs(hi))
+    tol = 4.0 * EPS * (abs(fl[FL_TA]) + abs(hi))
     for _ in range(ROOT_MAXITER):
-        x, v, acc, jerk = _state(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, t)
-        fpp = 0.0
-        if which == 0:
-            f = x - target
-            fp = v
-            fpp = acc
-        elif which == 1:
-            f = v
-            fp = acc
-            fpp = jerk
-        else:
-            f = acc
-            fp = jerk
+        f, fp, fpp = _component(which, target, fl, t)
         if f == 0.0:
             return t
         if _sgn(f) == sig_lo:
@@ -220,7 +375,7 @@ def _root(which, target, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, lo, hi, sig
     return t
 
 
-@_jit
+@_leaf
 def _side_sign_right(v, acc, jerk):
     """Sign of x' just after a point, from x', x'' and x''' there."""
     if v != 0.0:
@@ -230,7 +385,7 @@ def _side_sign_right(v, acc, jerk):
     return _sgn(jerk)
 
 
-@_jit
+@_leaf
 def _side_sign_left(v, acc, jerk):
     """Sign of x' just before a point, from x', x'' and x''' there."""
     if v != 0.0:
@@ -240,14 +395,15 @@ def _side_sign_left(v, acc, jerk):
     return _sgn(jerk)
 
 
-@_jit
-def _velocity_zeros(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, aa, ja, big_h, sig_a, qd_sign):
+@_leaf
+def _velocity_zeros(fl, aa, big_h, sig_a, qd_sign):
     """Interior zeros of x' on ``(0, big_h)``: returns ``(n, z1, z2, x(big_h), x'(big_h))``.
 
-    ``sig_a`` is the sign of x' just after 0; ``qd_sign`` the constant sign of q' on the
-    stretch (0 when q is constant). See the module docstring for the argument.
+    ``aa`` is x'' at the anchor and ``sig_a`` the sign of x' just after it; ``qd_sign`` the
+    constant sign of q' on the stretch (0 when q is constant). See the module docstring.
     """
-    xb, vb, ab, jb = _state(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, big_h)
+    va = fl[FL_VA]
+    xb, vb, ab, jb = _state(fl, big_h)
     sig_b = _side_sign_left(vb, ab, jb)
     n = 0
     z1 = 0.0
@@ -259,19 +415,19 @@ def _velocity_zeros(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, aa, ja, big_h, s
         n = 0
     elif sig_a != sig_b:
         n = 1
-        z1 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, big_h, sig_a, va, vb)
+        z1 = _root(1, 0.0, fl, 0.0, big_h, sig_a, va, vb)
     elif sig_a != hump and _sgn(aa) == hump and _sgn(ab) == -hump:
         # x' has sign -hump at both ends and x'' turns from hump to -hump: it may dip.
-        m = _root(2, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, big_h, hump, aa, ab)
-        vm = _state(kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, m)[1]
+        m = _root(2, 0.0, fl, 0.0, big_h, hump, aa, ab)
+        vm = _state(fl, m)[1]
         if _sgn(vm) == hump:
             n = 2
-            z1 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, 0.0, m, sig_a, va, vm)
-            z2 = _root(1, 0.0, kind, c0, c1, c2, cs, ks, s, p, ta, xa, va, m, big_h, hump, vm, vb)
+            z1 = _root(1, 0.0, fl, 0.0, m, sig_a, va, vm)
+            z2 = _root(1, 0.0, fl, m, big_h, hump, vm, vb)
     return n, z1, z2, xb, vb
 
 
-@_jit
+@_leaf
 def _free_time_to_zero(y, w, p):
     """Time for free motion ``y'' = p**2 y`` to go from ``(y, w)`` to ``y = -1``."""
     wp = w / p
@@ -288,7 +444,7 @@ def _free_time_to_zero(y, w, p):
     return max(math.asinh(1.0 / c) - math.asinh(-y / c), 0.0) / p
 
 
-@_jit
+@_leaf
 def _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest):
     """Free-rocking outcome; documented in ``freemotion.free_rocking``, which wraps it."""
     y = s * x - 1.0
@@ -322,19 +478,17 @@ def _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest):
     return False, math.nan, peak, dt_peak
 
 
-@_jit
-def _uplift_time(kind, c0, c1, c2, cs, ks, s, t, tb):
+@_leaf
+def _uplift_time(cell, ks, s, t, tb):
     """First time in ``[t, tb]`` at which the drive ``g = -s ks a`` exceeds 1, or ``-1``.
 
     The returned time is the bracket end at which ``g >= 1`` holds in floating point, so the
     closed form started there moves outward (theory §10, sub-resolution uplift).
     """
-    a_t, _ad_t = _accel(kind, c0, c1, c2, cs, t)
-    g_t = -s * ks * a_t
+    g_t = -s * ks * _accel(cell, t)[0]
     if g_t > 1.0:
         return t
-    a_b, _ad_b = _accel(kind, c0, c1, c2, cs, tb)
-    g_b = -s * ks * a_b
+    g_b = -s * ks * _accel(cell, tb)[0]
     if g_b <= 1.0:
         return -1.0
     # g is monotone in the cell: safeguarded Newton from the regula-falsi point, then the
@@ -344,7 +498,7 @@ def _uplift_time(kind, c0, c1, c2, cs, ks, s, t, tb):
     x = lo + (hi - lo) * min(max((1.0 - g_t) / (g_b - g_t), 0.0), 1.0)
     tol = 4.0 * EPS * (abs(t) + abs(tb))
     for _ in range(ROOT_MAXITER):
-        a_x, ad_x = _accel(kind, c0, c1, c2, cs, x)
+        a_x, ad_x = _accel(cell, x)
         g = -s * ks * a_x
         if g >= 1.0:
             hi = x
@@ -362,39 +516,13 @@ def _uplift_time(kind, c0, c1, c2, cs, ks, s, t, tb):
         x = xn
     # Step up from the converged point to the first time where g >= 1 (bounded by hi).
     for _ in range(8):
-        if x >= hi or -s * ks * _accel(kind, c0, c1, c2, cs, x)[0] >= 1.0:
+        if x >= hi or -s * ks * _accel(cell, x)[0] >= 1.0:
             break
         x = min(x + tol, hi)
     return min(x, hi)
 
 
-@_jit
-def _propagate_cov(pxx, pxv, pvv, p, tau, ex, ev):
-    """Covariance of the rounding error carried through a homogeneous flight of ``tau``."""
-    u = p * tau
-    ch = math.cosh(u)
-    sh = math.sinh(u)
-    a = ch
-    b = sh / p
-    c = p * sh
-    d = ch
-    nxx = a * a * pxx + 2.0 * a * b * pxv + b * b * pvv + ex * ex
-    nxv = a * c * pxx + (a * d + b * c) * pxv + b * d * pvv
-    nvv = c * c * pxx + 2.0 * c * d * pxv + d * d * pvv + ev * ev
-    return nxx, nxv, nvv
-
-
-@_jit
-def _record(trace_t, trace_x, ntr, t, x):
-    """Append ``(t, x)`` to the time-series buffers if there is room; return the new length."""
-    if ntr < trace_t.shape[0]:
-        trace_t[ntr] = t
-        trace_x[ntr] = x
-        return ntr + 1
-    return ntr
-
-
-@_jit
+@_leaf
 def _cap_cov(pxx, pxv, pvv, p):
     """Clip the error covariance to the physical span of the motion (``ERR_CAP``)."""
     xcap = ERR_CAP * ERR_CAP
@@ -409,55 +537,384 @@ def _cap_cov(pxx, pxv, pvv, p):
     return pxx, pxv, pvv
 
 
+@_leaf
+def _set_cov(st, pxx, pxv, pvv, p):
+    """Store the error covariance, clipped (``_cap_cov``)."""
+    pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p)
+    st[ST_PXX] = pxx
+    st[ST_PXV] = pxv
+    st[ST_PVV] = pvv
+
+
+@_leaf
+def _propagate_cov(st, p, tau, ex):
+    """Carry the error covariance through a homogeneous flight of ``tau`` [s].
+
+    ``ex`` is the rounding error added to x on the way (``ex * p`` to x'); the result is
+    capped (``_set_cov``).
+    """
+    aa, ab2, bb, ac, adbc, bd, cc, cd2, dd = _cov_coeffs(p, tau)
+    pxx = st[ST_PXX]
+    pxv = st[ST_PXV]
+    pvv = st[ST_PVV]
+    ev = ex * p
+    nxx = aa * pxx + ab2 * pxv + bb * pvv + ex * ex
+    nxv = ac * pxx + adbc * pxv + bd * pvv
+    nvv = cc * pxx + cd2 * pxv + dd * pvv + ev * ev
+    _set_cov(st, nxx, nxv, nvv, p)
+
+
+@_leaf
+def _record(st, trace, t, x):
+    """Append ``(t, x)`` to the time-series buffer ``trace`` (2, m) if there is room."""
+    ntr = int(st[OUT_N_TRACE])
+    if ntr < trace.shape[1]:
+        trace[0, ntr] = t
+        trace[1, ntr] = x
+        st[OUT_N_TRACE] = ntr + 1
+
+
+@_leaf
+def _log_impact(st, log, t, s, vi, v_out):
+    """Append an impact to the impact log ``log`` (4, k) if there is room."""
+    nlog = int(st[OUT_N_LOG])
+    if nlog < log.shape[1]:
+        log[0, nlog] = t
+        log[1, nlog] = s
+        log[2, nlog] = vi
+        log[3, nlog] = v_out
+        st[OUT_N_LOG] = nlog + 1
+
+
+@_leaf
+def _reset_state(st, t0, x0):
+    """Set ``st`` to the run state at ``t0``: at rest, or released from rest at ``x0``."""
+    st[:] = 0.0
+    st[ST_MODE] = REST
+    st[ST_T] = t0
+    if x0 != 0.0:
+        st[ST_MODE] = FLIGHT
+        st[ST_S] = _sgn(x0)
+        st[ST_X] = x0
+    st[OUT_PEAK] = abs(x0)
+    st[OUT_T_PEAK] = t0
+    st[OUT_T_EXCEED] = math.nan
+    st[ST_T_CROSS] = math.nan
+    if abs(x0) >= 1.0:
+        st[OUT_T_EXCEED] = t0
+        st[ST_T_CROSS] = t0
+    st[OUT_T_COLLAPSE] = math.nan
+    st[ST_HOLD] = -math.inf
+    st[ST_UPLIFT_T] = math.nan
+
+
 @_jit
-def _simulate(
-    kind,
-    c0,
-    c1,
-    c2,
-    tstart,
-    tend,
-    amax_after,
-    scale,
-    p_pos,
-    p_neg,
-    lam_pos,
-    lam_neg,
-    phiov_pos,
-    phiov_neg,
-    eta,
-    one_sided,
-    x0,
-    v_rest_rel,
-    max_impacts,
-    trace_t,
-    trace_x,
-    log,
-):
-    """Integrate one mechanism through a cell sequence (unpacked arguments; see ``simulate_cells``).
+def _init_state(t0, x0):
+    """Return a new run state at ``t0`` (``_reset_state``)."""
+    st = np.empty(NST)
+    _reset_state(st, t0, x0)
+    return st
+
+
+@_leaf
+def _set_rest(st):
+    """Come to rest on the base (no error is carried at rest)."""
+    st[ST_MODE] = REST
+    st[ST_S] = 0.0
+    st[ST_X] = 0.0
+    st[ST_V] = 0.0
+    st[ST_PXX] = 0.0
+    st[ST_PXV] = 0.0
+    st[ST_PVV] = 0.0
+    st[ST_T_CROSS] = math.nan
+
+
+@_leaf
+def _rest_step(st, cell, sides, rules, tb, trace):
+    """At rest until ``tb`` or until uplift; returns True when the segment is done."""
+    t = st[ST_T]
+    if t < st[ST_HOLD]:
+        st[ST_T] = tb
+        _record(st, trace, tb, 0.0)
+        return True
+    tu = -1.0
+    su = 0.0
+    t1 = _uplift_time(cell, sides[0, SIDE_KS], 1.0, t, tb)
+    if t1 >= 0.0:
+        tu = t1
+        su = 1.0
+    if rules[RULE_ONE_SIDED] == 0.0:
+        t2 = _uplift_time(cell, sides[1, SIDE_KS], -1.0, t, tb)
+        if t2 >= 0.0 and (tu < 0.0 or t2 < tu):
+            tu = t2
+            su = -1.0
+    if tu < 0.0 or tu >= tb:
+        st[ST_T] = tb
+        _record(st, trace, tb, 0.0)
+        return True
+    st[ST_MODE] = FLIGHT
+    st[ST_S] = su
+    st[ST_X] = 0.0
+    st[ST_V] = 0.0
+    st[ST_T] = tu
+    st[ST_UPLIFT_T] = tu
+    st[OUT_N_UPLIFTS] += 1
+    _record(st, trace, tu, 0.0)
+    return False
+
+
+@_leaf
+def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace):
+    """Walk the monotone pieces ``[0, z1], [z1, z2], [z2, H]`` of x in the flight ``fl``.
+
+    Records turning points, the first ``|x| = 1`` crossing and the peak. Returns the time
+    offset of the impact (``x = 0``) from the anchor, or -1 when there is none.
+    """
+    s = fl[FL_S]
+    ta = fl[FL_TA]
+    tau_l = 0.0
+    sx_l = s * fl[FL_XA]
+    for piece in range(nz + 1):
+        if piece < nz:
+            tau_r = z1 if piece == 0 else z2
+            xr = _state(fl, tau_r)[0]
+            if s * xr >= 0.0:  # turning point
+                _record(st, trace, ta + tau_r, xr)
+        else:
+            tau_r = big_h
+            xr = xb
+        sx_r = s * xr
+        if sx_r < 0.0:
+            # Impact in (tau_l, tau_r]: s*x falls through 0 on a monotone piece.
+            if sx_l <= 0.0:
+                return tau_l
+            return _root(0, 0.0, fl, tau_l, tau_r, s, s * sx_l, xr)
+        if sx_r >= 1.0 and sx_l < 1.0 and math.isnan(st[ST_T_CROSS]):
+            tc = _root(0, s, fl, tau_l, tau_r, -s, s * sx_l - s, xr - s)
+            st[ST_T_CROSS] = ta + tc
+            if math.isnan(st[OUT_T_EXCEED]):
+                st[OUT_T_EXCEED] = ta + tc
+        if sx_r > st[OUT_PEAK]:
+            st[OUT_PEAK] = sx_r
+            st[OUT_T_PEAK] = ta + tau_r
+            st[ST_VAR_PEAK] = st[ST_PXX]
+        tau_l = tau_r
+        sx_l = sx_r
+    return -1.0
+
+
+@_leaf
+def _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log):
+    """Impact at ``ta + tau_imp``: restitution, side change, rest rule, error saltation."""
+    s = fl[FL_S]
+    p = fl[FL_P]
+    eta = rules[RULE_ETA]
+    v_rest_rel = rules[RULE_V_REST]
+    _xi, vi, ai, _ji = _state(fl, tau_imp)
+    ex = EPS * (abs(fl[FL_XA]) + 1.0 + abs(fl[FL_KS] * fl[FL_C0]))
+    _propagate_cov(st, p, tau_imp, ex)
+    t = fl[FL_TA] + tau_imp
+    st[ST_T] = t
+    row = _side(s)
+    if rules[RULE_ONE_SIDED] != 0.0:
+        s_new = s
+        row_new = row
+        c_imp = eta
+    else:
+        s_new = -s
+        row_new = 1 - row
+        c_imp = eta * (sides[row, SIDE_PHIOV] / sides[row_new, SIDE_PHIOV])
+    p_new = sides[row_new, SIDE_P]
+    v_new = c_imp * vi
+    acc_new = p_new * p_new * (-s_new - sides[row_new, SIDE_KS] * _accel(cell, t)[0])
+    _record(st, trace, t, 0.0)
+    ends_in_rest = abs(v_new) < v_rest_rel * p_new or vi == 0.0
+    _log_impact(st, log, t, s, vi, 0.0 if ends_in_rest else v_new)
+    if abs(vi) >= v_rest_rel * p:
+        st[OUT_N_IMPACTS] += 1
+        if st[OUT_N_IMPACTS] >= rules[RULE_MAX_IMPACTS]:
+            st[OUT_STATUS] = -1
+    if ends_in_rest:
+        st[OUT_N_RESTS] += 1
+        # Rest rule (ends Zeno sequences, theory §10). A null excursion right after uplift
+        # in this segment holds the body until the segment ends.
+        if st[ST_UPLIFT_T] >= t_sub0 and abs(vi) < v_rest_rel * p:
+            st[ST_HOLD] = tb
+        _set_rest(st)
+        return
+    # Saltation of the error covariance: the impact time moves with the state.
+    pxx = st[ST_PXX]
+    pxv = st[ST_PXV]
+    pvv = st[ST_PVV]
+    m_s = (acc_new - c_imp * ai) / vi
+    nxx = c_imp * c_imp * pxx
+    nxv = c_imp * (m_s * pxx + c_imp * pxv)
+    nvv = m_s * m_s * pxx + 2.0 * m_s * c_imp * pxv + c_imp * c_imp * pvv
+    dtau = 4.0 * EPS * max(abs(t), 1.0)
+    _set_cov(st, nxx, nxv, nvv + (c_imp * ai * dtau) ** 2, p_new)
+    st[ST_S] = s_new
+    st[ST_X] = 0.0
+    st[ST_V] = v_new
+    st[ST_T_CROSS] = math.nan
+    st[ST_UPLIFT_T] = math.nan
+
+
+@_leaf
+def _advance(st, fl, xb, vb, tb, amax_after, trace):
+    """No impact in the flight: move to its end ``tb``; check for certain collapse."""
+    s = fl[FL_S]
+    ks = fl[FL_KS]
+    ex = EPS * (abs(fl[FL_XA]) + abs(xb) + 1.0 + abs(ks * fl[FL_C0]))
+    _propagate_cov(st, fl[FL_P], tb - fl[FL_TA], ex)
+    st[ST_X] = xb
+    st[ST_V] = vb
+    st[ST_T] = tb
+    if not (math.isfinite(xb) and math.isfinite(vb)):
+        st[OUT_STATUS] = -2
+        return
+    _record(st, trace, tb, xb)
+    # Certain collapse: moving outward beyond 1 + max future drive.
+    if s * vb > 0.0 and s * xb > 1.0 + ks * amax_after:
+        st[OUT_COLLAPSED] = 1.0
+        t_cross = st[ST_T_CROSS]
+        st[OUT_T_COLLAPSE] = t_cross if not math.isnan(t_cross) else tb
+        st[OUT_STATUS] = 1
+
+
+@_leaf
+def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
+    """Closed-form flight from the current state to ``tb`` or to the first impact.
+
+    Returns True when the segment is done (``tb`` reached, or the run ended there).
+    """
+    s = st[ST_S]
+    ta = st[ST_T]
+    big_h = tb - ta
+    if big_h <= 0.0:
+        return True
+    st[OUT_N_STEPS] += 1
+    xa = st[ST_X]
+    va = st[ST_V]
+    _anchor(fl, cell, sides, s, ta, xa, va)
+    p = fl[FL_P]
+    ks = fl[FL_KS]
+    a_a, ad_a = _accel(cell, ta)
+    # Sign of q' on the stretch: constant for linear cells; for sinusoidal quarter cells
+    # taken at the midpoint, clear of the zeros on the cell boundaries.
+    qd_sign = _sgn(ad_a) if cell[0] == 0 else _sgn(_accel(cell, 0.5 * (ta + tb))[1])
+    acc_a = p * p * (xa - s - ks * a_a)
+    jerk_a = p * p * (va - ks * ad_a)
+    sig_a = _side_sign_right(va, acc_a, jerk_a)
+    if xa == 0.0 and va == 0.0:
+        sig_a = s  # uplift: the drive exceeds the threshold, motion is outward
+    nz, z1, z2, xb, vb = _velocity_zeros(fl, acc_a, big_h, sig_a, qd_sign)
+    tau_imp = _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace)
+    if tau_imp >= 0.0:
+        _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log)
+        return False
+    _advance(st, fl, xb, vb, tb, cell[6], trace)
+    return True
+
+
+@_leaf
+def _free_tail(st, sides, rules):
+    """After the excitation: the exact free-rocking outcome (theory §1.8) and its error."""
+    s = st[ST_S]
+    x = st[ST_X]
+    v = st[ST_V]
+    t = st[ST_T]
+    row = _side(s)
+    p_s = sides[row, SIDE_P]
+    p_o = sides[1 - row, SIDE_P]
+    r_so = sides[row, SIDE_PHIOV] / sides[1 - row, SIDE_PHIOV]
+    eta = rules[RULE_ETA]
+    one_sided = rules[RULE_ONE_SIDED] != 0.0
+    v_rest = rules[RULE_V_REST] * (p_s if one_sided else p_o)
+    col, dt_cross, pk, dt_pk = _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest)
+    if col:
+        st[OUT_COLLAPSED] = 1.0
+        t_cross = st[ST_T_CROSS]
+        st[OUT_T_COLLAPSE] = t + dt_cross if math.isnan(t_cross) else t_cross
+        if math.isnan(st[OUT_T_EXCEED]):
+            st[OUT_T_EXCEED] = st[OUT_T_COLLAPSE]
+        st[OUT_STATUS] = 1
+    elif pk > st[OUT_PEAK]:
+        # Sensitivity of the analytic tail to the propagated state error.
+        dx = math.sqrt(st[ST_PXX]) + EPS
+        dv = math.sqrt(st[ST_PVV]) + EPS * p_s
+        pk_x = _free_rocking(s, x + s * dx, v, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
+        pk_v = _free_rocking(s, x, v + s * dv, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
+        st[ST_VAR_PEAK] = (pk_x - pk) ** 2 + (pk_v - pk) ** 2
+        st[OUT_PEAK] = pk
+        st[OUT_T_PEAK] = t + dt_pk
+        if pk >= 1.0 and math.isnan(st[OUT_T_EXCEED]):
+            st[OUT_T_EXCEED] = t + dt_pk
+
+
+@_leaf
+def _finalise(st, ntr_cap):
+    """Complete the output entries (``OUT_*``) of the final run state in place."""
+    if st[OUT_COLLAPSED] != 0.0:
+        st[OUT_PEAK] = 1.0
+        st[OUT_T_PEAK] = st[OUT_T_COLLAPSE]
+    peak = st[OUT_PEAK]
+    st[OUT_ERROR] = ERR_SAFETY * (math.sqrt(st[ST_VAR_PEAK]) + EPS * max(peak, 1.0))
+    st[OUT_TRACE_FULL] = 1.0 if ntr_cap > 0 and st[OUT_N_TRACE] == ntr_cap else 0.0
+
+
+@_jit
+def _finish(st, ntr_cap):
+    """Return the output vector (``OUT_*``) of the final run state."""
+    _finalise(st, ntr_cap)
+    return st[:NOUT].copy()
+
+
+@_leaf
+def _n_segments(cell, rules):
+    """Closed-form segments of a cell: each at most ``MAX_PH / p`` long."""
+    return max(1, math.ceil(rules[RULE_P_MAX] * (cell[5] - cell[4]) / MAX_PH))
+
+
+@_leaf
+def _run_cell(st, fl, cell, sides, rules, trace, log):
+    """Integrate one cell, event by event, from its start (where the run state is)."""
+    cs = cell[4]
+    ce = cell[5]
+    nsub = _n_segments(cell, rules)
+    hsub = (ce - cs) / nsub
+    for j in range(nsub):
+        if st[OUT_STATUS] != 0.0:
+            break
+        tb = ce if j == nsub - 1 else cs + (j + 1) * hsub
+        t_sub0 = st[ST_T]
+        while st[OUT_STATUS] == 0.0:
+            if st[ST_MODE] == REST:
+                if _rest_step(st, cell, sides, rules, tb, trace):
+                    break
+            elif _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
+                break
+
+
+@_jit
+def _simulate(cells, sides, rules, x0, trace, log):
+    """Integrate one mechanism through a cell sequence (see ``simulate_cells``).
 
     Parameters
     ----------
-    kind, c0, c1, c2, tstart, tend, amax_after : (n,) arrays
-        Cells (see module docstring); ``amax_after[i]`` bounds ``|a|`` from ``tstart[i]`` on
-        [m/s²].
-    scale : float
-        Factor on the ground acceleration [-].
-    p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg : float
-        Side constants [rad/s], [-], [rad].
-    eta : float
-        Coefficient of restitution [-].
-    one_sided : bool
-        One-sided rocking.
+    cells : (7, n) float
+        Rows ``CELL_ROWS``; ``amax_after[i]`` bounds ``|a|`` from ``t_start[i]`` on [m/s²].
+    sides : (2, NSIDE) float
+        ``SIDE_*`` constants of side +1 (row 0) and side -1 (row 1): p [rad/s],
+        ks [s²/m], phi_ov [rad].
+    rules : (NRULE,) float
+        ``RULE_*``: restitution [-], one-sided (1 or 0), rest rule [-] (an impact whose
+        outgoing speed is below ``v_rest_rel * p`` ends in rest), impact cap, largest p
+        [rad/s].
     x0 : float
         Initial normalised rotation, released from rest [-].
-    v_rest_rel : float
-        Rest rule: an impact whose outgoing speed is below ``v_rest_rel * p`` ends in rest.
-    max_impacts : int
-        Impact cap.
-    trace_t, trace_x : (m,) arrays
-        Output buffers for the time series (size 0: no trace).
-    log : (4, k) array
+    trace : (2, m) float
+        Output buffer for the time series (``m = 0``: no trace).
+    log : (4, k) float
         Output buffer for the impact log (rows ``LOG_ROWS``; ``k = 0``: no log). Every
         impact is logged, also those below the rest speed that end in rest.
 
@@ -465,326 +922,289 @@ def _simulate(
     -------
     (NOUT,) float array, indexed by the ``OUT_*`` constants.
     """
-    out = np.zeros(NOUT)
-    ntr_cap = trace_t.shape[0]
-    ntr = 0
-    nlog_cap = log.shape[1]
-    nlog = 0
-    n_up = 0
-    n_rest = 0
-    n = kind.shape[0]
-    p_max = max(p_pos, p_neg)
-    ks_pos = scale / (G * lam_pos)
-    ks_neg = scale / (G * lam_neg)
+    st = np.empty(NST)
+    _simulate_into(st, np.empty(NFL), cells, sides, rules, x0, trace, log)
+    return st[:NOUT].copy()
 
-    mode = REST
-    s = 0.0
-    x = 0.0
-    v = 0.0
-    t = tstart[0]
-    if x0 != 0.0:
-        mode = FLIGHT
-        s = _sgn(x0)
-        x = x0
-    peak = abs(x0)
-    t_peak = t
-    var_peak = 0.0
-    t_exceed = math.nan
-    t_cross = math.nan  # when |x| reached 1 on the current excursion
-    if abs(x0) >= 1.0:
-        t_exceed = t
-        t_cross = t
-    collapsed = False
-    t_collapse = math.nan
-    n_imp = 0
-    n_steps = 0
-    status = 0
-    pxx = 0.0
-    pxv = 0.0
-    pvv = 0.0
-    hold_until = -math.inf
-    uplift_t = math.nan
-    done = False
-    ntr = _record(trace_t, trace_x, ntr, t, x)
 
-    for i in range(n):
-        if done:
+@_leaf
+def _simulate_into(st, fl, cells, sides, rules, x0, trace, log):
+    """``_simulate`` into the caller's run state ``st`` and flight scratch ``fl``."""
+    _reset_state(st, cells[4, 0], x0)
+    _record(st, trace, st[ST_T], st[ST_X])
+    for i in range(cells.shape[1]):
+        if st[OUT_STATUS] != 0.0:
             break
-        k = kind[i]
-        a0 = c0[i]
-        a1 = c1[i]
-        a2 = c2[i]
-        cs = tstart[i]
-        ce = tend[i]
-        nsub = max(1, math.ceil(p_max * (ce - cs) / MAX_PH))
-        hsub = (ce - cs) / nsub
-        for j in range(nsub):
-            if done:
-                break
-            tb = ce if j == nsub - 1 else cs + (j + 1) * hsub
-            t_sub0 = t
-            while not done:
-                if mode == REST:
-                    if t < hold_until:
-                        t = tb
-                        ntr = _record(trace_t, trace_x, ntr, t, 0.0)
-                        break
-                    tu = -1.0
-                    su = 0.0
-                    t1 = _uplift_time(k, a0, a1, a2, cs, ks_pos, 1.0, t, tb)
-                    if t1 >= 0.0:
-                        tu = t1
-                        su = 1.0
-                    if not one_sided:
-                        t2 = _uplift_time(k, a0, a1, a2, cs, ks_neg, -1.0, t, tb)
-                        if t2 >= 0.0 and (tu < 0.0 or t2 < tu):
-                            tu = t2
-                            su = -1.0
-                    if tu < 0.0 or tu >= tb:
-                        t = tb
-                        ntr = _record(trace_t, trace_x, ntr, t, 0.0)
-                        break
-                    mode = FLIGHT
-                    s = su
-                    x = 0.0
-                    v = 0.0
-                    t = tu
-                    uplift_t = tu
-                    n_up += 1
-                    ntr = _record(trace_t, trace_x, ntr, t, 0.0)
-                    continue
+        _run_cell(st, fl, cells[:, i], sides, rules, trace, log)
+    if st[OUT_STATUS] == 0.0 and st[ST_MODE] == FLIGHT:
+        _free_tail(st, sides, rules)
+    _finalise(st, trace.shape[1])
 
-                # Flight on side s from the anchor (t, x, v) to tb or to the first impact.
-                if s > 0.0:
-                    p = p_pos
-                    ks = ks_pos
-                else:
-                    p = p_neg
-                    ks = ks_neg
-                big_h = tb - t
-                if big_h <= 0.0:
-                    break
-                n_steps += 1
-                ta = t
-                xa = x
-                va = v
-                ad_a = _accel(k, a0, a1, a2, cs, ta)[1]
-                # Sign of q' on the stretch: constant for linear cells; for sinusoidal quarter
-                # cells taken at the midpoint, clear of the zeros on the cell boundaries.
-                qd_sign = (
-                    _sgn(ad_a) if k == 0 else _sgn(_accel(k, a0, a1, a2, cs, 0.5 * (ta + tb))[1])
-                )
-                acc_a = p * p * (xa - s - ks * _accel(k, a0, a1, a2, cs, ta)[0])
-                jerk_a = p * p * (va - ks * ad_a)
-                sig_a = _side_sign_right(va, acc_a, jerk_a)
-                if xa == 0.0 and va == 0.0:
-                    sig_a = s  # uplift: the drive exceeds the threshold, motion is outward
-                nz, z1, z2, xb, vb = _velocity_zeros(
-                    k, a0, a1, a2, cs, ks, s, p, ta, xa, va, acc_a, jerk_a, big_h, sig_a, qd_sign
-                )
-                # Monotone pieces of x: [0, z1], [z1, z2], [z2, H].
-                tau_l = 0.0
-                sx_l = s * xa
-                tau_imp = -1.0
-                for piece in range(nz + 1):
-                    if piece < nz:
-                        tau_r = z1 if piece == 0 else z2
-                        xr = _state(k, a0, a1, a2, cs, ks, s, p, ta, xa, va, tau_r)[0]
-                        if s * xr >= 0.0:  # turning point
-                            ntr = _record(trace_t, trace_x, ntr, ta + tau_r, xr)
-                    else:
-                        tau_r = big_h
-                        xr = xb
-                    sx_r = s * xr
-                    if sx_r < 0.0:
-                        # Impact in (tau_l, tau_r]: s*x falls through 0 on a monotone piece.
-                        if sx_l <= 0.0:
-                            tau_imp = tau_l
-                        else:
-                            tau_imp = _root(
-                                0,
-                                0.0,
-                                k,
-                                a0,
-                                a1,
-                                a2,
-                                cs,
-                                ks,
-                                s,
-                                p,
-                                ta,
-                                xa,
-                                va,
-                                tau_l,
-                                tau_r,
-                                s,
-                                s * sx_l,
-                                xr,
-                            )
-                        break
-                    if sx_r >= 1.0 and sx_l < 1.0 and math.isnan(t_cross):
-                        tc = _root(
-                            0,
-                            s,
-                            k,
-                            a0,
-                            a1,
-                            a2,
-                            cs,
-                            ks,
-                            s,
-                            p,
-                            ta,
-                            xa,
-                            va,
-                            tau_l,
-                            tau_r,
-                            -s,
-                            s * sx_l - s,
-                            xr - s,
-                        )
-                        t_cross = ta + tc
-                        if math.isnan(t_exceed):
-                            t_exceed = t_cross
-                    if sx_r > peak:
-                        peak = sx_r
-                        t_peak = ta + tau_r
-                        var_peak = pxx
-                    tau_l = tau_r
-                    sx_l = sx_r
 
-                if tau_imp >= 0.0:
-                    _xi, vi, ai, _ji = _state(k, a0, a1, a2, cs, ks, s, p, ta, xa, va, tau_imp)
-                    ex = EPS * (abs(xa) + 1.0 + abs(ks * a0))
-                    pxx, pxv, pvv = _propagate_cov(pxx, pxv, pvv, p, tau_imp, ex, ex * p)
-                    pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p)
-                    t = ta + tau_imp
-                    if one_sided:
-                        s_new = s
-                        c_imp = eta
-                        p_new = p
-                        ks_new = ks
-                    else:
-                        s_new = -s
-                        c_imp = eta * (phiov_pos / phiov_neg if s > 0.0 else phiov_neg / phiov_pos)
-                        p_new = p_neg if s > 0.0 else p_pos
-                        ks_new = ks_neg if s > 0.0 else ks_pos
-                    v_new = c_imp * vi
-                    a_now = _accel(k, a0, a1, a2, cs, t)[0]
-                    acc_new = p_new * p_new * (-s_new - ks_new * a_now)
-                    ntr = _record(trace_t, trace_x, ntr, t, 0.0)
-                    ends_in_rest = abs(v_new) < v_rest_rel * p_new or vi == 0.0
-                    if nlog < nlog_cap:
-                        log[0, nlog] = t
-                        log[1, nlog] = s
-                        log[2, nlog] = vi
-                        log[3, nlog] = 0.0 if ends_in_rest else v_new
-                        nlog += 1
-                    if abs(vi) >= v_rest_rel * p:
-                        n_imp += 1
-                        if n_imp >= max_impacts:
-                            status = -1
-                            done = True
-                    if ends_in_rest:
-                        n_rest += 1
-                        # Rest rule (ends Zeno sequences, theory §10). A null excursion right
-                        # after uplift in this segment holds the body until the segment ends.
-                        if uplift_t >= t_sub0 and abs(vi) < v_rest_rel * p:
-                            hold_until = tb
-                        mode = REST
-                        s = 0.0
-                        x = 0.0
-                        v = 0.0
-                        pxx = 0.0
-                        pxv = 0.0
-                        pvv = 0.0
-                        t_cross = math.nan
-                        continue
-                    m_s = (acc_new - c_imp * ai) / vi
-                    nxx = c_imp * c_imp * pxx
-                    nxv = c_imp * (m_s * pxx + c_imp * pxv)
-                    nvv = m_s * m_s * pxx + 2.0 * m_s * c_imp * pxv + c_imp * c_imp * pvv
-                    dtau = 4.0 * EPS * max(abs(t), 1.0)
-                    pxx = nxx
-                    pxv = nxv
-                    pvv = nvv + (c_imp * ai * dtau) ** 2
-                    pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p_new)
-                    s = s_new
-                    x = 0.0
-                    v = v_new
-                    t_cross = math.nan
-                    uplift_t = math.nan
-                    continue
+@_jit
+def _run_constants(params, scale, v_rest_rel, max_impacts):
+    """Return ``sides`` and ``rules`` of one run (``params`` as in ``simulate_cells``)."""
+    sides = np.empty((2, NSIDE))
+    sides[0, SIDE_P] = params[0]
+    sides[1, SIDE_P] = params[1]
+    sides[0, SIDE_KS] = scale / (G * params[2])
+    sides[1, SIDE_KS] = scale / (G * params[3])
+    sides[0, SIDE_PHIOV] = params[4]
+    sides[1, SIDE_PHIOV] = params[5]
+    rules = np.empty(NRULE)
+    rules[RULE_ETA] = params[6]
+    rules[RULE_ONE_SIDED] = 1.0 if params[7] != 0.0 else 0.0
+    rules[RULE_V_REST] = v_rest_rel
+    rules[RULE_MAX_IMPACTS] = max_impacts
+    rules[RULE_P_MAX] = max(params[0], params[1])
+    return sides, rules
 
-                # No impact: advance to the segment end.
-                ex = EPS * (abs(xa) + abs(xb) + 1.0 + abs(ks * a0))
-                pxx, pxv, pvv = _propagate_cov(pxx, pxv, pvv, p, big_h, ex, ex * p)
-                pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p)
-                x = xb
-                v = vb
-                t = tb
-                if not (math.isfinite(x) and math.isfinite(v)):
-                    status = -2
-                    done = True
-                    break
-                ntr = _record(trace_t, trace_x, ntr, t, x)
-                # Certain collapse: moving outward beyond 1 + max future drive.
-                if s * v > 0.0 and s * x > 1.0 + ks * amax_after[i]:
-                    collapsed = True
-                    t_collapse = t_cross if not math.isnan(t_cross) else t
-                    status = 1
-                    done = True
-                break
 
-    err_var = var_peak
-    if status == 0 and mode == FLIGHT:
-        # Free rocking after the excitation: exact outcome (theory §1.8).
-        if s > 0.0:
-            p_s = p_pos
-            p_o = p_neg
-            r_so = phiov_pos / phiov_neg
+# Propagator of one side over one sample interval: the (2, NPROP) array ``prop``.
+PROP_CHM1 = 0
+PROP_SHP = 1
+PROP_SMP = 2
+PROP_PSH = 3
+PROP_P = 4
+#: Then the nine covariance coefficients of ``_cov_coeffs``.
+PROP_COV = 5
+NPROP = 14
+#: Scale factors integrated together by one batch task (structure of arrays).
+BLOCK = 32
+
+
+@_leaf
+def _propagator(prop, sides, h):
+    """Fill ``prop`` with the closed-form flow over ``h`` [s] on both sides (``_flow_coeffs``)."""
+    for row in range(2):
+        p = sides[row, SIDE_P]
+        chm1, shp, smp, psh = _flow_coeffs(p, h)
+        prop[row, PROP_CHM1] = chm1
+        prop[row, PROP_SHP] = shp
+        prop[row, PROP_SMP] = smp
+        prop[row, PROP_PSH] = psh
+        prop[row, PROP_P] = p
+        cov = _cov_coeffs(p, h)
+        for r in range(9):
+            prop[row, PROP_COV + r] = cov[r]
+
+
+@_leaf
+def _fast_rest(st, ksp, ksn, j, cell, one_sided):
+    """Return True when run ``j`` at rest stays at rest through a linear cell (no uplift).
+
+    The drive is linear in the cell, so ``g = -s ks a`` stays at or below 1 when it does at
+    both ends (``_uplift_time``); a held rest needs no test.
+    """
+    if st[ST_T, j] < st[ST_HOLD, j]:
+        return True
+    a_t = cell[1] + cell[2] * (cell[4] - cell[4])
+    a_b = cell[1] + cell[2] * (cell[5] - cell[4])
+    if -ksp[j] * a_t > 1.0 or -ksp[j] * a_b > 1.0:
+        return False
+    return one_sided or (ksn[j] * a_t <= 1.0 and ksn[j] * a_b <= 1.0)
+
+
+#: Margin [-] by which a bound on a turning point must clear the peak (and 1) for the batch
+#: path to skip locating it: far above the rounding of the bound and of the located value.
+BOUND_MARGIN = 1e-12
+
+
+@_leaf
+def _no_event(s, xa, va, xb, vb, q0, q1, h, p, peak):
+    """Return True when a flight of ``h`` [s] from ``(xa, va)`` to ``(xb, vb)`` has no event.
+
+    No impact, no ``|x| = 1`` crossing, no new peak inside, and no zero of ``x'`` whose
+    value the event path would use. With ``x~ = s x`` and ``w~ = s x'``, and ``q~' = s q1``
+    of one sign on the cell (maximum principle, module docstring):
+
+    * ``x'`` of one sign at both ends and no hump allowed: ``x`` is monotone;
+    * one zero of ``x'``, a maximum of ``x~``: ``x~ <= x~a + w~a h`` when ``q~' <= 0``, else
+      ``x~ <= x~b - w~b h``; the bound must stay below the peak and 1 (then the event path
+      would find the same state at the end and change nothing on the way);
+    * one zero of ``x'``, a minimum of ``x~``: ``x~ >= x~a + w~a h`` when ``q~' >= 0``, else
+      ``x~ >= x~b - w~b h``; the bound must stay above 0 (no impact).
+    """
+    sx = s * xb
+    if not (va != 0.0 and vb != 0.0 and 0.0 <= sx < 1.0 and abs(vb) <= 1.7976931348623157e308):
+        return False
+    wa = s * va
+    wb = s * vb
+    sq = s * q1
+    if (wa > 0.0) == (wb > 0.0):
+        hump = -1.0 if q1 <= 0.0 else 1.0
+        if _sgn(va) != hump and _sgn(p * p * (xa - s - q0)) == hump:
+            # x' may dip to zero inside: the event path decides.
+            return _sgn(p * p * (xb - s - (q0 + q1 * h))) != -hump
+        return True
+    if wa > 0.0:
+        top = s * xa + wa * h if sq <= 0.0 else sx - wb * h
+        return top + BOUND_MARGIN < min(peak, 1.0)
+    low = s * xa + wa * h if sq >= 0.0 else sx - wb * h
+    return low > BOUND_MARGIN
+
+
+@_leaf
+def _fast_flight(st, ksp, ksn, j, cell, props, w):
+    """Advance run ``j`` in flight through a linear cell when no event can lie inside it.
+
+    The cheap bound (``_no_event``) decides from the two ends of the step, computed with
+    the precomputed propagator, bit for bit the arithmetic of ``_flight_step``. Returns
+    False (nothing changed) when an event may lie in the cell.
+    """
+    s = st[ST_S, j]
+    row = 0 if s > 0.0 else 1
+    ks = ksp[j] if s > 0.0 else ksn[j]
+    c0 = cell[1]
+    c1 = cell[2]
+    h = cell[5] - cell[4]
+    xa = st[ST_X, j]
+    va = st[ST_V, j]
+    q0 = ks * (c0 + c1 * (cell[4] - cell[4]))
+    q1 = ks * c1
+    a = xa - s - q0
+    xb = (
+        xa
+        + a * props[w, row, PROP_CHM1]
+        + va * props[w, row, PROP_SHP]
+        - q1 * props[w, row, PROP_SMP]
+    )
+    vb = va + (va - q1) * props[w, row, PROP_CHM1] + a * props[w, row, PROP_PSH]
+    p = props[w, row, PROP_P]
+    if not _no_event(s, xa, va, xb, vb, q0, q1, h, p, st[OUT_PEAK, j]):
+        return False
+    st[OUT_N_STEPS, j] += 1
+    pxx = st[ST_PXX, j]
+    sx = s * xb
+    if sx > st[OUT_PEAK, j]:
+        st[OUT_PEAK, j] = sx
+        st[OUT_T_PEAK, j] = cell[4] + h
+        st[ST_VAR_PEAK, j] = pxx
+    pxv = st[ST_PXV, j]
+    pvv = st[ST_PVV, j]
+    ex = EPS * (abs(xa) + abs(xb) + 1.0 + abs(ks * c0))
+    ev = ex * p
+    k = PROP_COV
+    nxx = props[w, row, k] * pxx + props[w, row, k + 1] * pxv + props[w, row, k + 2] * pvv + ex * ex
+    nxv = props[w, row, k + 3] * pxx + props[w, row, k + 4] * pxv + props[w, row, k + 5] * pvv
+    nvv = (
+        props[w, row, k + 6] * pxx
+        + props[w, row, k + 7] * pxv
+        + props[w, row, k + 8] * pvv
+        + ev * ev
+    )
+    pxx, pxv, pvv = _cap_cov(nxx, nxv, nvv, p)
+    st[ST_PXX, j] = pxx
+    st[ST_PXV, j] = pxv
+    st[ST_PVV, j] = pvv
+    st[ST_X, j] = xb
+    st[ST_V, j] = vb
+    return True
+
+
+@_leaf
+def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow):
+    """One sample interval for every run of a block; mark in ``slow`` the runs it cannot do.
+
+    Returns the number of runs left to the event path. Runs that end (status != 0) are
+    skipped.
+    """
+    n_slow = 0
+    ce = cell[5]
+    for j in range(st.shape[1]):
+        slow[j] = False
+        if st[OUT_STATUS, j] != 0.0:
+            continue
+        if st[ST_MODE, j] == REST:
+            done = _fast_rest(st, ksp, ksn, j, cell, one_sided)
         else:
-            p_s = p_neg
-            p_o = p_pos
-            r_so = phiov_neg / phiov_pos
-        col, dt_cross, pk, dt_pk = _free_rocking(
-            s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest_rel * (p_s if one_sided else p_o)
-        )
-        if col:
-            collapsed = True
-            t_collapse = t + dt_cross if math.isnan(t_cross) else t_cross
-            if math.isnan(t_exceed):
-                t_exceed = t_collapse
-            status = 1
-        elif pk > peak:
-            # Sensitivity of the analytic tail to the propagated state error.
-            dx = math.sqrt(pxx) + EPS
-            dv = math.sqrt(pvv) + EPS * p_s
-            pk_x = _free_rocking(s, x + s * dx, v, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
-            pk_v = _free_rocking(s, x, v + s * dv, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
-            err_var = (pk_x - pk) ** 2 + (pk_v - pk) ** 2
-            peak = pk
-            t_peak = t + dt_pk
-            if peak >= 1.0 and math.isnan(t_exceed):
-                t_exceed = t_peak
-    if collapsed:
-        peak = 1.0
-        t_peak = t_collapse
+            done = _fast_flight(st, ksp, ksn, j, cell, props, w)
+        if done:
+            st[ST_T, j] = ce
+        else:
+            slow[j] = True
+            n_slow += 1
+    return n_slow
 
-    out[OUT_STATUS] = status
-    out[OUT_PEAK] = peak
-    out[OUT_T_PEAK] = t_peak
-    out[OUT_T_EXCEED] = t_exceed
-    out[OUT_COLLAPSED] = 1.0 if collapsed else 0.0
-    out[OUT_T_COLLAPSE] = t_collapse
-    out[OUT_N_IMPACTS] = n_imp
-    out[OUT_N_STEPS] = n_steps
-    out[OUT_ERROR] = ERR_SAFETY * (math.sqrt(err_var) + EPS * max(peak, 1.0))
-    out[OUT_N_TRACE] = ntr
-    out[OUT_TRACE_FULL] = 1.0 if ntr_cap > 0 and ntr == ntr_cap else 0.0
-    out[OUT_N_UPLIFTS] = n_up
-    out[OUT_N_RESTS] = n_rest
-    out[OUT_N_LOG] = nlog
+
+@_leaf
+def _load_run(st1, sides1, st, sides, j):
+    """Copy run ``j`` of a block into the contiguous scratch arrays of the event path."""
+    for r in range(NST):
+        st1[r] = st[r, j]
+    for row in range(2):
+        for c in range(NSIDE):
+            sides1[row, c] = sides[j, row, c]
+
+
+@_leaf
+def _store_run(st, st1, j):
+    """Copy the scratch run state back into column ``j`` of the block."""
+    for r in range(NST):
+        st[r, j] = st1[r]
+
+
+@_leaf
+def _event_path(st, sides, slow, cell, rules, st1, sides1, fl, trace, log):
+    """Integrate through ``cell`` the runs of a block marked in ``slow`` (``_run_cell``)."""
+    for j in range(st.shape[1]):
+        if slow[j] and st[OUT_STATUS, j] == 0.0:
+            _load_run(st1, sides1, st, sides, j)
+            _run_cell(st1, fl, cell, sides1, rules, trace, log)
+            _store_run(st, st1, j)
+
+
+@_jit
+def _simulate_block(cells, width_of, widths, params, scales, v_rest_rel, max_impacts):
+    """Run one mechanism at every scale of ``scales`` together; return (k, NOUT).
+
+    Structure of arrays: ``st[:, j]`` is the run state of scale ``j``. ``widths`` are the
+    distinct cell widths [s] and ``width_of[i]`` the one of cell ``i``. Each linear cell
+    short enough for one closed-form segment goes through ``_fast_cell`` with the
+    propagator of its width (computed once per side and width, not per sample or run); the
+    runs in which an event may lie, and every other cell, take the event path
+    (``_run_cell``) with the same arithmetic, so the results are those of
+    ``simulate_cells`` bit for bit.
+    """
+    k = scales.shape[0]
+    st = np.empty((NST, k))
+    sides = np.empty((k, 2, NSIDE))
+    rules = np.empty(NRULE)
+    for j in range(k):
+        sides[j], rules = _run_constants(params, scales[j], v_rest_rel, max_impacts)
+        st[:, j] = _init_state(cells[4, 0], 0.0)
+    ksp = sides[:, 0, SIDE_KS].copy()
+    ksn = sides[:, 1, SIDE_KS].copy()
+    one_sided = rules[RULE_ONE_SIDED] != 0.0
+    props = np.empty((widths.shape[0], 2, NPROP))
+    have = np.zeros(widths.shape[0], dtype=np.bool_)
+    slow = np.ones(k, dtype=np.bool_)
+    cell = np.empty(len(CELL_ROWS))
+    st1 = np.empty(NST)
+    sides1 = np.empty((2, NSIDE))
+    fl = np.empty(NFL)
+    trace = np.empty((2, 0))
+    log = np.empty((4, 0))
+    for i in range(cells.shape[1]):
+        for r in range(len(CELL_ROWS)):
+            cell[r] = cells[r, i]
+        n_slow = k
+        if cell[0] == 0 and _n_segments(cell, rules) == 1:
+            w = width_of[i]
+            if not have[w]:
+                _propagator(props[w], sides[0], widths[w])
+                have[w] = True
+            n_slow = _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow)
+        else:
+            slow[:] = True
+        if n_slow > 0:
+            _event_path(st, sides, slow, cell, rules, st1, sides1, fl, trace, log)
+    out = np.empty((k, NOUT))
+    for j in range(k):
+        _load_run(st1, sides1, st, sides, j)
+        if st1[OUT_STATUS] == 0.0 and st1[ST_MODE] == FLIGHT:
+            _free_tail(st1, sides1, rules)
+        out[j] = _finish(st1, 0)
     return out
 
 
@@ -799,7 +1219,7 @@ def simulate_cells(cells, params, scale, x0, v_rest_rel, max_impacts, trace):
     params : (8,) float
         ``p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided``.
     scale, x0, v_rest_rel, max_impacts
-        Scale factor, initial ratio, rest rule, impact cap (see ``_simulate``).
+        Scale factor [-], initial ratio [-], rest rule [-], impact cap (see ``_simulate``).
     trace : (2, m) float
         Time-series buffer (times, ratios); ``m = 0`` for none.
 
@@ -818,30 +1238,8 @@ def simulate_cells_logged(cells, params, scale, x0, v_rest_rel, max_impacts, tra
 
     The log holds the first ``k`` impacts; ``out[OUT_N_LOG]`` says how many were written.
     """
-    return _simulate(
-        cells[0],
-        cells[1],
-        cells[2],
-        cells[3],
-        cells[4],
-        cells[5],
-        cells[6],
-        scale,
-        params[0],
-        params[1],
-        params[2],
-        params[3],
-        params[4],
-        params[5],
-        params[6],
-        params[7] != 0.0,
-        x0,
-        v_rest_rel,
-        max_impacts,
-        trace[0],
-        trace[1],
-        log,
-    )
+    sides, rules = _run_constants(params, scale, v_rest_rel, max_impacts)
+    return _simulate(cells, sides, rules, x0, trace, log)
 
 
 @_jit_parallel
@@ -849,26 +1247,81 @@ def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
     """Run every mechanism (rows of ``params``) at every scale; return (m, k, NOUT).
 
     ``params[i] = (p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided)``.
+    The work is split in tasks of one mechanism × up to ``BLOCK`` scales
+    (``_simulate_block``), run in parallel; the distinct cell widths are found once.
     """
     m = params.shape[0]
     nk = scales.shape[0]
+    nb = (nk + BLOCK - 1) // BLOCK
+    cell_widths = cells[5] - cells[4]
+    widths = np.unique(cell_widths)
+    width_of = np.searchsorted(widths, cell_widths)
     out = np.empty((m, nk, NOUT))
-    for ij in _prange(m * nk):
-        i = ij // nk
-        j = ij % nk
-        out[i, j, :] = simulate_cells(
-            cells, params[i], scales[j], 0.0, v_rest_rel, max_impacts, np.empty((2, 0))
+    for ib in _prange(m * nb):
+        i = ib // nb
+        lo = (ib % nb) * BLOCK
+        hi = min(lo + BLOCK, nk)
+        out[i, lo:hi, :] = _simulate_block(
+            cells, width_of, widths, params[i], scales[lo:hi], v_rest_rel, max_impacts
         )
     return out
 
 
 @_jit
-def pulse_collapses(amp, omega, phase, eta, one_sided, v_rest_rel, quarter_cells, cells):
+def simulate_grid_serial(cells, params, scales, v_rest_rel, max_impacts):
+    """``simulate_grid`` on the calling thread only (for callers that run many in threads)."""
+    m = params.shape[0]
+    nk = scales.shape[0]
+    nb = (nk + BLOCK - 1) // BLOCK
+    cell_widths = cells[5] - cells[4]
+    widths = np.unique(cell_widths)
+    width_of = np.searchsorted(widths, cell_widths)
+    out = np.empty((m, nk, NOUT))
+    for ib in range(m * nb):
+        i = ib // nb
+        lo = (ib % nb) * BLOCK
+        hi = min(lo + BLOCK, nk)
+        out[i, lo:hi, :] = _simulate_block(
+            cells, width_of, widths, params[i], scales[lo:hi], v_rest_rel, max_impacts
+        )
+    return out
+
+
+@_jit
+def pulse_cells(a_p, omega, phase, duration, per_quarter, t_extra):
+    """Cells (``CELL_ROWS``) of a one-cycle pulse ``a = a_p sin(omega t + phase)``.
+
+    ``4 per_quarter`` sinusoidal cells over ``duration`` [s] (quarter periods hold every
+    extremum on a boundary, so the acceleration is monotone in each cell), then, when
+    ``t_extra > 0``, one cell of zero acceleration ``t_extra`` [s] long.
+    """
+    n = 4 * per_quarter
+    n_all = n + 1 if t_extra > 0.0 else n
+    cells = np.zeros((len(CELL_ROWS), n_all))
+    for i in range(n):
+        cells[0, i] = 1.0
+        cells[1, i] = a_p
+        cells[2, i] = omega
+        cells[3, i] = phase
+        cells[4, i] = duration * i / n
+        cells[5, i] = duration * (i + 1) / n
+        cells[6, i] = abs(a_p)
+    if t_extra > 0.0:
+        cells[4, n] = cells[5, n - 1]
+        cells[5, n] = cells[5, n - 1] + t_extra
+    return cells
+
+
+@_leaf
+def pulse_collapses(amp, omega, phase, quarter_cells, work):
     """Exact outcome of a dimensionless one-cycle pulse (p = 1, g lam = 1).
 
-    ``cells`` is a scratch (7, 4 * quarter_cells) array; ``amp`` is the signed amplitude
-    ``a_p / (g lam)`` and ``omega`` the ratio ``omega_p / p``.
+    ``amp`` is the signed amplitude ``a_p / (g lam)`` and ``omega`` the ratio
+    ``omega_p / p``. ``work`` is the scratch of ``pulse_work`` (its cells are overwritten);
+    nothing is allocated, so the scan and bisection of ``boundary_grid`` cost only the
+    integration.
     """
+    cells, sides, rules, st, fl, trace, log = work
     n = 4 * quarter_cells
     period = 2.0 * math.pi / omega
     for i in range(n):
@@ -879,9 +1332,17 @@ def pulse_collapses(amp, omega, phase, eta, one_sided, v_rest_rel, quarter_cells
         cells[4, i] = period * i / n
         cells[5, i] = period * (i + 1) / n
         cells[6, i] = abs(amp)
+    _simulate_into(st, fl, cells, sides, rules, 0.0, trace, log)
+    return st[OUT_COLLAPSED] != 0.0
+
+
+@_jit
+def pulse_work(eta, one_sided, v_rest_rel, quarter_cells):
+    """Scratch of ``pulse_collapses`` for a restitution and rest rule (any amplitude, Omega)."""
     params = np.array([1.0, 1.0, 1.0 / G, 1.0 / G, 1.0, 1.0, eta, 1.0 if one_sided else 0.0])
-    out = simulate_cells(cells, params, 1.0, 0.0, v_rest_rel, 1_000_000, np.empty((2, 0)))
-    return out[OUT_COLLAPSED] != 0.0
+    sides, rules = _run_constants(params, 1.0, v_rest_rel, 1_000_000)
+    cells = np.empty((len(CELL_ROWS), 4 * quarter_cells))
+    return cells, sides, rules, np.empty(NST), np.empty(NFL), np.empty((2, 0)), np.empty((4, 0))
 
 
 @_jit_parallel
@@ -896,23 +1357,24 @@ def boundary_grid(omegas, eta, one_sided, sign, phase, a_scan, rtol, max_edges, 
     edges = np.full((n_om, max_edges), np.nan)
     n_edges = np.zeros(n_om, dtype=np.int64)
     first = np.zeros(n_om, dtype=np.bool_)
-    for i in _prange(n_om):
-        cells = np.empty((7, 4))
+    # Static chunks of the parallel loop would give one thread the slow, low Omega: visit the
+    # Omega in golden-ratio order, so that every contiguous chunk samples the whole range.
+    order = np.argsort((np.arange(n_om) * 0.6180339887498949) % 1.0)
+    for c in _prange(n_om):
+        i = order[c]
+        work = pulse_work(eta, one_sided, v_rest_rel, 1)
         om = omegas[i]
-        prev = pulse_collapses(sign * a_scan[0], om, phase, eta, one_sided, v_rest_rel, 1, cells)
+        prev = pulse_collapses(sign * a_scan[0], om, phase, 1, work)
         first[i] = prev
         ne = 0
         for j in range(1, a_scan.shape[0]):
-            cur = pulse_collapses(sign * a_scan[j], om, phase, eta, one_sided, v_rest_rel, 1, cells)
+            cur = pulse_collapses(sign * a_scan[j], om, phase, 1, work)
             if cur != prev:
                 lo = a_scan[j - 1]
                 hi = a_scan[j]
                 while hi - lo > rtol * hi:
                     mid = 0.5 * (lo + hi)
-                    c_mid = pulse_collapses(
-                        sign * mid, om, phase, eta, one_sided, v_rest_rel, 1, cells
-                    )
-                    if c_mid == prev:
+                    if pulse_collapses(sign * mid, om, phase, 1, work) == prev:
                         lo = mid
                     else:
                         hi = mid

@@ -28,18 +28,21 @@ impact, rest and collapse rules are the same as in the linear reference.
 
 from __future__ import annotations
 
-import bisect
-import functools
-import importlib
 import math
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Literal, Optional
 
 import numpy as np
 
 from shared_schema.errors import InputError, SolverError
+from solver_service.core.exact import simulate as simulate_exact
 from solver_service.core.excitation import SampledAccel
+from solver_service.core.linearisation import (
+    LINEARISATION_MAP_PATH,
+    WARN_LINEARISATION,
+    linearisation_estimate,
+    linearisation_warnings,
+)
 from solver_service.core.model import G, RockingModel, check_positive
 from solver_service.core.reference import (
     MAX_IMPACTS,
@@ -56,7 +59,6 @@ from solver_service.core.reference import (
     _Physics,
     _run,
     _solve,
-    simulate_ivp,
 )
 from solver_service.core.result import RockingResult
 
@@ -75,20 +77,11 @@ __all__ = [
 #: practice.
 FREE_T_MAX = 1000.0
 
-#: Tolerance of the linear reference that ``linearisation_error`` uses when the exact
-#: integrator is not available [-].
-LINEAR_RTOL = 1e-12
-
 #: Default ``solve_ivp`` method and tolerances: the setting ``benchmarks/stiff.py``
 #: recommends for stiff event sequences (docs/numerics.md).
 DEFAULT_METHOD = "DOP853"
 DEFAULT_RTOL = 1e-12
 DEFAULT_ATOL = 1e-14
-
-#: Relative linearisation error above which results carry a warning [-] (issue 7: 10 %).
-WARN_LINEARISATION = 0.10
-#: The linearisation error map (``benchmarks/linearisation_map.py`` writes it).
-LINEARISATION_MAP_PATH = Path(__file__).resolve().parents[1] / "data" / "linearisation_map.npz"
 
 
 @dataclass(frozen=True)
@@ -385,20 +378,10 @@ def simulate_nonlinear(
 def _simulate_linear(
     model: RockingModel, excitation: Excitation, scale: float, kw: dict[str, Any]
 ) -> RockingResult:
-    """Run the exact linear integrator if it exists, else the reference at ``LINEAR_RTOL``."""
+    """Run the exact linear integrator with the ``criterion`` and ``x0`` of ``kw``."""
     criterion = kw.get("criterion")
     x0 = float(kw.get("x0", 0.0))
-    try:
-        exact = importlib.import_module("solver_service.core.exact")
-    except ImportError:
-        exact = None
-    simulate = getattr(exact, "simulate", None)
-    if simulate is not None:
-        result: RockingResult = simulate(model, excitation, scale=scale, criterion=criterion, x0=x0)
-        return result
-    return simulate_ivp(
-        model, excitation, scale=scale, rtol=LINEAR_RTOL, criterion=criterion, x0=x0
-    )
+    return simulate_exact(model, excitation, scale=scale, criterion=criterion, x0=x0)
 
 
 def linearisation_error(
@@ -428,8 +411,7 @@ def linearisation_error(
 
     Notes
     -----
-    The linear run uses the exact integrator (``exact.simulate``) when it is importable;
-    otherwise ``simulate_ivp`` at ``rtol = LINEAR_RTOL``. Both models share
+    The linear run uses the exact integrator (``exact.simulate``). Both models share
     ``p`` and ``phi_ov = alpha`` but not the uplift threshold (``G alpha`` linear,
     ``G tan alpha`` nonlinear, theory §1.8), which is part of the linearisation error.
     """
@@ -447,133 +429,3 @@ def linearisation_error(
         "relative_error": rel,
         "same_outcome": lin.overturned == nl.overturned,
     }
-
-
-@functools.lru_cache(maxsize=1)
-def _linearisation_map() -> Optional[dict[str, Any]]:
-    """Load the shipped map as arrays; None when the file is absent (then no warnings)."""
-    if not LINEARISATION_MAP_PATH.exists():
-        return None
-    with np.load(LINEARISATION_MAP_PATH) as data:
-        out: dict[str, Any] = {k: np.asarray(data[k]) for k in data.files}
-    # Smallest alpha at which any error of the map exceeds the warning level: below it no
-    # lookup is needed (keeps the check out of the exact integrator's hot path).
-    # Records: the typical (median over the map's p) error. A single record's peak is
-    # sensitive to any change of the model (many impacts), so the largest value over p
-    # scatters from case to case; the median shows the systematic part.
-    out["record_typical"] = np.median(np.nan_to_num(out["record_error"], nan=np.inf), axis=1)
-    worst = np.maximum(
-        np.nan_to_num(out["amplitude_error"], nan=np.inf).max(axis=1), out["record_typical"]
-    )
-    over = np.flatnonzero(worst > WARN_LINEARISATION)
-    out["alpha_warn"] = float(out["alpha"][max(over[0] - 1, 0)]) if over.size else math.inf
-    # Plain lists: the lookup runs inside exact.simulate, where numpy calls cost more than
-    # the integration of a pulse.
-    out["alpha_list"] = [float(x) for x in out["alpha"]]
-    out["omega_list"] = [float(x) for x in out["omega"]]
-    out["amplitude_list"] = np.nan_to_num(out["amplitude_error"], nan=np.inf).tolist()
-    out["record_list"] = [float(x) for x in out["record_typical"]]
-    return out
-
-
-def _bracket(grid: list[float], value: float) -> tuple[int, int]:
-    """Return the indices of the grid nodes around ``value`` (clamped to the grid)."""
-    i = bisect.bisect_left(grid, value)
-    return max(i - 1, 0), min(i, len(grid) - 1)
-
-
-def linearisation_estimate(alpha: float, omega: Optional[float] = None) -> float:
-    """Estimated relative error of the linearised model for a block of slenderness ``alpha``.
-
-    Parameters
-    ----------
-    alpha : float
-        Slenderness [rad]; for a mechanism, its ``lam`` (the equivalent block of theory §1.4).
-    omega : float, optional
-        Pulse frequency ratio ``omega_p / p`` [-]. Given: the error of the minimum
-        overturning amplitude of a one-sine pulse. None: the error of the peak rotation on
-        El Centro 1940 N-S (median over the map's ``p``: the systematic part, since single
-        peaks on a record scatter), an indication for records.
-
-    Returns
-    -------
-    float
-        The largest ``|error|`` [-] at the map's grid nodes around the point (so it errs high),
-        clamped to the map's range (alpha 0.01 to 1.2, Omega 0.1 to 20); NaN when the map is
-        not installed.
-
-    Notes
-    -----
-    The map is measured by ``benchmarks/linearisation_map.py`` with Housner's restitution
-    ``eta = max(0, 1 - 1.5 sin²alpha)`` and is published in ``docs/numerics.md``.
-
-    Examples
-    --------
-    >>> linearisation_estimate(0.05, 2.0) < 0.10
-    True
-    """
-    table = _linearisation_map()
-    a = check_positive(alpha, "alpha")
-    om = None if omega is None else check_positive(omega, "omega")
-    if table is None:
-        return math.nan
-    return _estimate(table, a, om)
-
-
-def _estimate(table: dict[str, Any], alpha: float, omega: Optional[float]) -> float:
-    """``linearisation_estimate`` without input checks (hot path of ``exact.simulate``)."""
-    i0, i1 = _bracket(table["alpha_list"], alpha)
-    if omega is None:
-        rec: list[float] = table["record_list"]
-        return max(rec[i0], rec[i1])
-    j0, j1 = _bracket(table["omega_list"], omega)
-    amp: list[list[float]] = table["amplitude_list"]
-    return max(amp[i0][j0], amp[i0][j1], amp[i1][j0], amp[i1][j1])
-
-
-def linearisation_warnings(model: RockingModel, omega_p: Optional[float] = None) -> list[str]:
-    """Warnings for a case where the linearised model may be off by more than 10 %.
-
-    Parameters
-    ----------
-    model : RockingModel
-        The mechanism; ``alpha`` is taken as ``lam`` of each side (for a single block
-        ``lam = alpha``, theory §2.1; for other mechanisms the equivalent block of §1.4).
-    omega_p : float, optional
-        Circular pulse frequency [rad/s]; each side is looked up at ``omega_p / p_eq``.
-        None for records.
-
-    Returns
-    -------
-    list of str
-        Empty when every side's estimate (``linearisation_estimate``) is at most
-        ``WARN_LINEARISATION``.
-
-    Examples
-    --------
-    >>> linearisation_warnings(RockingModel.symmetric(2.0, 0.05, 0.9), omega_p=4.0)
-    []
-    """
-    return list(_warnings_cached(model, omega_p))
-
-
-@functools.lru_cache(maxsize=4096)
-def _warnings_cached(model: RockingModel, omega_p: Optional[float]) -> tuple[str, ...]:
-    """``linearisation_warnings`` memoised: ``exact.simulate`` asks for every run."""
-    table = _linearisation_map()
-    sides = [model.positive] if model.one_sided else [model.positive, model.neg]
-    if table is None or max(sd.lam for sd in sides) < table["alpha_warn"]:
-        return ()
-    worst = 0.0
-    for sd in sides:
-        om = None if omega_p is None else omega_p / sd.p_eq
-        worst = max(worst, _estimate(table, sd.lam, om))
-    if not worst > WARN_LINEARISATION:
-        return ()
-    what = "pulse overturning amplitude" if omega_p is not None else "peak rotation on a record"
-    lams = " / ".join(f"{sd.lam:g}" for sd in sides)
-    return (
-        f"The linearised model may be off by about {100 * worst:.0f} % here ({what}, lam = "
-        f"{lams}): compare with Housner's nonlinear block (simulate_nonlinear); see "
-        "docs/numerics.md.",
-    )

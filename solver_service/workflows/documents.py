@@ -26,8 +26,8 @@ from ..core.envelope import (
 )
 from ..core.exact import simulate
 from ..core.excitation import Pulse
+from ..core.linearisation import linearisation_warnings
 from ..core.model import RockingModel, check_positive
-from ..core.nonlinear import linearisation_warnings
 from ..core.pulses import extract_pulses, largest_pulse
 from ..core.records import GroundMotion
 from ..core.spectra import Spectrum, response_spectrum
