@@ -36,6 +36,7 @@ from .workflows.documents import (
 )
 from .workflows.inputs import constants_from_files, read_constants, read_record
 from .workflows.outputs import finite_json, write_envelope, write_history, write_record
+from .workflows.assess import check_doc, read_site
 from .workflows.scaling import Building
 
 app = typer.Typer(
@@ -648,6 +649,52 @@ def serve(
     from .api.server import run, settings_with
 
     run(settings_with(host=host, port=port, compute_workers=workers, compute_timeout_s=timeout))
+
+
+def _verdict(check: dict[str, Any]) -> str:
+    if check.get("status") != "ok":
+        return "n/a"
+    return {True: "pass", False: "FAIL", None: "incomplete"}[check["passes"]]
+
+
+@app.command()
+@_user_errors
+def check(
+    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    site: Path = typer.Argument(..., help="Site file (SITE.json): hazard, FC, q, building."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+) -> None:
+    """Code checks (NTC 2018 / Circolare §C8.7.1, linear and nonlinear) of every mechanism."""
+    doc = check_doc(read_constants(constants), read_site(site))
+    if as_json:
+        _print_json(doc)
+        return
+    s = doc["site"]
+    typer.echo(f"{s['code']}: a_g S = {s['pga_g']:.4f} g, FC = {s['FC']:g}, q = {s['q']:g}")
+    typer.echo(
+        f"{'mechanism':<10}{'alpha0':>9}{'e*':>8}{'a0* m/s2':>10}{'demand':>9}{'linear':>8}"
+        f"{'du* m':>9}{'demand':>9}{'Ts s':>7}{'nonlinear':>11}"
+    )
+    for row in doc["mechanisms"]:
+        lin, non = row["linear"], row["nonlinear"]
+        if lin.get("status") == "ok":
+            left = (
+                f"{lin['alpha0']:>9.4g}{lin['e_star']:>8.4g}{lin['a0_star']:>10.4g}"
+                f"{lin['demand']:>9.4g}{_verdict(lin):>8}"
+            )
+        else:
+            left = f"{'-':>9}{'-':>8}{'-':>10}{'-':>9}{_verdict(lin):>8}"
+        if non.get("status") == "ok":
+            right = (
+                f"{non['du_star']:>9.4g}{non['demand']:>9.4g}{non['Ts']:>7.3g}{_verdict(non):>11}"
+            )
+        else:
+            right = f"{'-':>9}{'-':>9}{'-':>7}{_verdict(non):>11}"
+        typer.echo(f"{row['id']:<10}" + left + right)
+        for note in {lin.get("note"), non.get("note")} - {None, ""}:
+            typer.echo(f"  note: {row['id']}: {note}")
+    if doc["governing"] is not None:
+        typer.echo(f"governing mechanism: {doc['governing']}")
 
 
 def main() -> None:  # pragma: no cover - console entry point
