@@ -25,6 +25,7 @@ from .demo import run_demo
 from .ida import ida_csv, parse_levels, run_ida
 from .report.html import build_report, input_source, write_report
 from .report.plots import plot_fragility
+from .workflows.assess import assessment_doc, check_doc, read_site
 from .workflows.documents import (
     boundary_doc,
     frequency_grid,
@@ -36,7 +37,6 @@ from .workflows.documents import (
 )
 from .workflows.inputs import constants_from_files, read_constants, read_record
 from .workflows.outputs import finite_json, write_envelope, write_history, write_record
-from .workflows.assess import check_doc, read_site
 from .workflows.scaling import Building
 
 app = typer.Typer(
@@ -695,6 +695,47 @@ def check(
             typer.echo(f"  note: {row['id']}: {note}")
     if doc["governing"] is not None:
         typer.echo(f"governing mechanism: {doc['governing']}")
+
+
+@app.command()
+@_user_errors
+def assess(
+    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    site: Path = typer.Argument(..., help="Site file (SITE.json)."),
+    record: list[Path] = typer.Option([], "--record", help="Record(s) for the dynamic verdict."),
+    out: Path = typer.Option(..., "-o", "--out", help="HTML report to write."),
+    pdf: bool = typer.Option(False, "--pdf", help="Also print it to PDF (headless Chromium)."),
+    multiple: list[float] = typer.Option(
+        [0.5, 1.0, 1.5, 2.0], "--multiple", help="Multiples of the design scale to run."
+    ),
+    units: Optional[str] = _UNITS_OPT,
+    record_format: Optional[str] = _FORMAT_OPT,
+    dt: Optional[float] = _DT_OPT,
+    template_dir: Optional[Path] = typer.Option(
+        None, "--template-dir", help="Folder whose assess.html.j2 overrides the layout."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Also print the assessment JSON."),
+) -> None:
+    """Assessment report: code checks beside rocking dynamics for every mechanism."""
+    # jinja2 (the report extra) is loaded only by this command.
+    from .report.assess import print_pdf, render_assessment
+
+    cf, site_file = read_constants(constants), read_site(site)
+    motions = [read_record(r, record_format, units, dt) for r in record]
+    doc = assessment_doc(cf, site_file, motions, multiples=multiple)
+    sources = [
+        input_source("constants", constants.name, constants.read_bytes()),
+        input_source("site", site.name, site.read_bytes()),
+    ] + [input_source("record", r.name, r.read_bytes()) for r in record]
+    options = {"multiples": multiple, "units": units, "format": record_format, "dt": dt}
+    text = render_assessment(
+        doc, cf, site_file, motions, sources=sources, options=options, template_dir=template_dir
+    )
+    typer.echo(f"wrote {write_report(out, text)}")
+    if pdf:
+        typer.echo(f"wrote {print_pdf(out, out.with_suffix('.pdf'))}")
+    if as_json:
+        _print_json(doc)
 
 
 def main() -> None:  # pragma: no cover - console entry point

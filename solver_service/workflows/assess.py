@@ -31,10 +31,10 @@ from .scaling import mechanism_scale_factor
 
 __all__ = [
     "BAND_DEFAULT",
-    "read_site",
     "T1_COEFFICIENT",
     "assessment_doc",
     "check_doc",
+    "read_site",
     "record_scale_factor",
     "site_spectrum",
 ]
