@@ -1,4 +1,4 @@
-"""Elastic design spectra of NTC 2018 (Italy) and EN 1998-1 (Eurocode 8) (theory §11.3).
+"""Elastic design spectra of NTC 2018 (Italy) and EN 1998-1 (Eurocode 8) (theory §11.4).
 
 Both codes share one shape: a rising branch to ``T_B``, a plateau ``a_g S eta F`` to ``T_C``,
 ``1/T`` to ``T_D`` and ``1/T²`` beyond; the displacement spectrum is
