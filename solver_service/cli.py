@@ -25,7 +25,7 @@ from .demo import run_demo
 from .ida import ida_csv, parse_levels, run_ida
 from .report.html import build_report, input_source, write_report
 from .report.plots import plot_fragility
-from .workflows.assess import assessment_doc, check_doc, read_site
+from .workflows.assess import check_doc, read_site
 from .workflows.documents import (
     boundary_doc,
     frequency_grid,
@@ -718,18 +718,23 @@ def assess(
 ) -> None:
     """Assessment report: code checks beside rocking dynamics for every mechanism."""
     # jinja2 (the report extra) is loaded only by this command.
-    from .report.assess import print_pdf, render_assessment
+    from .report.assess import assess_report, print_pdf
 
     cf, site_file = read_constants(constants), read_site(site)
     motions = [read_record(r, record_format, units, dt) for r in record]
-    doc = assessment_doc(cf, site_file, motions, multiples=multiple)
     sources = [
         input_source("constants", constants.name, constants.read_bytes()),
         input_source("site", site.name, site.read_bytes()),
     ] + [input_source("record", r.name, r.read_bytes()) for r in record]
     options = {"multiples": multiple, "units": units, "format": record_format, "dt": dt}
-    text = render_assessment(
-        doc, cf, site_file, motions, sources=sources, options=options, template_dir=template_dir
+    doc, text = assess_report(
+        cf,
+        site_file,
+        motions,
+        multiples=multiple,
+        sources=sources,
+        options=options,
+        template_dir=template_dir,
     )
     typer.echo(f"wrote {write_report(out, text)}")
     if pdf:

@@ -37,11 +37,18 @@ from shared_schema.site import SiteFile
 from ..core.exact import simulate
 from ..core.model import G
 from ..workflows.adapter import to_rocking_model
-from ..workflows.assess import site_spectrum
+from ..workflows.assess import assessment_doc, site_spectrum
 from ..workflows.scaling import mechanism_scale_factor
 from .plots import _pyplot, _save_atomic
 
-__all__ = ["TEMPLATE_NAME", "chromium", "print_pdf", "render_assessment", "sig"]
+__all__ = [
+    "TEMPLATE_NAME",
+    "assess_report",
+    "chromium",
+    "print_pdf",
+    "render_assessment",
+    "sig",
+]
 
 #: The packaged template (a user folder may hold a file of this name to override it).
 TEMPLATE_NAME = "assess.html.j2"
@@ -238,7 +245,12 @@ def _history_figures(
 
 def _short(note: str) -> str:
     """Return the first clause of a note, for the verdict table (the section has it all)."""
-    return note.split(":")[0] if note else ""
+    if not note:
+        return ""
+    head, _, rest = note.partition(": ")
+    if rest and " " not in head:  # "<field>: <message>": keep the field and the first clause
+        return f"{head}: {rest.split(';')[0].split(' (')[0]}"
+    return head.split(" (")[0].split(";")[0]
 
 
 def _verdict_cell(check: dict[str, Any], what: str) -> dict[str, str]:
@@ -260,9 +272,11 @@ def _dynamics_cell(row: dict[str, Any]) -> dict[str, str]:
     if not dyn:
         return {"text": "not run", "cls": "na", "note": row.get("dynamics_note", "")}
     parts, cls = [], "ok"
+    notes = []
     for d in dyn:
         if "runs" not in d:
-            parts.append(f"{d['record']}: {d.get('note', 'not run')}")
+            parts.append(f"{d['record']}: not run")
+            notes.append(_short(d.get("note", "").removeprefix("not run: ")))
             cls = "na"
             continue
         first = d["first_overturning_multiple"]
@@ -273,13 +287,13 @@ def _dynamics_cell(row: dict[str, Any]) -> dict[str, str]:
         parts.append(f"{d['record']}: {state} at design; {tail}")
         if not d["survives_design"]:
             cls = "ko"
-    return {"text": "; ".join(parts), "cls": cls, "note": ""}
+    return {"text": "; ".join(parts), "cls": cls, "note": "; ".join(n for n in notes if n)}
 
 
 def _margin_cell(row: dict[str, Any]) -> dict[str, str]:
     env = row.get("envelope") or {}
     if "note" in env:
-        return {"text": "not run", "cls": "na", "note": env["note"]}
+        return {"text": "not run", "cls": "na", "note": _short(env["note"])}
     pulses = [p for p in env.get("pulses", []) if p.get("margin") is not None]
     if not pulses:
         return {"text": "–", "cls": "na", "note": "no pulse found in the records"}
@@ -473,6 +487,37 @@ def render_assessment(
         "versions_rows": _table_of(_versions()),
     }
     return str(env.get_template(TEMPLATE_NAME).render(**context))
+
+
+def assess_report(
+    cf: ConstantsFile,
+    site: SiteFile,
+    motions: Sequence[Any],
+    *,
+    multiples: Sequence[float] = (0.5, 1.0, 1.5, 2.0),
+    sources: Sequence[dict[str, Any]] = (),
+    options: Optional[dict[str, Any]] = None,
+    template_dir: Optional[Path] = None,
+) -> tuple[dict[str, Any], str]:
+    """Return the assessment document and its HTML page (for ``rockmech assess`` and REST).
+
+    Parameters
+    ----------
+    cf, site, motions, multiples
+        As ``workflows.assess.assessment_doc``.
+    sources, options, template_dir
+        As ``render_assessment``.
+
+    Returns
+    -------
+    (dict, str)
+        The JSON-ready document and the HTML page.
+    """
+    doc = assessment_doc(cf, site, motions, multiples=multiples)
+    text = render_assessment(
+        doc, cf, site, motions, sources=sources, options=options, template_dir=template_dir
+    )
+    return doc, text
 
 
 def chromium() -> Optional[str]:

@@ -122,3 +122,19 @@ def test_pdf_first_page_shows_the_verdict_table(tmp_path: Path) -> None:
         line = next(ln for ln in first.splitlines() if ln.strip().startswith(mech_id))
         assert verdict in line, line
     assert "Governing mechanism for the code check" in first
+
+
+def test_short_form_church_pdf_first_page_has_every_row(tmp_path: Path) -> None:
+    _tool("chromium", "chromium-browser", "google-chrome")
+    pdftotext = _tool("pdftotext")
+    page = _assess(tmp_path, CHURCH_SHORT, "--pdf")
+    first = subprocess.run(
+        [pdftotext, "-layout", "-f", "1", "-l", "1", str(page.with_suffix(".pdf")), "-"],
+        check=True,
+        capture_output=True,
+        timeout=60,
+    ).stdout.decode("utf-8")
+    ids = [m.id for m in parse_constants(CHURCH_SHORT.read_bytes()).mechanisms]
+    starts = [ln.split()[0] for ln in first.splitlines() if ln.split() and ln.split()[0] in ids]
+    assert starts == ids
+    assert "no virtual_work" in first
