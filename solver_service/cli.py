@@ -736,9 +736,10 @@ def assess(
         options=options,
         template_dir=template_dir,
     )
-    typer.echo(f"wrote {write_report(out, text)}")
+    # With --json, stdout carries exactly one JSON document; the file notes go to stderr.
+    typer.echo(f"wrote {write_report(out, text)}", err=as_json)
     if pdf:
-        typer.echo(f"wrote {print_pdf(out, out.with_suffix('.pdf'))}")
+        typer.echo(f"wrote {print_pdf(out, out.with_suffix('.pdf'))}", err=as_json)
     if as_json:
         _print_json(doc)
 

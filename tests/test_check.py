@@ -103,3 +103,31 @@ def test_example_church_from_geometry_checks_every_mechanism() -> None:
     # The two-block strip is a triangle of displacements: e* = 3/4 (theory §11.1).
     t1 = next(r for r in doc["mechanisms"] if r["id"] == "T1")
     assert t1["linear"]["e_star"] == pytest.approx(0.75, rel=1e-6)
+
+
+def test_ec8_site_says_which_method_it_applies() -> None:
+    site = parse_site({"hazard": {"code": "EC8", "a_gR": 0.2, "FC": 1.2}})
+    doc = check_doc(parse_constants(block_file()), site)
+    assert "EN 1998-1" in doc["site"]["method_note"]
+    lin = doc["mechanisms"][0]["linear"]
+    # EC8 ground A, type 1: S = 1, so the ground demand is a_g g / q.
+    assert lin["demand_ground"] == pytest.approx(0.2 * G / 2.0, rel=1e-12)
+    assert lin["a0_star"] == pytest.approx((0.5 / 3.0) * G / (0.75 * 1.2), rel=1e-12)
+
+
+def test_cli_assess_json_prints_one_document(tmp_path: Path) -> None:
+    pytest.importorskip("jinja2")
+    out = tmp_path / "r.html"
+    args = [
+        "assess",
+        str(EXAMPLES / "constants" / "church_geometry.json"),
+        str(EXAMPLES / "sites" / "ntc_site.json"),
+        "-o",
+        str(out),
+        "--json",
+    ]
+    res = runner.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    assert [r["id"] for r in doc["mechanisms"]] == ["F1", "F2", "A1", "T1"]
+    assert out.is_file() and "wrote" in res.stderr

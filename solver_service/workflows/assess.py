@@ -199,6 +199,12 @@ def check_doc(cf: ConstantsFile, site: SiteFile) -> dict[str, Any]:
             "pga_g": spectrum.pga,
             "FC": hz.FC,
             "q": hz.q,
+            "method_note": (
+                "the Circolare's kinematic checks applied to the EN 1998-1 spectrum "
+                "(EN 1998-3 has no kinematic check of its own)"
+                if hz.code == "EC8"
+                else ""
+            ),
             "building": None if site.building is None else site.building.model_dump(),
         },
         "spectrum": {
