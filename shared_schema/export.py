@@ -114,6 +114,9 @@ def main(argv: Optional[List[str]] = None) -> int:
                 continue
             print(f"{output}: up to date")
             continue
+        if output.is_file() and output.read_bytes().decode("utf-8") == text:
+            print(f"{output}: up to date")  # nothing to write (a read-only install stays so)
+            continue
         output.parent.mkdir(parents=True, exist_ok=True)
         write_atomic(output, text)
         print(f"wrote {output}")
