@@ -65,6 +65,7 @@ __all__ = [
     "SideConstants",
     "Typology",
     "Units",
+    "VirtualWork",
     "input_error_from_validation",
     "parse_constants",
 ]
@@ -151,6 +152,83 @@ class Units(BaseModel):
     h: Literal["m"] = "m"
 
 
+#: Relative slack allowed on the Cauchy-Schwarz bound ``S² <= mass * J`` (``e* <= 1``).
+VIRTUAL_WORK_RTOL = 1e-9
+
+
+class VirtualWork(BaseModel):
+    """What the code's kinematic check needs of a side, in the configuration at rest.
+
+    The virtual horizontal displacements ``δx`` of the mechanism's masses for a unit
+    virtual rotation of the mechanism's coordinate at rest (``phi = 0``), summed over the
+    masses whose inertia the mechanism mobilises (docs/theory.md §11.1).
+
+    Attributes
+    ----------
+    alpha0 : float
+        Activation multiplier: the exact static multiplier at rest by virtual work, with the
+        static forces at their own points [-]. Not ``lam``, which linearises about
+        ``phi_cr`` (a block has ``alpha0 = tan(alpha)``, ``lam = alpha``).
+    mass : float
+        Mass that the mechanism's horizontal inertia mobilises, ``sum P_i / g`` [kg], > 0.
+    S : float
+        First moment ``sum m δx`` at rest [kg m], > 0 (``Q`` is the same sum at ``phi_cr``).
+    J : float
+        Second moment ``sum ∫ δx² dm`` at rest [kg m²], > 0; for one block the second moment
+        of its mass about the horizontal plane through the axis.
+
+    Notes
+    -----
+    ``S² <= mass * J`` (Cauchy-Schwarz), i.e. the participating mass fraction
+    ``e* = S² / (mass J)`` is at most 1; a file that breaks it is rejected.
+    """
+
+    model_config = ConfigDict(
+        strict=True,
+        extra="forbid",
+        allow_inf_nan=False,
+        json_schema_extra={
+            "description": (
+                "Virtual-work quantities of a side at rest for the code's kinematic check "
+                "(NTC 2018 / Circolare 2019 §C8.7.1): alpha0, mass, S = sum m dx, "
+                "J = sum m dx^2 for a unit virtual rotation (docs/theory.md §11.1)."
+            )
+        },
+    )
+
+    alpha0: float = Field(
+        description=(
+            "Activation multiplier at rest by virtual work (exact static multiplier with the "
+            "static forces at their own points) [-]."
+        )
+    )
+    mass: float = Field(
+        gt=0, description="Mass mobilised by the mechanism's horizontal inertia [kg], > 0."
+    )
+    S: float = Field(
+        gt=0, description="First moment sum(m dx) for a unit virtual rotation at rest [kg m], > 0."
+    )
+    J: float = Field(
+        gt=0,
+        description=(
+            "Second moment sum(m dx^2) for a unit virtual rotation at rest [kg m^2], > 0 "
+            "(one block: second moment of its mass about the horizontal plane through the axis)."
+        ),
+    )
+
+    @model_validator(mode="after")
+    def _check_bound(self) -> "VirtualWork":
+        if self.S * self.S > self.mass * self.J * (1.0 + VIRTUAL_WORK_RTOL):
+            raise _error(
+                "J",
+                f"S^2 = {self.S * self.S:.6g} exceeds mass*J = {self.mass * self.J:.6g}: the "
+                "participating mass fraction S^2/(mass J) would exceed 1 (inconsistent "
+                "virtual-work quantities)",
+                "inconsistent_constant",
+            )
+        return self
+
+
 def _side_schema_extra(schema: Dict[str, Any]) -> None:
     schema["description"] = (
         "Constants of one rocking side: either the physical constants I0, K, Q, phi_cr "
@@ -188,6 +266,8 @@ class SideConstants(BaseModel):
         Linearised static load multiplier [-], > 0.
     phi_ov : float, optional
         Overturning rotation [rad], > 0.
+    virtual_work : VirtualWork, optional
+        The side's virtual-work quantities at rest for the code's kinematic check.
 
     Notes
     -----
@@ -233,6 +313,13 @@ class SideConstants(BaseModel):
     p_eq: Optional[float] = Field(None, gt=0, description=_P_EQ_DESCRIPTION)
     lam: Optional[float] = Field(None, gt=0, description=_LAM_DESCRIPTION)
     phi_ov: Optional[float] = Field(None, gt=0, description=_PHI_OV_DESCRIPTION)
+    virtual_work: Optional[VirtualWork] = Field(
+        None,
+        description=(
+            "Virtual-work quantities at rest for the code's kinematic check (alpha0, mass, "
+            "S, J); optional, in either form."
+        ),
+    )
 
     @model_validator(mode="after")
     def _check_form(self) -> "SideConstants":

@@ -1,8 +1,9 @@
-"""Export the JSON Schema of the kinematic-constants file.
+"""Export the JSON Schemas of the kinematic-constants file and of the site file.
 
-Run ``python -m shared_schema.export`` after changing ``shared_schema.constants``; it writes
-``shared_schema/jsonschema/kinematic_constants.schema.json``. With ``--check`` it writes
-nothing and exits 1 when the file on disk differs from the models (a test does the same).
+Run ``python -m shared_schema.export`` after changing ``shared_schema.constants`` or
+``shared_schema.site``; it writes ``shared_schema/jsonschema/kinematic_constants.schema.json``
+and ``shared_schema/jsonschema/site.schema.json``. With ``--check`` it writes nothing and
+exits 1 when a file on disk differs from the models (a test does the same).
 """
 
 import argparse
@@ -13,11 +14,23 @@ from typing import Any, Dict, List, Optional
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.io import write_atomic
+from shared_schema.site import SiteFile
 
-__all__ = ["SCHEMA_PATH", "build_schema", "main", "render_schema"]
+__all__ = [
+    "SCHEMA_PATH",
+    "SITE_SCHEMA_PATH",
+    "build_schema",
+    "build_site_schema",
+    "main",
+    "render_schema",
+    "render_site_schema",
+]
 
 #: Where the exported schema lives (shipped as package data).
 SCHEMA_PATH = Path(__file__).resolve().parent / "jsonschema" / "kinematic_constants.schema.json"
+
+#: Where the exported site-file schema lives.
+SITE_SCHEMA_PATH = SCHEMA_PATH.parent / "site.schema.json"
 
 #: JSON Schema dialect pydantic generates.
 DIALECT = "https://json-schema.org/draft/2020-12/schema"
@@ -43,8 +56,21 @@ def render_schema() -> str:
     return json.dumps(build_schema(), sort_keys=True, indent=2, ensure_ascii=False) + "\n"
 
 
+def build_site_schema() -> Dict[str, Any]:
+    """Return the JSON Schema of ``SiteFile`` (draft 2020-12) as a dict."""
+    schema = SiteFile.model_json_schema(mode="validation")
+    schema["$schema"] = DIALECT
+    schema["title"] = "rockmech site file"
+    return schema
+
+
+def render_site_schema() -> str:
+    """Return the site schema as the text stored on disk."""
+    return json.dumps(build_site_schema(), sort_keys=True, indent=2, ensure_ascii=False) + "\n"
+
+
 def main(argv: Optional[List[str]] = None) -> int:
-    """Write the schema file, or with ``--check`` report whether it is up to date.
+    """Write the schema files, or with ``--check`` report whether they are up to date.
 
     Parameters
     ----------
@@ -54,7 +80,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     Returns
     -------
     int
-        Exit status: 0 on success, 1 when ``--check`` finds the file missing or different.
+        Exit status: 0 on success, 1 when ``--check`` finds a file missing or different.
     """
     parser = argparse.ArgumentParser(
         prog="python -m shared_schema.export", description=__doc__.splitlines()[0]
@@ -65,24 +91,36 @@ def main(argv: Optional[List[str]] = None) -> int:
     parser.add_argument(
         "--output", type=Path, default=SCHEMA_PATH, help=f"schema file (default: {SCHEMA_PATH})"
     )
+    parser.add_argument(
+        "--site-output",
+        type=Path,
+        default=SITE_SCHEMA_PATH,
+        help=f"site schema file (default: {SITE_SCHEMA_PATH})",
+    )
     args = parser.parse_args(argv)
-    text = render_schema()
-    output: Path = args.output
-    if args.check:
-        try:
-            current = output.read_bytes().decode("utf-8")
-        except FileNotFoundError:
-            print(f"{output}: missing; run python -m shared_schema.export", file=sys.stderr)
-            return 1
-        if current != text:
-            print(f"{output}: out of date; run python -m shared_schema.export", file=sys.stderr)
-            return 1
-        print(f"{output}: up to date")
-        return 0
-    output.parent.mkdir(parents=True, exist_ok=True)
-    write_atomic(output, text)
-    print(f"wrote {output}")
-    return 0
+    pairs = ((Path(args.output), render_schema()), (Path(args.site_output), render_site_schema()))
+    status = 0
+    for output, text in pairs:
+        if args.check:
+            try:
+                current = output.read_bytes().decode("utf-8")
+            except FileNotFoundError:
+                print(f"{output}: missing; run python -m shared_schema.export", file=sys.stderr)
+                status = 1
+                continue
+            if current != text:
+                print(f"{output}: out of date; run python -m shared_schema.export", file=sys.stderr)
+                status = 1
+                continue
+            print(f"{output}: up to date")
+            continue
+        if output.is_file() and output.read_bytes().decode("utf-8") == text:
+            print(f"{output}: up to date")  # nothing to write (a read-only install stays so)
+            continue
+        output.parent.mkdir(parents=True, exist_ok=True)
+        write_atomic(output, text)
+        print(f"wrote {output}")
+    return status
 
 
 if __name__ == "__main__":

@@ -31,6 +31,7 @@ from .demo import run_demo
 from .ida import IM_MEASURES, ida_csv, parse_levels, run_ida
 from .report.html import build_report, input_source, write_report
 from .report.plots import plot_fragility
+from .workflows.assess import check_doc, read_site
 from .workflows.documents import (
     boundary_doc,
     frequency_grid,
@@ -847,6 +848,99 @@ def serve(
     typer.echo(f"rockmech {__version__} serving on http://{host_part}:{settings.port}")
     typer.echo(f"  docs: http://{host_part}:{settings.port}/api/v1/docs (Ctrl+C to stop)")
     run(settings)
+
+
+def _verdict(check: dict[str, Any]) -> str:
+    if check.get("status") != "ok":
+        return "n/a"
+    return {True: "pass", False: "FAIL", None: "incomplete"}[check["passes"]]
+
+
+@app.command()
+@_user_errors
+def check(
+    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    site: Path = typer.Argument(..., help="Site file (SITE.json): hazard, FC, q, building."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+) -> None:
+    """Code checks (NTC 2018 / Circolare §C8.7.1, linear and nonlinear) of every mechanism."""
+    doc = check_doc(read_constants(constants), read_site(site))
+    if as_json:
+        _print_json(doc)
+        return
+    s = doc["site"]
+    typer.echo(f"{s['code']}: a_g S = {s['pga_g']:.4f} g, FC = {s['FC']:g}, q = {s['q']:g}")
+    typer.echo(
+        f"{'mechanism':<10}{'alpha0':>9}{'e*':>8}{'a0* m/s2':>10}{'demand':>9}{'linear':>8}"
+        f"{'du* m':>9}{'demand':>9}{'Ts s':>7}{'nonlinear':>11}"
+    )
+    for row in doc["mechanisms"]:
+        lin, non = row["linear"], row["nonlinear"]
+        if lin.get("status") == "ok":
+            left = (
+                f"{lin['alpha0']:>9.4g}{lin['e_star']:>8.4g}{lin['a0_star']:>10.4g}"
+                f"{lin['demand']:>9.4g}{_verdict(lin):>8}"
+            )
+        else:
+            left = f"{'-':>9}{'-':>8}{'-':>10}{'-':>9}{_verdict(lin):>8}"
+        if non.get("status") == "ok":
+            right = (
+                f"{non['du_star']:>9.4g}{non['demand']:>9.4g}{non['Ts']:>7.3g}{_verdict(non):>11}"
+            )
+        else:
+            right = f"{'-':>9}{'-':>9}{'-':>7}{_verdict(non):>11}"
+        typer.echo(f"{row['id']:<10}" + left + right)
+        for note in {lin.get("note"), non.get("note")} - {None, ""}:
+            typer.echo(f"  note: {row['id']}: {note}")
+    if doc["governing"] is not None:
+        typer.echo(f"governing mechanism: {doc['governing']}")
+
+
+@app.command()
+@_user_errors
+def assess(
+    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    site: Path = typer.Argument(..., help="Site file (SITE.json)."),
+    record: list[Path] = typer.Option([], "--record", help="Record(s) for the dynamic verdict."),
+    out: Path = typer.Option(..., "-o", "--out", help="HTML report to write."),
+    pdf: bool = typer.Option(False, "--pdf", help="Also print it to PDF (headless Chromium)."),
+    multiple: list[float] = typer.Option(
+        [0.5, 1.0, 1.5, 2.0], "--multiple", help="Multiples of the design scale to run."
+    ),
+    units: Optional[str] = _UNITS_OPT,
+    record_format: Optional[str] = _FORMAT_OPT,
+    dt: Optional[float] = _DT_OPT,
+    template_dir: Optional[Path] = typer.Option(
+        None, "--template-dir", help="Folder whose assess.html.j2 overrides the layout."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Also print the assessment JSON."),
+) -> None:
+    """Assessment report: code checks beside rocking dynamics for every mechanism."""
+    # jinja2 (the report extra) is loaded only by this command.
+    from .report.assess import assess_report, print_pdf
+
+    cf, site_file = read_constants(constants), read_site(site)
+    motions = [read_record(r, record_format, units, dt) for r in record]
+    sources = [
+        input_source("constants", constants.name, constants.read_bytes()),
+        input_source("site", site.name, site.read_bytes()),
+    ] + [input_source("record", r.name, r.read_bytes()) for r in record]
+    options = {"multiples": multiple, "units": units, "format": record_format, "dt": dt}
+    doc, text = assess_report(
+        cf,
+        site_file,
+        motions,
+        multiples=multiple,
+        sources=sources,
+        options=options,
+        template_dir=template_dir,
+    )
+    # With --json, stdout carries exactly one JSON document; the file notes go to stderr.
+    typer.echo(f"wrote {write_report(out, text)}", err=as_json)
+    if pdf:
+        typer.echo(f"wrote {print_pdf(out, out.with_suffix('.pdf'))}", err=as_json)
+    if as_json:
+        _print_json(doc)
 
 
 def main() -> None:  # pragma: no cover - console entry point

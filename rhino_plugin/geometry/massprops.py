@@ -107,6 +107,50 @@ class MassProps:
         perp = r - np.dot(r, u) * u
         return float(u @ self.inertia_com @ u + self.mass * np.dot(perp, perp))
 
+    def second_moment_about_plane(self, point: np.ndarray, normal: np.ndarray) -> float:
+        """Second moment of the mass about a plane, the integral of (distance)² dm [kg m²].
+
+        Parameters
+        ----------
+        point : (3,) float
+            Any point of the plane [m].
+        normal : (3,) float
+            Normal of the plane; its length does not matter.
+
+        Returns
+        -------
+        float
+            ``nᵀ C_G n + M ((r_G - p)·n)²`` with ``C_G = tr(I_G)/2 · 1 - I_G`` the second-moment
+            tensor about the centre of mass [kg m²].
+
+        Raises
+        ------
+        InputError
+            If ``normal`` is zero or not finite.
+
+        Notes
+        -----
+        For the horizontal plane through a rocking axis it is the sum of ``m δx²`` over the
+        body for a unit virtual rotation, the denominator of the participating mass of the
+        code's kinematic check (docs/theory.md §11.1).
+
+        Examples
+        --------
+        A 1 x 1 x 3 m box of 3 kg centred at z = 1.5 m, about its base plane: M h²/3 = 9.
+
+        >>> p = MassProps(3.0, 3.0, [0, 0, 1.5], np.diag([2.5, 2.5, 0.5]), 1.0)
+        >>> round(p.second_moment_about_plane([0, 0, 0], [0, 0, 2]), 12)
+        9.0
+        """
+        d = np.asarray(normal, dtype=np.float64).reshape(3)
+        norm = float(np.linalg.norm(d))
+        if not (norm > 0.0 and math.isfinite(norm)):
+            raise InputError(f"must be a finite non-zero vector, got {normal!r}", "normal")
+        n = d / norm
+        c_g = 0.5 * float(np.trace(self.inertia_com)) * np.eye(3) - self.inertia_com
+        dist = float(np.dot(self.com - np.asarray(point, dtype=np.float64).reshape(3), n))
+        return float(n @ c_g @ n + self.mass * dist * dist)
+
 
 def _integrals(local: np.ndarray, faces: np.ndarray) -> Tuple[float, np.ndarray, np.ndarray]:
     """Volume integrals of 1, x and x xᵀ over a closed, outward mesh (coordinates local).

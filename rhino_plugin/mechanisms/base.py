@@ -10,7 +10,7 @@ Python 3.9-clean: imported by Rhino 8.
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional
 
-__all__ = ["Builder", "MechanismSides"]
+__all__ = ["Builder", "MechanismSides", "virtual_work_of"]
 
 
 @dataclass
@@ -36,6 +36,10 @@ class MechanismSides:
         Notes for the user (mesh repairs, assumptions).
     eta_info : dict
         Details of the restitution rule, kept in the geometry summary.
+    virtual_work : dict
+        Per side (``"positive"``, ``"negative"``), the virtual-work quantities at rest for
+        the code's kinematic check: ``alpha0`` [-], ``mass`` [kg], ``S`` [kg m], ``J``
+        [kg m²] (``shared_schema.constants.VirtualWork``, docs/theory.md §11.1).
     """
 
     positive: Dict[str, float]
@@ -46,7 +50,36 @@ class MechanismSides:
     object_ids: List[str]
     warnings: List[str] = field(default_factory=list)
     eta_info: Dict[str, Any] = field(default_factory=dict)
+    virtual_work: Dict[str, Dict[str, float]] = field(default_factory=dict)
 
 
 #: A typology's builder: ``(spec, scene, thrust_table) -> MechanismSides``.
 Builder = Callable[[Any, Any, Any], MechanismSides]
+
+
+def virtual_work_of(details: Dict[str, float], alpha0_key: str) -> Optional[Dict[str, float]]:
+    """Return a linkage side's virtual-work quantities from its ``details``, if computed.
+
+    Parameters
+    ----------
+    details : dict
+        A linkage result's details with ``S0``, ``J0``, ``mass0`` and ``alpha0_key``.
+    alpha0_key : str
+        The key of the exact static multiplier at rest (``lam_static_exact``,
+        ``lam_static``).
+
+    Returns
+    -------
+    dict or None
+        ``alpha0``, ``mass`` [kg], ``S`` [kg m], ``J`` [kg m²]; None where the blocks had no
+        second moments (docs/theory.md §11.1).
+    """
+    keys = ("S0", "J0", "mass0", alpha0_key)
+    if not all(k in details for k in keys):
+        return None
+    return {
+        "alpha0": float(details[alpha0_key]),
+        "mass": float(details["mass0"]),
+        "S": float(details["S0"]),
+        "J": float(details["J0"]),
+    }

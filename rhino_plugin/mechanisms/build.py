@@ -66,9 +66,18 @@ def _finish(spec: Any, entry: Dict[str, Any], sides: MechanismSides) -> Dict[str
     """
     positive, negative, eta = sides.positive, sides.negative, sides.eta
     geometry, eta_info, warnings = sides.geometry, sides.eta_info, sides.warnings
-    entry["positive"] = positive
-    if negative is not None and not _same(positive, negative):
-        entry["negative"] = negative
+    vw_pos = sides.virtual_work.get("positive")
+    vw_neg = sides.virtual_work.get("negative")
+    entry["positive"] = dict(positive) if vw_pos is None else {**positive, "virtual_work": vw_pos}
+    symmetric = negative is not None and _same(positive, negative)
+    if symmetric and (vw_pos is None) != (vw_neg is None):
+        symmetric = False
+    if symmetric and vw_pos is not None and vw_neg is not None:
+        symmetric = _same(vw_pos, vw_neg)
+    if negative is not None and not symmetric:
+        entry["negative"] = (
+            dict(negative) if vw_neg is None else {**negative, "virtual_work": vw_neg}
+        )
     if eta is not None:
         lo, hi = eta_range(spec.rocking == "one_sided")
         if not lo <= eta <= hi:

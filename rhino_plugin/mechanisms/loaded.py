@@ -269,6 +269,17 @@ def _constants(
 
     over = m_w * z(g_w) + sum(m * z(p) for m, p, _ in bearing + nonbearing)
     lam_exact = (G * m_c * x(g_c) - sum(f * z(p) for f, p, _ in forces)) / (G * over)
+    # theory §11.1: a unit virtual rotation moves each mass by its height above the axis;
+    # the added masses are points, the wall a solid (second moment about the axis plane).
+    plane_n = np.cross(side.outward, side.direction)
+    plane_n = plane_n / float(np.linalg.norm(plane_n))
+    j_wall = float(body.props.second_moment_about_plane(side.point, plane_n))
+    virtual_work = {
+        "alpha0": lam_exact,
+        "mass": m_cs,
+        "S": over,
+        "J": j_wall + sum(m * z(p) ** 2 for m, p, _ in bearing + nonbearing),
+    }
     summary: Dict[str, Any] = {
         "M_c_kg": m_c,
         "R_c_m": r_c,
@@ -278,6 +289,7 @@ def _constants(
         "alpha_c_star_rad": a_cs,
         "F_N": f_tot,
         "static_multiplier_exact": lam_exact,
+        "virtual_work": virtual_work,
         "elements": elements,
     }
     if f_tot != 0.0:
@@ -309,4 +321,7 @@ def build_loaded_wall(spec: Any, scene: Any, table: Any) -> MechanismSides:
     warnings.extend(notes)
     geometry["loaded"] = summary
     inertia = (summary["M_c_kg"], summary["R_c_m"], summary["alpha_c_rad"], positive["I0"])
-    return rigid_body_sides(spec, scene, body, pos, geometry, positive, inertia, warnings)
+    virtual_work = {"positive": dict(summary["virtual_work"])}
+    return rigid_body_sides(
+        spec, scene, body, pos, geometry, positive, inertia, warnings, virtual_work
+    )

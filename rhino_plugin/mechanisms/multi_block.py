@@ -48,7 +48,7 @@ import math
 from dataclasses import dataclass
 from typing import List, Optional, Sequence, Tuple
 
-from rhino_plugin.mechanisms.two_block import LinkageResult, PlanarBody
+from rhino_plugin.mechanisms.two_block import LinkageResult, PlanarBody, rest_virtual_work
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.rules import G
 
@@ -100,8 +100,10 @@ class FourBarResult(LinkageResult):
     details : dict
         ``omega2``, ``omega3``, ``domega2``, ``domega3`` (per radian of theta) at
         ``phi_cr``; ``dV0`` [N m] and ``Q0`` [kg m] at rest and the exact static multiplier
-        ``lam_static = dV0/(g Q0)``; ``L1``, ``L2``, ``L3`` [m]; ``sense`` (+1 when theta
-        is anticlockwise in the x-z plane, -1 when clockwise); ``xC``, ``zC`` at ``phi_cr``.
+        ``lam_static = dV0/(g Q0)``; where every block carries ``j_z``, ``S0`` [kg m],
+        ``J0`` [kg m²] and ``mass0`` [kg] at rest (theory §11.1); ``L1``, ``L2``, ``L3``
+        [m]; ``sense`` (+1 when theta is anticlockwise in the x-z plane, -1 when
+        clockwise); ``xC``, ``zC`` at ``phi_cr``.
     """
 
 
@@ -576,6 +578,13 @@ def four_bar_constants(
     }
     if at_rest.Q != 0.0:
         details["lam_static"] = at_rest.dV / (G * at_rest.Q)
+        # theory §11.1: the signs of u_x and omega drop out of J.
+        rest = rest_virtual_work(
+            link.blocks, [v[0] for v in at_rest.u], at_rest.omega, details["lam_static"]
+        )
+        if rest is not None and at_rest.Q > 0.0:
+            # Q is sum m u_x along the collapse direction, the S of §11.1.
+            details.update({"S0": at_rest.Q, "J0": rest["J"], "mass0": rest["mass"]})
     return FourBarResult(
         I0=i0,
         K=k,
@@ -644,7 +653,7 @@ def four_bar_restitution(
 
 def _rect(density: float, length: float, x0: float, z0: float, w: float, h: float) -> PlanarBody:
     m = density * w * h * length
-    return PlanarBody(m, (x0 + 0.5 * w, z0 + 0.5 * h), m * (w * w + h * h) / 12.0)
+    return PlanarBody(m, (x0 + 0.5 * w, z0 + 0.5 * h), m * (w * w + h * h) / 12.0, m * h * h / 12.0)
 
 
 def portal_frame(
@@ -721,11 +730,13 @@ def portal_frame(
     lx = x_r + b_r
     slope = (h_r - h) / lx
     m_beam = density * lx * beam_depth * length
-    # Sheared rectangle: I = m (lx² (1 + slope²) + depth²) / 12 about its centroid.
+    # Sheared rectangle about its centroid: I = m (lx² (1 + slope²) + depth²) / 12 and
+    # j_z = m (slope² lx² + depth²) / 12.
     beam = PlanarBody(
         m_beam,
         (0.5 * lx, 0.5 * (h + h_r) + 0.5 * beam_depth),
         m_beam * (lx * lx * (1.0 + slope * slope) + beam_depth * beam_depth) / 12.0,
+        m_beam * (slope * slope * lx * lx + beam_depth * beam_depth) / 12.0,
     )
     positive: Hinges = ((b, 0.0), (0.0, h), (x_r, h_r), (x_r + b_r, 0.0))
     negative: Hinges = ((0.0, 0.0), (b, h), (x_r + b_r, h_r), (x_r, 0.0))

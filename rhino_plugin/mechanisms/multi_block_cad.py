@@ -17,7 +17,7 @@ import numpy as np
 
 from rhino_plugin.geometry.massprops import combine, mass_properties
 from rhino_plugin.geometry.validate import check_solid
-from rhino_plugin.mechanisms.base import MechanismSides
+from rhino_plugin.mechanisms.base import MechanismSides, virtual_work_of
 from rhino_plugin.mechanisms.multi_block import four_bar_constants, four_bar_restitution
 from rhino_plugin.mechanisms.single import find_objects
 from rhino_plugin.mechanisms.two_block import PlanarBody
@@ -112,8 +112,14 @@ def multi_block_sides(
         d = np.asarray(p, dtype=float) - origin
         return float(d @ ex), float(d[2])
 
+    up = np.array([0.0, 0.0, 1.0])
     blocks = tuple(
-        PlanarBody(float(p.mass), planar(p.com), float(normal @ np.asarray(p.inertia_com) @ normal))
+        PlanarBody(
+            float(p.mass),
+            planar(p.com),
+            float(normal @ np.asarray(p.inertia_com) @ normal),
+            float(p.second_moment_about_plane(p.com, up)),
+        )
         for p in props
     )
     hinges_pos = [planar(p) for p in pos3]
@@ -121,6 +127,10 @@ def multi_block_sides(
     positive = res.constants()
     negative = None
     eta = None
+    virtual_work: Dict[str, Dict[str, float]] = {}
+    vw = virtual_work_of(res.details, "lam_static")
+    if vw is not None:
+        virtual_work["positive"] = vw
     summary: Dict[str, Any] = {
         "plane_x_axis": [float(v) for v in ex],
         "block_masses_kg": [b.mass for b in blocks],
@@ -150,12 +160,16 @@ def multi_block_sides(
                 f"{where}.hinges_negative",
             )
         negative = res_n.constants()
+        vw = virtual_work_of(res_n.details, "lam_static")
+        if vw is not None:
+            virtual_work["negative"] = vw
         eta = four_bar_restitution(blocks, tuple(hinges_pos), tuple(hinges_neg))
         summary["negative"] = {
             "collapse_sense": dir_n,
             **{k: float(v) for k, v in res_n.details.items()},
         }
     summary["warnings"] = notes
+    summary["virtual_work"] = virtual_work
     return positive, negative, eta, summary, ids
 
 
@@ -163,6 +177,14 @@ def build_multi_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
     """Builder of typology ``multi_block`` (docs/theory.md §2.4); ``table`` is unused."""
     positive, negative, eta, summary, ids = multi_block_sides(spec, scene)
     warnings = summary.pop("warnings")
+    virtual_work = summary.pop("virtual_work")
     return MechanismSides(
-        positive, negative, eta, "momentum_projection", {"multi_block": summary}, ids, warnings
+        positive,
+        negative,
+        eta,
+        "momentum_projection",
+        {"multi_block": summary},
+        ids,
+        warnings,
+        virtual_work=virtual_work,
     )

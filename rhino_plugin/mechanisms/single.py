@@ -17,7 +17,7 @@ farthest extent from the axis, horizontally towards G).
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -38,6 +38,7 @@ __all__ = [
     "negative_axis",
     "resolve_axis",
     "rocking_side",
+    "side_virtual_work",
 ]
 
 #: Largest tilt of a "horizontal" axis [rad] unless the spec allows inclined axes.
@@ -240,6 +241,27 @@ def side_constants(body: Body, side: RockingSide) -> Dict[str, float]:
     return {"I0": side.I_O, "K": m * G * side.R, "Q": m * side.R, "phi_cr": side.alpha, "M_F": 0.0}
 
 
+def side_virtual_work(body: Body, side: RockingSide) -> Dict[str, float]:
+    """Virtual-work quantities at rest of a plain block about one axis (theory §11.1).
+
+    A unit virtual rotation moves a point at height ``z`` above the axis by ``δx = z``
+    horizontally, so ``S = M z_G``, ``J`` is the second moment of the mass about the
+    horizontal plane through the axis, and ``alpha0 = x_G / z_G = tan(alpha)``.
+    """
+    m = float(body.props.mass)
+    n = np.cross(side.outward, side.direction)
+    n = n / float(np.linalg.norm(n))
+    if n[2] < 0.0:
+        n = -n
+    j = float(body.props.second_moment_about_plane(side.point, n))
+    return {
+        "alpha0": math.tan(side.alpha),
+        "mass": m,
+        "S": m * side.R * math.cos(side.alpha),
+        "J": j,
+    }
+
+
 def side_summary(side: RockingSide) -> Dict[str, Any]:
     """Geometry of a side for the constants file's summary."""
     return {
@@ -329,6 +351,7 @@ def rigid_body_sides(
     positive: Dict[str, float],
     restitution_body: Tuple[float, float, float, float],
     warnings: List[str],
+    virtual_work: Optional[Dict[str, Dict[str, float]]] = None,
 ) -> MechanismSides:
     """Finish a rigid body's sides: the negative side (two-sided) and eta.
 
@@ -336,12 +359,18 @@ def rigid_body_sides(
     ----------
     restitution_body : (M [kg], R [m], alpha [rad], I_O [kg m²])
         The body the one-sided restitution rule (Eq. 26) sees.
+    virtual_work : dict, optional
+        The positive side's virtual-work quantities (``{"positive": {...}}``); default
+        those of the plain block. The negative side's are always the plain block's.
     """
     negative = None
     eta_info: Dict[str, Any]
+    if virtual_work is None:
+        virtual_work = {"positive": side_virtual_work(body, pos)}
     if spec.rocking == "two_sided":
         neg = _negative_side(spec, scene, body, pos)
         negative = side_constants(body, neg)
+        virtual_work["negative"] = side_virtual_work(body, neg)
         geometry["negative"] = side_summary(neg)
         eta, eta_info = eta_two_sided(body, pos, neg)
         source = "housner_general"
@@ -350,7 +379,15 @@ def rigid_body_sides(
         eta = one_sided(*restitution_body, source)
         eta_info = {"rule": ONE_SIDED_RULES[source]}
     return MechanismSides(
-        positive, negative, eta, source, geometry, body.object_ids, warnings, eta_info
+        positive,
+        negative,
+        eta,
+        source,
+        geometry,
+        body.object_ids,
+        warnings,
+        eta_info,
+        virtual_work,
     )
 
 

@@ -59,6 +59,7 @@ __all__ = [
     "rectangular_bodies",
     "rectangular_hinges",
     "rectangular_two_block",
+    "rest_virtual_work",
     "two_block_constants",
     "two_block_restitution",
 ]
@@ -93,17 +94,24 @@ class PlanarBody:
     i_g : float
         Moment of inertia about the axis through the centre of mass, normal to the plane
         [kg m²], >= 0.
+    j_z : float, optional
+        Second moment of the mass about the horizontal plane through the centre of mass,
+        ``∫ (z - z_G)² dm`` [kg m²], >= 0; needed only for the code check's virtual-work
+        quantities (theory §11.1), which are omitted when a block lacks it.
     """
 
     mass: float
     com: Tuple[float, float]
     i_g: float
+    j_z: Optional[float] = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.mass) and self.mass > 0.0):
             raise InputError(f"must be finite and > 0, got {self.mass!r}", "mass")
         if not (math.isfinite(self.i_g) and self.i_g >= 0.0):
             raise InputError(f"must be finite and >= 0, got {self.i_g!r}", "i_g")
+        if self.j_z is not None and not (math.isfinite(self.j_z) and self.j_z >= 0.0):
+            raise InputError(f"must be finite and >= 0, got {self.j_z!r}", "j_z")
         _point(self.com, "com")
 
 
@@ -160,7 +168,8 @@ class TwoBlockResult(LinkageResult):
         name) [kg m²];
         ``phi2_cr`` [rad], ``omega2`` (dphi2/dphi) and ``domega2`` (its derivative) at
         phi_cr; ``lam_static_exact``, the exact static multiplier ``V'(0)/(g Q(0))`` with N
-        at its own point (theory §1.6).
+        at its own point (theory §1.6); where both blocks carry ``j_z``, ``S0`` [kg m],
+        ``J0`` [kg m²] and ``mass0`` [kg], the virtual-work quantities at rest (§11.1).
     eccentricity : str
         The treatment of an eccentric overburden that was used (``ECCENTRICITY_OPTIONS``).
     """
@@ -350,6 +359,38 @@ def _state(
     return _State(bet, dV, d2V, M, Q, ve[1] - vh[1])
 
 
+def rest_virtual_work(
+    bodies: Sequence[PlanarBody],
+    u_x: Sequence[float],
+    omega: Sequence[float],
+    alpha0: float,
+) -> Optional[Dict[str, float]]:
+    """Virtual-work quantities at rest of a linkage (theory §11.1), or None without ``j_z``.
+
+    Parameters
+    ----------
+    bodies : sequence of PlanarBody
+        The blocks.
+    u_x : sequence of float
+        Horizontal velocity ratio ``dx_G/dphi`` of each block's centre at rest, towards
+        collapse [m/rad].
+    omega : sequence of float
+        Rotation ratio ``dphi_k/dphi`` of each block at rest [-].
+    alpha0 : float
+        Exact static multiplier at rest [-].
+
+    Notes
+    -----
+    A point of block k at height ``z`` moves by ``δx = u_x,k ± omega_k (z - z_Gk)``, so
+    ``sum ∫ δx² dm = sum (m_k u_x,k² + omega_k² j_z,k)`` (the cross term vanishes about G).
+    """
+    if any(b.j_z is None for b in bodies):
+        return None
+    s = sum(b.mass * u for b, u in zip(bodies, u_x))
+    j = sum(b.mass * u * u + w * w * float(b.j_z or 0.0) for b, u, w in zip(bodies, u_x, omega))
+    return {"alpha0": alpha0, "mass": sum(b.mass for b in bodies), "S": s, "J": j}
+
+
 def _critical(
     chain: _Chain,
     lower: PlanarBody,
@@ -518,6 +559,13 @@ def two_block_constants(
         "domega2": -s.beta[2],
         "lam_static_exact": s_rest.dV / (G * s_rest.Q),
     }
+    _, v1_rest, _ = chain.motion(lower.com, 1, 0.0, s_rest.beta)
+    _, v2_rest, _ = chain.motion(upper.com, 2, 0.0, s_rest.beta)
+    rest = rest_virtual_work(
+        (lower, upper), (v1_rest[0], v2_rest[0]), (1.0, s_rest.beta[1]), details["lam_static_exact"]
+    )
+    if rest is not None:
+        details.update({"S0": rest["S"], "J0": rest["J"], "mass0": rest["mass"]})
     return TwoBlockResult(
         I0=s.M,
         K=K,
@@ -628,14 +676,15 @@ def rectangular_bodies(
     Returns
     -------
     (PlanarBody, PlanarBody)
-        Lower and upper block; ``i_g = m (b² + h_k²) / 12``.
+        Lower and upper block; ``i_g = m (b² + h_k²) / 12``, ``j_z = m h_k² / 12``.
     """
     b, h, h_c = _check_rect(b, h, h_c)
     rho_l = check_positive(density, "density") * check_positive(length, "length")
     out = []
     for z0, hk in ((0.0, h_c), (h_c, h - h_c)):
         m = rho_l * b * hk
-        out.append(PlanarBody(m, (0.5 * b, z0 + 0.5 * hk), m * (b * b + hk * hk) / 12.0))
+        i_g, j_z = m * (b * b + hk * hk) / 12.0, m * hk * hk / 12.0
+        out.append(PlanarBody(m, (0.5 * b, z0 + 0.5 * hk), i_g, j_z))
     return out[0], out[1]
 
 

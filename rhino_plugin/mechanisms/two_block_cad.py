@@ -23,7 +23,7 @@ import numpy as np
 
 from rhino_plugin.geometry.cut import cut_by_plane
 from rhino_plugin.geometry.massprops import combine, mass_properties
-from rhino_plugin.mechanisms.base import MechanismSides
+from rhino_plugin.mechanisms.base import MechanismSides, virtual_work_of
 from rhino_plugin.mechanisms.loaded import element_solids, largest_contact
 from rhino_plugin.mechanisms.single import rigid_body
 from rhino_plugin.mechanisms.two_block import (
@@ -43,13 +43,14 @@ def _planar(parts: List[Any], origin: np.ndarray, outward: np.ndarray, axis: np.
     props = combine(parts, name="block")
     d = np.asarray(props.com, dtype=float) - origin
     i_g = float(axis @ np.asarray(props.inertia_com) @ axis)
-    return PlanarBody(float(props.mass), (float(d @ outward), float(d[2])), i_g)
+    j_z = float(props.second_moment_about_plane(props.com, np.array([0.0, 0.0, 1.0])))
+    return PlanarBody(float(props.mass), (float(d @ outward), float(d[2])), i_g, j_z)
 
 
 def _mirror(body: Any, b: float) -> Any:
 
     x, z = body.com
-    return PlanarBody(body.mass, (-b - x, z), body.i_g)
+    return PlanarBody(body.mass, (-b - x, z), body.i_g, body.j_z)
 
 
 def two_block_sides(
@@ -115,6 +116,10 @@ def two_block_sides(
     positive = res.constants()
     negative = None
     eta = None
+    virtual_work: Dict[str, Dict[str, float]] = {}
+    vw = virtual_work_of(res.details, "lam_static_exact")
+    if vw is not None:
+        virtual_work["positive"] = vw
     if spec.rocking == "two_sided":
         neg = two_block_constants(
             _mirror(b1, b),
@@ -125,6 +130,9 @@ def two_block_sides(
             eccentricity=ecc,
         )
         negative = neg.constants()
+        vw = virtual_work_of(neg.details, "lam_static_exact")
+        if vw is not None:
+            virtual_work["negative"] = vw
         eta = two_block_restitution(b1, b2, *hinges, *mirrored)
     summary: Dict[str, Any] = {
         "thickness_m": b,
@@ -140,6 +148,7 @@ def two_block_sides(
         "upper_mass_kg": b2.mass,
         "static_multiplier_exact": res.details.get("lam_static_exact"),
         "details": {k: float(v) for k, v in res.details.items()},
+        "virtual_work": virtual_work,
     }
     if overburden_ids:
         summary["overburden_objects"] = overburden_ids
@@ -150,6 +159,7 @@ def build_two_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
     """Builder of typology ``two_block`` (docs/theory.md §2.3); ``table`` is unused."""
     body, pos, geometry = rigid_body(spec, scene)
     positive, negative, eta, summary = two_block_sides(spec, scene, body, pos)
+    virtual_work = summary.pop("virtual_work")
     geometry["two_block"] = summary
     return MechanismSides(
         positive,
@@ -159,4 +169,5 @@ def build_two_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
         geometry,
         body.object_ids,
         list(body.warnings),
+        virtual_work=virtual_work,
     )
