@@ -86,7 +86,8 @@ class SampledAccel:
     dt : float
         Sampling interval [s], > 0.
     t0 : float
-        Time of the first sample [s].
+        Time of the first sample [s], >= 0 (the body is at rest before it). Record files
+        whose time column starts elsewhere are shifted to 0 when read (with a note).
     """
 
     acc: NDArray[np.float64]
@@ -106,6 +107,13 @@ class SampledAccel:
             )
         if isinstance(self.dt, bool) or not (math.isfinite(float(self.dt)) and self.dt > 0):
             raise InputError(f"must be finite and > 0, got {self.dt!r}", "dt")
+        t0 = float(self.t0)
+        if not (math.isfinite(t0) and t0 >= 0.0):
+            raise InputError(
+                f"must be finite and >= 0, got {self.t0!r} (the body is at rest before the first "
+                "sample; shift the time axis so that it starts at 0)",
+                "t0",
+            )
         a.setflags(write=False)
         object.__setattr__(self, "acc", a)
         object.__setattr__(self, "dt", float(self.dt))

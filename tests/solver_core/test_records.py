@@ -373,3 +373,12 @@ def test_an_implausible_record_gets_a_warning_naming_its_units(
         assert any(expect in w and f"read in {units}" in w for w in motion.warnings), (
             motion.warnings
         )
+
+
+def test_a_record_starting_before_zero_is_refused_by_the_solver_view() -> None:
+    from solver_service.core.excitation import SampledAccel
+
+    with pytest.raises(InputError, match="t0: must be finite and >= 0"):
+        SampledAccel(np.zeros(10), 0.01, t0=-2.0)
+    later = SampledAccel(np.zeros(10), 0.01, t0=5.0)
+    assert later.time[0] == 5.0
