@@ -10,8 +10,10 @@ I0 : generalised inertia of the mechanism at ``phi_cr`` [kg m^2]
 K : rotational stiffness of the linearised system (acts as a negative stiffness) [N m/rad]
 Q : ground-motion coefficient [kg m]
 phi_cr : critical rotation, the unstable equilibrium under gravity alone [rad]
-M_F : moment of the external static forces about the hinge, positive when it drives
-    collapse (positive rotation); the same value and sign serve both sides [N m]
+M_F : moment of the external static forces about the side's hinge(s), signed in the
+    mechanism's positive sense on *both* sides: positive when it drives positive rotation
+    [N m]. On the negative side a moment that drives that side towards collapse is
+    therefore negative (theory §1.8)
 p_eq : equivalent frequency parameter, ``sqrt(K / I0)`` (Eq. 4) [rad/s]
 lam : linearised static load multiplier (Eq. 5; §1.8 for the negative side) [-]
 phi_ov : overturning rotation (Eq. 6; §1.8 for the negative side) [rad]
@@ -19,6 +21,15 @@ eta : coefficient of restitution on the angular velocity at impact [-]
 f_n : natural frequency of the supporting structure [Hz]
 h_e : effective (modal) height of the supporting structure [m]
 h : height of the mechanism's base above the ground [m]
+
+Sign conventions per side. ``I0``, ``K``, ``Q``, ``phi_cr``, ``p_eq``, ``lam`` and
+``phi_ov`` are magnitudes (> 0) on both sides, each measured for the motion of that side
+(``phi_cr`` and ``phi_ov`` are the sizes of the negative rotations on the negative side).
+``M_F`` alone keeps a global sign, positive when it drives positive rotation, so that one
+force can be written with the same sign on both sides; ``s = +1`` on the positive side and
+``-1`` on the negative side turns it into the side's own driving moment ``s * M_F`` in
+Eqs. 5-6. A builder that computes the negative side in a mirrored frame (where its moment
+is positive when it drives the negative collapse) must change its sign before writing it.
 
 A side is given either by its physical constants (``I0``, ``K``, ``Q``, ``phi_cr`` and
 optionally ``M_F``), from which ``p_eq``, ``lam`` and ``phi_ov`` are derived, or in the short
@@ -180,8 +191,10 @@ class SideConstants(BaseModel):
     phi_cr : float, optional
         Critical rotation [rad], > 0.
     M_F : float, optional
-        Moment of the static forces, positive when it drives collapse [N m]. Defaults to 0
-        in the physical form; absent in the short form.
+        Moment of the static forces about this side's hinge(s) [N m], signed in the
+        mechanism's positive sense on both sides: positive when it drives positive rotation,
+        so negative on the negative side when it drives that side towards collapse. Defaults
+        to 0 in the physical form; absent in the short form.
     p_eq : float, optional
         Equivalent frequency parameter [rad/s], > 0.
     lam : float, optional
@@ -225,9 +238,11 @@ class SideConstants(BaseModel):
     M_F: Optional[float] = Field(
         None,
         description=(
-            "Moment of the external static forces about the hinge at phi_cr [N m], any finite "
-            "value, positive when it drives collapse (positive rotation) on both sides. "
-            "Defaults to 0 in the physical form."
+            "Moment of the external static forces about this side's hinge(s) at phi_cr [N m], "
+            "any finite value, signed in the mechanism's positive sense on both sides: positive "
+            "when it drives positive rotation. On the negative side a moment that drives that "
+            "side towards collapse is negative (lam = (K*phi_cr + M_F)/(g*Q) there). The other "
+            "constants are magnitudes on both sides. Defaults to 0 in the physical form."
         ),
     )
     p_eq: Optional[float] = Field(None, gt=0, description=_P_EQ_DESCRIPTION)
@@ -436,8 +451,10 @@ class Mechanism(BaseModel):
     negative: Optional[SideConstants] = Field(
         None,
         description=(
-            "Constants for negative rotation, as magnitudes; absent for a symmetric "
-            "mechanism. Ignored for one-sided rocking."
+            "Constants for negative rotation, as magnitudes except M_F, which keeps the "
+            "positive sense; absent for a symmetric mechanism (the positive side's mirror "
+            "image: the same magnitudes and M_F of opposite sign). Ignored for one-sided "
+            "rocking."
         ),
     )
     eta: Optional[float] = Field(

@@ -22,8 +22,18 @@ __all__ = ["MECHANISMS", "constants_from_spec", "mechanism_entry"]
 SYMMETRY_RTOL = 1e-9
 
 
-def _same(a: Dict[str, float], b: Dict[str, float]) -> bool:
-    return all(abs(a[k] - b[k]) <= SYMMETRY_RTOL * max(abs(a[k]), abs(b[k]), 1e-300) for k in a)
+def _mirror_image(positive: Dict[str, float], negative: Dict[str, float]) -> bool:
+    """Tell whether the negative side is the positive side's mirror image.
+
+    The magnitudes agree and ``M_F``, signed in the positive sense on both sides
+    (``shared_schema.constants``), changes sign; the solver's constants then coincide.
+    """
+    mirrored = dict(negative, M_F=-negative.get("M_F", 0.0))
+    return all(
+        abs(positive[k] - mirrored[k])
+        <= SYMMETRY_RTOL * max(abs(positive[k]), abs(mirrored[k]), 1e-300)
+        for k in positive
+    )
 
 
 #: Mechanism typologies and their builders. Adding a typology: one module with a builder
@@ -59,7 +69,7 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
 def _finish(spec: Any, entry: Dict[str, Any], sides: MechanismSides) -> Dict[str, Any]:
     """Complete an entry: sides, restitution, amplification, geometry and provenance.
 
-    The negative side is stored only where it differs from the positive one. A computed
+    The negative side is stored only where it is not the positive side's mirror image. A computed
     ``eta`` outside the range of the rocking kind ([0, 1] two-sided, [-1, 0] one-sided; a
     very stocky body) is clamped with a warning; a user ``eta`` overrides it, and the
     computed value is kept in the geometry summary.
@@ -67,7 +77,7 @@ def _finish(spec: Any, entry: Dict[str, Any], sides: MechanismSides) -> Dict[str
     positive, negative, eta = sides.positive, sides.negative, sides.eta
     geometry, eta_info, warnings = sides.geometry, sides.eta_info, sides.warnings
     entry["positive"] = positive
-    if negative is not None and not _same(positive, negative):
+    if negative is not None and not _mirror_image(positive, negative):
         entry["negative"] = negative
     if eta is not None:
         lo, hi = eta_range(spec.rocking == "one_sided")

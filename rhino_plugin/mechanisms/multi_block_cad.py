@@ -149,7 +149,7 @@ def multi_block_sides(
                 "one; give the mirrored set",
                 f"{where}.hinges_negative",
             )
-        negative = res_n.constants()
+        negative = res_n.constants("negative")
         eta = four_bar_restitution(blocks, tuple(hinges_pos), tuple(hinges_neg))
         summary["negative"] = {
             "collapse_sense": dir_n,

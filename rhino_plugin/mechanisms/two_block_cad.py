@@ -114,6 +114,7 @@ def two_block_sides(
     )
     positive = res.constants()
     negative = None
+    neg_details: Optional[Dict[str, float]] = None
     eta = None
     if spec.rocking == "two_sided":
         neg = two_block_constants(
@@ -124,7 +125,11 @@ def two_block_sides(
             overburden_point=(-b - x_p, h),
             eccentricity=ecc,
         )
-        negative = neg.constants()
+        # neg is the mirrored wall: its M_F drives the inward collapse, which the file
+        # writes with a negative sign (shared_schema.constants: M_F per side is signed in
+        # the positive sense).
+        negative = neg.constants("negative")
+        neg_details = {k: float(v) for k, v in neg.details.items()}
         eta = two_block_restitution(b1, b2, *hinges, *mirrored)
     summary: Dict[str, Any] = {
         "thickness_m": b,
@@ -141,6 +146,9 @@ def two_block_sides(
         "static_multiplier_exact": res.details.get("lam_static_exact"),
         "details": {k: float(v) for k, v in res.details.items()},
     }
+    if neg_details is not None:
+        # The negative side's details are in the mirrored wall's frame (x inward).
+        summary["negative_details"] = neg_details
     if overburden_ids:
         summary["overburden_objects"] = overburden_ids
     return positive, negative, eta, summary
