@@ -148,7 +148,12 @@ class Vault(BaseModel):
 
 
 class Overburden(BaseModel):
-    """What loads the top of a two-block wall: objects (weight share) or a given force [N]."""
+    """What loads the top of a two-block wall: objects (weight share) or a given force [N].
+
+    With ``objects``, N is ``tributary`` times their weight; ``tributary`` defaults to 0.5
+    (a slab spanning between the wall and one parallel support), and the output says when
+    that default was used.
+    """
 
     model_config = _STRICT
     objects: Optional[List[Selector]] = Field(default=None, min_length=1)
@@ -207,7 +212,13 @@ class MechanismSpec(BaseModel):
     axis : Axis
         Rotation axis for positive rotation (the collapse direction).
     axis_negative : Axis, optional
-        Axis of the other rocking side (two-sided); derived from the base footprint if absent.
+        Axis of the other rocking side (two-sided ``single_block``); derived from the base
+        footprint if absent. Refused for ``two_block``, whose negative hinges are the mirror
+        of O, C, H about the wall's mid-plane.
+    hinges, hinges_negative : Hinges, optional
+        ``multi_block``: the four hinges of the positive set and of the negative set. The
+        negative set is optional for two-sided rocking: when absent it is derived (each
+        hinge reflected across its column at its height) and a warning gives the points.
     allow_non_horizontal_axis : bool
         Accept an inclined axis (off by default).
     cracks : list of Crack
@@ -291,6 +302,12 @@ class MechanismSpec(BaseModel):
             raise ValueError("eta_rule applies to one-sided rocking only")
         if self.axis_negative is not None and self.rocking == "one_sided":
             raise ValueError("axis_negative applies to two-sided rocking only")
+        if self.axis_negative is not None and self.typology == "two_block":
+            raise ValueError(
+                "axis_negative does not apply to a two_block wall: its negative hinges O', C', "
+                "H' are always the mirror of O, C, H about the wall's mid-plane (base inner "
+                "edge, outer face at h_c, top inner edge)"
+            )
         return self
 
 

@@ -1,9 +1,14 @@
 """Three blocks, four hinges (A4) from CAD solids.
 
 Each block is a list of density groups; the hinges A, B, C, D are points or line objects
-(a line's mid-point is used). The mechanism moves in the vertical plane through A and D:
+(a line's mid-point is used). The mechanism moves in the vertical plane fitted through all
+the hinges (``_plane``: each hinge must lie on it, each hinge line must be normal to it):
 planar x runs horizontally from A towards D, z up; each block's inertia is taken about
 the horizontal axis normal to that plane.
+
+Without ``hinges_negative`` a two-sided mechanism gets a derived negative set (each hinge
+reflected across its column at its height, ``_mirrored``), and a warning says so and gives
+the derived points.
 
 For each hinge set the sense of motion is the one in which the weight resists at rest
 (the hinges open; the other sense is not kinematically admissible for unilateral
@@ -44,6 +49,11 @@ def _hinge(scene: Any, hinge: Any, where: str) -> Tuple[np.ndarray, Optional[np.
     start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
     d = end - start
     return 0.5 * (start + end), d / float(np.linalg.norm(d))
+
+
+def _hinge_point(scene: Any, hinge: Any, where: str) -> np.ndarray:
+    """Return a hinge's point [m] (a line object's mid-point); used by the flows' marks."""
+    return _hinge(scene, hinge, where)[0]
 
 
 def _plane(
@@ -226,6 +236,14 @@ def multi_block_sides(
             ]
             hinges_neg = _mirrored(hinges_pos, cols)
             summary["hinges_negative_derived"] = [list(h) for h in hinges_neg]
+            derived = ", ".join(
+                f"{n}' = {[round(float(v), 6) for v in origin + x * ex + np.array([0, 0, z])]}"
+                for n, (x, z) in zip(names, hinges_neg)
+            )
+            notes.append(
+                f"{where}: hinges_negative not given; derived by reflecting each hinge across "
+                f"its column at its height: {derived} [m]. Give hinges_negative to set them"
+            )
         res_n, dir_n = _solve(blocks, hinges_neg, f"{where}.hinges_negative")
         if dir_n == direction:
             raise InputError(

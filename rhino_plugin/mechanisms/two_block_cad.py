@@ -55,7 +55,10 @@ def _mirror(body: Any, b: float) -> Any:
 def two_block_sides(
     spec: Any, scene: Any, body: Any, pos: Any
 ) -> Tuple[Dict[str, float], Optional[Dict[str, float]], Optional[float], Dict[str, Any]]:
-    """Constants of both sides of a two-block wall, eta (or None) and a summary."""
+    """Constants of both sides of a two-block wall, eta (or None) and a summary.
+
+    The summary's ``warnings`` (popped by the builder) state the defaults that were used.
+    """
     where = spec.id
     o, out, ax = pos.point, pos.outward, pos.direction
     rel = body.vertices - o
@@ -70,11 +73,19 @@ def two_block_sides(
     n = 0.0
     x_p = -0.5 * b  # a given force acts on the wall's centre line
     overburden_ids: List[str] = []
+    notes: List[str] = []
     if ob is not None and ob.force is not None:
         n = float(ob.force)
     elif ob is not None:
-        meshes, overburden_ids, _ = element_solids(scene, ob.objects, f"{where}.overburden")
+        meshes, overburden_ids, repairs = element_solids(scene, ob.objects, f"{where}.overburden")
+        notes.extend(repairs)
         n = ob.tributary * G * sum(mass_properties(m, ob.density).mass for m in meshes)
+        if "tributary" not in ob.model_fields_set:
+            notes.append(
+                f"{where}.overburden: tributary not given; the wall carries the default "
+                f"{ob.tributary:g} of the overburden's weight (N = {n:.6g} N). Give "
+                "'tributary' to set the share"
+            )
         _, point, _ = largest_contact(meshes, body.meshes, f"{where}.overburden")
         x_p = float((point - o) @ out)
     f_mt = float(spec.f_mt or 0.0)
@@ -151,6 +162,8 @@ def two_block_sides(
         summary["negative_details"] = neg_details
     if overburden_ids:
         summary["overburden_objects"] = overburden_ids
+        summary["overburden_tributary"] = float(ob.tributary) if ob is not None else None
+    summary["warnings"] = notes
     return positive, negative, eta, summary
 
 
@@ -158,13 +171,8 @@ def build_two_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
     """Builder of typology ``two_block`` (docs/theory.md §2.3); ``table`` is unused."""
     body, pos, geometry = rigid_body(spec, scene)
     positive, negative, eta, summary = two_block_sides(spec, scene, body, pos)
+    warnings = list(body.warnings) + summary.pop("warnings")
     geometry["two_block"] = summary
     return MechanismSides(
-        positive,
-        negative,
-        eta,
-        "momentum_projection",
-        geometry,
-        body.object_ids,
-        list(body.warnings),
+        positive, negative, eta, "momentum_projection", geometry, body.object_ids, warnings
     )
