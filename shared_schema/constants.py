@@ -18,6 +18,9 @@ p_eq : equivalent frequency parameter, ``sqrt(K / I0)`` (Eq. 4) [rad/s]
 lam : linearised static load multiplier (Eq. 5; §1.8 for the negative side) [-]
 phi_ov : overturning rotation (Eq. 6; §1.8 for the negative side) [rad]
 eta : coefficient of restitution on the angular velocity at impact [-]
+eta_to_negative, eta_to_positive : restitution at an impact after which the mechanism rocks
+    on its negative (positive) side, for asymmetric two-sided mechanisms whose two impact
+    directions differ [-]
 f_n : natural frequency of the supporting structure [Hz]
 h_e : effective (modal) height of the supporting structure [m]
 h : height of the mechanism's base above the ground [m]
@@ -415,6 +418,12 @@ class Mechanism(BaseModel):
     eta_source : str, optional
         Where ``eta`` comes from (one of ``ETA_SOURCES``); ``"user"`` when ``eta`` is given
         without it.
+    eta_to_negative, eta_to_positive : float, optional
+        Two-sided rocking only, given together and with ``eta``: the restitution at an
+        impact after which the mechanism rocks on its negative side (the hinges switch from
+        the positive to the negative set) and on its positive side [-], each in [0, 1] and
+        the ratio of the angular speeds after/before. ``eta`` must lie between them (it is
+        the one value a solver uses when it does not tell the impacts apart).
     amplification : Amplification, optional
         Data for amplifying the ground motion up the structure.
     geometry : dict, optional
@@ -468,6 +477,28 @@ class Mechanism(BaseModel):
     )
     eta_source: Optional[EtaSource] = Field(
         None, description="Where eta comes from; 'user' when eta is given without it."
+    )
+    eta_to_negative: Optional[float] = Field(
+        None,
+        ge=0,
+        le=1,
+        description=(
+            "Two-sided rocking: coefficient of restitution at an impact after which the "
+            "mechanism rocks on its negative side (hinges switch from the positive to the "
+            "negative set), |dphi after| / |dphi before| [-], in [0, 1]. Given together with "
+            "eta_to_positive and eta, for mechanisms whose two impact directions differ."
+        ),
+    )
+    eta_to_positive: Optional[float] = Field(
+        None,
+        ge=0,
+        le=1,
+        description=(
+            "Two-sided rocking: coefficient of restitution at an impact after which the "
+            "mechanism rocks on its positive side (hinges switch from the negative to the "
+            "positive set), |dphi after| / |dphi before| [-], in [0, 1]. Given together with "
+            "eta_to_negative and eta."
+        ),
     )
     amplification: Optional[Amplification] = Field(
         None, description="Data for amplifying the ground motion up the structure (theory §7)."
@@ -530,6 +561,29 @@ class Mechanism(BaseModel):
             raise _error("eta_source", "eta_source is given but eta is not")
         if self.eta is not None and self.eta_source is None:
             self.eta_source = "user"
+        to_neg, to_pos = self.eta_to_negative, self.eta_to_positive
+        if to_neg is not None or to_pos is not None:
+            if to_neg is None or to_pos is None:
+                missing = "eta_to_positive" if to_pos is None else "eta_to_negative"
+                raise _error(missing, "eta_to_negative and eta_to_positive go together")
+            if self.rocking == "one_sided":
+                raise _error(
+                    "eta_to_negative",
+                    "eta_to_negative and eta_to_positive apply to two-sided rocking only",
+                )
+            if self.eta is None:
+                raise _error(
+                    "eta",
+                    "eta_to_negative and eta_to_positive need eta, the value used where the "
+                    "two impacts are not told apart",
+                )
+            lo, hi = min(to_neg, to_pos), max(to_neg, to_pos)
+            if not lo <= self.eta <= hi:
+                raise _error(
+                    "eta",
+                    f"eta = {self.eta!r} is not between eta_to_negative = "
+                    f"{self.eta_to_negative!r} and eta_to_positive = {self.eta_to_positive!r}",
+                )
         if self.name is None:
             self.name = self.id
         return self

@@ -66,6 +66,24 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
     return _finish(spec, entry, sides)
 
 
+def _directional_etas(spec: Any, eta_info: Dict[str, Any]) -> Dict[str, float]:
+    """``eta_to_negative``/``eta_to_positive`` of a two-sided mechanism whose impacts differ.
+
+    The builders record the computed restitution of both impact directions in ``eta_info``
+    (``eta_pos_to_neg``, ``eta_neg_to_pos``); they are written only when they differ, and
+    clamped to [0, 1] like ``eta``.
+    """
+    to_neg, to_pos = eta_info.get("eta_pos_to_neg"), eta_info.get("eta_neg_to_pos")
+    if spec.rocking != "two_sided" or to_neg is None or to_pos is None:
+        return {}
+    if abs(to_neg - to_pos) <= SYMMETRY_RTOL * max(abs(to_neg), abs(to_pos), 1e-300):
+        return {}
+    return {
+        "eta_to_negative": min(max(float(to_neg), 0.0), 1.0),
+        "eta_to_positive": min(max(float(to_pos), 0.0), 1.0),
+    }
+
+
 def _finish(spec: Any, entry: Dict[str, Any], sides: MechanismSides) -> Dict[str, Any]:
     """Complete an entry: sides, restitution, amplification, geometry and provenance.
 
@@ -94,6 +112,7 @@ def _finish(spec: Any, entry: Dict[str, Any], sides: MechanismSides) -> Dict[str
             eta_info["computed"] = eta
     elif eta is not None:
         entry["eta"], entry["eta_source"] = eta, sides.eta_source
+        entry.update(_directional_etas(spec, eta_info))
     if eta_info:
         geometry["restitution"] = eta_info
     if spec.amplification is not None:

@@ -253,6 +253,12 @@ def multi_block_sides(
             )
         negative = res_n.constants("negative")
         eta = four_bar_restitution(blocks, tuple(hinges_pos), tuple(hinges_neg))
+        # Both impact directions (theory §3.4); they differ for an asymmetric linkage.
+        summary["restitution"] = {
+            "rule": "momentum projection (theory §3.4); eta is the positive-to-negative value",
+            "eta_pos_to_neg": eta,
+            "eta_neg_to_pos": four_bar_restitution(blocks, tuple(hinges_neg), tuple(hinges_pos)),
+        }
         summary["negative"] = {
             "collapse_sense": dir_n,
             **{k: float(v) for k, v in res_n.details.items()},
@@ -265,6 +271,14 @@ def build_multi_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
     """Builder of typology ``multi_block`` (docs/theory.md §2.4); ``table`` is unused."""
     positive, negative, eta, summary, ids = multi_block_sides(spec, scene)
     warnings = summary.pop("warnings")
+    eta_info = summary.pop("restitution", {})
     return MechanismSides(
-        positive, negative, eta, "momentum_projection", {"multi_block": summary}, ids, warnings
+        positive,
+        negative,
+        eta,
+        "momentum_projection",
+        {"multi_block": summary},
+        ids,
+        warnings,
+        eta_info,
     )

@@ -126,6 +126,7 @@ def two_block_sides(
     positive = res.constants()
     negative = None
     neg_details: Optional[Dict[str, float]] = None
+    summary_eta: Dict[str, Any] = {}
     eta = None
     if spec.rocking == "two_sided":
         neg = two_block_constants(
@@ -142,6 +143,12 @@ def two_block_sides(
         negative = neg.constants("negative")
         neg_details = {k: float(v) for k, v in neg.details.items()}
         eta = two_block_restitution(b1, b2, *hinges, *mirrored)
+        # Both impact directions (theory §3.4); they differ for an asymmetric wall.
+        summary_eta = {
+            "rule": "momentum projection (theory §3.4); eta is the positive-to-negative value",
+            "eta_pos_to_neg": eta,
+            "eta_neg_to_pos": two_block_restitution(b1, b2, *mirrored, *hinges),
+        }
     summary: Dict[str, Any] = {
         "thickness_m": b,
         "height_m": h,
@@ -164,6 +171,7 @@ def two_block_sides(
         summary["overburden_objects"] = overburden_ids
         summary["overburden_tributary"] = float(ob.tributary) if ob is not None else None
     summary["warnings"] = notes
+    summary["restitution"] = summary_eta
     return positive, negative, eta, summary
 
 
@@ -172,7 +180,15 @@ def build_two_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
     body, pos, geometry = rigid_body(spec, scene)
     positive, negative, eta, summary = two_block_sides(spec, scene, body, pos)
     warnings = list(body.warnings) + summary.pop("warnings")
+    eta_info = summary.pop("restitution")
     geometry["two_block"] = summary
     return MechanismSides(
-        positive, negative, eta, "momentum_projection", geometry, body.object_ids, warnings
+        positive,
+        negative,
+        eta,
+        "momentum_projection",
+        geometry,
+        body.object_ids,
+        warnings,
+        eta_info,
     )
