@@ -10,6 +10,7 @@ in kg/m³, forces in N.
 Python 3.9-clean: imported by Rhino 8.
 """
 
+import json
 from typing import Any, Dict, List, Literal, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
@@ -332,34 +333,40 @@ class SpecFile(BaseModel):
         return mechs
 
 
+def _error_line(err: Any, data: Any) -> str:
+    loc = list(err["loc"])
+    path = ""
+    for part in loc:
+        path += f"[{part}]" if isinstance(part, int) else (f".{part}" if path else str(part))
+    if len(loc) >= 2 and loc[0] == "mechanisms" and isinstance(loc[1], int):
+        try:
+            ident = data["mechanisms"][loc[1]]["id"]
+            path = path.replace(f"mechanisms[{loc[1]}]", f"mechanisms[{loc[1]}] (id {ident!r})")
+        except (TypeError, KeyError, IndexError):
+            pass
+    msg = err["msg"].replace("Value error, ", "")
+    return f"{path}: {msg}" if path else msg
+
+
 def parse_spec(text: Union[str, bytes], source: str = "spec") -> SpecFile:
     """Validate a spec file's JSON text; errors name the mechanism and the field.
+
+    Every error is reported at once, one per line, so that one bad mechanism does not hide
+    the others.
 
     Raises
     ------
     InputError
-        With a message like ``spec.json: mechanisms[0] (id 'W1').groups[0].density: ...``.
+        With a message like ``spec.json: mechanisms[0] (id 'W1').groups[0].density: ...``
+        (one line per error).
     """
     try:
         return SpecFile.model_validate_json(text)
     except ValidationError as exc:
-        err = exc.errors()[0]
-        loc = list(err["loc"])
-        path = ""
-        for part in loc:
-            path += f"[{part}]" if isinstance(part, int) else (f".{part}" if path else str(part))
         data: Any = None
         try:
-            import json
-
             data = json.loads(text)
         except ValueError:
             pass
-        if len(loc) >= 2 and loc[0] == "mechanisms" and isinstance(loc[1], int):
-            try:
-                ident = data["mechanisms"][loc[1]]["id"]
-                path = path.replace(f"mechanisms[{loc[1]}]", f"mechanisms[{loc[1]}] (id {ident!r})")
-            except (TypeError, KeyError, IndexError):
-                pass
-        msg = err["msg"].replace("Value error, ", "")
-        raise InputError(f"{path}: {msg}" if path else msg, source) from None
+        lines = [_error_line(err, data) for err in exc.errors()]
+        raise InputError("\n".join(lines), source) from None

@@ -16,6 +16,7 @@ from typing import Any, NoReturn, Optional, TypeVar
 
 import typer
 
+from rhino_plugin.mechanisms.build import MechanismFailure
 from shared_schema.errors import RockmechError
 from shared_schema.io import save_constants, write_atomic
 
@@ -34,7 +35,12 @@ from .workflows.documents import (
     record_analysis,
     record_pulse_doc,
 )
-from .workflows.inputs import constants_from_files, read_constants, read_record
+from .workflows.inputs import (
+    constants_from_files,
+    constants_keep_going,
+    read_constants,
+    read_record,
+)
 from .workflows.outputs import finite_json, write_envelope, write_history, write_record
 from .workflows.scaling import Building
 
@@ -404,12 +410,34 @@ def constants(
     spec: Path = typer.Argument(..., help="Mechanism spec (JSON)."),
     output: Path = typer.Option(..., "-o", "--output", help="Kinematic-constants JSON to write."),
     as_json: bool = typer.Option(False, "--json", help="Also print the constants JSON."),
+    keep_going: bool = typer.Option(
+        False,
+        "--keep-going",
+        help=(
+            "Write the mechanisms that succeed and list the ones that fail (exit status 1 "
+            "when any failed). Without it, any failure writes nothing and lists every failure."
+        ),
+    ),
 ) -> None:
     """Kinematic constants of every mechanism in SPEC from the solids of SCENE."""
-    cf = constants_from_files(scene, spec)
+    failures: list[MechanismFailure] = []
+    if keep_going:
+        cf, failures = constants_keep_going(scene, spec)
+    else:
+        cf = constants_from_files(scene, spec)
     save_constants(output, cf)
+    if failures:
+        typer.echo(
+            f"error: {len(failures)} of {len(failures) + len(cf.mechanisms)} mechanisms failed "
+            f"and are not in {output}:",
+            err=True,
+        )
+        for failure in failures:
+            typer.echo(f"  {failure.message}", err=True)
     if as_json:
         _print_json(json.loads(cf.model_dump_json(exclude_none=True)))
+        if failures:
+            raise typer.Exit(code=1)
         return
     typer.echo(f"wrote {output}")
     for m in cf.mechanisms:
@@ -421,6 +449,8 @@ def constants(
         notes = (m.provenance or {}).get("warnings") or []
         for note in notes if isinstance(notes, list) else []:
             typer.echo(f"    warning: {note}")
+    if failures:
+        raise typer.Exit(code=1)
 
 
 @app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})

@@ -6,17 +6,27 @@ combined quantities and every element) and its provenance (source files, object 
 options, warnings from mesh repair).
 """
 
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+from pydantic import ValidationError
 
 from rhino_plugin.mechanisms import loaded, multi_block_cad, single, two_block_cad
 from rhino_plugin.mechanisms.base import Builder, MechanismSides
 from rhino_plugin.mechanisms.thrust import ThrustTable
-from shared_schema.constants import ConstantsFile
-from shared_schema.errors import InputError
+from shared_schema.constants import ConstantsFile, input_error_from_validation
+from shared_schema.errors import InputError, RockmechError
 from shared_schema.rules import eta_range
 
-__all__ = ["MECHANISMS", "constants_from_spec", "mechanism_entry"]
+__all__ = [
+    "MECHANISMS",
+    "MechanismFailure",
+    "constants_and_failures",
+    "constants_from_spec",
+    "failures_error",
+    "mechanism_entry",
+]
 
 #: Two sides whose constants agree to this relative tolerance are stored once (symmetric).
 SYMMETRY_RTOL = 1e-9
@@ -122,6 +132,104 @@ def _finish(spec: Any, entry: Dict[str, Any], sides: MechanismSides) -> Dict[str
     return entry
 
 
+@dataclass(frozen=True)
+class MechanismFailure:
+    """Why one mechanism of a spec could not be computed.
+
+    Attributes
+    ----------
+    id : str
+        The mechanism's id.
+    error : RockmechError
+        The error (its message names the field or object, and the mechanism).
+    """
+
+    id: str
+    error: RockmechError
+
+    @property
+    def message(self) -> str:
+        """The error's message, prefixed with the mechanism's id unless it already names it."""
+        text = str(self.error)
+        return text if text.startswith(self.id) else f"{self.id}: {text}"
+
+
+def failures_error(failures: Sequence[MechanismFailure], total: int) -> RockmechError:
+    """One error listing every failed mechanism, of the first failure's class.
+
+    Parameters
+    ----------
+    failures : sequence of MechanismFailure
+        At least one.
+    total : int
+        Number of mechanisms in the spec.
+    """
+    first = failures[0].error
+    if total == 1 and len(failures) == 1:
+        return first
+    lines = [f"{len(failures)} of {total} mechanisms failed:"]
+    lines += [f"  {f.message}" for f in failures]
+    out = type(first)("\n".join(lines))
+    if isinstance(first, InputError) and isinstance(out, InputError):
+        out.field = first.field  # the first failure's field, for the REST answer
+    return out
+
+
+def constants_and_failures(
+    spec_file: Any,
+    scene: Any,
+    *,
+    scene_name: str,
+    spec_name: str,
+    spec_dir: Optional[Path] = None,
+) -> Tuple[Optional[ConstantsFile], List[MechanismFailure]]:
+    """Compute every mechanism of a spec; collect the failures instead of stopping at one.
+
+    Returns
+    -------
+    constants : ConstantsFile or None
+        The mechanisms that succeeded, in spec order; None when none did.
+    failures : list of MechanismFailure
+        The mechanisms that failed, in spec order, each with its error.
+    """
+    table_path = None
+    if spec_file.thrust_table is not None:
+        table_path = Path(spec_file.thrust_table)
+        if not table_path.is_absolute() and spec_dir is not None:
+            table_path = spec_dir / table_path
+    table = ThrustTable.load(table_path)
+    mechanisms: List[Dict[str, Any]] = []
+    failures: List[MechanismFailure] = []
+    for spec in spec_file.mechanisms:
+        entry: Dict[str, Any] = {}
+        try:
+            entry = mechanism_entry(spec, scene, table)
+            entry["provenance"].update(
+                {
+                    "scene": scene_name,
+                    "spec": spec_name,
+                    "scene_units": scene.units,
+                    "thrust_table": table.name if spec.vaults else None,
+                }
+            )
+            if entry["provenance"]["thrust_table"] is None:
+                del entry["provenance"]["thrust_table"]
+            # Validate each entry on its own, so that one bad entry does not hide the others.
+            ConstantsFile.model_validate({"mechanisms": [entry]})
+        except ValidationError as exc:
+            err = input_error_from_validation(exc, {"mechanisms": [entry]})
+            field = (err.field or "").replace(f"mechanisms[0] (id {spec.id!r})", spec.id)
+            failures.append(MechanismFailure(spec.id, InputError(err.reason, field or spec.id)))
+            continue
+        except RockmechError as exc:
+            failures.append(MechanismFailure(spec.id, exc))
+            continue
+        mechanisms.append(entry)
+    if not mechanisms:
+        return None, failures
+    return ConstantsFile.model_validate({"mechanisms": mechanisms}), failures
+
+
 def constants_from_spec(
     spec_file: Any,
     scene: Any,
@@ -130,25 +238,18 @@ def constants_from_spec(
     spec_name: str,
     spec_dir: Optional[Path] = None,
 ) -> ConstantsFile:
-    """Kinematic-constants file for every mechanism of a spec file."""
-    table_path = None
-    if spec_file.thrust_table is not None:
-        table_path = Path(spec_file.thrust_table)
-        if not table_path.is_absolute() and spec_dir is not None:
-            table_path = spec_dir / table_path
-    table = ThrustTable.load(table_path)
-    mechanisms: List[Dict[str, Any]] = []
-    for spec in spec_file.mechanisms:
-        entry = mechanism_entry(spec, scene, table)
-        entry["provenance"].update(
-            {
-                "scene": scene_name,
-                "spec": spec_name,
-                "scene_units": scene.units,
-                "thrust_table": table.name if spec.vaults else None,
-            }
-        )
-        if entry["provenance"]["thrust_table"] is None:
-            del entry["provenance"]["thrust_table"]
-        mechanisms.append(entry)
-    return ConstantsFile.model_validate({"mechanisms": mechanisms})
+    """Kinematic-constants file for every mechanism of a spec file.
+
+    Raises
+    ------
+    RockmechError
+        If any mechanism fails: one error listing every failed mechanism (the class of the
+        first failure), so that a user sees all of them at once.
+    """
+    cf, failures = constants_and_failures(
+        spec_file, scene, scene_name=scene_name, spec_name=spec_name, spec_dir=spec_dir
+    )
+    if failures:
+        raise failures_error(failures, len(spec_file.mechanisms))
+    assert cf is not None
+    return cf
