@@ -4,8 +4,9 @@ A spec file says, per mechanism, which objects (by name, layer or id) form its d
 groups, where the rotation axis is, which cracks cut off the collapsing part, the rocking
 kind, and the added elements that exist: floors, roof, vaults and tie-bars. Only declared
 elements are computed; absent sections stay absent in every output. Unknown keys are
-errors. Lengths are in metres once the scene is read (file units are converted), densities
-in kg/m³, forces in N.
+errors. Lengths are in metres once the scene is read (file units are converted); points
+written in the spec are in metres unless the file's ``units`` says otherwise (``"file"``:
+the scene's model units). Densities are in kg/m³, forces in N.
 
 Python 3.9-clean: imported by Rhino 8.
 """
@@ -313,10 +314,21 @@ class MechanismSpec(BaseModel):
 
 
 class SpecFile(BaseModel):
-    """A mechanism-spec file: version and mechanisms (ids unique)."""
+    """A mechanism-spec file: version, units of its points and mechanisms (ids unique).
+
+    ``units`` says in which unit the points written in the spec (axis ``start``/``end``,
+    crack ``points``, hinge points) are: ``"m"`` (the default when absent), ``"cm"``,
+    ``"mm"``, or ``"file"`` for the scene file's model units. Objects of the scene are
+    always converted from the file's units.
+    """
 
     model_config = _STRICT
     spec_version: str = SPEC_VERSION
+    units: Optional[Literal["m", "cm", "mm", "file"]] = Field(
+        default=None,
+        description="Unit of the points written in the spec: m (default), cm, mm, or 'file' "
+        "for the scene file's model units.",
+    )
     thrust_table: Optional[str] = Field(
         default=None, description="Path of a user thrust table (JSON), relative to the spec."
     )

@@ -16,7 +16,7 @@ from rhino_plugin.mechanisms import loaded, multi_block_cad, single, two_block_c
 from rhino_plugin.mechanisms.base import Builder, MechanismSides
 from rhino_plugin.mechanisms.thrust import ThrustTable
 from shared_schema.constants import ConstantsFile, input_error_from_validation
-from shared_schema.errors import InputError, RockmechError
+from shared_schema.errors import GeometryError, InputError, RockmechError
 from shared_schema.rules import eta_range
 
 __all__ = [
@@ -175,6 +175,70 @@ def failures_error(failures: Sequence[MechanismFailure], total: int) -> Rockmech
     return out
 
 
+#: Metres per unit of the points written in a spec (``SpecFile.units``; "file" is the scene's).
+POINT_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
+
+
+def _point_scale(spec_file: Any, scene: Any) -> float:
+    units = spec_file.units or "m"
+    return float(scene.unit_scale) if units == "file" else POINT_UNITS[units]
+
+
+def _scaled(p: Any, scale: float) -> Any:
+    return [float(v) * scale for v in p] if isinstance(p, list) else p
+
+
+def _points_in_metres(spec: Any, scale: float) -> Any:
+    """Return the mechanism spec with its written points (axes, cracks, hinges) in metres."""
+    if scale == 1.0:
+        return spec
+    update: Dict[str, Any] = {}
+    for key in ("axis", "axis_negative"):
+        axis = getattr(spec, key)
+        if axis is not None and axis.start is not None:
+            update[key] = axis.model_copy(
+                update={"start": _scaled(axis.start, scale), "end": _scaled(axis.end, scale)}
+            )
+    if any(c.points is not None for c in spec.cracks):
+        update["cracks"] = [
+            c
+            if c.points is None
+            else c.model_copy(update={"points": [_scaled(p, scale) for p in c.points]})
+            for c in spec.cracks
+        ]
+    for key in ("hinges", "hinges_negative"):
+        hinges = getattr(spec, key)
+        if hinges is not None:
+            update[key] = hinges.model_copy(
+                update={n: _scaled(getattr(hinges, n), scale) for n in ("A", "B", "C", "D")}
+            )
+    return spec.model_copy(update=update)
+
+
+def _written_points(spec: Any) -> bool:
+    axes = [a for a in (spec.axis, spec.axis_negative) if a is not None and a.start is not None]
+    hinges = [h for h in (spec.hinges, spec.hinges_negative) if h is not None]
+    return bool(
+        axes
+        or any(c.points is not None for c in spec.cracks)
+        or any(isinstance(getattr(h, n), list) for h in hinges for n in ("A", "B", "C", "D"))
+    )
+
+
+def _units_hint(spec_file: Any, scene: Any) -> str:
+    units = spec_file.units or "m"
+    said = "the spec's 'units'" if spec_file.units is not None else "the default"
+    return (
+        f" (the points written in the spec are read in {units} [{said}] and the scene is in "
+        f'{scene.units}: if they are in another unit, set the spec\'s "units" to "file", '
+        '"m", "cm" or "mm")'
+    )
+
+
+#: Words of the geometry errors that an axis, crack or hinge far from the body gives.
+FAR_FROM_BODY = ("does not touch the body", "misses the body", "not at the body's base")
+
+
 def constants_and_failures(
     spec_file: Any,
     scene: Any,
@@ -200,7 +264,9 @@ def constants_and_failures(
     table = ThrustTable.load(table_path)
     mechanisms: List[Dict[str, Any]] = []
     failures: List[MechanismFailure] = []
-    for spec in spec_file.mechanisms:
+    scale = _point_scale(spec_file, scene)
+    for given in spec_file.mechanisms:
+        spec = _points_in_metres(given, scale)
         entry: Dict[str, Any] = {}
         try:
             entry = mechanism_entry(spec, scene, table)
@@ -214,12 +280,21 @@ def constants_and_failures(
             )
             if entry["provenance"]["thrust_table"] is None:
                 del entry["provenance"]["thrust_table"]
+            if spec_file.units is not None:
+                entry["provenance"]["spec_point_units"] = spec_file.units
             # Validate each entry on its own, so that one bad entry does not hide the others.
             ConstantsFile.model_validate({"mechanisms": [entry]})
         except ValidationError as exc:
             err = input_error_from_validation(exc, {"mechanisms": [entry]})
             field = (err.field or "").replace(f"mechanisms[0] (id {spec.id!r})", spec.id)
             failures.append(MechanismFailure(spec.id, InputError(err.reason, field or spec.id)))
+            continue
+        except GeometryError as exc:
+            # A body far from the written points most often means points in another unit.
+            far = any(words in str(exc) for words in FAR_FROM_BODY)
+            if far and _written_points(given):
+                exc = GeometryError(str(exc) + _units_hint(spec_file, scene))
+            failures.append(MechanismFailure(spec.id, exc))
             continue
         except RockmechError as exc:
             failures.append(MechanismFailure(spec.id, exc))
