@@ -6,14 +6,17 @@ combined quantities and every element) and its provenance (source files, object 
 options, warnings from mesh repair).
 """
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
+import numpy as np
 from pydantic import ValidationError
 
 from rhino_plugin.mechanisms import loaded, multi_block_cad, single, two_block_cad
 from rhino_plugin.mechanisms.base import Builder, MechanismSides
+from rhino_plugin.mechanisms.single import AXIS_TILT_TOL, resolve_axis
 from rhino_plugin.mechanisms.thrust import ThrustTable
 from shared_schema.constants import ConstantsFile, input_error_from_validation
 from shared_schema.errors import GeometryError, InputError, RockmechError
@@ -58,6 +61,80 @@ MECHANISMS: Dict[str, Builder] = {
 }
 
 
+#: Relative error on lam (and p_eq²) accepted from the horizontal-axis formulas when an
+#: inclined axis is allowed (``allow_non_horizontal_axis``).
+TILT_RTOL = 1e-3
+#: Largest tilt of a rocking axis for any body [rad]: ``(pi/2) sqrt(2 TILT_RTOL)``, the bound
+#: below at the largest possible alpha.
+MAX_AXIS_TILT = 0.5 * math.pi * math.sqrt(2.0 * TILT_RTOL)
+
+
+def _axis_tilt(spec: Any, scene: Any) -> float:
+    """Largest tilt from the horizontal of the spec's rocking axes [rad] (0 without axes).
+
+    Raises
+    ------
+    GeometryError
+        An inclined axis is allowed but tilted beyond ``MAX_AXIS_TILT``, or a two-block
+        wall's axis is tilted beyond ``AXIS_TILT_TOL`` (refused up front, before any solid
+        is cut).
+    """
+    tilts = [0.0]
+    for key in ("axis", "axis_negative"):
+        axis = getattr(spec, key, None)
+        if axis is None:
+            continue
+        start, end = resolve_axis(scene, axis, f"{spec.id}.{key}")
+        u = (end - start) / float(np.linalg.norm(end - start))
+        tilts.append(math.asin(min(abs(float(u[2])), 1.0)))
+    tilt = max(tilts)
+    if tilt <= AXIS_TILT_TOL or not spec.allow_non_horizontal_axis:
+        return tilt  # the builder refuses a tilt beyond AXIS_TILT_TOL without the flag
+    if spec.typology == "two_block" or tilt > MAX_AXIS_TILT:
+        largest = AXIS_TILT_TOL if spec.typology == "two_block" else MAX_AXIS_TILT
+        raise GeometryError(
+            f"{spec.id}.axis: the axis is inclined by {math.degrees(tilt):.3f} deg; the "
+            f"largest tilt supported for a {spec.typology} is {math.degrees(largest):.3f} deg. "
+            "The constants (theory Eqs. 7-16, 18-23) are derived for a horizontal axis; about "
+            "an axis inclined by t, lam is overestimated by about t²/(2 alpha²). Model the "
+            "mechanism with a horizontal axis"
+        )
+    return tilt
+
+
+def _check_tilt(spec: Any, tilt: float, geometry: Dict[str, Any]) -> str:
+    """Refuse a tilt that the horizontal-axis formulas do not bear; else a warning.
+
+    About an axis inclined by ``t`` the potential energy is ``M g R cos(t) cos(phi - alpha)``
+    with ``alpha`` the angle, in the plane normal to the axis, between the axis-to-G
+    perpendicular and the vertical's projection: exactly ``K = M g R cos(t)``,
+    ``phi_cr = alpha``, ``Q = M R``. The horizontal-axis formulas use ``K = M g R`` and an
+    angle ``alpha_used`` with ``cos(alpha_used) = cos(alpha) cos(t)``, so they overestimate
+    lam by ``1 - alpha cos(t)/alpha_used``, about ``t²/(2 alpha²)`` (relative).
+    """
+    alphas = [
+        float(geometry[side]["alpha_rad"])
+        for side in ("positive", "negative")
+        if isinstance(geometry.get(side), dict) and "alpha_rad" in geometry[side]
+    ]
+    alpha = min(alphas) if alphas else 0.5 * math.pi
+    # The angle about the inclined axis: cos(alpha_true) = cos(alpha_used) / cos(t).
+    true_alpha = math.acos(min(math.cos(alpha) / math.cos(tilt), 1.0))
+    error = 1.0 - true_alpha * math.cos(tilt) / alpha
+    largest = true_alpha * math.sqrt(2.0 * TILT_RTOL)
+    if error > TILT_RTOL:
+        raise GeometryError(
+            f"{spec.id}.axis: the axis is inclined by {math.degrees(tilt):.3f} deg, which "
+            f"overestimates lam by {100 * error:.2g} % (the constants take the axis "
+            f"horizontal); the largest tilt supported for this body (alpha = "
+            f"{true_alpha:.4f} rad) is {math.degrees(largest):.3f} deg"
+        )
+    return (
+        f"{spec.id}.axis: the axis is inclined by {math.degrees(tilt):.3f} deg; the constants "
+        f"take it horizontal, which overestimates lam by {100 * error:.2g} % at most here"
+    )
+
+
 def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
     """One mechanism of the constants file from its spec (through ``MECHANISMS``)."""
     builder = MECHANISMS.get(spec.typology)
@@ -66,7 +143,10 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
             f"no builder for typology {spec.typology!r}; known: {sorted(MECHANISMS)}",
             f"{spec.id}.typology",
         )
+    tilt = _axis_tilt(spec, scene)
     sides = builder(spec, scene, table)
+    if tilt > AXIS_TILT_TOL:
+        sides.warnings.append(_check_tilt(spec, tilt, sides.geometry))
     entry: Dict[str, Any] = {
         "id": spec.id,
         "name": spec.name or spec.id,

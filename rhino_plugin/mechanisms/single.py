@@ -195,11 +195,11 @@ def rocking_side(
         raise GeometryError(
             f"{where}: the axis does not touch the body (closest vertex {dist.min():.4f} m away)"
         )
-    z_axis = float(start[2] + u[2] * np.dot(body.props.com - start, u))
-    if body.vertices[:, 2].min() < z_axis - tol:
+    # Height of the axis where each vertex projects on it (an inclined axis rises along u).
+    below = float(np.max(start[2] + u[2] * (d @ u) - body.vertices[:, 2]))
+    if below > tol:
         raise GeometryError(
-            f"{where}: the axis is not at the body's base (the body reaches "
-            f"{z_axis - body.vertices[:, 2].min():.4f} m below it)"
+            f"{where}: the axis is not at the body's base (the body reaches {below:.4f} m below it)"
         )
     g = np.asarray(body.props.com, dtype=float)
     dg = g - start
