@@ -97,17 +97,26 @@ class Crack(BaseModel):
 
     ``keep`` is ``"axis_side"`` (default: keep the part that contains the rotation axis),
     ``"positive"`` or ``"negative"`` (the side the plane normal points to, or the other).
+    ``keep_point`` names a point on the side to keep instead, which needs no knowledge of
+    the plane's normal (in the spec's ``units``).
     """
 
     model_config = _STRICT
     object: Optional[Selector] = Field(default=None, description="A planar object.")
     points: Optional[List[Point3]] = Field(default=None, description="Three points [m].")
     keep: Literal["axis_side", "positive", "negative"] = "axis_side"
+    keep_point: Optional[Point3] = Field(
+        default=None, description="A point on the side of the crack to keep [m]."
+    )
 
     @model_validator(mode="after")
     def _one_form(self) -> "Crack":
         if (self.object is None) == (self.points is None):
             raise ValueError("give either 'object' or 'points' (three points)")
+        if self.keep_point is not None:
+            _point(self.keep_point, "keep_point")
+            if "keep" in self.model_fields_set:
+                raise ValueError("give either 'keep' or 'keep_point', not both")
         if self.points is not None:
             if len(self.points) != 3:
                 raise ValueError(f"'points' needs exactly 3 points, got {len(self.points)}")

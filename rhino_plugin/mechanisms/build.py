@@ -279,11 +279,14 @@ def _points_in_metres(spec: Any, scale: float) -> Any:
             update[key] = axis.model_copy(
                 update={"start": _scaled(axis.start, scale), "end": _scaled(axis.end, scale)}
             )
-    if any(c.points is not None for c in spec.cracks):
+    if any(c.points is not None or c.keep_point is not None for c in spec.cracks):
         update["cracks"] = [
-            c
-            if c.points is None
-            else c.model_copy(update={"points": [_scaled(p, scale) for p in c.points]})
+            c.model_copy(
+                update={
+                    "points": None if c.points is None else [_scaled(p, scale) for p in c.points],
+                    "keep_point": None if c.keep_point is None else _scaled(c.keep_point, scale),
+                }
+            )
             for c in spec.cracks
         ]
     for key in ("hinges", "hinges_negative"):
@@ -300,7 +303,7 @@ def _written_points(spec: Any) -> bool:
     hinges = [h for h in (spec.hinges, spec.hinges_negative) if h is not None]
     return bool(
         axes
-        or any(c.points is not None for c in spec.cracks)
+        or any(c.points is not None or c.keep_point is not None for c in spec.cracks)
         or any(isinstance(getattr(h, n), list) for h in hinges for n in ("A", "B", "C", "D"))
     )
 
