@@ -24,7 +24,7 @@ import numpy as np
 from rhino_plugin.geometry.cut import cut_by_plane
 from rhino_plugin.geometry.massprops import combine, mass_properties
 from rhino_plugin.mechanisms.base import MechanismSides
-from rhino_plugin.mechanisms.loaded import element_solids, largest_contact
+from rhino_plugin.mechanisms.loaded import contact_tolerance, element_solids, largest_contact
 from rhino_plugin.mechanisms.single import rigid_body
 from rhino_plugin.mechanisms.two_block import (
     PlanarBody,
@@ -86,7 +86,9 @@ def two_block_sides(
                 f"{ob.tributary:g} of the overburden's weight (N = {n:.6g} N). Give "
                 "'tributary' to set the share"
             )
-        _, point, _ = largest_contact(meshes, body.meshes, f"{where}.overburden")
+        _, point, _ = largest_contact(
+            meshes, body.meshes, f"{where}.overburden", contact_tolerance(scene)
+        )
         x_p = float((point - o) @ out)
     f_mt = float(spec.f_mt or 0.0)
     h_c = hinge_height(h, weight, n, f_mt, length * b)
