@@ -10,15 +10,29 @@ I0 : generalised inertia of the mechanism at ``phi_cr`` [kg m^2]
 K : rotational stiffness of the linearised system (acts as a negative stiffness) [N m/rad]
 Q : ground-motion coefficient [kg m]
 phi_cr : critical rotation, the unstable equilibrium under gravity alone [rad]
-M_F : moment of the external static forces about the hinge, positive when it drives
-    collapse (positive rotation); the same value and sign serve both sides [N m]
+M_F : moment of the external static forces about the side's hinge(s), signed in the
+    mechanism's positive sense on *both* sides: positive when it drives positive rotation
+    [N m]. On the negative side a moment that drives that side towards collapse is
+    therefore negative (theory §1.8)
 p_eq : equivalent frequency parameter, ``sqrt(K / I0)`` (Eq. 4) [rad/s]
 lam : linearised static load multiplier (Eq. 5; §1.8 for the negative side) [-]
 phi_ov : overturning rotation (Eq. 6; §1.8 for the negative side) [rad]
 eta : coefficient of restitution on the angular velocity at impact [-]
+eta_to_negative, eta_to_positive : restitution at an impact after which the mechanism rocks
+    on its negative (positive) side, for asymmetric two-sided mechanisms whose two impact
+    directions differ [-]
 f_n : natural frequency of the supporting structure [Hz]
 h_e : effective (modal) height of the supporting structure [m]
 h : height of the mechanism's base above the ground [m]
+
+Sign conventions per side. ``I0``, ``K``, ``Q``, ``phi_cr``, ``p_eq``, ``lam`` and
+``phi_ov`` are magnitudes (> 0) on both sides, each measured for the motion of that side
+(``phi_cr`` and ``phi_ov`` are the sizes of the negative rotations on the negative side).
+``M_F`` alone keeps a global sign, positive when it drives positive rotation, so that one
+force can be written with the same sign on both sides; ``s = +1`` on the positive side and
+``-1`` on the negative side turns it into the side's own driving moment ``s * M_F`` in
+Eqs. 5-6. A builder that computes the negative side in a mirrored frame (where its moment
+is positive when it drives the negative collapse) must change its sign before writing it.
 
 A side is given either by its physical constants (``I0``, ``K``, ``Q``, ``phi_cr`` and
 optionally ``M_F``), from which ``p_eq``, ``lam`` and ``phi_ov`` are derived, or in the short
@@ -258,8 +272,10 @@ class SideConstants(BaseModel):
     phi_cr : float, optional
         Critical rotation [rad], > 0.
     M_F : float, optional
-        Moment of the static forces, positive when it drives collapse [N m]. Defaults to 0
-        in the physical form; absent in the short form.
+        Moment of the static forces about this side's hinge(s) [N m], signed in the
+        mechanism's positive sense on both sides: positive when it drives positive rotation,
+        so negative on the negative side when it drives that side towards collapse. Defaults
+        to 0 in the physical form; absent in the short form.
     p_eq : float, optional
         Equivalent frequency parameter [rad/s], > 0.
     lam : float, optional
@@ -305,9 +321,11 @@ class SideConstants(BaseModel):
     M_F: Optional[float] = Field(
         None,
         description=(
-            "Moment of the external static forces about the hinge at phi_cr [N m], any finite "
-            "value, positive when it drives collapse (positive rotation) on both sides. "
-            "Defaults to 0 in the physical form."
+            "Moment of the external static forces about this side's hinge(s) at phi_cr [N m], "
+            "any finite value, signed in the mechanism's positive sense on both sides: positive "
+            "when it drives positive rotation. On the negative side a moment that drives that "
+            "side towards collapse is negative (lam = (K*phi_cr + M_F)/(g*Q) there). The other "
+            "constants are magnitudes on both sides. Defaults to 0 in the physical form."
         ),
     )
     p_eq: Optional[float] = Field(None, gt=0, description=_P_EQ_DESCRIPTION)
@@ -487,6 +505,12 @@ class Mechanism(BaseModel):
     eta_source : str, optional
         Where ``eta`` comes from (one of ``ETA_SOURCES``); ``"user"`` when ``eta`` is given
         without it.
+    eta_to_negative, eta_to_positive : float, optional
+        Two-sided rocking only, given together and with ``eta``: the restitution at an
+        impact after which the mechanism rocks on its negative side (the hinges switch from
+        the positive to the negative set) and on its positive side [-], each in [0, 1] and
+        the ratio of the angular speeds after/before. ``eta`` must lie between them (it is
+        the one value a solver uses when it does not tell the impacts apart).
     amplification : Amplification, optional
         Data for amplifying the ground motion up the structure.
     geometry : dict, optional
@@ -523,8 +547,10 @@ class Mechanism(BaseModel):
     negative: Optional[SideConstants] = Field(
         None,
         description=(
-            "Constants for negative rotation, as magnitudes; absent for a symmetric "
-            "mechanism. Ignored for one-sided rocking."
+            "Constants for negative rotation, as magnitudes except M_F, which keeps the "
+            "positive sense; absent for a symmetric mechanism (the positive side's mirror "
+            "image: the same magnitudes and M_F of opposite sign). Ignored for one-sided "
+            "rocking."
         ),
     )
     eta: Optional[float] = Field(
@@ -538,6 +564,28 @@ class Mechanism(BaseModel):
     )
     eta_source: Optional[EtaSource] = Field(
         None, description="Where eta comes from; 'user' when eta is given without it."
+    )
+    eta_to_negative: Optional[float] = Field(
+        None,
+        ge=0,
+        le=1,
+        description=(
+            "Two-sided rocking: coefficient of restitution at an impact after which the "
+            "mechanism rocks on its negative side (hinges switch from the positive to the "
+            "negative set), |dphi after| / |dphi before| [-], in [0, 1]. Given together with "
+            "eta_to_positive and eta, for mechanisms whose two impact directions differ."
+        ),
+    )
+    eta_to_positive: Optional[float] = Field(
+        None,
+        ge=0,
+        le=1,
+        description=(
+            "Two-sided rocking: coefficient of restitution at an impact after which the "
+            "mechanism rocks on its positive side (hinges switch from the negative to the "
+            "positive set), |dphi after| / |dphi before| [-], in [0, 1]. Given together with "
+            "eta_to_negative and eta."
+        ),
     )
     amplification: Optional[Amplification] = Field(
         None, description="Data for amplifying the ground motion up the structure (theory §7)."
@@ -600,6 +648,29 @@ class Mechanism(BaseModel):
             raise _error("eta_source", "eta_source is given but eta is not")
         if self.eta is not None and self.eta_source is None:
             self.eta_source = "user"
+        to_neg, to_pos = self.eta_to_negative, self.eta_to_positive
+        if to_neg is not None or to_pos is not None:
+            if to_neg is None or to_pos is None:
+                missing = "eta_to_positive" if to_pos is None else "eta_to_negative"
+                raise _error(missing, "eta_to_negative and eta_to_positive go together")
+            if self.rocking == "one_sided":
+                raise _error(
+                    "eta_to_negative",
+                    "eta_to_negative and eta_to_positive apply to two-sided rocking only",
+                )
+            if self.eta is None:
+                raise _error(
+                    "eta",
+                    "eta_to_negative and eta_to_positive need eta, the value used where the "
+                    "two impacts are not told apart",
+                )
+            lo, hi = min(to_neg, to_pos), max(to_neg, to_pos)
+            if not lo <= self.eta <= hi:
+                raise _error(
+                    "eta",
+                    f"eta = {self.eta!r} is not between eta_to_negative = "
+                    f"{self.eta_to_negative!r} and eta_to_positive = {self.eta_to_positive!r}",
+                )
         if self.name is None:
             self.name = self.id
         return self

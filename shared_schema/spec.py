@@ -4,12 +4,14 @@ A spec file says, per mechanism, which objects (by name, layer or id) form its d
 groups, where the rotation axis is, which cracks cut off the collapsing part, the rocking
 kind, and the added elements that exist: floors, roof, vaults and tie-bars. Only declared
 elements are computed; absent sections stay absent in every output. Unknown keys are
-errors. Lengths are in metres once the scene is read (file units are converted), densities
-in kg/m³, forces in N.
+errors. Lengths are in metres once the scene is read (file units are converted); points
+written in the spec are in metres unless the file's ``units`` says otherwise (``"file"``:
+the scene's model units). Densities are in kg/m³, forces in N.
 
 Python 3.9-clean: imported by Rhino 8.
 """
 
+import json
 from typing import Any, Dict, List, Literal, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
@@ -95,17 +97,26 @@ class Crack(BaseModel):
 
     ``keep`` is ``"axis_side"`` (default: keep the part that contains the rotation axis),
     ``"positive"`` or ``"negative"`` (the side the plane normal points to, or the other).
+    ``keep_point`` names a point on the side to keep instead, which needs no knowledge of
+    the plane's normal (in the spec's ``units``).
     """
 
     model_config = _STRICT
     object: Optional[Selector] = Field(default=None, description="A planar object.")
     points: Optional[List[Point3]] = Field(default=None, description="Three points [m].")
     keep: Literal["axis_side", "positive", "negative"] = "axis_side"
+    keep_point: Optional[Point3] = Field(
+        default=None, description="A point on the side of the crack to keep [m]."
+    )
 
     @model_validator(mode="after")
     def _one_form(self) -> "Crack":
         if (self.object is None) == (self.points is None):
             raise ValueError("give either 'object' or 'points' (three points)")
+        if self.keep_point is not None:
+            _point(self.keep_point, "keep_point")
+            if "keep" in self.model_fields_set:
+                raise ValueError("give either 'keep' or 'keep_point', not both")
         if self.points is not None:
             if len(self.points) != 3:
                 raise ValueError(f"'points' needs exactly 3 points, got {len(self.points)}")
@@ -148,7 +159,12 @@ class Vault(BaseModel):
 
 
 class Overburden(BaseModel):
-    """What loads the top of a two-block wall: objects (weight share) or a given force [N]."""
+    """What loads the top of a two-block wall: objects (weight share) or a given force [N].
+
+    With ``objects``, N is ``tributary`` times their weight; ``tributary`` defaults to 0.5
+    (a slab spanning between the wall and one parallel support), and the output says when
+    that default was used.
+    """
 
     model_config = _STRICT
     objects: Optional[List[Selector]] = Field(default=None, min_length=1)
@@ -207,7 +223,13 @@ class MechanismSpec(BaseModel):
     axis : Axis
         Rotation axis for positive rotation (the collapse direction).
     axis_negative : Axis, optional
-        Axis of the other rocking side (two-sided); derived from the base footprint if absent.
+        Axis of the other rocking side (two-sided ``single_block``); derived from the base
+        footprint if absent. Refused for ``two_block``, whose negative hinges are the mirror
+        of O, C, H about the wall's mid-plane.
+    hinges, hinges_negative : Hinges, optional
+        ``multi_block``: the four hinges of the positive set and of the negative set. The
+        negative set is optional for two-sided rocking: when absent it is derived (each
+        hinge reflected across its column at its height) and a warning gives the points.
     allow_non_horizontal_axis : bool
         Accept an inclined axis (off by default).
     cracks : list of Crack
@@ -291,14 +313,31 @@ class MechanismSpec(BaseModel):
             raise ValueError("eta_rule applies to one-sided rocking only")
         if self.axis_negative is not None and self.rocking == "one_sided":
             raise ValueError("axis_negative applies to two-sided rocking only")
+        if self.axis_negative is not None and self.typology == "two_block":
+            raise ValueError(
+                "axis_negative does not apply to a two_block wall: its negative hinges O', C', "
+                "H' are always the mirror of O, C, H about the wall's mid-plane (base inner "
+                "edge, outer face at h_c, top inner edge)"
+            )
         return self
 
 
 class SpecFile(BaseModel):
-    """A mechanism-spec file: version and mechanisms (ids unique)."""
+    """A mechanism-spec file: version, units of its points and mechanisms (ids unique).
+
+    ``units`` says in which unit the points written in the spec (axis ``start``/``end``,
+    crack ``points``, hinge points) are: ``"m"`` (the default when absent), ``"cm"``,
+    ``"mm"``, or ``"file"`` for the scene file's model units. Objects of the scene are
+    always converted from the file's units.
+    """
 
     model_config = _STRICT
     spec_version: str = SPEC_VERSION
+    units: Optional[Literal["m", "cm", "mm", "file"]] = Field(
+        default=None,
+        description="Unit of the points written in the spec: m (default), cm, mm, or 'file' "
+        "for the scene file's model units.",
+    )
     thrust_table: Optional[str] = Field(
         default=None, description="Path of a user thrust table (JSON), relative to the spec."
     )
@@ -315,34 +354,40 @@ class SpecFile(BaseModel):
         return mechs
 
 
+def _error_line(err: Any, data: Any) -> str:
+    loc = list(err["loc"])
+    path = ""
+    for part in loc:
+        path += f"[{part}]" if isinstance(part, int) else (f".{part}" if path else str(part))
+    if len(loc) >= 2 and loc[0] == "mechanisms" and isinstance(loc[1], int):
+        try:
+            ident = data["mechanisms"][loc[1]]["id"]
+            path = path.replace(f"mechanisms[{loc[1]}]", f"mechanisms[{loc[1]}] (id {ident!r})")
+        except (TypeError, KeyError, IndexError):
+            pass
+    msg = err["msg"].replace("Value error, ", "")
+    return f"{path}: {msg}" if path else msg
+
+
 def parse_spec(text: Union[str, bytes], source: str = "spec") -> SpecFile:
     """Validate a spec file's JSON text; errors name the mechanism and the field.
+
+    Every error is reported at once, one per line, so that one bad mechanism does not hide
+    the others.
 
     Raises
     ------
     InputError
-        With a message like ``spec.json: mechanisms[0] (id 'W1').groups[0].density: ...``.
+        With a message like ``spec.json: mechanisms[0] (id 'W1').groups[0].density: ...``
+        (one line per error).
     """
     try:
         return SpecFile.model_validate_json(text)
     except ValidationError as exc:
-        err = exc.errors()[0]
-        loc = list(err["loc"])
-        path = ""
-        for part in loc:
-            path += f"[{part}]" if isinstance(part, int) else (f".{part}" if path else str(part))
         data: Any = None
         try:
-            import json
-
             data = json.loads(text)
         except ValueError:
             pass
-        if len(loc) >= 2 and loc[0] == "mechanisms" and isinstance(loc[1], int):
-            try:
-                ident = data["mechanisms"][loc[1]]["id"]
-                path = path.replace(f"mechanisms[{loc[1]}]", f"mechanisms[{loc[1]}] (id {ident!r})")
-            except (TypeError, KeyError, IndexError):
-                pass
-        msg = err["msg"].replace("Value error, ", "")
-        raise InputError(f"{path}: {msg}" if path else msg, source) from None
+        lines = [_error_line(err, data) for err in exc.errors()]
+        raise InputError("\n".join(lines), source) from None

@@ -18,6 +18,7 @@ from typing import Any, NoReturn, Optional, TypeVar
 
 import typer
 
+from rhino_plugin.mechanisms.build import MechanismFailure
 from rockmech._version import __version__
 from shared_schema.errors import RockmechError
 from shared_schema.extras import MissingExtra, extra_for, require
@@ -43,6 +44,7 @@ from .workflows.documents import (
 )
 from .workflows.inputs import (
     constants_from_files,
+    constants_keep_going,
     read_constants,
     read_record,
     read_record_spec,
@@ -567,12 +569,34 @@ def constants(
     spec: Path = typer.Argument(..., help="Mechanism spec (JSON)."),
     output: Path = typer.Option(..., "-o", "--output", help="Kinematic-constants JSON to write."),
     as_json: bool = typer.Option(False, "--json", help="Also print the constants JSON."),
+    keep_going: bool = typer.Option(
+        False,
+        "--keep-going",
+        help=(
+            "Write the mechanisms that succeed and list the ones that fail (exit status 1 "
+            "when any failed). Without it, any failure writes nothing and lists every failure."
+        ),
+    ),
 ) -> None:
     """Kinematic constants of every mechanism in SPEC from the solids of SCENE."""
-    cf = constants_from_files(scene, spec)
+    failures: list[MechanismFailure] = []
+    if keep_going:
+        cf, failures = constants_keep_going(scene, spec)
+    else:
+        cf = constants_from_files(scene, spec)
     save_constants(output, cf)
+    if failures:
+        typer.echo(
+            f"error: {len(failures)} of {len(failures) + len(cf.mechanisms)} mechanisms failed "
+            f"and are not in {output}:",
+            err=True,
+        )
+        for failure in failures:
+            typer.echo(f"  {failure.message}", err=True)
     if as_json:
         _print_json(json.loads(cf.model_dump_json(exclude_none=True)))
+        if failures:
+            raise typer.Exit(code=1)
         return
     typer.echo(f"wrote {output}")
     rows = []
@@ -585,6 +609,8 @@ def constants(
     headers = ["mechanism", "p_eq [rad/s]", "lam [-]", "phi_ov [rad]", "eta [-]"]
     for line in _table(headers, rows):
         typer.echo(line)
+    if failures:
+        raise typer.Exit(code=1)
 
 
 @app.command("constants-table")

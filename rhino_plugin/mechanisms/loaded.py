@@ -39,7 +39,7 @@ from rhino_plugin.mechanisms.thrust import roof_thrust
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.rules import G
 
-__all__ = ["BEARING_ANGLE", "element_solids", "largest_contact", "loaded_side"]
+__all__ = ["BEARING_ANGLE", "contact_tolerance", "element_solids", "largest_contact", "loaded_side"]
 
 #: A contact whose normal is within this angle of vertical counts as bearing [rad].
 BEARING_ANGLE = math.radians(30.0)
@@ -58,19 +58,48 @@ def element_solids(
     return meshes, ids, notes
 
 
+#: Contact tolerance when the file has no absolute tolerance [m].
+CONTACT_TOL = 1e-6
+
+
+def contact_tolerance(scene: Any) -> float:
+    """Return the file's absolute tolerance [m], or ``CONTACT_TOL`` when it has none."""
+    tol = float(getattr(scene, "tolerance", 0.0) or 0.0)
+    return tol if tol > 0.0 else CONTACT_TOL
+
+
+def _separation(a: Any, b: Any) -> float:
+    """Gap (> 0) or overlap (< 0) of two solids' bounding boxes along the clearest axis [m]."""
+    lo_a, hi_a = a.vertices.min(axis=0), a.vertices.max(axis=0)
+    lo_b, hi_b = b.vertices.min(axis=0), b.vertices.max(axis=0)
+    return float(np.max(np.maximum(lo_b - hi_a, lo_a - hi_b)))
+
+
 def largest_contact(
-    meshes: List[Any], wall: List[Any], where: str
+    meshes: List[Any], wall: List[Any], where: str, tol: float = CONTACT_TOL
 ) -> Tuple[float, np.ndarray, np.ndarray]:
-    """Return the largest planar contact between an element's solids and the wall's solids."""
+    """Return the largest planar contact between an element's solids and the wall's solids.
+
+    Faces within ``tol`` [m] of each other count as in contact. When there is none, the
+    error gives the gap (or overlap) between the element and the nearest wall solid.
+    """
     best = None
     for a in meshes:
         for b in wall:
-            hit = find_contact(a, b)
+            hit = find_contact(a, b, tol=tol)
             if hit is not None and (best is None or hit[0] > best[0]):
                 best = hit
     if best is None:
+        gap = min((_separation(a, b) for a in meshes for b in wall), key=abs)
+        how = (
+            f"a gap of {1000 * gap:.4g} mm"
+            if gap > 0.0
+            else f"an overlap of {-1000 * gap:.4g} mm (solids that interpenetrate share no face)"
+        )
         raise GeometryError(
-            f"{where}: touches no wall (no shared face with the mechanism's solids)"
+            f"{where}: touches no wall (no shared face with the mechanism's solids within the "
+            f"tolerance {1000 * tol:.3g} mm): its bounding box and the nearest wall solid's "
+            f"show {how}"
         )
     return best
 
@@ -114,13 +143,14 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
     elements: List[Dict[str, Any]] = []
     notes: List[str] = []
     wall = body.meshes
+    tol = contact_tolerance(scene)
 
     for k, floor in enumerate(spec.floors or []):
         label = f"{where}.floors[{k}]"
         meshes, ids, warn = element_solids(scene, floor.objects, label)
         notes.extend(warn)
         mass = floor.tributary * sum(mass_properties(m, floor.density).mass for m in meshes)
-        area, point, normal = largest_contact(meshes, wall, label)
+        area, point, normal = largest_contact(meshes, wall, label, tol)
         is_bearing = abs(float(normal[2])) >= math.cos(BEARING_ANGLE)
         (bearing if is_bearing else nonbearing).append((mass, point, label))
         elements.append(
@@ -141,7 +171,7 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
         meshes, ids, warn = element_solids(scene, roof.objects, label)
         notes.extend(warn)
         weight = G * sum(mass_properties(m, roof.density).mass for m in meshes)
-        area, point, _ = largest_contact(meshes, wall, label)
+        area, point, _ = largest_contact(meshes, wall, label, tol)
         span, _, rise = _box(meshes, side)
         thrust = roof_thrust(weight, span, rise, roof.tied)
         bearing.append((roof.tributary * weight / G, point, label))
@@ -171,7 +201,7 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
             raise GeometryError(f"{label}: degenerate bounding box (span or rise is zero)")
         v_area, h_area = table.per_area(vault.construction_class, rise / span_n, label)
         plan = span_n * span_p
-        area, point, _ = largest_contact(meshes, wall, label)
+        area, point, _ = largest_contact(meshes, wall, label, tol)
         bearing.append((v_area * plan / G, point, label))
         forces.append((h_area * plan, point, label))
         elements.append(

@@ -1,9 +1,14 @@
 """Three blocks, four hinges (A4) from CAD solids.
 
 Each block is a list of density groups; the hinges A, B, C, D are points or line objects
-(a line's mid-point is used). The mechanism moves in the vertical plane through A and D:
+(a line's mid-point is used). The mechanism moves in the vertical plane fitted through all
+the hinges (``_plane``: each hinge must lie on it, each hinge line must be normal to it):
 planar x runs horizontally from A towards D, z up; each block's inertia is taken about
 the horizontal axis normal to that plane.
+
+Without ``hinges_negative`` a two-sided mechanism gets a derived negative set (each hinge
+reflected across its column at its height, ``_mirrored``), and a warning says so and gives
+the derived points.
 
 For each hinge set the sense of motion is the one in which the weight resists at rest
 (the hinges open; the other sense is not kinematically admissible for unilateral
@@ -11,6 +16,7 @@ contacts). The constants follow theory §2.4 (``multi_block.four_bar_constants``
 restitution is the momentum projection of §3.4 from the positive to the negative mode.
 """
 
+import math
 from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
@@ -26,13 +32,103 @@ from shared_schema.errors import GeometryError, InputError
 __all__ = ["multi_block_sides"]
 
 
-def _hinge_point(scene: Any, hinge: Any, where: str) -> np.ndarray:
+#: Largest distance of a hinge from the mechanism's plane, relative to the largest distance
+#: between hinges (the file's absolute tolerance when that is larger).
+PLANE_RTOL = 1e-3
+#: Largest angle between a hinge line object and the normal of the mechanism's plane [rad]
+#: (the single block's tolerance on a horizontal axis).
+HINGE_AXIS_TOL = 1e-3
 
+
+def _hinge(scene: Any, hinge: Any, where: str) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+    """Return a hinge's point [m] and, for a line object, its unit direction (else None)."""
     if isinstance(hinge, list):
-        return np.asarray(hinge, dtype=float)
+        return np.asarray(hinge, dtype=float), None
     obj = find_objects(scene, [hinge], where)[0]
     start, end = scene.line(obj)
-    return 0.5 * (np.asarray(start, dtype=float) + np.asarray(end, dtype=float))
+    start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    d = end - start
+    return 0.5 * (start + end), d / float(np.linalg.norm(d))
+
+
+def _hinge_point(scene: Any, hinge: Any, where: str) -> np.ndarray:
+    """Return a hinge's point [m] (a line object's mid-point); used by the flows' marks."""
+    return _hinge(scene, hinge, where)[0]
+
+
+def _plane(
+    points: Dict[str, np.ndarray],
+    lines: Dict[str, np.ndarray],
+    tolerance: float,
+    where: str,
+) -> Tuple[np.ndarray, np.ndarray, Dict[str, Any]]:
+    """Fit the vertical plane through every hinge and check it; return x axis, normal, record.
+
+    The plane is the vertical plane that best fits the hinges in plan (least squares), with
+    x running from A towards D. Every hinge must lie within the tolerance of it, and every
+    hinge drawn as a line must be normal to it; a hinge given as a point is taken to turn
+    about the plane's normal.
+
+    Raises
+    ------
+    InputError
+        The hinges are all above one point, a hinge is off the plane, or a hinge line is
+        not normal to the plane; the message names the hinge and the amount.
+    """
+    names = list(points)
+    xyz = np.array([points[n] for n in names])
+    size = max(float(np.linalg.norm(p - q)) for p in xyz for q in xyz)
+    plan = xyz[:, :2] - xyz[:, :2].mean(axis=0)
+    _, sv, vt = np.linalg.svd(plan, full_matrices=False)
+    if sv[0] <= 1e-9 * max(size, 1e-300):
+        raise InputError(
+            "the hinges are vertically above one another; the mechanism's plane is undefined",
+            f"{where}.hinges",
+        )
+    ex = np.array([vt[0][0], vt[0][1], 0.0])
+    a, d = points["hinges.A"], points["hinges.D"]
+    if float((d - a) @ ex) < 0.0:
+        ex = -ex
+    normal = np.cross(np.array([0.0, 0.0, 1.0]), ex)
+    centre = xyz.mean(axis=0)
+    offsets = {n: float((points[n] - centre) @ normal) for n in names}
+    tol = max(PLANE_RTOL * size, tolerance)
+    worst = max(names, key=lambda n: abs(offsets[n]))
+    if abs(offsets[worst]) > tol:
+        listing = ", ".join(f"{n} {offsets[n]:+.4g}" for n in names)
+        raise InputError(
+            f"the hinges do not lie in one vertical plane: {worst} is {abs(offsets[worst]):.4g} m "
+            f"off the plane fitted through all of them (tolerance {tol:.3g} m; offsets [m]: "
+            f"{listing}). The mechanism is planar: put A, B, C and D (and the negative set) "
+            "in the plane in which it moves",
+            f"{where}.{worst}",
+        )
+    for n, u in lines.items():
+        skew = math.asin(min(float(np.linalg.norm(np.cross(u, normal))), 1.0))
+        if skew > HINGE_AXIS_TOL:
+            tilt = math.degrees(math.asin(min(abs(float(u[2])), 1.0)))
+            raise InputError(
+                f"the hinge line is {math.degrees(skew):.3f} deg off the normal of the "
+                f"mechanism's plane ({tilt:.3f} deg of it from the horizontal); a hinge turns "
+                "about the plane's normal, so draw it horizontal and across the plane",
+                f"{where}.{n}",
+            )
+    record = {
+        "method": "vertical plane fitted through all hinges (least squares in plan); x from A "
+        "towards D, z up; each hinge projected onto it",
+        "x_axis": [float(v) for v in ex],
+        "normal": [float(v) for v in normal],
+        "hinge_offsets_m": {n: offsets[n] for n in names},
+        "tolerance_m": tol,
+        "hinge_axes": "line objects checked normal to the plane"
+        if lines
+        else "given as points: taken to turn about the plane's normal",
+    }
+    if lines and len(lines) < len(names):
+        record["hinge_axes"] = (
+            "line objects checked normal to the plane; points taken to turn about its normal"
+        )
+    return ex, normal, record
 
 
 def _blocks(scene: Any, spec: Any) -> Tuple[List[Any], List[np.ndarray], List[str], List[str]]:
@@ -96,17 +192,20 @@ def multi_block_sides(
     where = spec.id
     props, verts, ids, notes = _blocks(scene, spec)
     names = ("A", "B", "C", "D")
-    pos3 = [_hinge_point(scene, getattr(spec.hinges, n), f"{where}.hinges.{n}") for n in names]
+    points: Dict[str, np.ndarray] = {}
+    lines: Dict[str, np.ndarray] = {}
+    sets = [("hinges", spec.hinges)]
+    if spec.rocking == "two_sided" and spec.hinges_negative is not None:
+        sets.append(("hinges_negative", spec.hinges_negative))
+    for key, hinges in sets:
+        for n in names:
+            point, line = _hinge(scene, getattr(hinges, n), f"{where}.{key}.{n}")
+            points[f"{key}.{n}"] = point
+            if line is not None:
+                lines[f"{key}.{n}"] = line
+    pos3 = [points[f"hinges.{n}"] for n in names]
     origin = pos3[0]
-    span = pos3[3] - pos3[0]
-    span[2] = 0.0
-    if float(np.linalg.norm(span)) < 1e-9:
-        raise InputError(
-            "A and D are vertically above each other; the mechanism's plane is undefined",
-            f"{where}.hinges",
-        )
-    ex = span / float(np.linalg.norm(span))
-    normal = np.cross(np.array([0.0, 0.0, 1.0]), ex)
+    ex, normal, plane = _plane(points, lines, float(getattr(scene, "tolerance", 0.0)), where)
 
     def planar(p: np.ndarray) -> Tuple[float, float]:
         d = np.asarray(p, dtype=float) - origin
@@ -133,18 +232,13 @@ def multi_block_sides(
         virtual_work["positive"] = vw
     summary: Dict[str, Any] = {
         "plane_x_axis": [float(v) for v in ex],
+        "plane": plane,
         "block_masses_kg": [b.mass for b in blocks],
         "positive": {"collapse_sense": direction, **{k: float(v) for k, v in res.details.items()}},
     }
     if spec.rocking == "two_sided":
         if spec.hinges_negative is not None:
-            neg3 = [
-                _hinge_point(
-                    scene, getattr(spec.hinges_negative, n), f"{where}.hinges_negative.{n}"
-                )
-                for n in names
-            ]
-            hinges_neg = [planar(p) for p in neg3]
+            hinges_neg = [planar(points[f"hinges_negative.{n}"]) for n in names]
         else:
             cols = [
                 np.column_stack([(verts[k] - origin) @ ex, verts[k][:, 2] - origin[2]])
@@ -152,6 +246,14 @@ def multi_block_sides(
             ]
             hinges_neg = _mirrored(hinges_pos, cols)
             summary["hinges_negative_derived"] = [list(h) for h in hinges_neg]
+            derived = ", ".join(
+                f"{n}' = {[round(float(v), 6) for v in origin + x * ex + np.array([0, 0, z])]}"
+                for n, (x, z) in zip(names, hinges_neg)
+            )
+            notes.append(
+                f"{where}: hinges_negative not given; derived by reflecting each hinge across "
+                f"its column at its height: {derived} [m]. Give hinges_negative to set them"
+            )
         res_n, dir_n = _solve(blocks, hinges_neg, f"{where}.hinges_negative")
         if dir_n == direction:
             raise InputError(
@@ -159,11 +261,17 @@ def multi_block_sides(
                 "one; give the mirrored set",
                 f"{where}.hinges_negative",
             )
-        negative = res_n.constants()
+        negative = res_n.constants("negative")
         vw = virtual_work_of(res_n.details, "lam_static")
         if vw is not None:
             virtual_work["negative"] = vw
         eta = four_bar_restitution(blocks, tuple(hinges_pos), tuple(hinges_neg))
+        # Both impact directions (theory §3.4); they differ for an asymmetric linkage.
+        summary["restitution"] = {
+            "rule": "momentum projection (theory §3.4); eta is the positive-to-negative value",
+            "eta_pos_to_neg": eta,
+            "eta_neg_to_pos": four_bar_restitution(blocks, tuple(hinges_neg), tuple(hinges_pos)),
+        }
         summary["negative"] = {
             "collapse_sense": dir_n,
             **{k: float(v) for k, v in res_n.details.items()},
@@ -178,6 +286,7 @@ def build_multi_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
     positive, negative, eta, summary, ids = multi_block_sides(spec, scene)
     warnings = summary.pop("warnings")
     virtual_work = summary.pop("virtual_work")
+    eta_info = summary.pop("restitution", {})
     return MechanismSides(
         positive,
         negative,
@@ -186,5 +295,6 @@ def build_multi_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
         {"multi_block": summary},
         ids,
         warnings,
+        eta_info,
         virtual_work=virtual_work,
     )

@@ -133,7 +133,15 @@ def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
     for k, crack in enumerate(spec.cracks):
         point, normal = _crack_plane(scene, crack, f"{where}.cracks[{k}]")
         keep = crack.keep
-        if keep == "axis_side":
+        said = f"keep = {crack.keep!r}"
+        if crack.keep_point is not None:
+            # The user's point on the side to keep decides, whatever the plane's normal.
+            said = f"keep_point = {list(crack.keep_point)}"
+            side = float(np.dot(np.asarray(crack.keep_point, dtype=float) - point, normal))
+            if abs(side) <= 1e-9:  # [m]: on the plane, the side is undefined
+                raise InputError("keep_point lies on the crack plane", f"{where}.cracks[{k}]")
+            keep = "positive" if side > 0.0 else "negative"
+        elif keep == "axis_side":
             keep = "positive" if float(np.dot(axis_mid - point, normal)) >= 0.0 else "negative"
         sign = 1.0 if keep == "positive" else -1.0
         kept: List[Tuple[Any, float]] = []
@@ -147,11 +155,15 @@ def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
                 cut_any = True
         if not cut_any:
             raise GeometryError(
-                f"{where}.cracks[{k}]: the crack plane misses the body (it cuts no solid)"
+                f"{where}.cracks[{k}] ({said}): the crack plane misses the body (it cuts no solid)"
+            )
+        if not kept:
+            raise GeometryError(
+                f"{where}.cracks[{k}] ({said}): nothing is left of the body on the kept side "
+                f"(the {keep} side of the plane through {[round(float(v), 6) for v in point]} "
+                f"with normal {[round(float(v), 6) for v in normal]})"
             )
         solids = kept
-    if not solids:
-        raise GeometryError(f"{where}: nothing is left of the body after the cracks")
     parts = [mass_properties(mesh, density) for mesh, density in solids]
     props = combine(parts, name=spec.id)
     verts = np.vstack([mesh.vertices for mesh, _ in solids])
@@ -196,11 +208,11 @@ def rocking_side(
         raise GeometryError(
             f"{where}: the axis does not touch the body (closest vertex {dist.min():.4f} m away)"
         )
-    z_axis = float(start[2] + u[2] * np.dot(body.props.com - start, u))
-    if body.vertices[:, 2].min() < z_axis - tol:
+    # Height of the axis where each vertex projects on it (an inclined axis rises along u).
+    below = float(np.max(start[2] + u[2] * (d @ u) - body.vertices[:, 2]))
+    if below > tol:
         raise GeometryError(
-            f"{where}: the axis is not at the body's base (the body reaches "
-            f"{z_axis - body.vertices[:, 2].min():.4f} m below it)"
+            f"{where}: the axis is not at the body's base (the body reaches {below:.4f} m below it)"
         )
     g = np.asarray(body.props.com, dtype=float)
     dg = g - start

@@ -139,9 +139,27 @@ class LinkageResult:
     phi_ov: float
     details: Dict[str, float] = field(default_factory=dict)
 
-    def constants(self) -> Dict[str, float]:
-        """Return the side's constants as the kinematic-constants file stores them."""
-        return {"I0": self.I0, "K": self.K, "Q": self.Q, "phi_cr": self.phi_cr, "M_F": self.M_F}
+    def constants(self, side: str = "positive") -> Dict[str, float]:
+        """Return the constants as the kinematic-constants file stores them for ``side``.
+
+        Parameters
+        ----------
+        side : {"positive", "negative"}
+            The side of the mechanism this result describes. A result is computed in that
+            side's own frame, where ``M_F > 0`` drives *that* side towards collapse. The
+            file signs ``M_F`` in the mechanism's positive sense on both sides
+            (``shared_schema.constants``, theory §1.8), so on the negative side it changes
+            sign; the other constants are magnitudes and are stored as they are.
+
+        Returns
+        -------
+        dict
+            ``I0`` [kg m²], ``K`` [N m/rad], ``Q`` [kg m], ``phi_cr`` [rad], ``M_F`` [N m].
+        """
+        if side not in ("positive", "negative"):
+            raise InputError(f"must be 'positive' or 'negative', got {side!r}", "side")
+        m_f = self.M_F if side == "positive" else 0.0 - self.M_F  # no -0.0
+        return {"I0": self.I0, "K": self.K, "Q": self.Q, "phi_cr": self.phi_cr, "M_F": m_f}
 
 
 @dataclass(frozen=True)

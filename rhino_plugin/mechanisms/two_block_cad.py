@@ -24,7 +24,7 @@ import numpy as np
 from rhino_plugin.geometry.cut import cut_by_plane
 from rhino_plugin.geometry.massprops import combine, mass_properties
 from rhino_plugin.mechanisms.base import MechanismSides, virtual_work_of
-from rhino_plugin.mechanisms.loaded import element_solids, largest_contact
+from rhino_plugin.mechanisms.loaded import contact_tolerance, element_solids, largest_contact
 from rhino_plugin.mechanisms.single import rigid_body
 from rhino_plugin.mechanisms.two_block import (
     PlanarBody,
@@ -56,7 +56,10 @@ def _mirror(body: Any, b: float) -> Any:
 def two_block_sides(
     spec: Any, scene: Any, body: Any, pos: Any
 ) -> Tuple[Dict[str, float], Optional[Dict[str, float]], Optional[float], Dict[str, Any]]:
-    """Constants of both sides of a two-block wall, eta (or None) and a summary."""
+    """Constants of both sides of a two-block wall, eta (or None) and a summary.
+
+    The summary's ``warnings`` (popped by the builder) state the defaults that were used.
+    """
     where = spec.id
     o, out, ax = pos.point, pos.outward, pos.direction
     rel = body.vertices - o
@@ -71,12 +74,22 @@ def two_block_sides(
     n = 0.0
     x_p = -0.5 * b  # a given force acts on the wall's centre line
     overburden_ids: List[str] = []
+    notes: List[str] = []
     if ob is not None and ob.force is not None:
         n = float(ob.force)
     elif ob is not None:
-        meshes, overburden_ids, _ = element_solids(scene, ob.objects, f"{where}.overburden")
+        meshes, overburden_ids, repairs = element_solids(scene, ob.objects, f"{where}.overburden")
+        notes.extend(repairs)
         n = ob.tributary * G * sum(mass_properties(m, ob.density).mass for m in meshes)
-        _, point, _ = largest_contact(meshes, body.meshes, f"{where}.overburden")
+        if "tributary" not in ob.model_fields_set:
+            notes.append(
+                f"{where}.overburden: tributary not given; the wall carries the default "
+                f"{ob.tributary:g} of the overburden's weight (N = {n:.6g} N). Give "
+                "'tributary' to set the share"
+            )
+        _, point, _ = largest_contact(
+            meshes, body.meshes, f"{where}.overburden", contact_tolerance(scene)
+        )
         x_p = float((point - o) @ out)
     f_mt = float(spec.f_mt or 0.0)
     h_c = hinge_height(h, weight, n, f_mt, length * b)
@@ -115,6 +128,8 @@ def two_block_sides(
     )
     positive = res.constants()
     negative = None
+    neg_details: Optional[Dict[str, float]] = None
+    summary_eta: Dict[str, Any] = {}
     eta = None
     virtual_work: Dict[str, Dict[str, float]] = {}
     vw = virtual_work_of(res.details, "lam_static_exact")
@@ -129,11 +144,21 @@ def two_block_sides(
             overburden_point=(-b - x_p, h),
             eccentricity=ecc,
         )
-        negative = neg.constants()
+        # neg is the mirrored wall: its M_F drives the inward collapse, which the file
+        # writes with a negative sign (shared_schema.constants: M_F per side is signed in
+        # the positive sense).
+        negative = neg.constants("negative")
+        neg_details = {k: float(v) for k, v in neg.details.items()}
         vw = virtual_work_of(neg.details, "lam_static_exact")
         if vw is not None:
             virtual_work["negative"] = vw
         eta = two_block_restitution(b1, b2, *hinges, *mirrored)
+        # Both impact directions (theory §3.4); they differ for an asymmetric wall.
+        summary_eta = {
+            "rule": "momentum projection (theory §3.4); eta is the positive-to-negative value",
+            "eta_pos_to_neg": eta,
+            "eta_neg_to_pos": two_block_restitution(b1, b2, *mirrored, *hinges),
+        }
     summary: Dict[str, Any] = {
         "thickness_m": b,
         "height_m": h,
@@ -150,8 +175,14 @@ def two_block_sides(
         "details": {k: float(v) for k, v in res.details.items()},
         "virtual_work": virtual_work,
     }
+    if neg_details is not None:
+        # The negative side's details are in the mirrored wall's frame (x inward).
+        summary["negative_details"] = neg_details
     if overburden_ids:
         summary["overburden_objects"] = overburden_ids
+        summary["overburden_tributary"] = float(ob.tributary) if ob is not None else None
+    summary["warnings"] = notes
+    summary["restitution"] = summary_eta
     return positive, negative, eta, summary
 
 
@@ -160,6 +191,8 @@ def build_two_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
     body, pos, geometry = rigid_body(spec, scene)
     positive, negative, eta, summary = two_block_sides(spec, scene, body, pos)
     virtual_work = summary.pop("virtual_work")
+    warnings = list(body.warnings) + summary.pop("warnings")
+    eta_info = summary.pop("restitution")
     geometry["two_block"] = summary
     return MechanismSides(
         positive,
@@ -168,6 +201,7 @@ def build_two_block(spec: Any, scene: Any, table: Any) -> MechanismSides:
         "momentum_projection",
         geometry,
         body.object_ids,
-        list(body.warnings),
+        warnings,
+        eta_info,
         virtual_work=virtual_work,
     )

@@ -90,6 +90,12 @@ class RockingModel:
         transverse walls); it rebounds off the restraint at ``x = 0``.
     name : str
         Identifier used in messages and outputs.
+    eta_to_negative, eta_to_positive : float, optional
+        Two-sided rocking of an asymmetric mechanism: the restitution at an impact after
+        which the body rocks on its negative (positive) side [-], each in [0, 1], given
+        together. They are carried for the integrators (theory §1.8: at an impact into side
+        ``s`` the angular velocity is scaled by the value of that direction); until an
+        integrator reads them, ``eta`` serves both impacts.
     """
 
     positive: RockingSide
@@ -97,12 +103,27 @@ class RockingModel:
     eta: Optional[float] = None
     one_sided: bool = False
     name: str = field(default="mechanism")
+    eta_to_negative: Optional[float] = None
+    eta_to_positive: Optional[float] = None
 
     def __post_init__(self) -> None:
         if self.negative is None:
             object.__setattr__(self, "negative", self.positive)
         if self.eta is not None:
             object.__setattr__(self, "eta", check_eta(self.eta, self.one_sided))
+        directional = {
+            "eta_to_negative": self.eta_to_negative,
+            "eta_to_positive": self.eta_to_positive,
+        }
+        given = [k for k, v in directional.items() if v is not None]
+        if given:
+            if len(given) == 1 or self.one_sided:
+                raise InputError(
+                    "eta_to_negative and eta_to_positive go together, for two-sided rocking",
+                    f"{self.name}.{given[0]}",
+                )
+            for key, value in directional.items():
+                object.__setattr__(self, key, check_eta(value, False, f"{self.name}.{key}"))
 
     @classmethod
     def symmetric(

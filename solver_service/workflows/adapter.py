@@ -9,6 +9,8 @@ p_eq : equivalent frequency parameter of a side [rad/s]
 lam : linearised static load multiplier of a side [-]
 phi_ov : overturning rotation of a side [rad]
 eta : coefficient of restitution [-]
+eta_to_negative, eta_to_positive : restitution of the impacts into the negative and the
+    positive side, for asymmetric two-sided mechanisms [-]
 """
 
 from shared_schema.constants import ConstantsFile, Mechanism, SideConstants
@@ -42,9 +44,10 @@ def to_rocking_model(mech: Mechanism) -> RockingModel:
     -------
     RockingModel
         ``positive``/``negative`` sides from the mechanism's sides (``negative`` absent
-        means symmetric), ``eta``, ``one_sided = (rocking == "one_sided")`` and
-        ``name = id``. A one-sided mechanism never rotates negatively, so its ``negative``
-        side is ignored.
+        means symmetric), ``eta``, the restitution of each impact direction
+        (``eta_to_negative``, ``eta_to_positive``, when the file gives them),
+        ``one_sided = (rocking == "one_sided")`` and ``name = id``. A one-sided mechanism
+        never rotates negatively, so its ``negative`` side is ignored.
 
     Raises
     ------
@@ -70,6 +73,8 @@ def to_rocking_model(mech: Mechanism) -> RockingModel:
         eta=mech.eta,
         one_sided=one_sided,
         name=mech.id,
+        eta_to_negative=None if one_sided else mech.eta_to_negative,
+        eta_to_positive=None if one_sided else mech.eta_to_positive,
     )
 
 

@@ -9,7 +9,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional, Union
 
-from rhino_plugin.mechanisms.build import constants_from_spec
+from rhino_plugin.mechanisms.build import (
+    MechanismFailure,
+    constants_and_failures,
+    constants_from_spec,
+    failures_error,
+)
 from rhino_plugin.scene_3dm import Scene
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
@@ -23,6 +28,7 @@ from .tables import constants_from_table, is_table
 __all__ = [
     "RecordSpec",
     "constants_from_files",
+    "constants_keep_going",
     "read_constants",
     "read_record",
     "read_record_spec",
@@ -184,6 +190,11 @@ def constants_from_files(scene: Path, spec: Path) -> ConstantsFile:
         Rhino ``.3dm`` file (read with rhino3dm).
     spec : Path
         Mechanism spec (JSON); relative paths inside it are taken from its folder.
+
+    Raises
+    ------
+    RockmechError
+        If any mechanism fails; the message lists every failed mechanism.
     """
     for label, path in (("scene", scene), ("spec", spec)):
         check_file(path, label)
@@ -195,3 +206,33 @@ def constants_from_files(scene: Path, spec: Path) -> ConstantsFile:
         spec_name=spec.name,
         spec_dir=spec.parent,
     )
+
+
+def constants_keep_going(scene: Path, spec: Path) -> tuple[ConstantsFile, list[MechanismFailure]]:
+    """Like ``constants_from_files``, but keep the mechanisms that succeed.
+
+    Returns
+    -------
+    constants : ConstantsFile
+        The mechanisms that succeeded, in spec order.
+    failures : list of MechanismFailure
+        The mechanisms that failed, each with its error.
+
+    Raises
+    ------
+    RockmechError
+        If the files cannot be read, or if every mechanism fails (nothing to write).
+    """
+    for label, path in (("scene", scene), ("spec", spec)):
+        check_file(path, label)
+    spec_file = parse_spec(spec.read_bytes(), spec.name)
+    cf, failures = constants_and_failures(
+        spec_file,
+        Scene.from_3dm(scene),
+        scene_name=scene.name,
+        spec_name=spec.name,
+        spec_dir=spec.parent,
+    )
+    if cf is None:
+        raise failures_error(failures, len(spec_file.mechanisms))
+    return cf, failures
