@@ -44,21 +44,22 @@ def _area2(p: np.ndarray) -> float:
 def triangulate_polygon(
     outer: np.ndarray, holes: Sequence[np.ndarray] = ()
 ) -> List[Tuple[int, int, int]]:
-    """Triangulate a simple polygon with holes by ear clipping.
+    """Triangulate a simple polygon with holes, keeping every vertex.
 
     Parameters
     ----------
     outer : (n, 2) float
         Outer boundary, either orientation, not repeating the first point.
     holes : sequence of (k, 2) float
-        Hole boundaries, inside ``outer`` and disjoint.
+        Hole boundaries, inside ``outer`` and disjoint, either orientation.
 
     Returns
     -------
     list of (int, int, int)
         Triangles, counter-clockwise, as indices into the concatenation
         ``[outer, holes[0], holes[1], ...]``. Every input vertex is used; collinear
-        vertices are kept (they are needed where a neighbouring face has a vertex there).
+        vertices are kept (they are needed where a neighbouring face has a vertex there,
+        else the mesh would have a T-junction).
 
     Raises
     ------
@@ -67,10 +68,15 @@ def triangulate_polygon(
 
     Notes
     -----
-    Each hole is joined to the boundary by a bridge edge from its right-most vertex to the
-    nearest visible boundary vertex (holes in decreasing order of x), which gives one weakly
-    simple polygon; ears are then clipped. The result is checked: the triangle areas must sum
-    to the polygon's area within ``AREA_RTOL``.
+    ``manifold3d.triangulate`` (ear clipping with hole bridging, O(n log n) in practice)
+    works on the float64 points as given and returns indices, so no coordinate is rounded:
+    the triangles reuse the caller's exact vertices. The rings are first oriented (outer
+    counter-clockwise, holes clockwise) and zero-area holes dropped. The result is checked:
+    every vertex used, ``n - 2 + 2 h`` triangles (Euler, ``h`` holes), none inverted, and
+    their areas summing to the polygon's within ``AREA_RTOL``. manifold3d may join
+    collinear vertices of different rings by a zero-area triangle; each such sliver is
+    removed by flipping its long edge with the neighbouring triangle (two proper triangles
+    replace the pair), so no triangle of the result is degenerate.
 
     Examples
     --------
@@ -79,18 +85,24 @@ def triangulate_polygon(
     >>> len(triangulate_polygon(sq, [hole]))
     8
     """
-    rings_in = [np.asarray(outer, dtype=np.float64)] + [
-        np.asarray(h, dtype=np.float64) for h in holes
+    import manifold3d  # compiled; only the Brep tessellation needs it
+
+    rings_in = [np.asarray(outer, dtype=np.float64).reshape(-1, 2)] + [
+        np.asarray(h, dtype=np.float64).reshape(-1, 2) for h in holes
     ]
     pts = np.vstack(rings_in)
     size = float(np.linalg.norm(pts.max(0) - pts.min(0))) if pts.size else 0.0
-    if size == 0.0:
-        raise ValueError("the polygon is degenerate (zero size)")
+    if not size > 0.0 or not np.all(np.isfinite(pts)):
+        raise ValueError("the polygon is degenerate (zero size or non-finite points)")
+    # areas about a point of the polygon: no cancellation far from the origin
+    lo = pts.min(axis=0)
+    pts = pts - lo
+    rings_in = [r - lo for r in rings_in]
     eps = 1e-12 * size * size  # area tolerance for orientation tests
-    rings: List[List[int]] = []
+    rings: List[np.ndarray] = []
     start = 0
     for k, r in enumerate(rings_in):
-        ids = list(range(start, start + r.shape[0]))
+        ids = np.arange(start, start + r.shape[0])
         start += r.shape[0]
         a2 = _area2(r) if r.shape[0] >= 3 else 0.0
         if abs(a2) <= eps:
@@ -98,144 +110,71 @@ def triangulate_polygon(
                 raise ValueError("the outer boundary has zero area")
             continue  # a zero-area hole removes nothing
         if (a2 > 0.0) != (k == 0):
-            ids.reverse()  # outer counter-clockwise, holes clockwise
+            ids = ids[::-1]  # outer counter-clockwise, holes clockwise
         rings.append(ids)
     target = sum(abs(_area2(pts[r])) * (1 if k == 0 else -1) for k, r in enumerate(rings))
-    ring = rings[0]
-    holes_sorted = sorted(rings[1:], key=lambda h: -float(pts[h, 0].max()))
-    for hole in holes_sorted:
-        ring = _bridge(pts, ring, hole, holes_sorted, eps)
-    tris = _ear_clip(pts, ring, eps)
-    if len(tris) != len(ring) - 2:  # a zero-area triangle was left: T-junction
-        raise ValueError("degenerate boundary (zero-width spike or repeated vertex)")
-    got = sum(_cross(pts[a], pts[b], pts[c]) for a, b, c in tris)
-    if abs(got - target) > AREA_RTOL * max(abs(target), eps) + 8 * eps:
+    order = np.concatenate(rings)
+    local = np.asarray(
+        manifold3d.triangulate([np.ascontiguousarray(pts[r]) for r in rings]), dtype=np.int64
+    ).reshape(-1, 3)
+    tris = _flip_slivers(pts, order[local], eps)
+    if tris.shape[0] != order.size - 2 + 2 * (len(rings) - 1) or np.unique(tris).size != order.size:
+        raise ValueError("degenerate boundary (zero-width spike, repeated vertex or crossing)")
+    a, b, c = pts[tris[:, 0]], pts[tris[:, 1]], pts[tris[:, 2]]
+    area2 = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    got = float(area2.sum())
+    if np.any(area2 < -eps) or abs(got - target) > AREA_RTOL * max(abs(target), eps) + 8 * eps:
         raise ValueError(
             f"triangulation covers area {got / 2:.6g} instead of {target / 2:.6g} "
             "(self-intersecting boundary or overlapping holes)"
         )
-    return tris
+    return [(int(i), int(j), int(k)) for i, j, k in tris.tolist()]
+
+
+def _flip_slivers(pts: np.ndarray, tris: np.ndarray, eps: float) -> np.ndarray:
+    """Replace each zero-area triangle and its neighbour across its long edge by two.
+
+    A sliver (a, b, c) with b on the segment ca shares the edge c→a with a neighbour
+    (a, c, d); the pair becomes (a, b, d) and (b, c, d), both counter-clockwise when d is
+    left of a→c. Repeats until no sliver is left (each flip removes one).
+    """
+    a, b, c = pts[tris[:, 0]], pts[tris[:, 1]], pts[tris[:, 2]]
+    area2 = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    bad = np.flatnonzero(np.abs(area2) <= eps)
+    if bad.size == 0:
+        return tris
+    out = tris.copy()
+    owner = {}
+    for t, (i, j, k) in enumerate(out.tolist()):
+        owner[(i, j)], owner[(j, k)], owner[(k, i)] = t, t, t
+    todo = [int(t) for t in bad]
+    for _ in range(4 * len(todo) + 8):
+        if not todo:
+            return out
+        t = todo.pop()
+        tri = out[t].tolist()
+        p = pts[tri]
+        # the middle vertex of a collinear triple is opposite the longest edge
+        lengths = [float(np.sum((p[(m + 2) % 3] - p[(m + 1) % 3]) ** 2)) for m in range(3)]
+        m = int(np.argmax(lengths))
+        vb, vc, va = tri[m], tri[(m + 1) % 3], tri[(m + 2) % 3]
+        nb = owner.get((va, vc))
+        if nb is None:
+            raise ValueError("degenerate boundary (a zero-area triangle on the boundary)")
+        vd = next(v for v in out[nb].tolist() if v not in (va, vc))
+        out[t], out[nb] = (va, vb, vd), (vb, vc, vd)
+        for u, w in ((va, vb), (vb, vd), (vd, va)):
+            owner[(u, w)] = t
+        for u, w in ((vb, vc), (vc, vd), (vd, vb)):
+            owner[(u, w)] = nb
+        owner.pop((vc, va), None)
+        owner.pop((va, vc), None)
+        for s_ in (t, nb):
+            q = pts[out[s_]]
+            if abs(_cross(q[0], q[1], q[2])) <= eps and s_ not in todo:
+                todo.append(s_)
+    raise ValueError("degenerate boundary (zero-area triangles cannot be removed)")
 
 
 def _cross(o: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
     return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
-
-
-def _segments_cross(
-    p1: np.ndarray, p2: np.ndarray, q1: np.ndarray, q2: np.ndarray, eps: float
-) -> bool:
-    """Whether segments p1p2 and q1q2 intersect (touching included, shared ends excluded)."""
-    d1 = _cross(q1, q2, p1)
-    d2 = _cross(q1, q2, p2)
-    d3 = _cross(p1, p2, q1)
-    d4 = _cross(p1, p2, q2)
-    if ((d1 > eps and d2 < -eps) or (d1 < -eps and d2 > eps)) and (
-        (d3 > eps and d4 < -eps) or (d3 < -eps and d4 > eps)
-    ):
-        return True
-
-    def on(a: np.ndarray, b: np.ndarray, p: np.ndarray, d: float) -> bool:
-        return (
-            abs(d) <= eps
-            and min(a[0], b[0]) <= p[0] <= max(a[0], b[0])
-            and min(a[1], b[1]) <= p[1] <= max(a[1], b[1])
-        )
-
-    return on(q1, q2, p1, d1) or on(q1, q2, p2, d2) or on(p1, p2, q1, d3) or on(p1, p2, q2, d4)
-
-
-def _locally_inside(
-    pts: np.ndarray, prev: int, cur: int, nxt: int, p: np.ndarray, eps: float
-) -> bool:
-    """Whether direction cur->p starts into the interior (left side) at vertex cur."""
-    c = pts[cur]
-    a, b = pts[nxt], pts[prev]
-    if _cross(b, c, a) >= 0.0:  # convex corner (interior angle <= 180 deg)
-        return _cross(c, a, p) > eps and _cross(c, p, b) > eps
-    return not (_cross(c, b, p) >= -eps and _cross(c, p, a) >= -eps)
-
-
-def _bridge(
-    pts: np.ndarray, ring: List[int], hole: List[int], holes: List[List[int]], eps: float
-) -> List[int]:
-    """Splice a hole into the ring through a bridge edge to a visible ring vertex."""
-    hm = max(range(len(hole)), key=lambda i: (pts[hole[i], 0], -pts[hole[i], 1]))
-    m = hole[hm]
-    pm = pts[m]
-    edges = [(ring[i], ring[(i + 1) % len(ring)]) for i in range(len(ring))]
-    for h in holes:
-        edges.extend((h[i], h[(i + 1) % len(h)]) for i in range(len(h)))
-    hprev, hnext = hole[hm - 1], hole[(hm + 1) % len(hole)]
-    cands = sorted(range(len(ring)), key=lambda i: float(np.sum((pts[ring[i]] - pm) ** 2)))
-    for i in cands:
-        p = ring[i]
-        pp = pts[p]
-        if np.array_equal(pp, pm):
-            continue
-        if not _locally_inside(pts, ring[i - 1], p, ring[(i + 1) % len(ring)], pm, eps):
-            continue
-        if not _locally_inside(pts, hprev, m, hnext, pp, eps):
-            continue
-        blocked = False
-        for a, b in edges:
-            if a in (p, m) or b in (p, m):
-                continue
-            if np.array_equal(pts[a], pp) or np.array_equal(pts[b], pp):
-                continue
-            if _segments_cross(pm, pp, pts[a], pts[b], eps):
-                blocked = True
-                break
-        if not blocked:
-            k = hm
-            loop = hole[k:] + hole[:k] + [m]
-            return ring[: i + 1] + loop + ring[i:]
-    raise ValueError("a hole cannot be joined to the boundary (does it lie outside it?)")
-
-
-def _ear_clip(pts: np.ndarray, ring: List[int], eps: float) -> List[Tuple[int, int, int]]:
-    tris: List[Tuple[int, int, int]] = []
-    ring = list(ring)
-    strict = True
-    i = 0
-    stall = 0
-    while len(ring) > 3:
-        n = len(ring)
-        a, b, c = ring[(i - 1) % n], ring[i % n], ring[(i + 1) % n]
-        if _is_ear(pts, ring, a, b, c, eps, strict):
-            tris.append((a, b, c))
-            del ring[i % n]
-            i = (i - 1) % len(ring)
-            stall = 0
-            strict = True
-            continue
-        i = (i + 1) % n
-        stall += 1
-        if stall > n:
-            if not strict:
-                raise ValueError("no ear found (self-intersecting boundary?)")
-            strict = False
-            stall = 0
-    if len(ring) == 3:
-        a, b, c = ring
-        if _cross(pts[a], pts[b], pts[c]) > eps:
-            tris.append((a, b, c))
-    return tris
-
-
-def _is_ear(
-    pts: np.ndarray, ring: List[int], a: int, b: int, c: int, eps: float, strict: bool
-) -> bool:
-    pa, pb, pc = pts[a], pts[b], pts[c]
-    if _cross(pa, pb, pc) <= eps:
-        return False
-    # a bridge revisits the same point: only points elsewhere can block the ear
-    for k in ring:
-        if k in (a, b, c):
-            continue
-        p = pts[k]
-        if np.array_equal(p, pa) or np.array_equal(p, pb) or np.array_equal(p, pc):
-            continue
-        lim = -eps if strict else eps
-        if _cross(pa, pb, p) >= lim and _cross(pb, pc, p) >= lim and _cross(pc, pa, p) >= lim:
-            return False
-    return True
