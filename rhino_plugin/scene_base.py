@@ -125,8 +125,9 @@ class BaseScene:
         Raises
         ------
         InputError
-            Unknown selector key, or nothing matches (the message lists available names or
-            layers).
+            Unknown selector key, nothing matches (the message lists available names or
+            layers), or a name that several objects share (the message lists their ids;
+            select them by id or by layer).
         """
         if isinstance(selector, str):
             key, value = "name", selector
@@ -166,6 +167,17 @@ class BaseScene:
             avail = f"; available {plural}: {listed}{more}" if pool else ""
             raise InputError(
                 f"no object with {key} {value!r} in {where}{avail}{self._miss_hint()}", "selector"
+            )
+        if key == "name" and len(hits) > 1:
+            # one rocking body per name: merging namesakes silently is issue #14
+            where = os.path.basename(self.path) if self.path else "the scene"
+            ids = ", ".join(repr(o.id) for o in hits[:N_LISTED])
+            more = f", ... ({len(hits)} in all)" if len(hits) > N_LISTED else ""
+            raise InputError(
+                f"{len(hits)} objects are named {value!r} in {where} (ids {ids}{more}); select "
+                'each by {"id": ...}, or put them on one layer and select {"layer": ...}, or '
+                "give them distinct names",
+                "selector",
             )
         return hits
 
