@@ -57,9 +57,10 @@ class SceneObject:
     geometry: Any = field(default=None, repr=False, compare=False)
 
     def label(self) -> str:
-        """Name, layer and short id, for messages: ``"wall (Walls, 1a2b3c4d)"``."""
+        """Name, layer (if any) and short id, for messages: ``"wall (Walls, 1a2b3c4d)"``."""
         name = self.name or f"<unnamed {self.kind}>"
-        return f"{name} ({self.layer}, {self.id[:8]})"
+        where = f"{self.layer}, " if self.layer else ""
+        return f"{name} ({where}{self.id[:8]})"
 
 
 class BaseScene:

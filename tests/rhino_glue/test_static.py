@@ -32,6 +32,8 @@ RHINO_IMPORTED = [
     ROOT / "rhino_plugin" / "flows",
     ROOT / "rhino_plugin" / "scene_3dm.py",
     ROOT / "rhino_plugin" / "scene_base.py",
+    ROOT / "rhino_plugin" / "scene_mesh.py",
+    ROOT / "rhino_plugin" / "scenes.py",
     ROOT / "rhino_plugin" / "__init__.py",
 ]
 COMMANDS = ["RM_Analyse", "RM_LoadedWall", "RM_MultiBlock", "RM_SingleBlock", "RM_TwoBlock"]
