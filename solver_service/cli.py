@@ -417,14 +417,17 @@ def ida(
 @app.command()
 @_user_errors
 def constants(
-    scene: Path = typer.Argument(..., help="Rhino .3dm file."),
+    scene: Path = typer.Argument(..., help="Rhino .3dm file, or a scan mesh .ply/.obj/.stl/.off."),
     spec: Path = typer.Argument(..., help="Mechanism spec (JSON)."),
     output: Path = typer.Option(..., "-o", "--output", help="Kinematic-constants JSON to write."),
     as_json: bool = typer.Option(False, "--json", help="Also print the constants JSON."),
+    units: Optional[str] = typer.Option(
+        None, "--units", help="Length unit of a scan mesh: mm, cm, m, in or ft (required there)."
+    ),
 ) -> None:
     """Kinematic constants of every mechanism in SPEC from the solids of SCENE."""
     from rhino_plugin.mechanisms.build import constants_from_spec
-    from rhino_plugin.scene_3dm import Scene
+    from rhino_plugin.scenes import read_scene
     from shared_schema.io import save_constants
     from shared_schema.spec import parse_spec
 
@@ -434,7 +437,7 @@ def constants(
     spec_file = parse_spec(spec.read_bytes(), spec.name)
     cf = constants_from_spec(
         spec_file,
-        Scene.from_3dm(scene),
+        read_scene(scene, units=units),
         scene_name=scene.name,
         spec_name=spec.name,
         spec_dir=spec.parent,

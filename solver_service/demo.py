@@ -167,7 +167,7 @@ def run_demo(out_dir: Path, record_path: Path | None = None) -> dict[str, Path]:
 def facade_from_scene(out_dir: Path) -> dict[str, Path]:
     """Scene -> constants -> envelopes for the example façade (the CAD path end to end)."""
     from rhino_plugin.mechanisms.build import constants_from_spec
-    from rhino_plugin.scene_3dm import Scene
+    from rhino_plugin.scenes import read_scene
     from shared_schema.spec import parse_spec
 
     from .analysis import frequency_grid, write_envelope
@@ -176,7 +176,7 @@ def facade_from_scene(out_dir: Path) -> dict[str, Path]:
     spec_path = EXAMPLES_DIR / "specs" / "facade.spec.json"
     cf = constants_from_spec(
         parse_spec(spec_path.read_bytes(), spec_path.name),
-        Scene.from_3dm(scene_path),
+        read_scene(scene_path),
         scene_name=scene_path.name,
         spec_name=spec_path.name,
         spec_dir=spec_path.parent,

@@ -409,9 +409,9 @@ def _scene_constants(params: dict[str, Any], blobs: list[bytes], limits: dict[st
     )
     try:
         from rhino_plugin.mechanisms.build import constants_from_spec
-        from rhino_plugin.scene_3dm import Scene
+        from rhino_plugin.scenes import read_scene
 
-        scene = Scene.from_bytes(scene_bytes, scene_name)
+        scene = read_scene(scene_bytes, name=scene_name, units=params.get("units"))
     except ImportError as exc:
         raise ServiceUnavailable(
             "constants from a .3dm scene need the geometry extra (pip install "

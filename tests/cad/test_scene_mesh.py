@@ -291,3 +291,29 @@ def test_duplicate_names_in_a_3dm_are_an_error_listing_ids(tmp_path: Path) -> No
         )
     )
     assert single["positive"]["p_eq"] == pytest.approx(ref["positive"]["p_eq"], rel=1e-12)
+
+
+def test_cli_constants_reads_a_scan_with_units(files: Dict[str, Path], tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from solver_service.cli import app
+
+    spec = tmp_path / "scan.spec.json"
+    spec.write_text(json.dumps(SPEC))
+    runner = CliRunner()
+    out = {}
+    for ext, extra in (("3dm", []), ("ply", ["--units", "mm"]), ("obj", ["--units", "mm"])):
+        out[ext] = tmp_path / f"{ext}.json"
+        res = runner.invoke(
+            app, ["constants", str(files[ext]), str(spec), "-o", str(out[ext]), *extra]
+        )
+        assert res.exit_code == 0, res.output
+    ref = json.loads(out["3dm"].read_text())["mechanisms"][0]["positive"]
+    for ext in ("ply", "obj"):
+        got = json.loads(out[ext].read_text())["mechanisms"][0]["positive"]
+        for k in KEYS:
+            assert got[k] == pytest.approx(ref[k], rel=1e-12), (ext, k)
+    res = runner.invoke(app, ["constants", str(files["ply"]), str(spec), "-o", str(out["ply"])])
+    assert res.exit_code == 2
+    assert "units: wall.ply: a .ply file carries no length unit; give units" in res.output
+    assert "Traceback" not in res.output
