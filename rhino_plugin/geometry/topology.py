@@ -177,7 +177,8 @@ def merge_vertices(vertices: np.ndarray, faces: np.ndarray, tol: float) -> Tuple
         rep = np.empty(n, dtype=np.int64)
         rep[order] = first[group]
         target = rep[target]
-    merged = int(n - len(np.unique(target)))
+    # distinct representatives by counting, not np.unique (a hash/sort of n values)
+    merged = int(n - np.count_nonzero(np.bincount(target, minlength=n)))
     return target[faces], merged
 
 
