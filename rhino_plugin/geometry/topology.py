@@ -139,7 +139,12 @@ def shell_labels(faces: np.ndarray, n_vertices: int) -> Tuple[int, np.ndarray]:
     return len(roots), flabel.reshape(-1)
 
 
-def merge_vertices(vertices: np.ndarray, faces: np.ndarray, tol: float) -> Tuple[np.ndarray, int]:
+def merge_vertices(
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    tol: float,
+    shifts: Tuple[float, ...] = (0.0, 0.5),
+) -> Tuple[np.ndarray, int]:
     """Re-index faces so that vertices within ``tol`` share one index (two grid passes).
 
     Parameters
@@ -150,6 +155,8 @@ def merge_vertices(vertices: np.ndarray, faces: np.ndarray, tol: float) -> Tuple
         Triangles.
     tol : float
         Grid cell size [m] (> 0).
+    shifts : tuple of float
+        Grid offsets, in cells, of the passes (one pass per offset).
 
     Returns
     -------
@@ -160,13 +167,14 @@ def merge_vertices(vertices: np.ndarray, faces: np.ndarray, tol: float) -> Tuple
 
     Notes
     -----
-    Coordinates are not moved. Two vertices in one grid cell merge; a pair straddling a cell
-    boundary in one grid usually shares a cell in the other, shifted by half a cell.
+    Coordinates are not moved. Two vertices in one grid cell merge; with two passes, a pair
+    straddling a cell boundary in one grid usually shares a cell in the other, shifted by
+    half a cell.
     """
     n = len(vertices)
     target = np.arange(n)
     lo = vertices.min(axis=0)
-    for shift in (0.0, 0.5):
+    for shift in shifts:
         q = np.floor((vertices - lo) / tol + shift).astype(np.int64)
         order = np.lexsort((q[:, 2], q[:, 1], q[:, 0]))
         qs = q[order]
@@ -215,7 +223,9 @@ def weld(
     if v.shape[0] == 0 or f.shape[0] == 0:
         return v[:0], f[:0]
     size = float(np.linalg.norm(v.max(0) - v.min(0)))
-    f, _ = merge_vertices(v, f, rtol * size if size > 0.0 else 1.0)
+    # one pass, cells centred on the grid points (rounding): CAD and scan files repeat
+    # vertices exactly; the solid check's repair makes a second, shifted pass if needed
+    f, _ = merge_vertices(v, f, rtol * size if size > 0.0 else 1.0, shifts=(0.5,))
     f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 2] != f[:, 0])]
     used = np.zeros(v.shape[0], dtype=bool)
     used[f.ravel()] = True
@@ -289,6 +299,28 @@ def fix_winding(faces: np.ndarray, n_vertices: int) -> Tuple[np.ndarray, int, np
     return out, int(np.count_nonzero(do_flip)), shell
 
 
+def _argsort_keys(keys: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """Return ``(order, keys[order])`` for non-negative int64 keys.
+
+    Packs each key with its index into one int64 and sorts values, which numpy does several
+    times faster than ``argsort`` (vectorised sort); falls back to ``argsort`` when the key
+    and the index need more than 63 bits together.
+    """
+    n = keys.size
+    if n == 0:
+        return np.zeros(0, dtype=np.int64), keys
+    index_bits = max(int(n - 1).bit_length(), 1)
+    if int(keys.max()).bit_length() + index_bits > 63:
+        order = np.argsort(keys)
+        return order, keys[order]
+    packed = keys << index_bits
+    packed |= np.arange(n, dtype=np.int64)
+    packed.sort()
+    order = packed & ((1 << index_bits) - 1)
+    packed >>= index_bits
+    return order, packed
+
+
 def orient_outward(vertices: np.ndarray, faces: np.ndarray) -> Tuple[np.ndarray, bool, int]:
     """Make the winding consistent and the volume of each closed shell positive.
 
@@ -317,9 +349,7 @@ def orient_outward(vertices: np.ndarray, faces: np.ndarray) -> Tuple[np.ndarray,
     n = len(vertices)
     m = faces.shape[0]
     keys = half_edge_keys(faces, n)
-    canon = keys >> 1
-    order = np.argsort(canon)
-    cs = canon[order]
+    order, cs = _argsort_keys(keys >> 1)
     starts = np.flatnonzero(np.concatenate([[True], cs[1:] != cs[:-1]]))
     counts = np.diff(np.concatenate([starts, [cs.size]]))
     n_bad = int(np.count_nonzero(counts != 2))
