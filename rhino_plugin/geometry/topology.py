@@ -304,14 +304,14 @@ def _argsort_keys(keys: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
 
     Packs each key with its index into one int64 and sorts values, which numpy does several
     times faster than ``argsort`` (vectorised sort); falls back to ``argsort`` when the key
-    and the index need more than 63 bits together.
+    and the index need more than 63 bits together. Equal keys come in index order either way.
     """
     n = keys.size
     if n == 0:
         return np.zeros(0, dtype=np.int64), keys
     index_bits = max(int(n - 1).bit_length(), 1)
     if int(keys.max()).bit_length() + index_bits > 63:
-        order = np.argsort(keys)
+        order = np.argsort(keys, kind="stable")
         return order, keys[order]
     packed = keys << index_bits
     packed |= np.arange(n, dtype=np.int64)

@@ -54,3 +54,15 @@ def test_orient_outward_reports_open_edges_and_leaves_faces() -> None:
     out, closed, n_bad = orient_outward(cube.vertices, f)
     assert not closed and n_bad == 3
     np.testing.assert_array_equal(out, f)
+
+
+@pytest.mark.parametrize("high", [2**20, 2**50])
+def test_packed_sort_orders_like_a_stable_argsort(high: int) -> None:
+    # 2**50 keys with 3e4 indices need more than 63 bits: the argsort fallback
+    from rhino_plugin.geometry.topology import _argsort_keys
+
+    keys = np.random.default_rng(3).integers(0, high, 30_000)
+    keys[::7] = keys[0]  # ties are ordered by index
+    order, sorted_keys = _argsort_keys(keys)
+    np.testing.assert_array_equal(order, np.argsort(keys, kind="stable"))
+    np.testing.assert_array_equal(sorted_keys, np.sort(keys))
