@@ -565,7 +565,7 @@ def ida(
 @app.command()
 @_user_errors
 def constants(
-    scene: Path = typer.Argument(..., help="Rhino .3dm file."),
+    scene: Path = typer.Argument(..., help="Rhino .3dm file, or a scan mesh .ply/.obj/.stl/.off."),
     spec: Path = typer.Argument(..., help="Mechanism spec (JSON)."),
     output: Path = typer.Option(..., "-o", "--output", help="Kinematic-constants JSON to write."),
     as_json: bool = typer.Option(False, "--json", help="Also print the constants JSON."),
@@ -577,13 +577,19 @@ def constants(
             "when any failed). Without it, any failure writes nothing and lists every failure."
         ),
     ),
+    units: Optional[str] = typer.Option(
+        None,
+        "--units",
+        metavar="[mm|cm|m|in|ft]",
+        help="Length unit of a scan mesh (.ply, .obj, .stl, .off; required there).",
+    ),
 ) -> None:
     """Kinematic constants of every mechanism in SPEC from the solids of SCENE."""
     failures: list[MechanismFailure] = []
     if keep_going:
-        cf, failures = constants_keep_going(scene, spec)
+        cf, failures = constants_keep_going(scene, spec, units)
     else:
-        cf = constants_from_files(scene, spec)
+        cf = constants_from_files(scene, spec, units)
     save_constants(output, cf)
     if failures:
         typer.echo(

@@ -7,7 +7,8 @@ Floors, each importing only from its own floor or below:
 
 0. formats and domain rules: ``shared_schema``;
 1. maths: ``solver_service.core``, ``rhino_plugin.geometry``, ``rhino_plugin.mechanisms``
-   and the scene readers (``rhino_plugin.scene*``);
+   and the scene readers (``rhino_plugin.scene_base``, ``scene_3dm``, ``scene_mesh``,
+   ``scenes``);
 2. workflows and documents: ``solver_service.workflows``, ``solver_service.report``,
    ``solver_service.ida``, ``solver_service.demo``;
 3. front ends: ``solver_service.cli``, ``solver_service.api``, ``rhino_plugin.flows``,
@@ -32,7 +33,10 @@ FLOORS = {
     "solver_service.core": 1,
     "rhino_plugin.geometry": 1,
     "rhino_plugin.mechanisms": 1,
+    "rhino_plugin.scene_base": 1,
     "rhino_plugin.scene_3dm": 1,
+    "rhino_plugin.scene_mesh": 1,
+    "rhino_plugin.scenes": 1,
     "solver_service.workflows": 2,
     "solver_service.report": 2,
     "solver_service.ida": 2,

@@ -104,6 +104,7 @@ def constants_from_prepared(
     unit_scale: float = 1.0,
     units: str = "meters",
     source: str = "grasshopper",
+    tolerance: float = 0.0,
 ) -> Any:
     """Kinematic constants of a spec over named prepared geometry.
 
@@ -119,6 +120,8 @@ def constants_from_prepared(
         Model unit name.
     source : str
         Scene name recorded in the provenance.
+    tolerance : float
+        The document's absolute tolerance [m] (contact between solids; 0: the default).
 
     Returns
     -------
@@ -133,6 +136,7 @@ def constants_from_prepared(
         unit_scale=unit_scale,
         units=units,
         path=source,
+        tolerance=tolerance,
     )
     spec_file = parse_spec(spec_text, "spec")
     return constants_from_spec(spec_file, scene, scene_name=source, spec_name="spec")

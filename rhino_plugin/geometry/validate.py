@@ -52,11 +52,18 @@ from shared_schema.extras import require
 
 from .frames import plane_basis
 from .mesh import TriMesh
+from .topology import (
+    MERGE_RTOL,
+    edge_defects,
+    fix_winding,
+    half_edge_keys,
+    is_closed_oriented,
+    merge_vertices,
+    shell_labels,
+)
 
 __all__ = ["check_solid", "shell_labels"]
 
-#: Vertices closer than this × the bounding-box diagonal are merged [-].
-MERGE_RTOL = 1e-9
 #: |volume| below this × (bounding-box diagonal)³ counts as zero [-].
 ZERO_VOLUME_RTOL = 1e-12
 #: A hole is filled when its loop deviates from its plane by less than this × its size [-].
@@ -127,125 +134,11 @@ def face_dets(local: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return out
 
 
-def _half_edge_keys(faces: np.ndarray, n_vertices: int) -> np.ndarray:
-    """One int64 per half-edge: 2 × (undirected edge id) + (1 if it runs high → low)."""
-    if n_vertices >= 1 << 31:
-        raise GeometryError(f"too many vertices ({n_vertices}) for the edge check")
-    a = faces.ravel()
-    b = np.roll(faces, -1, axis=1).ravel()
-    key = np.minimum(a, b)
-    key *= n_vertices
-    key += np.maximum(a, b)
-    key <<= 1
-    key |= a > b
-    return key
-
-
-def _is_closed_oriented(keys: np.ndarray) -> bool:
-    """Every undirected edge has exactly two half-edges, in opposite directions.
-
-    Sorts ``keys`` in place (their order carries no information).
-    """
-    if len(keys) % 2:
-        return False
-    keys.sort()
-    ks = keys
-    first, second = ks[0::2], ks[1::2]
-    if not (np.all(second - first == 1) and np.all(first % 2 == 0)):
-        return False
-    return bool(np.all((first[1:] >> 1) != (second[:-1] >> 1)))
-
-
-def _edge_defects(keys: np.ndarray) -> Tuple[int, int, int]:
-    """Numbers of boundary, non-manifold and misoriented edges."""
-    canon = keys >> 1
-    _, inverse, counts = np.unique(canon, return_inverse=True, return_counts=True)
-    downs = np.bincount(inverse, weights=keys & 1, minlength=len(counts))
-    n_boundary = int(np.count_nonzero(counts == 1))
-    n_nonmanifold = int(np.count_nonzero(counts > 2))
-    n_misoriented = int(np.count_nonzero((counts == 2) & (downs != 1)))
-    return n_boundary, n_nonmanifold, n_misoriented
-
-
-def _components(n_nodes: int, u: np.ndarray, w: np.ndarray) -> Tuple[int, np.ndarray]:
-    """Label the connected components of a graph given by its edges (u, w): 0..k-1."""
-    try:
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.csgraph import connected_components
-    except ImportError:  # Rhino's Python may lack scipy: hook-and-jump in numpy
-        label = np.arange(n_nodes)
-        while True:
-            lu, lw = label[u], label[w]
-            lo, hi = np.minimum(lu, lw), np.maximum(lu, lw)
-            differ = lo != hi
-            if not differ.any():
-                break
-            np.minimum.at(label, hi[differ], lo[differ])
-            while True:
-                jumped = label[label]
-                if np.array_equal(jumped, label):
-                    break
-                label = jumped
-        roots, compact = np.unique(label, return_inverse=True)
-        return len(roots), compact
-    graph = coo_matrix((np.ones(len(u), dtype=np.int8), (u, w)), shape=(n_nodes, n_nodes))
-    k, labels = connected_components(graph, directed=False)
-    return int(k), labels
-
-
-def shell_labels(faces: np.ndarray, n_vertices: int) -> Tuple[int, np.ndarray]:
-    """Label the faces of a mesh by connected shell (faces sharing a vertex).
-
-    Parameters
-    ----------
-    faces : (m, 3) int
-        Triangles.
-    n_vertices : int
-        Number of vertices.
-
-    Returns
-    -------
-    k : int
-        Number of shells.
-    labels : (m,) int
-        Shell index of each face, in 0..k-1.
-    """
-    u = np.concatenate([faces[:, 0], faces[:, 1]])
-    w = np.concatenate([faces[:, 1], faces[:, 2]])
-    _, vlabel = _components(n_vertices, u, w)
-    roots, flabel = np.unique(vlabel[faces[:, 0]], return_inverse=True)
-    return len(roots), flabel
-
-
 def _bbox_diag(points: np.ndarray) -> float:
     return float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
 
 
 # --------------------------------------------------------------------------- repairs
-
-
-def _merge_vertices(vertices: np.ndarray, faces: np.ndarray, tol: float) -> Tuple[np.ndarray, int]:
-    """Re-index faces so that vertices within ``tol`` share one index (two grid passes).
-
-    Coordinates are not moved: each cluster keeps its first vertex.
-    """
-    n = len(vertices)
-    target = np.arange(n)
-    lo = vertices.min(axis=0)
-    for shift in (0.0, 0.5):
-        # A pair straddling a cell boundary in one grid usually shares a cell in the other.
-        q = np.floor((vertices - lo) / tol + shift).astype(np.int64)
-        order = np.lexsort((q[:, 2], q[:, 1], q[:, 0]))
-        qs = q[order]
-        new_group = np.ones(n, dtype=bool)
-        new_group[1:] = np.any(qs[1:] != qs[:-1], axis=1)
-        group = np.cumsum(new_group) - 1
-        first = order[new_group]
-        rep = np.empty(n, dtype=np.int64)
-        rep[order] = first[group]
-        target = rep[target]
-    merged = int(n - len(np.unique(target)))
-    return target[faces], merged
 
 
 def _drop_duplicate_faces(faces: np.ndarray) -> Tuple[np.ndarray, int, int]:
@@ -284,59 +177,9 @@ def _cyclic_parity(faces: np.ndarray, srt: np.ndarray) -> np.ndarray:
     ).astype(np.int64)
 
 
-def _fix_winding(faces: np.ndarray, n_vertices: int) -> Tuple[np.ndarray, int]:
-    """Flip faces so that each shell is consistently oriented (breadth-first, by levels).
-
-    Each shell keeps the orientation of the majority of its faces.
-    """
-    m = len(faces)
-    keys = _half_edge_keys(faces, n_vertices)
-    canon = keys >> 1
-    order = np.argsort(canon, kind="stable")
-    cs = canon[order]
-    idx = np.nonzero(cs[1:] == cs[:-1])[0]
-    h1, h2 = order[idx], order[idx + 1]
-    f1, f2 = h1 // 3, h2 // 3
-    # Same direction on both faces: one of them must be flipped relative to the other.
-    rel = ((keys[h1] & 1) == (keys[h2] & 1)).astype(np.int8)
-    nbr = np.full((m, 3), -1, dtype=np.int64)
-    nrel = np.zeros((m, 3), dtype=np.int8)
-    nbr[f1, h1 % 3], nrel[f1, h1 % 3] = f2, rel
-    nbr[f2, h2 % 3], nrel[f2, h2 % 3] = f1, rel
-    flip = np.full(m, -1, dtype=np.int8)
-    root = np.full(m, -1, dtype=np.int64)
-    _, vshell = shell_labels(faces, n_vertices)
-    front = np.unique(vshell, return_index=True)[1]
-    while True:
-        flip[front], root[front] = 0, front
-        while len(front):
-            cand = nbr[front]
-            par = flip[front][:, None] ^ nrel[front]
-            src = np.broadcast_to(root[front][:, None], cand.shape)
-            ok = cand >= 0
-            ok[ok] = flip[cand[ok]] < 0
-            cand, par, src = cand[ok], par[ok], src[ok]
-            flip[cand], root[cand] = par, src
-            front = np.unique(cand)
-        # Shells joined only at a vertex need one more seed each.
-        left = np.nonzero(flip < 0)[0]
-        if len(left) == 0:
-            break
-        front = left[:1]
-    # Keep each shell's majority orientation.
-    _, shell = np.unique(root, return_inverse=True)
-    n_flip = np.bincount(shell, weights=flip)
-    n_all = np.bincount(shell)
-    invert = (2 * n_flip > n_all)[shell]
-    do_flip = (flip == 1) ^ invert
-    out = faces.copy()
-    out[do_flip] = out[do_flip][:, ::-1]
-    return out, int(np.count_nonzero(do_flip))
-
-
 def _boundary_loops(faces: np.ndarray, n_vertices: int) -> Optional[List[List[int]]]:
     """Vertex loops of the boundary, in the direction of their half-edges (None if pinched)."""
-    keys = _half_edge_keys(faces, n_vertices)
+    keys = half_edge_keys(faces, n_vertices)
     canon = keys >> 1
     _, inverse, counts = np.unique(canon, return_inverse=True, return_counts=True)
     single = counts[inverse] == 1
@@ -403,7 +246,7 @@ def _fill_holes(vertices: np.ndarray, faces: np.ndarray) -> Tuple[np.ndarray, in
 
 
 def _topology_message(name: str, keys: np.ndarray) -> str:
-    n_boundary, n_nonmanifold, n_misoriented = _edge_defects(keys)
+    n_boundary, n_nonmanifold, n_misoriented = edge_defects(keys)
     parts = []
     if n_boundary:
         parts.append(f"is open: {n_boundary} boundary edges")
@@ -586,7 +429,7 @@ def _repair_topology(
 ) -> np.ndarray:
     """Merge, deduplicate, re-orient and fill until closed and oriented, or raise."""
     n = len(vertices)
-    keys = _half_edge_keys(faces, n)
+    keys = half_edge_keys(faces, n)
     pts = vertices[np.unique(faces)]
     diag = _bbox_diag(pts)
     centred = pts - pts.mean(axis=0)
@@ -595,7 +438,7 @@ def _repair_topology(
     if not smallest > ZERO_VOLUME_RTOL * diag**2 * len(pts):
         raise GeometryError(f"{name}: has zero volume (all its vertices lie in one plane)")
 
-    faces, merged = _merge_vertices(vertices, faces, max(MERGE_RTOL * diag, 1e-300))
+    faces, merged = merge_vertices(vertices, faces, max(MERGE_RTOL * diag, 1e-300))
     if merged:
         notes.append(f"{name}: merged {merged} duplicate vertices")
         good = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2])
@@ -603,11 +446,11 @@ def _repair_topology(
         if not good.all():
             notes.append(f"{name}: removed {int((~good).sum())} faces collapsed by the merge")
             faces = faces[good]
-        keys = _half_edge_keys(faces, n)
-        if _is_closed_oriented(keys):
+        keys = half_edge_keys(faces, n)
+        if is_closed_oriented(keys):
             return faces
 
-    n_boundary, n_nonmanifold, n_misoriented = _edge_defects(keys)
+    n_boundary, n_nonmanifold, n_misoriented = edge_defects(keys)
     if n_nonmanifold:
         faces, n_dup, n_pairs = _drop_duplicate_faces(faces)
         if n_dup:
@@ -616,14 +459,14 @@ def _repair_topology(
             notes.append(
                 f"{name}: removed {n_pairs} pairs of coincident opposite faces (internal walls)"
             )
-        keys = _half_edge_keys(faces, n)
-        n_boundary, n_nonmanifold, n_misoriented = _edge_defects(keys)
+        keys = half_edge_keys(faces, n)
+        n_boundary, n_nonmanifold, n_misoriented = edge_defects(keys)
         if n_nonmanifold:
             raise GeometryError(_topology_message(name, keys))
     if n_misoriented:
-        faces, n_flipped = _fix_winding(faces, n)
-        keys = _half_edge_keys(faces, n)
-        if _edge_defects(keys)[2]:
+        faces, n_flipped, _ = fix_winding(faces, n)
+        keys = half_edge_keys(faces, n)
+        if edge_defects(keys)[2]:
             raise GeometryError(
                 f"{name}: has inconsistent face orientation that cannot be fixed "
                 "(non-orientable surface)"
@@ -631,8 +474,8 @@ def _repair_topology(
         notes.append(f"{name}: flipped {n_flipped} faces to make the orientation consistent")
     if n_boundary:
         faces, n_filled, n_open = _fill_holes(vertices, faces)
-        keys = _half_edge_keys(faces, n)
-        if n_open or not _is_closed_oriented(keys):
+        keys = half_edge_keys(faces, n)
+        if n_open or not is_closed_oriented(keys):
             msg = _topology_message(name, keys)
             if n_open < 0:
                 msg += " (its boundary is pinched; holes were not filled)"
@@ -640,7 +483,7 @@ def _repair_topology(
                 msg += f" ({n_open} holes are not planar or not simple and were not filled)"
             raise GeometryError(msg)
         notes.append(f"{name}: filled {n_filled} planar holes ({n_boundary} boundary edges)")
-    if not _is_closed_oriented(keys):
+    if not is_closed_oriented(keys):
         raise GeometryError(_topology_message(name, keys))
     return faces
 
@@ -713,8 +556,8 @@ def check_solid(mesh: TriMesh, *, repair: bool = True) -> Tuple[TriMesh, List[st
             notes.append(f"{name}: removed {int((~good).sum())} degenerate faces")
             changed = True
 
-    keys = _half_edge_keys(work, n)
-    if not _is_closed_oriented(keys):
+    keys = half_edge_keys(work, n)
+    if not is_closed_oriented(keys):
         if not repair:
             raise GeometryError(_topology_message(name, keys))
         work = _repair_topology(name, vertices, work, notes)

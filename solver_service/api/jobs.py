@@ -26,7 +26,7 @@ from typing import Any, Optional
 import numpy as np
 
 from rhino_plugin.mechanisms.build import constants_from_spec
-from rhino_plugin.scene_3dm import Scene
+from rhino_plugin.scenes import read_scene
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import MissingExtra
@@ -412,7 +412,7 @@ def _scene_constants(params: dict[str, Any], blobs: list[bytes], limits: dict[st
         len(spec_file.mechanisms), limits["max_mechanisms"], "mechanisms", "spec", "max_mechanisms"
     )
     try:
-        scene = Scene.from_bytes(scene_bytes, scene_name)
+        scene = read_scene(scene_bytes, name=scene_name, units=params.get("units"))
     except ImportError as exc:
         raise ServiceUnavailable(
             "constants from a .3dm scene need the geometry extra (pip install "

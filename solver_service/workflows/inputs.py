@@ -15,7 +15,7 @@ from rhino_plugin.mechanisms.build import (
     constants_from_spec,
     failures_error,
 )
-from rhino_plugin.scene_3dm import Scene
+from rhino_plugin.scenes import read_scene
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 from shared_schema.io import load_constants
@@ -181,34 +181,43 @@ def read_constants(path: Path) -> ConstantsFile:
     return load_constants(path)
 
 
-def constants_from_files(scene: Path, spec: Path) -> ConstantsFile:
+def _spec_and_scene(scene: Path, spec: Path, units: Optional[str]) -> tuple[Any, Any]:
+    for label, path in (("scene", scene), ("spec", spec)):
+        check_file(path, label)
+    return parse_spec(spec.read_bytes(), spec.name), read_scene(scene, units=units)
+
+
+def constants_from_files(scene: Path, spec: Path, units: Optional[str] = None) -> ConstantsFile:
     """Kinematic constants of every mechanism of a spec file from the solids of a scene file.
 
     Parameters
     ----------
     scene : Path
-        Rhino ``.3dm`` file (read with rhino3dm).
+        Rhino ``.3dm`` file (read with rhino3dm) or a scan mesh (``.ply``, ``.obj``, ``.stl``,
+        ``.off``, read with trimesh; ``rhino_plugin.scenes.read_scene``).
     spec : Path
         Mechanism spec (JSON); relative paths inside it are taken from its folder.
+    units : {"mm", "cm", "m", "in", "ft"}, optional
+        Length unit of a scan mesh (required there; a ``.3dm`` states its own).
 
     Raises
     ------
     RockmechError
         If any mechanism fails; the message lists every failed mechanism.
     """
-    for label, path in (("scene", scene), ("spec", spec)):
-        check_file(path, label)
-    spec_file = parse_spec(spec.read_bytes(), spec.name)
+    spec_file, scene_obj = _spec_and_scene(scene, spec, units)
     return constants_from_spec(
         spec_file,
-        Scene.from_3dm(scene),
+        scene_obj,
         scene_name=scene.name,
         spec_name=spec.name,
         spec_dir=spec.parent,
     )
 
 
-def constants_keep_going(scene: Path, spec: Path) -> tuple[ConstantsFile, list[MechanismFailure]]:
+def constants_keep_going(
+    scene: Path, spec: Path, units: Optional[str] = None
+) -> tuple[ConstantsFile, list[MechanismFailure]]:
     """Like ``constants_from_files``, but keep the mechanisms that succeed.
 
     Returns
@@ -223,12 +232,10 @@ def constants_keep_going(scene: Path, spec: Path) -> tuple[ConstantsFile, list[M
     RockmechError
         If the files cannot be read, or if every mechanism fails (nothing to write).
     """
-    for label, path in (("scene", scene), ("spec", spec)):
-        check_file(path, label)
-    spec_file = parse_spec(spec.read_bytes(), spec.name)
+    spec_file, scene_obj = _spec_and_scene(scene, spec, units)
     cf, failures = constants_and_failures(
         spec_file,
-        Scene.from_3dm(scene),
+        scene_obj,
         scene_name=scene.name,
         spec_name=spec.name,
         spec_dir=spec.parent,

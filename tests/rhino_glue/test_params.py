@@ -38,7 +38,8 @@ def test_any_spec_over_named_geometry_gives_the_cli_constants(
     scene = scenes["facade"]
     names = [o.name for o in scene.objects]
     spec_text = (SPECS / "facade.spec.json").read_text()
-    cf = constants_from_prepared(_records(scene, names), spec_text)
+    # The component passes the document's tolerance, as the .3dm reader does.
+    cf = constants_from_prepared(_records(scene, names), spec_text, tolerance=scene.tolerance)
     want = cli_constants("facade")
     for mech in json.loads(cf.model_dump_json(exclude_none=True))["mechanisms"]:
         ref = want[mech["id"]]

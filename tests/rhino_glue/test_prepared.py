@@ -43,7 +43,10 @@ def prepared_from(scene: Any, scale: float = 1.0) -> PreparedScene:
             pass
         records.append((obj.id, obj.name, obj.layer, obj.kind, Prepared(**fields)))
     units = "meters" if scale == 1.0 else "millimeters"
-    return PreparedScene.from_records(records, unit_scale=scale, units=units)
+    # As DocScene does in Rhino: the document's absolute tolerance [m] comes along.
+    return PreparedScene.from_records(
+        records, unit_scale=scale, units=units, tolerance=scene.tolerance
+    )
 
 
 @pytest.mark.parametrize("case", ["facade_loaded", "facade_crack", "statue_column", "side_aisle"])

@@ -31,6 +31,9 @@ RHINO_IMPORTED = [
     ROOT / "rhino_plugin" / "mechanisms",
     ROOT / "rhino_plugin" / "flows",
     ROOT / "rhino_plugin" / "scene_3dm.py",
+    ROOT / "rhino_plugin" / "scene_base.py",
+    ROOT / "rhino_plugin" / "scene_mesh.py",
+    ROOT / "rhino_plugin" / "scenes.py",
     ROOT / "rhino_plugin" / "__init__.py",
 ]
 COMMANDS = ["RM_Analyse", "RM_LoadedWall", "RM_MultiBlock", "RM_SingleBlock", "RM_TwoBlock"]

@@ -21,9 +21,11 @@ class RM_ComputeConstants(Grasshopper.Kernel.GH_ScriptInstance):
 
     def RunScript(self, geometry, names, spec, folder):
         """Return (constants JSON, summary)."""
-        scale, units, _ = model_units()
+        scale, units, tol = model_units()
         records = prepare_inputs(list(geometry or []), [str(n) for n in names or []])
-        cf = constants_from_prepared(records, str(spec or ""), unit_scale=scale, units=units)
+        cf = constants_from_prepared(
+            records, str(spec or ""), unit_scale=scale, units=units, tolerance=tol * scale
+        )
         text = cf.model_dump_json(indent=2, exclude_none=True)
         summary = [
             f"{m.id}: p_eq = {m.positive.p_eq:.4f} rad/s, lambda = {m.positive.lam:.4f}, "

@@ -5,7 +5,7 @@ import importlib
 
 import pytest
 
-MODULES = ["massprops", "validate", "cut", "contact", "frames"]
+MODULES = ["massprops", "validate", "cut", "contact", "frames", "polygon", "topology"]
 
 
 @pytest.mark.parametrize("name", MODULES)

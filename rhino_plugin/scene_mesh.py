@@ -1,0 +1,278 @@
+"""Scan meshes as scenes: PLY, OBJ, STL and OFF files read with trimesh.
+
+A scan (photogrammetry, laser) is a triangle mesh with no units and no line or plane
+objects, so a :class:`MeshScene` differs from a ``.3dm`` scene in three ways:
+
+- the length unit is given by the caller (``units``: mm, cm, m, in or ft) and is required;
+- its objects are the meshes the file names: OBJ objects (``o`` lines), else OBJ groups
+  (``g`` lines), else one object named after the file's stem (PLY, STL, OFF, plain OBJ);
+- axes, cracks and hinges must be given in the spec by points [m] (``axis.start``/``end``,
+  ``crack.points``); asking a scan for a line or a plane names the object and says so.
+
+Every mesh goes through the same welding, winding and closed-solid checks as a ``.3dm``
+mesh (:func:`~rhino_plugin.scene_base.solid_mesh`). trimesh is imported lazily, with
+``process=False`` so that it neither merges nor reorders anything before those checks.
+
+Python 3.9-clean (the Rhino side may import it; trimesh <= 4.12 works).
+"""
+
+import io
+import os
+import re
+from typing import Any, Dict, List, Optional, Tuple, Union
+
+import numpy as np
+
+from rhino_plugin.geometry.mesh import TriMesh
+from rhino_plugin.scene_base import BaseScene, SceneObject, solid_mesh
+from shared_schema.errors import GeometryError, InputError
+
+__all__ = ["SCAN_FORMATS", "UNITS", "MeshScene", "unit_ratio"]
+
+#: File extensions read as scan meshes (lower case, without the dot).
+SCAN_FORMATS = ("ply", "obj", "stl", "off")
+
+#: Length units a scan may be given in: short name -> (long name, exact metres ratio
+#: (numerator, denominator)), so that 1000 mm is exactly 1 m.
+UNITS: Dict[str, Tuple[str, Tuple[float, float]]] = {
+    "mm": ("millimeters", (1.0, 1e3)),
+    "cm": ("centimeters", (1.0, 1e2)),
+    "m": ("meters", (1.0, 1.0)),
+    "in": ("inches", (254.0, 1e4)),
+    "ft": ("feet", (3048.0, 1e4)),
+}
+
+#: What a spec for a scan must do instead of naming line or plane objects.
+POINTS_HINT = (
+    "a scan mesh has no line or plane objects: give the axis by its 'start' and 'end' "
+    "points [m], each crack by three 'points' [m], and hinges as points"
+)
+
+# OBJ statements that name objects and groups (trimesh merges repeated names).
+_OBJ_NAME = re.compile(rb"^[ \t]*([og])[ \t]+([^\r\n]*?)[ \t]*$", re.M)
+
+
+def unit_ratio(units: Optional[str], name: str) -> Tuple[str, Tuple[float, float]]:
+    """Long unit name and exact metres ratio of a scan's ``units``.
+
+    Parameters
+    ----------
+    units : str or None
+        ``"mm"``, ``"cm"``, ``"m"``, ``"in"`` or ``"ft"`` (long names such as
+        ``"millimeters"`` are accepted too).
+    name : str
+        The file's name, for the message.
+
+    Raises
+    ------
+    InputError
+        ``units`` missing or unknown (field ``"units"``).
+    """
+    choices = ", ".join(UNITS)
+    if units is None or not str(units).strip():
+        ext = os.path.splitext(name)[1].lower() or "scan"
+        raise InputError(
+            f"{os.path.basename(name)}: a {ext} file carries no length unit; give units "
+            f"({choices})",
+            "units",
+        )
+    key = str(units).strip().lower()
+    for short, (long, ratio) in UNITS.items():
+        if key in (short, long, long.rstrip("s")):
+            return long, ratio
+    raise InputError(f"unknown units {units!r}; use one of {choices}", "units")
+
+
+class MeshScene(BaseScene):
+    """The meshes of a scan file, in metres.
+
+    Construct with :meth:`from_file` or :meth:`from_bytes`. Each object's ``geometry`` is
+    a ``(vertices, faces)`` pair in file units; ``kind`` is ``"mesh"``, ``layer`` ``""``
+    and ``id`` ``"<name>#<k>"`` (k counts the file's meshes from 0).
+
+    Examples
+    --------
+    >>> scene = MeshScene.from_file("wall.ply", units="mm")  # doctest: +SKIP
+    >>> mesh = scene.mesh(scene.find("wall")[0])  # doctest: +SKIP
+    """
+
+    def __init__(
+        self,
+        objects: List[SceneObject],
+        unit_scale: float = 1.0,
+        units: str = "meters",
+        path: Optional[str] = None,
+        tolerance: float = 0.0,
+    ) -> None:
+        super().__init__(objects, unit_scale, units, path, tolerance)
+        # OBJ names used by more than one object (trimesh merged them): name -> count
+        self._repeated: Dict[str, int] = {}
+
+    # ------------------------------------------------------------------ reading
+
+    @classmethod
+    def from_file(
+        cls, path: Union[str, "os.PathLike[str]"], *, units: Optional[str]
+    ) -> "MeshScene":
+        """Read a ``.ply``, ``.obj``, ``.stl`` or ``.off`` file.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file.
+        units : str
+            Its length unit: mm, cm, m, in or ft (required: these formats carry none).
+
+        Raises
+        ------
+        InputError
+            Missing file (field ``"scene"``), missing or unknown ``units`` (``"units"``),
+            or a file trimesh cannot read (``"scene"``).
+        """
+        p = os.fspath(path)
+        if not os.path.isfile(p):
+            raise InputError(f"file not found: {p}", "scene")
+        with open(p, "rb") as fh:
+            data = fh.read()
+        return cls.from_bytes(data, p, units=units)
+
+    @classmethod
+    def from_bytes(cls, data: bytes, name: str, *, units: Optional[str]) -> "MeshScene":
+        """Read a scan from memory (an upload); ``name``'s extension gives the format.
+
+        Parameters
+        ----------
+        data : bytes
+            The file's content.
+        name : str
+            File name (``"wall.ply"``): its extension selects the reader and its stem
+            names a single-mesh file's object.
+        units : str
+            Length unit of the coordinates (see :data:`UNITS`).
+
+        Raises
+        ------
+        InputError
+            Unknown extension, missing or unknown ``units``, or unreadable content.
+        """
+        ext = os.path.splitext(name)[1].lower().lstrip(".")
+        if ext not in SCAN_FORMATS:
+            raise InputError(
+                f"{os.path.basename(name)}: not a scan mesh; use "
+                + ", ".join("." + e for e in SCAN_FORMATS),
+                "scene",
+            )
+        long, (num, den) = unit_ratio(units, name)
+        stem = os.path.splitext(os.path.basename(name))[0] or "mesh"
+        try:
+            parts, repeated = _load(bytes(data), ext, stem)
+        except InputError:
+            raise
+        except Exception as exc:  # trimesh raises many kinds on bad input
+            raise InputError(
+                f"cannot read {os.path.basename(name)} as a .{ext} mesh ({type(exc).__name__}: "
+                f"{exc})",
+                "scene",
+            ) from None
+        objects = [
+            SceneObject(id=f"{nm}#{k}", name=nm, layer="", kind="mesh", geometry=(v, f))
+            for k, (nm, v, f) in enumerate(parts)
+        ]
+        scene = cls(objects, unit_scale=num / den, units=long, path=name)
+        scene._ratio = (num, den)
+        scene._repeated = repeated
+        return scene
+
+    # ------------------------------------------------------------------ selection
+
+    def find(self, selector: Union[str, Dict[str, str]]) -> List[SceneObject]:
+        """Return the objects matching a selector (see :meth:`BaseScene.find`).
+
+        Raises
+        ------
+        InputError
+            As :meth:`BaseScene.find`; also for a name that several OBJ objects share
+            (trimesh merges them, so they cannot be told apart).
+        """
+        hits = super().find(selector)
+        name = selector if isinstance(selector, str) else selector.get("name")
+        if name is not None and name in self._repeated:
+            where = os.path.basename(self.path) if self.path else "the scene"
+            raise InputError(
+                f"{self._repeated[name]} meshes are named {name!r} in {where}; give each "
+                "rocking body its own OBJ object name",
+                "selector",
+            )
+        return hits
+
+    def _miss_hint(self) -> str:
+        return f" ({POINTS_HINT})"
+
+    # ------------------------------------------------------------------ geometry
+
+    def mesh(self, obj: SceneObject, require_closed: bool = True) -> TriMesh:
+        """Return the object as a triangle mesh in metres, oriented outward.
+
+        Raises
+        ------
+        GeometryError
+            No faces, or (with ``require_closed``) not a closed solid; names the object.
+        """
+        v, f = obj.geometry
+        return solid_mesh(self._to_m(v), f, obj, require_closed=require_closed)
+
+    def line(self, obj: SceneObject) -> Tuple[np.ndarray, np.ndarray]:
+        """Refuse: a scan has no line objects (the message says what to give instead)."""
+        raise GeometryError(f"{obj.label()}: a mesh is not a line; {POINTS_HINT}")
+
+    def plane(self, obj: SceneObject) -> Tuple[np.ndarray, np.ndarray]:
+        """Refuse: a scan has no plane objects (the message says what to give instead)."""
+        raise GeometryError(f"{obj.label()}: a mesh does not define a plane; {POINTS_HINT}")
+
+
+def _load(
+    data: bytes, ext: str, stem: str
+) -> Tuple[List[Tuple[str, np.ndarray, np.ndarray]], Dict[str, int]]:
+    """Meshes of a scan file as (name, vertices, faces), and OBJ names used twice."""
+    import trimesh  # heavy optional dependency (geometry extra)
+
+    if ext != "obj":
+        m = trimesh.load_mesh(io.BytesIO(data), file_type=ext, process=False)
+        return [(stem, _vertices(m.vertices), _faces(m.faces))], {}
+    from trimesh.exchange.obj import load_obj  # the OBJ reader keeps names apart
+
+    statements = _OBJ_NAME.findall(data)
+    objects = [n.decode("utf-8", "replace") for k, n in statements if k == b"o"]
+    groups = [n.decode("utf-8", "replace") for k, n in statements if k == b"g"]
+    by_objects = bool(objects)
+    loaded = load_obj(
+        io.BytesIO(data),
+        group_material=False,
+        skip_materials=True,
+        maintain_order=True,
+        split_objects=by_objects,
+        split_groups=not by_objects and bool(groups),
+    )
+    geometry: Dict[str, Dict[str, Any]] = (
+        loaded.get("geometry", {}) if "geometry" in loaded else {"geometry": loaded}
+    )
+    names = objects if by_objects else groups
+    repeated = {n: names.count(n) for n in set(names) if names.count(n) > 1}
+    parts = []
+    single = len(geometry) == 1 and not names
+    for key, kw in geometry.items():
+        faces = kw.get("faces")
+        if faces is None or len(faces) == 0:
+            continue
+        parts.append((stem if single else key, _vertices(kw["vertices"]), _faces(faces)))
+    if not parts:
+        raise InputError(f"{stem}.obj has no faces", "scene")
+    return parts, repeated
+
+
+def _vertices(v: Any) -> np.ndarray:
+    return np.ascontiguousarray(np.asarray(v, dtype=np.float64).reshape(-1, 3))
+
+
+def _faces(f: Any) -> np.ndarray:
+    return np.ascontiguousarray(np.asarray(f, dtype=np.int64).reshape(-1, 3))

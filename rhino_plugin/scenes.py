@@ -1,0 +1,101 @@
+"""One entry point for every scene file: ``.3dm`` models and scan meshes.
+
+:func:`read_scene` picks the reader from the file's extension: Rhino ``.3dm``
+(:class:`~rhino_plugin.scene_3dm.Scene`, units from the file) or a scan mesh ``.ply``,
+``.obj``, ``.stl``, ``.off`` (:class:`~rhino_plugin.scene_mesh.MeshScene`, units given).
+The CLI, the service and the demo call it; each reader stays importable on its own.
+
+Python 3.9-clean.
+"""
+
+import os
+from typing import Optional, Union
+
+from rhino_plugin.scene_3dm import Scene
+from rhino_plugin.scene_base import BaseScene
+from rhino_plugin.scene_mesh import SCAN_FORMATS, MeshScene, unit_ratio
+from shared_schema.errors import InputError
+
+__all__ = ["SCENE_FORMATS", "read_scene"]
+
+#: Extensions :func:`read_scene` reads (lower case, without the dot).
+SCENE_FORMATS = ("3dm", *SCAN_FORMATS)
+#: Model-unit names of a .3dm file saved without units (read as metres by default).
+UNITLESS_3DM = ("none", "unset")
+
+
+def read_scene(
+    source: Union[str, "os.PathLike[str]", bytes],
+    *,
+    name: Optional[str] = None,
+    units: Optional[str] = None,
+) -> BaseScene:
+    """Read a scene from a file or from bytes.
+
+    Parameters
+    ----------
+    source : str, path-like or bytes
+        The file, or its content (an upload).
+    name : str, optional
+        File name used for the format (its extension) and in messages; required with
+        bytes, defaults to ``source``'s path otherwise.
+    units : str, optional
+        Length unit of a scan mesh: mm, cm, m, in or ft (required for .ply, .obj, .stl and
+        .off, which carry none). A ``.3dm`` file has its own units: ``units`` may repeat
+        them but not contradict them, except in a file saved without units (read as metres
+        unless ``units`` is given).
+
+    Returns
+    -------
+    BaseScene
+        A :class:`~rhino_plugin.scene_3dm.Scene` or a
+        :class:`~rhino_plugin.scene_mesh.MeshScene`, in metres.
+
+    Raises
+    ------
+    InputError
+        Unknown format, unreadable file (field ``"scene"``), or missing, unknown or
+        contradicting ``units`` (field ``"units"``).
+
+    Examples
+    --------
+    >>> read_scene("examples/scenes/rect_wall.3dm").units  # doctest: +SKIP
+    'meters'
+    >>> read_scene(b"...", name="wall.ply")  # doctest: +SKIP
+    Traceback (most recent call last):
+    InputError: wall.ply: a .ply file carries no length unit; give units (mm, cm, m, in, ft)
+    """
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        if not name:
+            raise InputError("a scene given as bytes needs its file name", "scene")
+        label = name
+    else:
+        label = name or os.fspath(source)
+    ext = os.path.splitext(label)[1].lower().lstrip(".")
+    if ext not in SCENE_FORMATS:
+        raise InputError(
+            f"{os.path.basename(label)}: unknown scene format {('.' + ext) if ext else '(none)'}; "
+            "rockmech reads " + ", ".join("." + e for e in SCENE_FORMATS),
+            "scene",
+        )
+    if ext != "3dm":
+        if isinstance(source, (bytes, bytearray, memoryview)):
+            return MeshScene.from_bytes(bytes(source), label, units=units)
+        return MeshScene.from_file(source, units=units)
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        scene = Scene.from_bytes(bytes(source), label)
+    else:
+        scene = Scene.from_3dm(source)
+    if units is not None:
+        long, (num, den) = unit_ratio(units, label)
+        if scene.units in UNITLESS_3DM:
+            # a model saved without units: the caller says what they are
+            scene.units, scene._ratio = long, (num, den)
+            scene.unit_scale, scene.tolerance = num / den, scene.tolerance * num / den
+        elif long != scene.units:
+            raise InputError(
+                f"{os.path.basename(label)} is in {scene.units} (its model units), not "
+                f"{long}; drop units for a .3dm file",
+                "units",
+            )
+    return scene
