@@ -45,6 +45,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.errors import InputError
+from shared_schema.rules import G
 
 from . import _kernels as _k
 from .excitation import Pulse, SampledAccel
@@ -77,6 +78,17 @@ DENSE_PER_QUARTER = 50
 #: An error estimate of the peak ratio at or above this [-] means the peak is not resolved
 #: (the covariance reached its cap, ``_kernels.ERR_CAP``): the result says so.
 UNRESOLVED_ERROR = 0.1
+#: Most closed-form segments one run may need (``p_eq`` × duration / ``MAX_PH`` plus one per
+#: cell); beyond it a run takes minutes, so the input is refused with its valid range.
+MAX_SEGMENTS = 5e7
+#: ``p_eq`` [rad/s] above which no masonry body is plausible (a block of half-diagonal
+#: 0.1 mm); a run too long to compute names ``p_eq`` above it, the excitation below it.
+P_EQ_PLAUSIBLE = 1e3
+#: Largest ratio of the scaled peak ground acceleration to the uplift acceleration
+#: ``g · lam`` [-]: the top of the range the extreme-case sweep verifies
+#: (``benchmarks/extremes.py``); far past it every mechanism overturns at once, and the
+#: closed forms lose their meaning as the numbers approach overflow.
+MAX_AMPLITUDE_RATIO = 1e6
 #: Most impacts kept in an impact log (``impact_log=True``); later ones are counted only.
 IMPACT_LOG_CAP = 1_000_000
 
@@ -147,6 +159,55 @@ class Cells:
     def widths(self) -> NDArray[np.float64]:
         """Cell durations [s]."""
         return np.asarray(self.data[5] - self.data[4], dtype=np.float64)
+
+
+def check_range(
+    p_max: float, lam_min: float, cells: Cells, scale_max: float, pulse: bool, scale_field: str
+) -> None:
+    """Refuse up front a run the integrator cannot answer in bounded time or range.
+
+    Parameters
+    ----------
+    p_max : float
+        Largest ``p_eq`` of the mechanisms [rad/s].
+    lam_min : float
+        Smallest ``lam`` of the mechanisms [-].
+    cells : Cells
+        The excitation.
+    scale_max : float
+        Largest factor on the excitation [-].
+    pulse : bool
+        The excitation is a pulse (errors name ``f_p`` and ``a_p``, not the record).
+    scale_field : str
+        The field of the scale factors (``scale`` or ``scales``).
+
+    Raises
+    ------
+    InputError
+        When the run needs more than ``MAX_SEGMENTS`` closed-form segments (naming ``p_eq``
+        if it is above ``P_EQ_PLAUSIBLE``, else the excitation's duration: ``f_p`` or
+        ``record``); when the scaled peak is over ``MAX_AMPLITUDE_RATIO`` × ``g lam``.
+    """
+    data = cells.data
+    duration = float(data[5, -1] - data[4, 0])
+    segments = p_max * duration / _k.MAX_PH + data.shape[1]
+    if segments > MAX_SEGMENTS:
+        p_ok = (MAX_SEGMENTS - data.shape[1]) * _k.MAX_PH / duration
+        field = "p_eq" if p_max > P_EQ_PLAUSIBLE else ("f_p" if pulse else "record")
+        raise InputError(
+            f"p_eq = {p_max:.4g} rad/s over {duration:.4g} s of excitation needs about "
+            f"{segments:.2g} closed-form steps per run (at most {MAX_SEGMENTS:.0e}); for this "
+            f"excitation p_eq must be at most {p_ok:.4g} rad/s, or the excitation shorter",
+            field,
+        )
+    ratio = scale_max * float(data[6, 0]) / (G * lam_min)
+    if ratio > MAX_AMPLITUDE_RATIO * (1.0 + 1e-9):  # the sweep's own 1e6 passes round-off
+        raise InputError(
+            f"the scaled peak acceleration is {ratio:.3g} times the uplift acceleration "
+            f"g lam, beyond the solver's range (at most {MAX_AMPLITUDE_RATIO:.0e} times); any "
+            "mechanism overturns at once at such a level",
+            "a_p" if pulse else scale_field,
+        )
 
 
 def _record_cells(rec: SampledAccel, t_extra: float) -> Cells:
@@ -296,6 +357,15 @@ def simulate(
     if int(max_impacts) < 1:
         raise InputError(f"must be >= 1, got {max_impacts!r}", "max_impacts")
     cells = cells_for(excitation, dense=dense, t_extra=t_extra)
+    pos, neg = model.positive, model.neg
+    check_range(
+        max(pos.p_eq, neg.p_eq),
+        min(pos.lam, neg.lam),
+        cells,
+        scale,
+        isinstance(excitation, Pulse),
+        "scale",
+    )
     kern = kernels(backend)
     cap = 0
     if dense:
@@ -483,6 +553,14 @@ def simulate_batch(
     params = np.stack([_params(m) for m in models])
     crit = _criterion(criterion, excitation)
     cells = cells_for(excitation)
+    check_range(
+        max(max(m.positive.p_eq, m.neg.p_eq) for m in models),
+        min(min(m.positive.lam, m.neg.lam) for m in models),
+        cells,
+        float(sc.max()),
+        isinstance(excitation, Pulse),
+        "scales",
+    )
     kern = kernels(backend)
     grid = kern.simulate_grid_serial if getattr(_THREAD, "serial", False) else kern.simulate_grid
     out = grid(cells.data, params, sc, V_REST_REL, int(max_impacts))
