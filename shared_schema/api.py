@@ -22,6 +22,7 @@ from shared_schema.constants import Amplification, ConstantsFile
 __all__ = [
     "RECORD_UNITS",
     "Band",
+    "BuildingOptions",
     "ConstantsForm",
     "ConstantsResponse",
     "Ec8Request",
@@ -32,6 +33,7 @@ __all__ = [
     "ErrorResponse",
     "HealthResponse",
     "HistoryForm",
+    "HistoryOptions",
     "HistoryRequest",
     "HistoryResponse",
     "HistoryRow",
@@ -43,11 +45,13 @@ __all__ = [
     "RecordInfo",
     "RecordSamples",
     "ReportForm",
+    "ReportOptions",
     "ReportRequest",
     "ScaleFactorRequest",
     "ScaleFactorResponse",
     "SpectrumCurve",
     "SpectrumForm",
+    "SpectrumOptions",
     "SpectrumRequest",
     "SpectrumResponse",
 ]
@@ -129,7 +133,7 @@ class EnvelopeRequest(BaseModel):
     )
 
 
-class _BuildingOptions(BaseModel):
+class BuildingOptions(BaseModel):
     """Code scale factors and displacements of time histories (``rockmech history``)."""
 
     building_height: Optional[float] = Field(
@@ -144,7 +148,7 @@ class _BuildingOptions(BaseModel):
     )
 
 
-class _HistoryOptions(_BuildingOptions):
+class HistoryOptions(BuildingOptions):
     """Scale factors and verdict of time histories (``rockmech history``)."""
 
     scales: List[float] = Field(
@@ -164,7 +168,7 @@ class _HistoryOptions(_BuildingOptions):
     )
 
 
-class _ReportOptions(_HistoryOptions):
+class ReportOptions(HistoryOptions):
     """Envelope options and title of a report (``rockmech report``)."""
 
     f_min: float = Field(0.1, description="Lowest pulse frequency of the envelopes [Hz].")
@@ -174,7 +178,7 @@ class _ReportOptions(_HistoryOptions):
     title: Optional[str] = Field(None, max_length=200, description="Title of the report.")
 
 
-class HistoryRequest(_HistoryOptions):
+class HistoryRequest(HistoryOptions):
     """Time histories of every mechanism at every scale factor (``rockmech history``)."""
 
     model_config = _REQUEST
@@ -183,7 +187,7 @@ class HistoryRequest(_HistoryOptions):
     record: RecordSamples = Field(description="The ground motion.")
 
 
-class _SpectrumOptions(BaseModel):
+class SpectrumOptions(BaseModel):
     """Spectrum and pulse-search options (``rockmech record``)."""
 
     zeta: float = Field(0.05, description="Damping ratio of the spectrum [-], in [0, 1).")
@@ -195,7 +199,7 @@ class _SpectrumOptions(BaseModel):
     f_max: Optional[float] = Field(None, description="Pulse search: highest f_p [Hz].")
 
 
-class SpectrumRequest(_SpectrumOptions):
+class SpectrumRequest(SpectrumOptions):
     """A record's exact elastic response spectrum and largest sine pulses (``rockmech record``)."""
 
     model_config = _REQUEST
@@ -250,7 +254,7 @@ ScaleFactorRequest = Annotated[
 ]
 
 
-class ReportRequest(_ReportOptions):
+class ReportRequest(ReportOptions):
     """An HTML report: constants, envelopes, and with a record its time histories and spectrum."""
 
     model_config = _REQUEST
@@ -291,15 +295,15 @@ class RecordFileOptions(BaseModel):
     )
 
 
-class HistoryForm(RecordFileOptions, _HistoryOptions):
+class HistoryForm(RecordFileOptions, HistoryOptions):
     """Multipart form of ``history``: files ``constants`` and ``record``, plus these fields."""
 
 
-class SpectrumForm(RecordFileOptions, _SpectrumOptions):
+class SpectrumForm(RecordFileOptions, SpectrumOptions):
     """Multipart form of ``spectrum``: file ``record``, plus these fields."""
 
 
-class ReportForm(RecordFileOptions, _ReportOptions):
+class ReportForm(RecordFileOptions, ReportOptions):
     """Multipart form of ``report``: file ``constants``, optional file ``record``, and these."""
 
 

@@ -27,22 +27,28 @@ import json
 import logging
 import math
 from collections.abc import Callable
-from typing import Any, ClassVar, Optional
+from typing import Any, ClassVar
 
-from fastapi import APIRouter, Request, Response
-from pydantic import BaseModel
+from pydantic import BaseModel, ValidationError
 
-from shared_schema.api import EnvelopeRequest, HistoryRequest, PulseRequest
+from shared_schema.api import EnvelopeRequest, PulseRequest
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
 
-__all__ = ["HOPS_PREFIX", "HopsError", "RockmechHops", "hops_router"]
+from .jobspec import EnvelopeJob, HistoryJob, Job, PulseJob
+
+__all__ = ["HOPS_PREFIX", "HopsError", "JobRunner", "RockmechHops"]
 
 #: URL prefix of the Hops components.
 HOPS_PREFIX = "/hops"
 
-#: Runs one compute job: (kind, params) -> (status, media type, body).
-JobRunner = Callable[[str, dict[str, Any]], tuple[int, str, bytes]]
+#: Runs one compute job: job -> (status, media type, body).
+JobRunner = Callable[[Job], tuple[int, str, bytes]]
+
+
+def _default(model: type[BaseModel], name: str) -> Any:
+    """Return the REST default of a field (a Hops input defaults to the same value)."""
+    return model.model_fields[name].default
 
 
 def _import_ghhops() -> Any:
@@ -80,7 +86,7 @@ def _strict_number(value: Any) -> float:
 def _strict_integer(value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, int):
         raise HopsError(422, f"expected an integer, got {value!r}")
-    return value
+    return int(value)
 
 
 def _strict_boolean(value: Any) -> bool:
@@ -159,9 +165,9 @@ class RockmechHops:
             lam: float,
             a_p_g: float,
             f_p: float,
-            eta: float = 0.9,
-            one_sided: bool = False,
-            shape: str = "sine",
+            eta: float,
+            one_sided: bool = _default(PulseRequest, "one_sided"),
+            shape: str = _default(PulseRequest, "shape"),
         ) -> tuple[Any, ...]:
             request = {
                 "p_eq": p_eq,
@@ -172,7 +178,7 @@ class RockmechHops:
                 "one_sided": one_sided,
                 "shape": shape,
             }
-            doc = self._job("pulse", _params(PulseRequest, request))
+            doc = self._job(PulseJob.model_validate(request))
             t_ov = doc["t_overturn"]
             return (
                 doc["overturned"],
@@ -205,10 +211,14 @@ class RockmechHops:
                 Text("json", "J", "The whole result as JSON"),
             ],
         )
-        def envelope(constants: str, f_min: float = 0.1, f_max: float = 10.0, n: int = 100) -> Any:
+        def envelope(
+            constants: str,
+            f_min: float = _default(EnvelopeRequest, "f_min"),
+            f_max: float = _default(EnvelopeRequest, "f_max"),
+            n: int = _default(EnvelopeRequest, "n"),
+        ) -> Any:
             request = {"constants": _constants_json(constants), "f_min": f_min, "f_max": f_max}
-            params = _params(EnvelopeRequest, {**request, "n": n})
-            doc = self._job("envelope", params)
+            doc = self._job(EnvelopeJob.model_validate({**request, "n": n}))
             lowest = [
                 min((v for v in col if v is not None), default=None)
                 for col in zip(*(m["a_p_min_g"] for m in doc["mechanisms"]))
@@ -247,8 +257,7 @@ class RockmechHops:
                 "record": {"accel": accel_g, "dt": dt, "units": "g", "name": "grasshopper"},
                 "scales": scales,
             }
-            params = {**_params(HistoryRequest, request), "constants_label": "constants"}
-            doc = self._job("history", params)
+            doc = self._job(HistoryJob.model_validate(request))
             rows = doc["results"]
             return (
                 [r["mechanism"] for r in rows],
@@ -261,8 +270,8 @@ class RockmechHops:
 
         self.components = {"pulse": pulse, "envelope": envelope, "history": history}
 
-    def _job(self, kind: str, params: dict[str, Any]) -> dict[str, Any]:
-        status, _, body = self._run_job(kind, params)
+    def _job(self, job: Job) -> dict[str, Any]:
+        status, _, body = self._run_job(job)
         if status != 200:
             detail = json.loads(body).get("detail", "error")
             raise HopsError(status, detail)
@@ -324,20 +333,7 @@ def _constants_json(text: Any) -> Any:
         raise InputError(str(exc), "constants") from None
 
 
-def _params(model: type[BaseModel], request: dict[str, Any]) -> dict[str, Any]:
-    """Validate a component's inputs with the REST request model; return the job parameters."""
-    validated = model.model_validate(request)
-    params = validated.model_dump()
-    if "constants" in request:
-        params["constants"] = validated.model_dump(include={"constants"}, exclude_none=True)[
-            "constants"
-        ]
-    return params
-
-
 def _validation_text(exc: ValueError) -> str:
-    from pydantic import ValidationError
-
     if isinstance(exc, ValidationError):
         parts = []
         for err in exc.errors(include_url=False):
@@ -347,36 +343,3 @@ def _validation_text(exc: ValueError) -> str:
     if isinstance(exc, json.JSONDecodeError):
         return f"invalid JSON: {exc}"
     return str(exc)
-
-
-def hops_router(hops: Callable[[], Optional[RockmechHops]]) -> APIRouter:
-    """Return the ASGI routes of the Hops components (kept out of the OpenAPI document).
-
-    Parameters
-    ----------
-    hops : callable
-        Returns the app's ``RockmechHops``.
-    """
-    from starlette.concurrency import run_in_threadpool
-
-    router = APIRouter(prefix=HOPS_PREFIX, include_in_schema=False)
-
-    def _get() -> RockmechHops:
-        comp = hops()
-        assert comp is not None, "the Hops components are set up with the app"
-        return comp
-
-    @router.get("/")
-    @router.get("/{name}")
-    async def query(name: str = "") -> Response:
-        status, body = _get().query("/" + name if name else "/")
-        return Response(body, status_code=status, media_type="application/json")
-
-    @router.post("/{name}")
-    async def solve(name: str, request: Request) -> Response:
-        payload = await request.body()
-        # The handlers block on the compute pool; run them on a worker thread.
-        status, body = await run_in_threadpool(_get().solve, "/" + name, payload)
-        return Response(body, status_code=status, media_type="application/json")
-
-    return router

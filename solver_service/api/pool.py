@@ -26,6 +26,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Optional
 
+from .jobspec import Job
+
 __all__ = ["BudgetExceeded", "ComputePool", "PoolBusy", "WorkerLost", "WorkerResult"]
 
 log = logging.getLogger("rockmech.pool")
@@ -166,9 +168,7 @@ class ComputePool:
                 proc.kill()
             await proc.wait()
 
-    async def run(
-        self, kind: str, params: dict[str, Any], blobs: Sequence[bytes] = ()
-    ) -> WorkerResult:
+    async def run(self, job: Job, blobs: Sequence[bytes] = ()) -> WorkerResult:
         """Run one job and return its answer.
 
         Raises
@@ -187,8 +187,11 @@ class ComputePool:
             raise PoolBusy(
                 f"all {self.size} compute processes stayed busy for {self.queue_timeout_s:g} s"
             ) from None
-        header: dict[str, Any] = {"kind": kind, "params": params, "limits": self.limits}
-        header["blobs"] = [len(b) for b in blobs]
+        header: dict[str, Any] = {
+            "job": job.model_dump(mode="json", exclude_none=True),
+            "limits": self.limits,
+            "blobs": [len(b) for b in blobs],
+        }
         start = time.perf_counter()
         try:
             result = await asyncio.wait_for(self._exchange(worker, header, blobs), self.timeout_s)
@@ -212,7 +215,7 @@ class ComputePool:
             self._replace(worker)
             raise
         worker.jobs += 1
-        log.debug("job %s took %.3f s", kind, time.perf_counter() - start)
+        log.debug("job %s took %.3f s", job.kind, time.perf_counter() - start)
         self._idle.put_nowait(worker)
         return result
 
