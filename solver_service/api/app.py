@@ -18,10 +18,12 @@ from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 from typing import Optional
 
-from fastapi import FastAPI
+from fastapi import Depends, FastAPI
 
+from .deps import bind_client
+from .guard import HostGuard
 from .hops import RockmechHops
-from .limits import BodyLimit
+from .limits import VALUES_PER_MECHANISM, VALUES_SLACK, BodyLimit
 from .openapi import install_openapi, operation_id
 from .pool import ComputePool
 from .problems import install_handlers
@@ -79,8 +81,12 @@ def create_app(settings: Optional[Settings] = None) -> FastAPI:
         redoc_url=None,
         separate_input_output_schemas=False,
         generate_unique_id_function=operation_id,
+        dependencies=[Depends(bind_client)],
     )
-    app.add_middleware(BodyLimit, limit=cfg.max_body_bytes)
+    max_values = cfg.max_samples + VALUES_PER_MECHANISM * cfg.max_mechanisms + VALUES_SLACK
+    app.add_middleware(BodyLimit, limit=cfg.max_body_bytes, max_values=max_values)
+    # Added last, so it runs first: foreign hosts and origins are refused before any body.
+    app.add_middleware(HostGuard, hosts=cfg.allowed_hosts, origins=cfg.allowed_origins)
     app.state.settings = cfg
     app.state.pool = pool
     install_handlers(app, cfg.max_body_bytes)

@@ -12,10 +12,11 @@ from typing import Annotated, Any
 from fastapi import Depends, Request
 from starlette.exceptions import HTTPException
 
+from .compute import CLIENT
 from .pool import ComputePool
 from .settings import Settings
 
-__all__ = ["JSON", "MULTIPART", "PoolDep", "SettingsDep", "accepts", "media_type"]
+__all__ = ["JSON", "MULTIPART", "PoolDep", "SettingsDep", "accepts", "bind_client", "media_type"]
 
 JSON = "application/json"
 MULTIPART = "multipart/form-data"
@@ -54,3 +55,8 @@ def accepts(*allowed: str) -> Any:
             )
 
     return Depends(check)
+
+
+async def bind_client(request: Request) -> None:
+    """App-wide dependency: remember the request, so a job can notice its client leave."""
+    CLIENT.set(request)

@@ -37,6 +37,8 @@ from shared_schema.errors import InputError
 
 from .jobspec import EnvelopeJob, HistoryJob, Job, PulseJob
 
+log = logging.getLogger("rockmech.hops")
+
 __all__ = ["HOPS_PREFIX", "HopsError", "JobRunner", "RockmechHops"]
 
 #: URL prefix of the Hops components.
@@ -80,7 +82,13 @@ class HopsError(Exception):
 def _strict_number(value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise HopsError(422, f"expected a number, got {value!r}")
-    return float(value)
+    try:
+        number = float(value)
+    except OverflowError:  # an integer of hundreds of digits
+        raise HopsError(422, "a number is out of the range of double precision") from None
+    if not math.isfinite(number):
+        raise HopsError(422, f"expected a finite number, got {value!r}")
+    return number
 
 
 def _strict_integer(value: Any) -> int:
@@ -321,6 +329,13 @@ class RockmechHops:
             return 422, self.hops._return_with_err(_validation_text(exc)).encode("utf-8")
         except RecursionError:
             return 400, self.hops._return_with_err("JSON nested too deeply").encode("utf-8")
+        except OverflowError:
+            message = "a number is out of the range of double precision"
+            return 422, self.hops._return_with_err(message).encode("utf-8")
+        except Exception:  # a bug: logged; the caller gets Hops' error shape, no traceback
+            log.exception("Hops solve of %s failed", uri)
+            message = "internal error; see the service log"
+            return 500, self.hops._return_with_err(message).encode("utf-8")
 
 
 def _constants_json(text: Any) -> Any:

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -59,6 +58,12 @@ from ..workflows.inputs import read_record
 from ..workflows.outputs import finite_json
 from ..workflows.scaling import Building
 from .errors import error_body
+from .estimates import (
+    check_limit,
+    check_total_steps,
+    check_work,
+    history_steps,
+)
 from .jobspec import (
     EnvelopeJob,
     HistoryJob,
@@ -71,6 +76,7 @@ from .jobspec import (
     SpectrumJob,
     WarmupJob,
 )
+from .uploads import safe_filename
 
 __all__ = [
     "JOBS",
@@ -87,10 +93,6 @@ __all__ = [
     "safe_filename",
 ]
 
-#: Longest file name kept from an upload (characters).
-MAX_NAME = 100
-#: Characters kept in an uploaded file's name; others become "_".
-_NAME_OK = re.compile(r"[^A-Za-z0-9._-]")
 
 _LIBRARY: Any = None
 
@@ -113,51 +115,6 @@ def dumps(doc: Any) -> bytes:
     return json.dumps(finite_json(doc), allow_nan=False, separators=(",", ":")).encode("utf-8")
 
 
-def safe_filename(name: Optional[str], default: str) -> str:
-    """Return the last component of an uploaded file's name, with only safe characters.
-
-    Examples
-    --------
-    >>> safe_filename("../../etc/passwd", "record.dat")
-    'passwd'
-    >>> safe_filename("", "record.dat")
-    'record.dat'
-    """
-    base = re.split(r"[\\/]", name or "")[-1]
-    base = _NAME_OK.sub("_", base).lstrip(".")[-MAX_NAME:]
-    return base or default
-
-
-def check_limit(count: int, limit: int, what: str, field: str, setting: str) -> None:
-    """Raise ``InputError`` (naming the limit) when ``count`` exceeds ``limit``."""
-    if count > limit:
-        raise InputError(
-            f"{count} {what} exceed the service limit of {limit} per request "
-            f"(ROCKMECH_{setting.upper()})",
-            field,
-        )
-
-
-#: Closed-form steps per record sample the service computes at most, on average: one
-#: computation may take ``WORK_PER_SAMPLE * max_samples`` steps (segments of the exact
-#: integrator, or sub-steps of the spectrum recurrence), so that absurd but well-formed inputs
-#: (a two-sample record a day long, p_eq = 1e300) get 422 at once instead of running into the
-#: time budget. Real records stay far below it.
-WORK_PER_SAMPLE = 20
-
-
-def check_work(steps: float, limits: dict[str, int], what: str, field: str) -> None:
-    """Raise ``InputError`` (naming the limit) when a computation would take too many steps."""
-    limit = WORK_PER_SAMPLE * limits["max_samples"]
-    if steps > limit:
-        raise InputError(
-            f"{what} would take {steps:.3g} closed-form steps; the service computes at most "
-            f"{limit} per run ({WORK_PER_SAMPLE} x ROCKMECH_MAX_SAMPLES); resample the record "
-            "or run it with the rockmech command line",
-            field,
-        )
-
-
 def _positive(*values: Any) -> bool:
     return all(
         isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0
@@ -175,7 +132,7 @@ def _record_steps(motion: Any, rate: float) -> float:
 
 def check_record_work(
     motion: Any,
-    limits: dict[str, int],
+    limits: dict[str, Any],
     *,
     p_max: Optional[float] = None,
     t_min: Optional[float] = None,
@@ -192,9 +149,11 @@ def check_record_work(
         check_work(steps, limits, f"the spectrum down to T = {t_min:g} s", "record")
 
 
-def _history_work(cf: Any, motion: Any, sf: str, limits: dict[str, int]) -> None:
+def _history_work(cf: Any, motion: Any, sf: str, limits: dict[str, Any], n_scales: int = 1) -> None:
     sides = [s for m in cf.mechanisms for s in (m.positive, m.negative) if s is not None]
     check_record_work(motion, limits, p_max=max(s.p_eq for s in sides))
+    steps = history_steps(cf, motion.accel.n, motion.dt, n_scales)
+    check_total_steps(steps, limits, "the time histories", "record")
     if sf == "eq28":
         for mech in cf.mechanisms:
             if mech.amplification is not None:
@@ -208,7 +167,7 @@ def _library() -> Any:
     return _LIBRARY
 
 
-def _constants(data: Any, label: str, limits: dict[str, int]) -> Any:
+def _constants(data: Any, label: str, limits: dict[str, Any]) -> Any:
     """Validate a constants file given as data (JSON body) or bytes (upload)."""
     if isinstance(data, bytes):
         try:
@@ -224,7 +183,7 @@ def _constants(data: Any, label: str, limits: dict[str, int]) -> Any:
     return cf
 
 
-def _scales(values: list[float], limits: dict[str, int]) -> list[float]:
+def _scales(values: list[float], limits: dict[str, Any]) -> list[float]:
     check_limit(len(values), limits["max_scales"], "scale factors", "scales", "max_scales")
     return [float(v) for v in values]
 
@@ -238,7 +197,7 @@ def motion_from_params(
     record: Optional[RecordSamples],
     upload: Optional[RecordUpload],
     blob: Optional[bytes],
-    limits: dict[str, int],
+    limits: dict[str, Any],
 ) -> Any:
     """Build a ``GroundMotion`` from samples (JSON) or from an uploaded file.
 
@@ -286,7 +245,7 @@ def motion_from_params(
 # --- jobs -------------------------------------------------------------------------------------
 
 
-def pulse_doc(job: PulseRequest, limits: Optional[dict[str, int]] = None) -> dict[str, Any]:
+def pulse_doc(job: PulseRequest, limits: Optional[dict[str, Any]] = None) -> dict[str, Any]:
     """Response of one mechanism to a pulse, as ``rockmech pulse --json`` prints it.
 
     Parameters
@@ -313,16 +272,16 @@ def pulse_doc(job: PulseRequest, limits: Optional[dict[str, int]] = None) -> dic
     )
 
 
-def _pulse(job: PulseJob, blobs: list[bytes], limits: dict[str, int]) -> bytes:
+def _pulse(job: PulseJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     return dumps(pulse_doc(job, limits))
 
 
-def _grid(f_min: float, f_max: float, n: int, limits: dict[str, int]) -> Any:
+def _grid(f_min: float, f_max: float, n: int, limits: dict[str, Any]) -> Any:
     check_limit(n, limits["max_samples"], "frequencies", "n", "max_samples")
     return frequency_grid(f_min, f_max, n)
 
 
-def _envelope(job: EnvelopeJob, blobs: list[bytes], limits: dict[str, int]) -> bytes:
+def _envelope(job: EnvelopeJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     f_p = _grid(job.f_min, job.f_max, job.n, limits)
     cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
     doc, _ = envelope_doc(cf, f_p, exact=job.exact, library=None if job.exact else _library())
@@ -340,11 +299,11 @@ def history_options(job: HistoryOptions) -> dict[str, Any]:
     }
 
 
-def _history(job: HistoryJob, blobs: list[bytes], limits: dict[str, int]) -> bytes:
+def _history(job: HistoryJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     scales = _scales(job.scales, limits)
     cf = _constants(_constants_source(job.constants, blobs), job.constants_label, limits)
     motion = motion_from_params(job.record, job.upload, _blob(blobs), limits)
-    _history_work(cf, motion, job.sf, limits)
+    _history_work(cf, motion, job.sf, limits, len(scales))
     return dumps(history_doc(cf, motion, scales, **history_options(job)))
 
 
@@ -360,7 +319,7 @@ def _blob(blobs: list[bytes]) -> Optional[bytes]:
     return blobs[-1] if blobs else None
 
 
-def _spectrum(job: SpectrumJob, blobs: list[bytes], limits: dict[str, int]) -> bytes:
+def _spectrum(job: SpectrumJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     check_limit(job.n, limits["max_samples"], "periods", "n", "max_samples")
     motion = motion_from_params(job.record, job.upload, _blob(blobs), limits)
     periods = log_grid(job.t_min, job.t_max, job.n, names=("t_min", "t_max"))
@@ -372,7 +331,7 @@ def _spectrum(job: SpectrumJob, blobs: list[bytes], limits: dict[str, int]) -> b
 
 
 def scale_factor_doc(
-    request: Union[Eq28Request, Ec8Request, NzsRequest], limits: dict[str, int]
+    request: Union[Eq28Request, Ec8Request, NzsRequest], limits: dict[str, Any]
 ) -> dict[str, Any]:
     """Return a code or paper scale factor (``solver_service.core.codes``) with its inputs."""
     if isinstance(request, Ec8Request):
@@ -399,11 +358,11 @@ def scale_factor_doc(
     return info
 
 
-def _scale_factor(job: ScaleFactorJob, blobs: list[bytes], limits: dict[str, int]) -> bytes:
+def _scale_factor(job: ScaleFactorJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     return dumps(scale_factor_doc(job.request, limits))
 
 
-def _scene_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, int]) -> bytes:
+def _scene_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     scene_name = safe_filename(job.scene_name, "scene.3dm")
     spec_name = safe_filename(job.spec_name, "spec.json")
     scene_bytes, spec_bytes = blobs
@@ -444,7 +403,7 @@ REPORT_KEYS = (
 )
 
 
-def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, int]) -> bytes:
+def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     scales = _scales(job.scales, limits)
     check_limit(job.n, limits["max_samples"], "frequencies", "n", "max_samples")
     f_p = frequency_grid(job.f_min, job.f_max, job.n)
@@ -459,7 +418,7 @@ def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, int]) -> bytes
         motion = motion_from_params(
             job.record, job.upload, _blob(blobs) if has_upload else None, limits
         )
-        _history_work(cf, motion, job.sf, limits)
+        _history_work(cf, motion, job.sf, limits, len(scales))
         check_record_work(motion, limits, t_min=SPECTRUM_PERIODS[0])
         if has_upload:
             rec_raw = _blob(blobs)
@@ -483,7 +442,7 @@ def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, int]) -> bytes
     return html.encode("utf-8")
 
 
-def _warmup(job: WarmupJob, blobs: list[bytes], limits: dict[str, int]) -> bytes:
+def _warmup(job: WarmupJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     """Compile (or load from numba's cache) every kernel a request may need, once."""
     model = RockingModel.symmetric(2.0, 0.2, 0.9)
     simulate(model, Pulse(a_p=-3.0, f_p=1.0))
@@ -497,7 +456,7 @@ def _warmup(job: WarmupJob, blobs: list[bytes], limits: dict[str, int]) -> bytes
 _JSON = "application/json"
 
 #: Job kinds: media type of the answer and the function that computes it.
-JOBS: dict[str, tuple[str, Callable[[Any, list[bytes], dict[str, int]], bytes]]] = {
+JOBS: dict[str, tuple[str, Callable[[Any, list[bytes], dict[str, Any]], bytes]]] = {
     "pulse": (_JSON, _pulse),
     "envelope": (_JSON, _envelope),
     "history": (_JSON, _history),
@@ -509,7 +468,7 @@ JOBS: dict[str, tuple[str, Callable[[Any, list[bytes], dict[str, int]], bytes]]]
 }
 
 
-def run_job(job: Job, blobs: list[bytes], limits: dict[str, int]) -> JobOutput:
+def run_job(job: Job, blobs: list[bytes], limits: dict[str, Any]) -> JobOutput:
     """Run one job and turn rockmech's errors into 4xx answers with their messages.
 
     Returns

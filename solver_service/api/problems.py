@@ -17,7 +17,7 @@ from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
 
 from .errors import error_body
-from .limits import too_large_message
+from .limits import TooManyValues, too_large_message
 
 __all__ = ["Problem", "error_response", "install_handlers", "validation_message"]
 
@@ -106,6 +106,8 @@ def install_handlers(app: FastAPI, max_body_bytes: int) -> None:
         message = str(exc.detail)
         if exc.status_code == 413:
             message = too_large_message(max_body_bytes)
+        if isinstance(exc, TooManyValues):
+            return error_response(422, "InputError", message, "record")
         headers = dict(exc.headers) if exc.headers else None
         return error_response(exc.status_code, "HTTPError", message, headers=headers)
 

@@ -5,12 +5,15 @@ from __future__ import annotations
 from fastapi import APIRouter, Request, Response
 
 from shared_schema.api import ConstantsResponse
+from shared_schema.errors import InputError
 
 from ..compute import compute
 from ..deps import MULTIPART, PoolDep, accepts
 from ..forms import FORMS, parse_form, read_form, read_upload
 from ..jobspec import SceneJob
 from ..openapi import body_doc, responses
+from ..problems import Problem
+from ..uploads import check_3dm, safe_filename
 
 __all__ = ["router"]
 
@@ -36,4 +39,8 @@ async def constants(request: Request, pool: PoolDep) -> Response:
         await form.close()
     assert scene is not None and spec is not None
     job = SceneJob(scene_name=scene[1], spec_name=spec[1])
+    try:
+        check_3dm(scene[0], safe_filename(scene[1], "scene.3dm"))
+    except InputError as exc:
+        raise Problem(422, "InputError", str(exc), exc.field) from None
     return await compute(pool, job, [scene[0], spec[0]])

@@ -13,7 +13,7 @@ import anyio.from_thread
 from fastapi import APIRouter, Depends, Request, Response
 from starlette.concurrency import run_in_threadpool
 
-from ..compute import compute
+from ..compute import CLIENT, compute
 from ..hops import HOPS_PREFIX, JobRunner, RockmechHops
 from ..jobspec import Job
 from ..pool import ComputePool
@@ -25,8 +25,10 @@ def thread_job_runner(pool: ComputePool) -> JobRunner:
     """Return a job runner for the Hops handlers, which run on worker threads."""
 
     def run(job: Job) -> tuple[int, str, bytes]:
+        client = CLIENT.get()  # the thread runs in a copy of the request's context
+
         async def go() -> Response:
-            return await compute(pool, job)
+            return await compute(pool, job, request=client)
 
         response = anyio.from_thread.run(go)
         media = response.media_type or "application/json"
