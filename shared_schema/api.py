@@ -20,6 +20,8 @@ from pydantic import BaseModel, ConfigDict, Field
 from shared_schema.constants import Amplification, ConstantsFile
 
 __all__ = [
+    "EQ28_RULE",
+    "PULSE_ETA_RULE",
     "RECORD_UNITS",
     "Band",
     "BuildingOptions",
@@ -67,13 +69,86 @@ def _gt0(description: str) -> Any:
     return Field(description=description, json_schema_extra={"exclusiveMinimum": 0})
 
 
+# --- rules across fields, stated in the schema ------------------------------------------------
+# The service enforces these in the solver, with the messages ``rockmech`` prints; the schema
+# states them too (``oneOf``), so that clients learn them from the contract.
+
+_NUMBER = {"type": "number"}
+
+#: A pulse needs ``eta``: in [0, 1] for two-sided rocking, in [-1, 0] for one-sided.
+PULSE_ETA_RULE: Dict[str, Any] = {
+    "oneOf": [
+        {
+            "properties": {
+                "one_sided": {"const": False},
+                "eta": {**_NUMBER, "minimum": 0, "maximum": 1},
+            },
+            "required": ["eta"],
+        },
+        {
+            "properties": {
+                "one_sided": {"const": True},
+                "eta": {**_NUMBER, "minimum": -1, "maximum": 0},
+            },
+            "required": ["eta", "one_sided"],
+        },
+    ]
+}
+
+#: Eq. 28 from S_a and PGA, or from a record and f_n, never both.
+EQ28_RULE: Dict[str, Any] = {
+    "oneOf": [
+        {
+            "properties": {
+                "sa_g": {**_NUMBER, "minimum": 0},
+                "pga_g": {**_NUMBER, "exclusiveMinimum": 0},
+                "record": {"type": "null"},
+                "f_n": {"type": "null"},
+            },
+            "required": ["sa_g", "pga_g"],
+        },
+        {
+            "properties": {
+                "record": {"type": "object"},
+                "f_n": {**_NUMBER, "exclusiveMinimum": 0},
+                "sa_g": {"type": "null"},
+                "pga_g": {"type": "null"},
+            },
+            "required": ["record", "f_n"],
+        },
+    ]
+}
+
+#: Time-domain work (envelopes, time histories) needs ``eta`` for every two-sided mechanism.
+_TWO_SIDED_ETA: Dict[str, Any] = {
+    "properties": {
+        "mechanisms": {
+            "items": {
+                "anyOf": [
+                    {"properties": {"rocking": {"const": "one_sided"}}, "required": ["rocking"]},
+                    {"properties": {"eta": _NUMBER}, "required": ["eta"]},
+                ]
+            }
+        }
+    }
+}
+
+
+def _constants_need_eta(schema: Dict[str, Any]) -> None:
+    """State in the schema that time-domain constants give ``eta`` where needed."""
+    prop = schema["properties"]["constants"]
+    schema["properties"]["constants"] = {"allOf": [prop, _TWO_SIDED_ETA]}
+
+
 # --- requests ---------------------------------------------------------------------------------
 
 
 class PulseRequest(BaseModel):
     """One mechanism under a one-cycle sine or cosine pulse (``rockmech pulse``)."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=PULSE_ETA_RULE
+    )
 
     p_eq: float = _gt0("Frequency parameter p_eq [rad/s], > 0.")
     lam: float = _gt0("Static load multiplier lambda [-], > 0.")
@@ -122,7 +197,9 @@ class RecordSamples(BaseModel):
 class EnvelopeRequest(BaseModel):
     """Overturning envelopes of every mechanism and the critical bands (``rockmech envelope``)."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
+    )
 
     constants: ConstantsFile = Field(description="The kinematic-constants file.")
     f_min: float = Field(0.1, description="Lowest pulse frequency [Hz], > 0.")
@@ -181,7 +258,9 @@ class ReportOptions(HistoryOptions):
 class HistoryRequest(HistoryOptions):
     """Time histories of every mechanism at every scale factor (``rockmech history``)."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
+    )
 
     constants: ConstantsFile = Field(description="The kinematic-constants file.")
     record: RecordSamples = Field(description="The ground motion.")
@@ -210,10 +289,14 @@ class SpectrumRequest(SpectrumOptions):
 class Eq28Request(BaseModel):
     """Eq. 28 scale factor ``sqrt(1 + (S_a/a_g h/h_e)^2)``: from S_a and PGA, or from a record."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=EQ28_RULE
+    )
 
     method: Literal["eq28"]
-    h: float = Field(description="Height of the mechanism [m], >= 0.")
+    h: float = Field(
+        description="Height of the mechanism [m], >= 0.", json_schema_extra={"minimum": 0}
+    )
     h_e: float = _gt0("Effective (modal) height of the structure [m], > 0.")
     sa_g: Optional[float] = Field(None, description="Spectral acceleration S_a(T_n) [g], >= 0.")
     pga_g: Optional[float] = Field(None, description="Peak ground acceleration [g], > 0.")

@@ -89,6 +89,12 @@ async def compute(
         return error_response(422, "InputError", str(exc), exc.field)
     try:
         result = await _run_watched(pool, job, blobs, request or CLIENT.get())
+    except ValueError:  # the job could not be encoded: a derived number overflowed
+        message = (
+            "a number derived from the inputs is not finite; the inputs are too large or too "
+            "small for double precision"
+        )
+        return error_response(422, "InputError", message)
     except (BudgetExceeded, PoolBusy) as exc:
         return error_response(503, type(exc).__name__, str(exc))
     except WorkerLost as exc:

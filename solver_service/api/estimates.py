@@ -135,6 +135,22 @@ def _grid_sum(p: float, f_min: float, f_max: float, n: int) -> float:
     return series + (n - k)
 
 
+def _check_derived(cf: ConstantsFile) -> None:
+    """Refuse constants whose derived side values overflowed (``p_eq = sqrt(K/I0)`` = inf)."""
+    for i, mech in enumerate(cf.mechanisms):
+        for name in ("positive", "negative"):
+            side = getattr(mech, name)
+            for key in ("p_eq", "lam", "phi_ov"):
+                value = getattr(side, key, None) if side is not None else None
+                if isinstance(value, float) and not math.isfinite(value):
+                    raise InputError(
+                        f"mechanisms[{i}] (id {mech.id!r}).{name}.{key}: derived value {value} "
+                        "is not finite; the inputs are too large or too small for double "
+                        "precision",
+                        "constants",
+                    )
+
+
 def envelope_steps(cf: ConstantsFile, f_min: float, f_max: float, n: int) -> float:
     """Closed-form steps of exact envelopes of every mechanism at ``n`` frequencies."""
     return float(sum(N_SCAN * d * _grid_sum(p, f_min, f_max, n) for p, d in _sides(cf)))
@@ -196,6 +212,7 @@ def check_job(job: Job, limits: dict[str, Any]) -> None:
             "constants",
             "max_mechanisms",
         )
+        _check_derived(cf)
     if isinstance(job, PulseJob) and _positive(job.p_eq, job.f_p):
         # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
         check_work(job.p_eq / job.f_p, limits, "the pulse", "f_p")

@@ -83,6 +83,7 @@ class WorkerResult:
 class _Worker:
     proc: asyncio.subprocess.Process
     tmpdir: str
+    ready: bool = False
     jobs: int = 0
     watcher: Optional[asyncio.Task[None]] = field(default=None, repr=False)
 
@@ -139,8 +140,8 @@ class ComputePool:
 
     @property
     def alive(self) -> int:
-        """Number of worker processes that are running."""
-        return sum(1 for w in self._all if _running(w.proc))
+        """Number of worker processes that have warmed up and are running (ready or busy)."""
+        return sum(1 for w in self._all if w.ready and _running(w.proc))
 
     def pids(self) -> list[int]:
         """Process ids of the running workers (for memory reports and fault tests)."""
@@ -179,6 +180,7 @@ class ComputePool:
         if self._closing:
             await self._end(worker)
             return
+        worker.ready = True
         worker.watcher = self._background(self._watch(worker))
         await self._release(worker)
 
@@ -260,6 +262,8 @@ class ComputePool:
 
         Raises
         ------
+        ValueError
+            The job holds a number JSON cannot carry (infinity); no worker was used.
         PoolBusy
             No worker became free within ``queue_timeout_s``.
         BudgetExceeded
@@ -273,13 +277,14 @@ class ComputePool:
             "limits": self.limits,
             "blobs": [len(b) for b in blobs],
         }
+        # Encoded before a worker is taken: a value JSON cannot carry (a derived constant
+        # that overflowed) is the request's problem (ValueError), never a worker's.
+        line = json.dumps(header, allow_nan=False).encode("utf-8") + b"\n"
         for attempt in (1, 2):
             worker = await self._acquire()
             start = time.perf_counter()
             try:
-                result = await asyncio.wait_for(
-                    self._exchange(worker, header, blobs), self.timeout_s
-                )
+                result = await asyncio.wait_for(self._exchange(worker, line, blobs), self.timeout_s)
             except asyncio.TimeoutError:
                 self._replace(worker)
                 raise BudgetExceeded(
@@ -315,13 +320,11 @@ class ComputePool:
             f"and the process has been replaced: try again in {RETRY_AFTER_S} s"
         )
 
-    async def _exchange(
-        self, worker: _Worker, header: dict[str, Any], blobs: Sequence[bytes]
-    ) -> WorkerResult:
+    async def _exchange(self, worker: _Worker, line: bytes, blobs: Sequence[bytes]) -> WorkerResult:
         proc = worker.proc
         assert proc.stdin is not None and proc.stdout is not None
         try:
-            proc.stdin.write(json.dumps(header, allow_nan=False).encode("utf-8") + b"\n")
+            proc.stdin.write(line)
             for blob in blobs:
                 proc.stdin.write(blob)
             await proc.stdin.drain()

@@ -326,3 +326,29 @@ def test_sigterm_waits_for_work_in_flight_no_longer_than_the_setting(tmp_path: P
         thread.join(10)
         assert took < 2 + 3.0, took  # the setting, plus the compute process's exit grace
         assert _gone(pid, 5.0)
+
+
+def test_constants_whose_derived_values_overflow_get_422_not_a_worker_fault(
+    faulty: Server,
+) -> None:
+    side = {"I0": 5e-324, "K": 2.8e16, "Q": 5e-324, "phi_cr": 5e-324}
+    mech = {"id": "W", "p_eq": 2.0, "lam": 0.2, "eta": 0.3, "negative": side}
+    res = httpx.post(f"{faulty.url}/api/v1/envelope", json={"constants": {"mechanisms": [mech]}})
+    assert res.status_code == 422, res.text
+    assert res.json()["detail"].startswith("constants: mechanisms[0] (id 'W').negative.p_eq")
+
+
+def test_the_schema_states_the_rules_across_fields(faulty: Server) -> None:
+    api = httpx.get(f"{faulty.url}/api/v1/openapi.json").json()["components"]["schemas"]
+    pulse = api["PulseRequest"]["oneOf"]
+    assert [b["properties"]["eta"].get("minimum") for b in pulse] == [0, -1]
+    eq28 = api["Eq28Request"]["oneOf"]
+    assert [sorted(b["required"]) for b in eq28] == [["pga_g", "sa_g"], ["f_n", "record"]]
+    for name in ("EnvelopeRequest", "HistoryRequest"):
+        rule = api[name]["properties"]["constants"]["allOf"][1]
+        assert rule["properties"]["mechanisms"]["items"]["anyOf"][1]["required"] == ["eta"]
+    # What the schema states, the service enforces (with the CLI's messages).
+    two_sided = {**PULSE, "eta": -0.5}
+    assert httpx.post(f"{faulty.url}/api/v1/pulse", json=two_sided).status_code == 422
+    both = {"method": "eq28", "h": 3.0, "h_e": 4.0, "sa_g": 0.2, "pga_g": 0.1, "f_n": 2.0}
+    assert httpx.post(f"{faulty.url}/api/v1/scale-factor", json=both).status_code == 422
