@@ -131,7 +131,7 @@ class RockmechHops:
     Parameters
     ----------
     run_job : callable
-        ``(kind, params) -> (status, media_type, body)``; runs a compute job (the app passes
+        ``job -> (status, media_type, body)``; runs a compute job (the app passes
         one that goes through its compute pool, from a worker thread).
     """
 
@@ -142,6 +142,18 @@ class RockmechHops:
         Number, Integer, Boolean, Text = _param_types(params)
         item, many = params.HopsParamAccess.ITEM, params.HopsParamAccess.LIST
         component = self.hops.component
+
+        types, access = (Number, Integer, Boolean, Text), (item, many)
+        self.components = {
+            "pulse": self._pulse(component, types, access),
+            "envelope": self._envelope(component, types, access),
+            "history": self._history(component, types, access),
+        }
+
+    def _pulse(self, component: Any, types: tuple[Any, ...], access: tuple[Any, Any]) -> Any:
+        """Register the ``pulse`` component; return its handler."""
+        Number, Integer, Boolean, Text = types
+        item, _many = access
 
         @component(  # type: ignore[untyped-decorator]
             rule="/pulse",
@@ -197,6 +209,13 @@ class RockmechHops:
                 json.dumps(doc),
             )
 
+        return pulse
+
+    def _envelope(self, component: Any, types: tuple[Any, ...], access: tuple[Any, Any]) -> Any:
+        """Register the ``envelope`` component; return its handler."""
+        Number, Integer, _Boolean, Text = types
+        item, many = access
+
         @component(  # type: ignore[untyped-decorator]
             rule="/envelope",
             name="rockmech envelope",
@@ -237,6 +256,13 @@ class RockmechHops:
             governing = [g or "" for g in doc["governing"]]
             return doc["f_p"], governing, _finite_list(lowest), bands, json.dumps(doc)
 
+        return envelope
+
+    def _history(self, component: Any, types: tuple[Any, ...], access: tuple[Any, Any]) -> Any:
+        """Register the ``history`` component; return its handler."""
+        Number, _Integer, Boolean, Text = types
+        item, many = access
+
         @component(  # type: ignore[untyped-decorator]
             rule="/history",
             name="rockmech history",
@@ -276,7 +302,7 @@ class RockmechHops:
                 json.dumps(doc),
             )
 
-        self.components = {"pulse": pulse, "envelope": envelope, "history": history}
+        return history
 
     def _job(self, job: Job) -> dict[str, Any]:
         status, _, body = self._run_job(job)
