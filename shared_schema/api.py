@@ -340,7 +340,9 @@ ScaleFactorRequest = Annotated[
 class ReportRequest(ReportOptions):
     """An HTML report: constants, envelopes, and with a record its time histories and spectrum."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
+    )
 
     constants: ConstantsFile = Field(description="The kinematic-constants file.")
     record: Optional[RecordSamples] = Field(
