@@ -36,6 +36,7 @@ from shared_schema.api import (
 )
 from shared_schema.constants import ConstantsFile, parse_constants
 from shared_schema.errors import InputError, RockmechError
+from shared_schema.rules import CRITERIA, SF_METHODS, check_choice
 from shared_schema.spec import parse_spec
 
 from ..core import codes
@@ -404,6 +405,10 @@ REPORT_KEYS = (
 
 
 def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    # Checked with or without a record, as the schema states them.
+    check_choice(job.sf, SF_METHODS, "sf")
+    if job.criterion is not None:
+        check_choice(job.criterion, CRITERIA, "criterion")
     scales = _scales(job.scales, limits)
     check_limit(job.n, limits["max_samples"], "frequencies", "n", "max_samples")
     f_p = frequency_grid(job.f_min, job.f_max, job.n)
