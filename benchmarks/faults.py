@@ -56,8 +56,15 @@ def _children(pid: int) -> list[int]:
     return [int(p) for p in Path(f"/proc/{pid}/task/{pid}/children").read_text().split()]
 
 
+#: CPU ticks reported for a process that has already ended (it counts as having worked).
+GONE_TICKS = 1 << 60
+
+
 def _ticks(pid: int) -> int:
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:  # ended (and reaped) already
+        return GONE_TICKS
     return int(fields[11]) + int(fields[12])
 
 
