@@ -20,6 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator
 from shared_schema.constants import Amplification, ConstantsFile
 from shared_schema.rules import (
     CRITERIA,
+    LENGTH_UNITS,
     PULSE_SHAPES,
     RECORD_FORMATS,
     RECORD_UNITS,
@@ -28,8 +29,11 @@ from shared_schema.rules import (
 )
 
 __all__ = [
+    "EQ28_RULE",
+    "PULSE_ETA_RULE",
     "RECORD_UNITS",
     "Band",
+    "BuildingOptions",
     "ConstantsForm",
     "ConstantsResponse",
     "Ec8Request",
@@ -40,6 +44,7 @@ __all__ = [
     "ErrorResponse",
     "HealthResponse",
     "HistoryForm",
+    "HistoryOptions",
     "HistoryRequest",
     "HistoryResponse",
     "HistoryRow",
@@ -51,11 +56,13 @@ __all__ = [
     "RecordInfo",
     "RecordSamples",
     "ReportForm",
+    "ReportOptions",
     "ReportRequest",
     "ScaleFactorRequest",
     "ScaleFactorResponse",
     "SpectrumCurve",
     "SpectrumForm",
+    "SpectrumOptions",
     "SpectrumRequest",
     "SpectrumResponse",
 ]
@@ -69,13 +76,86 @@ def _gt0(description: str) -> Any:
     return Field(description=description, json_schema_extra={"exclusiveMinimum": 0})
 
 
+# --- rules across fields, stated in the schema ------------------------------------------------
+# The service enforces these in the solver, with the messages ``rockmech`` prints; the schema
+# states them too (``oneOf``), so that clients learn them from the contract.
+
+_NUMBER = {"type": "number"}
+
+#: A pulse needs ``eta``: in [0, 1] for two-sided rocking, in [-1, 0] for one-sided.
+PULSE_ETA_RULE: Dict[str, Any] = {
+    "oneOf": [
+        {
+            "properties": {
+                "one_sided": {"const": False},
+                "eta": {**_NUMBER, "minimum": 0, "maximum": 1},
+            },
+            "required": ["eta"],
+        },
+        {
+            "properties": {
+                "one_sided": {"const": True},
+                "eta": {**_NUMBER, "minimum": -1, "maximum": 0},
+            },
+            "required": ["eta", "one_sided"],
+        },
+    ]
+}
+
+#: Eq. 28 from S_a and PGA, or from a record and f_n, never both.
+EQ28_RULE: Dict[str, Any] = {
+    "oneOf": [
+        {
+            "properties": {
+                "sa_g": {**_NUMBER, "minimum": 0},
+                "pga_g": {**_NUMBER, "exclusiveMinimum": 0},
+                "record": {"type": "null"},
+                "f_n": {"type": "null"},
+            },
+            "required": ["sa_g", "pga_g"],
+        },
+        {
+            "properties": {
+                "record": {"type": "object"},
+                "f_n": {**_NUMBER, "exclusiveMinimum": 0},
+                "sa_g": {"type": "null"},
+                "pga_g": {"type": "null"},
+            },
+            "required": ["record", "f_n"],
+        },
+    ]
+}
+
+#: Time-domain work (envelopes, time histories) needs ``eta`` for every two-sided mechanism.
+_TWO_SIDED_ETA: Dict[str, Any] = {
+    "properties": {
+        "mechanisms": {
+            "items": {
+                "anyOf": [
+                    {"properties": {"rocking": {"const": "one_sided"}}, "required": ["rocking"]},
+                    {"properties": {"eta": _NUMBER}, "required": ["eta"]},
+                ]
+            }
+        }
+    }
+}
+
+
+def _constants_need_eta(schema: Dict[str, Any]) -> None:
+    """State in the schema that time-domain constants give ``eta`` where needed."""
+    prop = schema["properties"]["constants"]
+    schema["properties"]["constants"] = {"allOf": [prop, _TWO_SIDED_ETA]}
+
+
 # --- requests ---------------------------------------------------------------------------------
 
 
 class PulseRequest(BaseModel):
     """One mechanism under a one-cycle sine or cosine pulse (``rockmech pulse``)."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=PULSE_ETA_RULE
+    )
 
     p_eq: float = _gt0("Frequency parameter p_eq [rad/s], > 0.")
     lam: float = _gt0("Static load multiplier lambda [-], > 0.")
@@ -131,7 +211,9 @@ class RecordSamples(BaseModel):
 class EnvelopeRequest(BaseModel):
     """Overturning envelopes of every mechanism and the critical bands (``rockmech envelope``)."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
+    )
 
     constants: ConstantsFile = Field(description="The kinematic-constants file.")
     f_min: float = Field(0.1, description="Lowest pulse frequency [Hz], > 0.")
@@ -142,7 +224,7 @@ class EnvelopeRequest(BaseModel):
     )
 
 
-class _BuildingOptions(BaseModel):
+class BuildingOptions(BaseModel):
     """Code scale factors and displacements of time histories (``rockmech history``)."""
 
     building_height: Optional[float] = Field(
@@ -157,7 +239,7 @@ class _BuildingOptions(BaseModel):
     )
 
 
-class _HistoryOptions(_BuildingOptions):
+class HistoryOptions(BuildingOptions):
     """Scale factors and verdict of time histories (``rockmech history``)."""
 
     scales: List[float] = Field(
@@ -177,7 +259,7 @@ class _HistoryOptions(_BuildingOptions):
     )
 
 
-class _ReportOptions(_HistoryOptions):
+class ReportOptions(HistoryOptions):
     """Envelope options and title of a report (``rockmech report``)."""
 
     f_min: float = Field(0.1, description="Lowest pulse frequency of the envelopes [Hz].")
@@ -187,16 +269,18 @@ class _ReportOptions(_HistoryOptions):
     title: Optional[str] = Field(None, max_length=200, description="Title of the report.")
 
 
-class HistoryRequest(_HistoryOptions):
+class HistoryRequest(HistoryOptions):
     """Time histories of every mechanism at every scale factor (``rockmech history``)."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
+    )
 
     constants: ConstantsFile = Field(description="The kinematic-constants file.")
     record: RecordSamples = Field(description="The ground motion.")
 
 
-class _SpectrumOptions(BaseModel):
+class SpectrumOptions(BaseModel):
     """Spectrum and pulse-search options (``rockmech record``)."""
 
     zeta: float = Field(0.05, description="Damping ratio of the spectrum [-], in [0, 1).")
@@ -208,7 +292,7 @@ class _SpectrumOptions(BaseModel):
     f_max: Optional[float] = Field(None, description="Pulse search: highest f_p [Hz].")
 
 
-class SpectrumRequest(_SpectrumOptions):
+class SpectrumRequest(SpectrumOptions):
     """A record's exact elastic response spectrum and largest sine pulses (``rockmech record``)."""
 
     model_config = _REQUEST
@@ -219,10 +303,14 @@ class SpectrumRequest(_SpectrumOptions):
 class Eq28Request(BaseModel):
     """Eq. 28 scale factor ``sqrt(1 + (S_a/a_g h/h_e)^2)``: from S_a and PGA, or from a record."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=EQ28_RULE
+    )
 
     method: Literal["eq28"]
-    h: float = Field(description="Height of the mechanism [m], >= 0.")
+    h: float = Field(
+        description="Height of the mechanism [m], >= 0.", json_schema_extra={"minimum": 0}
+    )
     h_e: float = _gt0("Effective (modal) height of the structure [m], > 0.")
     sa_g: Optional[float] = Field(None, description="Spectral acceleration S_a(T_n) [g], >= 0.")
     pga_g: Optional[float] = Field(None, description="Peak ground acceleration [g], > 0.")
@@ -263,10 +351,12 @@ ScaleFactorRequest = Annotated[
 ]
 
 
-class ReportRequest(_ReportOptions):
+class ReportRequest(ReportOptions):
     """An HTML report: constants, envelopes, and with a record its time histories and spectrum."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
+    )
 
     constants: ConstantsFile = Field(description="The kinematic-constants file.")
     record: Optional[RecordSamples] = Field(
@@ -304,22 +394,38 @@ class RecordFileOptions(BaseModel):
     )
 
 
-class HistoryForm(RecordFileOptions, _HistoryOptions):
+class HistoryForm(RecordFileOptions, HistoryOptions):
     """Multipart form of ``history``: files ``constants`` and ``record``, plus these fields."""
 
 
-class SpectrumForm(RecordFileOptions, _SpectrumOptions):
+class SpectrumForm(RecordFileOptions, SpectrumOptions):
     """Multipart form of ``spectrum``: file ``record``, plus these fields."""
 
 
-class ReportForm(RecordFileOptions, _ReportOptions):
+class ReportForm(RecordFileOptions, ReportOptions):
     """Multipart form of ``report``: file ``constants``, optional file ``record``, and these."""
 
 
 class ConstantsForm(BaseModel):
-    """Multipart form of ``constants``: files ``scene`` (.3dm) and ``spec`` (JSON) only."""
+    """Multipart form of ``constants``: files ``scene`` and ``spec`` (JSON), and ``units``.
+
+    The scene is a Rhino ``.3dm`` file or a scan mesh (``.ply``, ``.obj``, ``.stl``, ``.off``,
+    told apart by the file name); a scan needs ``units``.
+    """
 
     model_config = _FORM
+
+    units: Optional[str] = Field(
+        None,
+        description=f"Length unit of a scan mesh: {', '.join(LENGTH_UNITS)} (required there; "
+        "a .3dm file states its own).",
+        json_schema_extra={"enum": list(LENGTH_UNITS)},
+    )
+
+    @field_validator("units")
+    @classmethod
+    def _known_length_unit(cls, units: Optional[str]) -> Optional[str]:
+        return None if units is None else check_choice(units, LENGTH_UNITS, "units")
 
 
 # --- responses --------------------------------------------------------------------------------

@@ -24,6 +24,7 @@ from shared_schema.errors import InputError
 
 __all__ = [
     "CRITERIA",
+    "LENGTH_UNITS",
     "PULSE_SHAPES",
     "RECORD_FORMATS",
     "RECORD_UNITS",
@@ -76,6 +77,9 @@ RECORD_UNITS: Dict[str, float] = {
     "mg": G / 1000.0,
     "in/s2": 0.0254,
 }
+
+#: Length units of a scan mesh (``rhino_plugin.scene_mesh.UNITS``; a .3dm states its own).
+LENGTH_UNITS: Tuple[str, ...] = ("mm", "cm", "m", "in", "ft")
 
 #: Scale-factor methods of time histories up the structure: none, Eq. 28 from the record's
 #: spectrum, or the EN 1998-1 and NZS 1170.5 code factors (docs/theory.md §7.3-7.4).

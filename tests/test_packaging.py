@@ -24,6 +24,7 @@ import rockmech
 from shared_schema.errors import RockmechError
 from shared_schema.extras import EXTRAS, MissingExtra, extra_for, require
 from solver_service.api.jobs import run_job
+from solver_service.api.jobspec import SceneJob
 from solver_service.cli import app
 from solver_service.core.exact import simulate
 from solver_service.core.excitation import Pulse
@@ -299,13 +300,13 @@ def test_service_answers_501_with_the_install_line_for_a_missing_geometry_module
         (ex / "scenes" / "facade.3dm").read_bytes(),
         (ex / "specs" / "facade.spec.json").read_bytes(),
     ]
-    params = {"scene_name": "facade.3dm", "spec_name": "facade.spec.json"}
+    job = SceneJob(scene_name="facade.3dm", spec_name="facade.spec.json")
     limits = {"max_samples": 500_000, "max_mechanisms": 100, "max_scales": 100}
-    ok = run_job("constants", params, blobs, limits)
+    ok = run_job(job, blobs, limits)
     assert ok.status == 200
     # rhino3dm present, shapely absent (the slim image before #15 answered 500 here).
     monkeypatch.setitem(sys.modules, "shapely", None)
-    out = run_job("constants", params, blobs, limits)
+    out = run_job(job, blobs, limits)
     assert out.status == 501
     body = json.loads(out.body)
     assert "shapely is not installed" in json.dumps(body)

@@ -20,6 +20,7 @@ from rhino_plugin.mechanisms.single import AXIS_TILT_TOL, resolve_axis
 from rhino_plugin.mechanisms.thrust import ThrustTable
 from shared_schema.constants import ConstantsFile, input_error_from_validation
 from shared_schema.errors import GeometryError, InputError, RockmechError
+from shared_schema.extras import MissingExtra
 from shared_schema.rules import eta_range
 
 __all__ = [
@@ -392,6 +393,8 @@ def constants_and_failures(
                 exc = GeometryError(str(exc) + _units_hint(spec_file, scene))
             failures.append(MechanismFailure(spec.id, exc))
             continue
+        except MissingExtra:
+            raise  # the installation, not this mechanism: every mechanism would fail alike
         except RockmechError as exc:
             failures.append(MechanismFailure(spec.id, exc))
             continue

@@ -7,15 +7,36 @@ bytes and read there, under their sanitised names, exactly as ``rockmech`` reads
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Optional, TypeVar
 
-from pydantic import BaseModel
+from fastapi import Request
+from pydantic import BaseModel, ValidationError
 from starlette.datastructures import FormData, UploadFile
 
 from shared_schema.api import ConstantsForm, HistoryForm, ReportForm, SpectrumForm
 
-__all__ = ["FORMS", "FormSpec", "form_fields", "multipart_schema"]
+from .problems import Problem, validation_message
+
+__all__ = [
+    "FORMS",
+    "MAX_FORM_FIELDS",
+    "MAX_FORM_FILES",
+    "FormSpec",
+    "form_fields",
+    "multipart_schema",
+    "parse_form",
+    "read_form",
+    "read_upload",
+    "validate_json",
+]
+
+#: Most files and fields a multipart request may carry.
+MAX_FORM_FILES = 4
+MAX_FORM_FIELDS = 200
+
+M = TypeVar("M", bound=BaseModel)
 
 
 @dataclass(frozen=True)
@@ -125,3 +146,48 @@ def multipart_schema(spec: FormSpec) -> dict[str, Any]:
     schema["required"] = required
     schema["additionalProperties"] = False
     return schema
+
+
+async def read_form(request: Request) -> FormData:
+    """Parse a multipart body (at most ``MAX_FORM_FILES`` files, ``MAX_FORM_FIELDS`` fields)."""
+    return await request.form(max_files=MAX_FORM_FILES, max_fields=MAX_FORM_FIELDS)
+
+
+async def read_upload(form: FormData, name: str, required: bool) -> Optional[tuple[bytes, str]]:
+    """Return an uploaded part's bytes and file name (a text part is accepted as a file)."""
+    items = form.getlist(name)
+    if not items:
+        if required:
+            raise Problem(422, "InputError", "missing; upload it as a file part", name)
+        return None
+    if len(items) > 1:
+        raise Problem(422, "InputError", "give one file", name)
+    item = items[0]
+    if isinstance(item, UploadFile):
+        return await item.read(), item.filename or ""
+    return item.encode("utf-8"), ""
+
+
+def parse_form(form: FormData, spec: FormSpec) -> dict[str, Any]:
+    """Validate the text fields of ``form`` with ``spec.model``; return them as data."""
+    try:
+        values = form_fields(form, spec)
+        return spec.model.model_validate(values).model_dump()
+    except ValidationError as exc:
+        message, field = validation_message(exc.errors(include_url=False), None)
+        raise Problem(422, "InputError", message, field) from None
+    except ValueError as exc:
+        raise Problem(422, "InputError", str(exc)) from None
+
+
+def validate_json(model: type[M], body: bytes) -> M:
+    """Validate a JSON body with ``model``; 422 with rockmech's message if it does not fit."""
+    try:
+        return model.model_validate_json(body)
+    except ValidationError as exc:
+        try:
+            data = json.loads(body)
+        except (ValueError, RecursionError):
+            data = None
+        message, field = validation_message(exc.errors(include_url=False), data)
+        raise Problem(422, "InputError", message, field) from None

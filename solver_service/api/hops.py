@@ -27,22 +27,30 @@ import json
 import logging
 import math
 from collections.abc import Callable
-from typing import Any, ClassVar, Optional
+from typing import Any, ClassVar
 
-from fastapi import APIRouter, Request, Response
-from pydantic import BaseModel
+from pydantic import BaseModel, ValidationError
 
-from shared_schema.api import EnvelopeRequest, HistoryRequest, PulseRequest
+from shared_schema.api import EnvelopeRequest, PulseRequest
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
 
-__all__ = ["HOPS_PREFIX", "HopsError", "RockmechHops", "hops_router"]
+from .jobspec import EnvelopeJob, HistoryJob, Job, PulseJob
+
+log = logging.getLogger("rockmech.hops")
+
+__all__ = ["HOPS_PREFIX", "HopsError", "JobRunner", "RockmechHops"]
 
 #: URL prefix of the Hops components.
 HOPS_PREFIX = "/hops"
 
-#: Runs one compute job: (kind, params) -> (status, media type, body).
-JobRunner = Callable[[str, dict[str, Any]], tuple[int, str, bytes]]
+#: Runs one compute job: job -> (status, media type, body).
+JobRunner = Callable[[Job], tuple[int, str, bytes]]
+
+
+def _default(model: type[BaseModel], name: str) -> Any:
+    """Return the REST default of a field (a Hops input defaults to the same value)."""
+    return model.model_fields[name].default
 
 
 def _import_ghhops() -> Any:
@@ -74,7 +82,13 @@ class HopsError(Exception):
 def _strict_number(value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise HopsError(422, f"expected a number, got {value!r}")
-    return float(value)
+    try:
+        number = float(value)
+    except OverflowError:  # an integer of hundreds of digits
+        raise HopsError(422, "a number is out of the range of double precision") from None
+    if not math.isfinite(number):
+        raise HopsError(422, f"expected a finite number, got {value!r}")
+    return number
 
 
 def _strict_integer(value: Any) -> int:
@@ -117,7 +131,7 @@ class RockmechHops:
     Parameters
     ----------
     run_job : callable
-        ``(kind, params) -> (status, media_type, body)``; runs a compute job (the app passes
+        ``job -> (status, media_type, body)``; runs a compute job (the app passes
         one that goes through its compute pool, from a worker thread).
     """
 
@@ -128,6 +142,18 @@ class RockmechHops:
         Number, Integer, Boolean, Text = _param_types(params)
         item, many = params.HopsParamAccess.ITEM, params.HopsParamAccess.LIST
         component = self.hops.component
+
+        types, access = (Number, Integer, Boolean, Text), (item, many)
+        self.components = {
+            "pulse": self._pulse(component, types, access),
+            "envelope": self._envelope(component, types, access),
+            "history": self._history(component, types, access),
+        }
+
+    def _pulse(self, component: Any, types: tuple[Any, ...], access: tuple[Any, Any]) -> Any:
+        """Register the ``pulse`` component; return its handler."""
+        Number, Integer, Boolean, Text = types
+        item, _many = access
 
         @component(  # type: ignore[untyped-decorator]
             rule="/pulse",
@@ -159,9 +185,9 @@ class RockmechHops:
             lam: float,
             a_p_g: float,
             f_p: float,
-            eta: float = 0.9,
-            one_sided: bool = False,
-            shape: str = "sine",
+            eta: float,
+            one_sided: bool = _default(PulseRequest, "one_sided"),
+            shape: str = _default(PulseRequest, "shape"),
         ) -> tuple[Any, ...]:
             request = {
                 "p_eq": p_eq,
@@ -172,7 +198,7 @@ class RockmechHops:
                 "one_sided": one_sided,
                 "shape": shape,
             }
-            doc = self._job("pulse", _params(PulseRequest, request))
+            doc = self._job(PulseJob.model_validate(request))
             t_ov = doc["t_overturn"]
             return (
                 doc["overturned"],
@@ -182,6 +208,13 @@ class RockmechHops:
                 doc["error_estimate"] if doc["error_estimate"] is not None else -1.0,
                 json.dumps(doc),
             )
+
+        return pulse
+
+    def _envelope(self, component: Any, types: tuple[Any, ...], access: tuple[Any, Any]) -> Any:
+        """Register the ``envelope`` component; return its handler."""
+        Number, Integer, _Boolean, Text = types
+        item, many = access
 
         @component(  # type: ignore[untyped-decorator]
             rule="/envelope",
@@ -205,10 +238,14 @@ class RockmechHops:
                 Text("json", "J", "The whole result as JSON"),
             ],
         )
-        def envelope(constants: str, f_min: float = 0.1, f_max: float = 10.0, n: int = 100) -> Any:
+        def envelope(
+            constants: str,
+            f_min: float = _default(EnvelopeRequest, "f_min"),
+            f_max: float = _default(EnvelopeRequest, "f_max"),
+            n: int = _default(EnvelopeRequest, "n"),
+        ) -> Any:
             request = {"constants": _constants_json(constants), "f_min": f_min, "f_max": f_max}
-            params = _params(EnvelopeRequest, {**request, "n": n})
-            doc = self._job("envelope", params)
+            doc = self._job(EnvelopeJob.model_validate({**request, "n": n}))
             lowest = [
                 min((v for v in col if v is not None), default=None)
                 for col in zip(*(m["a_p_min_g"] for m in doc["mechanisms"]))
@@ -218,6 +255,13 @@ class RockmechHops:
             ]
             governing = [g or "" for g in doc["governing"]]
             return doc["f_p"], governing, _finite_list(lowest), bands, json.dumps(doc)
+
+        return envelope
+
+    def _history(self, component: Any, types: tuple[Any, ...], access: tuple[Any, Any]) -> Any:
+        """Register the ``history`` component; return its handler."""
+        Number, _Integer, Boolean, Text = types
+        item, many = access
 
         @component(  # type: ignore[untyped-decorator]
             rule="/history",
@@ -247,8 +291,7 @@ class RockmechHops:
                 "record": {"accel": accel_g, "dt": dt, "units": "g", "name": "grasshopper"},
                 "scales": scales,
             }
-            params = {**_params(HistoryRequest, request), "constants_label": "constants"}
-            doc = self._job("history", params)
+            doc = self._job(HistoryJob.model_validate(request))
             rows = doc["results"]
             return (
                 [r["mechanism"] for r in rows],
@@ -259,10 +302,10 @@ class RockmechHops:
                 json.dumps(doc),
             )
 
-        self.components = {"pulse": pulse, "envelope": envelope, "history": history}
+        return history
 
-    def _job(self, kind: str, params: dict[str, Any]) -> dict[str, Any]:
-        status, _, body = self._run_job(kind, params)
+    def _job(self, job: Job) -> dict[str, Any]:
+        status, _, body = self._run_job(job)
         if status != 200:
             detail = json.loads(body).get("detail", "error")
             raise HopsError(status, detail)
@@ -312,6 +355,13 @@ class RockmechHops:
             return 422, self.hops._return_with_err(_validation_text(exc)).encode("utf-8")
         except RecursionError:
             return 400, self.hops._return_with_err("JSON nested too deeply").encode("utf-8")
+        except OverflowError:
+            message = "a number is out of the range of double precision"
+            return 422, self.hops._return_with_err(message).encode("utf-8")
+        except Exception:  # a bug: logged; the caller gets Hops' error shape, no traceback
+            log.exception("Hops solve of %s failed", uri)
+            message = "internal error; see the service log"
+            return 500, self.hops._return_with_err(message).encode("utf-8")
 
 
 def _constants_json(text: Any) -> Any:
@@ -324,20 +374,7 @@ def _constants_json(text: Any) -> Any:
         raise InputError(str(exc), "constants") from None
 
 
-def _params(model: type[BaseModel], request: dict[str, Any]) -> dict[str, Any]:
-    """Validate a component's inputs with the REST request model; return the job parameters."""
-    validated = model.model_validate(request)
-    params = validated.model_dump()
-    if "constants" in request:
-        params["constants"] = validated.model_dump(include={"constants"}, exclude_none=True)[
-            "constants"
-        ]
-    return params
-
-
 def _validation_text(exc: ValueError) -> str:
-    from pydantic import ValidationError
-
     if isinstance(exc, ValidationError):
         parts = []
         for err in exc.errors(include_url=False):
@@ -347,36 +384,3 @@ def _validation_text(exc: ValueError) -> str:
     if isinstance(exc, json.JSONDecodeError):
         return f"invalid JSON: {exc}"
     return str(exc)
-
-
-def hops_router(hops: Callable[[], Optional[RockmechHops]]) -> APIRouter:
-    """Return the ASGI routes of the Hops components (kept out of the OpenAPI document).
-
-    Parameters
-    ----------
-    hops : callable
-        Returns the app's ``RockmechHops``.
-    """
-    from starlette.concurrency import run_in_threadpool
-
-    router = APIRouter(prefix=HOPS_PREFIX, include_in_schema=False)
-
-    def _get() -> RockmechHops:
-        comp = hops()
-        assert comp is not None, "the Hops components are set up with the app"
-        return comp
-
-    @router.get("/")
-    @router.get("/{name}")
-    async def query(name: str = "") -> Response:
-        status, body = _get().query("/" + name if name else "/")
-        return Response(body, status_code=status, media_type="application/json")
-
-    @router.post("/{name}")
-    async def solve(name: str, request: Request) -> Response:
-        payload = await request.body()
-        # The handlers block on the compute pool; run them on a worker thread.
-        status, body = await run_in_threadpool(_get().solve, "/" + name, payload)
-        return Response(body, status_code=status, media_type="application/json")
-
-    return router

@@ -12,6 +12,15 @@ stdin/stdout (``solver_service.api.worker``), and no pickle is used.
 
 Every process warms its kernels up before it takes work (numba loads them from its cache),
 so a replacement does not make the next request pay for compilation.
+
+Faults. A worker that dies while idle is noticed (a watcher awaits every process) and
+replaced, and a worker is checked to be alive before it is handed out. A job whose worker
+died before it received the whole job is retried once on another worker: jobs are pure
+computations, so that is safe. A worker that dies while computing is a fault of the
+service: ``WorkerLost`` (503 with ``Retry-After``). A job whose caller gives up (its task is
+cancelled) ends its worker at once. Every worker gets a private temporary folder
+(``TMPDIR``), removed when the worker ends however it ends, so no temporary file outlives
+its process.
 """
 
 from __future__ import annotations
@@ -20,11 +29,18 @@ import asyncio
 import contextlib
 import json
 import logging
+import os
+import shutil
 import sys
+import tempfile
 import time
+from collections import deque
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Optional
+
+from .jobspec import Job
 
 __all__ = ["BudgetExceeded", "ComputePool", "PoolBusy", "WorkerLost", "WorkerResult"]
 
@@ -34,6 +50,8 @@ log = logging.getLogger("rockmech.pool")
 STREAM_LIMIT = 1 << 20
 #: Seconds a worker is given to exit after its stdin closes, before it is killed.
 EXIT_GRACE_S = 2.0
+#: Seconds a client is told to wait before retrying after a worker died (``Retry-After``).
+RETRY_AFTER_S = 2
 
 
 class BudgetExceeded(Exception):
@@ -48,6 +66,10 @@ class WorkerLost(Exception):
     """A compute process ended while it worked on a job (it has been replaced)."""
 
 
+class _SendFailed(Exception):
+    """The worker was gone before it received the whole job (safe to retry)."""
+
+
 @dataclass(frozen=True)
 class WorkerResult:
     """A job's answer from a worker."""
@@ -60,7 +82,24 @@ class WorkerResult:
 @dataclass(eq=False)
 class _Worker:
     proc: asyncio.subprocess.Process
+    tmpdir: str
+    ready: bool = False
     jobs: int = 0
+    watcher: Optional[asyncio.Task[None]] = field(default=None, repr=False)
+
+
+def _running(proc: asyncio.subprocess.Process) -> bool:
+    """Return True if ``proc`` has not exited (an unreaped zombie has exited)."""
+    if proc.returncode is not None:
+        return False
+    try:
+        stat = Path(f"/proc/{proc.pid}/stat").read_text()
+    except FileNotFoundError:
+        return False
+    except OSError:  # pragma: no cover - no /proc: trust the return code
+        return True
+    # Field 3, after the parenthesised command name, is the state; Z and X are dead.
+    return stat.rsplit(")", 1)[-1].split()[0] not in ("Z", "X")
 
 
 class ComputePool:
@@ -86,32 +125,39 @@ class ComputePool:
         timeout_s: float,
         queue_timeout_s: float,
         startup_timeout_s: float,
-        limits: dict[str, int],
+        limits: dict[str, Any],
     ) -> None:
         self.size = size
         self.timeout_s = timeout_s
         self.queue_timeout_s = queue_timeout_s
         self.startup_timeout_s = startup_timeout_s
         self.limits = dict(limits)
-        self._idle: asyncio.Queue[_Worker] = asyncio.Queue()
+        self._idle: deque[_Worker] = deque()
         self._all: set[_Worker] = set()
         self._tasks: set[asyncio.Task[None]] = set()
+        self._cond: Optional[asyncio.Condition] = None
         self._closing = False
 
     @property
     def alive(self) -> int:
-        """Number of worker processes that are running."""
-        return sum(1 for w in self._all if w.proc.returncode is None)
+        """Number of worker processes that have warmed up and are running (ready or busy)."""
+        return sum(1 for w in self._all if w.ready and _running(w.proc))
 
     def pids(self) -> list[int]:
-        """Process ids of the running workers (for memory reports)."""
-        return [w.proc.pid for w in self._all if w.proc.returncode is None]
+        """Process ids of the running workers (for memory reports and fault tests)."""
+        return [w.proc.pid for w in self._all if _running(w.proc)]
+
+    def _condition(self) -> asyncio.Condition:
+        if self._cond is None:
+            self._cond = asyncio.Condition()
+        return self._cond
 
     async def start(self) -> None:
         """Start every worker and wait until each has warmed up."""
         await asyncio.gather(*(self._spawn() for _ in range(self.size)))
 
     async def _spawn(self) -> None:
+        tmpdir = tempfile.mkdtemp(prefix="rockmech-worker-")
         proc = await asyncio.create_subprocess_exec(
             sys.executable,
             "-m",
@@ -119,8 +165,9 @@ class ComputePool:
             stdin=asyncio.subprocess.PIPE,
             stdout=asyncio.subprocess.PIPE,
             limit=STREAM_LIMIT,
+            env={**os.environ, "TMPDIR": tmpdir},
         )
-        worker = _Worker(proc)
+        worker = _Worker(proc, tmpdir)
         self._all.add(worker)
         try:
             assert proc.stdout is not None
@@ -133,10 +180,55 @@ class ComputePool:
         if self._closing:
             await self._end(worker)
             return
-        self._idle.put_nowait(worker)
+        worker.ready = True
+        worker.watcher = self._background(self._watch(worker))
+        await self._release(worker)
+
+    def _background(self, coro: Any) -> asyncio.Task[None]:
+        task: asyncio.Task[None] = asyncio.get_running_loop().create_task(coro)
+        self._tasks.add(task)
+        task.add_done_callback(self._tasks.discard)
+        return task
+
+    async def _watch(self, worker: _Worker) -> None:
+        """Replace ``worker`` when it exits on its own (killed while idle, out of memory)."""
+        await worker.proc.wait()
+        if worker in self._all and not self._closing:
+            log.warning("compute process %d exited (%s)", worker.proc.pid, worker.proc.returncode)
+            async with self._condition():
+                if worker in self._idle:
+                    self._idle.remove(worker)
+            self._replace(worker)
+
+    async def _release(self, worker: _Worker) -> None:
+        async with self._condition():
+            self._idle.append(worker)
+            self._condition().notify()
+
+    async def _acquire(self) -> _Worker:
+        """Hand out an idle worker that is alive; replace any found dead."""
+        cond = self._condition()
+        deadline = time.monotonic() + self.queue_timeout_s
+        async with cond:
+            while True:
+                while self._idle:
+                    worker = self._idle.popleft()
+                    if _running(worker.proc):
+                        return worker
+                    self._replace(worker)
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    raise PoolBusy(
+                        f"all {self.size} compute processes stayed busy for "
+                        f"{self.queue_timeout_s:g} s"
+                    )
+                with contextlib.suppress(asyncio.TimeoutError):
+                    await asyncio.wait_for(cond.wait(), remaining)
 
     def _replace(self, worker: _Worker) -> None:
         """End ``worker`` now (SIGKILL) and start a replacement in the background."""
+        if worker not in self._all:
+            return
         self._all.discard(worker)
         if worker.proc.returncode is None:
             with contextlib.suppress(ProcessLookupError):
@@ -150,9 +242,7 @@ class ComputePool:
                 except Exception:  # pragma: no cover - logged; the pool runs one short
                     log.exception("could not start a replacement compute process")
 
-        task = asyncio.get_running_loop().create_task(replace())
-        self._tasks.add(task)
-        task.add_done_callback(self._tasks.discard)
+        self._background(replace())
 
     async def _end(self, worker: _Worker, grace_s: float = 0.0) -> None:
         self._all.discard(worker)
@@ -164,15 +254,16 @@ class ComputePool:
         if proc.returncode is None:
             with contextlib.suppress(ProcessLookupError):
                 proc.kill()
-            await proc.wait()
+        await proc.wait()
+        shutil.rmtree(worker.tmpdir, ignore_errors=True)
 
-    async def run(
-        self, kind: str, params: dict[str, Any], blobs: Sequence[bytes] = ()
-    ) -> WorkerResult:
+    async def run(self, job: Job, blobs: Sequence[bytes] = ()) -> WorkerResult:
         """Run one job and return its answer.
 
         Raises
         ------
+        ValueError
+            The job holds a number JSON cannot carry (infinity); no worker was used.
         PoolBusy
             No worker became free within ``queue_timeout_s``.
         BudgetExceeded
@@ -181,50 +272,64 @@ class ComputePool:
         WorkerLost
             The worker ended during the job (for example killed by the operating system).
         """
-        try:
-            worker = await asyncio.wait_for(self._idle.get(), self.queue_timeout_s)
-        except asyncio.TimeoutError:
-            raise PoolBusy(
-                f"all {self.size} compute processes stayed busy for {self.queue_timeout_s:g} s"
-            ) from None
-        header: dict[str, Any] = {"kind": kind, "params": params, "limits": self.limits}
-        header["blobs"] = [len(b) for b in blobs]
-        start = time.perf_counter()
-        try:
-            result = await asyncio.wait_for(self._exchange(worker, header, blobs), self.timeout_s)
-        except asyncio.TimeoutError:
-            self._replace(worker)
-            raise BudgetExceeded(
-                f"the computation took longer than the service's budget of "
-                f"{self.timeout_s:g} s per request (ROCKMECH_COMPUTE_TIMEOUT_S) and was "
-                "stopped; ask for less work (fewer mechanisms, scale factors, frequencies "
-                "or samples, or the library instead of exact envelopes), or run it with "
-                "the rockmech command line"
-            ) from None
-        except (OSError, asyncio.IncompleteReadError, ValueError) as exc:
-            code = worker.proc.returncode
-            self._replace(worker)
-            raise WorkerLost(
-                f"the compute process stopped while working on this request "
-                f"(exit code {code}); the input may be too large or malformed"
-            ) from exc
-        except BaseException:  # cancelled mid-exchange: the worker's state is unknown
-            self._replace(worker)
-            raise
-        worker.jobs += 1
-        log.debug("job %s took %.3f s", kind, time.perf_counter() - start)
-        self._idle.put_nowait(worker)
-        return result
+        header: dict[str, Any] = {
+            "job": job.model_dump(mode="json", exclude_none=True),
+            "limits": self.limits,
+            "blobs": [len(b) for b in blobs],
+        }
+        # Encoded before a worker is taken: a value JSON cannot carry (a derived constant
+        # that overflowed) is the request's problem (ValueError), never a worker's.
+        line = json.dumps(header, allow_nan=False).encode("utf-8") + b"\n"
+        for attempt in (1, 2):
+            worker = await self._acquire()
+            start = time.perf_counter()
+            try:
+                result = await asyncio.wait_for(self._exchange(worker, line, blobs), self.timeout_s)
+            except asyncio.TimeoutError:
+                self._replace(worker)
+                raise BudgetExceeded(
+                    f"the computation took longer than the service's budget of "
+                    f"{self.timeout_s:g} s per request (ROCKMECH_COMPUTE_TIMEOUT_S) and was "
+                    "stopped; ask for less work (fewer mechanisms, scale factors, frequencies "
+                    "or samples, or the library instead of exact envelopes), or run it with "
+                    "the rockmech command line"
+                ) from None
+            except _SendFailed:
+                self._replace(worker)
+                if attempt == 1:
+                    log.warning("compute process gone before its job; retrying on another")
+                    continue
+                raise WorkerLost(self._lost_message(worker)) from None
+            except (OSError, asyncio.IncompleteReadError, ValueError) as exc:
+                self._replace(worker)
+                raise WorkerLost(self._lost_message(worker)) from exc
+            except BaseException:  # cancelled (client gone) mid-exchange: end the worker now
+                self._replace(worker)
+                raise
+            worker.jobs += 1
+            log.debug("job %s took %.3f s", job.kind, time.perf_counter() - start)
+            await self._release(worker)
+            return result
+        raise AssertionError("unreachable")  # pragma: no cover
 
-    async def _exchange(
-        self, worker: _Worker, header: dict[str, Any], blobs: Sequence[bytes]
-    ) -> WorkerResult:
+    @staticmethod
+    def _lost_message(worker: _Worker) -> str:
+        return (
+            f"a compute process stopped while working on this request (exit code "
+            f"{worker.proc.returncode}); this is a fault of the service, not of the request, "
+            f"and the process has been replaced: try again in {RETRY_AFTER_S} s"
+        )
+
+    async def _exchange(self, worker: _Worker, line: bytes, blobs: Sequence[bytes]) -> WorkerResult:
         proc = worker.proc
         assert proc.stdin is not None and proc.stdout is not None
-        proc.stdin.write(json.dumps(header, allow_nan=False).encode("utf-8") + b"\n")
-        for blob in blobs:
-            proc.stdin.write(blob)
-        await proc.stdin.drain()
+        try:
+            proc.stdin.write(line)
+            for blob in blobs:
+                proc.stdin.write(blob)
+            await proc.stdin.drain()
+        except (BrokenPipeError, ConnectionResetError) as exc:
+            raise _SendFailed() from exc
         line = await proc.stdout.readline()
         if not line:
             raise asyncio.IncompleteReadError(b"", None)
@@ -242,4 +347,4 @@ class ComputePool:
 
     def info(self) -> dict[str, Optional[int]]:
         """Return worker counts for the health endpoint."""
-        return {"alive": self.alive, "idle": self._idle.qsize()}
+        return {"alive": self.alive, "idle": len(self._idle)}

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import contextlib
+import math
 import subprocess
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, Optional
 
 from pydantic import ValidationError
 
@@ -45,6 +46,7 @@ def run(settings: Settings) -> None:
         port=settings.port,
         log_level=settings.log_level,
         access_log=False,
+        timeout_graceful_shutdown=math.ceil(settings.shutdown_timeout_s),
     )
 
 
@@ -59,7 +61,11 @@ def free_port() -> int:
 
 @contextlib.contextmanager
 def background_server(
-    settings: dict[str, Any], log: Path, *, start_timeout_s: float = 120.0
+    settings: dict[str, Any],
+    log: Path,
+    *,
+    start_timeout_s: float = 120.0,
+    env: Optional[dict[str, str]] = None,
 ) -> Iterator[tuple[str, subprocess.Popen[bytes]]]:
     """Run ``rockmech serve`` in a child process on a free loopback port (tests, benchmarks).
 
@@ -71,6 +77,8 @@ def background_server(
         File for the server's output.
     start_timeout_s : float
         Longest wait for ``/api/v1/health`` to answer [s].
+    env : dict, optional
+        More environment variables for the server (e.g. ``TMPDIR``).
 
     Yields
     ------
@@ -86,12 +94,13 @@ def background_server(
     import urllib.request
 
     port = free_port()
-    env = {k: v for k, v in os.environ.items() if not k.startswith("ROCKMECH_")}
-    env.update({f"ROCKMECH_{k.upper()}": str(v) for k, v in settings.items()})
+    child_env = {k: v for k, v in os.environ.items() if not k.startswith("ROCKMECH_")}
+    child_env.update(env or {})
+    child_env.update({f"ROCKMECH_{k.upper()}": _env_value(v) for k, v in settings.items()})
     code = "from solver_service.cli import main; main()"
     cmd = [sys.executable, "-c", code, "serve", "--port", str(port)]
     with log.open("wb") as out:
-        proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, env=env)
+        proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, env=child_env)
     url = f"http://127.0.0.1:{port}"
     try:
         deadline = time.monotonic() + start_timeout_s
@@ -115,6 +124,13 @@ def background_server(
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.wait()
+
+
+def _env_value(value: Any) -> str:
+    """Return a setting as an environment variable: lists as JSON, the rest as text."""
+    import json
+
+    return json.dumps(value) if isinstance(value, (list, tuple)) else str(value)
 
 
 def process_rss_bytes(pid: int) -> int:

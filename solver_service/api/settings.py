@@ -39,6 +39,19 @@ class Settings(BaseSettings):
         Most mechanisms in one request (constants file or spec); more gets 422.
     max_scales : int
         Most scale factors in one request; more gets 422.
+    max_answer_bytes : int
+        Largest answer a request may ask for [bytes], estimated before computing; more gets
+        422.
+    allowed_hosts : list of str
+        Host names the service answers to (the ``Host`` header, port ignored); others get
+        400. Default: the loopback names. Add the name clients use for a deployment on a
+        network, or ``"*"`` for any.
+    allowed_origins : list of str
+        Web page origins (``scheme://host[:port]``) allowed to call the service from a
+        browser, besides its own pages; others get 403. Default: none; ``"*"`` for any.
+    shutdown_timeout_s : float
+        On SIGTERM, longest wait for requests in flight [s]; then the compute processes
+        are stopped.
     log_level : str
         uvicorn's log level.
     """
@@ -55,12 +68,18 @@ class Settings(BaseSettings):
     max_samples: int = Field(500_000, ge=2)
     max_mechanisms: int = Field(100, ge=1)
     max_scales: int = Field(100, ge=1)
+    max_answer_bytes: int = Field(64 * 1024 * 1024, ge=1024)
+    allowed_hosts: list[str] = Field(default_factory=lambda: ["localhost", "127.0.0.1", "[::1]"])
+    allowed_origins: list[str] = Field(default_factory=list)
+    shutdown_timeout_s: float = Field(10.0, gt=0)
     log_level: str = "warning"
 
-    def limits(self) -> dict[str, int]:
-        """Return the per-request size limits, as the compute processes receive them."""
+    def limits(self) -> dict[str, float]:
+        """Return the per-request limits and the budget, as the compute processes get them."""
         return {
+            "budget_s": self.compute_timeout_s,
             "max_samples": self.max_samples,
             "max_mechanisms": self.max_mechanisms,
             "max_scales": self.max_scales,
+            "max_answer_bytes": self.max_answer_bytes,
         }

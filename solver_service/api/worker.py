@@ -7,7 +7,8 @@ followed by raw byte blobs whose sizes the line states.
 Protocol
 --------
 start-up : the process warms its kernels up, then writes ``{"ready": true}``.
-request : ``{"kind": str, "params": {...}, "limits": {...}, "blobs": [n1, n2, ...]}`` + blobs.
+request : ``{"job": {"kind": str, ...}, "limits": {...}, "blobs": [n1, n2, ...]}`` + blobs; the
+    job is one of ``solver_service.api.jobspec``'s models.
 answer : ``{"status": int, "media_type": str, "size": n}`` + ``n`` bytes of body.
 
 The process ends when its stdin closes. Anything a library prints goes to stderr: file
@@ -24,6 +25,7 @@ from typing import Any, BinaryIO
 
 from .errors import error_body
 from .jobs import JobOutput, run_job
+from .jobspec import JOB
 
 __all__ = ["main", "serve_forever"]
 
@@ -37,7 +39,7 @@ def _write(out: BinaryIO, header: dict[str, Any], body: bytes = b"") -> None:
 
 def _answer(request: dict[str, Any], blobs: list[bytes]) -> JobOutput:
     try:
-        return run_job(str(request["kind"]), request.get("params") or {}, blobs, request["limits"])
+        return run_job(JOB.validate_python(request["job"]), blobs, request["limits"])
     except Exception as exc:  # a bug: report it as such, keep serving
         traceback.print_exc(file=sys.stderr)
         message = f"internal error ({type(exc).__name__}); see the service log"
@@ -46,7 +48,10 @@ def _answer(request: dict[str, Any], blobs: list[bytes]) -> JobOutput:
 
 def serve_forever(inp: BinaryIO, out: BinaryIO) -> None:
     """Answer requests from ``inp`` on ``out`` until ``inp`` closes."""
-    _write(out, {"ready": True, "warmup": _answer({"kind": "warmup", "limits": {}}, []).status})
+    _write(
+        out,
+        {"ready": True, "warmup": _answer({"job": {"kind": "warmup"}, "limits": {}}, []).status},
+    )
     while True:
         line = inp.readline()
         if not line:

@@ -34,6 +34,9 @@ def _pyplot() -> Any:
     import matplotlib
 
     matplotlib.use("Agg")
+    # Labels are user text (mechanism ids, record names), never TeX: a "$" in an id must not
+    # start mathtext, whose parser recurses without bound on nested braces.
+    matplotlib.rcParams["text.parse_math"] = False
     import matplotlib.pyplot as plt
 
     return plt

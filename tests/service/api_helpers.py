@@ -50,10 +50,13 @@ class Server:
 
 
 @contextlib.contextmanager
-def start_server(tmp: Path, **settings: Any) -> Iterator[Server]:
+def start_server(tmp: Path, env: dict[str, str] | None = None, **settings: Any) -> Iterator[Server]:
     """Start ``rockmech serve`` with ``ROCKMECH_*`` settings on a free port; stop it after."""
     log = tmp / "server.log"
-    with background_server(settings, log, start_timeout_s=START_TIMEOUT_S) as (url, proc):
+    with background_server(settings, log, start_timeout_s=START_TIMEOUT_S, env=env) as (
+        url,
+        proc,
+    ):
         yield Server(url, proc, log)
 
 

@@ -264,3 +264,23 @@ def test_report_is_html_with_every_section(client: httpx.Client) -> None:
     assert hashlib.sha256(WALLS.read_bytes()).hexdigest() in page
     assert page.count('<img class="plot"') == 3
     assert "http://" not in page and "https://" not in page  # self-contained
+
+
+def test_operations_have_readable_ids_and_tags(client: httpx.Client) -> None:
+    api = client.get("/api/v1/openapi.json").json()
+    ops = {
+        path: (op["operationId"], op["tags"])
+        for path, item in api["paths"].items()
+        for op in item.values()
+    }
+    assert ops["/api/v1/pulse"] == ("pulse", ["solver"])
+    assert ops["/api/v1/scale-factor"] == ("scale_factor", ["solver"])
+    assert ops["/api/v1/history"] == ("history", ["records"])
+    assert ops["/api/v1/constants"] == ("constants", ["geometry"])
+    assert [t["name"] for t in api["tags"]] == [
+        "service",
+        "solver",
+        "records",
+        "geometry",
+        "reports",
+    ]

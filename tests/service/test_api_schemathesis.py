@@ -1,12 +1,16 @@
 """Schemathesis against the live OpenAPI document of a running server: no failures.
 
 Checks: all of schemathesis' checks except one, ``positive_data_acceptance`` ("a request
-the schema allows must succeed"). The schema cannot state every rule the service enforces:
-the content of uploaded files (a ``.3dm`` must be a Rhino model, a spec must be JSON naming
-objects of the scene), rules across fields (time histories of a two-sided mechanism need
-``eta``; ``eq28`` needs ``sa_g`` and ``pga_g`` or a record and ``f_n``; ``f_min < f_max``),
-so schema-valid requests can rightly get 422. Every other check runs, including
-``not_a_server_error`` (no 5xx), status-code, content-type and response-schema conformance,
+the schema allows must succeed"). The schema now states the rules across fields the
+service enforces (``oneOf``: a pulse needs ``eta``, in [0, 1] two-sided and [-1, 0]
+one-sided; ``eq28`` takes ``sa_g`` and ``pga_g``, or a record and ``f_n``; time-domain
+constants give ``eta`` for every two-sided mechanism), and a run of that check on the
+endpoints without uploads finds no violation of those. It still finds schema-valid
+requests that are rightly refused: absurd magnitudes (``f_p = 5e-324`` is past the work
+bound, ``p_eq = 5e-324`` makes ``omega`` infinite), an all-zero record (no PGA), and for the
+upload endpoints the content of the files (a ``.3dm`` must be a Rhino model, a spec must
+name objects of the scene). Every other check runs, including ``not_a_server_error`` (no
+5xx), status-code, content-type and response-schema conformance,
 ``negative_data_rejection`` (schema-invalid requests must get 4xx) and
 ``unsupported_method``.
 

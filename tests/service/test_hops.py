@@ -174,3 +174,14 @@ def test_invalid_constants_text_gives_the_constants_message(client: httpx.Client
     body = hops_payload(constants=json.dumps(doc), f_min=0.2, f_max=8.0, n=10)
     (message,) = _errors(client.post("/hops/envelope", json=body), 422)
     assert message.startswith("constants: mechanisms[0] (id 'W1').eta")
+
+
+def test_component_defaults_are_the_rest_defaults(client: httpx.Client) -> None:
+    from shared_schema.api import EnvelopeRequest, PulseRequest
+
+    pulse = {p["Name"]: p for p in client.get("/hops/pulse").json()["Inputs"]}
+    assert "Default" not in pulse["eta"]  # required, as for ``rockmech pulse`` and REST
+    assert pulse["shape"]["Default"] == PulseRequest.model_fields["shape"].default
+    envelope = {p["Name"]: p for p in client.get("/hops/envelope").json()["Inputs"]}
+    for name in ("f_min", "f_max", "n"):
+        assert envelope[name]["Default"] == EnvelopeRequest.model_fields[name].default

@@ -43,6 +43,13 @@ def test_api_enums_mirror_the_rules() -> None:
     assert tuple(_enum(api.RecordSamples, "units")) == tuple(rules.RECORD_UNITS)
 
 
+def test_scan_length_units_match_the_reader() -> None:
+    from rhino_plugin.scene_mesh import UNITS
+
+    assert tuple(UNITS) == rules.LENGTH_UNITS
+    assert tuple(_enum(api.ConstantsForm, "units")) == rules.LENGTH_UNITS
+
+
 def test_core_and_workflows_use_the_rules_themselves() -> None:
     assert model.G is constants.G is rules.G
     assert records.FORMATS is rules.RECORD_FORMATS

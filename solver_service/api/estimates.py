@@ -1,0 +1,236 @@
+"""Work and answer size of a job, estimated before any compute process is spent on it.
+
+A request whose work cannot finish within the compute budget, or whose answer would be
+larger than ``ROCKMECH_MAX_ANSWER_BYTES``, is refused with 422 at once instead of holding a
+compute process for the whole budget (or the server's memory for a huge answer). The app
+estimates every JSON job before sending it to the pool; a compute process repeats the
+history estimate after reading an uploaded record (the app cannot count its samples).
+
+Light on purpose (standard library and the request models only): the app process uses it.
+
+Notes
+-----
+Work is counted in closed-form steps of the exact integrator, which cuts each record sample
+interval (or a pulse of ``1/f_p`` seconds) into segments of at most ``1/p_eq`` seconds:
+
+* a pulse: ``p_eq / f_p`` steps;
+* exact envelopes: per mechanism side (both directions for one-sided rocking) and
+  frequency, ``N_SCAN`` pulse runs of ``max(1, p_eq / f_p)`` steps;
+* time histories: per mechanism side and scale factor, ``(n - 1) max(1, ceil(p_eq dt))``.
+
+A job is refused when its steps exceed ``MAX_STEPS_PER_S x budget``: ``MAX_STEPS_PER_S`` is
+about ten times the fastest rate measured (1.8e6 steps/s for envelope scans, 6.7e6 for time
+histories, on a loaded 2-core machine), so only work that cannot finish in the budget on any
+machine we know is refused; the budget still catches the rest.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from typing import Any, Optional
+
+from shared_schema.constants import ConstantsFile
+from shared_schema.errors import InputError
+
+from .jobspec import EnvelopeJob, HistoryJob, Job, PulseJob, ReportJob, ScaleFactorJob, SpectrumJob
+
+__all__ = [
+    "ANSWER_BYTES_PER_NUMBER",
+    "MAX_STEPS_PER_S",
+    "N_SCAN",
+    "WORK_PER_SAMPLE",
+    "check_job",
+    "check_limit",
+    "check_total_steps",
+    "check_work",
+    "envelope_steps",
+    "history_steps",
+]
+
+#: Upper bound of the exact integrator's speed [closed-form steps per second] (see Notes).
+MAX_STEPS_PER_S = 5.0e7
+#: Pulse amplitudes scanned per frequency by an exact envelope (``core.envelope.N_SCAN``;
+#: a test checks the copy).
+N_SCAN = 300
+#: Closed-form steps per record sample one run may take, on average: one run may take
+#: ``WORK_PER_SAMPLE * max_samples`` steps, so that absurd but well-formed inputs (a
+#: two-sample record a day long, p_eq = 1e300) get 422 at once.
+WORK_PER_SAMPLE = 20
+#: Bytes of JSON per number in an answer (17 significant digits, sign, exponent, comma).
+ANSWER_BYTES_PER_NUMBER = 24
+
+
+def check_limit(count: int, limit: int, what: str, field: str, setting: str) -> None:
+    """Raise ``InputError`` (naming the limit) when ``count`` exceeds ``limit``."""
+    if count > limit:
+        raise InputError(
+            f"{count} {what} exceed the service limit of {limit} per request "
+            f"(ROCKMECH_{setting.upper()})",
+            field,
+        )
+
+
+def check_work(steps: float, limits: dict[str, Any], what: str, field: str) -> None:
+    """Raise ``InputError`` (naming the limit) when one run would take too many steps."""
+    limit = WORK_PER_SAMPLE * limits["max_samples"]
+    if steps > limit:
+        raise InputError(
+            f"{what} would take {steps:.3g} closed-form steps; the service computes at most "
+            f"{limit} per run ({WORK_PER_SAMPLE} x ROCKMECH_MAX_SAMPLES); resample the record "
+            "or run it with the rockmech command line",
+            field,
+        )
+
+
+def check_total_steps(steps: float, limits: dict[str, Any], what: str, field: str) -> None:
+    """Raise ``InputError`` when ``steps`` cannot be computed within the compute budget."""
+    budget = limits.get("budget_s")
+    if budget is None or not steps > MAX_STEPS_PER_S * budget:
+        return
+    raise InputError(
+        f"{what} would take {steps:.3g} closed-form steps, which cannot finish within the "
+        f"service's budget of {budget:g} s per request (ROCKMECH_COMPUTE_TIMEOUT_S); ask for "
+        "less work or run it with the rockmech command line",
+        field,
+    )
+
+
+def _check_answer(n_numbers: float, limits: dict[str, Any], what: str, field: str) -> None:
+    size = n_numbers * ANSWER_BYTES_PER_NUMBER
+    limit = limits.get("max_answer_bytes")
+    if limit is not None and size > limit:
+        raise InputError(
+            f"{what} would be about {size / 2**20:.0f} MiB; the service answers at most "
+            f"{limit} bytes (ROCKMECH_MAX_ANSWER_BYTES); ask for fewer points",
+            field,
+        )
+
+
+def _positive(*values: Any) -> bool:
+    return all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0
+        for v in values
+    )
+
+
+def _sides(cf: ConstantsFile) -> Iterable[tuple[float, int]]:
+    """(p_eq, pulse directions) of every mechanism side."""
+    for mech in cf.mechanisms:
+        one_sided = mech.rocking == "one_sided"
+        sides = (mech.positive,) if one_sided else (mech.positive, mech.negative)
+        for side in sides:
+            if side is not None and side.p_eq is not None and _positive(side.p_eq):
+                yield float(side.p_eq), 2 if one_sided else 1
+
+
+def _grid_sum(p: float, f_min: float, f_max: float, n: int) -> float:
+    """Sum of ``max(1, p / f)`` over ``n`` log-spaced frequencies in ``[f_min, f_max]``."""
+    if n < 2 or not _positive(f_min, f_max) or f_max <= f_min:
+        return 0.0  # an invalid grid: the compute process refuses it with its own message
+    ratio = (f_max / f_min) ** (1.0 / (n - 1))
+    # Frequencies below p contribute p/f (a geometric series), the others 1 each.
+    k = min(n, max(0, math.ceil(math.log(p / f_min) / math.log(ratio)))) if p > f_min else 0
+    series = (p / f_min) * (1.0 - ratio ** (-k)) / (1.0 - 1.0 / ratio) if k else 0.0
+    return series + (n - k)
+
+
+def _check_derived(cf: ConstantsFile) -> None:
+    """Refuse constants whose derived side values overflowed (``p_eq = sqrt(K/I0)`` = inf)."""
+    for i, mech in enumerate(cf.mechanisms):
+        for name in ("positive", "negative"):
+            side = getattr(mech, name)
+            for key in ("p_eq", "lam", "phi_ov"):
+                value = getattr(side, key, None) if side is not None else None
+                if isinstance(value, float) and not math.isfinite(value):
+                    raise InputError(
+                        f"mechanisms[{i}] (id {mech.id!r}).{name}.{key}: derived value {value} "
+                        "is not finite; the inputs are too large or too small for double "
+                        "precision",
+                        "constants",
+                    )
+
+
+def envelope_steps(cf: ConstantsFile, f_min: float, f_max: float, n: int) -> float:
+    """Closed-form steps of exact envelopes of every mechanism at ``n`` frequencies."""
+    return float(sum(N_SCAN * d * _grid_sum(p, f_min, f_max, n) for p, d in _sides(cf)))
+
+
+def history_steps(
+    cf: ConstantsFile, n_samples: int, dt: float, n_scales: int, *, worst: bool = False
+) -> float:
+    """Closed-form steps of time histories of every mechanism side at every scale factor.
+
+    With ``worst``, the steps of the longest single run (the stiffest side) instead.
+    """
+    per_sample = [
+        max(1.0, math.ceil(p * dt)) if math.isfinite(p * dt) else math.inf for p, _ in _sides(cf)
+    ]
+    if not per_sample:
+        return 0.0
+    per_run = max(per_sample) if worst else sum(per_sample)
+    return float(max(n_samples - 1, 0) * per_run * n_scales)
+
+
+def _envelope(
+    cf: ConstantsFile, f_min: float, f_max: float, n: int, exact: bool, limits: dict[str, Any]
+) -> None:
+    check_limit(n, limits["max_samples"], "frequencies", "n", "max_samples")
+    columns = sum(4 if m.amplification is not None else 1 for m in cf.mechanisms) + 2
+    _check_answer(n * columns, limits, "the envelopes", "n")
+    if exact:
+        steps = envelope_steps(cf, f_min, f_max, n)
+        check_total_steps(steps, limits, "the exact envelopes", "exact")
+
+
+def _history(job: Any, cf: Optional[ConstantsFile], limits: dict[str, Any]) -> None:
+    check_limit(len(job.scales), limits["max_scales"], "scale factors", "scales", "max_scales")
+    if job.record is None:
+        return
+    n, dt = len(job.record.accel), job.record.dt
+    check_limit(n, limits["max_samples"], "samples", "record", "max_samples")
+    if cf is not None:
+        check_work(history_steps(cf, n, dt, 1, worst=True), limits, "the time history", "record")
+        steps = history_steps(cf, n, dt, len(job.scales))
+        check_total_steps(steps, limits, "the time histories", "record")
+
+
+def check_job(job: Job, limits: dict[str, Any]) -> None:
+    """Refuse a job whose work or answer is too large, before it reaches a compute process.
+
+    Raises
+    ------
+    InputError
+        The work or the answer exceeds a limit; the message names the setting.
+    """
+    cf = getattr(job, "constants", None)
+    if cf is not None:
+        check_limit(
+            len(cf.mechanisms),
+            limits["max_mechanisms"],
+            "mechanisms",
+            "constants",
+            "max_mechanisms",
+        )
+        _check_derived(cf)
+    if isinstance(job, PulseJob) and _positive(job.p_eq, job.f_p):
+        # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
+        check_work(job.p_eq / job.f_p, limits, "the pulse", "f_p")
+    elif isinstance(job, EnvelopeJob):
+        _envelope(job.constants, job.f_min, job.f_max, job.n, job.exact, limits)
+    elif isinstance(job, HistoryJob):
+        _history(job, cf, limits)
+    elif isinstance(job, ReportJob):
+        _history(job, cf, limits)
+        if cf is not None:
+            _envelope(cf, job.f_min, job.f_max, job.n, job.exact, limits)
+    elif isinstance(job, SpectrumJob):
+        check_limit(job.n, limits["max_samples"], "periods", "n", "max_samples")
+        if job.record is not None:
+            n = len(job.record.accel)
+            check_limit(n, limits["max_samples"], "samples", "record", "max_samples")
+    elif isinstance(job, ScaleFactorJob):
+        record = getattr(job.request, "record", None)
+        if record is not None:
+            n = len(record.accel)
+            check_limit(n, limits["max_samples"], "samples", "record", "max_samples")

@@ -1,0 +1,20 @@
+"""The service's routers, one module per resource, all under ``/api/v1`` (Hops under ``/hops``)."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from . import constants, envelope, meta, pulse, records, report, scale_factor
+
+__all__ = ["API_PREFIX", "api_router"]
+
+#: Version prefix of every REST endpoint.
+API_PREFIX = "/api/v1"
+
+
+def api_router() -> APIRouter:
+    """Return every REST route under ``API_PREFIX``."""
+    router = APIRouter(prefix=API_PREFIX)
+    for module in (meta, constants, pulse, envelope, scale_factor, records, report):
+        router.include_router(module.router)
+    return router

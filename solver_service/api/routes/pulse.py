@@ -1,0 +1,28 @@
+"""``POST /pulse``: one mechanism under a one-cycle pulse (``rockmech pulse``)."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, Response
+
+from shared_schema.api import PulseRequest, PulseResponse
+
+from ..compute import compute
+from ..deps import JSON, PoolDep, accepts
+from ..jobspec import PulseJob
+from ..openapi import responses
+
+__all__ = ["router"]
+
+router = APIRouter(tags=["solver"])
+
+
+@router.post(
+    "/pulse",
+    summary="One mechanism under a one-cycle sine or cosine pulse",
+    response_model=None,
+    responses=responses(PulseResponse),
+    dependencies=[accepts(JSON)],
+)
+async def pulse(request: PulseRequest, pool: PoolDep) -> Response:
+    """Return the document ``rockmech pulse --json`` prints."""
+    return await compute(pool, PulseJob(**dict(request)))
