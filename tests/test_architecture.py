@@ -204,3 +204,30 @@ def test_own_modules_are_imported_at_the_top(module: str) -> None:
     for target, line, in_function in imports(module):
         if in_function and not lines[line - 2].strip().startswith("#"):
             pytest.fail(f"{module} imports {target} inside a function at line {line} (no reason)")
+
+
+#: Longest function [lines, its docstring not counted] outside tests and benchmarks, unless a
+#: ``# long:`` comment inside it says why.
+MAX_FUNCTION_LINES = 120
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_functions_are_short_or_say_why(module: str) -> None:
+    text = MODULES[module].read_text(encoding="utf-8")
+    lines = text.splitlines()
+    for node in ast.walk(ast.parse(text)):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            assert node.end_lineno is not None
+            length = node.end_lineno - node.lineno + 1
+            doc = node.body[0]
+            if isinstance(doc, ast.Expr) and isinstance(doc.value, ast.Constant):
+                assert doc.end_lineno is not None
+                length -= doc.end_lineno - doc.lineno + 1
+            body = lines[node.lineno - 1 : node.end_lineno]
+            if length > MAX_FUNCTION_LINES and not any(
+                line.strip().startswith("# long:") for line in body
+            ):
+                pytest.fail(
+                    f"{module}.{node.name} is {length} lines (> {MAX_FUNCTION_LINES}) with no "
+                    "'# long:' note saying why"
+                )

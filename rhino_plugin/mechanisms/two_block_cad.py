@@ -53,6 +53,24 @@ def _mirror(body: Any, b: float) -> Any:
     return PlanarBody(body.mass, (-b - x, z), body.i_g, body.j_z)
 
 
+def _split(body: Any, plane_point: np.ndarray) -> Tuple[List[Any], List[Any]]:
+    """Mass properties of the body's parts below and above the horizontal plane at the hinge."""
+    up = np.array([0.0, 0.0, 1.0])
+    lower: List[Any] = []
+    upper: List[Any] = []
+    for mesh, part in zip(body.meshes, body.parts):
+        z = mesh.vertices[:, 2] - plane_point[2]
+        if z.max() <= 0.0:
+            lower.append(part)
+        elif z.min() >= 0.0:
+            upper.append(part)
+        else:
+            for side, keep in ((lower, "negative"), (upper, "positive")):
+                cut = cut_by_plane(mesh, plane_point, up, keep=keep)
+                side.append(mass_properties(cut, part.density))
+    return lower, upper
+
+
 def two_block_sides(
     spec: Any, scene: Any, body: Any, pos: Any
 ) -> Tuple[Dict[str, float], Optional[Dict[str, float]], Optional[float], Dict[str, Any]]:
@@ -98,24 +116,7 @@ def two_block_sides(
             f"{where}: with no overburden and no mortar tensile strength the hinge forms at the "
             "top (Eq. 17), so there is no two-block mechanism; give 'overburden' or 'f_mt'"
         )
-
-    plane_point = o + np.array([0.0, 0.0, h_c])
-    up = np.array([0.0, 0.0, 1.0])
-    lower: List[Any] = []
-    upper: List[Any] = []
-    for mesh, part in zip(body.meshes, body.parts):
-        z = mesh.vertices[:, 2] - plane_point[2]
-        if z.max() <= 0.0:
-            lower.append(part)
-        elif z.min() >= 0.0:
-            upper.append(part)
-        else:
-            lower.append(
-                mass_properties(cut_by_plane(mesh, plane_point, up, keep="negative"), part.density)
-            )
-            upper.append(
-                mass_properties(cut_by_plane(mesh, plane_point, up, keep="positive"), part.density)
-            )
+    lower, upper = _split(body, o + np.array([0.0, 0.0, h_c]))
     if not lower or not upper:
         raise GeometryError(f"{where}: the split plane at h_c = {h_c:.3f} m misses the wall")
     b1 = _planar(lower, o, out, ax)

@@ -471,6 +471,42 @@ class BatchResult:
         """Time of overturning under ``criterion`` [s], NaN where none; shape (m, k)."""
         return self.t_ratio_exceeded if self.criterion == "ratio" else self.t_collapse
 
+    @classmethod
+    def from_runs(
+        cls, names: list[str], scales: Sequence[float], runs: list[list[RockingResult]]
+    ) -> BatchResult:
+        """Collect single runs (``runs[i][j]``: mechanism ``i`` at ``scales[j]``) as a batch.
+
+        The batch kernel and ``simulate`` give the same numbers bit for bit, so a batch made
+        of single runs (kept for their time series) reads exactly as a computed one.
+        """
+        flat = [r for row in runs for r in row]
+        shape = (len(names), len(scales))
+
+        def grid(key: str, dtype: Any = float) -> Any:
+            values = [getattr(r, key) for r in flat]
+            if dtype is float:
+                values = [math.nan if v is None else v for v in values]
+            return np.asarray(values, dtype=dtype).reshape(shape)
+
+        return cls(
+            names=list(names),
+            scales=np.asarray(scales, dtype=float),
+            peak_ratio=grid("peak_ratio"),
+            t_peak=grid("t_peak"),
+            ratio_exceeded=grid("ratio_exceeded", bool),
+            t_ratio_exceeded=grid("t_ratio_exceeded"),
+            collapsed=grid("collapsed", bool),
+            t_collapse=grid("t_collapse"),
+            n_impacts=grid("n_impacts", np.int64),
+            n_steps=grid("n_steps", np.int64),
+            error_estimate=grid("error_estimate"),
+            status=grid("status", np.int64),
+            criterion=flat[0].criterion,
+            runtime_s=float(sum(r.runtime_s for r in flat)),
+            method=flat[0].method,
+        )
+
     def rows(self) -> list[dict[str, Any]]:
         """One JSON-ready dict per (mechanism, scale), mechanism-major.
 
@@ -489,6 +525,8 @@ class BatchResult:
                     "peak_ratio": float(self.peak_ratio[i, j]),
                     "overturned": bool(ov[i, j]),
                     "t_overturn": _nan_to_none(float(tov[i, j])),
+                    "ratio_exceeded": bool(self.ratio_exceeded[i, j]),
+                    "collapsed": bool(self.collapsed[i, j]),
                     "n_impacts": int(self.n_impacts[i, j]),
                     "error_estimate": err,
                     "status": int(self.status[i, j]),

@@ -415,6 +415,7 @@ def history_doc(
     building: Building = Building(),
     criterion: Optional[str] = None,
     at_height: Optional[float] = None,
+    runs: Optional[dict[tuple[str, float], Any]] = None,
 ) -> dict[str, Any]:
     """Time histories of every mechanism at every scale, as a JSON-ready document.
 
@@ -428,12 +429,15 @@ def history_doc(
     rotations), to compare with shake-table measurements. For a two-sided mechanism with
     different ``phi_ov`` on its two sides it is the bound ``z · peak_ratio · max(phi_ov)``,
     flagged ``peak_displacement_is_bound``.
+
+    Given a ``runs`` dict, each run is made once with its time series, which is kept in
+    ``runs[(mechanism id, user scale)]`` for plots (``run_scaled``); the document is the same.
     """
     if at_height is not None:
         at_height = check_positive(at_height, "at_height")
     cf, skipped = time_domain_mechanisms(cf)
     models = [to_rocking_model(m) for m in cf.mechanisms]
-    factors, batches = run_scaled(cf, models, motion, scales, sf, building, criterion)
+    factors, batches = run_scaled(cf, models, motion, scales, sf, building, criterion, runs)
     per_mech: list[list[dict[str, Any]]] = [[] for _ in models]
     for members, batch in batches:
         rows = batch.rows()

@@ -17,7 +17,6 @@ from shared_schema.constants import ConstantsFile
 
 from ..report.plots import plot_envelopes, plot_ratio_histories, plot_record
 from .documents import envelope_doc, history_doc
-from .scaling import dense_runs
 
 __all__ = ["envelope_csv", "finite_json", "write_envelope", "write_history", "write_record"]
 
@@ -97,19 +96,18 @@ def write_history(
     ``<stem>.png`` shows ``phi/phi_ov`` of every mechanism against time, one panel per
     scale (at most ``max_panels``, evenly chosen, the largest always included);
     ``<stem>_record.png`` the record with its largest sine pulse and its 5 % spectrum.
-    ``options`` go to ``history_doc``.
+    ``options`` go to ``history_doc``. Each run is made once, with its time series.
     """
-    doc = history_doc(cf, motion, scales, **options)
+    runs: dict[tuple[str, float], Any] = {}
+    doc = history_doc(cf, motion, scales, runs=runs, **options)
     out_dir.mkdir(parents=True, exist_ok=True)
     write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
     order = sorted(set(scales))
     picks = sorted(
         {order[round(k)] for k in np.linspace(0, len(order) - 1, min(max_panels, len(order)))}
     )
-    panels = [
-        (scale, [(mech_id, res) for mech_id, _, res in dense_runs(cf, motion, doc, scale)])
-        for scale in picks
-    ]
+    ids = list(dict.fromkeys(row["mechanism"] for row in doc["results"]))  # file order
+    panels = [(scale, [(mech_id, runs[(mech_id, scale)]) for mech_id in ids]) for scale in picks]
     plot_ratio_histories(panels, out_dir / f"{stem}.png", title=title or motion.name)
     plot_record(motion, out_dir / f"{stem}_record.png")
     return doc

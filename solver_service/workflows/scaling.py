@@ -15,7 +15,7 @@ from shared_schema.errors import InputError
 from shared_schema.rules import SF_METHODS, G, check_choice, check_non_negative, check_positive
 
 from ..core.codes import sf_ec8, sf_eq28, sf_nzs
-from ..core.exact import simulate, simulate_batch
+from ..core.exact import BatchResult, simulate, simulate_batch
 from ..core.spectra import response_spectrum
 from .adapter import to_rocking_model
 
@@ -126,6 +126,20 @@ def mechanism_scale_factor(
     )
 
 
+def _factor_groups(
+    cf: ConstantsFile, motion: Any, sf: str, building: Building
+) -> tuple[dict[str, Any], dict[float, list[int]]]:
+    """Scale-factor records per mechanism id, and the mechanisms (indices) per factor."""
+    factors: dict[str, Any] = {}
+    groups: dict[float, list[int]] = {}
+    for i, mech in enumerate(cf.mechanisms):
+        info = mechanism_scale_factor(mech, motion, sf, building)
+        if info is not None:
+            factors[mech.id] = info
+        groups.setdefault(1.0 if info is None else float(info["value"]), []).append(i)
+    return factors, groups
+
+
 def run_scaled(
     cf: ConstantsFile,
     models: list[Any],
@@ -134,10 +148,14 @@ def run_scaled(
     sf: str = "none",
     building: Building = Building(),
     criterion: Optional[str] = None,
+    runs: Optional[dict[tuple[str, float], Any]] = None,
 ) -> tuple[dict[str, Any], list[tuple[list[int], Any]]]:
     """Run every mechanism at every scale, each record scaled up the structure by ``sf``.
 
     Mechanisms that share a factor (all those at ground level) share one compiled batch.
+    Given a ``runs`` dict, every run is instead made once with its time series
+    (``simulate(dense=True)``), kept in ``runs[(mechanism id, user scale)]``, and collected
+    into the same batch results (identical numbers), for plots that need the traces.
 
     Returns
     -------
@@ -147,25 +165,25 @@ def run_scaled(
         Which mechanisms (indices into ``cf.mechanisms``) each batch ran; the batch's
         ``scales`` are the effective ones (user scale times factor).
     """
-    factors: dict[str, Any] = {}
-    groups: dict[float, list[int]] = {}
-    for i, mech in enumerate(cf.mechanisms):
-        info = mechanism_scale_factor(mech, motion, sf, building)
-        if info is not None:
-            factors[mech.id] = info
-        groups.setdefault(1.0 if info is None else float(info["value"]), []).append(i)
-    batches = [
-        (
-            members,
-            simulate_batch(
-                [models[i] for i in members],
-                motion.accel,
-                [s * factor for s in scales],
-                criterion=criterion,
-            ),
-        )
-        for factor, members in groups.items()
-    ]
+    factors, groups = _factor_groups(cf, motion, sf, building)
+    batches = []
+    for factor, members in groups.items():
+        effective = [s * factor for s in scales]
+        chosen = [models[i] for i in members]
+        if runs is None:
+            batch = simulate_batch(chosen, motion.accel, effective, criterion=criterion)
+        else:
+            dense = [
+                [
+                    simulate(m, motion.accel, scale=e, criterion=criterion, dense=True)
+                    for e in effective
+                ]
+                for m in chosen
+            ]
+            for i, row in zip(members, dense):
+                runs.update({(cf.mechanisms[i].id, s): r for s, r in zip(scales, row)})
+            batch = BatchResult.from_runs([m.name for m in chosen], effective, dense)
+        batches.append((members, batch))
     return factors, batches
 
 
