@@ -82,6 +82,7 @@ __all__ = [
     "VirtualWork",
     "input_error_from_validation",
     "parse_constants",
+    "validation_lines",
 ]
 
 #: Version of the file format written by this module.
@@ -781,6 +782,30 @@ def _format_loc(loc: Sequence[Union[int, str]], data: Any, extra: Optional[str])
     return out
 
 
+def validation_lines(
+    errors: Union[ValidationError, Sequence[Mapping[str, Any]]], data: Any = None
+) -> List[Tuple[str, str]]:
+    """``(path, message)`` of every error of a pydantic ``ValidationError``, in our words.
+
+    The one formatting of validation errors in rockmech: the constants file, spec files, API
+    requests, Hops inputs and settings all read the same. ``errors`` is the exception or its
+    ``errors()`` list (FastAPI's request errors). Paths look like
+    ``mechanisms[1] (id 'W2').positive.p_eq`` (the mechanism named by its id when ``data``,
+    the input as plain Python data, has one); pydantic's "Value error, " prefix is dropped
+    and an unknown key says so.
+    """
+    items = errors.errors(include_url=False) if isinstance(errors, ValidationError) else errors
+    out: List[Tuple[str, str]] = []
+    for err in items:
+        ctx = err.get("ctx") or {}
+        extra = ctx.get("field") if isinstance(ctx.get("field"), str) else None
+        msg = str(err["msg"]).replace("Value error, ", "")
+        if err["type"] == "extra_forbidden":
+            msg = "unknown key; " + msg
+        out.append((_format_loc(err["loc"], data, extra), msg))
+    return out
+
+
 def input_error_from_validation(exc: ValidationError, data: Any = None) -> InputError:
     """Turn a pydantic ``ValidationError`` into an ``InputError`` naming mechanism and field.
 
@@ -795,25 +820,15 @@ def input_error_from_validation(exc: ValidationError, data: Any = None) -> Input
     Returns
     -------
     InputError
-        One line per error, each ``<path>: <message>``, e.g.
+        One line per error, each ``<path>: <message>`` (``validation_lines``), e.g.
         ``mechanisms[1] (id 'W2').positive.p_eq: Input should be greater than 0``.
         ``field`` is the path of the first error.
     """
-    lines: List[str] = []
-    paths: List[str] = []
-    for err in exc.errors(include_url=False):
-        ctx = err.get("ctx") or {}
-        extra = ctx.get("field") if isinstance(ctx.get("field"), str) else None
-        path = _format_loc(err["loc"], data, extra)
-        msg = err["msg"]
-        if err["type"] == "extra_forbidden":
-            msg = "unknown key; " + msg
-        paths.append(path)
-        lines.append(f"{path}: {msg}" if path else msg)
-    if not lines:  # pragma: no cover - pydantic never raises an empty ValidationError
+    errors = validation_lines(exc, data)
+    if not errors:  # pragma: no cover - pydantic never raises an empty ValidationError
         return InputError(str(exc))
-    first_msg = lines[0][len(paths[0]) + 2 :] if paths[0] else lines[0]
-    return InputError("\n".join([first_msg, *lines[1:]]), paths[0] or None)
+    lines = [f"{path}: {msg}" if path else msg for path, msg in errors]
+    return InputError("\n".join([errors[0][1], *lines[1:]]), errors[0][0] or None)
 
 
 def parse_constants(source: Union[str, bytes, Mapping[str, Any], Sequence[Any]]) -> ConstantsFile:

@@ -16,7 +16,7 @@ from typing import Any, Dict, List, Literal, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-from shared_schema.constants import Amplification
+from shared_schema.constants import Amplification, validation_lines
 from shared_schema.errors import InputError
 from shared_schema.rules import eta_problem
 
@@ -354,21 +354,6 @@ class SpecFile(BaseModel):
         return mechs
 
 
-def _error_line(err: Any, data: Any) -> str:
-    loc = list(err["loc"])
-    path = ""
-    for part in loc:
-        path += f"[{part}]" if isinstance(part, int) else (f".{part}" if path else str(part))
-    if len(loc) >= 2 and loc[0] == "mechanisms" and isinstance(loc[1], int):
-        try:
-            ident = data["mechanisms"][loc[1]]["id"]
-            path = path.replace(f"mechanisms[{loc[1]}]", f"mechanisms[{loc[1]}] (id {ident!r})")
-        except (TypeError, KeyError, IndexError):
-            pass
-    msg = err["msg"].replace("Value error, ", "")
-    return f"{path}: {msg}" if path else msg
-
-
 def parse_spec(text: Union[str, bytes], source: str = "spec") -> SpecFile:
     """Validate a spec file's JSON text; errors name the mechanism and the field.
 
@@ -389,5 +374,5 @@ def parse_spec(text: Union[str, bytes], source: str = "spec") -> SpecFile:
             data = json.loads(text)
         except ValueError:
             pass
-        lines = [_error_line(err, data) for err in exc.errors()]
+        lines = [f"{path}: {msg}" if path else msg for path, msg in validation_lines(exc, data)]
         raise InputError("\n".join(lines), source) from None

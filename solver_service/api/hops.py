@@ -32,7 +32,7 @@ from typing import Any, ClassVar
 from pydantic import BaseModel, ValidationError
 
 from shared_schema.api import EnvelopeRequest, PulseRequest
-from shared_schema.constants import parse_constants
+from shared_schema.constants import parse_constants, validation_lines
 from shared_schema.errors import InputError
 
 from .jobspec import EnvelopeJob, HistoryJob, Job, PulseJob
@@ -376,11 +376,7 @@ def _constants_json(text: Any) -> Any:
 
 def _validation_text(exc: ValueError) -> str:
     if isinstance(exc, ValidationError):
-        parts = []
-        for err in exc.errors(include_url=False):
-            path = ".".join(str(p) for p in err["loc"])
-            parts.append(f"{path}: {err['msg']}" if path else err["msg"])
-        return "\n".join(parts)
+        return "\n".join(f"{p}: {m}" if p else m for p, m in validation_lines(exc))
     if isinstance(exc, json.JSONDecodeError):
         return f"invalid JSON: {exc}"
     return str(exc)

@@ -7,13 +7,13 @@ with rockmech's message; no traceback reaches a client.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, Optional, Union
+from typing import Any, Optional
 
 from fastapi import FastAPI, Request, Response
 from fastapi.exceptions import RequestValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from shared_schema.constants import parse_constants
+from shared_schema.constants import parse_constants, validation_lines
 from shared_schema.errors import InputError
 
 from .errors import error_body
@@ -53,16 +53,6 @@ def error_response(
     )
 
 
-def _loc_path(loc: Sequence[Union[int, str]]) -> str:
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        else:
-            out += f".{part}" if out else str(part)
-    return out
-
-
 def validation_message(errors: Sequence[Any], data: Any) -> tuple[str, Optional[str]]:
     """Turn pydantic errors of a request into one message and the path of the first field.
 
@@ -78,14 +68,9 @@ def validation_message(errors: Sequence[Any], data: Any) -> tuple[str, Optional[
                 return f"constants: {exc}", field
             except RecursionError:
                 return "constants: nested too deeply", "constants"
-    lines, first = [], None
-    for err in errors:
-        path = _loc_path(err["loc"])
-        msg = err["msg"]
-        if err["type"] == "extra_forbidden":
-            msg = "unknown key; " + msg
-        lines.append(f"{path}: {msg}" if path else msg)
-        first = first or path or None
+    found = validation_lines(errors)
+    lines = [f"{path}: {msg}" if path else msg for path, msg in found]
+    first = next((path for path, _ in found if path), None)
     return "\n".join(lines), first
 
 

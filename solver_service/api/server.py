@@ -11,6 +11,7 @@ from typing import Any, Optional
 
 from pydantic import ValidationError
 
+from shared_schema.constants import validation_lines
 from shared_schema.errors import InputError
 
 from .app import create_app
@@ -32,8 +33,8 @@ def settings_with(**overrides: Any) -> Settings:
         return Settings(**given)
     except ValidationError as exc:
         err = exc.errors(include_url=False)[0]
-        field = ".".join(str(p) for p in err["loc"])
-        raise InputError(f"{err['msg']}, got {err.get('input')!r}", field) from None
+        field, msg = validation_lines([err])[0]
+        raise InputError(f"{msg}, got {err.get('input')!r}", field) from None
 
 
 def run(settings: Settings) -> None:

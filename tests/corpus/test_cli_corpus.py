@@ -289,7 +289,6 @@ def _cases() -> list[Case]:
             [*hist, "--json"],
             "ok",
             check=lambda d: all({"ratio_exceeded", "collapsed"} <= set(r) for r in d["results"]),
-            xfail="#14 README: history rows lack ratio_exceeded and collapsed",
         ),
         Case(
             "history-missing-record",

@@ -36,9 +36,7 @@ def test_runs_with_time_series_give_the_batch_document_exactly(church_and_record
     assert set(runs) == {(m, s) for m in ran for s in scales}
     for (mech_id, scale), res in runs.items():
         assert res.t is not None and res.ratio is not None
-        row = next(
-            r for r in batch["results"] if r["mechanism"] == mech_id and r["scale"] == scale
-        )
+        row = next(r for r in batch["results"] if r["mechanism"] == mech_id and r["scale"] == scale)
         assert row["peak_ratio"] == res.peak_ratio
         if not res.collapsed:  # the trace of a survivor peaks at the reported ratio
             assert row["peak_ratio"] == pytest.approx(float(np.max(np.abs(res.ratio))), abs=1e-9)
