@@ -610,6 +610,20 @@ def _materialise(argv: list[str], tmp: Path) -> list[str]:
     return [fill(a) for a in argv]
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _compiled_kernels(tmp_path_factory: pytest.TempPathFactory) -> None:
+    """Compile the kernels once before any case is timed (numba's first call compiles)."""
+    tmp = tmp_path_factory.mktemp("warm")
+    for argv in (
+        ["pulse", "--p-eq", "2", "--lam", "0.2", "--eta", "0.9", "--f-p", "1", "--a-p-g", "-1"],
+        ["history", "{c:ok.json}", "{r:good.dat}", "--json"],
+        ["record", "{r:good.dat}", "--json", "--n", "5"],
+        ["envelope", "{c:ok.json}", "--out", "{tmp}/env", "--n", "5", "--exact"],
+    ):
+        res = runner.invoke(app, _materialise(argv, tmp))
+        assert res.exit_code == 0, res.output
+
+
 def _run_isolated(argv: list[str]) -> tuple[int, str, str]:
     """Run ``rockmech`` in a child process, killed after ``CASE_SECONDS``."""
     code = "import sys; from solver_service.cli import app; app(sys.argv[1:])"
