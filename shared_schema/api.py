@@ -27,13 +27,21 @@ from shared_schema.rules import (
     SF_METHODS,
     check_choice,
 )
+from shared_schema.site import SiteFile
 
 __all__ = [
+    "ASSESS_FORMATS",
     "EQ28_RULE",
+    "MAX_ASSESS_MULTIPLES",
+    "MAX_ASSESS_RECORDS",
     "PULSE_ETA_RULE",
     "RECORD_UNITS",
+    "AssessRequest",
+    "AssessResponse",
     "Band",
     "BuildingOptions",
+    "CheckRequest",
+    "CheckResponse",
     "ConstantsForm",
     "ConstantsResponse",
     "Ec8Request",
@@ -364,6 +372,50 @@ class ReportRequest(ReportOptions):
     )
 
 
+#: Most records of one assessment request.
+MAX_ASSESS_RECORDS = 5
+#: Most multiples of the design scale in one assessment request.
+MAX_ASSESS_MULTIPLES = 8
+#: What ``/assess`` answers: the assessment document or its HTML page.
+ASSESS_FORMATS = ("json", "html")
+
+
+class CheckRequest(BaseModel):
+    """Code checks of every mechanism on a site (``rockmech check``)."""
+
+    model_config = _REQUEST
+
+    constants: ConstantsFile = Field(
+        description="The kinematic-constants file; mechanisms need each side's virtual_work "
+        "for the checks (the others get a note)."
+    )
+    site: SiteFile = Field(description="The site file (SITE.json): hazard, FC, q, building.")
+
+
+class AssessRequest(BaseModel):
+    """Code checks beside rocking dynamics on records scaled to the site (``rockmech assess``)."""
+
+    model_config = _REQUEST
+
+    constants: ConstantsFile = Field(description="The kinematic-constants file.")
+    site: SiteFile = Field(description="The site file (SITE.json): hazard, FC, q, building.")
+    records: List[RecordSamples] = Field(
+        min_length=1,
+        max_length=MAX_ASSESS_RECORDS,
+        description="Ground motions (1 to 5), each scaled per mechanism to the site spectrum.",
+    )
+    multiples: List[Annotated[float, Field(gt=0)]] = Field(
+        [0.5, 1.0, 1.5, 2.0],
+        min_length=1,
+        max_length=MAX_ASSESS_MULTIPLES,
+        description="Multiples of the design scale factor to run [-], each > 0 (1 is the "
+        "design level); at most 8.",
+    )
+    format: Literal["json", "html"] = Field(
+        "json", description="Answer with the assessment document (json) or its HTML page (html)."
+    )
+
+
 # --- multipart forms (the text fields next to uploaded files) ---------------------------------
 
 # Form fields arrive as text, so these models convert text to numbers (lax mode); NaN,
@@ -618,6 +670,27 @@ class ScaleFactorResponse(BaseModel):
     method: str
     formula: str
     inputs: Dict[str, Optional[float]]
+
+
+class CheckResponse(BaseModel):
+    """Code checks (``rockmech check --json``); fields named as the Circolare names them."""
+
+    model_config = _RESPONSE
+
+    site: Dict[str, Any] = Field(description="Code, spectrum parameters, corner periods, FC, q.")
+    spectrum: Dict[str, Any] = Field(description="T [s], Se_g [g], SDe_m [m] for plotting.")
+    mechanisms: List[Dict[str, Any]] = Field(
+        description="Per mechanism: Z, per side and governing linear and nonlinear checks "
+        "(status ok, or not_run with a note), passes."
+    )
+    governing: Optional[str] = Field(description="Mechanism with the lowest capacity ratio.")
+
+
+class AssessResponse(CheckResponse):
+    """The assessment document (``rockmech assess --json``)."""
+
+    records: List[Dict[str, Any]] = Field(description="The records: name, pga_g, dt, duration.")
+    multiples: List[Optional[float]] = Field(description="Multiples of the design scale run.")
 
 
 #: The constants endpoint answers with a kinematic-constants file.

@@ -469,7 +469,11 @@ def _mechanism_schema_extra(schema: Dict[str, Any]) -> None:
     props = schema["properties"]
     props["p_eq"] = {"type": "number", "exclusiveMinimum": 0, "description": _P_EQ_DESCRIPTION}
     props["lam"] = {"type": "number", "exclusiveMinimum": 0, "description": _LAM_DESCRIPTION}
-    props["phi_ov"] = {"type": "number", "exclusiveMinimum": 0, "description": _PHI_OV_DESCRIPTION}
+    # As inside a side, null means "not given" (lam is used).
+    props["phi_ov"] = {
+        "anyOf": [{"type": "number", "exclusiveMinimum": 0}, {"type": "null"}],
+        "description": _PHI_OV_DESCRIPTION,
+    }
     for key in ("p_eq", "lam", "phi_ov"):
         props[key]["description"] += " Flat short form: describes the positive side."
     schema["required"] = [k for k in schema.get("required", []) if k != "positive"]

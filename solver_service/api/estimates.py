@@ -16,7 +16,15 @@ interval (or a pulse of ``1/f_p`` seconds) into segments of at most ``1/p_eq`` s
 * a pulse: ``p_eq / f_p`` steps;
 * exact envelopes: per mechanism side (both directions for one-sided rocking) and
   frequency, ``N_SCAN`` pulse runs of ``max(1, p_eq / f_p)`` steps;
-* time histories: per mechanism side and scale factor, ``(n - 1) max(1, ceil(p_eq dt))``.
+* time histories: per mechanism side and scale factor, ``(n - 1) max(1, ceil(p_eq dt))``;
+* an assessment: the time histories of every record at every multiple (one more run per
+  record for the HTML page's figures), then, once the check has given each mechanism's
+  matching band (in the compute process), ``BAND_POINTS`` spectrum periods per mechanism and
+  record of ``(n - 1) max(1, ceil(STEPS_PER_PERIOD dt / T))`` steps each.
+
+An assessment's HTML page draws ``1 + n_mechanisms (2 + n_records)`` figures; it is refused
+when they cannot be drawn within the budget at ``MAX_FIGURES_PER_S`` or would make the page
+larger than ``ROCKMECH_MAX_ANSWER_BYTES`` at ``ANSWER_BYTES_PER_FIGURE``.
 
 A job is refused when its steps exceed ``MAX_STEPS_PER_S x budget``: ``MAX_STEPS_PER_S`` is
 about ten times the fastest rate measured (1.8e6 steps/s for envelope scans, 6.7e6 for time
@@ -33,13 +41,26 @@ from typing import Any, Optional
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 
-from .jobspec import EnvelopeJob, HistoryJob, Job, PulseJob, ReportJob, ScaleFactorJob, SpectrumJob
+from .jobspec import (
+    AssessHtmlJob,
+    AssessJob,
+    EnvelopeJob,
+    HistoryJob,
+    Job,
+    PulseJob,
+    ReportJob,
+    ScaleFactorJob,
+    SpectrumJob,
+)
 
 __all__ = [
+    "ANSWER_BYTES_PER_FIGURE",
     "ANSWER_BYTES_PER_NUMBER",
+    "MAX_FIGURES_PER_S",
     "MAX_STEPS_PER_S",
     "N_SCAN",
     "WORK_PER_SAMPLE",
+    "assess_figures",
     "check_job",
     "check_limit",
     "check_total_steps",
@@ -59,6 +80,12 @@ N_SCAN = 300
 WORK_PER_SAMPLE = 20
 #: Bytes of JSON per number in an answer (17 significant digits, sign, exponent, comma).
 ANSWER_BYTES_PER_NUMBER = 24
+#: Upper bound of the figures an assessment page draws per second: about ten times the
+#: rate measured (4.7 figures/s, 13 figures of the El Centro church page on a loaded
+#: 2-core machine), so only pages that cannot be drawn in the budget anywhere are refused.
+MAX_FIGURES_PER_S = 50.0
+#: Bytes of HTML per embedded figure (base64 PNG): 69 kB measured on the same page.
+ANSWER_BYTES_PER_FIGURE = 60_000
 
 
 def check_limit(count: int, limit: int, what: str, field: str, setting: str) -> None:
@@ -195,6 +222,48 @@ def _history(job: Any, cf: Optional[ConstantsFile], limits: dict[str, Any]) -> N
         check_total_steps(steps, limits, "the time histories", "record")
 
 
+def assess_figures(n_mechanisms: int, n_records: int) -> int:
+    """Count the figures of an assessment page.
+
+    The site spectrum; per mechanism the capacity curve, the envelope and one time history
+    per record.
+    """
+    return 1 + n_mechanisms * (2 + n_records)
+
+
+def _assess(job: Any, cf: ConstantsFile, limits: dict[str, Any], html: bool) -> None:
+    total = sum(len(r.accel) for r in job.records)
+    check_limit(total, limits["max_samples"], "record samples", "records", "max_samples")
+    runs = len(job.multiples) + (1 if html else 0)
+    steps = 0.0
+    for i, record in enumerate(job.records):
+        n, dt = len(record.accel), record.dt
+        worst = history_steps(cf, n, dt, 1, worst=True)
+        check_work(worst, limits, "the time history", f"records[{i}]")
+        steps += history_steps(cf, n, dt, runs)
+    check_total_steps(steps, limits, "the time histories", "records")
+    if not html:
+        return
+    figures = assess_figures(len(cf.mechanisms), len(job.records))
+    budget = limits.get("budget_s")
+    if budget is not None and figures > MAX_FIGURES_PER_S * budget:
+        raise InputError(
+            f"the HTML page would draw {figures} figures, which cannot finish within the "
+            f"service's budget of {budget:g} s per request (ROCKMECH_COMPUTE_TIMEOUT_S); send "
+            "fewer mechanisms or records, ask for format json, or run rockmech assess",
+            "format",
+        )
+    size = figures * ANSWER_BYTES_PER_FIGURE
+    limit = limits.get("max_answer_bytes")
+    if limit is not None and size > limit:
+        raise InputError(
+            f"the HTML page would be about {size / 2**20:.0f} MiB ({figures} figures); the "
+            f"service answers at most {limit} bytes (ROCKMECH_MAX_ANSWER_BYTES); send fewer "
+            "mechanisms or records, or ask for format json",
+            "format",
+        )
+
+
 def check_job(job: Job, limits: dict[str, Any]) -> None:
     """Refuse a job whose work or answer is too large, before it reaches a compute process.
 
@@ -229,6 +298,8 @@ def check_job(job: Job, limits: dict[str, Any]) -> None:
         if job.record is not None:
             n = len(job.record.accel)
             check_limit(n, limits["max_samples"], "samples", "record", "max_samples")
+    elif isinstance(job, (AssessJob, AssessHtmlJob)):
+        _assess(job, job.constants, limits, isinstance(job, AssessHtmlJob))
     elif isinstance(job, ScaleFactorJob):
         record = getattr(job.request, "record", None)
         if record is not None:

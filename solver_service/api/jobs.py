@@ -14,6 +14,7 @@ Units: SI, pulse amplitudes and PGA in g (names end in ``_g``).
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
 import tempfile
@@ -47,7 +48,9 @@ from ..core.excitation import Pulse, SampledAccel
 from ..core.model import G, RockingModel, check_positive
 from ..core.records import GroundMotion
 from ..core.spectra import STEPS_PER_PERIOD, response_spectrum
+from ..report.assess import assess_report
 from ..report.html import SPECTRUM_PERIODS, build_report, input_source
+from ..workflows.assess import BAND_POINTS, assessment_doc, check_doc, matching_band
 from ..workflows.documents import (
     envelope_doc,
     frequency_grid,
@@ -67,6 +70,9 @@ from .estimates import (
     history_steps,
 )
 from .jobspec import (
+    AssessHtmlJob,
+    AssessJob,
+    CheckJob,
     EnvelopeJob,
     HistoryJob,
     Job,
@@ -448,6 +454,61 @@ def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes
     return html.encode("utf-8")
 
 
+def _check(job: CheckJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
+    return dumps(check_doc(cf, job.site))
+
+
+def _assess_inputs(job: AssessJob | AssessHtmlJob, limits: dict[str, Any]) -> tuple[Any, list[Any]]:
+    """Validate the constants and records and bound the spectrum work (as ``rockmech assess``).
+
+    The matching band of each mechanism comes from its nonlinear check (``Ts``), so the
+    spectrum work is bounded here, after the check, rather than in the app.
+    """
+    cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
+    motions = []
+    for i, record in enumerate(job.records):
+        try:
+            motions.append(motion_from_params(record, None, None, limits))
+        except InputError as exc:
+            raise InputError(str(exc), f"records[{i}]") from None
+    rows = check_doc(cf, job.site)["mechanisms"]
+    periods = [matching_band(row)[0] for row in rows]
+    periods += [1.0 / m.amplification.f_n for m in cf.mechanisms if m.amplification is not None]
+    steps = 0.0
+    for i, motion in enumerate(motions):
+        for t_lo in periods:
+            check_record_work(motion, limits, t_min=t_lo)
+            steps += BAND_POINTS * _record_steps(motion, STEPS_PER_PERIOD / t_lo)
+        if steps > 0.0:
+            check_total_steps(steps, limits, "the records' spectra", f"records[{i}]")
+    return cf, motions
+
+
+def _assess(job: AssessJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    cf, motions = _assess_inputs(job, limits)
+    return dumps(assessment_doc(cf, job.site, motions, multiples=list(job.multiples)))
+
+
+def _assess_html(job: AssessHtmlJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    if importlib.util.find_spec("jinja2") is None:
+        raise ServiceUnavailable(
+            "the assessment page needs the report extra (pip install 'rockmech[report]'), "
+            "which this deployment lacks (jinja2 is missing)"
+        )
+    cf, motions = _assess_inputs(job, limits)
+    sources = [
+        input_source("constants", "constants", dumps(job.constants.model_dump(exclude_none=True))),
+        input_source("site", "site", dumps(job.site.model_dump())),
+    ] + [input_source("record", r.name, dumps(r.model_dump())) for r in job.records]
+    multiples = list(job.multiples)
+    options = {"multiples": multiples}
+    _, page = assess_report(
+        cf, job.site, motions, multiples=multiples, sources=sources, options=options
+    )
+    return page.encode("utf-8")
+
+
 def _warmup(job: WarmupJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     """Compile (or load from numba's cache) every kernel a request may need, once."""
     model = RockingModel.symmetric(2.0, 0.2, 0.9)
@@ -470,6 +531,9 @@ JOBS: dict[str, tuple[str, Callable[[Any, list[bytes], dict[str, Any]], bytes]]]
     "scale_factor": (_JSON, _scale_factor),
     "constants": (_JSON, _scene_constants),
     "report": ("text/html; charset=utf-8", _report),
+    "check": (_JSON, _check),
+    "assess": (_JSON, _assess),
+    "assess_html": ("text/html; charset=utf-8", _assess_html),
     "warmup": (_JSON, _warmup),
 }
 

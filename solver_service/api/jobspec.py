@@ -16,6 +16,8 @@ from typing import Annotated, Literal, Optional, Union
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
 from shared_schema.api import (
+    AssessRequest,
+    CheckRequest,
     EnvelopeRequest,
     HistoryOptions,
     PulseRequest,
@@ -28,6 +30,9 @@ from shared_schema.constants import ConstantsFile
 
 __all__ = [
     "JOB",
+    "AssessHtmlJob",
+    "AssessJob",
+    "CheckJob",
     "EnvelopeJob",
     "HistoryJob",
     "Job",
@@ -45,7 +50,17 @@ _JOB = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
 
 #: The kinds of job a compute process runs.
 JobKind = Literal[
-    "pulse", "envelope", "history", "spectrum", "scale_factor", "constants", "report", "warmup"
+    "pulse",
+    "envelope",
+    "history",
+    "spectrum",
+    "scale_factor",
+    "constants",
+    "report",
+    "check",
+    "assess",
+    "assess_html",
+    "warmup",
 ]
 
 
@@ -130,6 +145,24 @@ class SceneJob(BaseModel):
     units: Optional[str] = None
 
 
+class CheckJob(CheckRequest):
+    """``rockmech check``."""
+
+    kind: Literal["check"] = "check"
+
+
+class AssessJob(AssessRequest):
+    """``rockmech assess --json``: the assessment document."""
+
+    kind: Literal["assess"] = "assess"
+
+
+class AssessHtmlJob(AssessRequest):
+    """``rockmech assess``: the assessment's HTML page."""
+
+    kind: Literal["assess_html"] = "assess_html"
+
+
 class WarmupJob(BaseModel):
     """Load every kernel once, before a compute process takes work."""
 
@@ -148,6 +181,9 @@ Job = Annotated[
         ReportJob,
         ScaleFactorJob,
         SceneJob,
+        CheckJob,
+        AssessJob,
+        AssessHtmlJob,
         WarmupJob,
     ],
     Field(discriminator="kind"),

@@ -24,6 +24,10 @@ TAGS = [
     {"name": "records", "description": "Time histories and spectra of ground motions."},
     {"name": "geometry", "description": "Kinematic constants from Rhino scenes."},
     {"name": "reports", "description": "Self-contained HTML reports."},
+    {
+        "name": "assessment",
+        "description": "Code checks (NTC 2018 / EC8 sites) beside rocking dynamics.",
+    },
 ]
 
 _ERRORS = {

@@ -15,6 +15,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from shared_schema.constants import parse_constants, validation_lines
 from shared_schema.errors import InputError
+from shared_schema.site import parse_site
 
 from .errors import error_body
 from .limits import TooManyValues, too_large_message
@@ -56,18 +57,20 @@ def error_response(
 def validation_message(errors: Sequence[Any], data: Any) -> tuple[str, Optional[str]]:
     """Turn pydantic errors of a request into one message and the path of the first field.
 
-    Errors inside ``constants`` are reported exactly as ``rockmech`` reports the same
-    constants file, with ``constants`` in place of the file name.
+    Errors inside ``constants`` (or ``site``) are reported exactly as ``rockmech`` reports
+    the same constants (or site) file, with ``constants`` (``site``) in place of the file name.
     """
-    if isinstance(data, dict) and isinstance(data.get("constants"), dict):
-        if any(tuple(e["loc"][:1]) == ("constants",) for e in errors):
+    for key, parse in (("constants", parse_constants), ("site", parse_site)):
+        if not (isinstance(data, dict) and isinstance(data.get(key), dict)):
+            continue
+        if any(tuple(e["loc"][:1]) == (key,) for e in errors):
             try:
-                parse_constants(data["constants"])
+                parse(data[key])
             except InputError as exc:
-                field = f"constants.{exc.field}" if exc.field else "constants"
-                return f"constants: {exc}", field
+                field = f"{key}.{exc.field}" if exc.field else key
+                return f"{key}: {exc}", field
             except RecursionError:
-                return "constants: nested too deeply", "constants"
+                return f"{key}: nested too deeply", key
     found = validation_lines(errors)
     lines = [f"{path}: {msg}" if path else msg for path, msg in found]
     first = next((path for path, _ in found if path), None)

@@ -34,6 +34,7 @@ __all__ = [
     "T1_COEFFICIENT",
     "assessment_doc",
     "check_doc",
+    "matching_band",
     "read_site",
     "record_scale_factor",
     "site_spectrum",
@@ -256,7 +257,12 @@ def record_scale_factor(
     }
 
 
-def _band(row: dict[str, Any]) -> tuple[float, float]:
+def matching_band(row: dict[str, Any]) -> tuple[float, float]:
+    """Periods [s] over which records are matched to the site spectrum for one mechanism.
+
+    ``[BAND_LOW Ts, BAND_HIGH Ts]`` from the row's nonlinear check (``check_doc``), else
+    ``BAND_DEFAULT``.
+    """
     non = row["nonlinear"]
     if non.get("status") == "ok" and math.isfinite(non["Ts"]):
         return BAND_LOW * non["Ts"], BAND_HIGH * non["Ts"]
@@ -367,7 +373,7 @@ def assessment_doc(
     spectrum = site_spectrum(site)
     freq = np.asarray(f_p if f_p is not None else log_grid(0.1, 10.0, 120), dtype=float)
     for row, mech in zip(doc["mechanisms"], cf.mechanisms):
-        band = _band(row)
+        band = matching_band(row)
         try:
             model = to_rocking_model(mech)
         except RockmechError as exc:

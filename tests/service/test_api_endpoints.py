@@ -277,10 +277,13 @@ def test_operations_have_readable_ids_and_tags(client: httpx.Client) -> None:
     assert ops["/api/v1/scale-factor"] == ("scale_factor", ["solver"])
     assert ops["/api/v1/history"] == ("history", ["records"])
     assert ops["/api/v1/constants"] == ("constants", ["geometry"])
+    assert ops["/api/v1/check"] == ("check", ["assessment"])
+    assert ops["/api/v1/assess"] == ("assess", ["assessment"])
     assert [t["name"] for t in api["tags"]] == [
         "service",
         "solver",
         "records",
         "geometry",
         "reports",
+        "assessment",
     ]

@@ -14,6 +14,12 @@ name objects of the scene). Every other check runs, including ``not_a_server_err
 ``negative_data_rejection`` (schema-invalid requests must get 4xx) and
 ``unsupported_method``.
 
+One schemathesis worker: with two, hypothesis' lambda descriptions call ``ast.parse`` from
+two threads at once, and CPython 3.11 (its AST recursion counter is shared between threads)
+answers with a spurious ``SystemError: AST constructor recursion depth mismatch`` in the
+client (the message of python/cpython#106905); with ``/check`` and ``/assess`` (deep
+strategies: constants, site, records) it happened on every run, never in the server.
+
 Schema-valid but absurd requests (a two-sample record 11 hours long, p_eq = 1e300) are
 refused up front with 422 by the service's work bound (``20 x ROCKMECH_MAX_SAMPLES``
 closed-form steps per run), so no 503 is expected either; the server still gets a 5 s budget
@@ -63,7 +69,7 @@ def test_schemathesis_finds_no_failures(fuzz_server: Server, tmp_path: Path) -> 
         "--generation-database",
         "none",
         "--workers",
-        "2",
+        "1",
         "--request-timeout",
         "60",
         "--no-color",
@@ -74,7 +80,7 @@ def test_schemathesis_finds_no_failures(fuzz_server: Server, tmp_path: Path) -> 
     ]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=900, cwd=tmp_path)
     assert res.returncode == 0, res.stdout[-6000:] + res.stderr[-2000:]
-    assert "9 passed" in res.stdout, res.stdout[-3000:]
+    assert "11 passed" in res.stdout, res.stdout[-3000:]
     assert fuzz_server.proc.poll() is None
     log = fuzz_server.log.read_text()
     assert "Traceback" not in log, log[-3000:]

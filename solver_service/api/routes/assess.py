@@ -1,0 +1,59 @@
+"""``POST /check`` and ``POST /assess``: code checks beside rocking dynamics (theory §11).
+
+``/check`` answers the document ``rockmech check --json`` prints; ``/assess`` the document
+``rockmech assess --json`` prints or, with ``format: "html"``, the page ``rockmech assess``
+writes (no PDF: print the page locally).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Union
+
+from fastapi import APIRouter, Response
+
+from shared_schema.api import AssessRequest, AssessResponse, CheckRequest, CheckResponse
+
+from ..compute import compute
+from ..deps import JSON, PoolDep, accepts
+from ..jobspec import AssessHtmlJob, AssessJob, CheckJob
+from ..openapi import responses
+
+__all__ = ["router"]
+
+router = APIRouter(tags=["assessment"], dependencies=[accepts(JSON)])
+
+
+def _json_or_html(model: Any) -> dict[Any, Any]:
+    """Documented answers: the document as JSON, or the page as text/html."""
+    out = responses(model)
+    out[200] = {
+        "model": model,
+        "description": "The assessment document (format json) or its HTML page (format html).",
+        "content": {"text/html": {"schema": {"type": "string"}}},
+    }
+    return out
+
+
+@router.post(
+    "/check",
+    summary="Code checks (NTC 2018 / Circolare §C8.7.1) of every mechanism on a site",
+    response_model=None,
+    responses=responses(CheckResponse),
+)
+async def check(request: CheckRequest, pool: PoolDep) -> Response:
+    """Return the document ``rockmech check --json`` prints."""
+    return await compute(pool, CheckJob(**dict(request)))
+
+
+@router.post(
+    "/assess",
+    summary="Assessment: code checks beside rocking dynamics on records scaled to the site",
+    response_model=None,
+    responses=_json_or_html(AssessResponse),
+)
+async def assess(request: AssessRequest, pool: PoolDep) -> Response:
+    """Return the document ``rockmech assess --json`` prints, or the page it writes."""
+    job: Union[AssessJob, AssessHtmlJob] = (
+        AssessHtmlJob(**dict(request)) if request.format == "html" else AssessJob(**dict(request))
+    )
+    return await compute(pool, job)
