@@ -50,6 +50,7 @@ from .workflows.inputs import (
     read_record_spec,
 )
 from .workflows.outputs import finite_json, write_envelope, write_history, write_record
+from .workflows.rundir import check_file_target, check_folder_target, os_reason, run_folder
 from .workflows.scaling import Building
 from .workflows.tables import constants_from_table
 
@@ -79,7 +80,7 @@ def _note(message: str) -> None:
 
 
 def _user_errors(fn: F) -> F:
-    """Turn rockmech's own errors, and missing extras, into a one-line message and exit 2."""
+    """Turn rockmech's own errors, write errors and missing extras into one line and exit 2."""
 
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -87,6 +88,10 @@ def _user_errors(fn: F) -> F:
             return fn(*args, **kwargs)
         except RockmechError as exc:
             _fail(str(exc))
+        except OSError as exc:
+            # Read-only folder, full disk, missing permission: one line, not a traceback.
+            where = f"{exc.filename}: " if exc.filename else ""
+            _fail(f"out: {where}{os_reason(exc)}")
         except ModuleNotFoundError as exc:
             # A heavy module imported without ``require``: still name the extra.
             name = exc.name or "a module"
@@ -332,6 +337,8 @@ def history(
 ) -> None:
     """Time history of every mechanism in CONSTANTS under RECORD at each scale factor."""
     scales = _scales(scale, ctx.args)
+    if out is not None:
+        check_folder_target(out)
     cf = read_constants(constants)
     motion = _read_record(record, record_format, units, dt, channel, component)
     options: dict[str, Any] = {
@@ -341,7 +348,8 @@ def history(
         "at_height": at_height,
     }
     if out is not None:
-        doc = write_history(cf, motion, scales, out, **options)
+        with run_folder(out) as tmp:
+            doc = write_history(cf, motion, scales, tmp, **options)
     else:
         doc = history_doc(cf, motion, scales, **options)
     if as_json:
@@ -403,13 +411,16 @@ def record_info(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Describe a record: metadata, largest sine pulses and exact response spectrum."""
+    if out is not None:
+        check_folder_target(out)
     motion = _read_record(record, record_format, units, dt, channel, component)
     periods = log_grid(t_min, t_max, n, names=("t_min", "t_max"))
     doc, spectrum, found = record_analysis(
         motion, periods, zeta, n_pulses=pulses, f_min=f_min, f_max=f_max
     )
     if out is not None:
-        write_record(motion, doc, spectrum, found, out)
+        with run_folder(out) as tmp:
+            write_record(motion, doc, spectrum, found, tmp)
     if as_json:
         _print_json(doc)
         return
@@ -503,6 +514,8 @@ def ida(
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     levels = parse_levels(scales)
+    if out is not None:
+        check_folder_target(out)
     cf = read_constants(constants)
     motions = [_read_record(p, record_format, units, dt, channel, component) for p in records or []]
     motions += [spec.read() for spec in (read_record_spec(record_spec) if record_spec else [])]
@@ -535,10 +548,10 @@ def ida(
             jobs=jobs,
         )
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        write_atomic(out / "ida.json", json.dumps(doc, indent=2) + "\n")
-        write_atomic(out / "ida.csv", ida_csv(doc))
-        plot_fragility(doc, out / "ida.png", title=f"Fragility: {constants.name}")
+        with run_folder(out) as tmp:
+            write_atomic(tmp / "ida.json", json.dumps(doc, indent=2) + "\n")
+            write_atomic(tmp / "ida.csv", ida_csv(doc))
+            plot_fragility(doc, tmp / "ida.png", title=f"Fragility: {constants.name}")
     if as_json:
         _print_json(doc)
         return
@@ -585,6 +598,7 @@ def constants(
     ),
 ) -> None:
     """Kinematic constants of every mechanism in SPEC from the solids of SCENE."""
+    check_file_target(output, "output")
     failures: list[MechanismFailure] = []
     if keep_going:
         cf, failures = constants_keep_going(scene, spec, units)
@@ -626,6 +640,7 @@ def constants_table(
     output: Path = typer.Option(..., "-o", "--output", help="Kinematic-constants JSON to write."),
 ) -> None:
     """Turn a table of mechanisms (id, p_eq, lam, eta, f_n, h_e, h...) into a constants file."""
+    check_file_target(output, "output")
     cf = constants_from_table(table)
     save_constants(output, cf)
     typer.echo(f"wrote {output}: {len(cf.mechanisms)} mechanism(s) from {table.name}")
@@ -662,6 +677,7 @@ def envelope(
 ) -> None:
     """Minimum overturning sine-pulse amplitude of every mechanism, and the critical bands."""
     f_p = frequency_grid(f_min, f_max, n)
+    check_folder_target(out)
     cf = read_constants(constants)
     pulse = None
     if record is not None:
@@ -669,14 +685,15 @@ def envelope(
         pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), exact=exact)
     elif ctx.args:
         _fail(f"unexpected argument {ctx.args[0]!r}")
-    doc = write_envelope(
-        cf,
-        f_p,
-        out,
-        exact=exact,
-        title=f"Overturning envelopes: {constants.name}",
-        record_pulse=pulse,
-    )
+    with run_folder(out) as tmp:
+        doc = write_envelope(
+            cf,
+            f_p,
+            tmp,
+            exact=exact,
+            title=f"Overturning envelopes: {constants.name}",
+            record_pulse=pulse,
+        )
     if as_json:
         _print_json(doc)
         return
@@ -742,6 +759,8 @@ def library_build(
     import numpy as np
     from rich.progress import Progress
 
+    if out is not None:
+        check_file_target(out)
     if n_omega < 2:
         _fail(f"n_omega: must be >= 2, got {n_omega}")
     if not 0.0 < eta_step <= 1.0:
@@ -772,7 +791,9 @@ def demo(
     ),
 ) -> None:
     """Run the bundled example: rectangular walls on El Centro 1940, exact integration."""
-    paths = run_demo(out, record, on_skip=lambda note: _note(f"note: {note}"))
+    with run_folder(out) as tmp:
+        written = run_demo(tmp, record, on_skip=lambda note: _note(f"note: {note}"))
+    paths = {kind: out / path.relative_to(tmp) for kind, path in written.items()}
     for kind, path in paths.items():
         typer.echo(f"wrote {kind}: {path}")
     summary = json.loads(paths["history"].read_text())
@@ -825,6 +846,7 @@ def report(
 ) -> None:
     """One self-contained HTML report: constants, envelopes, and with --record its histories."""
     scales = _scales(scale, ctx.args)
+    check_file_target(out)
     f_p = frequency_grid(f_min, f_max, n)
     cf = read_constants(constants)
     sources = [input_source("constants", constants.name, constants.read_bytes())]
@@ -951,6 +973,7 @@ def assess(
     # jinja2 (the report extra) is loaded only by this command.
     from .report.assess import assess_report, print_pdf
 
+    check_file_target(out)
     cf, site_file = read_constants(constants), read_site(site)
     motions = [read_record(r, record_format, units, dt) for r in record]
     sources = [

@@ -369,7 +369,6 @@ def _cases() -> list[Case]:
             "error",
             "out",
             "file|folder|directory",
-            xfail="#14 tracebacks: --out naming an existing file",
         ),
     ]
     for name in CONSTANTS_FILES:
@@ -445,7 +444,6 @@ def _cases() -> list[Case]:
             "error",
             "out",
             "file|folder|directory",
-            xfail="#14 tracebacks: --out naming an existing file",
         ),
     ]
     bnd = ["boundary", "--omega", "5", "--eta", "0.9"]
@@ -560,7 +558,6 @@ def _cases() -> list[Case]:
             "error",
             "out|-o",
             "folder|directory",
-            xfail="#14 tracebacks: report -o naming a folder",
         ),
         Case(
             "demo-record-missing",
