@@ -49,6 +49,7 @@ from .workflows.inputs import (
     read_record,
     read_record_spec,
 )
+from .workflows.limits import CLI_BUDGET_S, DEFAULT_LIMITS, check_run
 from .workflows.outputs import finite_json, write_envelope, write_history, write_record
 from .workflows.rundir import check_file_target, check_folder_target, os_reason, run_folder
 from .workflows.scaling import Building
@@ -283,6 +284,26 @@ _ELEMENT_PERIOD_OPT = typer.Option(
     0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
 )
 
+_NO_LIMITS_OPT = typer.Option(
+    False,
+    "--no-limits",
+    help=f"Lift the size limits, the REST service's: {DEFAULT_LIMITS['max_samples']} record "
+    f"samples, periods or frequencies, {DEFAULT_LIMITS['max_scales']} scale factors, "
+    f"{DEFAULT_LIMITS['max_mechanisms']} mechanisms, work that cannot finish in "
+    f"{CLI_BUDGET_S:g} s.",
+)
+
+
+def _limit(no_limits: bool, *args: Any, **kwargs: Any) -> None:
+    """Refuse a run above the size limits (``workflows.limits.check_run``) unless lifted."""
+    if not no_limits:
+        check_run(*args, **kwargs)
+
+
+def _record_size(motions: Sequence[GroundMotion]) -> tuple[int, float]:
+    """Return (samples [-], time step [s]) bounding the work of each record in ``motions``."""
+    return max(len(m.accel.acc) for m in motions), max(m.dt for m in motions)
+
 
 def _scales(first: list[float], extra: list[str]) -> list[float]:
     """Collect the --scale values, also those typed after the first (``--scale 0.5 1 2``)."""
@@ -333,14 +354,17 @@ def history(
         help="Folder for history.json, history.png (phi/phi_ov per scale) and "
         "history_record.png (record, largest pulse and spectrum).",
     ),
+    no_limits: bool = _NO_LIMITS_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Time history of every mechanism in CONSTANTS under RECORD at each scale factor."""
     scales = _scales(scale, ctx.args)
+    _limit(no_limits, scales=len(scales))
     if out is not None:
         check_folder_target(out)
     cf = read_constants(constants)
     motion = _read_record(record, record_format, units, dt, channel, component)
+    _limit(no_limits, cf, scales=len(scales), record=_record_size([motion]))
     options: dict[str, Any] = {
         "sf": sf,
         "building": Building(building_height, soil_factor, element_period),
@@ -408,12 +432,17 @@ def record_info(
     out: Optional[Path] = typer.Option(
         None, "--out", help="Folder for record.json and record.png (record and spectrum)."
     ),
+    no_limits: bool = _NO_LIMITS_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Describe a record: metadata, largest sine pulses and exact response spectrum."""
+    if pulses < 1:
+        _fail(f"pulses: must be >= 1, got {pulses}")
+    _limit(no_limits, periods=n)
     if out is not None:
         check_folder_target(out)
     motion = _read_record(record, record_format, units, dt, channel, component)
+    _limit(no_limits, record=_record_size([motion]))
     periods = log_grid(t_min, t_max, n, names=("t_min", "t_max"))
     doc, spectrum, found = record_analysis(
         motion, periods, zeta, n_pulses=pulses, f_min=f_min, f_max=f_max
@@ -507,6 +536,7 @@ def ida(
     out: Optional[Path] = typer.Option(
         None, "--out", help="Folder for ida.json, ida.csv and ida.png (fragility curves)."
     ),
+    no_limits: bool = _NO_LIMITS_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Incremental dynamic analysis: overturned fraction per intensity and fragility fits."""
@@ -514,6 +544,7 @@ def ida(
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     levels = parse_levels(scales)
+    _limit(no_limits, scales=len(levels))
     if out is not None:
         check_folder_target(out)
     cf = read_constants(constants)
@@ -521,6 +552,7 @@ def ida(
     motions += [spec.read() for spec in (read_record_spec(record_spec) if record_spec else [])]
     if not motions:
         _fail("records: give record files or --record-spec")
+    _limit(no_limits, cf, scales=len(levels), record=_record_size(motions), records=len(motions))
     console = Console(stderr=True)
     show = console.is_terminal if progress is None else progress
     bar = Progress(
@@ -673,12 +705,15 @@ def envelope(
     dt: Optional[float] = _DT_OPT,
     channel: Optional[str] = _CHANNEL_OPT,
     component: Optional[str] = _COMPONENT_OPT,
+    no_limits: bool = _NO_LIMITS_OPT,
     as_json: bool = typer.Option(False, "--json", help="Also print the JSON document."),
 ) -> None:
     """Minimum overturning sine-pulse amplitude of every mechanism, and the critical bands."""
+    _limit(no_limits, envelope=(f_min, f_max, n, False))
     f_p = frequency_grid(f_min, f_max, n)
     check_folder_target(out)
     cf = read_constants(constants)
+    _limit(no_limits, cf, envelope=(f_min, f_max, n, exact))
     pulse = None
     if record is not None:
         motion = _read_record(record, record_format, units, dt, channel, component)
@@ -843,10 +878,12 @@ def report(
     n: int = typer.Option(200, "--n", help="Number of log-spaced frequencies."),
     exact: bool = typer.Option(False, "--exact", help="Exact envelopes, not the library."),
     title: Optional[str] = typer.Option(None, "--title", help="Title of the report."),
+    no_limits: bool = _NO_LIMITS_OPT,
 ) -> None:
     """One self-contained HTML report: constants, envelopes, and with --record its histories."""
     scales = _scales(scale, ctx.args)
     check_file_target(out)
+    _limit(no_limits, scales=len(scales), envelope=(f_min, f_max, n, False))
     f_p = frequency_grid(f_min, f_max, n)
     cf = read_constants(constants)
     sources = [input_source("constants", constants.name, constants.read_bytes())]
@@ -854,6 +891,8 @@ def report(
     if record is not None:
         motion = _read_record(record, record_format, units, dt, channel, component)
         sources.append(input_source("record", record.name, record.read_bytes()))
+    size = None if motion is None else _record_size([motion])
+    _limit(no_limits, cf, scales=len(scales), record=size, envelope=(f_min, f_max, n, exact))
     options = {"scales": scales, "sf": sf, "building_height": building_height}
     options.update(soil_factor=soil_factor, element_period=element_period, at_height=at_height)
     options.update(criterion=criterion)

@@ -845,3 +845,25 @@ def test_a_run_killed_mid_write_leaves_the_old_run_whole(
         "history.png",
         "history_record.png",
     ]
+
+
+def test_size_limits_name_the_option_and_no_limits_lifts_them(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from solver_service.workflows import limits
+
+    monkeypatch.setitem(limits.DEFAULT_LIMITS, "max_scales", 2)
+    argv = ["history", str(WALLS), str(RECORD), "--scale", "0.5", "1", "2", "--json"]
+    res = runner.invoke(app, argv)
+    assert res.exit_code == 2
+    assert res.stderr.strip() == (
+        "error: scales: 3 scale factors exceed the limit of 2; give --no-limits to lift it"
+    )
+    res = runner.invoke(app, [*argv, "--no-limits"])
+    assert res.exit_code == 0, res.output
+    assert len(json.loads(res.stdout)["results"]) == 9
+
+
+def test_record_pulses_below_one_names_pulses() -> None:
+    res = runner.invoke(app, ["record", str(RECORD), "--pulses", "0"])
+    assert res.exit_code == 2 and res.stderr.strip() == "error: pulses: must be >= 1, got 0"

@@ -416,7 +416,6 @@ def _cases() -> list[Case]:
             "error",
             "n",
             "limit|at most|<=",
-            xfail="#14 tracebacks and hangs: the CLI has no size limits",
             isolate=True,
         ),
         Case(
@@ -499,7 +498,6 @@ def _cases() -> list[Case]:
             "error",
             "n",
             "limit|at most|<=",
-            xfail="#14 tracebacks and hangs: the CLI has no size limits",
             isolate=True,
         ),
         Case(
@@ -508,7 +506,6 @@ def _cases() -> list[Case]:
             "error",
             "pulses",
             ">= 1|> 0",
-            xfail="#14 messages: --pulses reported as n",
         ),
         Case("record-fmin-neg", [*rec, "--f-min", "-1"], "error", "f_min", r"> 0"),
     ]
@@ -525,7 +522,6 @@ def _cases() -> list[Case]:
             "error",
             "scales",
             "limit|at most|<=",
-            xfail="#14 tracebacks and hangs: the CLI has no size limits",
             isolate=True,
         ),
         Case("ida-im-bad", [*ida, "--scales", "1", "--im", "pgv"], "error", "im", "scale|pga"),
