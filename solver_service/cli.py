@@ -10,11 +10,12 @@ otherwise (``--a-p-g`` is in g); every ``--help`` shows the units in brackets.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
-from typing import Any, NoReturn, Optional, TypeVar
+from typing import Any, Iterator, NoReturn, Optional, TypeVar
 
 import typer
 
@@ -102,6 +103,20 @@ def _user_errors(fn: F) -> F:
             _fail(f"{name} is not installed; reinstall rockmech (pip install rockmech)")
 
     return wrapper  # type: ignore[return-value]
+
+
+@contextlib.contextmanager
+def _status(message: str) -> Iterator[None]:
+    """Show a spinner with ``message`` on stderr while the block runs, on a terminal only."""
+    # rich is imported here: only a terminal run draws a spinner.
+    from rich.console import Console
+
+    console = Console(stderr=True)
+    if not console.is_terminal:
+        yield
+        return
+    with console.status(message):
+        yield
 
 
 def _read_record(path: Path, *args: Any) -> GroundMotion:
@@ -371,11 +386,13 @@ def history(
         "criterion": criterion,
         "at_height": at_height,
     }
-    if out is not None:
-        with run_folder(out) as tmp:
-            doc = write_history(cf, motion, scales, tmp, **options)
-    else:
-        doc = history_doc(cf, motion, scales, **options)
+    runs = len(scales) * len(cf.mechanisms)
+    with _status(f"history: {runs} runs of {motion.name}"):
+        if out is not None:
+            with run_folder(out) as tmp:
+                doc = write_history(cf, motion, scales, tmp, **options)
+        else:
+            doc = history_doc(cf, motion, scales, **options)
     if as_json:
         _print_json(doc)
         return
@@ -444,9 +461,10 @@ def record_info(
     motion = _read_record(record, record_format, units, dt, channel, component)
     _limit(no_limits, record=_record_size([motion]))
     periods = log_grid(t_min, t_max, n, names=("t_min", "t_max"))
-    doc, spectrum, found = record_analysis(
-        motion, periods, zeta, n_pulses=pulses, f_min=f_min, f_max=f_max
-    )
+    with _status(f"record: spectrum at {len(periods)} periods and pulses"):
+        doc, spectrum, found = record_analysis(
+            motion, periods, zeta, n_pulses=pulses, f_min=f_min, f_max=f_max
+        )
     if out is not None:
         with run_folder(out) as tmp:
             write_record(motion, doc, spectrum, found, tmp)
@@ -474,7 +492,7 @@ def record_info(
     k = max(range(len(spec["psa_g"])), key=lambda i: spec["psa_g"][i])
     typer.echo(
         f"spectrum ({100 * zeta:g} %): peak PSA {spec['psa_g'][k]:.4f} g at "
-        f"T = {spec['periods_s'][k]:.3f} s ({spec['runtime_s'] * 1e3:.1f} ms)"
+        f"T = {spec['periods_s'][k]:.3f} s (computed in {spec['runtime_s'] * 1e3:.1f} ms)"
     )
     if out is not None:
         typer.echo(f"wrote {out / 'record.json'}, record.png")
@@ -632,10 +650,11 @@ def constants(
     """Kinematic constants of every mechanism in SPEC from the solids of SCENE."""
     check_file_target(output, "output")
     failures: list[MechanismFailure] = []
-    if keep_going:
-        cf, failures = constants_keep_going(scene, spec, units)
-    else:
-        cf = constants_from_files(scene, spec, units)
+    with _status(f"constants: reading {scene.name}"):
+        if keep_going:
+            cf, failures = constants_keep_going(scene, spec, units)
+        else:
+            cf = constants_from_files(scene, spec, units)
     save_constants(output, cf)
     if failures:
         typer.echo(
@@ -720,7 +739,11 @@ def envelope(
         pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), exact=exact)
     elif ctx.args:
         _fail(f"unexpected argument {ctx.args[0]!r}")
-    with run_folder(out) as tmp:
+    kind = "exact envelopes" if exact else "envelopes"
+    with (
+        _status(f"{kind}: {len(cf.mechanisms)} mechanisms x {n} frequencies"),
+        run_folder(out) as tmp,
+    ):
         doc = write_envelope(
             cf,
             f_p,
@@ -792,6 +815,7 @@ def library_build(
 ) -> None:
     """Compute A_min(Omega; eta) for eta in [0, 1] and the one-sided curve (about a minute)."""
     import numpy as np
+    from rich.console import Console
     from rich.progress import Progress
 
     if out is not None:
@@ -803,7 +827,9 @@ def library_build(
     omega = np.geomspace(LIBRARY_OMEGA[0], LIBRARY_OMEGA[1], n_omega)
     eta = np.unique(np.append(np.round(np.arange(0.0, 1.0, eta_step), 12), 1.0))
 
-    with Progress(transient=True) as bar:
+    # Progress on stderr, and only on a terminal.
+    console = Console(stderr=True)
+    with Progress(transient=True, console=console, disable=not console.is_terminal) as bar:
         task = bar.add_task("overturning curves", total=None)
 
         def tick(done: int, total: int) -> None:
@@ -897,22 +923,23 @@ def report(
     options.update(soil_factor=soil_factor, element_period=element_period, at_height=at_height)
     options.update(criterion=criterion)
     options.update(f_min=f_min, f_max=f_max, n=n, exact=exact)
-    text = build_report(
-        cf,
-        f_p,
-        motion=motion,
-        scales=scales,
-        history={
-            "sf": sf,
-            "building": Building(building_height, soil_factor, element_period),
-            "criterion": criterion,
-            "at_height": at_height,
-        },
-        exact=exact,
-        title=title or f"rockmech report: {constants.name}",
-        sources=sources,
-        request=options,
-    )
+    with _status("report: envelopes and histories"):
+        text = build_report(
+            cf,
+            f_p,
+            motion=motion,
+            scales=scales,
+            history={
+                "sf": sf,
+                "building": Building(building_height, soil_factor, element_period),
+                "criterion": criterion,
+                "at_height": at_height,
+            },
+            exact=exact,
+            title=title or f"rockmech report: {constants.name}",
+            sources=sources,
+            request=options,
+        )
     typer.echo(f"wrote {write_report(out, text)}")
 
 
@@ -1020,15 +1047,16 @@ def assess(
         input_source("site", site.name, site.read_bytes()),
     ] + [input_source("record", r.name, r.read_bytes()) for r in record]
     options = {"multiples": multiple, "units": units, "format": record_format, "dt": dt}
-    doc, text = assess_report(
-        cf,
-        site_file,
-        motions,
-        multiples=multiple,
-        sources=sources,
-        options=options,
-        template_dir=template_dir,
-    )
+    with _status("assess: code checks and rocking dynamics"):
+        doc, text = assess_report(
+            cf,
+            site_file,
+            motions,
+            multiples=multiple,
+            sources=sources,
+            options=options,
+            template_dir=template_dir,
+        )
     # With --json, stdout carries exactly one JSON document; the file notes go to stderr.
     typer.echo(f"wrote {write_report(out, text)}", err=as_json)
     if pdf:

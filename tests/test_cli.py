@@ -867,3 +867,18 @@ def test_size_limits_name_the_option_and_no_limits_lifts_them(
 def test_record_pulses_below_one_names_pulses() -> None:
     res = runner.invoke(app, ["record", str(RECORD), "--pulses", "0"])
     assert res.exit_code == 2 and res.stderr.strip() == "error: pulses: must be >= 1, got 0"
+
+
+def test_progress_goes_to_stderr_on_a_terminal_and_nowhere_otherwise(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    argv = ["envelope", str(WALLS), "--n", "5", "--out", str(tmp_path / "e"), "--json"]
+    plain = runner.invoke(app, argv)
+    assert plain.exit_code == 0 and plain.stderr == "", plain.stderr
+    from rich.console import Console
+
+    monkeypatch.setattr(Console, "is_terminal", property(lambda self: True))
+    shown = runner.invoke(app, argv)
+    assert shown.exit_code == 0, shown.output
+    assert json.loads(shown.stdout) == json.loads(plain.stdout)  # stdout: the JSON only
+    assert "envelopes: 3 mechanisms x 5 frequencies" in shown.stderr
