@@ -10,11 +10,12 @@ otherwise (``--a-p-g`` is in g); every ``--help`` shows the units in brackets.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
-from typing import Any, NoReturn, Optional, TypeVar
+from typing import Any, Iterator, NoReturn, Optional, TypeVar
 
 import typer
 
@@ -22,16 +23,15 @@ from rhino_plugin.mechanisms.build import MechanismFailure
 from rockmech._version import __version__
 from shared_schema.errors import RockmechError
 from shared_schema.extras import MissingExtra, extra_for, require
-from shared_schema.io import save_constants, write_atomic
+from shared_schema.io import save_constants
 from shared_schema.rules import CRITERIA, PULSE_SHAPES, RECORD_FORMATS, RECORD_UNITS, SF_METHODS
 
 from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
 from .core.model import check_positive
 from .core.records import GroundMotion
 from .demo import run_demo
-from .ida import IM_MEASURES, ida_csv, parse_levels, run_ida
+from .ida import IM_MEASURES, parse_levels, run_ida
 from .report.html import build_report, input_source, write_report
-from .report.plots import plot_fragility
 from .workflows.assess import check_doc, read_site
 from .workflows.documents import (
     boundary_doc,
@@ -49,7 +49,9 @@ from .workflows.inputs import (
     read_record,
     read_record_spec,
 )
-from .workflows.outputs import finite_json, write_envelope, write_history, write_record
+from .workflows.limits import CLI_BUDGET_S, DEFAULT_LIMITS, check_run
+from .workflows.outputs import finite_json, write_envelope, write_history, write_ida, write_record
+from .workflows.rundir import check_file_target, check_folder_target, os_reason, run_folder
 from .workflows.scaling import Building
 from .workflows.tables import constants_from_table
 
@@ -79,7 +81,7 @@ def _note(message: str) -> None:
 
 
 def _user_errors(fn: F) -> F:
-    """Turn rockmech's own errors, and missing extras, into a one-line message and exit 2."""
+    """Turn rockmech's own errors, write errors and missing extras into one line and exit 2."""
 
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -87,6 +89,10 @@ def _user_errors(fn: F) -> F:
             return fn(*args, **kwargs)
         except RockmechError as exc:
             _fail(str(exc))
+        except OSError as exc:
+            # Read-only folder, full disk, missing permission: one line, not a traceback.
+            where = f"{exc.filename}: " if exc.filename else ""
+            _fail(f"out: {where}{os_reason(exc)}")
         except ModuleNotFoundError as exc:
             # A heavy module imported without ``require``: still name the extra.
             name = exc.name or "a module"
@@ -96,6 +102,20 @@ def _user_errors(fn: F) -> F:
             _fail(f"{name} is not installed; reinstall rockmech (pip install rockmech)")
 
     return wrapper  # type: ignore[return-value]
+
+
+@contextlib.contextmanager
+def _status(message: str) -> Iterator[None]:
+    """Show a spinner with ``message`` on stderr while the block runs, on a terminal only."""
+    # rich is imported here: only a terminal run draws a spinner.
+    from rich.console import Console
+
+    console = Console(stderr=True)
+    if not console.is_terminal:
+        yield
+        return
+    with console.status(message):
+        yield
 
 
 def _read_record(path: Path, *args: Any) -> GroundMotion:
@@ -278,6 +298,26 @@ _ELEMENT_PERIOD_OPT = typer.Option(
     0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
 )
 
+_NO_LIMITS_OPT = typer.Option(
+    False,
+    "--no-limits",
+    help=f"Lift the size limits, the REST service's: {DEFAULT_LIMITS['max_samples']} record "
+    f"samples, periods or frequencies, {DEFAULT_LIMITS['max_scales']} scale factors, "
+    f"{DEFAULT_LIMITS['max_mechanisms']} mechanisms, work that cannot finish in "
+    f"{CLI_BUDGET_S:g} s.",
+)
+
+
+def _limit(no_limits: bool, *args: Any, **kwargs: Any) -> None:
+    """Refuse a run above the size limits (``workflows.limits.check_run``) unless lifted."""
+    if not no_limits:
+        check_run(*args, **kwargs)
+
+
+def _record_size(motions: Sequence[GroundMotion]) -> tuple[int, float]:
+    """Return (samples [-], time step [s]) bounding the work of each record in ``motions``."""
+    return max(len(m.accel.acc) for m in motions), max(m.dt for m in motions)
+
 
 def _scales(first: list[float], extra: list[str]) -> list[float]:
     """Collect the --scale values, also those typed after the first (``--scale 0.5 1 2``)."""
@@ -328,22 +368,30 @@ def history(
         help="Folder for history.json, history.png (phi/phi_ov per scale) and "
         "history_record.png (record, largest pulse and spectrum).",
     ),
+    no_limits: bool = _NO_LIMITS_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Time history of every mechanism in CONSTANTS under RECORD at each scale factor."""
     scales = _scales(scale, ctx.args)
+    _limit(no_limits, scales=len(scales))
+    if out is not None:
+        check_folder_target(out)
     cf = read_constants(constants)
     motion = _read_record(record, record_format, units, dt, channel, component)
+    _limit(no_limits, cf, scales=len(scales), record=_record_size([motion]))
     options: dict[str, Any] = {
         "sf": sf,
         "building": Building(building_height, soil_factor, element_period),
         "criterion": criterion,
         "at_height": at_height,
     }
-    if out is not None:
-        doc = write_history(cf, motion, scales, out, **options)
-    else:
-        doc = history_doc(cf, motion, scales, **options)
+    runs = len(scales) * len(cf.mechanisms)
+    with _status(f"history: {runs} runs of {motion.name}"):
+        if out is not None:
+            with run_folder(out) as tmp:
+                doc = write_history(cf, motion, scales, tmp, **options)
+        else:
+            doc = history_doc(cf, motion, scales, **options)
     if as_json:
         _print_json(doc)
         return
@@ -400,16 +448,25 @@ def record_info(
     out: Optional[Path] = typer.Option(
         None, "--out", help="Folder for record.json and record.png (record and spectrum)."
     ),
+    no_limits: bool = _NO_LIMITS_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Describe a record: metadata, largest sine pulses and exact response spectrum."""
-    motion = _read_record(record, record_format, units, dt, channel, component)
-    periods = log_grid(t_min, t_max, n, names=("t_min", "t_max"))
-    doc, spectrum, found = record_analysis(
-        motion, periods, zeta, n_pulses=pulses, f_min=f_min, f_max=f_max
-    )
+    if pulses < 1:
+        _fail(f"pulses: must be >= 1, got {pulses}")
+    _limit(no_limits, periods=n)
     if out is not None:
-        write_record(motion, doc, spectrum, found, out)
+        check_folder_target(out)
+    motion = _read_record(record, record_format, units, dt, channel, component)
+    _limit(no_limits, record=_record_size([motion]))
+    periods = log_grid(t_min, t_max, n, names=("t_min", "t_max"))
+    with _status(f"record: spectrum at {len(periods)} periods and pulses"):
+        doc, spectrum, found = record_analysis(
+            motion, periods, zeta, n_pulses=pulses, f_min=f_min, f_max=f_max
+        )
+    if out is not None:
+        with run_folder(out) as tmp:
+            write_record(motion, doc, spectrum, found, tmp)
     if as_json:
         _print_json(doc)
         return
@@ -434,7 +491,7 @@ def record_info(
     k = max(range(len(spec["psa_g"])), key=lambda i: spec["psa_g"][i])
     typer.echo(
         f"spectrum ({100 * zeta:g} %): peak PSA {spec['psa_g'][k]:.4f} g at "
-        f"T = {spec['periods_s'][k]:.3f} s ({spec['runtime_s'] * 1e3:.1f} ms)"
+        f"T = {spec['periods_s'][k]:.3f} s (computed in {spec['runtime_s'] * 1e3:.1f} ms)"
     )
     if out is not None:
         typer.echo(f"wrote {out / 'record.json'}, record.png")
@@ -496,6 +553,7 @@ def ida(
     out: Optional[Path] = typer.Option(
         None, "--out", help="Folder for ida.json, ida.csv and ida.png (fragility curves)."
     ),
+    no_limits: bool = _NO_LIMITS_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Incremental dynamic analysis: overturned fraction per intensity and fragility fits."""
@@ -503,11 +561,15 @@ def ida(
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     levels = parse_levels(scales)
+    _limit(no_limits, scales=len(levels))
+    if out is not None:
+        check_folder_target(out)
     cf = read_constants(constants)
     motions = [_read_record(p, record_format, units, dt, channel, component) for p in records or []]
     motions += [spec.read() for spec in (read_record_spec(record_spec) if record_spec else [])]
     if not motions:
         _fail("records: give record files or --record-spec")
+    _limit(no_limits, cf, scales=len(levels), record=_record_size(motions), records=len(motions))
     console = Console(stderr=True)
     show = console.is_terminal if progress is None else progress
     bar = Progress(
@@ -535,10 +597,8 @@ def ida(
             jobs=jobs,
         )
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        write_atomic(out / "ida.json", json.dumps(doc, indent=2) + "\n")
-        write_atomic(out / "ida.csv", ida_csv(doc))
-        plot_fragility(doc, out / "ida.png", title=f"Fragility: {constants.name}")
+        with run_folder(out) as tmp:
+            write_ida(doc, tmp, title=f"Fragility: {constants.name}")
     if as_json:
         _print_json(doc)
         return
@@ -585,11 +645,13 @@ def constants(
     ),
 ) -> None:
     """Kinematic constants of every mechanism in SPEC from the solids of SCENE."""
+    check_file_target(output, "output")
     failures: list[MechanismFailure] = []
-    if keep_going:
-        cf, failures = constants_keep_going(scene, spec, units)
-    else:
-        cf = constants_from_files(scene, spec, units)
+    with _status(f"constants: reading {scene.name}"):
+        if keep_going:
+            cf, failures = constants_keep_going(scene, spec, units)
+        else:
+            cf = constants_from_files(scene, spec, units)
     save_constants(output, cf)
     if failures:
         typer.echo(
@@ -626,6 +688,7 @@ def constants_table(
     output: Path = typer.Option(..., "-o", "--output", help="Kinematic-constants JSON to write."),
 ) -> None:
     """Turn a table of mechanisms (id, p_eq, lam, eta, f_n, h_e, h...) into a constants file."""
+    check_file_target(output, "output")
     cf = constants_from_table(table)
     save_constants(output, cf)
     typer.echo(f"wrote {output}: {len(cf.mechanisms)} mechanism(s) from {table.name}")
@@ -658,25 +721,34 @@ def envelope(
     dt: Optional[float] = _DT_OPT,
     channel: Optional[str] = _CHANNEL_OPT,
     component: Optional[str] = _COMPONENT_OPT,
+    no_limits: bool = _NO_LIMITS_OPT,
     as_json: bool = typer.Option(False, "--json", help="Also print the JSON document."),
 ) -> None:
     """Minimum overturning sine-pulse amplitude of every mechanism, and the critical bands."""
+    _limit(no_limits, envelope=(f_min, f_max, n, False))
     f_p = frequency_grid(f_min, f_max, n)
+    check_folder_target(out)
     cf = read_constants(constants)
+    _limit(no_limits, cf, envelope=(f_min, f_max, n, exact))
     pulse = None
     if record is not None:
         motion = _read_record(record, record_format, units, dt, channel, component)
         pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), exact=exact)
     elif ctx.args:
         _fail(f"unexpected argument {ctx.args[0]!r}")
-    doc = write_envelope(
-        cf,
-        f_p,
-        out,
-        exact=exact,
-        title=f"Overturning envelopes: {constants.name}",
-        record_pulse=pulse,
-    )
+    kind = "exact envelopes" if exact else "envelopes"
+    with (
+        _status(f"{kind}: {len(cf.mechanisms)} mechanisms x {n} frequencies"),
+        run_folder(out) as tmp,
+    ):
+        doc = write_envelope(
+            cf,
+            f_p,
+            tmp,
+            exact=exact,
+            title=f"Overturning envelopes: {constants.name}",
+            record_pulse=pulse,
+        )
     if as_json:
         _print_json(doc)
         return
@@ -740,8 +812,11 @@ def library_build(
 ) -> None:
     """Compute A_min(Omega; eta) for eta in [0, 1] and the one-sided curve (about a minute)."""
     import numpy as np
+    from rich.console import Console
     from rich.progress import Progress
 
+    if out is not None:
+        check_file_target(out)
     if n_omega < 2:
         _fail(f"n_omega: must be >= 2, got {n_omega}")
     if not 0.0 < eta_step <= 1.0:
@@ -749,7 +824,9 @@ def library_build(
     omega = np.geomspace(LIBRARY_OMEGA[0], LIBRARY_OMEGA[1], n_omega)
     eta = np.unique(np.append(np.round(np.arange(0.0, 1.0, eta_step), 12), 1.0))
 
-    with Progress(transient=True) as bar:
+    # Progress on stderr, and only on a terminal.
+    console = Console(stderr=True)
+    with Progress(transient=True, console=console, disable=not console.is_terminal) as bar:
         task = bar.add_task("overturning curves", total=None)
 
         def tick(done: int, total: int) -> None:
@@ -772,7 +849,9 @@ def demo(
     ),
 ) -> None:
     """Run the bundled example: rectangular walls on El Centro 1940, exact integration."""
-    paths = run_demo(out, record, on_skip=lambda note: _note(f"note: {note}"))
+    with run_folder(out) as tmp:
+        written = run_demo(tmp, record, on_skip=lambda note: _note(f"note: {note}"))
+    paths = {kind: out / path.relative_to(tmp) for kind, path in written.items()}
     for kind, path in paths.items():
         typer.echo(f"wrote {kind}: {path}")
     summary = json.loads(paths["history"].read_text())
@@ -822,9 +901,12 @@ def report(
     n: int = typer.Option(200, "--n", help="Number of log-spaced frequencies."),
     exact: bool = typer.Option(False, "--exact", help="Exact envelopes, not the library."),
     title: Optional[str] = typer.Option(None, "--title", help="Title of the report."),
+    no_limits: bool = _NO_LIMITS_OPT,
 ) -> None:
     """One self-contained HTML report: constants, envelopes, and with --record its histories."""
     scales = _scales(scale, ctx.args)
+    check_file_target(out)
+    _limit(no_limits, scales=len(scales), envelope=(f_min, f_max, n, False))
     f_p = frequency_grid(f_min, f_max, n)
     cf = read_constants(constants)
     sources = [input_source("constants", constants.name, constants.read_bytes())]
@@ -832,26 +914,29 @@ def report(
     if record is not None:
         motion = _read_record(record, record_format, units, dt, channel, component)
         sources.append(input_source("record", record.name, record.read_bytes()))
+    size = None if motion is None else _record_size([motion])
+    _limit(no_limits, cf, scales=len(scales), record=size, envelope=(f_min, f_max, n, exact))
     options = {"scales": scales, "sf": sf, "building_height": building_height}
     options.update(soil_factor=soil_factor, element_period=element_period, at_height=at_height)
     options.update(criterion=criterion)
     options.update(f_min=f_min, f_max=f_max, n=n, exact=exact)
-    text = build_report(
-        cf,
-        f_p,
-        motion=motion,
-        scales=scales,
-        history={
-            "sf": sf,
-            "building": Building(building_height, soil_factor, element_period),
-            "criterion": criterion,
-            "at_height": at_height,
-        },
-        exact=exact,
-        title=title or f"rockmech report: {constants.name}",
-        sources=sources,
-        request=options,
-    )
+    with _status("report: envelopes and histories"):
+        text = build_report(
+            cf,
+            f_p,
+            motion=motion,
+            scales=scales,
+            history={
+                "sf": sf,
+                "building": Building(building_height, soil_factor, element_period),
+                "criterion": criterion,
+                "at_height": at_height,
+            },
+            exact=exact,
+            title=title or f"rockmech report: {constants.name}",
+            sources=sources,
+            request=options,
+        )
     typer.echo(f"wrote {write_report(out, text)}")
 
 
@@ -951,6 +1036,7 @@ def assess(
     # jinja2 (the report extra) is loaded only by this command.
     from .report.assess import assess_report, print_pdf
 
+    check_file_target(out)
     cf, site_file = read_constants(constants), read_site(site)
     motions = [read_record(r, record_format, units, dt) for r in record]
     sources = [
@@ -958,15 +1044,16 @@ def assess(
         input_source("site", site.name, site.read_bytes()),
     ] + [input_source("record", r.name, r.read_bytes()) for r in record]
     options = {"multiples": multiple, "units": units, "format": record_format, "dt": dt}
-    doc, text = assess_report(
-        cf,
-        site_file,
-        motions,
-        multiples=multiple,
-        sources=sources,
-        options=options,
-        template_dir=template_dir,
-    )
+    with _status("assess: code checks and rocking dynamics"):
+        doc, text = assess_report(
+            cf,
+            site_file,
+            motions,
+            multiples=multiple,
+            sources=sources,
+            options=options,
+            template_dir=template_dir,
+        )
     # With --json, stdout carries exactly one JSON document; the file notes go to stderr.
     typer.echo(f"wrote {write_report(out, text)}", err=as_json)
     if pdf:

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import errno
 import json
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -720,3 +722,164 @@ def test_serve_prints_the_address_it_listens_on(monkeypatch: pytest.MonkeyPatch)
     assert res.exit_code == 0, res.output
     assert res.stdout.splitlines()[0].endswith("serving on http://127.0.0.1:8765")
     assert calls and calls[0].port == 8765
+
+
+# --- #19: a run's outputs are committed together; write errors are one line ------------------
+
+RECORD = EXAMPLES / "records" / "elcentro_NS.dat"
+WALLS = EXAMPLES / "constants" / "rect_walls.json"
+
+
+def _writing_commands(target: Path) -> dict[str, list[str]]:
+    """Every command that writes, each aimed at ``target``."""
+    c, r = str(WALLS), str(RECORD)
+    return {
+        "history": ["history", c, r, "--out", str(target)],
+        "envelope": ["envelope", c, "--n", "5", "--out", str(target)],
+        "record": ["record", r, "--n", "5", "--out", str(target)],
+        "ida": ["ida", c, r, "--scales", "1", "--out", str(target)],
+        "demo": ["demo", "--out", str(target)],
+        "report": ["report", c, "--n", "5", "-o", str(target / "r.html")],
+        "assess": ["assess", c, str(EXAMPLES / "sites" / "ntc_site.json"), "-o", str(target)],
+        "constants-table": ["constants-table", str(target) + ".csv", "-o", str(target)],
+    }
+
+
+@pytest.mark.parametrize("command", ["history", "envelope", "record", "ida", "demo", "report"])
+def test_an_unwritable_output_is_one_line_and_exit_2_in_every_command(
+    tmp_path: Path, command: str
+) -> None:
+    # Tests run as root, where chmod does not stop a write: a path under a file cannot be
+    # written by anyone (ENOTDIR), whatever the permissions.
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    res = runner.invoke(app, _writing_commands(blocker / "run")[command])
+    assert res.exception is None or isinstance(res.exception, SystemExit), repr(res.exception)
+    assert res.exit_code == 2, res.output
+    lines = res.stderr.strip().splitlines()
+    assert lines[-1].startswith("error: out: ") and str(blocker) in lines[-1], res.stderr
+    assert "Traceback" not in res.stderr
+
+
+@pytest.mark.parametrize("command", ["history", "envelope", "record", "ida", "demo"])
+def test_out_naming_a_file_is_refused_before_any_work(tmp_path: Path, command: str) -> None:
+    target = tmp_path / "taken.json"
+    target.write_text("keep me")
+    res = runner.invoke(app, _writing_commands(target)[command])
+    assert res.exit_code == 2, res.output
+    assert "error: out:" in res.stderr and "is a file" in res.stderr
+    assert target.read_text() == "keep me"
+
+
+@pytest.mark.parametrize("command", ["report", "assess", "constants-table"])
+def test_a_file_option_naming_a_folder_is_refused(tmp_path: Path, command: str) -> None:
+    folder = tmp_path / "folder"
+    (folder / "r.html").mkdir(parents=True)
+    argv = _writing_commands(folder)[command]
+    res = runner.invoke(app, argv)
+    assert res.exit_code == 2, res.output
+    last = res.stderr.strip().splitlines()[-1]
+    assert re.match(r"error: (out|output): .* is a folder", last), last
+
+
+def test_full_disk_and_permission_errors_are_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from solver_service import cli
+    from solver_service.workflows import outputs
+
+    def full(path: object, data: object) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device", str(path))
+
+    monkeypatch.setattr(outputs, "write_atomic", full)
+    res = runner.invoke(app, _writing_commands(tmp_path / "ida")["ida"])
+    assert res.exit_code == 2 and "the disk is full" in res.stderr.splitlines()[-1], res.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # no half run, no temp folder
+
+    def denied(path: object, data: object) -> None:
+        raise PermissionError(errno.EACCES, "Permission denied", str(path))
+
+    monkeypatch.setattr(cli, "save_constants", denied)
+    table = tmp_path / "t.csv"
+    table.write_text("id,name,p_eq,lam,eta\nW1,wall,2.0,0.2,0.9\n")
+    res = runner.invoke(app, ["constants-table", str(table), "-o", str(tmp_path / "c.json")])
+    assert res.exit_code == 2, res.output
+    assert res.stderr.strip() == f"error: out: {tmp_path / 'c.json'}: permission denied"
+
+
+def test_a_run_killed_mid_write_leaves_the_old_run_whole(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from solver_service.workflows import outputs
+
+    out = tmp_path / "run"
+    argv = ["history", str(WALLS), str(RECORD), "--scale", "0.5", "--out", str(out)]
+    assert runner.invoke(app, argv).exit_code == 0
+    (out / "note.txt").write_text("from the old run")
+    old = {p.name: p.read_bytes() for p in out.iterdir()}
+
+    def killed(*args: object, **kwargs: object) -> None:
+        raise KeyboardInterrupt  # the JSON and one plot are written, the record plot is not
+
+    monkeypatch.setattr(outputs, "plot_record", killed)
+    res = runner.invoke(app, [*argv[:-3], "1", "2", "--out", str(out)])
+    assert isinstance(res.exception, KeyboardInterrupt) or res.exit_code != 0
+    monkeypatch.undo()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]  # no temp folder left
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == old
+
+    # A run whose process died mid-write left its folder: the next run removes it, and
+    # replaces the old run whole (the old run's stray file goes with it).
+    dead = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    stale = tmp_path / f".run.{int(dead.stdout)}.tmp"
+    stale.mkdir()
+    (stale / ".history.json.abc.tmp").write_text("half")
+    assert runner.invoke(app, argv).exit_code == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "history.json",
+        "history.png",
+        "history_record.png",
+    ]
+
+
+def test_size_limits_name_the_option_and_no_limits_lifts_them(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from solver_service.workflows import limits
+
+    monkeypatch.setitem(limits.DEFAULT_LIMITS, "max_scales", 2)
+    argv = ["history", str(WALLS), str(RECORD), "--scale", "0.5", "1", "2", "--json"]
+    res = runner.invoke(app, argv)
+    assert res.exit_code == 2
+    assert res.stderr.strip() == (
+        "error: scales: 3 scale factors exceed the limit of 2; give --no-limits to lift it"
+    )
+    res = runner.invoke(app, [*argv, "--no-limits"])
+    assert res.exit_code == 0, res.output
+    assert len(json.loads(res.stdout)["results"]) == 9
+
+
+def test_record_pulses_below_one_names_pulses() -> None:
+    res = runner.invoke(app, ["record", str(RECORD), "--pulses", "0"])
+    assert res.exit_code == 2 and res.stderr.strip() == "error: pulses: must be >= 1, got 0"
+
+
+def test_progress_goes_to_stderr_on_a_terminal_and_nowhere_otherwise(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    argv = ["envelope", str(WALLS), "--n", "5", "--out", str(tmp_path / "e"), "--json"]
+    plain = runner.invoke(app, argv)
+    assert plain.exit_code == 0 and plain.stderr == "", plain.stderr
+    from rich.console import Console
+
+    monkeypatch.setattr(Console, "is_terminal", property(lambda self: True))
+    shown = runner.invoke(app, argv)
+    assert shown.exit_code == 0, shown.output
+    assert json.loads(shown.stdout) == json.loads(plain.stdout)  # stdout: the JSON only
+    assert "envelopes: 3 mechanisms x 5 frequencies" in shown.stderr

@@ -35,12 +35,18 @@ machine we know is refused; the budget still catches the rest.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
 from typing import Any, Optional
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 
+from ..workflows.limits import (  # the numbers and estimates shared with the command line
+    MAX_STEPS_PER_S,
+    N_SCAN,
+    WORK_PER_SAMPLE,
+    envelope_steps,
+    history_steps,
+)
 from .jobspec import (
     AssessHtmlJob,
     AssessJob,
@@ -69,15 +75,6 @@ __all__ = [
     "history_steps",
 ]
 
-#: Upper bound of the exact integrator's speed [closed-form steps per second] (see Notes).
-MAX_STEPS_PER_S = 5.0e7
-#: Pulse amplitudes scanned per frequency by an exact envelope (``core.envelope.N_SCAN``;
-#: a test checks the copy).
-N_SCAN = 300
-#: Closed-form steps per record sample one run may take, on average: one run may take
-#: ``WORK_PER_SAMPLE * max_samples`` steps, so that absurd but well-formed inputs (a
-#: two-sample record a day long, p_eq = 1e300) get 422 at once.
-WORK_PER_SAMPLE = 20
 #: Bytes of JSON per number in an answer (17 significant digits, sign, exponent, comma).
 ANSWER_BYTES_PER_NUMBER = 24
 #: Upper bound of the figures an assessment page draws per second: about ten times the
@@ -141,27 +138,6 @@ def _positive(*values: Any) -> bool:
     )
 
 
-def _sides(cf: ConstantsFile) -> Iterable[tuple[float, int]]:
-    """(p_eq, pulse directions) of every mechanism side."""
-    for mech in cf.mechanisms:
-        one_sided = mech.rocking == "one_sided"
-        sides = (mech.positive,) if one_sided else (mech.positive, mech.negative)
-        for side in sides:
-            if side is not None and side.p_eq is not None and _positive(side.p_eq):
-                yield float(side.p_eq), 2 if one_sided else 1
-
-
-def _grid_sum(p: float, f_min: float, f_max: float, n: int) -> float:
-    """Sum of ``max(1, p / f)`` over ``n`` log-spaced frequencies in ``[f_min, f_max]``."""
-    if n < 2 or not _positive(f_min, f_max) or f_max <= f_min:
-        return 0.0  # an invalid grid: the compute process refuses it with its own message
-    ratio = (f_max / f_min) ** (1.0 / (n - 1))
-    # Frequencies below p contribute p/f (a geometric series), the others 1 each.
-    k = min(n, max(0, math.ceil(math.log(p / f_min) / math.log(ratio)))) if p > f_min else 0
-    series = (p / f_min) * (1.0 - ratio ** (-k)) / (1.0 - 1.0 / ratio) if k else 0.0
-    return series + (n - k)
-
-
 def _check_derived(cf: ConstantsFile) -> None:
     """Refuse constants whose derived side values overflowed (``p_eq = sqrt(K/I0)`` = inf)."""
     for i, mech in enumerate(cf.mechanisms):
@@ -176,27 +152,6 @@ def _check_derived(cf: ConstantsFile) -> None:
                         "precision",
                         "constants",
                     )
-
-
-def envelope_steps(cf: ConstantsFile, f_min: float, f_max: float, n: int) -> float:
-    """Closed-form steps of exact envelopes of every mechanism at ``n`` frequencies."""
-    return float(sum(N_SCAN * d * _grid_sum(p, f_min, f_max, n) for p, d in _sides(cf)))
-
-
-def history_steps(
-    cf: ConstantsFile, n_samples: int, dt: float, n_scales: int, *, worst: bool = False
-) -> float:
-    """Closed-form steps of time histories of every mechanism side at every scale factor.
-
-    With ``worst``, the steps of the longest single run (the stiffest side) instead.
-    """
-    per_sample = [
-        max(1.0, math.ceil(p * dt)) if math.isfinite(p * dt) else math.inf for p, _ in _sides(cf)
-    ]
-    if not per_sample:
-        return 0.0
-    per_run = max(per_sample) if worst else sum(per_sample)
-    return float(max(n_samples - 1, 0) * per_run * n_scales)
 
 
 def _envelope(

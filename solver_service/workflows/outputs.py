@@ -15,10 +15,18 @@ import numpy as np
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile
 
-from ..report.plots import plot_envelopes, plot_ratio_histories, plot_record
+from ..ida import ida_csv
+from ..report.plots import plot_envelopes, plot_fragility, plot_ratio_histories, plot_record
 from .documents import envelope_doc, history_doc
 
-__all__ = ["envelope_csv", "finite_json", "write_envelope", "write_history", "write_record"]
+__all__ = [
+    "envelope_csv",
+    "finite_json",
+    "write_envelope",
+    "write_history",
+    "write_ida",
+    "write_record",
+]
 
 
 def finite_json(value: Any) -> Any:
@@ -130,3 +138,11 @@ def write_record(
     out_dir.mkdir(parents=True, exist_ok=True)
     write_atomic(out_dir / "record.json", json.dumps(doc, indent=2) + "\n")
     plot_record(motion, out_dir / "record.png", spectrum=spectrum, pulses=pulses)
+
+
+def write_ida(doc: dict[str, Any], out_dir: Path, *, title: str = "") -> None:
+    """Write ``ida.json``, ``ida.csv`` and ``ida.png`` (fragility curves) of an IDA document."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_atomic(out_dir / "ida.json", json.dumps(doc, indent=2) + "\n")
+    write_atomic(out_dir / "ida.csv", ida_csv(doc))
+    plot_fragility(doc, out_dir / "ida.png", title=title)

@@ -23,7 +23,7 @@ from typing import Union
 
 from shared_schema.errors import InputError
 
-__all__ = ["run_folder", "stale_folders"]
+__all__ = ["check_file_target", "check_folder_target", "os_reason", "run_folder", "stale_folders"]
 
 #: Suffixes of the sibling folders of a run in progress and of the folder it replaces.
 TMP_SUFFIX = ".tmp"
@@ -56,7 +56,8 @@ def stale_folders(out: Path) -> list[Path]:
     return found
 
 
-def _reason(exc: OSError) -> str:
+def os_reason(exc: OSError) -> str:
+    """Return a short reason for a write error: full disk, permission, read-only, ..."""
     if exc.errno == errno.ENOSPC:
         return "the disk is full"
     if exc.errno in (errno.EACCES, errno.EPERM):
@@ -64,6 +65,20 @@ def _reason(exc: OSError) -> str:
     if exc.errno == errno.EROFS:
         return "the file system is read-only"
     return exc.strerror or type(exc).__name__
+
+
+def check_folder_target(out: Union[str, Path], field: str = "out") -> None:
+    """Raise ``InputError`` if ``out`` exists and is not a folder (checked before a run)."""
+    target = Path(out)
+    if target.exists() and not target.is_dir():
+        raise InputError(f"{target} is a file; give a folder for the run's outputs", field)
+
+
+def check_file_target(out: Union[str, Path], field: str = "out") -> None:
+    """Raise ``InputError`` if ``out`` is an existing folder where a file is to be written."""
+    target = Path(out)
+    if target.is_dir():
+        raise InputError(f"{target} is a folder; give a file name to write", field)
 
 
 def _remove(path: Path) -> None:
@@ -100,8 +115,7 @@ def run_folder(out: Union[str, Path], field: str = "out") -> Iterator[Path]:
     (['run'], True)
     """
     target = Path(out)
-    if target.exists() and not target.is_dir():
-        raise InputError(f"{target} is a file; give a folder for the run's outputs", field)
+    check_folder_target(target, field)
     tmp = target.parent / f".{target.name}.{os.getpid()}{TMP_SUFFIX}"
     old = target.parent / f".{target.name}.{os.getpid()}{OLD_SUFFIX}"
     try:
@@ -112,7 +126,7 @@ def run_folder(out: Union[str, Path], field: str = "out") -> Iterator[Path]:
         _remove(old)
         tmp.mkdir()
     except OSError as exc:
-        raise InputError(f"cannot write to {target.parent}: {_reason(exc)}", field) from None
+        raise InputError(f"cannot write to {target.parent}: {os_reason(exc)}", field) from None
     try:
         yield tmp
         if target.exists():
@@ -123,7 +137,7 @@ def run_folder(out: Union[str, Path], field: str = "out") -> Iterator[Path]:
         if old.exists() and not target.exists():
             with contextlib.suppress(OSError):
                 os.replace(old, target)
-        raise InputError(f"cannot write to {target}: {_reason(exc)}", field) from None
+        raise InputError(f"cannot write to {target}: {os_reason(exc)}", field) from None
     except BaseException:
         _remove(tmp)
         raise

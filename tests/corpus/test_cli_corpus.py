@@ -368,7 +368,6 @@ def _cases() -> list[Case]:
             "error",
             "out",
             "file|folder|directory",
-            xfail="#14 tracebacks: --out naming an existing file",
         ),
     ]
     for name in CONSTANTS_FILES:
@@ -416,7 +415,6 @@ def _cases() -> list[Case]:
             "error",
             "n",
             "limit|at most|<=",
-            xfail="#14 tracebacks and hangs: the CLI has no size limits",
             isolate=True,
         ),
         Case(
@@ -444,7 +442,6 @@ def _cases() -> list[Case]:
             "error",
             "out",
             "file|folder|directory",
-            xfail="#14 tracebacks: --out naming an existing file",
         ),
     ]
     bnd = ["boundary", "--omega", "5", "--eta", "0.9"]
@@ -500,7 +497,6 @@ def _cases() -> list[Case]:
             "error",
             "n",
             "limit|at most|<=",
-            xfail="#14 tracebacks and hangs: the CLI has no size limits",
             isolate=True,
         ),
         Case(
@@ -509,7 +505,6 @@ def _cases() -> list[Case]:
             "error",
             "pulses",
             ">= 1|> 0",
-            xfail="#14 messages: --pulses reported as n",
         ),
         Case("record-fmin-neg", [*rec, "--f-min", "-1"], "error", "f_min", r"> 0"),
     ]
@@ -526,7 +521,6 @@ def _cases() -> list[Case]:
             "error",
             "scales",
             "limit|at most|<=",
-            xfail="#14 tracebacks and hangs: the CLI has no size limits",
             isolate=True,
         ),
         Case("ida-im-bad", [*ida, "--scales", "1", "--im", "pgv"], "error", "im", "scale|pga"),
@@ -559,7 +553,6 @@ def _cases() -> list[Case]:
             "error",
             "out|-o",
             "folder|directory",
-            xfail="#14 tracebacks: report -o naming a folder",
         ),
         Case(
             "demo-record-missing",

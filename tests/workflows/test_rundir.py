@@ -93,3 +93,16 @@ def test_a_full_disk_at_commit_is_one_line_and_keeps_the_old_run(
     monkeypatch.undo()
     assert _names(tmp_path) == ["run"]
     assert (out / "a.json").read_text() == "1"
+
+
+def test_targets_of_the_wrong_kind_are_named(tmp_path: Path) -> None:
+    afile = tmp_path / "a.json"
+    afile.write_text("{}")
+    with pytest.raises(InputError, match=r"^out: .*a\.json is a file"):
+        rundir.check_folder_target(afile)
+    with pytest.raises(InputError, match=r"^output: .* is a folder"):
+        rundir.check_file_target(tmp_path, "output")
+    rundir.check_folder_target(tmp_path / "new")  # not there yet: fine
+    rundir.check_file_target(afile)
+    message = rundir.os_reason(OSError(errno.EROFS, "Read-only file system"))
+    assert message == "the file system is read-only"

@@ -1,0 +1,225 @@
+"""Size limits of a request and estimates of its work, shared by every front end.
+
+The REST service refuses a request above these limits with 422 (its settings can change
+them: ``ROCKMECH_MAX_SAMPLES`` and so on); the command line refuses it with exit status 2
+unless ``--no-limits`` is given. Both count the work the same way, before any is done.
+
+Light on purpose (standard library and ``shared_schema`` only): the service's app process
+imports it.
+
+Notes
+-----
+Work is counted in closed-form steps of the exact integrator, which cuts each record sample
+interval (or a pulse of ``1/f_p`` seconds) into segments of at most ``1/p_eq`` seconds:
+
+* a pulse: ``p_eq / f_p`` steps;
+* exact envelopes: per mechanism side (both directions for one-sided rocking) and
+  frequency, ``N_SCAN`` pulse runs of ``max(1, p_eq / f_p)`` steps;
+* time histories: per mechanism side and scale factor, ``(n - 1) max(1, ceil(p_eq dt))``.
+
+``MAX_STEPS_PER_S`` is about ten times the fastest rate measured (1.8e6 steps/s for
+envelope scans, 6.7e6 for time histories, on a loaded 2-core machine), so a budget check
+refuses only work that cannot finish in the budget on any machine we know.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from typing import Any, Optional
+
+from shared_schema.constants import ConstantsFile
+from shared_schema.errors import InputError
+
+__all__ = [
+    "CLI_BUDGET_S",
+    "DEFAULT_LIMITS",
+    "MAX_STEPS_PER_S",
+    "NO_LIMITS",
+    "N_SCAN",
+    "P_EQ_PLAUSIBLE",
+    "WORK_PER_SAMPLE",
+    "check_count",
+    "check_run",
+    "envelope_steps",
+    "history_steps",
+    "mechanism_sides",
+]
+
+#: Upper bound of the exact integrator's speed [closed-form steps per second] (see Notes).
+MAX_STEPS_PER_S = 5.0e7
+#: Pulse amplitudes scanned per frequency by an exact envelope (``core.envelope.N_SCAN``;
+#: a test checks the copy).
+N_SCAN = 300
+#: Closed-form steps per record sample one run may take, on average: one run may take
+#: ``WORK_PER_SAMPLE * max_samples`` steps.
+WORK_PER_SAMPLE = 20
+#: The default limits of one request (the service's settings start from these) [count, bytes].
+DEFAULT_LIMITS: dict[str, int] = {
+    "max_samples": 500_000,
+    "max_mechanisms": 100,
+    "max_scales": 100,
+    "max_answer_bytes": 64 * 1024 * 1024,
+}
+#: Work budget of one command-line run [s]: work that cannot finish in it even at
+#: ``MAX_STEPS_PER_S`` is refused (the service's budget is its compute timeout).
+CLI_BUDGET_S = 600.0
+#: ``core.exact.P_EQ_PLAUSIBLE`` [rad/s] (a test checks the copy): the solver refuses a run
+#: of a stiffer side itself, naming ``p_eq`` and its valid range, so ``check_run`` leaves
+#: such sides to it rather than blaming the record.
+P_EQ_PLAUSIBLE = 1e3
+#: How a command-line user lifts the limits (named in every message).
+NO_LIMITS = "--no-limits"
+
+
+def _positive(*values: Any) -> bool:
+    return all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0
+        for v in values
+    )
+
+
+def mechanism_sides(cf: ConstantsFile, p_max: float = math.inf) -> Iterable[tuple[float, int]]:
+    """(p_eq [rad/s], pulse directions) of every side with a valid ``p_eq`` up to ``p_max``."""
+    for mech in cf.mechanisms:
+        one_sided = mech.rocking == "one_sided"
+        sides = (mech.positive,) if one_sided else (mech.positive, mech.negative)
+        for side in sides:
+            p = None if side is None else side.p_eq
+            if p is not None and _positive(p) and p <= p_max:
+                yield float(p), 2 if one_sided else 1
+
+
+def _grid_sum(p: float, f_min: float, f_max: float, n: int) -> float:
+    """Sum of ``max(1, p / f)`` over ``n`` log-spaced frequencies in ``[f_min, f_max]``."""
+    if n < 2 or not _positive(f_min, f_max) or f_max <= f_min:
+        return 0.0  # an invalid grid: the compute refuses it with its own message
+    ratio = (f_max / f_min) ** (1.0 / (n - 1))
+    # Frequencies below p contribute p/f (a geometric series), the others 1 each.
+    k = min(n, max(0, math.ceil(math.log(p / f_min) / math.log(ratio)))) if p > f_min else 0
+    series = (p / f_min) * (1.0 - ratio ** (-k)) / (1.0 - 1.0 / ratio) if k else 0.0
+    return series + (n - k)
+
+
+def envelope_steps(
+    cf: ConstantsFile, f_min: float, f_max: float, n: int, *, p_max: float = math.inf
+) -> float:
+    """Closed-form steps of exact envelopes of every mechanism at ``n`` frequencies.
+
+    Sides with ``p_eq`` above ``p_max`` [rad/s] are left out.
+    """
+    sides = mechanism_sides(cf, p_max)
+    return float(sum(N_SCAN * d * _grid_sum(p, f_min, f_max, n) for p, d in sides))
+
+
+def history_steps(
+    cf: ConstantsFile,
+    n_samples: int,
+    dt: float,
+    n_scales: int,
+    *,
+    worst: bool = False,
+    p_max: float = math.inf,
+) -> float:
+    """Closed-form steps of time histories of every mechanism side at every scale factor.
+
+    With ``worst``, the steps of the longest single run (the stiffest side) instead; sides
+    with ``p_eq`` above ``p_max`` [rad/s] are left out.
+    """
+    per_sample = [
+        max(1.0, math.ceil(p * dt)) if math.isfinite(p * dt) else math.inf
+        for p, _ in mechanism_sides(cf, p_max)
+    ]
+    if not per_sample:
+        return 0.0
+    per_run = max(per_sample) if worst else sum(per_sample)
+    return float(max(n_samples - 1, 0) * per_run * n_scales)
+
+
+def check_count(count: int, limit: int, what: str, field: str) -> None:
+    """Refuse ``count`` above ``limit`` with a message naming the option, limit and lift.
+
+    Raises
+    ------
+    InputError
+        ``count > limit``; e.g. ``n: 10000000 frequencies exceed the limit of 500000;
+        give --no-limits to lift it``.
+    """
+    if count > limit:
+        raise InputError(
+            f"{count} {what} exceed the limit of {limit}; give {NO_LIMITS} to lift it", field
+        )
+
+
+def check_run(
+    cf: Optional[ConstantsFile] = None,
+    *,
+    scales: int = 0,
+    record: Optional[tuple[int, float]] = None,
+    records: int = 1,
+    envelope: Optional[tuple[float, float, int, bool]] = None,
+    periods: int = 0,
+    limits: Optional[dict[str, Any]] = None,
+    budget_s: float = CLI_BUDGET_S,
+) -> None:
+    """Refuse a command-line run above the service's size limits, before any work.
+
+    Parameters
+    ----------
+    cf : ConstantsFile, optional
+        The mechanisms (their count and ``p_eq`` [rad/s] set the work).
+    scales : int
+        Scale factors (or intensity levels) per record [-].
+    record : (int, float), optional
+        Samples [-] and time step [s] of the record (of the longest one, with ``records``).
+    records : int
+        Records run at each scale (IDA) [-].
+    envelope : (float, float, int, bool), optional
+        ``(f_min [Hz], f_max [Hz], n, exact)`` of the envelopes.
+    periods : int
+        Periods of a response spectrum [-].
+    limits : dict, optional
+        ``DEFAULT_LIMITS`` unless given.
+    budget_s : float
+        Work that cannot finish in this time [s] at ``MAX_STEPS_PER_S`` is refused.
+
+    Raises
+    ------
+    InputError
+        Naming the option (``n``, ``scales``, ``record``, ``constants``, ``exact``), the limit
+        and ``--no-limits``.
+    """
+    lim = DEFAULT_LIMITS if limits is None else limits
+    if cf is not None:
+        check_count(len(cf.mechanisms), lim["max_mechanisms"], "mechanisms", "constants")
+    check_count(scales, lim["max_scales"], "scale factors", "scales")
+    check_count(periods, lim["max_samples"], "periods", "n")
+    steps = 0.0
+    if envelope is not None:
+        f_min, f_max, n, exact = envelope
+        check_count(n, lim["max_samples"], "frequencies", "n")
+        if exact and cf is not None:
+            steps += envelope_steps(cf, f_min, f_max, n, p_max=P_EQ_PLAUSIBLE)
+    if record is not None:
+        n_samples, dt = record
+        check_count(n_samples, lim["max_samples"], "record samples", "record")
+        if cf is not None:
+            one = history_steps(cf, n_samples, dt, 1, worst=True, p_max=P_EQ_PLAUSIBLE)
+            limit = WORK_PER_SAMPLE * lim["max_samples"]
+            if one > limit:
+                raise InputError(
+                    f"one time history would take {one:.3g} closed-form steps, over the "
+                    f"limit of {limit:.3g} ({WORK_PER_SAMPLE} per sample of the largest "
+                    f"record); resample the record, or give {NO_LIMITS} to lift it",
+                    "record",
+                )
+            runs = max(scales, 1)
+            steps += history_steps(cf, n_samples, dt, runs, p_max=P_EQ_PLAUSIBLE) * records
+    if steps > MAX_STEPS_PER_S * budget_s:
+        field = "record" if record is not None else "exact"
+        raise InputError(
+            f"the run would take {steps:.3g} closed-form steps, more than can finish in "
+            f"{budget_s:g} s on any machine we know; ask for less work, or give {NO_LIMITS} "
+            "to lift the limit",
+            field,
+        )
