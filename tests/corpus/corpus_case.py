@@ -19,6 +19,7 @@ import re
 import subprocess
 import sys
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Optional
@@ -84,7 +85,14 @@ def run_case(case: Case, argv: list[str]) -> tuple[str, str]:
     if case.isolate:
         exit_code, stdout, stderr = _run_isolated(argv)
     else:
-        res = runner.invoke(app, argv)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            res = runner.invoke(app, argv)
+        # a numpy RuntimeWarning reaches the user as "path:line: RuntimeWarning: ..." on stderr
+        leaked = [
+            f"{w.filename}:{w.lineno}: {w.message}" for w in caught if w.category is RuntimeWarning
+        ]
+        assert not leaked, f"a RuntimeWarning reaches the user: {leaked}"
         if res.exception is not None and not isinstance(res.exception, SystemExit):
             raise AssertionError(f"traceback: {res.exception!r}\n{res.output}") from res.exception
         exit_code, stdout, stderr = res.exit_code, res.stdout, res.stderr

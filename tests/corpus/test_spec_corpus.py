@@ -486,6 +486,7 @@ SPEC_CASES: list[SpecCase] = [
         "error",
         "axis|start|end",
         "range|far|finite|at most|units",
+        "#14 messages: an axis at +-1e300 m prints numpy overflow RuntimeWarnings",
     ),
     (
         "axis-vertical",
