@@ -510,7 +510,6 @@ def _cases() -> list[Case]:
             "error",
             "pulses",
             ">= 1|> 0",
-            xfail="#14 messages: --pulses reported as n",
         ),
         Case("record-fmin-neg", [*rec, "--f-min", "-1"], "error", "f_min", r"> 0"),
     ]

@@ -633,7 +633,6 @@ OVERRIDES: dict[str, dict[str, Any]] = {
         }
         for ep in ("history", "spectrum")
     },
-    "spectrum-pulses-zero": {"xfail": "#14 messages: pulses reported as n"},
     "scale-factor-z-above-H": {
         "xfail": "#14 silent wrong answer: EC8 with z = 5 H gives a factor of 8.5"
     },
