@@ -387,7 +387,7 @@ def parse_spec(text: Union[str, bytes], source: str = "spec") -> SpecFile:
         data: Any = None
         try:
             data = json.loads(text)
-        except ValueError:
+        except (ValueError, RecursionError):  # pydantic has named the error; a deep nest too
             pass
         lines = [_error_line(err, data) for err in exc.errors()]
         raise InputError("\n".join(lines), source) from None

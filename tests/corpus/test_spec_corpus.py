@@ -117,7 +117,6 @@ SPEC_CASES: list[SpecCase] = [
         "error",
         "spec",
         "nest|deep|JSON|object",
-        "#14 tracebacks: a deeply nested spec file raises RecursionError (#19)",
     ),
     ("binary", "rect_wall", lambda d: bytes(range(256)) * 4, "error", "spec", "JSON|UTF|decode"),
     (
