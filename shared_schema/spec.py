@@ -372,7 +372,7 @@ def parse_spec(text: Union[str, bytes], source: str = "spec") -> SpecFile:
         data: Any = None
         try:
             data = json.loads(text)
-        except ValueError:
+        except (ValueError, RecursionError):  # pydantic has named the error; a deep nest too
             pass
         lines = [f"{path}: {msg}" if path else msg for path, msg in validation_lines(exc, data)]
         raise InputError("\n".join(lines), source) from None

@@ -218,7 +218,7 @@ def record_analysis(
     zeta : float
         Damping ratio [-].
     n_pulses : int
-        How many of the largest pulses to list.
+        How many of the largest pulses to list, >= 1 (field ``pulses``).
     f_min, f_max : float, optional
         Pulse search range [Hz].
 
@@ -231,6 +231,8 @@ def record_analysis(
     pulses : list of ExtractedPulse
         The pulses, for plots.
     """
+    if isinstance(n_pulses, bool) or int(n_pulses) < 1:  # the user's name for it, not n
+        raise InputError(f"must be >= 1, got {n_pulses!r}", "pulses")
     found = extract_pulses(motion.accel, f_min=f_min, f_max=f_max, n=n_pulses)
     spectrum = response_spectrum(motion.accel.acc, motion.dt, periods, zeta)
     return record_doc(motion, spectrum, found), spectrum, found
