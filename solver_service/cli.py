@@ -452,8 +452,6 @@ def record_info(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Describe a record: metadata, largest sine pulses and exact response spectrum."""
-    if pulses < 1:
-        _fail(f"pulses: must be >= 1, got {pulses}")
     _limit(no_limits, periods=n)
     if out is not None:
         check_folder_target(out)
