@@ -1,6 +1,6 @@
 """RM_Analyse: envelopes, critical bands, time histories or a pulse on a constants file.
 
-The analyses run through the Python API (``solver_service.analysis``; the pure-Python
+The analyses run through the Python API (``solver_service.workflows``; the pure-Python
 kernels are used where numba is missing, as in Rhino 8's CPython 3.9) or, when a service
 URL is configured, through the REST service: ``POST <url>/api/v1/envelope``, ``/history``
 and ``/pulse`` with the JSON bodies of ``shared_schema.api`` (``EnvelopeRequest``,
