@@ -89,6 +89,8 @@ __all__ = [
 SCHEMA_VERSION = "1.0"
 
 
+#: Nesting depth past which a JSON document is refused (Python's own recursion limit).
+MAX_JSON_DEPTH = 1000
 #: Relative tolerance within which given ``p_eq``/``lam``/``phi_ov`` must match the values
 #: derived from the physical constants.
 CONSISTENCY_RTOL = 1e-9
@@ -869,6 +871,8 @@ def parse_constants(source: Union[str, bytes, Mapping[str, Any], Sequence[Any]])
             data = json.loads(text)
         except ValueError as exc:
             raise InputError(f"invalid JSON: {exc}") from None
+        except RecursionError:
+            raise InputError(f"invalid JSON: nested deeper than {MAX_JSON_DEPTH} levels") from None
         if isinstance(data, list):
             text = '{"mechanisms": ' + text + "}"
             data = {"mechanisms": data}
