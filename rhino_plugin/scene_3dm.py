@@ -80,18 +80,7 @@ def _rhino3dm() -> Any:
 class Scene(BaseScene):
     """The objects of a ``.3dm`` file and their conversion to metres.
 
-    Parameters
-    ----------
-    objects : list of SceneObject
-        The objects, in file order.
-    unit_scale : float
-        Metres per model unit [m/unit].
-    units : str
-        Model unit name, lower case (``"millimeters"``).
-    path : str, optional
-        Where the scene was read from (or the upload's name).
-    tolerance : float
-        Model absolute tolerance [m] (0 if the file has none).
+    Constructed as ``BaseScene``; ``from_3dm`` and ``from_bytes`` read a file.
 
     Examples
     --------
@@ -100,16 +89,8 @@ class Scene(BaseScene):
     >>> mesh = scene.mesh(wall)  # doctest: +SKIP
     """
 
-    def __init__(
-        self,
-        objects: List[SceneObject],
-        unit_scale: float = 1.0,
-        units: str = "meters",
-        path: Optional[str] = None,
-        tolerance: float = 0.0,
-    ) -> None:
-        super().__init__(objects, unit_scale, units, path, tolerance)
-        self._file: Any = None  # keeps the File3dm (owner of the geometry) alive
+    #: The File3dm the geometry belongs to, kept alive with the scene (set when read).
+    _file: Any = None
 
     # ------------------------------------------------------------------ reading
 

@@ -102,6 +102,13 @@ class Building:
             raise InputError(f"must be an integer >= 1, got {self.N!r}", "N")
 
 
+#: Why a check above ground is incomplete: the height demand needs the building.
+NO_BUILDING_NOTE = (
+    "the mechanism is above ground (Z > 0) but the site file gives no building "
+    "(height, storeys, T1): the height demand was not evaluated"
+)
+
+
 def participating_mass(vw: VirtualWork) -> tuple[float, float]:
     """Participating mass ``M*`` [kg] and mass fraction ``e*`` [-] (theory §11.1).
 
@@ -194,10 +201,7 @@ def linear_check(
     if Z > 0.0:
         if building is None:
             complete = False
-            out["note"] = (
-                "the mechanism is above ground (Z > 0) but the site file gives no building "
-                "(height, storeys, T1): the height demand was not evaluated"
-            )
+            out["note"] = NO_BUILDING_NOTE
         else:
             psi, gamma = _height_terms(Z, building)
             se_t1 = float(spectrum.Se([building.T1])[0]) * G
@@ -301,10 +305,7 @@ def nonlinear_check(
     if Z > 0.0:
         if building is None:
             complete = False
-            out["note"] = (
-                "the mechanism is above ground (Z > 0) but the site file gives no building "
-                "(height, storeys, T1): the height demand was not evaluated"
-            )
+            out["note"] = NO_BUILDING_NOTE
         else:
             psi, gamma = _height_terms(Z, building)
             r = ts / building.T1
