@@ -20,7 +20,9 @@ alternates on scales of 1e-4 in A (many impacts, chaotic); the optional ``n_scan
 adds a scan log-spaced in ``A - 1`` from ``NEAR_MIN`` to resolve it, at ~10x the cost.
 
 Library (``OverturningLibrary``): ``A_min`` on a log grid of Omega for eta in [0, 1] and for
-one-sided rocking, generated once by ``rockmech library build`` and shipped as package data.
+one-sided rocking, generated once by ``rockmech library build`` and shipped as package data. The build searches
+all its curves in one parallel loop and skips the scan points that overturn whatever eta
+(``_boundary_kernels``); its edges are those of ``boundary_curve``, bit for bit.
 Between grid points ``log A_min`` is interpolated linearly in ``log Omega`` and in eta. The
 curves jump where the overturning mode changes (impact / no impact); across such a jump
 (neighbours differing by more than ``JUMP`` in ``log A``) the lower neighbour is used, so
@@ -40,6 +42,7 @@ import math
 import time
 import warnings
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Optional, Union
@@ -50,6 +53,7 @@ from numpy.typing import ArrayLike, NDArray
 from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError
 
+from . import _boundary_kernels as _bk
 from .amplification import pulse_response_spectrum
 from .exact import kernels
 from .excitation import PULSE_SHAPES
@@ -100,6 +104,8 @@ SPECTRUM_ZETA = 0.05
 #: Pulse directions: +1 first pushes towards negative rotation (against a one-sided
 #: mechanism's restraint), -1 first opens the mechanism (Housner's sign convention).
 DIRECTIONS = {1: "positive", -1: "negative"}
+#: The library's curves are searched in this many parallel calls (progress between them).
+LIBRARY_GROUPS = 8
 
 
 def _scan(a_max: float, n_scan: int, n_scan_near: int) -> NDArray[np.float64]:
@@ -427,6 +433,95 @@ def _ragged(curves: Sequence[BoundaryCurve]) -> tuple[NDArray[np.float64], NDArr
     return np.array(flat), np.array(offsets, dtype=np.int64)
 
 
+def _curve(
+    om: NDArray[np.float64],
+    spec: tuple[float, bool, int],
+    found: tuple[Any, Any, Any],
+    shape: str,
+    scan_ratio: float,
+    runtime_s: float,
+) -> BoundaryCurve:
+    """One library curve from the kernel's ``(edges, n_edges, first)`` of its spec."""
+    eta, one_sided, direction = spec
+    edges, n_edges, first = found
+    if np.any(n_edges > MAX_EDGES):
+        warnings.warn(
+            f"more than {MAX_EDGES} outcome changes at some Omega; only the first "
+            f"{MAX_EDGES} are kept",
+            RuntimeWarning,
+            stacklevel=4,
+        )
+    return BoundaryCurve(
+        omega=om,
+        edges=edges,
+        n_edges=np.minimum(n_edges, MAX_EDGES).astype(np.int64),
+        collapsed_at_start=first.astype(bool),
+        eta=eta,
+        one_sided=one_sided,
+        shape=shape,
+        direction=direction,
+        a_max=A_MAX,
+        scan_ratio=scan_ratio,
+        rtol=RTOL,
+        runtime_s=runtime_s,
+    )
+
+
+def _library_curves(
+    om: NDArray[np.float64],
+    specs: list[tuple[float, bool, int]],
+    shape: str,
+    progress: Any,
+) -> list[BoundaryCurve]:
+    """Boundary curves for ``(eta, one_sided, direction)`` specs, searched in parallel.
+
+    Each is ``boundary_curve`` with the defaults, bit for bit (``_boundary_kernels``): first
+    the two-sided ``eta = 0`` curve, which marks the scan points that overturn whatever
+    ``eta`` (the other two-sided curves skip them), then the rest in ``LIBRARY_GROUPS``
+    parallel calls over (curve, Omega), with ``progress(done, total)`` after each.
+    """
+    scan = _scan(A_MAX, N_SCAN, 0)
+    scan_ratio = float(np.max(scan[1:] / scan[:-1]))
+    phase = PULSE_SHAPES[shape]
+    probe_dir = -1
+    t0 = time.perf_counter()
+    *probe, known = _bk.probe_grid(
+        om, float(probe_dir), phase, scan, RTOL, MAX_EDGES, V_REST_BOUNDARY
+    )
+    probe_spec = (0.0, False, probe_dir)
+    out: dict[int, BoundaryCurve] = {}
+    for k, spec in enumerate(specs):
+        if spec == probe_spec:
+            out[k] = _curve(om, spec, tuple(probe), shape, scan_ratio, time.perf_counter() - t0)
+    todo = [k for k in range(len(specs)) if k not in out]
+    if progress is not None:
+        progress(len(out), len(specs))
+    step = max(1, -(-len(todo) // LIBRARY_GROUPS))
+    for lo in range(0, len(todo), step):
+        t0 = time.perf_counter()
+        group = [specs[k] for k in todo[lo : lo + step]]
+        found = _bk.boundary_grids(
+            om,
+            np.array([e for e, _, _ in group], dtype=float),
+            np.array([one for _, one, _ in group], dtype=np.bool_),
+            np.array([d for _, _, d in group], dtype=float),
+            phase,
+            scan,
+            RTOL,
+            MAX_EDGES,
+            V_REST_BOUNDARY,
+            known,
+            np.array([not one and d == probe_dir for _, one, d in group], dtype=np.bool_),
+        )
+        each_s = (time.perf_counter() - t0) / len(group)
+        for c, k in enumerate(todo[lo : lo + step]):
+            parts = (found[0][c], found[1][c], found[2][c])
+            out[k] = _curve(om, specs[k], parts, shape, scan_ratio, each_s)
+        if progress is not None:
+            progress(len(out), len(specs))
+    return [out[k] for k in range(len(specs))]
+
+
 def build_library(
     *,
     omega: Optional[ArrayLike] = None,
@@ -444,7 +539,14 @@ def build_library(
     shape : {"sine", "cosine"}
         Pulse shape.
     progress : callable, optional
-        Called as ``progress(done, total)`` after each curve.
+        Called as ``progress(done, total)`` as the curves are done.
+
+    Notes
+    -----
+    Every curve is ``boundary_curve`` with the defaults (the one-sided ones as in
+    ``governing_one_sided``), to the bit; all of them are searched in one parallel loop over
+    (curve, Omega), while the pulse response spectrum (Python, holding the GIL) is computed
+    on a second thread beside the compiled search, which releases it.
     """
     t0 = time.perf_counter()
     om = (
@@ -452,24 +554,27 @@ def build_library(
         if omega is None
         else np.asarray(omega, dtype=float)
     )
+    if om.ndim != 1 or om.size == 0 or not np.all(np.isfinite(om) & (om > 0)):
+        raise InputError("must be finite and > 0 (at least one value)", "omega")
     etas = (
         np.round(np.arange(0.0, 1.0 + 1e-9, LIBRARY_ETA_STEP), 12)
         if eta is None
         else np.asarray(eta, dtype=float)
     )
-    total = etas.size + 2
-    curves = []
-    for k, e in enumerate(etas):
-        curves.append(boundary_curve(om, float(e), shape=shape))
-        if progress is not None:
-            progress(k + 1, total)
-    pos, neg, a_one, direction = governing_one_sided(om, 0.0, shape=shape)
-    if progress is not None:
-        progress(total, total)
-    flat, offsets = _ragged([*curves, pos, neg])
-
+    if shape not in PULSE_SHAPES:
+        raise InputError(f"must be one of {sorted(PULSE_SHAPES)}, got {shape!r}", "shape")
+    specs = [(check_eta(float(e), False), False, -1) for e in etas]
+    specs += [(0.0, True, 1), (0.0, True, -1)]
     ratio = np.geomspace(*SPECTRUM_GRID[:2], SPECTRUM_GRID[2])
-    spectrum = pulse_response_spectrum(ratio, zeta=SPECTRUM_ZETA)
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        spectrum_job = pool.submit(pulse_response_spectrum, ratio, zeta=SPECTRUM_ZETA)
+        curves = _library_curves(om, specs, shape, progress)
+        spectrum = spectrum_job.result()
+    pos, neg = curves[-2:]
+    curves = curves[:-2]
+    a_one = np.minimum(pos.a_min, neg.a_min)
+    direction = np.where(pos.a_min <= neg.a_min, 1, -1).astype(np.int64)
+    flat, offsets = _ragged([*curves, pos, neg])
     meta = {
         "library_version": LIBRARY_VERSION,
         "generated": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),

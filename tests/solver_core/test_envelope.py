@@ -10,12 +10,20 @@ from scipy.optimize import brentq
 
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
+from solver_service.core import _boundary_kernels as _bk
 from solver_service.core.amplification import pulse_scale_factor
 from solver_service.core.envelope import (
+    A_MAX,
     LIBRARY_ETA_STEP,
+    MAX_EDGES,
+    N_SCAN,
+    RTOL,
+    V_REST_BOUNDARY,
     Envelope,
     OverturningLibrary,
+    _scan,
     boundary_curve,
+    build_library,
     critical_bands,
     governing_one_sided,
     mechanism_envelope,
@@ -141,6 +149,54 @@ def test_rebuilding_a_sample_reproduces_the_stored_library(library: OverturningL
         np.testing.assert_allclose(fresh, library.a_min_two_sided[j, idx], rtol=1e-12)
     fresh_one = governing_one_sided(library.omega[idx])[2]
     np.testing.assert_allclose(fresh_one, library.a_min_one_sided[idx], rtol=1e-12)
+
+
+@pytest.mark.parametrize("etas", [(0.0, 0.4, 0.9, 1.0), (0.3, 0.96)])
+def test_build_library_is_boundary_curve_bit_for_bit(
+    library: OverturningLibrary, etas: tuple[float, ...]
+) -> None:
+    # The library's parallel search skips the scan points that the eta = 0 probe shows to
+    # overturn whatever eta; every curve must still be boundary_curve's, to the bit, and the
+    # shipped library's rows (with or without eta = 0 in the grid).
+    idx = np.arange(3, library.omega.size, 23)
+    om = library.omega[idx]
+    ticks: list[tuple[int, int]] = []
+    built = build_library(omega=om, eta=etas, progress=lambda d, n: ticks.append((d, n)))
+    assert ticks[-1] == (len(etas) + 2, len(etas) + 2)
+    assert [d for d, _ in ticks] == sorted(d for d, _ in ticks)
+    direct = [boundary_curve(om, e) for e in etas]
+    pos, neg, a_one, direction = governing_one_sided(om)
+    offsets = built.edges_offsets
+    for k, curve in enumerate([*direct, pos, neg]):
+        for i in range(om.size):
+            row = k * om.size + i
+            got = built.edges_flat[offsets[row] : offsets[row + 1]]
+            want = curve.edges[i, : curve.n_edges[i]]
+            np.testing.assert_array_equal(got, want)
+    np.testing.assert_array_equal(built.a_min_two_sided, np.stack([c.a_min for c in direct]))
+    np.testing.assert_array_equal(built.a_min_one_sided, a_one)
+    np.testing.assert_array_equal(built.direction_one_sided, direction)
+    for k, eta in enumerate(etas):
+        j = int(np.argmin(np.abs(library.eta - eta)))
+        np.testing.assert_array_equal(built.a_min_two_sided[k], library.a_min_two_sided[j, idx])
+    np.testing.assert_array_equal(built.a_min_one_sided, library.a_min_one_sided[idx])
+
+
+def test_eta_zero_probe_marks_only_collapses_that_hold_for_every_eta() -> None:
+    # The skipped scan points (restitution-free collapses) are most of the scan, and each one
+    # overturns at every eta when run directly.
+    om = np.array([0.3, 2.0, 9.0])
+    scan = _scan(A_MAX, N_SCAN, 0)
+    probe = _bk.probe_grid(om, -1.0, 0.0, scan, RTOL, MAX_EDGES, V_REST_BOUNDARY)
+    known = probe[3]
+    assert 0.3 < known.mean() < 1.0
+    rng = np.random.default_rng(7)
+    for i, omega in enumerate(om):
+        for j in rng.choice(np.flatnonzero(known[i]), 5, replace=False):
+            for eta in (0.0, 0.5, 1.0):
+                model = RockingModel.symmetric(1.0, 1.0 / G, eta)
+                pulse = Pulse(a_p=-scan[j], f_p=omega / (2 * math.pi))
+                assert simulate(model, pulse, criterion="exact").collapsed
 
 
 def test_interpolation_is_close_and_errs_on_the_safe_side(library: OverturningLibrary) -> None:

@@ -1,0 +1,176 @@
+"""Compiled search of many overturning boundary curves at once (the library build).
+
+``boundary_grids`` runs the scan-and-bisect of ``_kernels.boundary_grid`` for several curves
+(each its own restitution, one-sided flag and pulse direction) in one parallel loop over
+every (curve, Omega) pair, so that all threads share the work of all curves (no thread idle
+at the end of each curve). Each pair is searched with exactly the arithmetic of
+``boundary_grid`` (the same scan, the same bisection, the same ``_kernels.pulse_collapses``),
+so the edges are those of ``boundary_grid`` bit for bit.
+
+Restitution-free outcomes. The restitution enters a run only at an impact (and in the
+analytic free tail only after one). A two-sided run with ``eta = 0`` that overturns without
+any impact (no impact counted, no rest: with ``eta = 0`` every impact is one or the other)
+therefore follows the same arithmetic for every ``eta`` up to its collapse: in a cell, or at
+the end of the pulse by the free tail's first test, which looks only at the state. Such a
+run overturns for every ``eta``. ``probe_grid`` scans ``eta = 0`` and marks these scan points
+(70 % of the library's), and ``boundary_grids`` takes them as overturned without running
+them again; the outcome, and so every edge, is the same bit for bit.
+
+Without numba the same source runs as plain Python, like ``_kernels``.
+"""
+
+import numpy as np
+
+from ._kernels import (
+    OUT_N_IMPACTS,
+    OUT_N_RESTS,
+    _jit,
+    _jit_parallel,
+    _prange,
+    pulse_collapses,
+    pulse_work,
+)
+
+#: Golden-ratio conjugate: the visiting order of the (curve, Omega) pairs.
+GOLDEN = 0.6180339887498949
+#: What ``_search`` does with its ``known`` row: nothing, take its True entries as overturned
+#: without a run, or fill it with the restitution-free outcomes (the ``eta = 0`` probe).
+KNOWN_IGNORE = 0
+KNOWN_USE = 1
+KNOWN_FILL = 2
+
+
+@_jit
+def _scan_point(amp, om, phase, work, known, j, mode):
+    """Outcome at scan point ``j``, using or filling ``known[j]`` as ``mode`` says."""
+    if mode == KNOWN_USE and known[j]:
+        return True
+    out = pulse_collapses(amp, om, phase, 1, work)
+    if mode == KNOWN_FILL:
+        st = work[3]
+        known[j] = out and st[OUT_N_IMPACTS] == 0.0 and st[OUT_N_RESTS] == 0.0
+    return out
+
+
+@_jit
+def _search(eta, one_sided, sign, om, phase, a_scan, rtol, v_rest_rel, edges_row, known, mode):
+    """Scan and bisect the outcome in A at one Omega; return (n_edges, collapsed at first).
+
+    ``edges_row`` (max_edges,) receives the first edges; the count may exceed its size.
+    ``known`` (n_scan,) and ``mode``: see ``KNOWN_*``.
+    """
+    max_edges = edges_row.shape[0]
+    work = pulse_work(eta, one_sided, v_rest_rel, 1)
+    prev = _scan_point(sign * a_scan[0], om, phase, work, known, 0, mode)
+    first = prev
+    ne = 0
+    for j in range(1, a_scan.shape[0]):
+        cur = _scan_point(sign * a_scan[j], om, phase, work, known, j, mode)
+        if cur != prev:
+            lo = a_scan[j - 1]
+            hi = a_scan[j]
+            while hi - lo > rtol * hi:
+                mid = 0.5 * (lo + hi)
+                if pulse_collapses(sign * mid, om, phase, 1, work) == prev:
+                    lo = mid
+                else:
+                    hi = mid
+            if ne < max_edges:
+                edges_row[ne] = 0.5 * (lo + hi)
+            ne += 1
+            prev = cur
+    return ne, first
+
+
+@_jit_parallel
+def probe_grid(omegas, sign, phase, a_scan, rtol, max_edges, v_rest_rel):
+    """Search the two-sided ``eta = 0`` curve; mark where its scan overturns whatever eta.
+
+    Returns ``(edges, n_edges, first, known)``: the first three as one curve of
+    ``boundary_grids``, and ``known`` (n, n_scan) bool, True at the scan points that
+    overturn for every ``eta`` (module docstring).
+    """
+    n_om = omegas.shape[0]
+    edges = np.full((n_om, max_edges), np.nan)
+    n_edges = np.zeros(n_om, dtype=np.int64)
+    first = np.zeros(n_om, dtype=np.bool_)
+    known = np.zeros((n_om, a_scan.shape[0]), dtype=np.bool_)
+    order = np.argsort((np.arange(n_om) * GOLDEN) % 1.0)
+    for c in _prange(n_om):
+        i = order[c]
+        ne, f = _search(
+            0.0,
+            False,
+            sign,
+            omegas[i],
+            phase,
+            a_scan,
+            rtol,
+            v_rest_rel,
+            edges[i],
+            known[i],
+            KNOWN_FILL,
+        )
+        n_edges[i] = ne
+        first[i] = f
+    return edges, n_edges, first, known
+
+
+@_jit_parallel
+def boundary_grids(
+    omegas, etas, one_sided, signs, phase, a_scan, rtol, max_edges, v_rest_rel, known, use_known
+):
+    """Overturning edges in A for every curve and Omega.
+
+    Parameters
+    ----------
+    omegas : (n,) float
+        Frequency ratios, shared by every curve [-].
+    etas, one_sided, signs : (c,) float, (c,) bool, (c,) float
+        Per curve: restitution, one-sided rocking, pulse direction (+1 / -1).
+    phase, a_scan, rtol, max_edges, v_rest_rel
+        As in ``_kernels.boundary_grid``.
+    known : (n, n_scan) bool
+        Restitution-free overturning scan points (``probe_grid``, same ``omegas``, ``phase``,
+        ``a_scan`` and direction).
+    use_known : (c,) bool
+        Per curve: take ``known`` as overturned (two-sided curves of the probe's direction).
+
+    Returns
+    -------
+    edges : (c, n, max_edges) float
+        NaN-padded edges per curve and Omega.
+    n_edges : (c, n) int
+        Number of edges found (may exceed ``max_edges``).
+    first : (c, n) bool
+        Outcome at ``a_scan[0]``.
+    """
+    n_c = etas.shape[0]
+    n_om = omegas.shape[0]
+    total = n_c * n_om
+    edges = np.full((n_c, n_om, max_edges), np.nan)
+    n_edges = np.zeros((n_c, n_om), dtype=np.int64)
+    first = np.zeros((n_c, n_om), dtype=np.bool_)
+    # The parallel loop is cut into static chunks, and the cost varies with Omega and eta:
+    # visiting the pairs in golden-ratio order gives every chunk a sample of the whole set.
+    order = np.argsort((np.arange(total) * GOLDEN) % 1.0)
+    for t in _prange(total):
+        k = order[t]
+        c = k // n_om
+        i = k % n_om
+        ne, f = _search(
+            etas[c],
+            one_sided[c],
+            signs[c],
+            omegas[i],
+            phase,
+            a_scan,
+            rtol,
+            v_rest_rel,
+            edges[c, i],
+            known[i],
+            KNOWN_USE if use_known[c] else KNOWN_IGNORE,
+        )
+        n_edges[c, i] = ne
+        first[c, i] = f
+    return edges, n_edges, first
