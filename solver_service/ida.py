@@ -199,6 +199,16 @@ def _tasks(payloads: list[dict[str, Any]], n_workers: int) -> list[tuple[int, di
     ]
 
 
+def _longest_first(tasks: list[tuple[int, dict[str, Any]]]) -> list[int]:
+    """Task indices by decreasing work (samples × levels): the longest tasks start first.
+
+    Greedy longest-first scheduling leaves the workers at most one short task apart at the
+    end, where the submission order would leave them up to one long task apart.
+    """
+    cost = [len(p["acc"]) * len(p["levels"]) for _, p in tasks]
+    return sorted(range(len(tasks)), key=lambda k: -cost[k])
+
+
 def _gather(
     tasks: list[tuple[int, dict[str, Any]]],
     n_records: int,
@@ -234,7 +244,7 @@ def _collect(
         n_jobs = jobs if jobs is not None else (os.cpu_count() or 1)
         tasks = _tasks(payloads, n_jobs)
         with ThreadPoolExecutor(max_workers=n_jobs) as pool:
-            pending = {pool.submit(_run_serial, p): k for k, (_, p) in enumerate(tasks)}
+            pending = {pool.submit(_run_serial, tasks[k][1]): k for k in _longest_first(tasks)}
 
             def finished_local() -> Any:
                 for future in as_completed(pending):
@@ -250,8 +260,9 @@ def _collect(
         n_workers = len(workers)
         n_threads = sum(int(w.get("nthreads", 1)) for w in workers.values()) or 1
         tasks = _tasks(payloads, n_threads)
-        futures = [client.submit(run_record, **p, pure=False) for _, p in tasks]
-        index = {f.key: k for k, f in enumerate(futures)}
+        order = _longest_first(tasks)
+        futures = [client.submit(run_record, **tasks[k][1], pure=False) for k in order]
+        index = {f.key: k for k, f in zip(order, futures)}
 
         def finished_dask() -> Any:
             with client.as_current():

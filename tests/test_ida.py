@@ -16,7 +16,7 @@ from shared_schema.io import load_constants
 from solver_service.cli import app
 from solver_service.core.exact import simulate
 from solver_service.core.records import GroundMotion
-from solver_service.ida import level_blocks, parse_levels, run_ida
+from solver_service.ida import _longest_first, _tasks, level_blocks, parse_levels, run_ida
 from solver_service.workflows.adapter import models_from_file
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -87,6 +87,34 @@ def test_local_ida_is_the_same_on_any_number_of_threads(motions: list[GroundMoti
     assert many["mechanisms"][1]["n_overturned"] == [int(p) for p in peaks]
     with pytest.raises(InputError, match="jobs"):
         run_ida(cf, motions[:1], LEVELS, jobs=0)
+
+
+def test_longest_tasks_start_first_and_results_keep_record_order(
+    motions: list[GroundMotion],
+) -> None:
+    # Records of 1/4, full and 1/2 length: the full one is submitted first, yet the document
+    # lists the records in the order given, with the numbers of a one-thread run.
+    acc, dt = motions[0].accel.acc, motions[0].dt
+    cut = [
+        GroundMotion.from_samples(acc[: acc.size // 4], dt, name="quarter"),
+        GroundMotion.from_samples(acc, dt, name="full"),
+        GroundMotion.from_samples(acc[: acc.size // 2], dt, name="half"),
+    ]
+    payloads = [{"acc": m.accel.acc, "levels": LEVELS} for m in cut]
+    tasks = _tasks(payloads, 2)
+    assert len(tasks) == 9  # 3 records x 3 level blocks (1, 2 and 2 levels)
+    order = _longest_first(tasks)
+    assert sorted(order) == list(range(9))
+    work = [tasks[k][1]["acc"].size * len(tasks[k][1]["levels"]) for k in order]
+    assert work == sorted(work, reverse=True)
+    assert [tasks[k][0] for k in order[:3]] == [1, 1, 1]  # the full record's blocks first
+    assert tasks[order[-1]][0] == 0  # the quarter record's one-level block last
+    cf = load_constants(CONSTANTS)
+    one = run_ida(cf, cut, LEVELS, jobs=1)
+    two = run_ida(cf, cut, LEVELS, jobs=2)
+    assert [r["name"] for r in two["records"]] == ["quarter", "full", "half"]
+    for key in ("records", "mechanisms", "max_error_estimate"):
+        assert one[key] == two[key], key
 
 
 def test_pga_intensity_scales_each_record_to_the_level(motions: list[GroundMotion]) -> None:

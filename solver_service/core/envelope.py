@@ -20,9 +20,10 @@ alternates on scales of 1e-4 in A (many impacts, chaotic); the optional ``n_scan
 adds a scan log-spaced in ``A - 1`` from ``NEAR_MIN`` to resolve it, at ~10x the cost.
 
 Library (``OverturningLibrary``): ``A_min`` on a log grid of Omega for eta in [0, 1] and for
-one-sided rocking, generated once by ``rockmech library build`` and shipped as package data. The build searches
-all its curves in one parallel loop and skips the scan points that overturn whatever eta
-(``_boundary_kernels``); its edges are those of ``boundary_curve``, bit for bit.
+one-sided rocking, generated once by ``rockmech library build`` and shipped as package data.
+The build searches all its curves in one parallel loop and skips the scan points that
+overturn whatever eta (``_boundary_kernels``); its edges are those of ``boundary_curve``, bit
+for bit.
 Between grid points ``log A_min`` is interpolated linearly in ``log Omega`` and in eta. The
 curves jump where the overturning mode changes (impact / no impact); across such a jump
 (neighbours differing by more than ``JUMP`` in ``log A``) the lower neighbour is used, so
