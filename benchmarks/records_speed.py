@@ -5,9 +5,14 @@ What is measured
 1. IDA, locally: ``run_ida`` for ``N_RECORDS`` records × ``N_LEVELS`` scale factors ×
    ``N_MECHANISMS`` mechanisms (the ten of ``examples/constants``: the three rectangular
    walls and the church's seven with a coefficient of restitution), ratio criterion, in
-   process: tasks of (record × block of levels) on ``jobs`` threads, each running the
-   single-threaded batch kernel. Run with 1 worker thread and with 2 (all cores here); the
-   scaling efficiency is ``t1 / (2 t2)``. Target <= ``TARGET_IDA_S`` with all cores.
+   process: tasks of (record × block of levels), longest first, on ``jobs`` threads, each
+   running the single-threaded batch kernel. Run with 1 worker thread and with 2 (all cores
+   here); the scaling efficiency is ``t1 / (2 t2)``. Target <= ``TARGET_IDA_S`` with all
+   cores. Wall and CPU time (``time.process_time``, all threads) of both runs and the load
+   average around each are printed: on a shared machine the wall times and the efficiency
+   fall with the load, while the CPU times (the work done) do not, so their ratio
+   ``cpu2 / cpu1`` (1 = running on two threads costs no extra work) and ``cpu2 / 2`` (the
+   wall time with two free cores and perfect balance) stay informative.
 2. The same run on a dask.distributed ``LocalCluster`` (2 worker processes, 1 thread each),
    in the same process run; the overhead is the difference. Cluster start-up is timed apart.
    The two results must be identical.
@@ -49,6 +54,7 @@ from _docs import (  # noqa: E402  (benchmarks/ is not a package)
     DOC_MD,
     best_of,
     fmt_time,
+    load_average,
     machine_info,
     md_table,
     text_table,
@@ -106,6 +112,25 @@ def mechanisms() -> Any:
     )
 
 
+def autogroup() -> bool:
+    """Whether Linux autogroup scheduling (equal CPU shares per session) is on."""
+    try:
+        return Path("/proc/sys/kernel/sched_autogroup_enabled").read_text().strip() == "1"
+    except OSError:
+        return False
+
+
+def timed(run: Any) -> tuple[Any, float, float, str]:
+    """Call ``run()``; return its result, wall and CPU time [s] and the load before / after."""
+    before = load_average()
+    t0 = time.perf_counter()
+    c0 = time.process_time()
+    out = run()
+    wall = time.perf_counter() - t0
+    cpu = time.process_time() - c0
+    return out, wall, cpu, f"{before} / {load_average()}"
+
+
 def main(argv: Optional[list[str]] = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smoke run: 8 records, 10 levels")
@@ -130,16 +155,16 @@ def main(argv: Optional[list[str]] = None) -> int:
     run_ida(cf, records[:2], levels[:2], jobs=1)
     run_ida(cf, records[:2], levels[:2], jobs=2)
     warm = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    c0 = time.process_time()
-    one = run_ida(cf, records, levels, jobs=1)
-    t_one = time.perf_counter() - t0
-    cpu_one = time.process_time() - c0
-    t0 = time.perf_counter()
-    local = run_ida(cf, records, levels, jobs=2)
-    t_local = time.perf_counter() - t0
+    one, t_one, cpu_one, load_one = timed(lambda: run_ida(cf, records, levels, jobs=1))
+    local, t_local, cpu_local, load_two = timed(lambda: run_ida(cf, records, levels, jobs=2))
     same_jobs = all(one[k] == local[k] for k in ("mechanisms", "records", "max_error_estimate"))
     efficiency = t_one / (2.0 * t_local)
+    print(
+        f"IDA 1 thread: wall {fmt_time(t_one)}, CPU {fmt_time(cpu_one)} (load {load_one}); "
+        f"2 threads: wall {fmt_time(t_local)}, CPU {fmt_time(cpu_local)} (load {load_two}); "
+        f"efficiency {100 * efficiency:.0f} %, CPU ratio {cpu_local / cpu_one:.3f}, "
+        f"cpu2 / 2 = {fmt_time(cpu_local / 2)}"
+    )
 
     t0 = time.perf_counter()
     with LocalCluster(
@@ -164,7 +189,7 @@ def main(argv: Optional[list[str]] = None) -> int:
         [
             "IDA, local, 1 worker thread (--jobs 1)",
             f"{runs} runs",
-            fmt_time(t_one),
+            f"{fmt_time(t_one)} (CPU {fmt_time(cpu_one)})",
             f"{1e3 * t_one / runs:.3f} ms/run",
             "-",
             "-",
@@ -172,8 +197,9 @@ def main(argv: Optional[list[str]] = None) -> int:
         [
             "IDA, local, 2 worker threads (default: all cores)",
             f"{runs} runs",
-            fmt_time(t_local),
-            f"{1e3 * t_local / runs:.3f} ms/run; scaling efficiency {100 * efficiency:.0f} %",
+            f"{fmt_time(t_local)} (CPU {fmt_time(cpu_local)})",
+            f"{1e3 * t_local / runs:.3f} ms/run; scaling efficiency {100 * efficiency:.0f} %; "
+            f"CPU ratio {cpu_local / cpu_one:.2f}; CPU / 2 = {fmt_time(cpu_local / 2)}",
             f"<= {TARGET_IDA_S:g} s, same numbers as 1 thread",
             "PASS" if (t_local <= TARGET_IDA_S or args.quick) and same_jobs else "FAIL",
         ],
@@ -217,13 +243,28 @@ def main(argv: Optional[list[str]] = None) -> int:
         "",
         f"Warm-up excluded: {fmt_time(warm)}. Scaling efficiency = t(1 thread) / (2 t(2 "
         "threads)). The local run cuts the work into tasks of (record x block of levels), at "
-        "least four per worker thread (here one per record: 100 records are plenty), on a "
-        "thread pool; the kernels release the GIL. The Dask run maps the same `run_record` "
-        f"over the same kind of tasks ({local['backend']['tasks']} locally, "
+        "least four per worker thread (here one per record: 100 records are plenty), started "
+        "longest first on a thread pool; each task is one compiled batch over all mechanisms "
+        "x its levels, and the kernels release the GIL. The Dask run maps the same "
+        f"`run_record` over the same kind of tasks ({local['backend']['tasks']} locally, "
         f"{remote['backend']['tasks']} on Dask); its overhead is serialising each task and the "
         "constants to the workers and gathering the results, measured in the same process "
-        "run as the local one. CPU time of the 1-thread run: "
-        f"{fmt_time(cpu_one)} (the machine's load inflates wall times, not CPU time).",
+        "run as the local one.",
+        "",
+        f"Load average (1, 5, 15 min) before / after: 1 thread {load_one}; 2 threads "
+        f"{load_two}. CPU time is `time.process_time` (all threads of the process): the "
+        "machine's load inflates wall times and lowers the efficiency, not the CPU time. "
+        f"CPU ratio = CPU(2 threads) / CPU(1 thread) = {cpu_local / cpu_one:.2f} (1: two "
+        "threads do no extra work); CPU / 2 is the wall time two free cores would give with "
+        "perfect balance."
+        + (
+            " Linux autogroup scheduling is on here (`/proc/sys/kernel/sched_autogroup_enabled`"
+            " = 1): every session gets an equal share of the CPU, so while other sessions are "
+            "busy a 2-thread run gets no more CPU per second than a 1-thread run, and the "
+            "efficiency measures the load, not the code."
+            if autogroup()
+            else ""
+        ),
     ]
     write_section(DOC_MD, "records_speed", "\n".join(lines))
     return 0
