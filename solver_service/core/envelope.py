@@ -557,11 +557,14 @@ def build_library(
     )
     if om.ndim != 1 or om.size == 0 or not np.all(np.isfinite(om) & (om > 0)):
         raise InputError("must be finite and > 0 (at least one value)", "omega")
+    om = np.ascontiguousarray(om)
     etas = (
         np.round(np.arange(0.0, 1.0 + 1e-9, LIBRARY_ETA_STEP), 12)
         if eta is None
         else np.asarray(eta, dtype=float)
     )
+    if etas.ndim != 1 or etas.size == 0:
+        raise InputError("needs at least one value", "eta")
     if shape not in PULSE_SHAPES:
         raise InputError(f"must be one of {sorted(PULSE_SHAPES)}, got {shape!r}", "shape")
     specs = [(check_eta(float(e), False), False, -1) for e in etas]

@@ -182,6 +182,24 @@ def test_build_library_is_boundary_curve_bit_for_bit(
     np.testing.assert_array_equal(built.a_min_one_sided, library.a_min_one_sided[idx])
 
 
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"eta": []}, "eta"),
+        ({"eta": [0.5, 1.2]}, "eta"),
+        ({"omega": [0.5, -1.0]}, "omega"),
+        ({"omega": []}, "omega"),
+        ({"shape": "square"}, "shape"),
+    ],
+)
+def test_build_library_refuses_bad_grids_naming_the_field(
+    kwargs: dict[str, object], field: str
+) -> None:
+    with pytest.raises(InputError) as err:
+        build_library(**{"omega": [1.0, 2.0], "eta": [0.5], **kwargs})  # type: ignore[arg-type]
+    assert err.value.field == field
+
+
 def test_eta_zero_probe_marks_only_collapses_that_hold_for_every_eta() -> None:
     # The skipped scan points (restitution-free collapses) are most of the scan, and each one
     # overturns at every eta when run directly.
