@@ -528,7 +528,9 @@ def library_rows(lb: dict[str, Any], quick: bool) -> list[list[str]]:
         ],
         [
             "CPU time of the build (all threads)",
-            f"{fmt_time(lb['cpu_s'])} (load average before / after: {lb['load']})",
+            f"{fmt_time(lb['cpu_s'])}; CPU / 2 = {fmt_time(lb['cpu_s'] / 2)}, the wall time "
+            f"two free cores would give with perfect balance (load average before / after: "
+            f"{lb['load']})",
         ],
         [
             "pulse spectrum alone (timed apart, after the build)",
@@ -701,8 +703,20 @@ def reading(c: dict[str, Any], lb: dict[str, Any], ev: dict[str, Any], iv: dict[
     if bad:
         txt += f" At {len(bad)} frequencies the two disagree (see the table)."
     txt += (
-        " Times depend on the machine's load (given above); parallel parts (numba threads) "
-        "suffer first."
+        f" The library build searches all {lb['n_eta'] + 2} curves in one parallel loop over "
+        "(curve, Omega); the scan points where the eta = 0 curve overturns without any impact "
+        "overturn for every eta (restitution acts only at impacts) and are not run again, and "
+        "the pulse spectrum is computed on a thread beside the compiled search"
+    )
+    if lb["same_as_shipped"] is not None:
+        txt += (
+            "; the result equals the shipped library bit for bit"
+            if lb["same_as_shipped"]
+            else "; the result DIFFERS from the shipped library"
+        )
+    txt += (
+        ". Times depend on the machine's load (given above); parallel parts (numba threads) "
+        "suffer first, and the CPU time (all threads) shows the work apart from the load."
     )
     return txt
 

@@ -207,7 +207,8 @@ def main(argv: Optional[list[str]] = None) -> int:
             "IDA, dask LocalCluster (2 workers x 1 thread)",
             f"{runs} runs",
             fmt_time(t_dask),
-            f"overhead {fmt_time(t_dask - t_local)} ({100 * (t_dask / t_local - 1):+.0f} %)",
+            f"overhead {'-' if t_dask < t_local else '+'}{fmt_time(abs(t_dask - t_local))} "
+            f"({100 * (t_dask / t_local - 1):+.0f} %)",
             "same numbers as local",
             "PASS" if same else "FAIL",
         ],

@@ -543,7 +543,9 @@ def ida(
         10.0, "--timeout", help="Seconds to wait for the Dask scheduler to answer [s]."
     ),
     jobs: Optional[int] = typer.Option(
-        None, "--jobs", help="Threads of a local run (default: all cores)."
+        None,
+        "--jobs",
+        help="Threads of a local run, >= 1 (default: one per core this process may use).",
     ),
     progress: Optional[bool] = typer.Option(
         None, "--progress/--no-progress", help="Progress bar (default: on a terminal)."

@@ -3,11 +3,11 @@
 The unit of work is one record at a block of intensity levels (``run_record``): every
 mechanism at every level of the block in one compiled batch (``exact.simulate_batch``).
 ``run_ida`` cuts the work into tasks of (record × block of levels), enough for every worker
-to get several, and runs them in-process on ``jobs`` threads (all cores by default; the
-kernels release the GIL), or maps the same function over the tasks on a dask.distributed
-cluster when a scheduler address is given (only plain data, arrays and the function's import
-path travel to the workers). The results do not depend on the cutting: every run is
-independent. The fraction of records that overturn
+to get several, and runs them longest first, in-process on ``jobs`` threads (by default one
+per core the process may use; the kernels release the GIL), or maps the same function over
+the tasks on a dask.distributed cluster when a scheduler address is given (only plain data,
+arrays and the function's import path travel to the workers). The results do not depend on
+the cutting or the order: every run is independent. The fraction of records that overturn
 each mechanism at each level is then fitted with a lognormal fragility curve
 (``core.fragility``).
 
@@ -173,6 +173,13 @@ def level_blocks(n_records: int, n_levels: int, n_workers: int) -> list[tuple[in
     return list(zip(bounds[:-1], bounds[1:]))
 
 
+def available_cores() -> int:
+    """Cores this process may run on (its CPU affinity where the system has one)."""
+    if hasattr(os, "sched_getaffinity"):
+        return max(1, len(os.sched_getaffinity(0)))
+    return os.cpu_count() or 1
+
+
 def _run_serial(payload: dict[str, Any]) -> dict[str, Any]:
     """``run_record`` with the batch kernels confined to the calling thread."""
     with single_threaded():
@@ -241,7 +248,7 @@ def _collect(
 ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """Run the (record × level block) tasks locally or on Dask; results in record order."""
     if scheduler is None:
-        n_jobs = jobs if jobs is not None else (os.cpu_count() or 1)
+        n_jobs = jobs if jobs is not None else available_cores()
         tasks = _tasks(payloads, n_jobs)
         with ThreadPoolExecutor(max_workers=n_jobs) as pool:
             pending = {pool.submit(_run_serial, tasks[k][1]): k for k in _longest_first(tasks)}
@@ -316,7 +323,8 @@ def run_ida(
     timeout : float
         Seconds to wait for the scheduler [s].
     jobs : int, optional
-        Threads of the local run (default: all cores); ignored on Dask.
+        Threads of the local run (default: one per core this process may use,
+        ``available_cores``); ignored on Dask.
 
     Returns
     -------

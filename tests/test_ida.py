@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import socket
 import time
 from pathlib import Path
@@ -16,7 +17,14 @@ from shared_schema.io import load_constants
 from solver_service.cli import app
 from solver_service.core.exact import simulate
 from solver_service.core.records import GroundMotion
-from solver_service.ida import _longest_first, _tasks, level_blocks, parse_levels, run_ida
+from solver_service.ida import (
+    _longest_first,
+    _tasks,
+    available_cores,
+    level_blocks,
+    parse_levels,
+    run_ida,
+)
 from solver_service.workflows.adapter import models_from_file
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -58,7 +66,8 @@ def test_local_ida_counts_equal_direct_simulations(motions: list[GroundMotion]) 
         assert mech["fraction"] == pytest.approx(verdicts.mean(axis=0).tolist())
         for row, first in zip(verdicts, mech["first_overturning_level"]):
             assert first == (LEVELS[int(np.argmax(row))] if row.any() else None)
-    assert doc["backend"]["kind"] == "local" and doc["backend"]["jobs"] >= 1
+    assert doc["backend"]["kind"] == "local" and doc["backend"]["jobs"] == available_cores()
+    assert 1 <= available_cores() <= (os.cpu_count() or 1)
     assert "scale_factors" not in doc["mechanisms"][0]
 
 
