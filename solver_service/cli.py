@@ -543,9 +543,7 @@ def ida(
         10.0, "--timeout", help="Seconds to wait for the Dask scheduler to answer [s]."
     ),
     jobs: Optional[int] = typer.Option(
-        None,
-        "--jobs",
-        help="Threads of a local run, >= 1 (default: one per core this process may use).",
+        None, "--jobs", help="Threads of a local run, >= 1 (default: one per usable core)."
     ),
     progress: Optional[bool] = typer.Option(
         None, "--progress/--no-progress", help="Progress bar (default: on a terminal)."
