@@ -173,7 +173,6 @@ SPEC_CASES: list[SpecCase] = [
         "error",
         "spec_version",
         "version|support",
-        "#14 silent acceptance: an unknown spec_version is read as the current one",
     ),
     (
         "top-unknown-key",
@@ -289,7 +288,6 @@ SPEC_CASES: list[SpecCase] = [
         "error",
         "density",
         "range|at most|implausible|<=",
-        "#14 messages: density 1e308 reported as non-finite I0, K, Q, not as density",
     ),
     # a single block's p_eq and lam do not depend on its density: the right answer is the base one
     (
@@ -399,7 +397,6 @@ SPEC_CASES: list[SpecCase] = [
         "error",
         "wall|objects",
         "twice|duplicate|more than once",
-        "#14 silent wrong answer: an object listed twice is counted twice (I0, Q doubled)",
     ),
     ("label-number", "rect_wall", _set("m.groups.0.label", 5), "error", "label", "str"),
     # axis
@@ -485,7 +482,6 @@ SPEC_CASES: list[SpecCase] = [
         "error",
         "axis|start|end",
         "range|far|finite|at most|units",
-        "#14 messages: an axis at +-1e300 m prints numpy overflow RuntimeWarnings",
     ),
     (
         "axis-vertical",
@@ -579,7 +575,6 @@ SPEC_CASES: list[SpecCase] = [
         "error",
         "force",
         "range|at most|implausible|<=",
-        "#14 silent wrong answer: a 1e300 N tie force is accepted (lam 2.4e294)",
     ),
     (
         "tie-force-string",
@@ -638,7 +633,6 @@ SPEC_CASES: list[SpecCase] = [
         "error",
         "f_mt",
         "range|at most|implausible|<=",
-        "#14 silent acceptance: f_mt 1e308 N changes p_eq without a word",
     ),
     (
         "overburden-force-negative",
