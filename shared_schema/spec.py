@@ -427,13 +427,20 @@ class MechanismSpec(BaseModel):
             raise ValueError("eta_rule applies to one-sided rocking only")
         if self.axis_negative is not None and self.rocking == "one_sided":
             raise ValueError("axis_negative applies to two-sided rocking only")
-        body = list(self.groups or []) + [g for block in self.blocks or [] for g in block]
-        twice = _repeated([sel for g in body for sel in g.objects])
-        if twice is not None:
-            raise ValueError(
-                f"{twice!r} is listed in two density groups; it would be counted twice (its "
-                "mass, I0 and Q doubled): list each object in one group"
-            )
+        body = [(f"groups[{k}]", g) for k, g in enumerate(self.groups or [])]
+        for b, block in enumerate(self.blocks or []):
+            body += [(f"blocks[{b}][{k}]", g) for k, g in enumerate(block)]
+        first: List[Any] = []  # (selector, group path), in spec order
+        for path, group in body:
+            for sel in group.objects:
+                earlier = [p for s, p in first if s == sel]
+                if earlier:
+                    raise ValueError(
+                        f"{sel!r} is listed in two density groups, {earlier[0]} and {path}; it "
+                        "would be counted twice (its mass, I0 and Q doubled): list each object "
+                        "in one group"
+                    )
+                first.append((sel, path))
         if self.axis_negative is not None and self.typology == "two_block":
             raise ValueError(
                 "axis_negative does not apply to a two_block wall: its negative hinges O', C', "

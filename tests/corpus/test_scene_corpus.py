@@ -58,6 +58,12 @@ def _with_nan(mesh: Mesh) -> Mesh:
     return v, mesh[1]
 
 
+def _far_vertex(mesh: Mesh, value: float = 2e6) -> Mesh:
+    v = mesh[0].copy()
+    v[0, 1] = value
+    return v, mesh[1]
+
+
 def _self_intersecting() -> Mesh:
     """One closed mesh made of two boxes that pass through each other."""
     a = _box((0.0, 0.0, 0.0), (0.5, 1.0, 3.0))
@@ -305,6 +311,24 @@ SCENE_CASES: list[tuple[Any, ...]] = [
         "finite|nan|invalid",
     ),
     (
+        "3dm-vertex-beyond-limit",
+        _3dm(lambda: _wall_scene(_far_vertex(WALL))),
+        SPEC_3DM,
+        [],
+        "error",
+        "wall",
+        "beyond the largest magnitude accepted, 1e\\+06 meters",
+    ),
+    (
+        "3dm-axis-line-beyond-limit",
+        _3dm(lambda: _wall_scene(axis=False).line("axis", (0.5, -5e6, 0.0), (0.5, 5e6, 0.0))),
+        SPEC_3DM,
+        [],
+        "error",
+        "axis",
+        "beyond the largest magnitude accepted",
+    ),
+    (
         "3dm-sphere-brep",
         _3dm(lambda: Scene().brep("wall", _sphere_brep()).line("axis", (0.5, 0, 0), (0.5, 1, 0))),
         SPEC_3DM,
@@ -482,6 +506,24 @@ SCENE_CASES += [
         "error",
         "selector|wall",
         "named 'wall'|give each",
+    ),
+    (
+        "scan-obj-inf-vertex",
+        _scan("obj", _far_vertex(WALL, np.inf)),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "wall|scene",
+        "finite|inf|cannot read",
+    ),
+    (
+        "scan-stl-vertex-beyond-limit-in-mm",
+        _scan("stl", _far_vertex(WALL, 5e5), 1000.0),
+        SPEC_SCAN,
+        ["--units", "mm"],
+        "error",
+        "wall",
+        "beyond the largest magnitude accepted, 1e\\+06 millimeters",
     ),
     (
         "scan-off-nan-vertex",
