@@ -285,10 +285,10 @@ _METRES_PER_UNIT: Dict[str, float] = {
 }
 
 
-def quantity_problem(value: float, kind: str) -> Optional[str]:
+def quantity_problem(value: object, kind: str) -> Optional[str]:
     """Return why a value of ``kind`` (a key of ``QUANTITY_RANGES``) is refused, or None.
 
-    The value must be finite, > 0 and at most the kind's ``limit``.
+    The value must be a finite number, > 0 and at most the kind's ``limit``.
 
     Examples
     --------
@@ -321,10 +321,10 @@ def check_quantity(value: object, kind: str, name: str) -> float:
     >>> check_quantity(1800, "density", "density")
     1800.0
     """
-    problem = quantity_problem(value, kind)  # type: ignore[arg-type]
+    problem = quantity_problem(value, kind)
     if problem is not None:
         raise InputError(problem, name)
-    return float(value)  # type: ignore[arg-type]
+    return check_number(value, name)
 
 
 def quantity_note(value: float, kind: str, name: str) -> Optional[str]:
