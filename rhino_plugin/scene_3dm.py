@@ -240,7 +240,16 @@ class Scene(BaseScene):
                 f"{obj.label()}: a {obj.kind} is not a solid; select a closed mesh, "
                 "polysurface or extrusion"
             )
-        return solid_mesh(self._to_m(v), f, obj, require_closed=require_closed)
+        return solid_mesh(self._to_m(v, obj), f, obj, require_closed=require_closed)
+
+    def extent(self, obj: SceneObject) -> Tuple[np.ndarray, np.ndarray]:
+        """Lowest and highest corner of the object's bounding box [m] (rhino3dm's own)."""
+        box = getattr(obj.geometry, "GetBoundingBox", None)
+        if box is None:
+            return super().extent(obj)
+        b = box()
+        lo = self._to_m([b.Min.X, b.Min.Y, b.Min.Z], obj)
+        return lo, self._to_m([b.Max.X, b.Max.Y, b.Max.Z], obj)
 
     def _brep_arrays(
         self, brep: Any, obj: SceneObject, stored: Any = None
@@ -299,8 +308,8 @@ class Scene(BaseScene):
         if not isinstance(geo, rhino3dm.Curve):
             raise GeometryError(f"{obj.label()}: a {obj.kind} is not a line; draw a Line")
         a, b = geo.PointAtStart, geo.PointAtEnd
-        start = self._to_m([a.X, a.Y, a.Z])
-        end = self._to_m([b.X, b.Y, b.Z])
+        start = self._to_m([a.X, a.Y, a.Z], obj)
+        end = self._to_m([b.X, b.Y, b.Z], obj)
         length = float(np.linalg.norm(end - start))
         if length == 0.0 or geo.IsClosed:
             raise GeometryError(f"{obj.label()}: the {obj.kind} is closed or has zero length")
@@ -376,7 +385,7 @@ class Scene(BaseScene):
                 f"{obj.label()}: a {obj.kind} does not define a plane; use a planar surface, "
                 "a planar closed curve or a 3-point polyline"
             )
-        pts = self._to_m(pts)
+        pts = self._to_m(pts, obj)
         point = pts.mean(axis=0)
         normal = surface_normal if surface_normal is not None else newell(pts)
         norm = float(np.linalg.norm(normal))

@@ -20,6 +20,7 @@ import numpy as np
 from rhino_plugin.geometry.mesh import TriMesh
 from rhino_plugin.geometry.topology import orient_outward, weld
 from shared_schema.errors import GeometryError, InputError
+from shared_schema.rules import COORDINATE_LIMIT, body_size_note
 
 __all__ = ["BaseScene", "SceneObject", "solid_mesh"]
 
@@ -184,14 +185,63 @@ class BaseScene:
 
     # ------------------------------------------------------------------ conversion
 
-    def _to_m(self, xyz: Any) -> np.ndarray:
+    def _to_m(self, xyz: Any, obj: Optional[SceneObject] = None) -> np.ndarray:
+        """Coordinates in file units -> metres, refusing what the maths cannot take.
+
+        Raises
+        ------
+        GeometryError
+            A coordinate that is not finite, or beyond ``rules.COORDINATE_LIMIT`` in the
+            file's units (checked here, so that no NaN or overflow reaches the geometry).
+        """
         num, den = self._ratio
         a = np.asarray(xyz, dtype=np.float64)
+        what = obj.label() if obj is not None else "a point of the scene"
+        finite = np.isfinite(a)
+        if not finite.all():
+            k = int(np.argmin(finite.all(axis=-1))) if a.ndim > 1 else 0
+            raise GeometryError(
+                f"{what}: coordinates must be finite, but point {k} is "
+                f"{np.atleast_2d(a)[k].tolist()} (NaN or infinite); repair or re-export it"
+            )
+        if a.size and float(np.abs(a).max()) > COORDINATE_LIMIT:
+            raise GeometryError(
+                f"{what}: a coordinate of {float(np.abs(a).max()):g} {self.units} is beyond the "
+                f"largest magnitude accepted, {COORDINATE_LIMIT:g} {self.units}; check the "
+                "file's units, or move the model near the origin"
+            )
         if num != 1.0:
             a = a * num
         if den != 1.0:
             a = a / den
         return a
+
+    #: True for a reader whose file carries no unit (a scan: the user gives ``units``).
+    scan = False
+
+    def extent(self, obj: SceneObject) -> Tuple[np.ndarray, np.ndarray]:
+        """Lowest and highest corner of an object's bounding box [m].
+
+        Readers with a cheaper bounding box than the mesh override this.
+        """
+        v = self.mesh(obj, require_closed=False).vertices
+        return v.min(axis=0), v.max(axis=0)
+
+    def size_note(self, object_ids: List[str], what: str) -> Optional[str]:
+        """Warn when the objects' bounding box is an implausible size for a rocking body.
+
+        The one plausibility check of a scene's size (``rules.BODY_SIZE_PLAUSIBLE``): a body
+        of kilometres or of millimetres was most likely read in the wrong length unit; the
+        note names the unit the file was read in and the one that fits.
+        """
+        wanted = set(object_ids)
+        boxes = [self.extent(o) for o in self.objects if o.id in wanted]
+        if not boxes:
+            return None
+        lo = np.min([b[0] for b in boxes], axis=0)
+        hi = np.max([b[1] for b in boxes], axis=0)
+        size = float(np.linalg.norm(hi - lo))
+        return body_size_note(size, self.unit_scale, self.units, what, self.scan)
 
     def _miss_hint(self) -> str:
         """Extra advice appended when a selector matches nothing (reader-specific)."""

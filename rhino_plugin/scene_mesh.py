@@ -96,6 +96,8 @@ class MeshScene(BaseScene):
     >>> mesh = scene.mesh(scene.find("wall")[0])  # doctest: +SKIP
     """
 
+    scan = True
+
     def __init__(
         self,
         objects: List[SceneObject],
@@ -219,7 +221,12 @@ class MeshScene(BaseScene):
             No faces, or (with ``require_closed``) not a closed solid; names the object.
         """
         v, f = obj.geometry
-        return solid_mesh(self._to_m(v), f, obj, require_closed=require_closed)
+        return solid_mesh(self._to_m(v, obj), f, obj, require_closed=require_closed)
+
+    def extent(self, obj: SceneObject) -> Tuple[np.ndarray, np.ndarray]:
+        """Lowest and highest corner of the mesh's vertices [m]."""
+        v = self._to_m(obj.geometry[0], obj)
+        return v.min(axis=0), v.max(axis=0)
 
     def line(self, obj: SceneObject) -> Tuple[np.ndarray, np.ndarray]:
         """Refuse: a scan has no line objects (the message says what to give instead)."""

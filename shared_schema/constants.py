@@ -394,6 +394,21 @@ def _derive_side(side: SideConstants, which: str) -> SideConstants:
         "lam": (side.K * side.phi_cr - s * m_f) / (G * side.Q),  # Eq. 5
         "phi_ov": side.phi_cr - s * m_f / side.K,  # Eq. 6
     }
+    inputs = {
+        "p_eq": ("sqrt(K/I0)", ("K", "I0")),
+        "lam": (f"(K*phi_cr {sign} M_F)/(g*Q)", ("K", "phi_cr", "M_F", "Q")),
+        "phi_ov": (f"phi_cr {sign} M_F/K", ("phi_cr", "M_F", "K")),
+    }
+    for key, (formula, names) in inputs.items():
+        # issue #14: huge or tiny inputs can overflow a derived constant; never store inf
+        if not math.isfinite(derived[key]):
+            given = ", ".join(f"{n} = {m_f if n == 'M_F' else getattr(side, n):g}" for n in names)
+            raise _error(
+                key,
+                f"{formula} = {derived[key]!r} is not finite: the inputs {given} are out of "
+                "any physical range (overflow)",
+                "non_finite_constant",
+            )
     for key, formula in (
         ("lam", f"(K*phi_cr {sign} M_F)/(g*Q)"),
         ("phi_ov", f"phi_cr {sign} M_F/K"),

@@ -11,35 +11,47 @@ What lives here
   methods, overturning criteria, pulse shapes); the pydantic enums are built from these tuples,
   and a test fails if a copy drifts;
 - the coefficient-of-restitution sign rule (docs/theory.md §1.8, §3);
-- the number checks every input goes through (finite, bounds, booleans refused).
+- the number checks every input goes through (finite, bounds, booleans refused);
+- the physical ranges of user inputs (densities, forces, strengths, coordinates, body
+  sizes): a hard limit refused with the range named, and a plausible band outside which a
+  warning says what was most likely meant (issue #14).
 """
 
 import math
 import numbers
 import os
 from pathlib import Path
-from typing import Dict, Optional, Tuple, Union
+from typing import Dict, NamedTuple, Optional, Sequence, Tuple, Union
 
 from shared_schema.errors import InputError
 
 __all__ = [
+    "BODY_SIZE_PLAUSIBLE",
+    "COORDINATE_LIMIT",
     "CRITERIA",
     "LENGTH_UNITS",
     "PULSE_SHAPES",
+    "QUANTITY_RANGES",
     "RECORD_FORMATS",
     "RECORD_UNITS",
     "ROCKING_KINDS",
     "SF_METHODS",
     "TYPOLOGIES",
     "G",
+    "QuantityRange",
+    "body_size_note",
     "check_choice",
     "check_eta",
     "check_file",
     "check_non_negative",
     "check_number",
     "check_positive",
+    "check_quantity",
+    "coordinate_problem",
     "eta_problem",
     "eta_range",
+    "quantity_note",
+    "quantity_problem",
 ]
 
 #: Standard gravity [m/s²].
@@ -191,3 +203,215 @@ def check_eta(value: object, one_sided: bool, name: str = "eta") -> float:
     if problem is not None:
         raise InputError(problem, name)
     return eta
+
+
+# ---------------------------------------------------------------- physical ranges (#14)
+
+
+class QuantityRange(NamedTuple):
+    """The admissible and the plausible range of one kind of physical input.
+
+    Attributes
+    ----------
+    unit : str
+        SI unit the values are in, for messages (``"kg/m^3"``).
+    limit : float
+        Largest admissible value; above it the input is refused (> 0 always required).
+    low, high : float
+        Plausible band; outside it (but admissible) the input gets a warning.
+    hint : str
+        What a value outside the band most likely means, for the warning.
+    """
+
+    unit: str
+    limit: float
+    low: float
+    high: float
+    hint: str
+
+
+#: Ranges of the physical inputs of a mechanism spec, by kind. Every spec field of that kind
+#: goes through ``check_quantity`` (refused beyond ``limit``) and ``quantity_note`` (a warning
+#: outside the band), so the CLI, the REST service and the Rhino flows answer alike.
+QUANTITY_RANGES: Dict[str, QuantityRange] = {
+    # Densities: timber floors (~350) to bronze and steel (~8500); the densest element,
+    # osmium, is 22,590 kg/m^3, so anything above 30,000 is no material at all.
+    "density": QuantityRange(
+        "kg/m^3",
+        30000.0,
+        300.0,
+        9000.0,
+        "masonry is 1500-2800 kg/m^3; a value near 2 is likely in t/m^3 or g/cm^3, one "
+        "near 18,000 a unit weight in N/m^3",
+    ),
+    # Forces on one wall: a tie-bar carries at most a few hundred kN and the overburden of a
+    # wall is its share of the floors above; 10 MN is already 1000 t on one element, 1 GN is
+    # beyond the weight of any masonry building.
+    "force": QuantityRange(
+        "N",
+        1e9,
+        0.0,
+        1e7,
+        "a tie-bar carries at most a few hundred kN; check that the value is in N, not in "
+        "mN or kgf",
+    ),
+    # Mortar tensile strength: lime mortar 0.05-0.5 MPa, cement mortar up to about 2 MPa;
+    # above 100 MPa no mortar (nor concrete) exists.
+    "tensile_strength": QuantityRange(
+        "Pa",
+        1e8,
+        0.0,
+        2e6,
+        "mortar tensile strength is 0.05-2 MPa; check that the value is in Pa, not in kPa or MPa",
+    ),
+}
+
+#: Largest magnitude of a coordinate, in the unit it is written in (a scene file's model
+#: units, a spec's ``units``); beyond it the point is refused before any geometry is done,
+#: so that overflow cannot reach the maths (1e6 m is a thousand kilometres).
+COORDINATE_LIMIT = 1e6
+
+#: Plausible size (bounding-box diagonal) of one rocking body [m]: from a 1 cm fragment to a
+#: 200 m tower. Outside it, the scene was most likely read in the wrong length unit.
+BODY_SIZE_PLAUSIBLE: Tuple[float, float] = (0.01, 200.0)
+
+#: Metres per length unit, for suggesting the unit a scene was meant to be read in.
+_METRES_PER_UNIT: Dict[str, float] = {
+    "mm": 0.001,
+    "cm": 0.01,
+    "m": 1.0,
+    "in": 0.0254,
+    "ft": 0.3048,
+}
+
+
+def quantity_problem(value: object, kind: str) -> Optional[str]:
+    """Return why a value of ``kind`` (a key of ``QUANTITY_RANGES``) is refused, or None.
+
+    The value must be a finite number, > 0 and at most the kind's ``limit``.
+
+    Examples
+    --------
+    >>> quantity_problem(1e300, "force")
+    'must be at most 1e+09 N (the admissible range is (0, 1e+09] N), got 1e+300'
+    >>> quantity_problem(2e4, "force") is None
+    True
+    """
+    r = QUANTITY_RANGES[kind]
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return f"must be a number [{r.unit}], got {value!r}"
+    v = float(value)
+    if not math.isfinite(v):
+        return f"must be finite [{r.unit}], got {value!r}"
+    if not v > 0.0:
+        return f"must be > 0 [{r.unit}], got {value!r}"
+    if v > r.limit:
+        return (
+            f"must be at most {r.limit:g} {r.unit} (the admissible range is (0, {r.limit:g}] "
+            f"{r.unit}), got {value!r}"
+        )
+    return None
+
+
+def check_quantity(value: object, kind: str, name: str) -> float:
+    """Return ``value`` as a float if admissible for ``kind``; else raise ``InputError``.
+
+    Examples
+    --------
+    >>> check_quantity(1800, "density", "density")
+    1800.0
+    """
+    problem = quantity_problem(value, kind)
+    if problem is not None:
+        raise InputError(problem, name)
+    return check_number(value, name)
+
+
+def quantity_note(value: float, kind: str, name: str) -> Optional[str]:
+    """Return a warning for a value of ``kind`` outside its plausible band, or None.
+
+    Examples
+    --------
+    >>> quantity_note(1.8, "density", "groups[0].density")[:60]
+    'groups[0].density = 1.8 kg/m^3 is outside the plausible rang'
+    """
+    r = QUANTITY_RANGES[kind]
+    if r.low <= value <= r.high:
+        return None
+    band = f"[{r.low:g}, {r.high:g}]" if r.low > 0.0 else f"up to {r.high:g}"
+    return f"{name} = {value:g} {r.unit} is outside the plausible range {band} {r.unit}: {r.hint}"
+
+
+def coordinate_problem(values: Sequence[float], unit: str = "m") -> Optional[str]:
+    """Return why a point's coordinates are refused (non-finite, or beyond the limit), or None.
+
+    Parameters
+    ----------
+    values : sequence of float
+        The coordinates, in the unit they were written in.
+    unit : str
+        That unit, for the message.
+
+    Examples
+    --------
+    >>> coordinate_problem([0.0, 1e300, 0.0])
+    'coordinate 1e+300 is beyond the largest magnitude accepted, 1e+06 m; check the units'
+    """
+    for v in values:
+        if not math.isfinite(v):
+            return f"coordinates must be finite, got {v!r}"
+    for v in values:
+        if abs(v) > COORDINATE_LIMIT:
+            return (
+                f"coordinate {v:g} is beyond the largest magnitude accepted, "
+                f"{COORDINATE_LIMIT:g} {unit}; check the units"
+            )
+    return None
+
+
+def body_size_note(
+    size_m: float, unit_scale: float, units: str, what: str, scan: bool
+) -> Optional[str]:
+    """Return a warning for a body of implausible size, naming the unit it was read in.
+
+    Parameters
+    ----------
+    size_m : float
+        Diagonal of the body's bounding box [m].
+    unit_scale : float
+        Metres per unit of the file [m/unit].
+    units : str
+        Name of that unit (``"millimeters"``), for the message.
+    what : str
+        What the body is, for the message (the mechanism's id).
+    scan : bool
+        A scan mesh (its unit is given with ``units``/``--units``) rather than a ``.3dm``
+        file (whose model units are set in Rhino).
+
+    Examples
+    --------
+    >>> print(body_size_note(3041.4, 1.0, "meters", "W", scan=True).split(": ")[-1])
+    if the file is in mm, give units mm (--units mm)
+    >>> body_size_note(3.04, 1.0, "meters", "W", scan=True) is None
+    True
+    """
+    lo, hi = BODY_SIZE_PLAUSIBLE
+    if lo <= size_m <= hi:
+        return None
+    in_file = size_m / unit_scale  # the size as the file's numbers give it
+    # The unit in which the file's numbers give the most ordinary size (about 5 m).
+    fits = sorted(
+        (abs(math.log10(in_file * m / 5.0)), u)
+        for u, m in _METRES_PER_UNIT.items()
+        if lo <= in_file * m <= hi
+    )
+    if fits:
+        u = fits[0][1]
+        how = f"give units {u} (--units {u})" if scan else f"set its model units to {u} in Rhino"
+        advice = f"if the file is in {u}, {how}"
+    else:
+        advice = "check the file's length unit"
+    return (
+        f"{what}: the body is {size_m:.4g} m across as read in {units}, but a rocking body is "
+        f"between {lo:g} and {hi:g} m: {advice}"
+    )

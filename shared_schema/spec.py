@@ -14,14 +14,23 @@ Python 3.9-clean: imported by Rhino 8.
 import json
 from typing import Any, Dict, List, Literal, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from shared_schema.constants import Amplification, validation_lines
 from shared_schema.errors import InputError
-from shared_schema.rules import eta_problem
+from shared_schema.rules import coordinate_problem, eta_problem, quantity_note, quantity_problem
 
 __all__ = [
     "SPEC_VERSION",
+    "SPEC_VERSIONS",
     "Axis",
     "Crack",
     "DensityGroup",
@@ -36,8 +45,10 @@ __all__ = [
     "parse_spec",
 ]
 
-#: Format version of spec files.
+#: Format version of spec files written today; a file without ``spec_version`` is read as it.
 SPEC_VERSION = "1.0"
+#: Versions this reader understands; any other is refused (a newer file may mean other things).
+SPEC_VERSIONS = ("1.0",)
 
 _STRICT = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
 
@@ -49,7 +60,48 @@ Point3 = List[float]
 def _point(value: List[float], what: str) -> List[float]:
     if len(value) != 3:
         raise ValueError(f"{what} must have 3 coordinates [m], got {len(value)}")
+    problem = coordinate_problem(value, "in the spec's units")
+    if problem is not None:
+        raise ValueError(f"{what}: {problem}")
     return value
+
+
+def _in_range(value: Optional[float], kind: str, zero: bool = False) -> Optional[float]:
+    """Check a physical input against ``rules.QUANTITY_RANGES`` (a field validator's body)."""
+    if value is None or (zero and value == 0.0):
+        return value
+    problem = quantity_problem(value, kind)
+    if problem is not None:
+        raise ValueError(problem)
+    return value
+
+
+def _density(value: float) -> float:
+    """Check a density [kg/m³] against ``rules.QUANTITY_RANGES["density"]``."""
+    out = _in_range(value, "density")
+    assert out is not None
+    return out
+
+
+def _repeated(selectors: List[Selector]) -> Optional[Selector]:
+    """Return the first selector listed more than once, or None."""
+    seen: List[Selector] = []
+    for sel in selectors:
+        if sel in seen:
+            return sel
+        seen.append(sel)
+    return None
+
+
+def _once(selectors: List[Selector]) -> List[Selector]:
+    """Refuse an object listed twice: it would be counted twice (mass, I0 and Q doubled)."""
+    twice = _repeated(selectors)
+    if twice is not None:
+        raise ValueError(
+            f"{twice!r} is listed twice; an object listed twice would be counted twice "
+            "(its mass, I0 and Q doubled): list each object once"
+        )
+    return selectors
 
 
 class DensityGroup(BaseModel):
@@ -69,6 +121,16 @@ class DensityGroup(BaseModel):
     objects: List[Selector] = Field(min_length=1, description="Object selectors.")
     density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
     label: Optional[str] = Field(default=None, description="Material name for reports.")
+
+    @field_validator("density")
+    @classmethod
+    def _check_density(cls, value: float) -> float:
+        return _density(value)
+
+    @field_validator("objects")
+    @classmethod
+    def _check_objects(cls, value: List[Selector]) -> List[Selector]:
+        return _once(value)
 
 
 class Axis(BaseModel):
@@ -137,6 +199,16 @@ class Floor(BaseModel):
     density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
     tributary: float = Field(default=0.5, gt=0, le=1, description="Share carried by the wall.")
 
+    @field_validator("density")
+    @classmethod
+    def _check_density(cls, value: Optional[float]) -> Optional[float]:
+        return _in_range(value, "density")
+
+    @field_validator("objects")
+    @classmethod
+    def _check_objects(cls, value: Optional[List[Selector]]) -> Optional[List[Selector]]:
+        return value if value is None else _once(value)
+
 
 class Roof(BaseModel):
     """A pitched roof: weight share on the wall and thrust from its bounding box (§5)."""
@@ -146,6 +218,16 @@ class Roof(BaseModel):
     density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
     tributary: float = Field(default=0.5, gt=0, le=1, description="Share carried by the wall.")
     tied: bool = Field(default=False, description="Tied truss (no thrust on the wall).")
+
+    @field_validator("density")
+    @classmethod
+    def _check_density(cls, value: Optional[float]) -> Optional[float]:
+        return _in_range(value, "density")
+
+    @field_validator("objects")
+    @classmethod
+    def _check_objects(cls, value: Optional[List[Selector]]) -> Optional[List[Selector]]:
+        return value if value is None else _once(value)
 
 
 class Vault(BaseModel):
@@ -172,6 +254,21 @@ class Overburden(BaseModel):
     tributary: float = Field(default=0.5, gt=0, le=1, description="Share carried by the wall.")
     force: Optional[float] = Field(default=None, ge=0, description="Given overburden N [N].")
 
+    @field_validator("density")
+    @classmethod
+    def _check_density(cls, value: Optional[float]) -> Optional[float]:
+        return _in_range(value, "density")
+
+    @field_validator("force")
+    @classmethod
+    def _check_force(cls, value: Optional[float]) -> Optional[float]:
+        return _in_range(value, "force", zero=True)
+
+    @field_validator("objects")
+    @classmethod
+    def _check_objects(cls, value: Optional[List[Selector]]) -> Optional[List[Selector]]:
+        return value if value is None else _once(value)
+
     @model_validator(mode="after")
     def _one_form(self) -> "Overburden":
         if (self.force is None) == (self.objects is None):
@@ -187,6 +284,11 @@ class TieBar(BaseModel):
     model_config = _STRICT
     object: Selector
     force: float = Field(gt=0, description="Tie force [N], > 0; it restrains the wall.")
+
+    @field_validator("force")
+    @classmethod
+    def _check_force(cls, value: Optional[float]) -> Optional[float]:
+        return _in_range(value, "force")
 
 
 #: A hinge: a point [x, y, z] in metres, or a line object (its mid-point; its direction is
@@ -205,6 +307,13 @@ class Hinges(BaseModel):
     B: Hinge
     C: Hinge
     D: Hinge
+
+    @field_validator("A", "B", "C", "D")
+    @classmethod
+    def _check_point(cls, value: Hinge, info: ValidationInfo) -> Hinge:
+        if isinstance(value, list):
+            _point(value, str(info.field_name))
+        return value
 
 
 class MechanismSpec(BaseModel):
@@ -278,6 +387,11 @@ class MechanismSpec(BaseModel):
         "default) or exactly inside the potential.",
     )
 
+    @field_validator("f_mt")
+    @classmethod
+    def _check_f_mt(cls, value: Optional[float]) -> Optional[float]:
+        return _in_range(value, "tensile_strength", zero=True)
+
     @model_validator(mode="after")
     def _consistent(self) -> "MechanismSpec":
         if self.typology == "multi_block":
@@ -313,6 +427,20 @@ class MechanismSpec(BaseModel):
             raise ValueError("eta_rule applies to one-sided rocking only")
         if self.axis_negative is not None and self.rocking == "one_sided":
             raise ValueError("axis_negative applies to two-sided rocking only")
+        body = [(f"groups[{k}]", g) for k, g in enumerate(self.groups or [])]
+        for b, block in enumerate(self.blocks or []):
+            body += [(f"blocks[{b}][{k}]", g) for k, g in enumerate(block)]
+        first: List[Any] = []  # (selector, group path), in spec order
+        for path, group in body:
+            for sel in group.objects:
+                earlier = [p for s, p in first if s == sel]
+                if earlier:
+                    raise ValueError(
+                        f"{sel!r} is listed in two density groups, {earlier[0]} and {path}; it "
+                        "would be counted twice (its mass, I0 and Q doubled): list each object "
+                        "in one group"
+                    )
+                first.append((sel, path))
         if self.axis_negative is not None and self.typology == "two_block":
             raise ValueError(
                 "axis_negative does not apply to a two_block wall: its negative hinges O', C', "
@@ -321,9 +449,40 @@ class MechanismSpec(BaseModel):
             )
         return self
 
+    def plausibility_notes(self) -> List[str]:
+        """Warnings for admissible but implausible inputs (``rules.QUANTITY_RANGES``).
+
+        Each names the field (``W1.groups[0].density``) and what the value most likely
+        means; the builders add them to the mechanism's warnings.
+        """
+        values: List[Any] = []
+        for k, g in enumerate(self.groups or []):
+            values.append((g.density, "density", f"groups[{k}].density"))
+        for b, block in enumerate(self.blocks or []):
+            for k, g in enumerate(block):
+                values.append((g.density, "density", f"blocks[{b}][{k}].density"))
+        for k, fl in enumerate(self.floors or []):
+            values.append((fl.density, "density", f"floors[{k}].density"))
+        if self.roof is not None:
+            values.append((self.roof.density, "density", "roof.density"))
+        for k, tie in enumerate(self.tie_bars or []):
+            values.append((tie.force, "force", f"tie_bars[{k}].force"))
+        ob = self.overburden
+        if ob is not None and ob.density is not None:
+            values.append((ob.density, "density", "overburden.density"))
+        if ob is not None and ob.force:
+            values.append((ob.force, "force", "overburden.force"))
+        if self.f_mt:
+            values.append((self.f_mt, "tensile_strength", "f_mt"))
+        notes = [quantity_note(v, kind, f"{self.id}.{name}") for v, kind, name in values]
+        return [n for n in notes if n is not None]
+
 
 class SpecFile(BaseModel):
     """A mechanism-spec file: version, units of its points and mechanisms (ids unique).
+
+    ``spec_version`` is one of ``SPEC_VERSIONS``; a file without it is read as the current
+    version, ``SPEC_VERSION``, and any other version is refused.
 
     ``units`` says in which unit the points written in the spec (axis ``start``/``end``,
     crack ``points``, hinge points) are: ``"m"`` (the default when absent), ``"cm"``,
@@ -342,6 +501,17 @@ class SpecFile(BaseModel):
         default=None, description="Path of a user thrust table (JSON), relative to the spec."
     )
     mechanisms: List[MechanismSpec] = Field(min_length=1)
+
+    @field_validator("spec_version")
+    @classmethod
+    def _known_version(cls, version: str) -> str:
+        if version not in SPEC_VERSIONS:
+            raise ValueError(
+                f"unknown spec_version {version!r}; this rockmech reads spec_version "
+                f"{', '.join(repr(v) for v in SPEC_VERSIONS)} (omit it for the current, "
+                f"{SPEC_VERSION!r})"
+            )
+        return version
 
     @field_validator("mechanisms")
     @classmethod

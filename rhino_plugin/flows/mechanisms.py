@@ -31,6 +31,7 @@ from rhino_plugin.mechanisms.build import constants_from_spec
 from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.io import save_constants
+from shared_schema.rules import quantity_problem
 from shared_schema.spec import parse_spec
 
 __all__ = [
@@ -67,8 +68,14 @@ def _number(
     above: Optional[float] = None,
     at_least: Optional[float] = None,
     at_most: Optional[float] = None,
+    kind: Optional[str] = None,
 ) -> float:
-    """Return a prompt's answer as a finite float within bounds, or raise InputError."""
+    """Return a prompt's answer as a finite float within bounds, or raise InputError.
+
+    ``kind`` (a key of ``shared_schema.rules.QUANTITY_RANGES``: density, force,
+    tensile_strength) also refuses a non-zero value beyond that quantity's admissible range,
+    at the prompt, with the rule the spec file obeys.
+    """
     if isinstance(answer, bool) or answer is None:
         raise InputError(f"{what} must be a number, got {answer!r}", where)
     try:
@@ -83,6 +90,10 @@ def _number(
         raise InputError(f"{what} must be >= {at_least:g}, got {value:g}", where)
     if at_most is not None and value > at_most:
         raise InputError(f"{what} must be <= {at_most:g}, got {value:g}", where)
+    if kind is not None and value != 0.0:
+        problem = quantity_problem(value, kind)
+        if problem is not None:
+            raise InputError(f"{what} {problem}", where)
     return value
 
 
@@ -163,6 +174,7 @@ class _Asker:
                 "the density [kg/m³]",
                 f"{path}[{k}].density",
                 above=0.0,
+                kind="density",
             )
             groups.append({"objects": sels, "density": density})
 
@@ -295,13 +307,18 @@ def loaded_wall_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, 
                 "the density [kg/m³]",
                 f"floors[{k}].density",
                 above=0.0,
+                kind="density",
             )
             floors.append({"objects": sels, "density": density})
         mech["floors"] = floors
     if ticked.get("Roof"):
         sels = ask.objects("Select the roof", "solid", "roof.objects")
         density = ask.number(
-            "Density of the roof [kg/m³]", "the density [kg/m³]", "roof.density", above=0.0
+            "Density of the roof [kg/m³]",
+            "the density [kg/m³]",
+            "roof.density",
+            above=0.0,
+            kind="density",
         )
         roof: Dict[str, Any] = {"objects": sels, "density": density}
         if ask.option("Roof structure", ["Thrusting", "Tied"], 0) == "Tied":
@@ -340,6 +357,7 @@ def loaded_wall_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, 
                 "the tie force [N]",
                 f"tie_bars[{k}].force",
                 above=0.0,
+                kind="force",
             )
             ties.append({"object": sels[0], "force": force})
         mech["tie_bars"] = ties
@@ -360,13 +378,22 @@ def two_block_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, An
             "the density [kg/m³]",
             "overburden.density",
             above=0.0,
+            kind="density",
         )
         mech["overburden"] = {"objects": sels, "density": density}
     elif source == "Force":
         mech["overburden"] = {
-            "force": ask.number("Overburden N [N]", "N [N]", "overburden.force", at_least=0.0)
+            "force": ask.number(
+                "Overburden N [N]", "N [N]", "overburden.force", at_least=0.0, kind="force"
+            )
         }
-    f_mt = ask.number("Mortar tensile strength f_mt [Pa]", "f_mt [Pa]", "f_mt", at_least=0.0)
+    f_mt = ask.number(
+        "Mortar tensile strength f_mt [Pa]",
+        "f_mt [Pa]",
+        "f_mt",
+        at_least=0.0,
+        kind="tensile_strength",
+    )
     if f_mt > 0.0:
         mech["f_mt"] = f_mt
     mech["rocking"] = ROCKING[ask.option("Rocking", list(ROCKING), 0)]

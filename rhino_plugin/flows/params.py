@@ -65,7 +65,7 @@ def spec_from_parameters(
     if not has_axis:
         raise InputError("connect the rotation axis (a line)", "axis")
     dens = [
-        _number(d, "the density [kg/m³]", f"densities[{k}]", above=0.0)
+        _number(d, "the density [kg/m³]", f"densities[{k}]", above=0.0, kind="density")
         for k, d in enumerate(densities)
     ]
     if len(dens) == 1:

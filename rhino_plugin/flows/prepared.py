@@ -108,7 +108,7 @@ class PreparedScene(Scene):
             raise GeometryError(
                 f"{obj.label()}: {why}; select a closed mesh, polysurface or extrusion"
             )
-        v = self._to_m(np.asarray(geo.vertices, dtype=np.float64).reshape(-1, 3))
+        v = self._to_m(np.asarray(geo.vertices, dtype=np.float64).reshape(-1, 3), obj)
         f = np.asarray(geo.faces, dtype=np.int64).reshape(-1, 3)
         return solid_mesh(v, f, obj, require_closed=require_closed)
 
@@ -118,7 +118,7 @@ class PreparedScene(Scene):
         if geo.line is None:
             why = geo.problem or f"a {obj.kind} is not a line"
             raise GeometryError(f"{obj.label()}: {why}; draw a Line (or a 2-point polyline)")
-        start, end = self._to_m(geo.line[0]), self._to_m(geo.line[1])
+        start, end = self._to_m(geo.line[0], obj), self._to_m(geo.line[1], obj)
         if float(np.linalg.norm(end - start)) == 0.0:
             raise GeometryError(f"{obj.label()}: the {obj.kind} has zero length")
         return start, end
@@ -132,7 +132,7 @@ class PreparedScene(Scene):
                 f"{obj.label()}: {why}; use a planar surface, a planar closed curve or a "
                 "3-point polyline"
             )
-        point = self._to_m(geo.plane[0])
+        point = self._to_m(geo.plane[0], obj)
         normal = np.asarray(geo.plane[1], dtype=np.float64)
         norm = float(np.linalg.norm(normal))
         if not norm > 0.0:

@@ -152,6 +152,11 @@ def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
     sides = builder(spec, scene, table)
     if tilt > AXIS_TILT_TOL:
         sides.warnings.append(_check_tilt(spec, tilt, sides.geometry))
+    # issue #14: admissible but implausible inputs are said, not silently used
+    sides.warnings.extend(spec.plausibility_notes())
+    size_note = scene.size_note(sides.object_ids, spec.id)
+    if size_note is not None:
+        sides.warnings.append(size_note)
     entry: Dict[str, Any] = {
         "id": spec.id,
         "name": spec.name or spec.id,

@@ -120,6 +120,15 @@ Loads = List[Tuple[float, np.ndarray, str]]
 Result = Tuple[Dict[str, float], Dict[str, Any], List[str]]
 
 
+def _default_share(label: str, share: float, mass: float) -> str:
+    """Say that a floor's or roof's share on the wall is the default (issue #14)."""
+    return (
+        f"{label}: tributary not given; the wall carries the default {share:g} of its weight "
+        f"and inertia ({mass:.6g} kg, a slab spanning between the wall and one parallel "
+        "support). Give 'tributary' to set the share"
+    )
+
+
 def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Result:
     """Constants of a loaded wall about one axis, its summary and warnings.
 
@@ -150,6 +159,8 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
         meshes, ids, warn = element_solids(scene, floor.objects, label)
         notes.extend(warn)
         mass = floor.tributary * sum(mass_properties(m, floor.density).mass for m in meshes)
+        if "tributary" not in floor.model_fields_set:
+            notes.append(_default_share(label, floor.tributary, mass))
         area, point, normal = largest_contact(meshes, wall, label, tol)
         is_bearing = abs(float(normal[2])) >= math.cos(BEARING_ANGLE)
         (bearing if is_bearing else nonbearing).append((mass, point, label))
@@ -175,6 +186,8 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
         span, _, rise = _box(meshes, side)
         thrust = roof_thrust(weight, span, rise, roof.tied)
         bearing.append((roof.tributary * weight / G, point, label))
+        if "tributary" not in roof.model_fields_set:
+            notes.append(_default_share(label, roof.tributary, roof.tributary * weight / G))
         if thrust > 0.0:
             forces.append((thrust, point, label))
         elements.append(

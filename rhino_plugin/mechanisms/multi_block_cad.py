@@ -25,7 +25,7 @@ from rhino_plugin.geometry.massprops import combine, mass_properties
 from rhino_plugin.geometry.validate import check_solid
 from rhino_plugin.mechanisms.base import MechanismSides, virtual_work_of
 from rhino_plugin.mechanisms.multi_block import four_bar_constants, four_bar_restitution
-from rhino_plugin.mechanisms.single import find_objects
+from rhino_plugin.mechanisms.single import claim_once, find_objects
 from rhino_plugin.mechanisms.two_block import PlanarBody
 from shared_schema.errors import GeometryError, InputError
 
@@ -134,11 +134,13 @@ def _plane(
 def _blocks(scene: Any, spec: Any) -> Tuple[List[Any], List[np.ndarray], List[str], List[str]]:
 
     props, verts, ids, notes = [], [], [], []
+    seen: Dict[str, str] = {}
     for k, groups in enumerate(spec.blocks):
         parts = []
         pts = []
         for j, group in enumerate(groups):
             for obj in find_objects(scene, group.objects, f"{spec.id}.blocks[{k}][{j}]"):
+                claim_once(seen, obj, f"{spec.id}.blocks[{k}][{j}]")
                 mesh, warn = check_solid(scene.mesh(obj))
                 notes.extend(warn)
                 parts.append(mass_properties(mesh, group.density))

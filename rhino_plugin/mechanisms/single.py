@@ -33,6 +33,7 @@ __all__ = [
     "AXIS_TILT_TOL",
     "Body",
     "RockingSide",
+    "claim_once",
     "find_objects",
     "load_body",
     "negative_axis",
@@ -106,6 +107,22 @@ def find_objects(scene: Any, selectors: Sequence[Any], where: str) -> List[Any]:
     return found
 
 
+def claim_once(seen: Dict[str, str], obj: Any, where: str) -> None:
+    """Refuse an object that two selectors of one body pick (it would be counted twice).
+
+    ``seen`` maps the ids claimed so far to the group that claimed them; the spec refuses a
+    selector written twice, this catches one object reached two ways (by name and by id, or
+    by its name and its layer).
+    """
+    if obj.id in seen:
+        raise InputError(
+            f"{obj.label()} is selected twice ({seen[obj.id]} and {where}); it would be counted "
+            "twice (its mass, I0 and Q doubled): select each object once",
+            where,
+        )
+    seen[obj.id] = where
+
+
 def _crack_plane(scene: Any, crack: Any, where: str) -> Tuple[np.ndarray, np.ndarray]:
     if crack.object is not None:
         objs = find_objects(scene, [crack.object], where)
@@ -124,8 +141,10 @@ def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
     solids: List[Tuple[Any, float]] = []
     ids: List[str] = []
     warnings: List[str] = []
+    seen: Dict[str, str] = {}
     for k, group in enumerate(spec.groups):
         for obj in find_objects(scene, group.objects, f"{where}.groups[{k}]"):
+            claim_once(seen, obj, f"{where}.groups[{k}]")
             mesh, notes = check_solid(scene.mesh(obj))
             warnings.extend(notes)
             solids.append((mesh, group.density))

@@ -109,3 +109,45 @@ def test_derived_negative_hinges_are_stated_with_their_points(tmp_path: Path) ->
         "D' = [3.5, 0.5, 0.0]",
     ):
         assert text in notes[0], notes[0]
+
+
+def loaded_wall(b: Any) -> None:
+    b.box("wall", "Walls", (0, 0, 0), (0.3, 2.0, 4.0), "brick")
+    # a slab abutting the wall's inner face, and a roof block on the wall's top
+    b.box("slab", "Floors", (0.3, 0, 2.0), (4.0, 2.0, 2.2), "concrete")
+    b.box("roof", "Roof", (0.0, 0, 4.0), (4.0, 2.0, 4.4), "brick")
+    b.line("axis", "Axes", (0.3, 0, 0), (0.3, 2.0, 0))
+
+
+def loaded(**extra: Any) -> dict[str, Any]:
+    mech: dict[str, Any] = {
+        "id": "L",
+        "typology": "single_block_loaded",
+        "rocking": "one_sided",
+        "groups": [{"objects": ["wall"], "density": 1800}],
+        "axis": {"object": "axis"},
+        "floors": [{"objects": ["slab"], "density": 2400}],
+        "roof": {"objects": ["roof"], "density": 500, "tied": True},
+    }
+    mech.update(extra)
+    return mech
+
+
+def test_default_tributary_share_of_floors_and_roof_is_stated(tmp_path: Path) -> None:
+    scene = scene_of(tmp_path, loaded_wall)
+    out = run(scene, loaded())
+    notes = [w for w in out["provenance"]["warnings"] if "tributary not given" in w]
+    slab = 0.5 * 2400 * 3.7 * 2.0 * 0.2  # half the slab's mass [kg], by hand
+    roof = 0.5 * 500 * 4.0 * 2.0 * 0.4
+    assert len(notes) == 2, notes
+    assert notes[0].startswith("L.floors[0]:") and f"({slab:.6g} kg" in notes[0]
+    assert notes[1].startswith("L.roof:") and f"({roof:.6g} kg" in notes[1]
+    floor = next(e for e in out["geometry"]["loaded"]["elements"] if e["kind"] == "floor")
+    assert floor["mass_kg"] == pytest.approx(slab, rel=1e-12)
+    given = loaded(
+        floors=[{"objects": ["slab"], "density": 2400, "tributary": 0.5}],
+        roof={"objects": ["roof"], "density": 500, "tied": True, "tributary": 0.5},
+    )
+    again = run(scene, given)
+    assert not [w for w in again["provenance"]["warnings"] if "tributary" in w]
+    assert again["positive"] == out["positive"]  # the same numbers, now said

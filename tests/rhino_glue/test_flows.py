@@ -389,12 +389,34 @@ def test_closed_box_of_the_same_file_is_accepted(open_box_scene: Any, tmp_path: 
     assert side.I0 == pytest.approx(i_o, rel=1e-12)
 
 
-@pytest.mark.parametrize("answer", ["abc", "", None, -1800, 0, float("nan"), float("inf"), True])
+@pytest.mark.parametrize(
+    "answer", ["abc", "", None, -1800, 0, float("nan"), float("inf"), True, 1e308, 30001]
+)
 def test_bad_density_is_refused(answer: Any, scenes: Any, tmp_path: Path) -> None:
     script = SCRIPTS["rect_wall"][3]
     result, prompter = _run("rect_wall", scenes, tmp_path, [*script[:1], ("get_number", answer)])
     assert result is None
     _assert_nothing_written(tmp_path, prompter, "W1.groups[0].density", "density")
+
+
+@pytest.mark.parametrize(
+    ("case", "value", "field", "words"),
+    [
+        ("facade_loaded", 1e300, "F1.tie_bars[0].force", "must be at most 1e+09 N"),
+        ("two_block_wall", 1e308, "T1.f_mt", "must be at most 1e+08 Pa"),
+        ("two_block_wall", 40000.0, "T1.overburden.density", "must be at most 30000 kg/m^3"),
+    ],
+)
+def test_a_value_beyond_its_range_is_refused_at_the_prompt(
+    case: str, value: float, field: str, words: str, scenes: Any, tmp_path: Path
+) -> None:
+    """The prompts obey the spec's ranges (shared_schema.rules), before any geometry."""
+    script = SCRIPTS[case][3]
+    good = {"force": 20000, "f_mt": 100000, "density": 2400}[field.rsplit(".", 1)[-1]]
+    k = script.index(("get_number", good))
+    result, prompter = _run(case, scenes, tmp_path, [*script[:k], ("get_number", value)])
+    assert result is None
+    _assert_nothing_written(tmp_path, prompter, field, words)
 
 
 def test_a_line_is_not_a_solid(scenes: Any, tmp_path: Path) -> None:

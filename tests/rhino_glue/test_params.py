@@ -80,6 +80,7 @@ def test_equal_densities_form_one_group_and_cracks_are_named() -> None:
     [
         (("M", "two_sided", 2, [1800, 1800, 1800], True), "densities"),
         (("M", "two_sided", 1, ["heavy"], True), "densities[0]"),
+        (("M", "two_sided", 2, [1800, 1e308], True), "densities[1]"),
         (("M", "two_sided", 0, [1800], True), "solids"),
         (("M", "two_sided", 1, [1800], False), "axis"),
         (("M", "sideways", 1, [1800], True), "rocking"),

@@ -357,3 +357,32 @@ def test_non_object_file_is_rejected():
 def test_model_itself_is_strict_without_parse_constants():
     with pytest.raises(ValidationError, match="valid number"):
         ConstantsFile.model_validate(one_file(dict(W1, lam=False)))
+
+
+@pytest.mark.parametrize(
+    ("positive", "field", "inputs"),
+    [
+        (
+            {"I0": 1e-300, "K": 1e300, "Q": 1.0, "phi_cr": 0.2},
+            "positive.p_eq",
+            "K = 1e+300, I0 = 1e-300",
+        ),
+        (
+            {"I0": 1.0, "K": 1e300, "Q": 1e-300, "phi_cr": 0.2},
+            "positive.lam",
+            "K = 1e+300, phi_cr = 0.2, M_F = 0, Q = 1e-300",
+        ),
+        (
+            {"I0": 1.0, "K": 1e-300, "Q": 1.0, "phi_cr": 0.2, "M_F": 1e300},
+            "positive.phi_ov",
+            "phi_cr = 0.2, M_F = 1e+300, K = 1e-300",
+        ),
+    ],
+)
+def test_a_non_finite_derived_constant_is_refused_naming_its_inputs(
+    positive: dict[str, float], field: str, inputs: str
+) -> None:
+    with pytest.raises(InputError, match="is not finite") as err:
+        parse_constants([{"id": "a", "positive": positive, "eta": 0.9}])
+    assert err.value.field == f"mechanisms[0] (id 'a').{field}"
+    assert f"the inputs {inputs} are out of any physical range" in str(err.value)

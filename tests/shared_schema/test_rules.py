@@ -111,3 +111,86 @@ def test_eta_sign_rule_is_the_same_everywhere(eta: float, one_sided: bool, ok: b
             rules.check_eta(eta, one_sided)
         with pytest.raises(InputError, match="eta"):
             constants.parse_constants({"mechanisms": [entry]})
+
+
+# ---------------------------------------------------------------- physical ranges (#14)
+
+
+@pytest.mark.parametrize(
+    ("kind", "value", "words"),
+    [
+        ("density", 1e308, "at most 30000 kg/m\\^3"),
+        ("density", 30000.5, "at most 30000 kg/m\\^3"),
+        ("density", 0.0, "> 0"),
+        ("density", float("nan"), "finite"),
+        ("force", 1e300, "at most 1e\\+09 N"),
+        ("force", -1.0, "> 0"),
+        ("tensile_strength", 1e308, "at most 1e\\+08 Pa"),
+        ("density", True, "a number"),
+    ],
+)
+def test_a_quantity_beyond_its_range_is_refused_with_the_range_named(
+    kind: str, value: float, words: str
+) -> None:
+    with pytest.raises(InputError, match=words) as err:
+        rules.check_quantity(value, kind, "f")
+    assert err.value.field == "f"
+
+
+@pytest.mark.parametrize(
+    ("kind", "value", "note"),
+    [
+        ("density", 30000.0, True),  # the limit itself is admissible, and implausible
+        ("density", 9000.0, False),
+        ("density", 300.0, False),
+        ("density", 299.0, True),
+        ("force", 1e7, False),
+        ("force", 1.01e7, True),
+        ("tensile_strength", 2e6, False),
+        ("tensile_strength", 5e6, True),
+    ],
+)
+def test_an_admissible_quantity_outside_its_band_gets_a_note(
+    kind: str, value: float, note: bool
+) -> None:
+    assert rules.check_quantity(value, kind, "f") == value
+    text = rules.quantity_note(value, kind, "W.f")
+    assert (text is not None) == note
+    if text is not None:
+        assert text.startswith(f"W.f = {value:g} {rules.QUANTITY_RANGES[kind].unit} is outside")
+
+
+def test_coordinates_are_refused_when_not_finite_or_beyond_the_limit() -> None:
+    assert rules.coordinate_problem([1e6, -1e6, 0.0]) is None
+    assert "finite" in str(rules.coordinate_problem([0.0, float("nan"), 0.0]))
+    assert "beyond the largest magnitude accepted, 1e+06 m" in str(
+        rules.coordinate_problem([0.0, -1.00001e6, 0.0])
+    )
+    assert "inf" in str(rules.coordinate_problem([float("inf"), 0.0, 0.0]))
+
+
+@pytest.mark.parametrize(
+    ("size_m", "scale", "units", "scan", "advice"),
+    [
+        (3202.0, 1.0, "meters", True, "if the file is in mm, give units mm (--units mm)"),
+        (320.2, 1.0, "meters", True, "if the file is in cm, give units cm (--units cm)"),
+        (
+            0.0032,
+            0.001,
+            "millimeters",
+            False,
+            "if the file is in m, set its model units to m in Rhino",
+        ),
+        (1e5, 1.0, "meters", False, "if the file is in mm, set its model units to mm in Rhino"),
+        (1e7, 1.0, "meters", False, "check the file's length unit"),
+    ],
+)
+def test_an_implausible_body_size_names_the_unit_read_and_the_one_that_fits(
+    size_m: float, scale: float, units: str, scan: bool, advice: str
+) -> None:
+    note = rules.body_size_note(size_m, scale, units, "W", scan)
+    assert note is not None
+    assert note.startswith(f"W: the body is {size_m:.4g} m across as read in {units}")
+    assert note.endswith(advice), note
+    assert rules.body_size_note(0.01, 1.0, "meters", "W", scan) is None
+    assert rules.body_size_note(200.0, 1.0, "meters", "W", scan) is None
