@@ -11,13 +11,16 @@ otherwise (``--a-p-g`` is in g); every ``--help`` shows the units in brackets.
 from __future__ import annotations
 
 import contextlib
+import difflib
 import functools
+import importlib
 import json
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any, Iterator, NoReturn, Optional, TypeVar
 
 import typer
+from typer.core import TyperGroup, TyperOption
 
 from rhino_plugin.mechanisms.build import MechanismFailure
 from rockmech._version import __version__
@@ -32,7 +35,7 @@ from .core.records import GroundMotion
 from .demo import run_demo
 from .ida import IM_MEASURES, parse_levels, run_ida
 from .report.html import build_report, input_source, write_report
-from .workflows.assess import check_doc, read_site
+from .workflows.assess import check_doc, check_multiples, read_site
 from .workflows.documents import (
     boundary_doc,
     frequency_grid,
@@ -55,7 +58,93 @@ from .workflows.rundir import check_file_target, check_folder_target, os_reason,
 from .workflows.scaling import Building
 from .workflows.tables import constants_from_table
 
+# typer re-exports click's exceptions, and newer typer vendors click (``typer._click``): the
+# classes are taken from the module typer's own BadParameter comes from.
+_CLICK = importlib.import_module(typer.BadParameter.__module__)
+#: Raised by click for a bare group call that shows the help: not an error to reword.
+_HELP_ERROR: Any = getattr(_CLICK, "NoArgsIsHelpError", ())
+
+
+class _UsageError(_CLICK.ClickException):  # type: ignore[misc,name-defined]
+    """A usage error shown as rockmech shows its own: ``error: <option>: <problem>``, exit 2."""
+
+    exit_code = 2
+
+    def show(self, file: Any = None) -> None:
+        """Print the one line on stderr."""
+        typer.echo(f"error: {self.message}", err=True)
+
+
+def _param_name(param: Any) -> str:
+    """How an error names a parameter: an option as typed (``--p-eq``), an argument by name."""
+    if isinstance(param, TyperOption):
+        return str(max(param.opts, key=len))
+    return str(param.name or param.human_readable_name)
+
+
+def _usage_line(exc: Any) -> str:
+    """One line for click's usage error ``exc``: the option or argument, the problem, a hint."""
+    ctx = exc.ctx
+    see = f"; see '{ctx.command_path} --help'" if ctx is not None else ""
+    problem = str(exc.message).rstrip(".")
+    problem = problem[:1].lower() + problem[1:]
+    field = ctx.command_path if ctx is not None else "rockmech"
+    if isinstance(exc, _CLICK.NoSuchOption):
+        field, problem = exc.option_name, "no such option"
+        if exc.possibilities:
+            problem += f" (did you mean {' or '.join(exc.possibilities)}?)"
+    elif isinstance(exc, _CLICK.BadOptionUsage):
+        field = exc.option_name
+        if "requires an argument" in problem:
+            problem = "needs a value"
+    elif isinstance(exc, _CLICK.BadParameter):
+        if exc.param is not None:
+            field = _param_name(exc.param)
+        elif exc.param_hint:
+            field = str(exc.param_hint)
+        if isinstance(exc, _CLICK.MissingParameter):
+            kind = exc.param.param_type_name if exc.param is not None else exc.param_type
+            problem = f"missing {kind or 'value'}"
+    return f"{field}: {problem}{see}"
+
+
+class _Commands(TyperGroup):
+    """The ``rockmech`` command group: click's usage errors as one line, like our own."""
+
+    def make_context(
+        self, info_name: Optional[str], args: list[str], parent: Any = None, **extra: Any
+    ) -> Any:
+        """Parse the group's own options; a usage error becomes one line."""
+        try:
+            return super().make_context(info_name, args, parent, **extra)
+        except _HELP_ERROR:
+            raise
+        except _CLICK.UsageError as exc:
+            raise _UsageError(_usage_line(exc)) from None
+
+    def resolve_command(self, ctx: Any, args: list[str]) -> Any:
+        """Find the command; an unknown one is named with the closest commands."""
+        name = args[0] if args else ""
+        if name and not name.startswith("-") and self.get_command(ctx, name) is None:
+            close = difflib.get_close_matches(name, self.list_commands(ctx))
+            hint = f" (did you mean {' or '.join(close)}?)" if close else ""
+            raise _UsageError(
+                f"command: no such command {name!r}{hint}; see '{ctx.command_path} --help'"
+            )
+        return super().resolve_command(ctx, args)
+
+    def invoke(self, ctx: Any) -> Any:
+        """Run a command; a usage error in its arguments becomes one line."""
+        try:
+            return super().invoke(ctx)
+        except _HELP_ERROR:
+            raise
+        except _CLICK.UsageError as exc:
+            raise _UsageError(_usage_line(exc)) from None
+
+
 app = typer.Typer(
+    cls=_Commands,
     name="rockmech",
     help="Rocking collapse mechanisms of masonry: exact rocking solver and tools (SI units).",
     no_args_is_help=True,
@@ -1034,6 +1123,7 @@ def assess(
     # jinja2 (the report extra) is loaded only by this command.
     from .report.assess import assess_report, print_pdf
 
+    multiple = check_multiples(multiple)
     check_file_target(out)
     cf, site_file = read_constants(constants), read_site(site)
     motions = [read_record(r, record_format, units, dt) for r in record]

@@ -7,9 +7,8 @@ bytes and read there, under their sanitised names, exactly as ``rockmech`` reads
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
-from typing import Any, Optional, TypeVar
+from typing import Any, Optional
 
 from fastapi import Request
 from pydantic import BaseModel, ValidationError
@@ -29,14 +28,11 @@ __all__ = [
     "parse_form",
     "read_form",
     "read_upload",
-    "validate_json",
 ]
 
 #: Most files and fields a multipart request may carry.
 MAX_FORM_FILES = 4
 MAX_FORM_FIELDS = 200
-
-M = TypeVar("M", bound=BaseModel)
 
 
 @dataclass(frozen=True)
@@ -178,16 +174,3 @@ def parse_form(form: FormData, spec: FormSpec) -> dict[str, Any]:
         raise Problem(422, "InputError", message, field) from None
     except ValueError as exc:
         raise Problem(422, "InputError", str(exc)) from None
-
-
-def validate_json(model: type[M], body: bytes) -> M:
-    """Validate a JSON body with ``model``; 422 with rockmech's message if it does not fit."""
-    try:
-        return model.model_validate_json(body)
-    except ValidationError as exc:
-        try:
-            data = json.loads(body)
-        except (ValueError, RecursionError):
-            data = None
-        message, field = validation_message(exc.errors(include_url=False), data)
-        raise Problem(422, "InputError", message, field) from None

@@ -8,9 +8,9 @@ from typing import Any, Optional
 from fastapi import FastAPI
 from fastapi.openapi.utils import get_openapi
 from fastapi.routing import APIRoute
-from pydantic import BaseModel
+from pydantic import BaseModel, TypeAdapter
 
-from shared_schema.api import ErrorResponse, HistoryRequest, ReportRequest, SpectrumRequest
+from shared_schema.api import ErrorResponse
 
 from .deps import JSON, MULTIPART
 from .forms import FORMS, multipart_schema
@@ -42,6 +42,12 @@ _ERRORS = {
 }
 
 
+#: Where the document keeps a schema.
+_REF = "#/components/schemas/{model}"
+#: Schemas of the JSON bodies that routes parse themselves (``body_doc``), by name.
+_BODY_SCHEMAS: dict[str, dict[str, Any]] = {}
+
+
 def operation_id(route: APIRoute) -> str:
     """Operation id of a route: its function's name (``pulse``, ``scale_factor``, ...)."""
     return route.name
@@ -62,11 +68,26 @@ def responses(model: Any, media: str = JSON, extra: Sequence[int] = ()) -> dict[
     return out
 
 
-def body_doc(json_model: Optional[type[BaseModel]], form: Optional[str]) -> dict[str, Any]:
-    """``openapi_extra`` of a route that reads its body itself: JSON and/or multipart."""
+def _json_schema(model: Any) -> dict[str, Any]:
+    """Return the schema of a JSON body (a reference, or a union inline); keep its parts."""
+    doc = TypeAdapter(model).json_schema(ref_template=_REF)
+    for name, sub in doc.pop("$defs", {}).items():
+        _BODY_SCHEMAS.setdefault(name, sub)
+    if isinstance(model, type) and issubclass(model, BaseModel):
+        _BODY_SCHEMAS.setdefault(model.__name__, doc)
+        return {"$ref": _REF.format(model=model.__name__)}
+    return doc
+
+
+def body_doc(json_model: Any, form: Optional[str]) -> dict[str, Any]:
+    """``openapi_extra`` of a route that reads its body itself: JSON and/or multipart.
+
+    ``json_model`` is a pydantic model or a union of them (``ScaleFactorRequest``); its
+    schemas go into the document's components (``install_openapi``).
+    """
     content: dict[str, Any] = {}
     if json_model is not None:
-        content[JSON] = {"schema": {"$ref": f"#/components/schemas/{json_model.__name__}"}}
+        content[JSON] = {"schema": _json_schema(json_model)}
     if form is not None:
         content[MULTIPART] = {"schema": multipart_schema(FORMS[form])}
     return {"requestBody": {"required": True, "content": content}}
@@ -86,11 +107,8 @@ def install_openapi(app: FastAPI) -> None:
                 separate_input_output_schemas=False,
             )
             components = schema.setdefault("components", {}).setdefault("schemas", {})
-            for model in (HistoryRequest, SpectrumRequest, ReportRequest):
-                doc = model.model_json_schema(ref_template="#/components/schemas/{model}")
-                for name, sub in doc.pop("$defs", {}).items():
-                    components.setdefault(name, sub)
-                components.setdefault(model.__name__, doc)
+            for name, sub in _BODY_SCHEMAS.items():
+                components.setdefault(name, sub)
             app.openapi_schema = schema
         return app.openapi_schema
 

@@ -19,10 +19,16 @@ from __future__ import annotations
 
 from typing import Any
 
+from shared_schema.errors import InputError
+
 from .amplification import scale_factor
 from .model import check_non_negative, check_positive
 
-__all__ = ["sf_ec8", "sf_eq28", "sf_nzs"]
+__all__ = ["BUILDING_HEIGHT_MAX_M", "check_height", "sf_ec8", "sf_eq28", "sf_nzs"]
+
+#: Tallest structure [m] a height may describe: above the tallest building (828 m), so a
+#: larger value is a slip of units or digits, never a building.
+BUILDING_HEIGHT_MAX_M = 1000.0
 
 #: NZS 1170.5 §8.3: height [m] below which ``C_Hi = 1 + h_i/6`` applies.
 NZS_LOW_HEIGHT = 12.0
@@ -30,6 +36,38 @@ NZS_LOW_HEIGHT = 12.0
 NZS_LOW_FRACTION = 0.2
 #: NZS 1170.5 §8.3: the general value of ``C_Hi``.
 NZS_CAP = 3.0
+
+
+def check_height(value: object, name: str, *, positive: bool = True) -> float:
+    """Return a height [m] as a float: finite, > 0 (>= 0 if not ``positive``), at most 1000 m.
+
+    Raises
+    ------
+    InputError
+        Naming ``name``: not finite, not > 0 (>= 0), or above ``BUILDING_HEIGHT_MAX_M``.
+
+    Examples
+    --------
+    >>> check_height(12.5, "H")
+    12.5
+    """
+    h = check_positive(value, name) if positive else check_non_negative(value, name)
+    if h > BUILDING_HEIGHT_MAX_M:
+        raise InputError(
+            f"must be at most {BUILDING_HEIGHT_MAX_M:g} m (taller than any building), got {h:g} m",
+            name,
+        )
+    return h
+
+
+def _within(low: float, low_name: str, top: float, top_name: str) -> None:
+    """Refuse a height ``low`` above the top of the structure ``top`` (both [m])."""
+    if low > top:
+        raise InputError(
+            f"must be at most {top_name} = {top:g} m (the height of the structure), "
+            f"got {low_name} = {low:g} m",
+            low_name,
+        )
 
 
 def sf_eq28(sa_g: float, pga_g: float, h: float, h_e: float) -> dict[str, Any]:
@@ -63,8 +101,8 @@ def sf_eq28(sa_g: float, pga_g: float, h: float, h_e: float) -> dict[str, Any]:
     inputs = {
         "sa_g": check_non_negative(sa_g, "sa_g"),
         "pga_g": check_positive(pga_g, "pga_g"),
-        "h": check_non_negative(h, "h"),
-        "h_e": check_positive(h_e, "h_e"),
+        "h": check_height(h, "h", positive=False),
+        "h_e": check_height(h_e, "h_e"),
     }
     return {
         "value": scale_factor(**inputs),
@@ -80,9 +118,9 @@ def sf_ec8(z: float, H: float, T_a: float, T_1: float, S: float = 1.0) -> dict[s
     Parameters
     ----------
     z : float
-        Height of the element above the foundation [m], ``0 <= z``.
+        Height of the element above the foundation [m], ``0 <= z <= H``.
     H : float
-        Height of the building [m], > 0.
+        Height of the building [m], > 0 and at most ``BUILDING_HEIGHT_MAX_M``.
     T_a : float
         Fundamental period of the element [s], >= 0 (0: rigid).
     T_1 : float
@@ -111,7 +149,8 @@ def sf_ec8(z: float, H: float, T_a: float, T_1: float, S: float = 1.0) -> dict[s
     2.5
     """
     zz = check_non_negative(z, "z")
-    hh = check_positive(H, "H")
+    hh = check_height(H, "H")
+    _within(zz, "z", hh, "H")
     ta = check_non_negative(T_a, "T_a")
     t1 = check_positive(T_1, "T_1")
     s = check_positive(S, "S")
@@ -131,9 +170,9 @@ def sf_nzs(h_i: float, h_n: float) -> dict[str, Any]:
     Parameters
     ----------
     h_i : float
-        Height of the level (the mechanism) above the base [m], >= 0.
+        Height of the level (the mechanism) above the base [m], ``0 <= h_i <= h_n``.
     h_n : float
-        Height of the top of the structure [m], > 0.
+        Height of the top of the structure [m], > 0 and at most ``BUILDING_HEIGHT_MAX_M``.
 
     Returns
     -------
@@ -153,7 +192,8 @@ def sf_nzs(h_i: float, h_n: float) -> dict[str, Any]:
     1.77
     """
     hi = check_non_negative(h_i, "h_i")
-    hn = check_positive(h_n, "h_n")
+    hn = check_height(h_n, "h_n")
+    _within(hi, "h_i", hn, "h_n")
     candidates = {"3.0": NZS_CAP}
     if hi < NZS_LOW_HEIGHT:
         candidates["1 + h_i/6"] = 1.0 + hi / 6.0

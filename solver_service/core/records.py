@@ -50,7 +50,9 @@ from .formats import detect as detect_strong_motion
 from .formats._text import units_or_none
 
 __all__ = [
+    "ACCEL_MAX_G",
     "DT_PLAUSIBLE_S",
+    "DT_RANGE_S",
     "DT_RTOL",
     "FORMATS",
     "PGA_PLAUSIBLE_G",
@@ -66,6 +68,12 @@ UNITS = RECORD_UNITS
 PGA_PLAUSIBLE_G = (0.001, 5.0)
 #: Time step [s] outside which a record gets a plausibility warning.
 DT_PLAUSIBLE_S = (1e-4, 0.1)
+#: Time step [s] outside which a record is refused: no accelerograph samples faster than
+#: 1 MHz or slower than once a second (issue #14: a dt of 1e300 s overflows the spectrum).
+DT_RANGE_S = (1e-6, 1.0)
+#: Largest acceleration [g] a record may hold: 200 times the strongest ground motion
+#: recorded (about 5 g); beyond it the numbers are wrong units, not an earthquake.
+ACCEL_MAX_G = 1e3
 #: Relative tolerance on the spacing of time stamps read from a file.
 DT_RTOL = 1e-6
 #: Record formats ``GroundMotion.from_file`` reads (``shared_schema.rules``).
@@ -161,10 +169,44 @@ def _check_samples(a: NDArray[np.float64], name: str) -> None:
     bad = np.flatnonzero(~np.isfinite(a))
     if bad.size:
         raise InputError(
-            f"{name}: sample {int(bad[0])} is not finite ({a[bad[0]]!r}); "
+            f"{name}: sample {int(bad[0])} is not finite ({float(a[bad[0]])}); "
             f"{bad.size} non-finite sample(s) in all",
             "record",
         )
+
+
+def _sampled(a: NDArray[np.float64], units: str, dt: Any, name: str) -> SampledAccel:
+    """Return samples ``a`` in ``units`` at step ``dt`` [s] as SI samples, checked first.
+
+    Raises
+    ------
+    InputError
+        A sample not finite or above ``ACCEL_MAX_G`` (field ``record``; in m/s² it might
+        overflow), or ``dt`` outside ``DT_RANGE_S`` (field ``dt``).
+    """
+    factor = _unit_factor(units)
+    a = np.asarray(a, dtype=float)
+    _check_samples(a, name)
+    # compared in the given units, so that a huge sample cannot overflow on the way to SI
+    big = np.flatnonzero(np.abs(a) > ACCEL_MAX_G * G / factor)
+    if big.size:
+        k = int(big[0])
+        raise InputError(
+            f"{name}: sample {k} is {float(a[k]):.6g} {units}, above the largest acceleration "
+            f"a record may hold ({ACCEL_MAX_G:g} g; plausible PGA: {PGA_PLAUSIBLE_G[0]:g} to "
+            f"{PGA_PLAUSIBLE_G[1]:g} g); {big.size} such sample(s) in all: check the units",
+            "record",
+        )
+    step = _check_dt(dt)
+    lo, hi = DT_RANGE_S
+    if not lo <= step <= hi:
+        raise InputError(
+            f"{name}: time step dt = {step:.6g} s is outside the range a record can have, "
+            f"[{lo:g}, {hi:g}] s (plausible: {DT_PLAUSIBLE_S[0]:g} to {DT_PLAUSIBLE_S[1]:g} s); "
+            "check the time units",
+            "dt",
+        )
+    return SampledAccel(a * factor, step)
 
 
 def _uniform_step(t: NDArray[np.float64], name: str) -> float:
@@ -326,9 +368,8 @@ class GroundMotion:
         metadata: dict[str, Any] | None = None,
     ) -> GroundMotion:
         """Build a record from acceleration samples in ``units`` at interval ``dt`` [s]."""
-        factor = _unit_factor(units)
         meta = {"units": units, **(metadata or {})}
-        return cls(SampledAccel(np.asarray(acc, dtype=float) * factor, dt), name, meta)
+        return cls(_sampled(np.asarray(acc, dtype=float), units, dt, name), name, meta)
 
     @classmethod
     def from_file(
@@ -456,7 +497,7 @@ class GroundMotion:
             "channels": channel_list(channels),
         }
         name = p.stem if len(channels) == 1 else f"{p.stem}_{chosen.metadata['channel']}"
-        accel = SampledAccel(chosen.values * UNITS[chosen.units], chosen.dt)
+        accel = _sampled(chosen.values, chosen.units, chosen.dt, p.name)
         motion = cls(accel, name, meta)
         meta["pga_g"] = motion.pga_g
         return motion
@@ -525,7 +566,7 @@ class GroundMotion:
             "dt": dt,
             "npts": npts,
         }
-        motion = cls(SampledAccel(a * UNITS[units], dt), p.stem, meta)
+        motion = cls(_sampled(a, units, dt, p.name), p.stem, meta)
         meta["pga_g"] = motion.pga_g
         return motion
 
@@ -548,7 +589,7 @@ class GroundMotion:
             Missing file, unparsable line, fewer than 2 samples, non-finite values, or time
             that is not strictly increasing and uniform (within ``DT_RTOL``).
         """
-        factor = _unit_factor(units)
+        _unit_factor(units)  # unknown units are refused before the file is read
         p, text = _read_text(path)
         rows: list[tuple[float, float]] = []
         for lineno, raw, line in _data_lines(text):
@@ -566,7 +607,7 @@ class GroundMotion:
         dt = _uniform_step(t, p.name)
         meta = {"source": p.name, "format": "two_column", "units": units, "npts": int(t.size)}
         meta.update(_time_origin(float(t[0]), p.name))
-        return cls(SampledAccel(a * factor, dt), p.stem, meta)
+        return cls(_sampled(a, units, dt, p.name), p.stem, meta)
 
     @classmethod
     def from_one_column(cls, path: PathLike, dt: float, units: str) -> GroundMotion:
@@ -588,7 +629,7 @@ class GroundMotion:
             fewer than 2 samples or non-finite values.
         """
         dt = _check_dt(dt)
-        factor = _unit_factor(units)
+        _unit_factor(units)  # unknown units are refused before the file is read
         p, text = _read_text(path)
         values: list[float] = []
         for lineno, raw, line in _data_lines(text):
@@ -600,7 +641,7 @@ class GroundMotion:
         a = np.array(values, dtype=float)
         _check_samples(a, p.name)
         meta = {"source": p.name, "format": "one_column", "units": units, "npts": int(a.size)}
-        return cls(SampledAccel(a * factor, dt), p.stem, meta)
+        return cls(_sampled(a, units, dt, p.name), p.stem, meta)
 
     @classmethod
     def from_csv(
@@ -683,7 +724,6 @@ class GroundMotion:
             )
         units = stated or units
         assert units is not None
-        factor = UNITS[units]
         if it is not None and names:
             _check_time_units(header[it], p.name)
         need = max(ia, -1 if it is None else it) + 1
@@ -715,7 +755,7 @@ class GroundMotion:
             "units_from": "header" if stated is not None else "given",
         }
         meta.update(_time_origin(t0, p.name))
-        return cls(SampledAccel(a * factor, dt), p.stem, meta)
+        return cls(_sampled(a, units, dt, p.name), p.stem, meta)
 
 
 def _time_origin(t0: float, name: str) -> dict[str, Any]:

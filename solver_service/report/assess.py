@@ -203,8 +203,14 @@ def _plot_history(
         plt.close(fig)
 
 
-def _history_png(label: str, res: Any, motion: Any, scale: float, path: Path) -> Path:
-    return _plot_history(label, res, motion, scale, path)[0]
+def _history_png(label: str, model: Any, motion: Any, design: float, up: float, path: Path) -> Path:
+    """Run one mechanism at ``design × up`` and plot its time history.
+
+    Both happen inside the figure's guard (``_embed``): a run that fails becomes the
+    figure's note, not a traceback.
+    """
+    res = simulate(model, motion.accel, scale=design * up, dense=True)
+    return _plot_history(label, res, motion, design, path)[0]
 
 
 def _history_figures(
@@ -219,22 +225,25 @@ def _history_figures(
         if "scale_factor" not in dyn:
             continue
         design = float(dyn["scale_factor"]["value"])
-        height = mechanism_scale_factor(mech, motion, "eq28")
+        caption = f"{mech.id} on {motion.name} at the design scale {sig(design)}"
+        try:
+            height = mechanism_scale_factor(mech, motion, "eq28")
+        except (ValueError, ArithmeticError, RockmechError) as exc:
+            out.append({"caption": caption, "note": f"not run: {exc}"})
+            continue
         up = 1.0 if height is None else float(height["value"])
-        res = simulate(model, motion.accel, scale=design * up, dense=True)
-        caption = (
-            f"{mech.id} on {motion.name} at the design scale {sig(design)}"
-            + (f" × {sig(up)} up the structure (Eq. 28)" if height is not None else "")
-            + "; time axis cropped to the motion"
-        )
+        caption += (
+            f" × {sig(up)} up the structure (Eq. 28)" if height is not None else ""
+        ) + "; time axis cropped to the motion"
         out.append(
             _embed(
                 functools.partial(
                     _history_png,
                     mech.id,
-                    res,
+                    model,
                     motion,
                     design,
+                    up,
                     folder / f"{mech.id}_history_{k}.png",
                 ),
                 caption,

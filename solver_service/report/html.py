@@ -32,11 +32,13 @@ from typing import Any, Optional
 import numpy as np
 
 from shared_schema.atomic import write_atomic
+from shared_schema.errors import InputError, RockmechError
+from shared_schema.rules import check_positive
 
 from ..core.model import G
 from ..core.spectra import response_spectrum
 from ..workflows.documents import envelope_doc, history_doc
-from ..workflows.scaling import dense_runs
+from ..workflows.scaling import Building, dense_runs
 from .plots import plot_envelopes, plot_record, plot_time_histories
 
 __all__ = ["MAX_TRACES", "build_report", "input_source", "write_report"]
@@ -114,7 +116,7 @@ def _figure(draw: Callable[[], Path], caption: str) -> str:
     """Draw a plot and embed it; on degenerate data say why there is no plot."""
     try:
         path = draw()
-    except (ValueError, ArithmeticError) as exc:  # e.g. overflowing values on a log axis
+    except (ValueError, ArithmeticError, RockmechError) as exc:  # e.g. overflow on a log axis
         return (
             f"<p class='muted'>{_e(caption)}: not drawn ({_e(type(exc).__name__)}: {_e(exc)})</p>"
         )
@@ -234,11 +236,17 @@ def _history_table(doc: dict[str, Any]) -> str:
 def _history_figures(
     cf: Any, motion: Any, doc: dict[str, Any], scales: Sequence[float], folder: Path
 ) -> list[str]:
-
+    """Figures of the time histories at the largest scale, or a note on why there are none."""
     top = max(scales)
-    runs = [
-        (f"{mech_id} ×{scale:.3g}", res) for mech_id, scale, res in dense_runs(cf, motion, doc, top)
-    ]
+    caption = f"φ/φ_ov against time at scale {top:g}"
+    try:
+        # the runs are made again with their time series: a run can fail here alone
+        runs = [
+            (f"{mech_id} ×{scale:.3g}", res)
+            for mech_id, scale, res in dense_runs(cf, motion, doc, top)
+        ]
+    except (ValueError, ArithmeticError, RockmechError) as exc:
+        return [f"<p class='muted'>{_e(caption)}: not drawn ({_e(exc)})</p>"]
     figures = []
     for k in range(0, len(runs), MAX_TRACES):
         part = runs[k : k + MAX_TRACES]
@@ -253,7 +261,7 @@ def _history_figures(
                     record_a_g=top * motion.accel.acc / G,
                     title=f"{motion.name} × {top:g}",
                 ),
-                f"φ/φ_ov against time at scale {top:g}: {names}",
+                f"{caption}: {names}",
             )
         )
     return figures
@@ -335,6 +343,42 @@ def _accuracy(hist: Optional[dict[str, Any]]) -> str:
     return "<h2>Error estimates</h2><ul>" + "".join(items) + "</ul>"
 
 
+def check_history_options(
+    scales: Sequence[float], history: Optional[dict[str, Any]], motion: Optional[Any]
+) -> None:
+    """Refuse history options that are invalid, or that have nothing to act on.
+
+    The scale factors must be > 0 with or without a record; without a record there are no
+    time histories, so scales, ``sf``, the building, ``criterion`` and ``at_height`` given
+    then would be silently ignored and are refused instead (issue #14).
+
+    Raises
+    ------
+    InputError
+        A scale not finite and > 0 (field ``scales[j]``), or an option given without a record
+        (field: its name).
+    """
+    for j, value in enumerate(scales):
+        check_positive(value, f"scales[{j}]")
+    if motion is not None:
+        return
+    opts = dict(history or {})
+    given = {
+        "scales": [float(v) for v in scales] != [1.0],
+        "sf": opts.get("sf", "none") != "none",
+        "building": opts.get("building", Building()) != Building(),
+        "criterion": opts.get("criterion") is not None,
+        "at_height": opts.get("at_height") is not None,
+    }
+    named = [name for name, is_given in given.items() if is_given]
+    if named:
+        raise InputError(
+            "acts on the time histories of a record, and no record is given; give a record "
+            f"or leave out {' and '.join(named)}",
+            named[0],
+        )
+
+
 def build_report(
     cf: Any,
     f_p: Any,
@@ -378,7 +422,14 @@ def build_report(
     -------
     str
         The page.
+
+    Raises
+    ------
+    InputError
+        Invalid history options, or options given without a record
+        (``check_history_options``).
     """
+    check_history_options(scales, history, motion)
     env, envelopes = envelope_doc(cf, np.asarray(f_p, dtype=float), exact=exact, library=library)
     hist = None
     if motion is not None:

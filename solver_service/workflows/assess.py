@@ -16,8 +16,10 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from shared_schema.api import MAX_ASSESS_MULTIPLES
 from shared_schema.constants import ConstantsFile, Mechanism, SideConstants
 from shared_schema.errors import InputError, RockmechError
+from shared_schema.rules import check_number
 from shared_schema.site import SiteFile, parse_site
 
 from ..core.exact import simulate
@@ -31,9 +33,11 @@ from .scaling import mechanism_scale_factor
 
 __all__ = [
     "BAND_DEFAULT",
+    "MULTIPLE_MAX",
     "T1_COEFFICIENT",
     "assessment_doc",
     "check_doc",
+    "check_multiples",
     "matching_band",
     "read_site",
     "record_scale_factor",
@@ -49,6 +53,8 @@ BAND_DEFAULT = (0.15, 2.0)
 BAND_LOW, BAND_HIGH = 0.5, 1.5
 #: Periods in a matching band.
 BAND_POINTS = 40
+#: Largest multiple of the design scale factor [-]: a hundred times the design earthquake.
+MULTIPLE_MAX = 100.0
 
 NO_VIRTUAL_WORK = (
     "no virtual_work in the constants (short form or an older file): the code check needs "
@@ -337,6 +343,37 @@ def _envelope_margin(
     return out
 
 
+def check_multiples(multiples: Sequence[float]) -> list[float]:
+    """Return the multiples of the design scale as floats: 1 to 8 of them, each in (0, 100].
+
+    Raises
+    ------
+    InputError
+        Too few or too many (field ``multiples``), or one outside ``(0, MULTIPLE_MAX]``
+        (field ``multiples[j]``).
+
+    Examples
+    --------
+    >>> check_multiples([0.5, 1])
+    [0.5, 1.0]
+    """
+    if not 1 <= len(multiples) <= MAX_ASSESS_MULTIPLES:
+        raise InputError(
+            f"give 1 to {MAX_ASSESS_MULTIPLES} multiples of the design scale, got {len(multiples)}",
+            "multiples",
+        )
+    out = []
+    for j, value in enumerate(multiples):
+        v = check_number(value, f"multiples[{j}]")
+        if not 0.0 < v <= MULTIPLE_MAX:
+            raise InputError(
+                f"a multiple of the design scale must be in (0, {MULTIPLE_MAX:g}], got {v:g}",
+                f"multiples[{j}]",
+            )
+        out.append(v)
+    return out
+
+
 def assessment_doc(
     cf: ConstantsFile,
     site: SiteFile,
@@ -356,7 +393,8 @@ def assessment_doc(
         (``[0.5 Ts, 1.5 Ts]`` from the nonlinear check, else ``BAND_DEFAULT``) and, above
         ground, amplified by Eq. 28; then run at ``multiples`` of that design scale.
     multiples : sequence of float
-        Multiples of the design scale factor to run (1 is the design level).
+        Multiples of the design scale factor to run (1 is the design level): 1 to 8, each in
+        ``(0, MULTIPLE_MAX]`` (``check_multiples``).
     f_p : sequence of float, optional
         Pulse frequencies [Hz] of the envelope margin (default 0.1-10 Hz, 120 points).
 
@@ -369,6 +407,7 @@ def assessment_doc(
         envelope and each record's largest pulse at design scale with the margin
         ``a_p,min / a_p``); a part that cannot run carries a ``note`` instead.
     """
+    multiples = check_multiples(multiples)
     doc = check_doc(cf, site)
     spectrum = site_spectrum(site)
     freq = np.asarray(f_p if f_p is not None else log_grid(0.1, 10.0, 120), dtype=float)

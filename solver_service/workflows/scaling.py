@@ -14,7 +14,7 @@ from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError
 from shared_schema.rules import SF_METHODS, G, check_choice, check_non_negative, check_positive
 
-from ..core.codes import sf_ec8, sf_eq28, sf_nzs
+from ..core.codes import check_height, sf_ec8, sf_eq28, sf_nzs
 from ..core.exact import BatchResult, simulate, simulate_batch
 from ..core.spectra import response_spectrum
 from .adapter import to_rocking_model
@@ -36,7 +36,8 @@ class Building:
     Attributes
     ----------
     height : float, optional
-        Height of the building above its foundation, ``H`` (EC8) or ``h_n`` (NZS) [m], > 0.
+        Height of the building above its foundation, ``H`` (EC8) or ``h_n`` (NZS) [m], > 0
+        and at most ``core.codes.BUILDING_HEIGHT_MAX_M``.
     soil_factor : float
         EC8 soil factor ``S`` [-], > 0; 1 gives the bare amplification.
     element_period : float
@@ -50,7 +51,7 @@ class Building:
 
     def __post_init__(self) -> None:
         if self.height is not None:
-            check_positive(self.height, "building_height")
+            check_height(self.height, "building_height")
         check_positive(self.soil_factor, "soil_factor")
         check_non_negative(self.element_period, "element_period")
 

@@ -21,6 +21,10 @@ import numpy as np
 import pytest
 from api_helpers import TEST_SETTINGS
 
+from shared_schema.api import PulseRequest
+from solver_service.api.bodies import MAX_BODY_DEPTH, validate_json
+from solver_service.api.problems import Problem
+
 REPO = Path(__file__).resolve().parents[2]
 WALLS: dict[str, Any] = json.loads(
     (REPO / "examples" / "constants" / "rect_walls.json").read_text()
@@ -511,7 +515,7 @@ def _cases() -> list[Rest]:
             "scale-factor",
             {"z": 50.0},
             field="z",
-            problem="H|above|<=|height",
+            problem="at most H = 10 m",
         ),
         Rest(
             "scale-factor-T1-negative",
@@ -542,6 +546,22 @@ def _cases() -> list[Rest]:
             field="H|z",
             problem="range|at most|<=|implausible|too",
         ),
+        Rest(
+            "scale-factor-nzs-h_i-above-h_n",
+            "scale-factor",
+            {"method": "nzs", "h_i": 30.0, "h_n": 10.0, "z": DROP, "H": DROP, "T_a": DROP}
+            | {"T_1": DROP},
+            field="h_i",
+            problem="h_n = 10",
+        ),
+        Rest(
+            "scale-factor-eq28-h_e-1e308",
+            "scale-factor",
+            {"method": "eq28", "h": 3.0, "h_e": 1e308, "sa_g": 0.5, "pga_g": 0.3}
+            | {k: DROP for k in ("z", "H", "T_a", "T_1")},
+            field="h_e",
+            problem="at most 1000 m",
+        ),
     ]
     # report
     cases += [
@@ -559,6 +579,21 @@ def _cases() -> list[Rest]:
             {"scales": [-1.0]},
             field="scales",
             problem="> 0|greater",
+        ),
+        Rest(
+            "report-scales-without-record",
+            "report",
+            {"scales": [2.0]},
+            field="scales",
+            problem="no record",
+        ),
+        Rest("report-sf-without-record", "report", {"sf": "eq28"}, field="sf", problem="record"),
+        Rest(
+            "report-building-without-record",
+            "report",
+            {"building_height": 10.0},
+            field="building",
+            problem="record",
         ),
         Rest(
             "report-record-dt-zero",
@@ -589,17 +624,18 @@ def _cases() -> list[Rest]:
     return cases
 
 
-EMPTY_BODY = "#14 messages: an empty body answers 'Field required', naming no field"
-NESTED = (
-    "#14 messages: a 5000-deep JSON body gets 400 'There was an error parsing the body' "
-    "(history, spectrum, report: 422 naming the field)"
-)
 #: What the cases above learnt from the service: id -> corrected expectation. The per-request
 #: limits (samples, frequencies, scales, mechanisms) are 422 naming the field and the
 #: ROCKMECH_* setting; 413 is for the body's size.
 OVERRIDES: dict[str, dict[str, Any]] = {
-    **{f"{ep}-empty-body": {"xfail": EMPTY_BODY} for ep in ("pulse", "envelope", "scale-factor")},
-    **{f"{ep}-deeply-nested": {"xfail": NESTED} for ep in ("pulse", "envelope", "scale-factor")},
+    # every JSON body is parsed in one place (solver_service.api.bodies): an empty body names
+    # the fields to send, a deep one the depth limit
+    **{
+        f"{ep}-empty-body": {"problem": "body is empty; send a JSON object with [a-z]"}
+        for ep in BODIES
+    },
+    **{f"{ep}-deeply-nested": {"problem": "nested deeper than 200 levels"} for ep in BODIES},
+    "pulse-empty-body": {"problem": "send a JSON object with p_eq, lam, a_p_g and f_p$"},
     # the run's length is p_eq / f_p: naming either is right
     "pulse-p_eq-1e300": {"field": "p_eq|f_p", "problem": "steps|at most"},
     "pulse-eta-2": {"problem": r"\[-1, 1\]"},
@@ -623,22 +659,12 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     "report-record-dt-zero": {"field": "dt"},
     "envelope-too-many-mechanisms": {"status": 422, "field": "constants"},
     **{
-        f"{ep}-dt-1e300": {"field": "dt|record", "problem": "steps|at most"}
-        for ep in ("history", "spectrum")
-    },
-    **{
-        f"{ep}-accel-1e308": {
-            "xfail": "#14 messages: an accel of 1e308 g is reported as "
-            "'not finite (np.float64(inf))'"
+        # refused by the record's time-step range, or by the work estimate: either names it
+        f"{ep}-dt-1e300": {
+            "field": "dt|record",
+            "problem": r"steps|at most|outside .*\[1e-06, 1\] s",
         }
         for ep in ("history", "spectrum")
-    },
-    "scale-factor-z-above-H": {
-        "xfail": "#14 silent wrong answer: EC8 with z = 5 H gives a factor of 8.5"
-    },
-    "scale-factor-H-1e308": {"xfail": "#14 silent acceptance: a 1e308 m building"},
-    "report-scales-negative": {
-        "xfail": "#14 silent acceptance: report without a record ignores scales [-1]"
     },
 }
 
@@ -687,6 +713,18 @@ def test_rest_case(case: Rest, client: httpx.Client) -> None:
     if case.field:
         named = f"{doc.get('field') or ''} {detail.split(': ')[0]}"
         assert re.search(case.field, named, re.I), doc
+
+
+@pytest.mark.parametrize("depth", [MAX_BODY_DEPTH, MAX_BODY_DEPTH + 1])
+def test_the_body_depth_limit_is_the_json_parsers(depth: int) -> None:
+    """``MAX_BODY_DEPTH`` is where pydantic's JSON parser stops: the message states it."""
+    body = _nested(json.dumps(PULSE), depth - 1)  # lists inside the body's object
+    if depth <= MAX_BODY_DEPTH:
+        with pytest.raises(Problem, match=r"^x: "):
+            validate_json(PulseRequest, body)
+    else:
+        with pytest.raises(Problem, match=f"nested deeper than {MAX_BODY_DEPTH} levels"):
+            validate_json(PulseRequest, body)
 
 
 def test_rest_corpus_is_large() -> None:

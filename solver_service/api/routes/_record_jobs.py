@@ -7,9 +7,10 @@ from typing import Any, Union
 from fastapi import Request, Response
 from pydantic import BaseModel
 
+from ..bodies import validate_json
 from ..compute import compute
 from ..deps import JSON, media_type
-from ..forms import FORMS, parse_form, read_form, read_upload, validate_json
+from ..forms import FORMS, parse_form, read_form, read_upload
 from ..jobspec import HistoryJob, RecordUpload, ReportJob, SpectrumJob
 from ..pool import ComputePool
 

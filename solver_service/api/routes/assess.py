@@ -7,16 +7,17 @@ writes (no PDF: print the page locally).
 
 from __future__ import annotations
 
-from typing import Any, Union
+from typing import Annotated, Any, Union
 
 from fastapi import APIRouter, Response
 
 from shared_schema.api import AssessRequest, AssessResponse, CheckRequest, CheckResponse
 
+from ..bodies import json_body
 from ..compute import compute
 from ..deps import JSON, PoolDep, accepts
 from ..jobspec import AssessHtmlJob, AssessJob, CheckJob
-from ..openapi import responses
+from ..openapi import body_doc, responses
 
 __all__ = ["router"]
 
@@ -39,8 +40,11 @@ def _json_or_html(model: Any) -> dict[Any, Any]:
     summary="Code checks (NTC 2018 / Circolare §C8.7.1) of every mechanism on a site",
     response_model=None,
     responses=responses(CheckResponse),
+    openapi_extra=body_doc(CheckRequest, None),
 )
-async def check(request: CheckRequest, pool: PoolDep) -> Response:
+async def check(
+    request: Annotated[CheckRequest, json_body(CheckRequest)], pool: PoolDep
+) -> Response:
     """Return the document ``rockmech check --json`` prints."""
     return await compute(pool, CheckJob(**dict(request)))
 
@@ -50,8 +54,11 @@ async def check(request: CheckRequest, pool: PoolDep) -> Response:
     summary="Assessment: code checks beside rocking dynamics on records scaled to the site",
     response_model=None,
     responses=_json_or_html(AssessResponse),
+    openapi_extra=body_doc(AssessRequest, None),
 )
-async def assess(request: AssessRequest, pool: PoolDep) -> Response:
+async def assess(
+    request: Annotated[AssessRequest, json_body(AssessRequest)], pool: PoolDep
+) -> Response:
     """Return the document ``rockmech assess --json`` prints, or the page it writes."""
     job: Union[AssessJob, AssessHtmlJob] = (
         AssessHtmlJob(**dict(request)) if request.format == "html" else AssessJob(**dict(request))

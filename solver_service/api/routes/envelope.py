@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+from typing import Annotated
+
 from fastapi import APIRouter, Response
 
 from shared_schema.api import EnvelopeRequest, EnvelopeResponse
 
+from ..bodies import json_body
 from ..compute import compute
 from ..deps import JSON, PoolDep, accepts
 from ..jobspec import EnvelopeJob
-from ..openapi import responses
+from ..openapi import body_doc, responses
 
 __all__ = ["router"]
 
@@ -21,8 +24,11 @@ router = APIRouter(tags=["solver"])
     summary="Overturning envelopes and the critical mechanism per frequency",
     response_model=None,
     responses=responses(EnvelopeResponse),
+    openapi_extra=body_doc(EnvelopeRequest, None),
     dependencies=[accepts(JSON)],
 )
-async def envelope(request: EnvelopeRequest, pool: PoolDep) -> Response:
+async def envelope(
+    request: Annotated[EnvelopeRequest, json_body(EnvelopeRequest)], pool: PoolDep
+) -> Response:
     """Return the document ``rockmech envelope --json`` prints."""
     return await compute(pool, EnvelopeJob(**dict(request)))

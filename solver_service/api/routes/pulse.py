@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+from typing import Annotated
+
 from fastapi import APIRouter, Response
 
 from shared_schema.api import PulseRequest, PulseResponse
 
+from ..bodies import json_body
 from ..compute import compute
 from ..deps import JSON, PoolDep, accepts
 from ..jobspec import PulseJob
-from ..openapi import responses
+from ..openapi import body_doc, responses
 
 __all__ = ["router"]
 
@@ -21,8 +24,11 @@ router = APIRouter(tags=["solver"])
     summary="One mechanism under a one-cycle sine or cosine pulse",
     response_model=None,
     responses=responses(PulseResponse),
+    openapi_extra=body_doc(PulseRequest, None),
     dependencies=[accepts(JSON)],
 )
-async def pulse(request: PulseRequest, pool: PoolDep) -> Response:
+async def pulse(
+    request: Annotated[PulseRequest, json_body(PulseRequest)], pool: PoolDep
+) -> Response:
     """Return the document ``rockmech pulse --json`` prints."""
     return await compute(pool, PulseJob(**dict(request)))
