@@ -46,8 +46,6 @@ README_DISAGREES = {
     "constants": "`constants -o out/facade.json` fails in a fresh folder (no out/): "
     "shared_schema.io.save_constants does not create the parent folder, which `report -o` "
     "and `--out` do (#14 README; proposed to the lead)",
-    "pulse[--one-sided]": "README: `--eta 0.9 --one-sided`, but one-sided rocking needs "
-    "eta <= 0 (rebound, theory §1.8); the README line is to change (proposed to the lead)",
 }
 
 runner = CliRunner()
