@@ -169,6 +169,12 @@ def _note(message: str) -> None:
     typer.echo(message, err=True)
 
 
+def _mechanism_warning(mech_id: str, note: str) -> None:
+    """Print a mechanism's warning, naming it once (a note may already start with its id)."""
+    named = note.startswith((f"{mech_id}.", f"{mech_id}:", f"{mech_id} "))
+    _note(f"warning: {note}" if named else f"warning: {mech_id}: {note}")
+
+
 def _user_errors(fn: F) -> F:
     """Turn rockmech's own errors, write errors and missing extras into one line and exit 2."""
 
@@ -509,7 +515,7 @@ def history(
         typer.echo(line)
     for mech_id, notes in doc.get("warnings", {}).items():
         for note in notes:
-            _note(f"warning: {mech_id}: {note}")
+            _mechanism_warning(mech_id, note)
     for note in doc.get("option_warnings", []):
         _note(f"warning: {note}")
     for skip in doc.get("skipped", []):
@@ -760,7 +766,7 @@ def constants(
         rows.append([m.id, _g4(side.p_eq), _g4(side.lam), _g4(side.phi_ov), _g4(m.eta)])
         notes = (m.provenance or {}).get("warnings") or []
         for note in notes if isinstance(notes, list) else []:
-            _note(f"warning: {m.id}: {note}")
+            _mechanism_warning(m.id, note)
     headers = ["mechanism", "p_eq [rad/s]", "lam [-]", "phi_ov [rad]", "eta [-]"]
     for line in _table(headers, rows):
         typer.echo(line)
