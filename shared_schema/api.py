@@ -15,12 +15,18 @@ Python 3.9-clean: no ``X | Y`` annotations.
 
 from typing import Annotated, Any, Dict, List, Literal, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from shared_schema.constants import Amplification, ConstantsFile
+from shared_schema.errors import InputError
 from shared_schema.rules import (
+    A_P_G_MAX,
+    ACCEL_MIN,
     CRITERIA,
+    F_P_RANGE,
+    LAM_RANGE,
     LENGTH_UNITS,
+    P_EQ_RANGE,
     PULSE_SHAPES,
     RECORD_FORMATS,
     RECORD_UNITS,
@@ -124,7 +130,15 @@ EQ28_RULE: Dict[str, Any] = {
         },
         {
             "properties": {
-                "record": {"type": "object"},
+                "record": {
+                    "type": "object",
+                    # A peak ground acceleration: a sample of magnitude ACCEL_MIN at least.
+                    "properties": {
+                        "accel": {
+                            "contains": {"anyOf": [{"minimum": ACCEL_MIN}, {"maximum": -ACCEL_MIN}]}
+                        }
+                    },
+                },
                 "f_n": {**_NUMBER, "exclusiveMinimum": 0},
                 "sa_g": {"type": "null"},
                 "pga_g": {"type": "null"},
@@ -165,13 +179,30 @@ class PulseRequest(BaseModel):
         strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=PULSE_ETA_RULE
     )
 
-    p_eq: float = _gt0("Frequency parameter p_eq [rad/s], > 0.")
-    lam: float = _gt0("Static load multiplier lambda [-], > 0.")
-    a_p_g: float = Field(
-        description="Signed pulse amplitude [g]; > 0 first pushes towards negative rotation "
-        "(Housner's convention), < 0 first opens the mechanism."
+    p_eq: float = Field(
+        ge=P_EQ_RANGE[0],
+        le=P_EQ_RANGE[1],
+        description=f"Frequency parameter p_eq [rad/s], in [{P_EQ_RANGE[0]:g}, "
+        f"{P_EQ_RANGE[1]:g}] (blocks of half-diagonal 74 km down to 7 µm).",
     )
-    f_p: float = _gt0("Pulse frequency [Hz], > 0.")
+    lam: float = Field(
+        ge=LAM_RANGE[0],
+        le=LAM_RANGE[1],
+        description=f"Static load multiplier lambda [-], in [{LAM_RANGE[0]:g}, {LAM_RANGE[1]:g}].",
+    )
+    a_p_g: float = Field(
+        ge=-A_P_G_MAX,
+        le=A_P_G_MAX,
+        description=f"Signed pulse amplitude [g], in [{-A_P_G_MAX:g}, {A_P_G_MAX:g}]; > 0 "
+        "first pushes towards negative rotation (Housner's convention), < 0 first opens the "
+        "mechanism.",
+    )
+    f_p: float = Field(
+        ge=F_P_RANGE[0],
+        le=F_P_RANGE[1],
+        description=f"Pulse frequency [Hz], in [{F_P_RANGE[0]:g}, {F_P_RANGE[1]:g}] (pulses "
+        "of 1000 s down to 1 ms).",
+    )
     eta: Optional[float] = Field(
         None,
         description="Coefficient of restitution [-], in [0, 1] two-sided, [-1, 0] one-sided; "
@@ -323,11 +354,24 @@ class Eq28Request(BaseModel):
     sa_g: Optional[float] = Field(None, description="Spectral acceleration S_a(T_n) [g], >= 0.")
     pga_g: Optional[float] = Field(None, description="Peak ground acceleration [g], > 0.")
     record: Optional[RecordSamples] = Field(
-        None, description="A record instead of sa_g and pga_g (needs f_n)."
+        None,
+        description="A record instead of sa_g and pga_g (needs f_n); one sample at least "
+        f"must be of magnitude {ACCEL_MIN:g} or more, in its units (a peak ground "
+        "acceleration).",
     )
     f_n: Optional[float] = Field(
         None, description="Natural frequency of the structure [Hz], > 0 (with record)."
     )
+
+    @model_validator(mode="after")
+    def _record_has_a_pga(self) -> "Eq28Request":
+        if self.record is not None and not any(abs(a) >= ACCEL_MIN for a in self.record.accel):
+            raise InputError(
+                f"needs a sample of magnitude {ACCEL_MIN:g} at least (a peak ground "
+                "acceleration) for Eq. 28",
+                "record.accel",
+            )
+        return self
 
 
 class Ec8Request(BaseModel):
