@@ -13,7 +13,7 @@ Units are SI, except where a name says otherwise (``a_p_g`` and ``pga_g`` are in
 Python 3.9-clean: no ``X | Y`` annotations.
 """
 
-from typing import Annotated, Any, Dict, List, Literal, Optional, Union
+from typing import Annotated, Any, Dict, List, Literal, Optional, Tuple, Union
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
@@ -180,28 +180,24 @@ class PulseRequest(BaseModel):
     )
 
     p_eq: float = Field(
-        ge=P_EQ_RANGE[0],
-        le=P_EQ_RANGE[1],
         description=f"Frequency parameter p_eq [rad/s], in [{P_EQ_RANGE[0]:g}, "
         f"{P_EQ_RANGE[1]:g}] (blocks of half-diagonal 74 km down to 7 µm).",
+        json_schema_extra={"minimum": P_EQ_RANGE[0], "maximum": P_EQ_RANGE[1]},
     )
     lam: float = Field(
-        ge=LAM_RANGE[0],
-        le=LAM_RANGE[1],
         description=f"Static load multiplier lambda [-], in [{LAM_RANGE[0]:g}, {LAM_RANGE[1]:g}].",
+        json_schema_extra={"minimum": LAM_RANGE[0], "maximum": LAM_RANGE[1]},
     )
     a_p_g: float = Field(
-        ge=-A_P_G_MAX,
-        le=A_P_G_MAX,
         description=f"Signed pulse amplitude [g], in [{-A_P_G_MAX:g}, {A_P_G_MAX:g}]; > 0 "
         "first pushes towards negative rotation (Housner's convention), < 0 first opens the "
         "mechanism.",
+        json_schema_extra={"minimum": -A_P_G_MAX, "maximum": A_P_G_MAX},
     )
     f_p: float = Field(
-        ge=F_P_RANGE[0],
-        le=F_P_RANGE[1],
         description=f"Pulse frequency [Hz], in [{F_P_RANGE[0]:g}, {F_P_RANGE[1]:g}] (pulses "
         "of 1000 s down to 1 ms).",
+        json_schema_extra={"minimum": F_P_RANGE[0], "maximum": F_P_RANGE[1]},
     )
     eta: Optional[float] = Field(
         None,
@@ -223,6 +219,28 @@ class PulseRequest(BaseModel):
         description="Overturning verdict: exact (default for pulses) or ratio.",
         json_schema_extra={"enum": [*CRITERIA, None]},
     )
+
+    @field_validator("p_eq", "lam", "f_p", "a_p_g")
+    @classmethod
+    def _plausible(cls, value: float, info: Any) -> float:
+        # Zero and negative values get the command line's message (the solver's check);
+        # the others the plausible range of shared_schema.rules.
+        name = info.field_name
+        lo, hi = _PULSE_RANGES[name]
+        if name != "a_p_g" and not value > 0:
+            raise ValueError(f"must be finite and > 0, got {value!r}")
+        if not lo <= value <= hi:
+            raise ValueError(f"must be in [{lo:g}, {hi:g}] (a plausible range), got {value!r}")
+        return value
+
+
+#: (lowest, highest) of each number of a pulse request (shared_schema.rules).
+_PULSE_RANGES: Dict[str, Tuple[float, float]] = {
+    "p_eq": P_EQ_RANGE,
+    "lam": LAM_RANGE,
+    "f_p": F_P_RANGE,
+    "a_p_g": (-A_P_G_MAX, A_P_G_MAX),
+}
 
 
 class RecordSamples(BaseModel):

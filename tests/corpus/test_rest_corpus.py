@@ -145,14 +145,13 @@ def _cases() -> list[Rest]:
         ]
     for fld in ("p_eq", "lam", "f_p"):
         cases += [
-            # The pulse's plausible ranges (shared_schema.rules) refuse these in the schema.
-            Rest(f"pulse-{fld}-zero", "pulse", {fld: 0.0}, field=fld, problem="greater than|> 0"),
+            Rest(f"pulse-{fld}-zero", "pulse", {fld: 0.0}, field=fld, problem="greater than 0|> 0"),
             Rest(
                 f"pulse-{fld}-negative",
                 "pulse",
                 {fld: -1.0},
                 field=fld,
-                problem="greater than|> 0",
+                problem="greater than 0|> 0",
             ),
             Rest(
                 f"pulse-{fld}-missing", "pulse", {fld: DROP}, field=fld, problem="required|missing"
@@ -168,21 +167,21 @@ def _cases() -> list[Rest]:
             "pulse",
             {"p_eq": 1e300},
             field="p_eq",
-            problem="range|at most|<=|too|less than or equal to 1000",
+            problem="range|at most|<=|too",
         ),
         Rest(
             "pulse-f_p-1e-9",
             "pulse",
             {"f_p": 1e-9},
             field="f_p",
-            problem="at most|shorter|range|budget|greater than or equal to 0.001",
+            problem="at most|shorter|range|budget",
         ),
         Rest(
             "pulse-a_p_g-1e300",
             "pulse",
             {"a_p_g": 1e300},
             field="a_p",
-            problem="range|at most|<=|too|less than or equal to 100",
+            problem="range|at most|<=|too",
         ),
         Rest(
             "pulse-eta-missing-two-sided",
@@ -601,8 +600,6 @@ NESTED = (
 OVERRIDES: dict[str, dict[str, Any]] = {
     **{f"{ep}-empty-body": {"xfail": EMPTY_BODY} for ep in ("pulse", "envelope", "scale-factor")},
     **{f"{ep}-deeply-nested": {"xfail": NESTED} for ep in ("pulse", "envelope", "scale-factor")},
-    # the run's length is p_eq / f_p: naming either is right
-    "pulse-p_eq-1e300": {"field": "p_eq|f_p", "problem": "steps|at most"},
     "pulse-eta-2": {"problem": r"\[-1, 1\]"},
     "pulse-number-400-digits": {"problem": "valid number|range|finite"},
     **{
