@@ -28,6 +28,7 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
+from rhino_plugin.archive_3dm import check_3dm, check_3dm_file
 from rhino_plugin.geometry.mesh import TriMesh
 from rhino_plugin.geometry.polygon import newell, triangulate_polygon
 from rhino_plugin.scene_base import BaseScene, SceneObject, solid_mesh
@@ -113,6 +114,7 @@ class Scene(BaseScene):
         p = os.fspath(path)
         if not os.path.isfile(p):
             raise InputError(f"file not found: {p}", "scene")
+        check_3dm_file(p)  # rhino3dm trusts the lengths a file declares
         model = rhino3dm.File3dm.Read(p)
         if model is None:
             raise InputError(
@@ -139,6 +141,8 @@ class Scene(BaseScene):
         """
         rhino3dm = _rhino3dm()
 
+        if data:
+            check_3dm(data, name)  # rhino3dm trusts the lengths a file declares
         model = rhino3dm.File3dm.FromByteArray(bytes(data)) if data else None
         if model is None:
             raise InputError(

@@ -13,14 +13,20 @@ Units are SI, except where a name says otherwise (``a_p_g`` and ``pga_g`` are in
 Python 3.9-clean: no ``X | Y`` annotations.
 """
 
-from typing import Annotated, Any, Dict, List, Literal, Optional, Union
+from typing import Annotated, Any, Dict, List, Literal, Optional, Tuple, Union
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from shared_schema.constants import Amplification, ConstantsFile
+from shared_schema.errors import InputError
 from shared_schema.rules import (
+    A_P_G_MAX,
+    ACCEL_MIN,
     CRITERIA,
+    F_P_RANGE,
+    LAM_RANGE,
     LENGTH_UNITS,
+    P_EQ_RANGE,
     PULSE_SHAPES,
     RECORD_FORMATS,
     RECORD_UNITS,
@@ -124,7 +130,15 @@ EQ28_RULE: Dict[str, Any] = {
         },
         {
             "properties": {
-                "record": {"type": "object"},
+                "record": {
+                    "type": "object",
+                    # A peak ground acceleration: a sample of magnitude ACCEL_MIN at least.
+                    "properties": {
+                        "accel": {
+                            "contains": {"anyOf": [{"minimum": ACCEL_MIN}, {"maximum": -ACCEL_MIN}]}
+                        }
+                    },
+                },
                 "f_n": {**_NUMBER, "exclusiveMinimum": 0},
                 "sa_g": {"type": "null"},
                 "pga_g": {"type": "null"},
@@ -165,13 +179,26 @@ class PulseRequest(BaseModel):
         strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=PULSE_ETA_RULE
     )
 
-    p_eq: float = _gt0("Frequency parameter p_eq [rad/s], > 0.")
-    lam: float = _gt0("Static load multiplier lambda [-], > 0.")
-    a_p_g: float = Field(
-        description="Signed pulse amplitude [g]; > 0 first pushes towards negative rotation "
-        "(Housner's convention), < 0 first opens the mechanism."
+    p_eq: float = Field(
+        description=f"Frequency parameter p_eq [rad/s], in [{P_EQ_RANGE[0]:g}, "
+        f"{P_EQ_RANGE[1]:g}] (blocks of half-diagonal 74 km down to 7 µm).",
+        json_schema_extra={"minimum": P_EQ_RANGE[0], "maximum": P_EQ_RANGE[1]},
     )
-    f_p: float = _gt0("Pulse frequency [Hz], > 0.")
+    lam: float = Field(
+        description=f"Static load multiplier lambda [-], in [{LAM_RANGE[0]:g}, {LAM_RANGE[1]:g}].",
+        json_schema_extra={"minimum": LAM_RANGE[0], "maximum": LAM_RANGE[1]},
+    )
+    a_p_g: float = Field(
+        description=f"Signed pulse amplitude [g], in [{-A_P_G_MAX:g}, {A_P_G_MAX:g}]; > 0 "
+        "first pushes towards negative rotation (Housner's convention), < 0 first opens the "
+        "mechanism.",
+        json_schema_extra={"minimum": -A_P_G_MAX, "maximum": A_P_G_MAX},
+    )
+    f_p: float = Field(
+        description=f"Pulse frequency [Hz], in [{F_P_RANGE[0]:g}, {F_P_RANGE[1]:g}] (pulses "
+        "of 1000 s down to 1 ms).",
+        json_schema_extra={"minimum": F_P_RANGE[0], "maximum": F_P_RANGE[1]},
+    )
     eta: Optional[float] = Field(
         None,
         description="Coefficient of restitution [-], in [0, 1] two-sided, [-1, 0] one-sided; "
@@ -192,6 +219,28 @@ class PulseRequest(BaseModel):
         description="Overturning verdict: exact (default for pulses) or ratio.",
         json_schema_extra={"enum": [*CRITERIA, None]},
     )
+
+    @field_validator("p_eq", "lam", "f_p", "a_p_g")
+    @classmethod
+    def _plausible(cls, value: float, info: Any) -> float:
+        # Zero and negative values get the command line's message (the solver's check);
+        # the others the plausible range of shared_schema.rules.
+        name = info.field_name
+        lo, hi = _PULSE_RANGES[name]
+        if name != "a_p_g" and not value > 0:
+            raise ValueError(f"must be finite and > 0, got {value!r}")
+        if not lo <= value <= hi:
+            raise ValueError(f"must be in [{lo:g}, {hi:g}] (a plausible range), got {value!r}")
+        return value
+
+
+#: (lowest, highest) of each number of a pulse request (shared_schema.rules).
+_PULSE_RANGES: Dict[str, Tuple[float, float]] = {
+    "p_eq": P_EQ_RANGE,
+    "lam": LAM_RANGE,
+    "f_p": F_P_RANGE,
+    "a_p_g": (-A_P_G_MAX, A_P_G_MAX),
+}
 
 
 class RecordSamples(BaseModel):
@@ -323,11 +372,24 @@ class Eq28Request(BaseModel):
     sa_g: Optional[float] = Field(None, description="Spectral acceleration S_a(T_n) [g], >= 0.")
     pga_g: Optional[float] = Field(None, description="Peak ground acceleration [g], > 0.")
     record: Optional[RecordSamples] = Field(
-        None, description="A record instead of sa_g and pga_g (needs f_n)."
+        None,
+        description="A record instead of sa_g and pga_g (needs f_n); one sample at least "
+        f"must be of magnitude {ACCEL_MIN:g} or more, in its units (a peak ground "
+        "acceleration).",
     )
     f_n: Optional[float] = Field(
         None, description="Natural frequency of the structure [Hz], > 0 (with record)."
     )
+
+    @model_validator(mode="after")
+    def _record_has_a_pga(self) -> "Eq28Request":
+        if self.record is not None and not any(abs(a) >= ACCEL_MIN for a in self.record.accel):
+            raise InputError(
+                f"needs a sample of magnitude {ACCEL_MIN:g} at least (a peak ground "
+                "acceleration) for Eq. 28",
+                "record.accel",
+            )
+        return self
 
 
 class Ec8Request(BaseModel):

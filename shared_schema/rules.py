@@ -26,11 +26,16 @@ from typing import Dict, NamedTuple, Optional, Sequence, Tuple, Union
 from shared_schema.errors import InputError
 
 __all__ = [
+    "ACCEL_MIN",
+    "A_P_G_MAX",
     "BODY_SIZE_PLAUSIBLE",
     "COORDINATE_LIMIT",
     "CRITERIA",
+    "F_P_RANGE",
+    "LAM_RANGE",
     "LENGTH_UNITS",
     "PULSE_SHAPES",
+    "P_EQ_RANGE",
     "QUANTITY_RANGES",
     "RECORD_FORMATS",
     "RECORD_UNITS",
@@ -102,6 +107,27 @@ CRITERIA: Tuple[str, ...] = ("ratio", "exact")
 
 #: One-cycle acceleration pulse shapes.
 PULSE_SHAPES: Tuple[str, ...] = ("sine", "cosine")
+
+# Plausible ranges of the numbers a pulse request gives directly (the REST service's
+# ``/pulse``; its OpenAPI schema states them). Each bound lies far past any masonry body and
+# any ground-motion pulse, so no real case is refused; inside them the closed forms stay
+# far from overflow and a pulse takes at most ``P_EQ_RANGE[1] / F_P_RANGE[0]`` = 1e6
+# closed-form steps, within the service's work bound at its default settings
+# (``20 x ROCKMECH_MAX_SAMPLES`` = 1e7; a test checks).
+
+#: Frequency parameter ``p_eq`` [rad/s]: a block of half-diagonal ``R = 3 g / (4 p²)`` from
+#: 74 km down to 7 µm (the top is ``core.exact.P_EQ_PLAUSIBLE``; a test checks the copy).
+P_EQ_RANGE: Tuple[float, float] = (1e-2, 1e3)
+#: Static load multiplier ``lam`` [-]: a block's slenderness ``b/h`` from 1/1000 to 100.
+LAM_RANGE: Tuple[float, float] = (1e-3, 1e2)
+#: Pulse frequency ``f_p`` [Hz]: pulses of 1000 s down to 1 ms.
+F_P_RANGE: Tuple[float, float] = (1e-3, 1e3)
+#: Largest pulse amplitude ``|a_p_g|`` [g]; with ``LAM_RANGE`` the ratio to the uplift
+#: acceleration stays below ``core.exact.MAX_AMPLITUDE_RATIO``.
+A_P_G_MAX = 1e2
+#: A record used for Eq. 28 needs a peak ground acceleration: one sample at least this large
+#: in magnitude [in the record's units] (smaller ones could round to zero when converted).
+ACCEL_MIN = 1e-300
 
 
 def check_number(

@@ -24,6 +24,7 @@ from typer.core import TyperGroup, TyperOption
 
 from rhino_plugin.mechanisms.build import MechanismFailure
 from rockmech._version import __version__
+from shared_schema.atomic import remove_stale_temps
 from shared_schema.errors import RockmechError
 from shared_schema.extras import MissingExtra, extra_for, require
 from shared_schema.io import save_constants
@@ -52,7 +53,13 @@ from .workflows.inputs import (
     read_record,
     read_record_spec,
 )
-from .workflows.limits import CLI_BUDGET_S, DEFAULT_LIMITS, check_run
+from .workflows.limits import (
+    CLI_BUDGET_S,
+    DEFAULT_LIMITS,
+    TimeLimitExceeded,
+    check_run,
+)
+from .workflows.limits import time_limit as run_time_limit
 from .workflows.outputs import finite_json, write_envelope, write_history, write_ida, write_record
 from .workflows.rundir import check_file_target, check_folder_target, os_reason, run_folder
 from .workflows.scaling import Building
@@ -181,7 +188,11 @@ def _user_errors(fn: F) -> F:
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
-            return fn(*args, **kwargs)
+            _clean_stale_temps(kwargs)
+            with run_time_limit(None if kwargs.get("no_limits") else kwargs.get("time_limit")):
+                return fn(*args, **kwargs)
+        except TimeLimitExceeded as exc:
+            _fail(str(exc))
         except RockmechError as exc:
             _fail(str(exc))
         except OSError as exc:
@@ -197,6 +208,16 @@ def _user_errors(fn: F) -> F:
             _fail(f"{name} is not installed; reinstall rockmech (pip install rockmech)")
 
     return wrapper  # type: ignore[return-value]
+
+
+def _clean_stale_temps(kwargs: dict[str, Any]) -> None:
+    """Remove temporary files of killed runs beside this run's outputs, with a note each."""
+    for key in ("out", "output"):
+        target = kwargs.get(key)
+        if isinstance(target, Path):
+            for folder in dict.fromkeys((target.parent, target)):
+                for path in remove_stale_temps(folder):
+                    _note(f"note: removed {path}, a temporary file left by a run that was killed")
 
 
 @contextlib.contextmanager
@@ -399,7 +420,15 @@ _NO_LIMITS_OPT = typer.Option(
     help=f"Lift the size limits, the REST service's: {DEFAULT_LIMITS['max_samples']} record "
     f"samples, periods or frequencies, {DEFAULT_LIMITS['max_scales']} scale factors, "
     f"{DEFAULT_LIMITS['max_mechanisms']} mechanisms, work that cannot finish in "
-    f"{CLI_BUDGET_S:g} s.",
+    f"{CLI_BUDGET_S:g} s of work, and the time limit.",
+)
+_TIME_LIMIT_OPT = typer.Option(
+    CLI_BUDGET_S,
+    "--time-limit",
+    metavar="S",
+    help="Stop a run that takes longer than S seconds (exit status 2, outputs left as they "
+    "were); work that cannot finish in S seconds is refused up front. The REST service's "
+    "is ROCKMECH_COMPUTE_TIMEOUT_S.",
 )
 
 
@@ -464,6 +493,7 @@ def history(
         "history_record.png (record, largest pulse and spectrum).",
     ),
     no_limits: bool = _NO_LIMITS_OPT,
+    time_limit: float = _TIME_LIMIT_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Time history of every mechanism in CONSTANTS under RECORD at each scale factor."""
@@ -544,6 +574,7 @@ def record_info(
         None, "--out", help="Folder for record.json and record.png (record and spectrum)."
     ),
     no_limits: bool = _NO_LIMITS_OPT,
+    time_limit: float = _TIME_LIMIT_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Describe a record: metadata, largest sine pulses and exact response spectrum."""
@@ -647,9 +678,11 @@ def ida(
         None, "--out", help="Folder for ida.json, ida.csv and ida.png (fragility curves)."
     ),
     no_limits: bool = _NO_LIMITS_OPT,
+    time_limit: float = _TIME_LIMIT_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Incremental dynamic analysis: overturned fraction per intensity and fragility fits."""
+    # long: 21 options (57 lines of signature), the progress bar and the summary table
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
@@ -815,6 +848,7 @@ def envelope(
     channel: Optional[str] = _CHANNEL_OPT,
     component: Optional[str] = _COMPONENT_OPT,
     no_limits: bool = _NO_LIMITS_OPT,
+    time_limit: float = _TIME_LIMIT_OPT,
     as_json: bool = typer.Option(False, "--json", help="Also print the JSON document."),
 ) -> None:
     """Minimum overturning sine-pulse amplitude of every mechanism, and the critical bands."""
@@ -995,6 +1029,7 @@ def report(
     exact: bool = typer.Option(False, "--exact", help="Exact envelopes, not the library."),
     title: Optional[str] = typer.Option(None, "--title", help="Title of the report."),
     no_limits: bool = _NO_LIMITS_OPT,
+    time_limit: float = _TIME_LIMIT_OPT,
 ) -> None:
     """One self-contained HTML report: constants, envelopes, and with --record its histories."""
     scales = _scales(scale, ctx.args)

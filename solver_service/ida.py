@@ -257,7 +257,12 @@ def _collect(
                 for future in as_completed(pending):
                     yield pending[future], future.result()
 
-            results = _gather(tasks, len(payloads), finished_local, progress)
+            try:
+                results = _gather(tasks, len(payloads), finished_local, progress)
+            except BaseException:
+                # Stopped (time limit, Ctrl+C): drop the queued tasks, wait for the running ones.
+                pool.shutdown(wait=False, cancel_futures=True)
+                raise
         return results, {"kind": "local", "jobs": n_jobs, "tasks": len(tasks)}
     # Checked before anything else touches dask: a missing extra names its install line.
     distributed = require("dask.distributed", "dask", "for ida --scheduler")

@@ -33,6 +33,7 @@ FLOORS = {
     "solver_service.core": 1,
     "rhino_plugin.geometry": 1,
     "rhino_plugin.mechanisms": 1,
+    "rhino_plugin.archive_3dm": 1,
     "rhino_plugin.scene_base": 1,
     "rhino_plugin.scene_3dm": 1,
     "rhino_plugin.scene_mesh": 1,

@@ -21,6 +21,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Union
 
+from shared_schema.atomic import pid_alive
 from shared_schema.errors import InputError
 
 __all__ = ["check_file_target", "check_folder_target", "os_reason", "run_folder", "stale_folders"]
@@ -28,16 +29,6 @@ __all__ = ["check_file_target", "check_folder_target", "os_reason", "run_folder"
 #: Suffixes of the sibling folders of a run in progress and of the folder it replaces.
 TMP_SUFFIX = ".tmp"
 OLD_SUFFIX = ".old"
-
-
-def _pid_alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # another user's process: alive
-        return True
-    return True
 
 
 def stale_folders(out: Path) -> list[Path]:
@@ -51,7 +42,7 @@ def stale_folders(out: Path) -> list[Path]:
         if not name.startswith(prefix) or not name.endswith((TMP_SUFFIX, OLD_SUFFIX)):
             continue
         pid_text = name[len(prefix) :].rsplit(".", 1)[0]
-        if pid_text.isdigit() and not _pid_alive(int(pid_text)):
+        if pid_text.isdigit() and not pid_alive(int(pid_text)):
             found.append(path)
     return found
 
@@ -139,6 +130,10 @@ def run_folder(out: Union[str, Path], field: str = "out") -> Iterator[Path]:
                 os.replace(old, target)
         raise InputError(f"cannot write to {target}: {os_reason(exc)}", field) from None
     except BaseException:
+        # Interrupted (Ctrl+C, the time limit) between the two renames: the old run is kept.
         _remove(tmp)
+        if old.exists() and not target.exists():
+            with contextlib.suppress(OSError):
+                os.replace(old, target)
         raise
     _remove(old)

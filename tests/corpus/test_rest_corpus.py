@@ -636,8 +636,6 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     },
     **{f"{ep}-deeply-nested": {"problem": "nested deeper than 200 levels"} for ep in BODIES},
     "pulse-empty-body": {"problem": "send a JSON object with p_eq, lam, a_p_g and f_p$"},
-    # the run's length is p_eq / f_p: naming either is right
-    "pulse-p_eq-1e300": {"field": "p_eq|f_p", "problem": "steps|at most"},
     "pulse-eta-2": {"problem": r"\[-1, 1\]"},
     "pulse-number-400-digits": {"problem": "valid number|range|finite"},
     **{

@@ -234,7 +234,6 @@ def test_a_record_without_units_gets_the_cli_message(client: httpx.Client, tmp_p
 @pytest.mark.parametrize(
     ("endpoint", "body"),
     [
-        ("/api/v1/pulse", {**PULSE, "p_eq": 1e300, "f_p": 1e-300}),
         (
             "/api/v1/history",
             {

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Request, Response
 
+from rhino_plugin.archive_3dm import check_3dm
 from shared_schema.api import ConstantsResponse
 from shared_schema.errors import InputError
 
@@ -13,7 +14,7 @@ from ..forms import FORMS, parse_form, read_form, read_upload
 from ..jobspec import SceneJob
 from ..openapi import body_doc, responses
 from ..problems import Problem
-from ..uploads import check_3dm, safe_filename
+from ..uploads import safe_filename
 
 __all__ = ["router"]
 
