@@ -130,12 +130,15 @@ SIDE_PHIOV = 2
 NSIDE = 3
 
 # Rules of one run: the (NRULE,) array ``rules``.
+#: Restitution at an impact after which the body rocks on side +1 (the one-sided rebound).
 RULE_ETA = 0
 RULE_ONE_SIDED = 1
 RULE_V_REST = 2
 RULE_MAX_IMPACTS = 3
 RULE_P_MAX = 4
-NRULE = 5
+#: Restitution at an impact after which the body rocks on side -1 (two-sided).
+RULE_ETA_NEG = 5
+NRULE = 6
 
 # A closed-form flight: the (NFL,) array ``fl`` holds the cell and the anchor state.
 FL_KIND = 0
@@ -704,11 +707,16 @@ def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace):
 
 
 @_leaf
+def _eta_into(rules, s_new):
+    """Restitution of a two-sided impact after which the body rocks on side ``s_new``."""
+    return rules[RULE_ETA] if s_new > 0.0 else rules[RULE_ETA_NEG]
+
+
+@_leaf
 def _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log):
     """Impact at ``ta + tau_imp``: restitution, side change, rest rule, error saltation."""
     s = fl[FL_S]
     p = fl[FL_P]
-    eta = rules[RULE_ETA]
     v_rest_rel = rules[RULE_V_REST]
     _xi, vi, ai, _ji = _state(fl, tau_imp)
     ex = EPS * (abs(fl[FL_XA]) + 1.0 + abs(fl[FL_KS] * fl[FL_C0]))
@@ -719,11 +727,11 @@ def _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log):
     if rules[RULE_ONE_SIDED] != 0.0:
         s_new = s
         row_new = row
-        c_imp = eta
+        c_imp = rules[RULE_ETA]
     else:
         s_new = -s
         row_new = 1 - row
-        c_imp = eta * (sides[row, SIDE_PHIOV] / sides[row_new, SIDE_PHIOV])
+        c_imp = _eta_into(rules, s_new) * (sides[row, SIDE_PHIOV] / sides[row_new, SIDE_PHIOV])
     p_new = sides[row_new, SIDE_P]
     v_new = c_imp * vi
     acc_new = p_new * p_new * (-s_new - sides[row_new, SIDE_KS] * _accel(cell, t)[0])
@@ -827,8 +835,9 @@ def _free_tail(st, sides, rules):
     p_s = sides[row, SIDE_P]
     p_o = sides[1 - row, SIDE_P]
     r_so = sides[row, SIDE_PHIOV] / sides[1 - row, SIDE_PHIOV]
-    eta = rules[RULE_ETA]
     one_sided = rules[RULE_ONE_SIDED] != 0.0
+    # The next impact, the only one that can matter (theory §1.8), leads into side -s.
+    eta = rules[RULE_ETA] if one_sided else _eta_into(rules, -s)
     v_rest = rules[RULE_V_REST] * (p_s if one_sided else p_o)
     col, dt_cross, pk, dt_pk = _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest)
     if col:
@@ -943,7 +952,11 @@ def _simulate_into(st, fl, cells, sides, rules, x0, trace, log):
 
 @_jit
 def _run_constants(params, scale, v_rest_rel, max_impacts):
-    """Return ``sides`` and ``rules`` of one run (``params`` as in ``simulate_cells``)."""
+    """Return ``sides`` and ``rules`` of one run (``params`` as in ``simulate_cells``).
+
+    ``params`` has 8 entries (one restitution for both impact directions) or 10 (then
+    entries 8 and 9 are the restitution into side -1 and into side +1).
+    """
     sides = np.empty((2, NSIDE))
     sides[0, SIDE_P] = params[0]
     sides[1, SIDE_P] = params[1]
@@ -952,7 +965,8 @@ def _run_constants(params, scale, v_rest_rel, max_impacts):
     sides[0, SIDE_PHIOV] = params[4]
     sides[1, SIDE_PHIOV] = params[5]
     rules = np.empty(NRULE)
-    rules[RULE_ETA] = params[6]
+    rules[RULE_ETA] = params[9] if params.shape[0] >= 10 else params[6]
+    rules[RULE_ETA_NEG] = params[8] if params.shape[0] >= 10 else params[6]
     rules[RULE_ONE_SIDED] = 1.0 if params[7] != 0.0 else 0.0
     rules[RULE_V_REST] = v_rest_rel
     rules[RULE_MAX_IMPACTS] = max_impacts
@@ -1216,8 +1230,10 @@ def simulate_cells(cells, params, scale, x0, v_rest_rel, max_impacts, trace):
     ----------
     cells : (7, n) float
         Rows ``kind, c0, c1, c2, t_start, t_end, amax_after`` (see ``CELL_ROWS``).
-    params : (8,) float
-        ``p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided``.
+    params : (8,) or (10,) float
+        ``p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided`` and
+        optionally ``eta_to_negative, eta_to_positive``, the restitution at an impact into
+        side -1 and +1 (two-sided; without them ``eta`` serves both).
     scale, x0, v_rest_rel, max_impacts
         Scale factor [-], initial ratio [-], rest rule [-], impact cap (see ``_simulate``).
     trace : (2, m) float
@@ -1246,7 +1262,8 @@ def simulate_cells_logged(cells, params, scale, x0, v_rest_rel, max_impacts, tra
 def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
     """Run every mechanism (rows of ``params``) at every scale; return (m, k, NOUT).
 
-    ``params[i] = (p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided)``.
+    ``params[i] = (p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided)``,
+    optionally followed by ``eta_to_negative, eta_to_positive`` (``simulate_cells``).
     The work is split in tasks of one mechanism × up to ``BLOCK`` scales
     (``_simulate_block``), run in parallel; the distinct cell widths are found once.
     """
@@ -1337,17 +1354,29 @@ def pulse_collapses(amp, omega, phase, quarter_cells, work):
 
 
 @_jit
-def pulse_work(eta, one_sided, v_rest_rel, quarter_cells):
-    """Scratch of ``pulse_collapses`` for a restitution and rest rule (any amplitude, Omega)."""
-    params = np.array([1.0, 1.0, 1.0 / G, 1.0 / G, 1.0, 1.0, eta, 1.0 if one_sided else 0.0])
+def pulse_work(eta, one_sided, v_rest_rel, quarter_cells, eta_neg=math.nan):
+    """Scratch of ``pulse_collapses`` for a restitution and rest rule (any amplitude, Omega).
+
+    ``eta`` is the restitution of impacts into side +1 and ``eta_neg`` of those into side -1
+    (NaN: ``eta`` for both).
+    """
+    e_neg = eta if math.isnan(eta_neg) else eta_neg
+    params = np.array(
+        [1.0, 1.0, 1.0 / G, 1.0 / G, 1.0, 1.0, eta, 1.0 if one_sided else 0.0, e_neg, eta]
+    )
     sides, rules = _run_constants(params, 1.0, v_rest_rel, 1_000_000)
     cells = np.empty((len(CELL_ROWS), 4 * quarter_cells))
     return cells, sides, rules, np.empty(NST), np.empty(NFL), np.empty((2, 0)), np.empty((4, 0))
 
 
 @_jit_parallel
-def boundary_grid(omegas, eta, one_sided, sign, phase, a_scan, rtol, max_edges, v_rest_rel):
+def boundary_grid(
+    omegas, eta, one_sided, sign, phase, a_scan, rtol, max_edges, v_rest_rel, eta_neg=math.nan
+):
     """Overturning edges in A for every Omega: scan ``a_scan`` and bisect each change.
+
+    ``eta_neg`` is the restitution of impacts into side -1 when it differs from ``eta``
+    (which then serves the impacts into side +1); NaN: ``eta`` for both.
 
     Returns ``(edges, n_edges, collapsed_at_first)``: ``edges[i, :n_edges[i]]`` are the
     amplitudes ``a_p/(g lam)`` where the outcome changes at ``omegas[i]`` (relative width
@@ -1362,7 +1391,7 @@ def boundary_grid(omegas, eta, one_sided, sign, phase, a_scan, rtol, max_edges, 
     order = np.argsort((np.arange(n_om) * 0.6180339887498949) % 1.0)
     for c in _prange(n_om):
         i = order[c]
-        work = pulse_work(eta, one_sided, v_rest_rel, 1)
+        work = pulse_work(eta, one_sided, v_rest_rel, 1, eta_neg)
         om = omegas[i]
         prev = pulse_collapses(sign * a_scan[0], om, phase, 1, work)
         first[i] = prev

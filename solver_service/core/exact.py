@@ -9,7 +9,8 @@ Rules (all documented in theory §1.8 and §10):
 
 * uplift from rest when the drive exceeds the static multiplier, ``-a_g > g lam+`` or
   ``a_g > g lam-``; the crossing time is exact;
-* at an impact the angular velocity is multiplied by ``eta`` (and by
+* at an impact the angular velocity is multiplied by ``eta`` (by the restitution of the
+  direction entered, ``RockingModel.eta_into``, when the two directions differ; and by
   ``phi_ov_old/phi_ov_new`` in the normalised variable, for asymmetric mechanisms);
   one-sided mechanisms rebound (``eta <= 0``) and stay on the positive side;
 * **rest rule**: an impact whose outgoing speed is below ``V_REST_REL * p`` ends in rest.
@@ -272,6 +273,8 @@ def _params(model: RockingModel) -> NDArray[np.float64]:
             neg.phi_ov,
             model.require_eta(),
             1.0 if model.one_sided else 0.0,
+            model.eta_into(-1),
+            model.eta_into(1),
         ]
     )
 

@@ -43,7 +43,9 @@ def free_rocking(
     r_so : float
         ``phi_ov`` of the current side over ``phi_ov`` of the opposite side [-].
     eta : float
-        Coefficient of restitution [-] (<= 0 for one-sided rocking).
+        Coefficient of restitution [-] of the next impact (<= 0 for one-sided rocking): for
+        two-sided rocking the value into the opposite side (``RockingModel.eta_into(-s)``);
+        later impacts cannot change the outcome.
     one_sided : bool
         One-sided rocking: impacts keep the body on side +1.
     v_rest : float
