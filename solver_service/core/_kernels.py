@@ -55,7 +55,7 @@ try:  # numba is optional: without it the same code runs as plain Python.
     import numba as _numba
 
     def _jit(fn):
-        return _numba.njit(cache=True, nogil=True)(fn)
+        return _numba.njit(cache=True, nogil=True, error_model="numpy")(fn)
 
     def _jit_parallel(fn):
         return _numba.njit(cache=True, nogil=True, parallel=True)(fn)
@@ -63,7 +63,10 @@ try:  # numba is optional: without it the same code runs as plain Python.
     def _leaf(fn):
         # Helpers that allocate nothing run without the reference counting of their array
         # arguments, which would otherwise cost more than the arithmetic of a step.
-        options: dict[str, Any] = {"_nrt": False}  # not in numba's type stubs
+        options: dict[str, Any] = {
+            "_nrt": False,
+            "error_model": "numpy",
+        }  # not in numba's type stubs
         return _numba.njit(cache=True, nogil=True, **options)(fn)
 
     _prange: Any = _numba.prange
@@ -325,37 +328,80 @@ def _sgn(z):
 
 @_leaf
 def _component(which, target, fl, t):
-    """Return function ``which`` (0: x - target, 1: x', 2: x'') at ``t`` and two derivatives.
+    """Return function ``which`` (0: x - target, 1: x', 2: x''), 2 derivatives, |3rd| bound.
 
-    The second derivative is returned as 0 for ``which == 2`` (Newton's step, not Halley's).
+    The second derivative is returned as 0 for ``which == 2`` (Newton's step, not Halley's),
+    and the bound as infinite there (no a-priori stop). For ``which == 1`` the third
+    derivative is ``x'''' = p**2 (x'' - q'')``, bounded with ``|q''| <= w**2 max|q|`` in a
+    sinusoidal cell (``q'' = 0`` in a linear one).
     """
     x, v, acc, jerk = _state(fl, t)
     if which == 0:
-        return x - target, v, acc
+        return x - target, v, acc, abs(jerk)
     if which == 1:
-        return v, acc, jerk
-    return acc, jerk, 0.0
+        p2 = fl[FL_P] * fl[FL_P]
+        qdd = 0.0 if fl[FL_KIND] == 0 else fl[FL_C1] * fl[FL_C1] * abs(fl[FL_KS] * fl[FL_C0])
+        return v, acc, jerk, p2 * (abs(acc) + qdd)
+    return acc, jerk, 0.0, math.inf
 
 
 @_leaf
-def _root(which, target, fl, lo, hi, sig_lo, f_lo, f_hi):
+def _taylor_start(f, fp, fpp, t, lo, hi):
+    """Start for a root in ``(lo, hi)`` from the value and two derivatives at ``t``.
+
+    The root of ``f + fp d + fpp d**2 / 2`` nearest to ``t`` that lies inside the bracket,
+    computed without cancellation; NaN when there is none.
+    """
+    best = math.nan
+    if fpp == 0.0:
+        if fp != 0.0:
+            best = t - f / fp
+    else:
+        disc = fp * fp - 2.0 * fpp * f
+        if disc < 0.0:
+            return math.nan
+        # The sign of fp (of -f when fp is 0) keeps the result odd under (f, fp, fpp) -> -(...).
+        q = -0.5 * (fp + math.copysign(math.sqrt(disc), fp if fp != 0.0 else -f))
+        d1 = 2.0 * q / fpp
+        d2 = f / q if q != 0.0 else math.nan
+        if lo < t + d1 < hi:
+            best = t + d1
+        if lo < t + d2 < hi and not abs(d2) >= abs(best - t):
+            best = t + d2
+    if lo < best < hi:
+        return best
+    return math.nan
+
+
+#: An iterate is final when the a-priori bound on the next Halley correction, times this
+#: factor, is below the time tolerance (Halley converges cubically).
+APRIORI_SAFETY = 16.0
+
+
+@_leaf
+def _root(which, target, fl, lo, hi, sig_lo, f_lo, f_hi, t0):
     """Zero of component ``which`` (0: x - target, 1: x', 2: x'') of flight ``fl`` in ``[lo, hi]``.
 
     ``sig_lo`` is the sign of the function just right of ``lo``; the function is assumed to
-    change sign once in the bracket. ``f_lo``, ``f_hi`` are its values at the ends when known
-    (NaN otherwise) and give a regula-falsi start. Safeguarded Halley iteration (Newton for
+    change sign once in the bracket. ``t0`` is a start inside the bracket (a Taylor estimate,
+    ``_taylor_start``) or NaN; without one, ``f_lo``, ``f_hi`` (values at the ends when known,
+    NaN otherwise) give a regula-falsi start. Safeguarded Halley iteration (Newton for
     ``x''``): a step is taken when it stays inside the bracket and shrinks fast enough,
-    otherwise bisection.
+    otherwise bisection. It stops when the bracket or the step is below the time resolution,
+    or when the a-priori bound ``C d**3`` on the next correction is
+    (``C = f''**2/(4 f'**2) + |f'''|/(6 |f'|)``, ``d`` the step just taken).
     Returns the root (time offset from the anchor).
     """
     t = 0.5 * (lo + hi)
-    if f_lo - f_hi != 0.0 and math.isfinite(f_lo - f_hi):
+    if lo < t0 < hi:
+        t = t0
+    elif f_lo - f_hi != 0.0 and math.isfinite(f_lo - f_hi):
         t = lo + (hi - lo) * min(max(f_lo / (f_lo - f_hi), 0.01), 0.99)
     width = hi - lo
     # Absolute time cannot be resolved finer than a few ulps of ta + t.
     tol = 4.0 * EPS * (abs(fl[FL_TA]) + abs(hi))
     for _ in range(ROOT_MAXITER):
-        f, fp, fpp = _component(which, target, fl, t)
+        f, fp, fpp, c3 = _component(which, target, fl, t)
         if f == 0.0:
             return t
         if _sgn(f) == sig_lo:
@@ -371,6 +417,10 @@ def _root(which, target, fl, lo, hi, sig_lo, f_lo, f_hi):
             width = abs(tn - t)
             if width <= tol:
                 return tn
+            if fp != 0.0:
+                r = fpp / (2.0 * fp)
+                if APRIORI_SAFETY * (r * r + c3 / (6.0 * abs(fp))) * width**3 <= tol:
+                    return tn
             t = tn
         else:
             width = hi - lo
@@ -399,11 +449,12 @@ def _side_sign_left(v, acc, jerk):
 
 
 @_leaf
-def _velocity_zeros(fl, aa, big_h, sig_a, qd_sign):
+def _velocity_zeros(fl, aa, ja, big_h, sig_a, qd_sign):
     """Interior zeros of x' on ``(0, big_h)``: returns ``(n, z1, z2, x(big_h), x'(big_h))``.
 
-    ``aa`` is x'' at the anchor and ``sig_a`` the sign of x' just after it; ``qd_sign`` the
-    constant sign of q' on the stretch (0 when q is constant). See the module docstring.
+    ``aa``, ``ja`` are x'' and x''' at the anchor (Taylor starts of the searches) and
+    ``sig_a`` the sign of x' just after it; ``qd_sign`` the constant sign of q' on the
+    stretch (0 when q is constant). See the module docstring.
     """
     va = fl[FL_VA]
     xb, vb, ab, jb = _state(fl, big_h)
@@ -418,15 +469,19 @@ def _velocity_zeros(fl, aa, big_h, sig_a, qd_sign):
         n = 0
     elif sig_a != sig_b:
         n = 1
-        z1 = _root(1, 0.0, fl, 0.0, big_h, sig_a, va, vb)
+        t1 = _taylor_start(va, aa, ja, 0.0, 0.0, big_h)
+        z1 = _root(1, 0.0, fl, 0.0, big_h, sig_a, va, vb, t1)
     elif sig_a != hump and _sgn(aa) == hump and _sgn(ab) == -hump:
         # x' has sign -hump at both ends and x'' turns from hump to -hump: it may dip.
-        m = _root(2, 0.0, fl, 0.0, big_h, hump, aa, ab)
-        vm = _state(fl, m)[1]
+        tm = _taylor_start(aa, ja, 0.0, 0.0, 0.0, big_h)
+        m = _root(2, 0.0, fl, 0.0, big_h, hump, aa, ab, tm)
+        _xm, vm, am, jm = _state(fl, m)
         if _sgn(vm) == hump:
             n = 2
-            z1 = _root(1, 0.0, fl, 0.0, m, sig_a, va, vm)
-            z2 = _root(1, 0.0, fl, m, big_h, hump, vm, vb)
+            t1 = _taylor_start(va, aa, ja, 0.0, 0.0, m)
+            z1 = _root(1, 0.0, fl, 0.0, m, sig_a, va, vm, t1)
+            t2 = _taylor_start(vm, am, jm, m, m, big_h)
+            z2 = _root(1, 0.0, fl, m, big_h, hump, vm, vb, t2)
     return n, z1, z2, xb, vb
 
 
@@ -667,33 +722,42 @@ def _rest_step(st, cell, sides, rules, tb, trace):
 
 
 @_leaf
-def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace):
+def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, acc_a, trace):
     """Walk the monotone pieces ``[0, z1], [z1, z2], [z2, H]`` of x in the flight ``fl``.
 
     Records turning points, the first ``|x| = 1`` crossing and the peak. Returns the time
-    offset of the impact (``x = 0``) from the anchor, or -1 when there is none.
+    offset of the impact (``x = 0``) from the anchor, or -1 when there is none. ``acc_a``
+    is x'' at the anchor: with x, x' and x'' at the left end of a piece, a Taylor estimate
+    starts each search in it.
     """
     s = fl[FL_S]
     ta = fl[FL_TA]
     tau_l = 0.0
-    sx_l = s * fl[FL_XA]
+    x_l = fl[FL_XA]
+    v_l = fl[FL_VA]
+    a_l = acc_a
     for piece in range(nz + 1):
+        vr = 0.0
+        ar = 0.0
         if piece < nz:
             tau_r = z1 if piece == 0 else z2
-            xr = _state(fl, tau_r)[0]
+            xr, vr, ar, _jr = _state(fl, tau_r)
             if s * xr >= 0.0:  # turning point
                 _record(st, trace, ta + tau_r, xr)
         else:
             tau_r = big_h
             xr = xb
+        sx_l = s * x_l
         sx_r = s * xr
         if sx_r < 0.0:
             # Impact in (tau_l, tau_r]: s*x falls through 0 on a monotone piece.
             if sx_l <= 0.0:
                 return tau_l
-            return _root(0, 0.0, fl, tau_l, tau_r, s, s * sx_l, xr)
+            t0 = _taylor_start(x_l, v_l, a_l, tau_l, tau_l, tau_r)
+            return _root(0, 0.0, fl, tau_l, tau_r, s, x_l, xr, t0)
         if sx_r >= 1.0 and sx_l < 1.0 and math.isnan(st[ST_T_CROSS]):
-            tc = _root(0, s, fl, tau_l, tau_r, -s, s * sx_l - s, xr - s)
+            t0 = _taylor_start(x_l - s, v_l, a_l, tau_l, tau_l, tau_r)
+            tc = _root(0, s, fl, tau_l, tau_r, -s, x_l - s, xr - s, t0)
             st[ST_T_CROSS] = ta + tc
             if math.isnan(st[OUT_T_EXCEED]):
                 st[OUT_T_EXCEED] = ta + tc
@@ -702,7 +766,9 @@ def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace):
             st[OUT_T_PEAK] = ta + tau_r
             st[ST_VAR_PEAK] = st[ST_PXX]
         tau_l = tau_r
-        sx_l = sx_r
+        x_l = xr
+        v_l = vr
+        a_l = ar
     return -1.0
 
 
@@ -815,8 +881,8 @@ def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
     sig_a = _side_sign_right(va, acc_a, jerk_a)
     if xa == 0.0 and va == 0.0:
         sig_a = s  # uplift: the drive exceeds the threshold, motion is outward
-    nz, z1, z2, xb, vb = _velocity_zeros(fl, acc_a, big_h, sig_a, qd_sign)
-    tau_imp = _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace)
+    nz, z1, z2, xb, vb = _velocity_zeros(fl, acc_a, jerk_a, big_h, sig_a, qd_sign)
+    tau_imp = _scan_pieces(st, fl, nz, z1, z2, xb, big_h, acc_a, trace)
     if tau_imp >= 0.0:
         _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log)
         return False
