@@ -855,6 +855,48 @@ def _advance(st, fl, xb, vb, tb, amax_after, trace):
         st[OUT_STATUS] = 1
 
 
+#: Most Halley iterations of the short-flight search before it leaves the flight to the
+#: general scan (it converges in one or two from its Taylor start).
+SHORT_MAXITER = 6
+
+
+@_leaf
+def _short_return(st, fl, va, acc_a, big_h):
+    """Time of the return to ``x = 0`` of a flight leaving ``x = 0`` outward, or -1.
+
+    For the flights of a chattering sequence, without the general scan of the step. From
+    the Taylor start ``-2 x'/x''`` Halley's iteration (a-priori stop as in ``_root``) finds
+    a zero ``tau`` of x in ``(0, big_h)`` at which x' points inward. In a linear cell x' has
+    at most two zeros (module docstring), and it changes sign an odd number of times on
+    ``(0, tau)``: once. So x is unimodal there and ``tau`` is the first return; its top is
+    bounded by the maximum-principle bound of ``_no_event``. Returns -1 (the caller takes
+    the general path, nothing is changed) when the iteration leaves the step or does not
+    settle, or when the top could raise the peak or reach 1.
+    """
+    s = fl[FL_S]
+    t = _taylor_start(0.0, va, acc_a, 0.0, 0.0, big_h)
+    if not t > 0.0:
+        return -1.0
+    tol = 4.0 * EPS * (abs(fl[FL_TA]) + abs(big_h))
+    for _ in range(SHORT_MAXITER):
+        f, fp, fpp, c3 = _component(0, 0.0, fl, t)
+        den = 2.0 * fp * fp - f * fpp
+        if not (s * fp < 0.0 and den != 0.0):
+            return -1.0
+        tn = t - 2.0 * f * fp / den
+        if not 0.0 < tn < big_h:
+            return -1.0
+        width = abs(tn - t)
+        r = fpp / (2.0 * fp)
+        if width <= tol or APRIORI_SAFETY * (r * r + c3 / (6.0 * abs(fp))) * width**3 <= tol:
+            top = max(s * va * t, s * f - s * fp * t)
+            if top + BOUND_MARGIN < min(st[OUT_PEAK], 1.0):
+                return tn
+            return -1.0
+        t = tn
+    return -1.0
+
+
 @_leaf
 def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
     """Closed-form flight from the current state to ``tb`` or to the first impact.
@@ -881,6 +923,12 @@ def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
     sig_a = _side_sign_right(va, acc_a, jerk_a)
     if xa == 0.0 and va == 0.0:
         sig_a = s  # uplift: the drive exceeds the threshold, motion is outward
+    elif xa == 0.0 and s * va > 0.0 and cell[0] == 0 and trace.shape[1] == 0:
+        # Leaving an impact (chattering): no turning point to record, none to search.
+        tau_imp = _short_return(st, fl, va, acc_a, big_h)
+        if tau_imp > 0.0:
+            _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log)
+            return False
     nz, z1, z2, xb, vb = _velocity_zeros(fl, acc_a, jerk_a, big_h, sig_a, qd_sign)
     tau_imp = _scan_pieces(st, fl, nz, z1, z2, xb, big_h, acc_a, trace)
     if tau_imp >= 0.0:
