@@ -1127,19 +1127,16 @@ def _propagator(prop, sides, h):
 
 
 @_leaf
-def _fast_rest(st, ksp, ksn, j, cell, one_sided):
+def _fast_rest(st, ksp, ksn, j, a_lo, a_hi, one_sided):
     """Return True when run ``j`` at rest stays at rest through a linear cell (no uplift).
 
     The drive is linear in the cell, so ``g = -s ks a`` stays at or below 1 when it does at
-    both ends (``_uplift_time``); a held rest needs no test.
+    both ends (``_uplift_time``), that is at the lower end value ``a_lo`` for side +1 and
+    the upper ``a_hi`` for side -1; a held rest needs no test.
     """
-    if st[ST_T, j] < st[ST_HOLD, j]:
+    if -ksp[j] * a_lo <= 1.0 and (one_sided or ksn[j] * a_hi <= 1.0):
         return True
-    a_t = cell[1] + cell[2] * (cell[4] - cell[4])
-    a_b = cell[1] + cell[2] * (cell[5] - cell[4])
-    if -ksp[j] * a_t > 1.0 or -ksp[j] * a_b > 1.0:
-        return False
-    return one_sided or (ksn[j] * a_t <= 1.0 and ksn[j] * a_b <= 1.0)
+    return st[ST_T, j] < st[ST_HOLD, j]
 
 
 #: Margin [-] by which a bound on a turning point must clear the peak (and 1) for the batch
@@ -1248,12 +1245,16 @@ def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow):
     """
     n_slow = 0
     ce = cell[5]
+    a_t = cell[1] + cell[2] * (cell[4] - cell[4])
+    a_b = cell[1] + cell[2] * (cell[5] - cell[4])
+    a_lo = min(a_t, a_b)
+    a_hi = max(a_t, a_b)
     for j in range(st.shape[1]):
         slow[j] = False
         if st[OUT_STATUS, j] != 0.0:
             continue
         if st[ST_MODE, j] == REST:
-            done = _fast_rest(st, ksp, ksn, j, cell, one_sided)
+            done = _fast_rest(st, ksp, ksn, j, a_lo, a_hi, one_sided)
         else:
             done = _fast_flight(st, ksp, ksn, j, cell, props, w)
         if done:
