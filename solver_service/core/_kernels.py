@@ -17,17 +17,24 @@ maximum when ``q' <= 0`` (or negative minimum when ``q' >= 0``). Hence ``x'`` ha
 two zeros per cell, and their presence is decided from the signs of ``x'`` and ``x''`` at
 the cell ends, plus one bracketed search for a zero of ``x''`` in the ambiguous case.
 ``x`` is then monotone on at most three pieces, and every impact (``x = 0``), turning
-point and ``|x| = 1`` crossing is bracketed and solved by safeguarded Newton iteration
-to machine precision. No grazing impact is missed.
+point and ``|x| = 1`` crossing is bracketed and solved to machine precision by a
+safeguarded Halley iteration started from the Taylor estimate at the left end of its
+piece, stopped by an a-priori bound on the next correction (one or two closed-form
+evaluations). No grazing impact is missed. A flight that leaves an impact in a linear cell
+(chattering) takes a shorter route when no trace is asked (``_short_return``): the return
+found from the Taylor start is the first one because ``x'`` changes sign once before it,
+and the maximum-principle bound shows that the flight cannot raise the peak.
 
 Layout. One run carries small arrays instead of long argument lists: ``sides`` (p, ks,
 phi_ov of each side, ``SIDE_*``), ``rules`` (restitution, one-sided, rest rule, impact cap,
 ``RULE_*``), the closed-form flight ``fl`` (cell and anchor, ``FL_*``) and the run state
 ``st`` (``ST_*``; its first ``NOUT`` entries are the output vector). The event path is
-``_run_cell`` -> ``_rest_step`` (uplift) / ``_flight_step`` (``_velocity_zeros``,
-``_scan_pieces``, then ``_impact`` or ``_advance``), and ``_free_tail`` after the
-excitation. Helpers that allocate nothing are compiled without reference counting
-(``_leaf``): passing arrays to them costs nothing.
+``_run_cell`` -> ``_rest_step`` (uplift) / ``_flight_step`` (``_short_return``, or
+``_velocity_zeros`` and ``_scan_pieces``; then ``_impact`` or ``_advance``), and
+``_free_tail`` after the excitation. At an impact into side ``s`` the restitution of that
+direction applies (``RULE_ETA`` into +1, ``RULE_ETA_NEG`` into -1; theory §1.8).
+Helpers that allocate nothing are compiled without reference counting (``_leaf``):
+passing arrays to them costs nothing.
 
 Batch path (``simulate_grid``). Scales are run in blocks as a structure of arrays
 (``_simulate_block``). For a linear cell of one closed-form segment, the flow over the
@@ -88,7 +95,7 @@ EPS = 2.220446049250313e-16
 MAX_PH = 1.0
 #: Below this p*tau, sinh and cosh are evaluated by their Taylor series (no cancellation).
 SERIES_U = 0.5
-#: Iteration cap of the safeguarded Newton root finder (bisection alone needs < 1100).
+#: Iteration cap of the safeguarded Halley root finder (bisection alone needs < 1100).
 ROOT_MAXITER = 200
 #: Safety factor applied to the propagated rounding-error standard deviation.
 ERR_SAFETY = 10.0
