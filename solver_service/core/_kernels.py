@@ -21,9 +21,9 @@ point and ``|x| = 1`` crossing is bracketed and solved to machine precision by a
 safeguarded Halley iteration started from the Taylor estimate at the left end of its
 piece, stopped by an a-priori bound on the next correction (one or two closed-form
 evaluations). No grazing impact is missed. A flight that leaves an impact in a linear cell
-(chattering) takes a shorter route when no trace is asked (``_short_return``): the return
-found from the Taylor start is the first one because ``x'`` changes sign once before it,
-and the maximum-principle bound shows that the flight cannot raise the peak.
+(chattering) takes a shorter route (``_short_return``, the same with or without a trace):
+the return found from the Taylor start is the first one because ``x'`` changes sign once
+before it, and the maximum-principle bound shows that the flight cannot raise the peak.
 
 Layout. One run carries small arrays instead of long argument lists: ``sides`` (p, ks,
 phi_ov of each side, ``SIDE_*``), ``rules`` (restitution, one-sided, rest rule, impact cap,
@@ -880,7 +880,8 @@ SHORT_MAXITER = 6
 def _short_return(st, fl, va, acc_a, big_h):
     """Time of the return to ``x = 0`` of a flight leaving ``x = 0`` outward, or -1.
 
-    For the flights of a chattering sequence, without the general scan of the step. From
+    For the flights of a chattering sequence, without the general scan of the step (a
+    time series gets the turning point from ``_record_turn``). From
     the Taylor start ``-2 x'/x''`` Halley's iteration (a-priori stop as in ``_root``) finds
     a zero ``tau`` of x in ``(0, big_h)`` at which x' points inward. In a linear cell x' has
     at most two zeros (module docstring), and it changes sign an odd number of times on
@@ -914,6 +915,15 @@ def _short_return(st, fl, va, acc_a, big_h):
 
 
 @_leaf
+def _record_turn(st, fl, acc_a, jerk_a, tau_imp, trace):
+    """Record the one turning point of a short flight (``_short_return``) in the trace."""
+    va = fl[FL_VA]
+    t0 = _taylor_start(va, acc_a, jerk_a, 0.0, 0.0, tau_imp)
+    z = _root(1, 0.0, fl, 0.0, tau_imp, _sgn(va), va, math.nan, t0)
+    _record(st, trace, fl[FL_TA] + z, _state(fl, z)[0])
+
+
+@_leaf
 def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
     """Closed-form flight from the current state to ``tb`` or to the first impact.
 
@@ -939,10 +949,13 @@ def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
     sig_a = _side_sign_right(va, acc_a, jerk_a)
     if xa == 0.0 and va == 0.0:
         sig_a = s  # uplift: the drive exceeds the threshold, motion is outward
-    elif xa == 0.0 and s * va > 0.0 and cell[0] == 0 and trace.shape[1] == 0:
-        # Leaving an impact (chattering): no turning point to record, none to search.
+    elif xa == 0.0 and s * va > 0.0 and cell[0] == 0:
+        # Leaving an impact (chattering): the turning point cannot raise the peak, so it is
+        # searched only for the time series, and the motion is the same with or without one.
         tau_imp = _short_return(st, fl, va, acc_a, big_h)
         if tau_imp > 0.0:
+            if trace.shape[1] > 0:
+                _record_turn(st, fl, acc_a, jerk_a, tau_imp, trace)
             _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log)
             return False
     nz, z1, z2, xb, vb = _velocity_zeros(fl, acc_a, jerk_a, big_h, sig_a, qd_sign)

@@ -1,7 +1,8 @@
 """The event search of the exact kernel: short route for chattering, few evaluations, symmetry.
 
-A flight that leaves an impact takes ``_short_return`` when no time series is asked; with
-``dense=True`` every flight takes the general scan. Both must give the same motion.
+A flight that leaves an impact takes ``_short_return``; switched off (python kernels,
+``_short_return`` patched to decline), every flight takes the general scan. Both must give
+the same motion, and a time series must not change it.
 """
 
 from __future__ import annotations
@@ -23,16 +24,42 @@ def elcentro(elcentro_path: Any) -> SampledAccel:
     return GroundMotion.from_two_column(elcentro_path).accel
 
 
-def test_short_route_agrees_with_the_general_scan(elcentro: SampledAccel) -> None:
+@pytest.fixture()
+def general_scan_only() -> Iterator[None]:
+    """The python kernels with the short route declined (every flight takes the scan)."""
+    kern = kernels("python")
+    short = kern._short_return
+    kern._short_return = lambda *args: -1.0
+    try:
+        yield
+    finally:
+        kern._short_return = short
+
+
+def test_short_route_agrees_with_the_general_scan(
+    elcentro: SampledAccel, general_scan_only: None
+) -> None:
     model = RockingModel.symmetric(2.0, 0.15, 0.9)
-    fast = simulate(model, elcentro, impact_log=True)
-    full = simulate(model, elcentro, impact_log=True, dense=True)
+    fast = simulate(model, elcentro, impact_log=True, backend="numba")
+    full = simulate(model, elcentro, impact_log=True, backend="python")
     assert fast.n_impacts == full.n_impacts > 100
     assert fast.impacts is not None and full.impacts is not None
     assert fast.impacts.shape == full.impacts.shape
     np.testing.assert_allclose(fast.impacts[0], full.impacts[0], rtol=0, atol=1e-12)
     assert fast.peak_ratio == pytest.approx(full.peak_ratio, rel=1e-12)
     assert abs(fast.peak_ratio - full.peak_ratio) <= fast.error_estimate
+
+
+def test_a_time_series_does_not_change_the_motion(elcentro: SampledAccel) -> None:
+    model = RockingModel.symmetric(2.0, 0.15, 0.9)
+    plain = simulate(model, elcentro, impact_log=True)
+    dense = simulate(model, elcentro, impact_log=True, dense=True)
+    assert plain.impacts is not None and dense.impacts is not None
+    np.testing.assert_array_equal(plain.impacts, dense.impacts)
+    assert (plain.peak_ratio, plain.t_peak) == (dense.peak_ratio, dense.t_peak)
+    assert dense.ratio is not None
+    # Every impact is in the series (x = 0), with the turning points between them.
+    assert np.count_nonzero(dense.ratio == 0.0) >= plain.impacts.shape[1]
 
 
 def test_mirrored_record_gives_the_mirrored_impacts_bit_for_bit(elcentro: SampledAccel) -> None:
