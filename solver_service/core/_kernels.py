@@ -1256,12 +1256,61 @@ def _fast_flight(st, ksp, ksn, j, cell, props, w):
     return True
 
 
+#: Cells per stretch over which a run at rest that cannot lift off anywhere is left asleep
+#: (``_doze``): its uplift test is skipped for the whole stretch.
+DOZE = 16
+
+
+@_jit
+def _doze_table(cells, rules):
+    """Per stretch of ``DOZE`` cells: largest ``-a`` and ``a`` at the cell ends, fast or not.
+
+    Returns ``(neg, pos, fast)``: the extremes [m/s²] and whether every cell of the stretch
+    is linear and of one closed-form segment (the batch fast path).
+    """
+    n = cells.shape[1]
+    nb = (n + DOZE - 1) // DOZE
+    neg = np.full(nb, -np.inf)
+    pos = np.full(nb, -np.inf)
+    fast = np.ones(nb, dtype=np.bool_)
+    for i in range(n):
+        b = i // DOZE
+        cell = cells[:, i]
+        a_t = cell[1] + cell[2] * (cell[4] - cell[4])
+        a_b = cell[1] + cell[2] * (cell[5] - cell[4])
+        neg[b] = max(neg[b], -min(a_t, a_b))
+        pos[b] = max(pos[b], max(a_t, a_b))
+        if not (cell[0] == 0 and _n_segments(cell, rules) == 1):
+            fast[b] = False
+    return neg, pos, fast
+
+
 @_leaf
-def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow):
+def _doze(st, ksp, ksn, asleep, neg, pos, fast, one_sided, t_start):
+    """Wake the runs asleep (time ``t_start`` [s]); put to sleep those no cell can lift.
+
+    At rest, a run sleeps through a stretch when no cell of it can lift it. The test is
+    ``_fast_rest``'s on the stretch's extremes ``neg``, ``pos`` [m/s²]; the product with
+    ``ks > 0`` keeps the order, so it decides as the per-cell tests would.
+    """
+    for j in range(st.shape[1]):
+        if asleep[j]:
+            st[ST_T, j] = t_start
+        asleep[j] = (
+            fast
+            and st[OUT_STATUS, j] == 0.0
+            and st[ST_MODE, j] == REST
+            and ksp[j] * neg <= 1.0
+            and (one_sided or ksn[j] * pos <= 1.0)
+        )
+
+
+@_leaf
+def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow, asleep):
     """One sample interval for every run of a block; mark in ``slow`` the runs it cannot do.
 
-    Returns the number of runs left to the event path. Runs that end (status != 0) are
-    skipped.
+    Returns the number of runs left to the event path. Runs that end (status != 0) and runs
+    asleep (``_doze``) are skipped.
     """
     n_slow = 0
     ce = cell[5]
@@ -1271,7 +1320,7 @@ def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow):
     a_hi = max(a_t, a_b)
     for j in range(st.shape[1]):
         slow[j] = False
-        if st[OUT_STATUS, j] != 0.0:
+        if asleep[j] or st[OUT_STATUS, j] != 0.0:
             continue
         if st[ST_MODE, j] == REST:
             done = _fast_rest(st, ksp, ksn, j, a_lo, a_hi, one_sided)
@@ -1343,7 +1392,12 @@ def _simulate_block(cells, width_of, widths, params, scales, v_rest_rel, max_imp
     fl = np.empty(NFL)
     trace = np.empty((2, 0))
     log = np.empty((4, 0))
+    neg, pos, fast = _doze_table(cells, rules)
+    asleep = np.zeros(k, dtype=np.bool_)
     for i in range(cells.shape[1]):
+        if i % DOZE == 0:
+            b = i // DOZE
+            _doze(st, ksp, ksn, asleep, neg[b], pos[b], fast[b], one_sided, cells[4, i])
         for r in range(len(CELL_ROWS)):
             cell[r] = cells[r, i]
         n_slow = k
@@ -1352,11 +1406,12 @@ def _simulate_block(cells, width_of, widths, params, scales, v_rest_rel, max_imp
             if not have[w]:
                 _propagator(props[w], sides[0], widths[w])
                 have[w] = True
-            n_slow = _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow)
+            n_slow = _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow, asleep)
         else:
             slow[:] = True
         if n_slow > 0:
             _event_path(st, sides, slow, cell, rules, st1, sides1, fl, trace, log)
+    _doze(st, ksp, ksn, asleep, 0.0, 0.0, False, one_sided, cells[5, cells.shape[1] - 1])
     out = np.empty((k, NOUT))
     for j in range(k):
         _load_run(st1, sides1, st, sides, j)
