@@ -124,6 +124,11 @@ class MPModel:
         neg = model.negative if model.negative is not None else pos
         if model.eta is None:
             raise ValueError("the model needs eta for a time history")
+        if getattr(model, "is_directional", False):
+            raise ValueError(
+                "the reference applies one eta to every impact; this model has two "
+                "(eta_to_negative, eta_to_positive)"
+            )
         return cls(
             float(pos.p_eq),
             float(neg.p_eq),

@@ -17,17 +17,24 @@ maximum when ``q' <= 0`` (or negative minimum when ``q' >= 0``). Hence ``x'`` ha
 two zeros per cell, and their presence is decided from the signs of ``x'`` and ``x''`` at
 the cell ends, plus one bracketed search for a zero of ``x''`` in the ambiguous case.
 ``x`` is then monotone on at most three pieces, and every impact (``x = 0``), turning
-point and ``|x| = 1`` crossing is bracketed and solved by safeguarded Newton iteration
-to machine precision. No grazing impact is missed.
+point and ``|x| = 1`` crossing is bracketed and solved to machine precision by a
+safeguarded Halley iteration started from the Taylor estimate at the left end of its
+piece, stopped by an a-priori bound on the next correction (one or two closed-form
+evaluations). No grazing impact is missed. A flight that leaves an impact in a linear cell
+(chattering) takes a shorter route (``_short_return``, the same with or without a trace):
+the return found from the Taylor start is the first one because ``x'`` changes sign once
+before it, and the maximum-principle bound shows that the flight cannot raise the peak.
 
 Layout. One run carries small arrays instead of long argument lists: ``sides`` (p, ks,
 phi_ov of each side, ``SIDE_*``), ``rules`` (restitution, one-sided, rest rule, impact cap,
 ``RULE_*``), the closed-form flight ``fl`` (cell and anchor, ``FL_*``) and the run state
 ``st`` (``ST_*``; its first ``NOUT`` entries are the output vector). The event path is
-``_run_cell`` -> ``_rest_step`` (uplift) / ``_flight_step`` (``_velocity_zeros``,
-``_scan_pieces``, then ``_impact`` or ``_advance``), and ``_free_tail`` after the
-excitation. Helpers that allocate nothing are compiled without reference counting
-(``_leaf``): passing arrays to them costs nothing.
+``_run_cell`` -> ``_rest_step`` (uplift) / ``_flight_step`` (``_short_return``, or
+``_velocity_zeros`` and ``_scan_pieces``; then ``_impact`` or ``_advance``), and
+``_free_tail`` after the excitation. At an impact into side ``s`` the restitution of that
+direction applies (``RULE_ETA`` into +1, ``RULE_ETA_NEG`` into -1; theory §1.8).
+Helpers that allocate nothing are compiled without reference counting (``_leaf``):
+passing arrays to them costs nothing.
 
 Batch path (``simulate_grid``). Scales are run in blocks as a structure of arrays
 (``_simulate_block``). For a linear cell of one closed-form segment, the flow over the
@@ -55,7 +62,7 @@ try:  # numba is optional: without it the same code runs as plain Python.
     import numba as _numba
 
     def _jit(fn):
-        return _numba.njit(cache=True, nogil=True)(fn)
+        return _numba.njit(cache=True, nogil=True, error_model="numpy")(fn)
 
     def _jit_parallel(fn):
         return _numba.njit(cache=True, nogil=True, parallel=True)(fn)
@@ -63,7 +70,10 @@ try:  # numba is optional: without it the same code runs as plain Python.
     def _leaf(fn):
         # Helpers that allocate nothing run without the reference counting of their array
         # arguments, which would otherwise cost more than the arithmetic of a step.
-        options: dict[str, Any] = {"_nrt": False}  # not in numba's type stubs
+        options: dict[str, Any] = {
+            "_nrt": False,
+            "error_model": "numpy",
+        }  # not in numba's type stubs
         return _numba.njit(cache=True, nogil=True, **options)(fn)
 
     _prange: Any = _numba.prange
@@ -85,7 +95,7 @@ EPS = 2.220446049250313e-16
 MAX_PH = 1.0
 #: Below this p*tau, sinh and cosh are evaluated by their Taylor series (no cancellation).
 SERIES_U = 0.5
-#: Iteration cap of the safeguarded Newton root finder (bisection alone needs < 1100).
+#: Iteration cap of the safeguarded Halley root finder (bisection alone needs < 1100).
 ROOT_MAXITER = 200
 #: Safety factor applied to the propagated rounding-error standard deviation.
 ERR_SAFETY = 10.0
@@ -130,12 +140,15 @@ SIDE_PHIOV = 2
 NSIDE = 3
 
 # Rules of one run: the (NRULE,) array ``rules``.
+#: Restitution at an impact after which the body rocks on side +1 (the one-sided rebound).
 RULE_ETA = 0
 RULE_ONE_SIDED = 1
 RULE_V_REST = 2
 RULE_MAX_IMPACTS = 3
 RULE_P_MAX = 4
-NRULE = 5
+#: Restitution at an impact after which the body rocks on side -1 (two-sided).
+RULE_ETA_NEG = 5
+NRULE = 6
 
 # A closed-form flight: the (NFL,) array ``fl`` holds the cell and the anchor state.
 FL_KIND = 0
@@ -149,7 +162,10 @@ FL_P = 7
 FL_TA = 8
 FL_XA = 9
 FL_VA = 10
-NFL = 11
+#: sin and cos of the pulse phase ``c1 ta + c2`` at the anchor (sinusoidal cells).
+FL_SIN = 11
+FL_COS = 12
+NFL = 13
 
 # Run state: the (NST,) array ``st``; its first NOUT entries are the output vector.
 ST_MODE = NOUT
@@ -198,6 +214,10 @@ def _anchor(fl, cell, sides, s, ta, xa, va):
     fl[FL_TA] = ta
     fl[FL_XA] = xa
     fl[FL_VA] = va
+    if cell[0] != 0:
+        th = cell[2] * ta + cell[3]
+        fl[FL_SIN] = math.sin(th)
+        fl[FL_COS] = math.cos(th)
 
 
 #: Below this ``u**2`` four terms of each series reach full double precision.
@@ -290,22 +310,24 @@ def _state(fl, tau):
         q = q0 + q1 * tau
         qd = q1
     else:
-        u = p * tau
-        sh = math.sinh(u)
-        h = math.sinh(0.5 * u)
-        chm1 = 2.0 * h * h  # cosh(u) - 1 without cancellation
+        chm1, shp, _smp, psh = _flow_coeffs(p, tau)
         kk = ks * fl[FL_C0]
         w = fl[FL_C1]
-        th = w * ta + fl[FL_C2]
+        sn = fl[FL_SIN]
+        cn = fl[FL_COS]
         kap = p * p * kk / (p * p + w * w)
-        y = xa - s - kap * math.sin(th)
-        yp = va - kap * w * math.cos(th)
-        half = th + 0.5 * w * tau
+        y = xa - s - kap * sn
+        yp = va - kap * w * cn
+        # Phases th + w tau / 2 and th + w tau by angle addition from the anchor's (FL_SIN,
+        # FL_COS): two sines per evaluation instead of six.
         sw = math.sin(0.5 * w * tau)
-        x = xa + 2.0 * kap * math.cos(half) * sw + y * chm1 + yp * sh / p
-        v = va - 2.0 * kap * w * math.sin(half) * sw + y * p * sh + yp * chm1
-        q = kk * math.sin(th + w * tau)
-        qd = kk * w * math.cos(th + w * tau)
+        cw = math.cos(0.5 * w * tau)
+        sin_h = sn * cw + cn * sw
+        cos_h = cn * cw - sn * sw
+        x = xa + 2.0 * kap * cos_h * sw + y * chm1 + yp * shp
+        v = va - 2.0 * kap * w * sin_h * sw + y * psh + yp * chm1
+        q = kk * (sin_h * cw + cos_h * sw)
+        qd = kk * w * (cos_h * cw - sin_h * sw)
     acc = p * p * (x - s - q)
     jerk = p * p * (v - qd)
     return x, v, acc, jerk
@@ -322,37 +344,80 @@ def _sgn(z):
 
 @_leaf
 def _component(which, target, fl, t):
-    """Return function ``which`` (0: x - target, 1: x', 2: x'') at ``t`` and two derivatives.
+    """Return function ``which`` (0: x - target, 1: x', 2: x''), 2 derivatives, |3rd| bound.
 
-    The second derivative is returned as 0 for ``which == 2`` (Newton's step, not Halley's).
+    The second derivative is returned as 0 for ``which == 2`` (Newton's step, not Halley's),
+    and the bound as infinite there (no a-priori stop). For ``which == 1`` the third
+    derivative is ``x'''' = p**2 (x'' - q'')``, bounded with ``|q''| <= w**2 max|q|`` in a
+    sinusoidal cell (``q'' = 0`` in a linear one).
     """
     x, v, acc, jerk = _state(fl, t)
     if which == 0:
-        return x - target, v, acc
+        return x - target, v, acc, abs(jerk)
     if which == 1:
-        return v, acc, jerk
-    return acc, jerk, 0.0
+        p2 = fl[FL_P] * fl[FL_P]
+        qdd = 0.0 if fl[FL_KIND] == 0 else fl[FL_C1] * fl[FL_C1] * abs(fl[FL_KS] * fl[FL_C0])
+        return v, acc, jerk, p2 * (abs(acc) + qdd)
+    return acc, jerk, 0.0, math.inf
 
 
 @_leaf
-def _root(which, target, fl, lo, hi, sig_lo, f_lo, f_hi):
+def _taylor_start(f, fp, fpp, t, lo, hi):
+    """Start for a root in ``(lo, hi)`` from the value and two derivatives at ``t``.
+
+    The root of ``f + fp d + fpp d**2 / 2`` nearest to ``t`` that lies inside the bracket,
+    computed without cancellation; NaN when there is none.
+    """
+    best = math.nan
+    if fpp == 0.0:
+        if fp != 0.0:
+            best = t - f / fp
+    else:
+        disc = fp * fp - 2.0 * fpp * f
+        if disc < 0.0:
+            return math.nan
+        # The sign of fp (of -f when fp is 0) keeps the result odd under (f, fp, fpp) -> -(...).
+        q = -0.5 * (fp + math.copysign(math.sqrt(disc), fp if fp != 0.0 else -f))
+        d1 = 2.0 * q / fpp
+        d2 = f / q if q != 0.0 else math.nan
+        if lo < t + d1 < hi:
+            best = t + d1
+        if lo < t + d2 < hi and not abs(d2) >= abs(best - t):
+            best = t + d2
+    if lo < best < hi:
+        return best
+    return math.nan
+
+
+#: An iterate is final when the a-priori bound on the next Halley correction, times this
+#: factor, is below the time tolerance (Halley converges cubically).
+APRIORI_SAFETY = 16.0
+
+
+@_leaf
+def _root(which, target, fl, lo, hi, sig_lo, f_lo, f_hi, t0):
     """Zero of component ``which`` (0: x - target, 1: x', 2: x'') of flight ``fl`` in ``[lo, hi]``.
 
     ``sig_lo`` is the sign of the function just right of ``lo``; the function is assumed to
-    change sign once in the bracket. ``f_lo``, ``f_hi`` are its values at the ends when known
-    (NaN otherwise) and give a regula-falsi start. Safeguarded Halley iteration (Newton for
+    change sign once in the bracket. ``t0`` is a start inside the bracket (a Taylor estimate,
+    ``_taylor_start``) or NaN; without one, ``f_lo``, ``f_hi`` (values at the ends when known,
+    NaN otherwise) give a regula-falsi start. Safeguarded Halley iteration (Newton for
     ``x''``): a step is taken when it stays inside the bracket and shrinks fast enough,
-    otherwise bisection.
+    otherwise bisection. It stops when the bracket or the step is below the time resolution,
+    or when the a-priori bound ``C d**3`` on the next correction is
+    (``C = f''**2/(4 f'**2) + |f'''|/(6 |f'|)``, ``d`` the step just taken).
     Returns the root (time offset from the anchor).
     """
     t = 0.5 * (lo + hi)
-    if f_lo - f_hi != 0.0 and math.isfinite(f_lo - f_hi):
+    if lo < t0 < hi:
+        t = t0
+    elif f_lo - f_hi != 0.0 and math.isfinite(f_lo - f_hi):
         t = lo + (hi - lo) * min(max(f_lo / (f_lo - f_hi), 0.01), 0.99)
     width = hi - lo
     # Absolute time cannot be resolved finer than a few ulps of ta + t.
     tol = 4.0 * EPS * (abs(fl[FL_TA]) + abs(hi))
     for _ in range(ROOT_MAXITER):
-        f, fp, fpp = _component(which, target, fl, t)
+        f, fp, fpp, c3 = _component(which, target, fl, t)
         if f == 0.0:
             return t
         if _sgn(f) == sig_lo:
@@ -368,6 +433,10 @@ def _root(which, target, fl, lo, hi, sig_lo, f_lo, f_hi):
             width = abs(tn - t)
             if width <= tol:
                 return tn
+            if fp != 0.0:
+                r = fpp / (2.0 * fp)
+                if APRIORI_SAFETY * (r * r + c3 / (6.0 * abs(fp))) * width**3 <= tol:
+                    return tn
             t = tn
         else:
             width = hi - lo
@@ -396,11 +465,12 @@ def _side_sign_left(v, acc, jerk):
 
 
 @_leaf
-def _velocity_zeros(fl, aa, big_h, sig_a, qd_sign):
+def _velocity_zeros(fl, aa, ja, big_h, sig_a, qd_sign):
     """Interior zeros of x' on ``(0, big_h)``: returns ``(n, z1, z2, x(big_h), x'(big_h))``.
 
-    ``aa`` is x'' at the anchor and ``sig_a`` the sign of x' just after it; ``qd_sign`` the
-    constant sign of q' on the stretch (0 when q is constant). See the module docstring.
+    ``aa``, ``ja`` are x'' and x''' at the anchor (Taylor starts of the searches) and
+    ``sig_a`` the sign of x' just after it; ``qd_sign`` the constant sign of q' on the
+    stretch (0 when q is constant). See the module docstring.
     """
     va = fl[FL_VA]
     xb, vb, ab, jb = _state(fl, big_h)
@@ -415,15 +485,19 @@ def _velocity_zeros(fl, aa, big_h, sig_a, qd_sign):
         n = 0
     elif sig_a != sig_b:
         n = 1
-        z1 = _root(1, 0.0, fl, 0.0, big_h, sig_a, va, vb)
+        t1 = _taylor_start(va, aa, ja, 0.0, 0.0, big_h)
+        z1 = _root(1, 0.0, fl, 0.0, big_h, sig_a, va, vb, t1)
     elif sig_a != hump and _sgn(aa) == hump and _sgn(ab) == -hump:
         # x' has sign -hump at both ends and x'' turns from hump to -hump: it may dip.
-        m = _root(2, 0.0, fl, 0.0, big_h, hump, aa, ab)
-        vm = _state(fl, m)[1]
+        tm = _taylor_start(aa, ja, 0.0, 0.0, 0.0, big_h)
+        m = _root(2, 0.0, fl, 0.0, big_h, hump, aa, ab, tm)
+        _xm, vm, am, jm = _state(fl, m)
         if _sgn(vm) == hump:
             n = 2
-            z1 = _root(1, 0.0, fl, 0.0, m, sig_a, va, vm)
-            z2 = _root(1, 0.0, fl, m, big_h, hump, vm, vb)
+            t1 = _taylor_start(va, aa, ja, 0.0, 0.0, m)
+            z1 = _root(1, 0.0, fl, 0.0, m, sig_a, va, vm, t1)
+            t2 = _taylor_start(vm, am, jm, m, m, big_h)
+            z2 = _root(1, 0.0, fl, m, big_h, hump, vm, vb, t2)
     return n, z1, z2, xb, vb
 
 
@@ -664,33 +738,42 @@ def _rest_step(st, cell, sides, rules, tb, trace):
 
 
 @_leaf
-def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace):
+def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, acc_a, trace):
     """Walk the monotone pieces ``[0, z1], [z1, z2], [z2, H]`` of x in the flight ``fl``.
 
     Records turning points, the first ``|x| = 1`` crossing and the peak. Returns the time
-    offset of the impact (``x = 0``) from the anchor, or -1 when there is none.
+    offset of the impact (``x = 0``) from the anchor, or -1 when there is none. ``acc_a``
+    is x'' at the anchor: with x, x' and x'' at the left end of a piece, a Taylor estimate
+    starts each search in it.
     """
     s = fl[FL_S]
     ta = fl[FL_TA]
     tau_l = 0.0
-    sx_l = s * fl[FL_XA]
+    x_l = fl[FL_XA]
+    v_l = fl[FL_VA]
+    a_l = acc_a
     for piece in range(nz + 1):
+        vr = 0.0
+        ar = 0.0
         if piece < nz:
             tau_r = z1 if piece == 0 else z2
-            xr = _state(fl, tau_r)[0]
+            xr, vr, ar, _jr = _state(fl, tau_r)
             if s * xr >= 0.0:  # turning point
                 _record(st, trace, ta + tau_r, xr)
         else:
             tau_r = big_h
             xr = xb
+        sx_l = s * x_l
         sx_r = s * xr
         if sx_r < 0.0:
             # Impact in (tau_l, tau_r]: s*x falls through 0 on a monotone piece.
             if sx_l <= 0.0:
                 return tau_l
-            return _root(0, 0.0, fl, tau_l, tau_r, s, s * sx_l, xr)
+            t0 = _taylor_start(x_l, v_l, a_l, tau_l, tau_l, tau_r)
+            return _root(0, 0.0, fl, tau_l, tau_r, s, x_l, xr, t0)
         if sx_r >= 1.0 and sx_l < 1.0 and math.isnan(st[ST_T_CROSS]):
-            tc = _root(0, s, fl, tau_l, tau_r, -s, s * sx_l - s, xr - s)
+            t0 = _taylor_start(x_l - s, v_l, a_l, tau_l, tau_l, tau_r)
+            tc = _root(0, s, fl, tau_l, tau_r, -s, x_l - s, xr - s, t0)
             st[ST_T_CROSS] = ta + tc
             if math.isnan(st[OUT_T_EXCEED]):
                 st[OUT_T_EXCEED] = ta + tc
@@ -699,8 +782,16 @@ def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace):
             st[OUT_T_PEAK] = ta + tau_r
             st[ST_VAR_PEAK] = st[ST_PXX]
         tau_l = tau_r
-        sx_l = sx_r
+        x_l = xr
+        v_l = vr
+        a_l = ar
     return -1.0
+
+
+@_leaf
+def _eta_into(rules, s_new):
+    """Restitution of a two-sided impact after which the body rocks on side ``s_new``."""
+    return rules[RULE_ETA] if s_new > 0.0 else rules[RULE_ETA_NEG]
 
 
 @_leaf
@@ -708,7 +799,6 @@ def _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log):
     """Impact at ``ta + tau_imp``: restitution, side change, rest rule, error saltation."""
     s = fl[FL_S]
     p = fl[FL_P]
-    eta = rules[RULE_ETA]
     v_rest_rel = rules[RULE_V_REST]
     _xi, vi, ai, _ji = _state(fl, tau_imp)
     ex = EPS * (abs(fl[FL_XA]) + 1.0 + abs(fl[FL_KS] * fl[FL_C0]))
@@ -719,11 +809,11 @@ def _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log):
     if rules[RULE_ONE_SIDED] != 0.0:
         s_new = s
         row_new = row
-        c_imp = eta
+        c_imp = rules[RULE_ETA]
     else:
         s_new = -s
         row_new = 1 - row
-        c_imp = eta * (sides[row, SIDE_PHIOV] / sides[row_new, SIDE_PHIOV])
+        c_imp = _eta_into(rules, s_new) * (sides[row, SIDE_PHIOV] / sides[row_new, SIDE_PHIOV])
     p_new = sides[row_new, SIDE_P]
     v_new = c_imp * vi
     acc_new = p_new * p_new * (-s_new - sides[row_new, SIDE_KS] * _accel(cell, t)[0])
@@ -781,6 +871,58 @@ def _advance(st, fl, xb, vb, tb, amax_after, trace):
         st[OUT_STATUS] = 1
 
 
+#: Most Halley iterations of the short-flight search before it leaves the flight to the
+#: general scan (it converges in one or two from its Taylor start).
+SHORT_MAXITER = 6
+
+
+@_leaf
+def _short_return(st, fl, va, acc_a, big_h):
+    """Time of the return to ``x = 0`` of a flight leaving ``x = 0`` outward, or -1.
+
+    For the flights of a chattering sequence, without the general scan of the step (a
+    time series gets the turning point from ``_record_turn``). From
+    the Taylor start ``-2 x'/x''`` Halley's iteration (a-priori stop as in ``_root``) finds
+    a zero ``tau`` of x in ``(0, big_h)`` at which x' points inward. In a linear cell x' has
+    at most two zeros (module docstring), and it changes sign an odd number of times on
+    ``(0, tau)``: once. So x is unimodal there and ``tau`` is the first return; its top is
+    bounded by the maximum-principle bound of ``_no_event``. Returns -1 (the caller takes
+    the general path, nothing is changed) when the iteration leaves the step or does not
+    settle, or when the top could raise the peak or reach 1.
+    """
+    s = fl[FL_S]
+    t = _taylor_start(0.0, va, acc_a, 0.0, 0.0, big_h)
+    if not t > 0.0:
+        return -1.0
+    tol = 4.0 * EPS * (abs(fl[FL_TA]) + abs(big_h))
+    for _ in range(SHORT_MAXITER):
+        f, fp, fpp, c3 = _component(0, 0.0, fl, t)
+        den = 2.0 * fp * fp - f * fpp
+        if not (s * fp < 0.0 and den != 0.0):
+            return -1.0
+        tn = t - 2.0 * f * fp / den
+        if not 0.0 < tn < big_h:
+            return -1.0
+        width = abs(tn - t)
+        r = fpp / (2.0 * fp)
+        if width <= tol or APRIORI_SAFETY * (r * r + c3 / (6.0 * abs(fp))) * width**3 <= tol:
+            top = max(s * va * t, s * f - s * fp * t)
+            if top + BOUND_MARGIN < min(st[OUT_PEAK], 1.0):
+                return tn
+            return -1.0
+        t = tn
+    return -1.0
+
+
+@_leaf
+def _record_turn(st, fl, acc_a, jerk_a, tau_imp, trace):
+    """Record the one turning point of a short flight (``_short_return``) in the trace."""
+    va = fl[FL_VA]
+    t0 = _taylor_start(va, acc_a, jerk_a, 0.0, 0.0, tau_imp)
+    z = _root(1, 0.0, fl, 0.0, tau_imp, _sgn(va), va, math.nan, t0)
+    _record(st, trace, fl[FL_TA] + z, _state(fl, z)[0])
+
+
 @_leaf
 def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
     """Closed-form flight from the current state to ``tb`` or to the first impact.
@@ -807,8 +949,17 @@ def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
     sig_a = _side_sign_right(va, acc_a, jerk_a)
     if xa == 0.0 and va == 0.0:
         sig_a = s  # uplift: the drive exceeds the threshold, motion is outward
-    nz, z1, z2, xb, vb = _velocity_zeros(fl, acc_a, big_h, sig_a, qd_sign)
-    tau_imp = _scan_pieces(st, fl, nz, z1, z2, xb, big_h, trace)
+    elif xa == 0.0 and s * va > 0.0 and cell[0] == 0:
+        # Leaving an impact (chattering): the turning point cannot raise the peak, so it is
+        # searched only for the time series, and the motion is the same with or without one.
+        tau_imp = _short_return(st, fl, va, acc_a, big_h)
+        if tau_imp > 0.0:
+            if trace.shape[1] > 0:
+                _record_turn(st, fl, acc_a, jerk_a, tau_imp, trace)
+            _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log)
+            return False
+    nz, z1, z2, xb, vb = _velocity_zeros(fl, acc_a, jerk_a, big_h, sig_a, qd_sign)
+    tau_imp = _scan_pieces(st, fl, nz, z1, z2, xb, big_h, acc_a, trace)
     if tau_imp >= 0.0:
         _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log)
         return False
@@ -827,8 +978,9 @@ def _free_tail(st, sides, rules):
     p_s = sides[row, SIDE_P]
     p_o = sides[1 - row, SIDE_P]
     r_so = sides[row, SIDE_PHIOV] / sides[1 - row, SIDE_PHIOV]
-    eta = rules[RULE_ETA]
     one_sided = rules[RULE_ONE_SIDED] != 0.0
+    # The next impact, the only one that can matter (theory §1.8), leads into side -s.
+    eta = rules[RULE_ETA] if one_sided else _eta_into(rules, -s)
     v_rest = rules[RULE_V_REST] * (p_s if one_sided else p_o)
     col, dt_cross, pk, dt_pk = _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest)
     if col:
@@ -943,7 +1095,11 @@ def _simulate_into(st, fl, cells, sides, rules, x0, trace, log):
 
 @_jit
 def _run_constants(params, scale, v_rest_rel, max_impacts):
-    """Return ``sides`` and ``rules`` of one run (``params`` as in ``simulate_cells``)."""
+    """Return ``sides`` and ``rules`` of one run (``params`` as in ``simulate_cells``).
+
+    ``params`` has 8 entries (one restitution for both impact directions) or 10 (then
+    entries 8 and 9 are the restitution into side -1 and into side +1).
+    """
     sides = np.empty((2, NSIDE))
     sides[0, SIDE_P] = params[0]
     sides[1, SIDE_P] = params[1]
@@ -952,7 +1108,8 @@ def _run_constants(params, scale, v_rest_rel, max_impacts):
     sides[0, SIDE_PHIOV] = params[4]
     sides[1, SIDE_PHIOV] = params[5]
     rules = np.empty(NRULE)
-    rules[RULE_ETA] = params[6]
+    rules[RULE_ETA] = params[9] if params.shape[0] >= 10 else params[6]
+    rules[RULE_ETA_NEG] = params[8] if params.shape[0] >= 10 else params[6]
     rules[RULE_ONE_SIDED] = 1.0 if params[7] != 0.0 else 0.0
     rules[RULE_V_REST] = v_rest_rel
     rules[RULE_MAX_IMPACTS] = max_impacts
@@ -990,19 +1147,16 @@ def _propagator(prop, sides, h):
 
 
 @_leaf
-def _fast_rest(st, ksp, ksn, j, cell, one_sided):
+def _fast_rest(st, ksp, ksn, j, a_lo, a_hi, one_sided):
     """Return True when run ``j`` at rest stays at rest through a linear cell (no uplift).
 
     The drive is linear in the cell, so ``g = -s ks a`` stays at or below 1 when it does at
-    both ends (``_uplift_time``); a held rest needs no test.
+    both ends (``_uplift_time``), that is at the lower end value ``a_lo`` for side +1 and
+    the upper ``a_hi`` for side -1; a held rest needs no test.
     """
-    if st[ST_T, j] < st[ST_HOLD, j]:
+    if -ksp[j] * a_lo <= 1.0 and (one_sided or ksn[j] * a_hi <= 1.0):
         return True
-    a_t = cell[1] + cell[2] * (cell[4] - cell[4])
-    a_b = cell[1] + cell[2] * (cell[5] - cell[4])
-    if -ksp[j] * a_t > 1.0 or -ksp[j] * a_b > 1.0:
-        return False
-    return one_sided or (ksn[j] * a_t <= 1.0 and ksn[j] * a_b <= 1.0)
+    return st[ST_T, j] < st[ST_HOLD, j]
 
 
 #: Margin [-] by which a bound on a turning point must clear the peak (and 1) for the batch
@@ -1102,21 +1256,74 @@ def _fast_flight(st, ksp, ksn, j, cell, props, w):
     return True
 
 
+#: Cells per stretch over which a run at rest that cannot lift off anywhere is left asleep
+#: (``_doze``): its uplift test is skipped for the whole stretch.
+DOZE = 16
+
+
+@_jit
+def _doze_table(cells, rules):
+    """Per stretch of ``DOZE`` cells: largest ``-a`` and ``a`` at the cell ends, fast or not.
+
+    Returns ``(neg, pos, fast)``: the extremes [m/s²] and whether every cell of the stretch
+    is linear and of one closed-form segment (the batch fast path).
+    """
+    n = cells.shape[1]
+    nb = (n + DOZE - 1) // DOZE
+    neg = np.full(nb, -np.inf)
+    pos = np.full(nb, -np.inf)
+    fast = np.ones(nb, dtype=np.bool_)
+    for i in range(n):
+        b = i // DOZE
+        cell = cells[:, i]
+        a_t = cell[1] + cell[2] * (cell[4] - cell[4])
+        a_b = cell[1] + cell[2] * (cell[5] - cell[4])
+        neg[b] = max(neg[b], -min(a_t, a_b))
+        pos[b] = max(pos[b], max(a_t, a_b))
+        if not (cell[0] == 0 and _n_segments(cell, rules) == 1):
+            fast[b] = False
+    return neg, pos, fast
+
+
 @_leaf
-def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow):
+def _doze(st, ksp, ksn, asleep, neg, pos, fast, one_sided, t_start):
+    """Wake the runs asleep (time ``t_start`` [s]); put to sleep those no cell can lift.
+
+    At rest, a run sleeps through a stretch when no cell of it can lift it. The test is
+    ``_fast_rest``'s on the stretch's extremes ``neg``, ``pos`` [m/s²]; the product with
+    ``ks > 0`` keeps the order, so it decides as the per-cell tests would.
+    """
+    for j in range(st.shape[1]):
+        if asleep[j]:
+            st[ST_T, j] = t_start
+        asleep[j] = (
+            fast
+            and st[OUT_STATUS, j] == 0.0
+            and st[ST_MODE, j] == REST
+            and ksp[j] * neg <= 1.0
+            and (one_sided or ksn[j] * pos <= 1.0)
+        )
+
+
+@_leaf
+def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow, asleep):
     """One sample interval for every run of a block; mark in ``slow`` the runs it cannot do.
 
-    Returns the number of runs left to the event path. Runs that end (status != 0) are
-    skipped.
+    Returns the number of runs left to the event path. Runs that end (status != 0) and runs
+    asleep (``_doze``) are skipped.
     """
     n_slow = 0
     ce = cell[5]
+    a_t = cell[1] + cell[2] * (cell[4] - cell[4])
+    a_b = cell[1] + cell[2] * (cell[5] - cell[4])
+    a_lo = min(a_t, a_b)
+    a_hi = max(a_t, a_b)
     for j in range(st.shape[1]):
         slow[j] = False
-        if st[OUT_STATUS, j] != 0.0:
+        if asleep[j] or st[OUT_STATUS, j] != 0.0:
             continue
         if st[ST_MODE, j] == REST:
-            done = _fast_rest(st, ksp, ksn, j, cell, one_sided)
+            done = _fast_rest(st, ksp, ksn, j, a_lo, a_hi, one_sided)
         else:
             done = _fast_flight(st, ksp, ksn, j, cell, props, w)
         if done:
@@ -1185,7 +1392,12 @@ def _simulate_block(cells, width_of, widths, params, scales, v_rest_rel, max_imp
     fl = np.empty(NFL)
     trace = np.empty((2, 0))
     log = np.empty((4, 0))
+    neg, pos, fast = _doze_table(cells, rules)
+    asleep = np.zeros(k, dtype=np.bool_)
     for i in range(cells.shape[1]):
+        if i % DOZE == 0:
+            b = i // DOZE
+            _doze(st, ksp, ksn, asleep, neg[b], pos[b], fast[b], one_sided, cells[4, i])
         for r in range(len(CELL_ROWS)):
             cell[r] = cells[r, i]
         n_slow = k
@@ -1194,11 +1406,12 @@ def _simulate_block(cells, width_of, widths, params, scales, v_rest_rel, max_imp
             if not have[w]:
                 _propagator(props[w], sides[0], widths[w])
                 have[w] = True
-            n_slow = _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow)
+            n_slow = _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow, asleep)
         else:
             slow[:] = True
         if n_slow > 0:
             _event_path(st, sides, slow, cell, rules, st1, sides1, fl, trace, log)
+    _doze(st, ksp, ksn, asleep, 0.0, 0.0, False, one_sided, cells[5, cells.shape[1] - 1])
     out = np.empty((k, NOUT))
     for j in range(k):
         _load_run(st1, sides1, st, sides, j)
@@ -1216,8 +1429,10 @@ def simulate_cells(cells, params, scale, x0, v_rest_rel, max_impacts, trace):
     ----------
     cells : (7, n) float
         Rows ``kind, c0, c1, c2, t_start, t_end, amax_after`` (see ``CELL_ROWS``).
-    params : (8,) float
-        ``p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided``.
+    params : (8,) or (10,) float
+        ``p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided`` and
+        optionally ``eta_to_negative, eta_to_positive``, the restitution at an impact into
+        side -1 and +1 (two-sided; without them ``eta`` serves both).
     scale, x0, v_rest_rel, max_impacts
         Scale factor [-], initial ratio [-], rest rule [-], impact cap (see ``_simulate``).
     trace : (2, m) float
@@ -1246,7 +1461,8 @@ def simulate_cells_logged(cells, params, scale, x0, v_rest_rel, max_impacts, tra
 def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
     """Run every mechanism (rows of ``params``) at every scale; return (m, k, NOUT).
 
-    ``params[i] = (p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided)``.
+    ``params[i] = (p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided)``,
+    optionally followed by ``eta_to_negative, eta_to_positive`` (``simulate_cells``).
     The work is split in tasks of one mechanism × up to ``BLOCK`` scales
     (``_simulate_block``), run in parallel; the distinct cell widths are found once.
     """
@@ -1337,17 +1553,29 @@ def pulse_collapses(amp, omega, phase, quarter_cells, work):
 
 
 @_jit
-def pulse_work(eta, one_sided, v_rest_rel, quarter_cells):
-    """Scratch of ``pulse_collapses`` for a restitution and rest rule (any amplitude, Omega)."""
-    params = np.array([1.0, 1.0, 1.0 / G, 1.0 / G, 1.0, 1.0, eta, 1.0 if one_sided else 0.0])
+def pulse_work(eta, one_sided, v_rest_rel, quarter_cells, eta_neg=math.nan):
+    """Scratch of ``pulse_collapses`` for a restitution and rest rule (any amplitude, Omega).
+
+    ``eta`` is the restitution of impacts into side +1 and ``eta_neg`` of those into side -1
+    (NaN: ``eta`` for both).
+    """
+    e_neg = eta if math.isnan(eta_neg) else eta_neg
+    params = np.array(
+        [1.0, 1.0, 1.0 / G, 1.0 / G, 1.0, 1.0, eta, 1.0 if one_sided else 0.0, e_neg, eta]
+    )
     sides, rules = _run_constants(params, 1.0, v_rest_rel, 1_000_000)
     cells = np.empty((len(CELL_ROWS), 4 * quarter_cells))
     return cells, sides, rules, np.empty(NST), np.empty(NFL), np.empty((2, 0)), np.empty((4, 0))
 
 
 @_jit_parallel
-def boundary_grid(omegas, eta, one_sided, sign, phase, a_scan, rtol, max_edges, v_rest_rel):
+def boundary_grid(
+    omegas, eta, one_sided, sign, phase, a_scan, rtol, max_edges, v_rest_rel, eta_neg=math.nan
+):
     """Overturning edges in A for every Omega: scan ``a_scan`` and bisect each change.
+
+    ``eta_neg`` is the restitution of impacts into side -1 when it differs from ``eta``
+    (which then serves the impacts into side +1); NaN: ``eta`` for both.
 
     Returns ``(edges, n_edges, collapsed_at_first)``: ``edges[i, :n_edges[i]]`` are the
     amplitudes ``a_p/(g lam)`` where the outcome changes at ``omegas[i]`` (relative width
@@ -1362,7 +1590,7 @@ def boundary_grid(omegas, eta, one_sided, sign, phase, a_scan, rtol, max_edges, 
     order = np.argsort((np.arange(n_om) * 0.6180339887498949) % 1.0)
     for c in _prange(n_om):
         i = order[c]
-        work = pulse_work(eta, one_sided, v_rest_rel, 1)
+        work = pulse_work(eta, one_sided, v_rest_rel, 1, eta_neg)
         om = omegas[i]
         prev = pulse_collapses(sign * a_scan[0], om, phase, 1, work)
         first[i] = prev

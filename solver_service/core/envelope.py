@@ -137,6 +137,9 @@ class BoundaryCurve:
         Search limits: largest A, ratio between scanned amplitudes, bisection width.
     runtime_s : float
         Wall-clock time [s].
+    eta_neg : float or None
+        Restitution of the impacts into side -1 when it differs from ``eta`` (which then
+        is that of the impacts into side +1); None: ``eta`` for both.
     """
 
     omega: NDArray[np.float64]
@@ -151,6 +154,7 @@ class BoundaryCurve:
     scan_ratio: float
     rtol: float
     runtime_s: float
+    eta_neg: Optional[float] = None
 
     def intervals(self, i: int) -> list[tuple[float, Optional[float]]]:
         """Return the overturning intervals ``(A_lo, A_hi)`` at ``omega[i]``.
@@ -189,6 +193,7 @@ def boundary_curve(
     n_scan_near: int = 0,
     rtol: float = RTOL,
     backend: str = "auto",
+    eta_neg: Optional[float] = None,
 ) -> BoundaryCurve:
     """Every overturning interval in A at each Omega (exact integrator, exact criterion).
 
@@ -208,6 +213,9 @@ def boundary_curve(
         Search limits (see module docstring).
     backend : str
         Kernel back end.
+    eta_neg : float, optional
+        Two-sided only: restitution [-] of the impacts into side -1 when the two impact
+        directions differ (``eta`` is then that of the impacts into side +1; theory §6.6).
 
     Returns
     -------
@@ -227,6 +235,10 @@ def boundary_curve(
     if om.ndim != 1 or om.size == 0 or not np.all(np.isfinite(om) & (om > 0)):
         raise InputError("must be finite and > 0 (at least one value)", "omega")
     eta = check_eta(eta, one_sided)
+    if eta_neg is not None:
+        if one_sided:
+            raise InputError("applies to two-sided rocking only", "eta_neg")
+        eta_neg = check_eta(eta_neg, False, "eta_neg")
     if shape not in PULSE_SHAPES:
         raise InputError(f"must be one of {sorted(PULSE_SHAPES)}, got {shape!r}", "shape")
     if direction not in DIRECTIONS:
@@ -251,6 +263,7 @@ def boundary_curve(
         rtol,
         MAX_EDGES,
         V_REST_BOUNDARY,
+        math.nan if eta_neg is None else eta_neg,
     )
     if np.any(n_edges > MAX_EDGES):
         warnings.warn(
@@ -272,6 +285,7 @@ def boundary_curve(
         scan_ratio=float(np.max(scan[1:] / scan[:-1])),
         rtol=rtol,
         runtime_s=time.perf_counter() - t0,
+        eta_neg=eta_neg,
     )
 
 
@@ -629,6 +643,9 @@ class Envelope:
         Amplification from the ground to the mechanism (1 at ground level) [-].
     governing_side : (n,) int
         +1 or -1: the side (two-sided asymmetric) or pulse direction (one-sided) that governs.
+    notes : list of str
+        How the envelope was computed, where a user should know it (e.g. the exact
+        integrator used for a mechanism with two restitution coefficients).
     """
 
     name: str
@@ -636,6 +653,7 @@ class Envelope:
     a_p_min_local_g: NDArray[np.float64]
     scale_factor: NDArray[np.float64]
     governing_side: NDArray[np.int64]
+    notes: list[str] = field(default_factory=list)
 
     @property
     def a_p_min_g(self) -> NDArray[np.float64]:
@@ -643,23 +661,40 @@ class Envelope:
         return self.a_p_min_local_g / self.scale_factor
 
 
+#: Note of an envelope of a mechanism whose two impact directions have different restitution.
+DIRECTIONAL_NOTE = (
+    "two restitution coefficients (eta_to_negative {neg:g}, eta_to_positive {pos:g}): the "
+    "envelope is computed with the exact integrator, both pulse directions, since the "
+    "library's single-eta curves are not conservative for every Omega with either value "
+    "(theory §6.6)"
+)
+
+
+def _directional_curve(omega: NDArray[np.float64], model: RockingModel) -> NDArray[np.float64]:
+    """``A_min`` with the restitution of each impact direction, lower over both pulses."""
+    pos, neg = model.eta_into(1), model.eta_into(-1)
+    curves = [boundary_curve(omega, pos, direction=d, eta_neg=neg).a_min for d in DIRECTIONS]
+    return np.minimum(curves[0], curves[1])
+
+
 def _side_curve(
     side: RockingSide,
     f_p: NDArray[np.float64],
-    eta: Optional[float],
-    one_sided: bool,
+    model: RockingModel,
     library: Optional[OverturningLibrary],
     exact: bool,
 ) -> NDArray[np.float64]:
     omega = 2.0 * np.pi * f_p / side.p_eq
-    if exact or library is None:
-        if one_sided:
+    if model.is_directional:
+        a_min = _directional_curve(omega, model)
+    elif exact or library is None:
+        if model.one_sided:
             a_min = governing_one_sided(omega, 0.0)[2]
         else:
-            assert eta is not None
-            a_min = boundary_curve(omega, eta).a_min
+            a_min = boundary_curve(omega, model.require_eta()).a_min
     else:
-        a_min = library.a_min(omega, eta, one_sided=one_sided)
+        eta = None if model.one_sided else model.require_eta()
+        a_min = library.a_min(omega, eta, one_sided=model.one_sided)
     return side.lam * a_min
 
 
@@ -689,31 +724,34 @@ def mechanism_envelope(
     Notes
     -----
     Asymmetric two-sided mechanisms take, per frequency, the lower of the two sides'
-    envelopes (each side's constants used as a symmetric mechanism).
+    envelopes (each side's constants used as a symmetric mechanism). A mechanism with two
+    restitution coefficients (``eta_to_negative != eta_to_positive``) is always computed
+    with the exact integrator, each impact with its direction's value and the pulse applied
+    in both directions, and says so in ``notes`` (theory §6.6).
     """
     f = np.atleast_1d(np.asarray(f_p, dtype=float))
     if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f) & (f > 0)):
         raise InputError("must be finite and > 0 (at least one value)", f"{model.name}.f_p")
-    eta = None
-    if not model.one_sided:
-        if model.eta is None:
-            raise InputError(
-                "a two-sided envelope needs a coefficient of restitution", f"{model.name}.eta"
-            )
-        eta = model.eta
-    if library is None and not exact:
+    if not model.one_sided and model.eta is None:
+        raise InputError(
+            "a two-sided envelope needs a coefficient of restitution", f"{model.name}.eta"
+        )
+    notes = []
+    if model.is_directional:
+        notes.append(DIRECTIONAL_NOTE.format(neg=model.eta_into(-1), pos=model.eta_into(1)))
+    elif library is None and not exact:
         library = OverturningLibrary.load()
-    pos = _side_curve(model.positive, f, eta, model.one_sided, library, exact)
+    pos = _side_curve(model.positive, f, model, library, exact)
     if model.one_sided or model.is_symmetric:
         local, side = pos, np.ones(f.size, dtype=np.int64)
     else:
-        neg = _side_curve(model.neg, f, eta, False, library, exact)
+        neg = _side_curve(model.neg, f, model, library, exact)
         local = np.minimum(pos, neg)
         side = np.where(pos <= neg, 1, -1).astype(np.int64)
     sf = np.ones(f.size) if scale_factor is None else np.asarray(scale_factor, dtype=float)
     if sf.shape != f.shape or not np.all(np.isfinite(sf) & (sf >= 1.0)):
         raise InputError("must be finite and >= 1 at every frequency", f"{model.name}.scale_factor")
-    return Envelope(model.name, f, local, sf, side)
+    return Envelope(model.name, f, local, sf, side, notes)
 
 
 def critical_bands(envelopes: Sequence[Envelope]) -> tuple[NDArray[np.int64], list[dict[str, Any]]]:

@@ -9,7 +9,8 @@ Rules (all documented in theory §1.8 and §10):
 
 * uplift from rest when the drive exceeds the static multiplier, ``-a_g > g lam+`` or
   ``a_g > g lam-``; the crossing time is exact;
-* at an impact the angular velocity is multiplied by ``eta`` (and by
+* at an impact the angular velocity is multiplied by ``eta`` (by the restitution of the
+  direction entered, ``RockingModel.eta_into``, when the two directions differ; and by
   ``phi_ov_old/phi_ov_new`` in the normalised variable, for asymmetric mechanisms);
   one-sided mechanisms rebound (``eta <= 0``) and stay on the positive side;
 * **rest rule**: an impact whose outgoing speed is below ``V_REST_REL * p`` ends in rest.
@@ -30,6 +31,7 @@ resolved: the trajectory is too sensitive for any double-precision integrator.
 from __future__ import annotations
 
 import contextlib
+import functools
 import importlib.util
 import math
 import sys
@@ -69,6 +71,8 @@ Excitation = Union[Pulse, SampledAccel]
 
 #: Rest rule: an impact leaving at below ``V_REST_REL * p`` [1/s per rad/s] ends in rest.
 V_REST_REL = 1e-9
+#: Pulses whose cells ``simulate`` keeps for reuse.
+PULSE_CELLS_CACHE = 256
 #: Default impact cap per simulation.
 MAX_IMPACTS = 1_000_000
 #: Kernel back ends: numba-compiled, or the same source as plain Python.
@@ -222,6 +226,16 @@ def _record_cells(rec: SampledAccel, t_extra: float) -> Cells:
     return _append_rest(Cells(data), t_extra)
 
 
+@functools.lru_cache(maxsize=PULSE_CELLS_CACHE)
+def _pulse_cells_shared(pulse: Pulse, per_quarter: int, t_extra: float) -> Cells:
+    """``_pulse_cells`` memoised for ``simulate`` (the kernels never write to the cells).
+
+    Repeated runs of one pulse (scans over mechanisms or scales) skip building them; the
+    cells are never handed to callers, who get fresh ones from ``cells_for``.
+    """
+    return _pulse_cells(pulse, per_quarter, t_extra)
+
+
 def _pulse_cells(pulse: Pulse, per_quarter: int, t_extra: float) -> Cells:
     # Quarter periods hold every extremum of both shapes on a boundary, so the
     # acceleration is monotone in each cell (built in the kernels: a few microseconds
@@ -272,6 +286,8 @@ def _params(model: RockingModel) -> NDArray[np.float64]:
             neg.phi_ov,
             model.require_eta(),
             1.0 if model.one_sided else 0.0,
+            model.eta_into(-1),
+            model.eta_into(1),
         ]
     )
 
@@ -346,7 +362,8 @@ def simulate(
     """
     t_start = time.perf_counter()
     params = _params(model)
-    scale = check_positive(scale, "scale")
+    if not (type(scale) is float and 0.0 < scale < math.inf):  # the common case costs nothing
+        scale = check_positive(scale, "scale")
     crit = _criterion(criterion, excitation)
     if isinstance(x0, bool) or not (math.isfinite(float(x0)) and abs(float(x0)) < 1.0):
         raise InputError(f"must be finite with |x0| < 1, got {x0!r}", "x0")
@@ -356,7 +373,11 @@ def simulate(
         raise InputError(f"must be finite and >= 0, got {t_extra!r}", "t_extra")
     if int(max_impacts) < 1:
         raise InputError(f"must be >= 1, got {max_impacts!r}", "max_impacts")
-    cells = cells_for(excitation, dense=dense, t_extra=t_extra)
+    if isinstance(excitation, Pulse):
+        per_quarter = DENSE_PER_QUARTER if dense else 1
+        cells = _pulse_cells_shared(excitation, per_quarter, float(t_extra))
+    else:
+        cells = cells_for(excitation, dense=dense, t_extra=t_extra)
     pos, neg = model.positive, model.neg
     check_range(
         max(pos.p_eq, neg.p_eq),

@@ -5,8 +5,9 @@ Between impacts the free linearised motion on side ``s`` conserves
 excursion if and only if ``(s*x - 1) + s*v/p > 0``; otherwise it returns to ``x = 0`` with
 speed ``p*sqrt(E + 1)``, is scaled by the impact rule, and the next excursion overturns if
 and only if its outward speed exceeds ``p`` of the new side. Every later excursion is
-smaller (its speed carries another factor ``eta**2`` two-sided, ``|eta|`` one-sided), so
-two excursions decide the outcome and the peak.
+smaller (its speed carries another factor ``eta**2`` two-sided, the product of the two
+directions' values when they differ, ``|eta|`` one-sided), so two excursions decide the
+outcome and the peak, and only the restitution of the next impact enters.
 
 The computation lives in the integrator's kernels (``_kernels._free_rocking``), which
 the exact integrator calls compiled; this module is its documented Python entry point.
@@ -43,7 +44,9 @@ def free_rocking(
     r_so : float
         ``phi_ov`` of the current side over ``phi_ov`` of the opposite side [-].
     eta : float
-        Coefficient of restitution [-] (<= 0 for one-sided rocking).
+        Coefficient of restitution [-] of the next impact (<= 0 for one-sided rocking): for
+        two-sided rocking the value into the opposite side (``RockingModel.eta_into(-s)``);
+        later impacts cannot change the outcome.
     one_sided : bool
         One-sided rocking: impacts keep the body on side +1.
     v_rest : float

@@ -93,9 +93,8 @@ class RockingModel:
     eta_to_negative, eta_to_positive : float, optional
         Two-sided rocking of an asymmetric mechanism: the restitution at an impact after
         which the body rocks on its negative (positive) side [-], each in [0, 1], given
-        together. They are carried for the integrators (theory §1.8: at an impact into side
-        ``s`` the angular velocity is scaled by the value of that direction); until an
-        integrator reads them, ``eta`` serves both impacts.
+        together. Every integrator applies the value of the direction entered at each
+        impact (theory §1.8, ``eta_into``); without them ``eta`` serves both impacts.
     """
 
     positive: RockingSide
@@ -157,6 +156,29 @@ class RockingModel:
     def is_symmetric(self) -> bool:
         """True when both sides have the same constants (or the mechanism is one-sided)."""
         return self.one_sided or self.positive == self.negative
+
+    @property
+    def is_directional(self) -> bool:
+        """True when the two impact directions have different restitution."""
+        return self.eta_to_negative is not None and self.eta_to_negative != self.eta_to_positive
+
+    def eta_into(self, s: int) -> float:
+        """Restitution [-] at an impact after which the body rocks on side ``s`` (±1).
+
+        One-sided rocking and mechanisms without directional values return ``eta``
+        (``require_eta``). Theory §1.8.
+
+        Examples
+        --------
+        >>> side = RockingSide(2.0, 0.2)
+        >>> m = RockingModel(side, eta=0.9, eta_to_negative=0.9, eta_to_positive=0.8)
+        >>> m.eta_into(1), m.eta_into(-1)
+        (0.8, 0.9)
+        """
+        eta = self.require_eta()
+        if self.one_sided or self.eta_to_negative is None or self.eta_to_positive is None:
+            return eta
+        return self.eta_to_positive if s > 0 else self.eta_to_negative
 
     def require_eta(self) -> float:
         """Return ``eta``, or raise a clear error when a time-domain analysis needs it."""

@@ -418,10 +418,14 @@ class _LinearPhysics(_Physics):
         return 1.0 + amax / (G * self._sides[s].lam)
 
     def impact(self, s: int, v: float) -> tuple[int, float]:
-        """Theory §1.8: ``v -> eta (phi_ov_s/phi_ov_new) v`` two-sided, ``eta v`` one-sided."""
+        """Theory §1.8: ``v -> eta_new (phi_ov_s/phi_ov_new) v`` two-sided, ``eta v`` one-sided.
+
+        ``eta_new`` is the restitution of the direction entered (``RockingModel.eta_into``).
+        """
         if self.one_sided:
             return 1, self.eta * v
-        return -s, self.eta * (self._sides[s].phi_ov / self._sides[-s].phi_ov) * v
+        eta = self.model.eta_into(-s)
+        return -s, eta * (self._sides[s].phi_ov / self._sides[-s].phi_ov) * v
 
     def free(self, s: int, x: float, v: float, zeno_vrel: float) -> _FreeOutcome:
         """Exact free rocking (``freemotion.free_rocking``, theory §1.8)."""
@@ -434,7 +438,7 @@ class _LinearPhysics(_Physics):
             self._sides[s].p_eq,
             self._sides[o].p_eq,
             r_so,
-            self.eta,
+            self.model.eta_into(o),
             self.one_sided,
             zeno_vrel * self._sides[o].p_eq,
         )
