@@ -291,6 +291,8 @@ def envelope_doc(
             entry["scale_factor"] = [float(v) for v in env.scale_factor]
         if np.any(env.governing_side != 1):
             entry["governing_side"] = [int(v) for v in env.governing_side]
+        if env.notes:
+            entry["notes"] = list(env.notes)
         entries.append(entry)
     index, bands = critical_bands(envelopes)
     doc: dict[str, Any] = {

@@ -331,3 +331,26 @@ def test_envelope_bad_input() -> None:
                 ]
             }
         )
+
+
+def test_envelope_document_says_a_two_eta_mechanism_was_computed_exactly() -> None:
+    cf = parse_constants(
+        {
+            "mechanisms": [
+                {"id": "S", "p_eq": 2.0, "lam": 0.2, "eta": 0.9},
+                {
+                    "id": "D",
+                    "p_eq": 2.0,
+                    "lam": 0.2,
+                    "eta": 0.9,
+                    "eta_to_negative": 0.9,
+                    "eta_to_positive": 0.7,
+                },
+            ]
+        }
+    )
+    doc, envs = envelope_doc(cf, frequency_grid(0.5, 4.0, 6))
+    same, directional = doc["mechanisms"]
+    assert "notes" not in same
+    assert directional["notes"] == envs[1].notes
+    assert "exact" in directional["notes"][0]
