@@ -799,7 +799,7 @@ def constants(
         rows.append([m.id, _g4(side.p_eq), _g4(side.lam), _g4(side.phi_ov), _g4(m.eta)])
         notes = (m.provenance or {}).get("warnings") or []
         for note in notes if isinstance(notes, list) else []:
-            _mechanism_warning(m.id, note)
+            _mechanism_warning(m.id, str(note))
     headers = ["mechanism", "p_eq [rad/s]", "lam [-]", "phi_ov [rad]", "eta [-]"]
     for line in _table(headers, rows):
         typer.echo(line)
