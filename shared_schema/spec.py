@@ -31,6 +31,7 @@ from shared_schema.rules import coordinate_problem, eta_problem, quantity_note, 
 __all__ = [
     "SPEC_VERSION",
     "SPEC_VERSIONS",
+    "TRIBUTARY_DEFAULT",
     "Axis",
     "Crack",
     "DensityGroup",
@@ -49,6 +50,10 @@ __all__ = [
 SPEC_VERSION = "1.0"
 #: Versions this reader understands; any other is refused (a newer file may mean other things).
 SPEC_VERSIONS = ("1.0",)
+#: Share of a floor's, roof's or overburden's weight and inertia a wall carries when the spec
+#: does not say (a slab spanning between the wall and one parallel support); stated in a
+#: warning whenever it is used.
+TRIBUTARY_DEFAULT = 0.5
 
 _STRICT = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
 
@@ -197,7 +202,9 @@ class Floor(BaseModel):
     model_config = _STRICT
     objects: List[Selector] = Field(min_length=1)
     density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
-    tributary: float = Field(default=0.5, gt=0, le=1, description="Share carried by the wall.")
+    tributary: float = Field(
+        default=TRIBUTARY_DEFAULT, gt=0, le=1, description="Share carried by the wall."
+    )
 
     @field_validator("density")
     @classmethod
@@ -216,7 +223,9 @@ class Roof(BaseModel):
     model_config = _STRICT
     objects: List[Selector] = Field(min_length=1)
     density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
-    tributary: float = Field(default=0.5, gt=0, le=1, description="Share carried by the wall.")
+    tributary: float = Field(
+        default=TRIBUTARY_DEFAULT, gt=0, le=1, description="Share carried by the wall."
+    )
     tied: bool = Field(default=False, description="Tied truss (no thrust on the wall).")
 
     @field_validator("density")
@@ -251,7 +260,9 @@ class Overburden(BaseModel):
     model_config = _STRICT
     objects: Optional[List[Selector]] = Field(default=None, min_length=1)
     density: Optional[float] = Field(default=None, gt=0, description="Density [kg/m^3].")
-    tributary: float = Field(default=0.5, gt=0, le=1, description="Share carried by the wall.")
+    tributary: float = Field(
+        default=TRIBUTARY_DEFAULT, gt=0, le=1, description="Share carried by the wall."
+    )
     force: Optional[float] = Field(default=None, ge=0, description="Given overburden N [N].")
 
     @field_validator("density")

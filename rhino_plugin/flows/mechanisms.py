@@ -32,7 +32,7 @@ from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.io import save_constants
 from shared_schema.rules import quantity_problem
-from shared_schema.spec import parse_spec
+from shared_schema.spec import TRIBUTARY_DEFAULT, parse_spec
 
 __all__ = [
     "COMMANDS",
@@ -140,8 +140,22 @@ class _Asker:
             selectors.append(spec_selector(self.scene, obj))
         return selectors
 
-    def number(self, prompt: str, what: str, path: str, **bounds: Any) -> float:
-        return _number(self.prompter.get_number(prompt), what, self.where(path), **bounds)
+    def number(
+        self, prompt: str, what: str, path: str, default: Optional[float] = None, **bounds: Any
+    ) -> float:
+        answer = self.prompter.get_number(prompt, default)
+        return _number(answer, what, self.where(path), **bounds)
+
+    def tributary(self, what: str, path: str) -> float:
+        """Ask the share of ``what``'s weight and inertia the wall carries (0.5 offered)."""
+        return self.number(
+            f"Share of {what} the wall carries (tributary) [-]",
+            "the tributary share [-]",
+            path,
+            default=TRIBUTARY_DEFAULT,
+            above=0.0,
+            at_most=1.0,
+        )
 
     def option(self, prompt: str, options: Sequence[str], default: int = 0) -> str:
         answer = self.prompter.get_option(prompt, list(options), default)
@@ -309,7 +323,8 @@ def loaded_wall_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, 
                 above=0.0,
                 kind="density",
             )
-            floors.append({"objects": sels, "density": density})
+            share = ask.tributary(f"floor {k + 1}", f"floors[{k}].tributary")
+            floors.append({"objects": sels, "density": density, "tributary": share})
         mech["floors"] = floors
     if ticked.get("Roof"):
         sels = ask.objects("Select the roof", "solid", "roof.objects")
@@ -320,7 +335,8 @@ def loaded_wall_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, 
             above=0.0,
             kind="density",
         )
-        roof: Dict[str, Any] = {"objects": sels, "density": density}
+        share = ask.tributary("the roof", "roof.tributary")
+        roof: Dict[str, Any] = {"objects": sels, "density": density, "tributary": share}
         if ask.option("Roof structure", ["Thrusting", "Tied"], 0) == "Tied":
             roof["tied"] = True
         mech["roof"] = roof
@@ -380,7 +396,8 @@ def two_block_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, An
             above=0.0,
             kind="density",
         )
-        mech["overburden"] = {"objects": sels, "density": density}
+        share = ask.tributary("the elements carrying N", "overburden.tributary")
+        mech["overburden"] = {"objects": sels, "density": density, "tributary": share}
     elif source == "Force":
         mech["overburden"] = {
             "force": ask.number(

@@ -16,6 +16,8 @@ SPECS = ROOT / "examples" / "specs"
 
 #: An answer that makes the prompter behave as if the user pressed Escape.
 CANCEL = object()
+#: A scripted answer meaning: press Enter and take the prompt's default.
+ENTER = object()
 
 
 class ScriptedPrompter:
@@ -51,7 +53,11 @@ class ScriptedPrompter:
         return [self._id(n) for n in names]
 
     def get_number(self, prompt: str, default: Any = None, optional: bool = False) -> Any:
-        return self._next("get_number", prompt)
+        answer = self._next("get_number", prompt)
+        if answer is ENTER:
+            assert default is not None, f"{prompt!r} offers no default"
+            return default
+        return answer
 
     def get_line(self, prompt: str) -> Any:
         answer = self._next("get_line", prompt)

@@ -16,7 +16,7 @@ import pytest
 from rhino_plugin.flows.mechanisms import run_mechanism_command
 from shared_schema.io import load_constants
 
-from .conftest import CANCEL, ScriptedPrompter
+from .conftest import CANCEL, ENTER, ScriptedPrompter
 
 TAIL_DEFAULT = [("get_option", "Computed"), ("get_option", "No")]  # eta, amplification
 
@@ -86,11 +86,14 @@ SCRIPTS: Dict[str, Tuple[str, str, str, List[Tuple[str, Any]]]] = {
             ("get_checkboxes", ["Floors", "Roof", "Vaults", "Tie-bars"]),
             ("get_objects", ["floor_bearing"]),
             ("get_number", 2400),
+            ("get_number", ENTER),  # tributary: the default offered, 0.5
             ("get_objects", ["floor_abutting"]),
             ("get_number", 2400),
+            ("get_number", 0.5),
             ("get_objects", []),
             ("get_objects", ["roof"]),
             ("get_number", 350),
+            ("get_number", "0.5"),
             ("get_option", "Tied"),
             ("get_objects", ["vault"]),
             ("get_option", "b"),
@@ -115,6 +118,7 @@ SCRIPTS: Dict[str, Tuple[str, str, str, List[Tuple[str, Any]]]] = {
             ("get_option", "Objects"),
             ("get_objects", ["floor"]),
             ("get_number", 2400),
+            ("get_number", ENTER),
             ("get_number", 100000),
             ("get_option", "TwoSided"),
             *TAIL_DEFAULT,
@@ -305,7 +309,7 @@ def test_empty_first_selection_is_refused(case: str, scenes: Any, tmp_path: Path
 
 @pytest.mark.parametrize(
     ("case", "step"),
-    [("facade_crack", 0), ("facade_loaded", 0), ("facade_loaded", 7), ("facade_loaded", 12)],
+    [("facade_crack", 0), ("facade_loaded", 0), ("facade_loaded", 7), ("facade_loaded", 14)],
 )
 def test_surface_offered_as_a_solid_is_refused_by_name(
     case: str, step: int, scenes: Any, tmp_path: Path
@@ -417,6 +421,27 @@ def test_a_value_beyond_its_range_is_refused_at_the_prompt(
     result, prompter = _run(case, scenes, tmp_path, [*script[:k], ("get_number", value)])
     assert result is None
     _assert_nothing_written(tmp_path, prompter, field, words)
+
+
+@pytest.mark.parametrize(
+    ("case", "k", "value", "field"),
+    [
+        ("facade_loaded", 0, 1.5, "F1.floors[0].tributary"),
+        ("facade_loaded", 2, 0.0, "F1.roof.tributary"),
+        ("two_block_wall", 0, -0.5, "T1.overburden.tributary"),
+    ],
+)
+def test_a_tributary_share_outside_0_1_is_refused_at_the_prompt(
+    case: str, k: int, value: float, field: str, scenes: Any, tmp_path: Path
+) -> None:
+    script = SCRIPTS[case][3]
+    ok = _run(case, scenes, tmp_path / "ok")[1]
+    i = [j for j, (_, prompt) in enumerate(ok.asked) if "tributary" in prompt][k]
+    out = tmp_path / "bad"
+    out.mkdir()
+    result, prompter = _run(case, scenes, out, [*script[:i], ("get_number", value)])
+    assert result is None
+    _assert_nothing_written(out, prompter, field, "tributary share")
 
 
 def test_a_line_is_not_a_solid(scenes: Any, tmp_path: Path) -> None:
