@@ -424,7 +424,7 @@ def write_binary_ply(path: Path, v: np.ndarray, f: np.ndarray, comment: str) -> 
 
 
 def scan_wall_ply(out: Path) -> Path:
-    """The scan wall as a scan file: ``scan_wall.ply``, in millimetres, no axis objects."""
+    """Write the scan wall as a scan file: ``scan_wall.ply``, in millimetres, no axis objects."""
     v, f = scan_wall_vertices(SCAN_PLY_CELLS)
     comment = "rockmech example scan_wall: units mm, built by examples/scenes/build_scenes.py"
     return write_binary_ply(out / "scan_wall.ply", v * MM_PER_M, f, comment)
