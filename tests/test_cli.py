@@ -782,6 +782,48 @@ def test_a_file_option_naming_a_folder_is_refused(tmp_path: Path, command: str) 
     assert re.match(r"error: (out|output): .* is a folder", last), last
 
 
+def _file_commands(target: Path) -> dict[str, list[str]]:
+    """Every command that writes one file, aimed at ``target``, and its option's field name."""
+    scene, spec = EXAMPLES / "scenes" / "rect_wall.3dm", EXAMPLES / "specs" / "rect_wall.spec.json"
+    site, table = EXAMPLES / "sites" / "ntc_site.json", EXAMPLES / "constants" / "walls.csv"
+    return {
+        "constants": ["constants", str(scene), str(spec), "-o", str(target)],
+        "constants-table": ["constants-table", str(table), "-o", str(target)],
+        "report": ["report", str(WALLS), "--n", "5", "-o", str(target)],
+        "assess": ["assess", str(WALLS), str(site), "-o", str(target)],
+    }
+
+
+#: The option name each single-file command gives in its errors.
+FILE_FIELDS = {"constants": "output", "constants-table": "output", "report": "out", "assess": "out"}
+
+
+@pytest.mark.parametrize("command", ["constants", "constants-table"])
+def test_a_file_output_creates_its_missing_parent_folders(tmp_path: Path, command: str) -> None:
+    target = tmp_path / "out" / "deeper" / "c.json"
+    res = runner.invoke(app, _file_commands(target)[command])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(target.read_text(encoding="utf-8"))
+    assert [m["id"] for m in doc["mechanisms"]] == (
+        ["W1"] if command == "constants" else ["W1", "W2", "P1", "F1"]
+    )
+
+
+@pytest.mark.parametrize("command", sorted(FILE_FIELDS))
+def test_a_file_output_whose_folder_cannot_be_made_is_one_line_before_any_work(
+    tmp_path: Path, command: str
+) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    res = runner.invoke(app, _file_commands(blocker / "sub" / "c.json")[command])
+    assert res.exit_code == 2, res.output
+    assert res.stderr.strip() == (
+        f"error: {FILE_FIELDS[command]}: cannot create folder {blocker / 'sub'}: "
+        f"{blocker} is a file"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]
+
+
 def test_full_disk_and_permission_errors_are_one_line(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

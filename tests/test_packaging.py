@@ -165,12 +165,16 @@ def test_bundled_examples_are_package_data() -> None:
         "records/README.md",
         "constants/church.json",
         "constants/rect_walls.json",
+        "constants/walls.csv",
         "scenes/facade.3dm",
         "specs/facade.spec.json",
+        "scenes/scan_wall.ply",
+        "specs/scan_wall_ply.spec.json",
     ):
         assert ROOT / "examples" / needed in shipped, needed
-    # Every scene has its spec, both shipped.
+    # Every scene has its spec, both shipped (a scan's spec is named <stem>_<format>).
     scenes = {p.stem for p in shipped if p.suffix == ".3dm"}
+    scenes |= {f"{p.stem}_{p.suffix[1:]}" for p in shipped if p.suffix == ".ply"}
     specs = {p.name.removesuffix(".spec.json") for p in shipped if p.name.endswith(".spec.json")}
     assert scenes == specs and len(scenes) >= 8
     assert examples_dir() == ROOT / "examples"
@@ -365,7 +369,7 @@ def test_wheel_holds_the_packages_examples_licence_and_metadata(dists: dict[str,
     for path in examples.rglob("*"):
         rel = path.relative_to(examples).as_posix()
         inside = f"solver_service/data/examples/{rel}"
-        if path.suffix in (".3dm", ".dat") or path.name.endswith(".json"):
+        if path.suffix in (".3dm", ".ply", ".dat", ".csv") or path.name.endswith(".json"):
             assert inside in names, rel
     assert "solver_service/data/examples/scenes/build_scenes.py" not in names
     assert {"rockmech/__init__.py", "rockmech/_version.py", "shared_schema/extras.py"} <= names

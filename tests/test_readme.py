@@ -3,10 +3,11 @@
 The commands are read from the README's fenced shell blocks. Each runs in a fresh folder that
 holds the bundled ``examples/`` (outputs go there too): first as written with its optional
 ``[...]`` parts left out, then once with each optional part (each alternative of ``a|b``).
-Each must exit 0 without a traceback. Placeholders are filled (``DIR``, ``N``); parts that
-need what a test machine lacks (a Dask scheduler, headless Chromium) and commands that do not
-end (``serve``) or rewrite the shipped library (``library build``) are skipped with the reason,
-and so is a command whose input file the repository does not ship (named in the reason).
+Each must exit 0 without a traceback and write what its ``-o``/``--out`` names (its parent
+folders too). Placeholders are filled (``DIR``, ``N``); parts that need what a test machine
+lacks (a Dask scheduler, headless Chromium) and commands that do not end (``serve``) or
+rewrite the shipped library (``library build``) are skipped with the reason. A command whose
+input file the repository does not ship fails: every file the README names is bundled.
 """
 
 from __future__ import annotations
@@ -42,11 +43,7 @@ NOT_RUN_COMMANDS = {
 #: Options whose value is a file the command writes (not an input that must exist).
 OUTPUT_OPTIONS = {"-o", "--out"}
 #: Variants the code answers otherwise than the README says: id -> reason (strict xfail).
-README_DISAGREES = {
-    "constants": "`constants -o out/facade.json` fails in a fresh folder (no out/): "
-    "shared_schema.io.save_constants does not create the parent folder, which `report -o` "
-    "and `--out` do (#14 README; proposed to the lead)",
-}
+README_DISAGREES: dict[str, str] = {}
 
 runner = CliRunner()
 
@@ -151,14 +148,16 @@ def test_readme_command_runs(run: Run, tmp_path: Path, monkeypatch: pytest.Monke
         pytest.skip(run.skip)
     os.symlink(REPO / "examples", tmp_path / "examples")
     missing = _missing_input(list(run.argv), tmp_path)
-    if missing:
-        pytest.skip(f"README uses {missing}, which the repository does not ship")
+    assert not missing, f"README uses {missing}, which the repository does not ship"
     monkeypatch.chdir(tmp_path)
     res = runner.invoke(app, list(run.argv))
     if res.exception is not None and not isinstance(res.exception, SystemExit):
         raise AssertionError(f"traceback: {res.exception!r}\n{res.output}") from res.exception
     assert "Traceback" not in res.output, res.output
     assert res.exit_code == 0, f"exit {res.exit_code}\n{res.stdout}\n{res.stderr}"
+    for option, value in zip(run.argv, run.argv[1:]):
+        if option in OUTPUT_OPTIONS:
+            assert (tmp_path / value).exists(), f"{option} {value} was not written"
 
 
 def test_the_readme_has_commands_of_every_kind() -> None:

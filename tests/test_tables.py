@@ -187,3 +187,33 @@ def test_history_accepts_a_table_where_constants_are_expected(
     strip = ("runtime_s", "input")
     rows = [[{k: v for k, v in r.items() if k not in strip} for r in d["results"]] for d in docs]
     assert rows[0] == rows[1] and len(rows[0]) == 2
+
+
+#: The shipped example table's walls: thickness and height [m] of each rectangular block.
+WALLS_CSV_BLOCKS = {"W1": (0.25, 3.0), "W2": (0.50, 3.0), "P1": (0.25, 1.0), "F1": (0.60, 6.0)}
+
+
+def test_shipped_walls_table_holds_housner_closed_forms() -> None:
+    """examples/constants/walls.csv (README): each row is a rectangular block in closed form.
+
+    p_eq = sqrt(3 g / 4R), lam = phi_ov = alpha = atan(b/h) (Housner 1963); eta = 1 - 1.5
+    sin^2(alpha) two-sided, 1 - 1.5 cos^2(alpha) one-sided (Eq. 26 with I_O = 4/3 M R^2).
+    The cells hold 10 significant digits.
+    """
+    cf = constants_from_table(EXAMPLES / "walls.csv")
+    assert [m.id for m in cf.mechanisms] == list(WALLS_CSV_BLOCKS)
+    g = 9.80665
+    for mech in cf.mechanisms:
+        t, height = WALLS_CSV_BLOCKS[mech.id]
+        assert f"{t:.2f} m x {height:.1f} m" in (mech.name or "")
+        r, alpha = math.hypot(t / 2, height / 2), math.atan(t / height)
+        side = mech.positive
+        assert side.p_eq == pytest.approx(math.sqrt(3 * g / (4 * r)), rel=1e-9)
+        assert side.lam == pytest.approx(alpha, rel=1e-9)
+        assert side.phi_ov == pytest.approx(alpha, rel=1e-9)
+        two_sided = mech.rocking == "two_sided"
+        trig = math.sin(alpha) if two_sided else math.cos(alpha)
+        assert mech.eta == pytest.approx(1 - 1.5 * trig**2, rel=1e-9)
+    (parapet,) = [m for m in cf.mechanisms if m.amplification is not None]
+    assert parapet.id == "P1" and parapet.amplification is not None
+    assert parapet.amplification.h == 10.0  # on the roof

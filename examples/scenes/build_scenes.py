@@ -6,6 +6,9 @@ them; README.md in this folder lists them. Only the file time stamps change betw
 
 Solids use several rhino3dm kinds on purpose (Brep, Extrusion, Mesh), so each reading path of
 ``rhino_plugin.scene_3dm`` is exercised by the examples.
+
+One example is a scan mesh instead: ``scan_wall.ply`` (binary PLY, in millimetres), a coarser
+mesh of the ``scan_wall.3dm`` wall, for ``rockmech constants ... --units mm``.
 """
 
 import math
@@ -367,8 +370,19 @@ def _relief(y: np.ndarray, z: np.ndarray, phase: float) -> np.ndarray:
     return SCAN_RELIEF * w * s
 
 
-def scan_wall(out: Path) -> Path:
-    b = Builder("scan_wall")
+# The same wall as a small scan file: 5 times coarser along y and z, so its vertices are
+# vertices of scan_wall.3dm's mesh (8,360 triangles, about 0.2 MB).
+SCAN_PLY_CELLS = (1, 40, 50)
+# Millimetres per metre: the PLY is in mm, as scans usually are.
+MM_PER_M = 1000.0
+
+
+def scan_wall_vertices(counts: Tuple[int, int, int]) -> Tuple[np.ndarray, np.ndarray]:
+    """Return the scan wall's closed mesh with ``counts`` cells (x, y, z): vertices [m], faces.
+
+    Both large faces carry :func:`_relief` (a different phase on each), blended linearly
+    through the thickness.
+    """
     t = SCAN_SIZE[0]
 
     def displace(p: np.ndarray) -> np.ndarray:
@@ -377,11 +391,43 @@ def scan_wall(out: Path) -> Path:
         q[:, 0] += (1.0 - s) * _relief(p[:, 1], p[:, 2], 0.0) + s * _relief(p[:, 1], p[:, 2], 1.7)
         return q
 
-    v, f = grid_box_solid(SCAN_SIZE, SCAN_CELLS, displace)
+    return grid_box_solid(SCAN_SIZE, counts, displace)
+
+
+def scan_wall(out: Path) -> Path:
+    b = Builder("scan_wall")
+    t = SCAN_SIZE[0]
+    v, f = scan_wall_vertices(SCAN_CELLS)
     b.mesh("scan_wall", "Scan", v, f, "stone")
     b.line("axis", "Axes", (t, 0.0, 0.0), (t, 4.0, 0.0))
     b.line("axis_back", "Axes", (0.0, 0.0, 0.0), (0.0, 4.0, 0.0))
     return b.write(out / "scan_wall.3dm")
+
+
+def write_binary_ply(path: Path, v: np.ndarray, f: np.ndarray, comment: str) -> Path:
+    """Write a triangle mesh as a little-endian binary PLY (double vertices, int indices)."""
+    _check_closed(v, f, path.stem)
+    header = (
+        "ply\nformat binary_little_endian 1.0\n"
+        f"comment {comment}\n"
+        f"element vertex {v.shape[0]}\n"
+        "property double x\nproperty double y\nproperty double z\n"
+        f"element face {f.shape[0]}\n"
+        "property list uchar int vertex_indices\nend_header\n"
+    )
+    rows = np.empty(f.shape[0], dtype=[("n", "u1"), ("idx", "<i4", (3,))])
+    rows["n"], rows["idx"] = 3, f
+    path.write_bytes(
+        header.encode("ascii") + np.ascontiguousarray(v, dtype="<f8").tobytes() + rows.tobytes()
+    )
+    return path
+
+
+def scan_wall_ply(out: Path) -> Path:
+    """Write the scan wall as a scan file: ``scan_wall.ply``, in millimetres, no axis objects."""
+    v, f = scan_wall_vertices(SCAN_PLY_CELLS)
+    comment = "rockmech example scan_wall: units mm, built by examples/scenes/build_scenes.py"
+    return write_binary_ply(out / "scan_wall.ply", v * MM_PER_M, f, comment)
 
 
 def two_block_wall(out: Path) -> Path:
@@ -501,12 +547,14 @@ SCENES = {
     "portal_frame": portal_frame,
     "asym_frame": asym_frame,
 }
+#: Scan-mesh examples (no rhino3dm needed to write them).
+SCANS = {"scan_wall_ply": scan_wall_ply}
 
 
 def build_all(out: Path = HERE) -> List[Path]:
-    """Write every example scene into ``out``; return the paths."""
+    """Write every example scene (``.3dm``, then the scans) into ``out``; return the paths."""
     out.mkdir(parents=True, exist_ok=True)
-    return [build(out) for build in SCENES.values()]
+    return [build(out) for build in (*SCENES.values(), *SCANS.values())]
 
 
 def main(argv: Sequence[str] = ()) -> None:

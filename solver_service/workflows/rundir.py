@@ -66,10 +66,44 @@ def check_folder_target(out: Union[str, Path], field: str = "out") -> None:
 
 
 def check_file_target(out: Union[str, Path], field: str = "out") -> None:
-    """Raise ``InputError`` if ``out`` is an existing folder where a file is to be written."""
+    """Check that a file can be written at ``out``, creating its missing parent folders.
+
+    Every command that writes one file calls this before any work, so ``-o out/walls.json``
+    works in a fresh folder and an impossible target fails at once.
+
+    Parameters
+    ----------
+    out : path
+        The file to be written (it may exist; it is replaced later).
+    field : str
+        Names the option in error messages.
+
+    Raises
+    ------
+    InputError
+        ``out`` is an existing folder, or its parent folder cannot be created (a file stands
+        in the way, permission, read-only file system); one line naming the folder.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     check_file_target(Path(d) / "out" / "walls.json")
+    ...     (Path(d) / "out").is_dir()
+    True
+    """
     target = Path(out)
     if target.is_dir():
         raise InputError(f"{target} is a folder; give a file name to write", field)
+    parent = target.parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        # A file where a folder must go: name it rather than print "File exists".
+        blocker = next((p for p in (parent, *parent.parents) if p.is_file()), parent)
+        raise InputError(f"cannot create folder {parent}: {blocker} is a file", field) from None
+    except OSError as exc:
+        raise InputError(f"cannot create folder {parent}: {os_reason(exc)}", field) from None
 
 
 def _remove(path: Path) -> None:

@@ -26,6 +26,8 @@ FILES = [
     "portal_frame.3dm",
     "asym_frame.3dm",
 ]
+#: Scan-mesh examples (binary PLY in mm) that build_scenes.py writes too.
+SCANS = ["scan_wall.ply"]
 SOLID_KINDS = ("mesh", "brep", "extrusion")
 # Namespace of the fixed object ids, as documented in the README.
 ID_NAMESPACE = uuid.UUID("6f1c2a52-0d0e-4c8b-9a57-3d1e2b7a9c40")
@@ -78,10 +80,11 @@ def readme_rows() -> Dict[str, List[Tuple[str, str, str]]]:
     rows: Dict[str, List[Tuple[str, str, str]]] = {}
     current = None
     for line in (SCENES / "README.md").read_text(encoding="utf-8").splitlines():
-        head = re.match(r"^### (\S+\.3dm)", line)
-        if head:
-            current = head.group(1)
-            rows[current] = []
+        head = re.match(r"^### (\S+)", line)
+        if head:  # a .3dm scene's table; other sections (the scan) are not rows of one
+            current = head.group(1) if head.group(1).endswith(".3dm") else None
+            if current:
+                rows[current] = []
         row = re.match(r"^\| `([^`]+)` \| `([^`]+)` \| (\w+) \|", line)
         if row and current:
             rows[current].append((row.group(1), row.group(2), row.group(3)))
@@ -244,7 +247,17 @@ def test_build_script_is_deterministic(
     tmp_path: Path, committed_geometry: Dict[str, Dict[str, object]]
 ) -> None:
     paths = load_builder().build_all(tmp_path)
-    assert sorted(p.name for p in paths) == sorted(FILES)
+    assert sorted(p.name for p in paths) == sorted([*FILES, *SCANS])
+    for name in SCANS:  # the header and the faces byte for byte, the vertices to the last bits
+        new, old = (tmp_path / name).read_bytes(), (SCENES / name).read_bytes()
+        start = new.index(b"end_header\n") + len(b"end_header\n")
+        assert new[:start] == old[:start] and len(new) == len(old), name
+        n_v = int(re.search(rb"element vertex (\d+)", new[:start]).group(1))  # type: ignore[union-attr]
+        end = start + 24 * n_v
+        assert new[end:] == old[end:], name
+        np.testing.assert_allclose(
+            np.frombuffer(new[start:end], "<f8"), np.frombuffer(old[start:end], "<f8"), atol=1e-9
+        )
     for name in FILES:
         rebuilt = geometry(Scene.from_3dm(tmp_path / name))
         old = committed_geometry[name]

@@ -106,3 +106,24 @@ def test_targets_of_the_wrong_kind_are_named(tmp_path: Path) -> None:
     rundir.check_file_target(afile)
     message = rundir.os_reason(OSError(errno.EROFS, "Read-only file system"))
     assert message == "the file system is read-only"
+
+
+def test_a_file_target_gets_its_parent_folders_or_one_line_why_not(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    target = tmp_path / "a" / "b" / "c.json"
+    rundir.check_file_target(target, "output")
+    assert (tmp_path / "a" / "b").is_dir() and not target.exists()
+    rundir.check_file_target(target, "output")  # already there: fine
+    (tmp_path / "f").write_text("x")
+    with pytest.raises(InputError, match=r"^output: cannot create folder .*f/g: .*f is a file$"):
+        rundir.check_file_target(tmp_path / "f" / "g" / "c.json", "output")
+    with pytest.raises(InputError, match=r"^out: cannot create folder .*f: .*f is a file$"):
+        rundir.check_file_target(tmp_path / "f" / "c.json")
+
+    def denied(self: Path, *args: object, **kwargs: object) -> None:
+        raise PermissionError(errno.EACCES, "Permission denied", str(self))
+
+    monkeypatch.setattr(Path, "mkdir", denied)
+    with pytest.raises(InputError, match=r"^out: cannot create folder .*new: permission denied$"):
+        rundir.check_file_target(tmp_path / "new" / "c.json")
