@@ -176,6 +176,12 @@ def _note(message: str) -> None:
     typer.echo(message, err=True)
 
 
+def _skipped_notes(doc: dict[str, Any]) -> None:
+    """Print a warning for each mechanism an analysis left out (``doc["skipped"]``)."""
+    for skip in doc.get("skipped", []):
+        _note(f"warning: {skip['mechanism']} skipped: {skip['reason']}")
+
+
 def _mechanism_warning(mech_id: str, note: str) -> None:
     """Print a mechanism's warning, naming it once (a note may already start with its id)."""
     named = note.startswith((f"{mech_id}.", f"{mech_id}:", f"{mech_id} "))
@@ -548,8 +554,7 @@ def history(
             _mechanism_warning(mech_id, note)
     for note in doc.get("option_warnings", []):
         _note(f"warning: {note}")
-    for skip in doc.get("skipped", []):
-        _note(f"warning: {skip['mechanism']} skipped: {skip['reason']}")
+    _skipped_notes(doc)
     if out is not None:
         typer.echo(f"wrote {out / 'history.json'}, history.png, history_record.png")
 
@@ -725,6 +730,7 @@ def ida(
     if out is not None:
         with run_folder(out) as tmp:
             write_ida(doc, tmp, title=f"Fragility: {constants.name}")
+    _skipped_notes(doc)
     if as_json:
         _print_json(doc)
         return
@@ -732,7 +738,7 @@ def ida(
     where = "locally" if backend["kind"] == "local" else f"on Dask at {backend['scheduler']}"
     typer.echo(
         f"{doc['runs']} runs ({len(motions)} records x {len(levels)} levels x "
-        f"{len(cf.mechanisms)} mechanisms) {where} in {doc['runtime_s']:.2f} s; "
+        f"{len(doc['mechanisms'])} mechanisms) {where} in {doc['runtime_s']:.2f} s; "
         f"largest error estimate {doc['max_error_estimate']:.1e}"
     )
     unit = doc["intensity"]["units"]

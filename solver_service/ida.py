@@ -36,6 +36,7 @@ from .core.fragility import fit_lognormal
 from .core.model import check_positive
 from .core.records import GroundMotion
 from .workflows.adapter import to_rocking_model
+from .workflows.documents import time_domain_mechanisms
 from .workflows.scaling import Building, run_scaled
 
 __all__ = ["IM_MEASURES", "ida_csv", "parse_levels", "run_ida", "run_record"]
@@ -307,7 +308,7 @@ def run_ida(
     Parameters
     ----------
     cf : ConstantsFile
-        The mechanisms (each needs ``eta``).
+        The mechanisms; one without ``eta`` is left out and listed in ``skipped``.
     motions : sequence of GroundMotion
         The records, at least one.
     levels : sequence of float
@@ -353,6 +354,7 @@ def run_ida(
     if jobs is not None and (isinstance(jobs, bool) or int(jobs) != jobs or jobs < 1):
         raise InputError(f"must be a whole number >= 1, got {jobs!r}", "jobs")
     building = building or Building()
+    cf, skipped = time_domain_mechanisms(cf)
     for mech in cf.mechanisms:
         to_rocking_model(mech).require_eta()
     constants = cf.model_dump(mode="json", exclude_none=True)
@@ -421,6 +423,8 @@ def run_ida(
     incomplete = int(np.count_nonzero(status < 0))
     if incomplete:
         doc["incomplete_runs"] = incomplete
+    if skipped:
+        doc["skipped"] = skipped
     return doc
 
 

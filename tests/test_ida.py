@@ -214,3 +214,30 @@ def test_parse_levels() -> None:
     assert parse_levels("1:100:3") == pytest.approx([1.0, 10.0, 100.0])
     with pytest.raises(InputError, match="scales"):
         parse_levels("1:0.5:3")
+
+
+def test_a_mechanism_without_eta_is_skipped_with_a_note_not_fatal(
+    motions: list[GroundMotion], tmp_path: Path
+) -> None:
+    church = load_constants(EXAMPLES / "constants" / "church.json")
+    no_eta = [m.id for m in church.mechanisms if m.eta is None]
+    assert no_eta == ["F1"]
+    levels = [0.5, 1.0, 2.0]
+    doc = run_ida(church, motions[:1], levels, jobs=1)
+    assert [s["mechanism"] for s in doc["skipped"]] == ["F1"]
+    assert "eta" in doc["skipped"][0]["reason"]
+    kept = church.model_copy(update={"mechanisms": church.mechanisms[1:]})
+    alone = run_ida(kept, motions[:1], levels, jobs=1)
+    assert [m["id"] for m in doc["mechanisms"]] == [m["id"] for m in alone["mechanisms"]]
+    assert [m["n_overturned"] for m in doc["mechanisms"]] == [
+        m["n_overturned"] for m in alone["mechanisms"]
+    ]
+    assert "skipped" not in alone
+    rec = tmp_path / "r.dat"
+    rec.write_text("".join(f"{0.02 * i:.2f} {0.1 * np.sin(i / 3):.5f}\n" for i in range(200)))
+    res = CliRunner().invoke(
+        app, ["ida", str(EXAMPLES / "constants" / "church.json"), str(rec), "--scales", "1,2"]
+    )
+    assert res.exit_code == 0, res.output
+    assert "warning: F1 skipped" in res.stderr
+    assert f"x {len(church.mechanisms) - 1} mechanisms" in res.stdout
