@@ -12,11 +12,13 @@ input file the repository does not ship fails: every file the README names is bu
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import shlex
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import pytest
 from typer.testing import CliRunner
@@ -165,3 +167,26 @@ def test_the_readme_has_commands_of_every_kind() -> None:
     names = {r.argv[0] for r in RUNS}
     assert {"pulse", "history", "record", "envelope", "boundary", "demo", "assess"} <= names
     assert len(RUNS) >= 30
+
+
+def _python_blocks(text: str) -> list[str]:
+    """The source of every fenced ``python`` block."""
+    return re.findall(r"^```python\n(.*?)^```", text, flags=re.S | re.M)
+
+
+def test_the_readme_python_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The README's Python example runs as written, and its pulse answers as the CLI's does."""
+    blocks = _python_blocks(README.read_text(encoding="utf-8"))
+    assert blocks, "README.md has no python block"
+    monkeypatch.chdir(tmp_path)
+    scope: dict[str, Any] = {}
+    for source in blocks:
+        exec(compile(source, str(README), "exec"), scope)  # the README's own code
+    assert (tmp_path / "facade.json").is_file()
+    res = scope["res"]
+    cli = runner.invoke(
+        app, "pulse --p-eq 2.2 --lam 0.165 --eta 0.96 --a-p-g -0.3 --f-p 1.0 --json".split()
+    )
+    assert cli.exit_code == 0, cli.output
+    doc = json.loads(cli.stdout)
+    assert (res.overturned, res.t_overturn) == (doc["overturned"], doc["t_overturn"])

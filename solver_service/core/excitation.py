@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.errors import InputError
+from shared_schema.rules import G
 
 __all__ = ["PULSE_SHAPES", "Pulse", "SampledAccel"]
 
@@ -32,7 +33,9 @@ class Pulse:
     Parameters
     ----------
     a_p : float
-        Signed amplitude [m/s²]. Positive first pushes towards negative rotation.
+        Signed amplitude [m/s²]. Positive first pushes towards negative rotation. The command
+        line and the service take the amplitude in g (``a_p_g``): build such a pulse with
+        ``Pulse.from_g``.
     f_p : float
         Pulse frequency [Hz]; the pulse lasts ``1/f_p`` seconds.
     shape : {"sine", "cosine"}
@@ -50,6 +53,28 @@ class Pulse:
             raise InputError(f"must be finite and > 0, got {self.f_p!r}", "f_p")
         if self.shape not in PULSE_SHAPES:
             raise InputError(f"must be one of {sorted(PULSE_SHAPES)}, got {self.shape!r}", "shape")
+
+    @classmethod
+    def from_g(cls, a_p_g: float, f_p: float, shape: str = "sine") -> "Pulse":
+        """The pulse of signed amplitude ``a_p_g`` given in g, as the CLI and REST take it.
+
+        Parameters
+        ----------
+        a_p_g : float
+            Signed amplitude [g].
+        f_p : float
+            Pulse frequency [Hz].
+        shape : {"sine", "cosine"}
+            Pulse shape.
+
+        Examples
+        --------
+        >>> round(Pulse.from_g(-0.5, 1.0).a_p, 6)
+        -4.903325
+        """
+        if isinstance(a_p_g, bool) or not math.isfinite(float(a_p_g)):
+            raise InputError(f"must be a finite number, got {a_p_g!r}", "a_p_g")
+        return cls(float(a_p_g) * G, f_p, shape)
 
     @property
     def omega_p(self) -> float:
