@@ -265,27 +265,17 @@ def boundary_curve(
         V_REST_BOUNDARY,
         math.nan if eta_neg is None else eta_neg,
     )
-    if np.any(n_edges > MAX_EDGES):
-        warnings.warn(
-            f"more than {MAX_EDGES} outcome changes at some Omega; only the first "
-            f"{MAX_EDGES} are kept",
-            RuntimeWarning,
-            stacklevel=2,
-        )
-    return BoundaryCurve(
-        omega=om,
-        edges=edges,
-        n_edges=np.minimum(n_edges, MAX_EDGES).astype(np.int64),
-        collapsed_at_start=first.astype(bool),
-        eta=eta,
-        one_sided=one_sided,
-        shape=shape,
-        direction=direction,
-        a_max=float(a_max),
+    return _curve(
+        om,
+        (eta, one_sided, direction),
+        (edges, n_edges, first),
+        shape,
         scan_ratio=float(np.max(scan[1:] / scan[:-1])),
-        rtol=rtol,
         runtime_s=time.perf_counter() - t0,
+        a_max=float(a_max),
+        rtol=rtol,
         eta_neg=eta_neg,
+        stacklevel=3,
     )
 
 
@@ -453,10 +443,18 @@ def _curve(
     spec: tuple[float, bool, int],
     found: tuple[Any, Any, Any],
     shape: str,
+    *,
     scan_ratio: float,
     runtime_s: float,
+    a_max: float = A_MAX,
+    rtol: float = RTOL,
+    eta_neg: Optional[float] = None,
+    stacklevel: int = 4,
 ) -> BoundaryCurve:
-    """One library curve from the kernel's ``(edges, n_edges, first)`` of its spec."""
+    """Build a curve from the kernel's ``(edges, n_edges, first)`` of one library spec.
+
+    ``stacklevel`` points the warning (more edges than kept) at the public caller.
+    """
     eta, one_sided, direction = spec
     edges, n_edges, first = found
     if np.any(n_edges > MAX_EDGES):
@@ -464,7 +462,7 @@ def _curve(
             f"more than {MAX_EDGES} outcome changes at some Omega; only the first "
             f"{MAX_EDGES} are kept",
             RuntimeWarning,
-            stacklevel=4,
+            stacklevel=stacklevel,
         )
     return BoundaryCurve(
         omega=om,
@@ -475,10 +473,11 @@ def _curve(
         one_sided=one_sided,
         shape=shape,
         direction=direction,
-        a_max=A_MAX,
+        a_max=a_max,
         scan_ratio=scan_ratio,
-        rtol=RTOL,
+        rtol=rtol,
         runtime_s=runtime_s,
+        eta_neg=eta_neg,
     )
 
 
@@ -507,7 +506,14 @@ def _library_curves(
     out: dict[int, BoundaryCurve] = {}
     for k, spec in enumerate(specs):
         if spec == probe_spec:
-            out[k] = _curve(om, spec, tuple(probe), shape, scan_ratio, time.perf_counter() - t0)
+            out[k] = _curve(
+                om,
+                spec,
+                tuple(probe),
+                shape,
+                scan_ratio=scan_ratio,
+                runtime_s=time.perf_counter() - t0,
+            )
     todo = [k for k in range(len(specs)) if k not in out]
     if progress is not None:
         progress(len(out), len(specs))
@@ -531,7 +537,7 @@ def _library_curves(
         each_s = (time.perf_counter() - t0) / len(group)
         for c, k in enumerate(todo[lo : lo + step]):
             parts = (found[0][c], found[1][c], found[2][c])
-            out[k] = _curve(om, specs[k], parts, shape, scan_ratio, each_s)
+            out[k] = _curve(om, specs[k], parts, shape, scan_ratio=scan_ratio, runtime_s=each_s)
         if progress is not None:
             progress(len(out), len(specs))
     return [out[k] for k in range(len(specs))]

@@ -56,7 +56,7 @@ class Pulse:
 
     @classmethod
     def from_g(cls, a_p_g: float, f_p: float, shape: str = "sine") -> "Pulse":
-        """The pulse of signed amplitude ``a_p_g`` given in g, as the CLI and REST take it.
+        """Build the pulse of signed amplitude ``a_p_g`` in g, as the CLI and REST take it.
 
         Parameters
         ----------
