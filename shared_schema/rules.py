@@ -26,11 +26,14 @@ from typing import Dict, NamedTuple, Optional, Sequence, Tuple, Union
 from shared_schema.errors import InputError
 
 __all__ = [
+    "ACCEL_MAX_G",
     "ACCEL_MIN",
     "A_P_G_MAX",
     "BODY_SIZE_PLAUSIBLE",
+    "BUILDING_HEIGHT_MAX_M",
     "COORDINATE_LIMIT",
     "CRITERIA",
+    "DT_RANGE_S",
     "F_P_RANGE",
     "LAM_RANGE",
     "LENGTH_UNITS",
@@ -44,6 +47,7 @@ __all__ = [
     "TYPOLOGIES",
     "G",
     "QuantityRange",
+    "accel_max",
     "body_size_note",
     "check_choice",
     "check_eta",
@@ -128,6 +132,29 @@ A_P_G_MAX = 1e2
 #: A record used for Eq. 28 needs a peak ground acceleration: one sample at least this large
 #: in magnitude [in the record's units] (smaller ones could round to zero when converted).
 ACCEL_MIN = 1e-300
+#: Tallest structure [m] a height may describe: above the tallest building (828 m), so a
+#: larger value is a slip of units or digits, never a building.
+BUILDING_HEIGHT_MAX_M = 1000.0
+#: Time step [s] outside which a record is refused: no accelerograph samples faster than
+#: 1 MHz or slower than once a second (issue #14: a dt of 1e300 s overflows the spectrum).
+DT_RANGE_S: Tuple[float, float] = (1e-6, 1.0)
+#: Largest acceleration [g] a record may hold: 200 times the strongest ground motion
+#: recorded (about 5 g); beyond it the numbers are wrong units, not an earthquake.
+ACCEL_MAX_G = 1e3
+
+
+def accel_max(units: str) -> float:
+    """Return the largest sample magnitude a record may hold, in ``units`` (``ACCEL_MAX_G``).
+
+    The readers compare each sample with this value in the record's own units, so that a
+    huge sample cannot overflow on the way to m/s²; the REST schema states the same value.
+
+    Examples
+    --------
+    >>> accel_max("mg")
+    1000000.0
+    """
+    return ACCEL_MAX_G * G / RECORD_UNITS[units]
 
 
 def check_number(
