@@ -26,6 +26,7 @@ from shared_schema.rules import (
     BUILDING_HEIGHT_MAX_M,
     CRITERIA,
     DT_RANGE_S,
+    F_N_RANGE,
     F_P_RANGE,
     LAM_RANGE,
     LENGTH_UNITS,
@@ -101,7 +102,10 @@ def _height(description: str, *, positive: bool = True, below: str = "") -> Any:
     ``below`` names a height it may not exceed either (a rule across fields, told in words).
     """
     low = ("> 0" if positive else ">= 0") + (f", at most {below}" if below else "")
-    bounds = {"exclusiveMinimum" if positive else "minimum": 0, "maximum": BUILDING_HEIGHT_MAX_M}
+    bounds: Dict[str, Any] = {
+        "exclusiveMinimum" if positive else "minimum": 0,
+        "maximum": BUILDING_HEIGHT_MAX_M,
+    }
     return Field(
         description=f"{description} [m], {low} and at most {BUILDING_HEIGHT_MAX_M:g} m "
         "(taller than any building).",
@@ -158,7 +162,7 @@ EQ28_RULE: Dict[str, Any] = {
                         }
                     },
                 },
-                "f_n": {**_NUMBER, "exclusiveMinimum": 0},
+                "f_n": {**_NUMBER, "minimum": F_N_RANGE[0], "maximum": F_N_RANGE[1]},
                 "sa_g": {"type": "null"},
                 "pga_g": {"type": "null"},
             },
@@ -418,7 +422,9 @@ class Eq28Request(BaseModel):
         "acceleration).",
     )
     f_n: Optional[float] = Field(
-        None, description="Natural frequency of the structure [Hz], > 0 (with record)."
+        None,
+        description=f"Natural frequency of the structure [Hz], in [{F_N_RANGE[0]:g}, "
+        f"{F_N_RANGE[1]:g}] (periods of 1000 s down to 1 ms; with record).",
     )
 
     @model_validator(mode="after")

@@ -34,6 +34,7 @@ __all__ = [
     "COORDINATE_LIMIT",
     "CRITERIA",
     "DT_RANGE_S",
+    "F_N_RANGE",
     "F_P_RANGE",
     "LAM_RANGE",
     "LENGTH_UNITS",
@@ -122,6 +123,10 @@ PULSE_SHAPES: Tuple[str, ...] = ("sine", "cosine")
 #: Frequency parameter ``p_eq`` [rad/s]: a block of half-diagonal ``R = 3 g / (4 p²)`` from
 #: 74 km down to 7 µm (the top is ``core.exact.P_EQ_PLAUSIBLE``; a test checks the copy).
 P_EQ_RANGE: Tuple[float, float] = (1e-2, 1e3)
+#: Natural frequency ``f_n`` [Hz] of a structure whose spectrum a record gives (Eq. 28 from a
+#: record): periods of 1000 s down to 1 ms, far past the tallest building (about 10 s) and
+#: the stiffest wall; outside it ``T_n = 1/f_n`` can overflow.
+F_N_RANGE: Tuple[float, float] = (1e-3, 1e3)
 #: Static load multiplier ``lam`` [-]: a block's slenderness ``b/h`` from 1/1000 to 100.
 LAM_RANGE: Tuple[float, float] = (1e-3, 1e2)
 #: Pulse frequency ``f_p`` [Hz]: pulses of 1000 s down to 1 ms.

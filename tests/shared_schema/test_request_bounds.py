@@ -200,3 +200,26 @@ def test_the_restitutions_that_go_together_are_stated_as_the_file_enforces_them(
     full["eta_to_positive"] = 0.7
     assert _valid(ConstantsFile, {"mechanisms": [full]})
     ConstantsFile.model_validate({"mechanisms": [full]})
+
+
+@pytest.mark.parametrize(
+    ("f_n", "ok"),
+    [
+        (rules.F_N_RANGE[0], True),
+        (rules.F_N_RANGE[1], True),
+        (math.nextafter(rules.F_N_RANGE[0], 0.0), False),
+        (math.nextafter(rules.F_N_RANGE[1], math.inf), False),
+        (5e-324, False),
+    ],
+)
+def test_the_natural_frequency_range_is_stated_as_the_service_enforces_it(
+    f_n: float, ok: bool
+) -> None:
+    body = {**_eq28([0.0, 0.3, -0.2, 0.1]), "f_n": f_n}
+    assert _valid(Eq28Request, body) is ok
+    try:
+        doc = scale_factor_doc(Eq28Request.model_validate(body), DEFAULT_LIMITS)
+    except InputError as exc:
+        assert not ok and exc.field == "f_n", exc
+    else:
+        assert ok and doc["value"] >= 1.0 and math.isclose(doc["inputs"]["T_n"], 1 / f_n)
