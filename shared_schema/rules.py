@@ -125,7 +125,7 @@ PULSE_SHAPES: Tuple[str, ...] = ("sine", "cosine")
 P_EQ_RANGE: Tuple[float, float] = (1e-2, 1e3)
 #: Natural frequency ``f_n`` [Hz] of a structure whose spectrum a record gives (Eq. 28 from a
 #: record): periods of 1000 s down to 1 ms, far past the tallest building (about 10 s) and
-#: the stiffest wall; outside it ``T_n = 1/f_n`` can overflow.
+#: the stiffest wall; below 5.6e-309 Hz, ``T_n = 1/f_n`` would overflow.
 F_N_RANGE: Tuple[float, float] = (1e-3, 1e3)
 #: Static load multiplier ``lam`` [-]: a block's slenderness ``b/h`` from 1/1000 to 100.
 LAM_RANGE: Tuple[float, float] = (1e-3, 1e2)
