@@ -21,8 +21,12 @@ from shared_schema.constants import Amplification, ConstantsFile
 from shared_schema.errors import InputError
 from shared_schema.rules import (
     A_P_G_MAX,
+    ACCEL_MAX_G,
     ACCEL_MIN,
+    BUILDING_HEIGHT_MAX_M,
     CRITERIA,
+    DT_RANGE_S,
+    F_N_RANGE,
     F_P_RANGE,
     LAM_RANGE,
     LENGTH_UNITS,
@@ -31,6 +35,7 @@ from shared_schema.rules import (
     RECORD_FORMATS,
     RECORD_UNITS,
     SF_METHODS,
+    accel_max,
     check_choice,
 )
 from shared_schema.site import SiteFile
@@ -41,6 +46,7 @@ __all__ = [
     "MAX_ASSESS_MULTIPLES",
     "MAX_ASSESS_RECORDS",
     "PULSE_ETA_RULE",
+    "RECORD_SAMPLE_RULE",
     "RECORD_UNITS",
     "AssessRequest",
     "AssessResponse",
@@ -88,6 +94,23 @@ _RESPONSE = ConfigDict(extra="allow")
 
 def _gt0(description: str) -> Any:
     return Field(description=description, json_schema_extra={"exclusiveMinimum": 0})
+
+
+def _height(description: str, *, positive: bool = True, below: str = "") -> Any:
+    """Return a height field [m]: > 0 (>= 0 unless ``positive``), <= ``BUILDING_HEIGHT_MAX_M``.
+
+    ``below`` names a height it may not exceed either (a rule across fields, told in words).
+    """
+    low = ("> 0" if positive else ">= 0") + (f", at most {below}" if below else "")
+    bounds: Dict[str, Any] = {
+        "exclusiveMinimum" if positive else "minimum": 0,
+        "maximum": BUILDING_HEIGHT_MAX_M,
+    }
+    return Field(
+        description=f"{description} [m], {low} and at most {BUILDING_HEIGHT_MAX_M:g} m "
+        "(taller than any building).",
+        json_schema_extra=bounds,
+    )
 
 
 # --- rules across fields, stated in the schema ------------------------------------------------
@@ -139,12 +162,25 @@ EQ28_RULE: Dict[str, Any] = {
                         }
                     },
                 },
-                "f_n": {**_NUMBER, "exclusiveMinimum": 0},
+                "f_n": {**_NUMBER, "minimum": F_N_RANGE[0], "maximum": F_N_RANGE[1]},
                 "sa_g": {"type": "null"},
                 "pga_g": {"type": "null"},
             },
             "required": ["record", "f_n"],
         },
+    ]
+}
+
+#: A record's samples are at most ``ACCEL_MAX_G`` in magnitude, stated in its own units.
+RECORD_SAMPLE_RULE: Dict[str, Any] = {
+    "oneOf": [
+        {
+            "properties": {
+                "units": {"const": units},
+                "accel": {"items": {**_NUMBER, "minimum": -top, "maximum": top}},
+            }
+        }
+        for units, top in ((u, accel_max(u)) for u in RECORD_UNITS)
     ]
 }
 
@@ -246,12 +282,22 @@ _PULSE_RANGES: Dict[str, Tuple[float, float]] = {
 class RecordSamples(BaseModel):
     """A ground-acceleration record given as samples at a uniform time step."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=RECORD_SAMPLE_RULE
+    )
 
     accel: List[float] = Field(
-        min_length=2, description="Acceleration samples, in `units`, at a uniform step `dt`."
+        min_length=2,
+        description="Acceleration samples, in `units`, at a uniform step `dt`; each of "
+        f"magnitude at most {ACCEL_MAX_G:g} g in those units ("
+        + ", ".join(f"{accel_max(u):.6g} {u}" for u in RECORD_UNITS)
+        + ").",
     )
-    dt: float = _gt0("Time step [s], > 0.")
+    dt: float = Field(
+        description=f"Time step [s], in [{DT_RANGE_S[0]:g}, {DT_RANGE_S[1]:g}] (an "
+        "accelerograph samples at 1 MHz at most and once a second at least).",
+        json_schema_extra={"minimum": DT_RANGE_S[0], "maximum": DT_RANGE_S[1]},
+    )
     units: str = Field(
         description="Units of `accel`.", json_schema_extra={"enum": list(RECORD_UNITS)}
     )
@@ -365,10 +411,8 @@ class Eq28Request(BaseModel):
     )
 
     method: Literal["eq28"]
-    h: float = Field(
-        description="Height of the mechanism [m], >= 0.", json_schema_extra={"minimum": 0}
-    )
-    h_e: float = _gt0("Effective (modal) height of the structure [m], > 0.")
+    h: float = _height("Height of the mechanism", positive=False)
+    h_e: float = _height("Effective (modal) height of the structure")
     sa_g: Optional[float] = Field(None, description="Spectral acceleration S_a(T_n) [g], >= 0.")
     pga_g: Optional[float] = Field(None, description="Peak ground acceleration [g], > 0.")
     record: Optional[RecordSamples] = Field(
@@ -378,7 +422,9 @@ class Eq28Request(BaseModel):
         "acceleration).",
     )
     f_n: Optional[float] = Field(
-        None, description="Natural frequency of the structure [Hz], > 0 (with record)."
+        None,
+        description=f"Natural frequency of the structure [Hz], in [{F_N_RANGE[0]:g}, "
+        f"{F_N_RANGE[1]:g}] (periods of 1000 s down to 1 ms; with record).",
     )
 
     @model_validator(mode="after")
@@ -398,11 +444,16 @@ class Ec8Request(BaseModel):
     model_config = _REQUEST
 
     method: Literal["ec8"]
-    z: float = Field(description="Height of the element above the foundation [m], >= 0.")
-    H: float = _gt0("Height of the building [m], > 0.")
-    T_a: float = Field(description="Fundamental period of the element [s], >= 0.")
+    z: float = _height("Height of the element above the foundation", positive=False, below="H")
+    H: float = _height("Height of the building")
+    T_a: float = Field(
+        description="Fundamental period of the element [s], >= 0.",
+        json_schema_extra={"minimum": 0},
+    )
     T_1: float = _gt0("Fundamental period of the building [s], > 0.")
-    S: float = Field(1.0, description="Soil factor [-], > 0.")
+    S: float = Field(
+        1.0, description="Soil factor [-], > 0.", json_schema_extra={"exclusiveMinimum": 0}
+    )
 
 
 class NzsRequest(BaseModel):
@@ -411,8 +462,8 @@ class NzsRequest(BaseModel):
     model_config = _REQUEST
 
     method: Literal["nzs"]
-    h_i: float = Field(description="Height of the level above the base [m], >= 0.")
-    h_n: float = _gt0("Height of the top of the structure [m], > 0.")
+    h_i: float = _height("Height of the level above the base", positive=False, below="h_n")
+    h_n: float = _height("Height of the top of the structure")
 
 
 #: One scale-factor request, chosen by ``method``.

@@ -494,6 +494,13 @@ def _mechanism_schema_extra(schema: Dict[str, Any]) -> None:
     for key in ("p_eq", "lam", "phi_ov"):
         props[key]["description"] += " Flat short form: describes the positive side."
     schema["required"] = [k for k in schema.get("required", []) if k != "positive"]
+    # Mechanism._fill_defaults: the two impact restitutions go together and with eta, and
+    # eta_source describes an eta.
+    schema["dependentRequired"] = {
+        "eta_to_negative": ["eta_to_positive", "eta"],
+        "eta_to_positive": ["eta_to_negative", "eta"],
+        "eta_source": ["eta"],
+    }
     schema["oneOf"] = [
         {
             "required": ["positive"],

@@ -26,11 +26,15 @@ from typing import Dict, NamedTuple, Optional, Sequence, Tuple, Union
 from shared_schema.errors import InputError
 
 __all__ = [
+    "ACCEL_MAX_G",
     "ACCEL_MIN",
     "A_P_G_MAX",
     "BODY_SIZE_PLAUSIBLE",
+    "BUILDING_HEIGHT_MAX_M",
     "COORDINATE_LIMIT",
     "CRITERIA",
+    "DT_RANGE_S",
+    "F_N_RANGE",
     "F_P_RANGE",
     "LAM_RANGE",
     "LENGTH_UNITS",
@@ -44,6 +48,7 @@ __all__ = [
     "TYPOLOGIES",
     "G",
     "QuantityRange",
+    "accel_max",
     "body_size_note",
     "check_choice",
     "check_eta",
@@ -118,6 +123,10 @@ PULSE_SHAPES: Tuple[str, ...] = ("sine", "cosine")
 #: Frequency parameter ``p_eq`` [rad/s]: a block of half-diagonal ``R = 3 g / (4 p²)`` from
 #: 74 km down to 7 µm (the top is ``core.exact.P_EQ_PLAUSIBLE``; a test checks the copy).
 P_EQ_RANGE: Tuple[float, float] = (1e-2, 1e3)
+#: Natural frequency ``f_n`` [Hz] of a structure whose spectrum a record gives (Eq. 28 from a
+#: record): periods of 1000 s down to 1 ms, far past the tallest building (about 10 s) and
+#: the stiffest wall; below 5.6e-309 Hz, ``T_n = 1/f_n`` would overflow.
+F_N_RANGE: Tuple[float, float] = (1e-3, 1e3)
 #: Static load multiplier ``lam`` [-]: a block's slenderness ``b/h`` from 1/1000 to 100.
 LAM_RANGE: Tuple[float, float] = (1e-3, 1e2)
 #: Pulse frequency ``f_p`` [Hz]: pulses of 1000 s down to 1 ms.
@@ -128,6 +137,29 @@ A_P_G_MAX = 1e2
 #: A record used for Eq. 28 needs a peak ground acceleration: one sample at least this large
 #: in magnitude [in the record's units] (smaller ones could round to zero when converted).
 ACCEL_MIN = 1e-300
+#: Tallest structure [m] a height may describe: above the tallest building (828 m), so a
+#: larger value is a slip of units or digits, never a building.
+BUILDING_HEIGHT_MAX_M = 1000.0
+#: Time step [s] outside which a record is refused: no accelerograph samples faster than
+#: 1 MHz or slower than once a second (issue #14: a dt of 1e300 s overflows the spectrum).
+DT_RANGE_S: Tuple[float, float] = (1e-6, 1.0)
+#: Largest acceleration [g] a record may hold: 200 times the strongest ground motion
+#: recorded (about 5 g); beyond it the numbers are wrong units, not an earthquake.
+ACCEL_MAX_G = 1e3
+
+
+def accel_max(units: str) -> float:
+    """Return the largest sample magnitude a record may hold, in ``units`` (``ACCEL_MAX_G``).
+
+    The readers compare each sample with this value in the record's own units, so that a
+    huge sample cannot overflow on the way to m/s²; the REST schema states the same value.
+
+    Examples
+    --------
+    >>> accel_max("mg")
+    1000000.0
+    """
+    return ACCEL_MAX_G * G / RECORD_UNITS[units]
 
 
 def check_number(

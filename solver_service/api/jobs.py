@@ -38,7 +38,7 @@ from shared_schema.api import (
 from shared_schema.constants import ConstantsFile, parse_constants
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import MissingExtra
-from shared_schema.rules import CRITERIA, SF_METHODS, check_choice
+from shared_schema.rules import CRITERIA, F_N_RANGE, SF_METHODS, check_choice
 from shared_schema.spec import parse_spec
 
 from ..core import codes
@@ -358,6 +358,13 @@ def scale_factor_doc(
     if request.f_n is None:
         raise InputError("eq28 from a record needs the natural frequency f_n [Hz]", "f_n")
     f_n = check_positive(request.f_n, "f_n")
+    lo, hi = F_N_RANGE
+    if not lo <= f_n <= hi:
+        raise InputError(
+            f"must be in [{lo:g}, {hi:g}] Hz (periods of {1 / lo:g} s down to {1 / hi:g} s, "
+            f"a plausible range), got {request.f_n!r}",
+            "f_n",
+        )
     motion = motion_from_params(request.record, None, None, limits)
     check_record_work(motion, limits, t_min=1.0 / f_n)
     spec = response_spectrum(motion.accel.acc, motion.dt, [1.0 / f_n])

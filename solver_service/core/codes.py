@@ -20,15 +20,13 @@ from __future__ import annotations
 from typing import Any
 
 from shared_schema.errors import InputError
+from shared_schema.rules import BUILDING_HEIGHT_MAX_M
 
 from .amplification import scale_factor
 from .model import check_non_negative, check_positive
 
 __all__ = ["BUILDING_HEIGHT_MAX_M", "check_height", "sf_ec8", "sf_eq28", "sf_nzs"]
 
-#: Tallest structure [m] a height may describe: above the tallest building (828 m), so a
-#: larger value is a slip of units or digits, never a building.
-BUILDING_HEIGHT_MAX_M = 1000.0
 
 #: NZS 1170.5 §8.3: height [m] below which ``C_Hi = 1 + h_i/6`` applies.
 NZS_LOW_HEIGHT = 12.0

@@ -42,7 +42,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from shared_schema.errors import InputError
-from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, G, check_file
+from shared_schema.rules import (
+    ACCEL_MAX_G,
+    DT_RANGE_S,
+    RECORD_FORMATS,
+    RECORD_UNITS,
+    G,
+    accel_max,
+    check_file,
+)
 
 from .excitation import SampledAccel
 from .formats import READERS, Channel, channel_list, select_channel
@@ -68,12 +76,6 @@ UNITS = RECORD_UNITS
 PGA_PLAUSIBLE_G = (0.001, 5.0)
 #: Time step [s] outside which a record gets a plausibility warning.
 DT_PLAUSIBLE_S = (1e-4, 0.1)
-#: Time step [s] outside which a record is refused: no accelerograph samples faster than
-#: 1 MHz or slower than once a second (issue #14: a dt of 1e300 s overflows the spectrum).
-DT_RANGE_S = (1e-6, 1.0)
-#: Largest acceleration [g] a record may hold: 200 times the strongest ground motion
-#: recorded (about 5 g); beyond it the numbers are wrong units, not an earthquake.
-ACCEL_MAX_G = 1e3
 #: Relative tolerance on the spacing of time stamps read from a file.
 DT_RTOL = 1e-6
 #: Record formats ``GroundMotion.from_file`` reads (``shared_schema.rules``).
@@ -188,7 +190,7 @@ def _sampled(a: NDArray[np.float64], units: str, dt: Any, name: str) -> SampledA
     a = np.asarray(a, dtype=float)
     _check_samples(a, name)
     # compared in the given units, so that a huge sample cannot overflow on the way to SI
-    big = np.flatnonzero(np.abs(a) > ACCEL_MAX_G * G / factor)
+    big = np.flatnonzero(np.abs(a) > accel_max(units))
     if big.size:
         k = int(big[0])
         raise InputError(

@@ -1,5 +1,6 @@
 """The plausible ranges of a pulse request: consistent with the solver and the work bound,
-stated in the published schema, and wide enough that every corner still computes."""
+stated in the published schema, and wide enough that every corner still computes; and the
+record, height and restitution rules the schema states, each exactly as the service enforces it."""
 
 from __future__ import annotations
 
@@ -8,14 +9,20 @@ import json
 import math
 from typing import Any
 
+import jsonschema
+import numpy as np
 import pytest
-from pydantic import ValidationError
+from pydantic import BaseModel, ValidationError
 from typer.testing import CliRunner
 
 from shared_schema import rules
-from shared_schema.api import Eq28Request, PulseRequest
+from shared_schema.api import Ec8Request, Eq28Request, NzsRequest, PulseRequest, RecordSamples
+from shared_schema.constants import ConstantsFile
+from shared_schema.errors import InputError
+from solver_service.api.jobs import scale_factor_doc
 from solver_service.cli import app
-from solver_service.core import exact
+from solver_service.core import codes, exact
+from solver_service.core.records import GroundMotion
 from solver_service.workflows.limits import DEFAULT_LIMITS, WORK_PER_SAMPLE
 
 runner = CliRunner()
@@ -92,3 +99,127 @@ def test_an_eq28_record_needs_a_peak_ground_acceleration() -> None:
     assert branch["properties"]["accel"]["contains"] == {
         "anyOf": [{"minimum": 1e-300}, {"maximum": -1e-300}]
     }
+
+
+# --- records and heights: what the schema states is what the service enforces -----------------
+
+
+def _valid(model: type[BaseModel], doc: dict[str, Any]) -> bool:
+    """Whether ``doc`` is valid against ``model``'s published JSON Schema (draft 2020-12)."""
+    validator = jsonschema.Draft202012Validator(model.model_json_schema())
+    return not list(validator.iter_errors(doc))
+
+
+def _read(accel: list[float], dt: float, units: str) -> str | None:
+    """Return the field the record reader refuses, or None when it reads the samples."""
+    try:
+        GroundMotion.from_samples(np.asarray(accel), dt, units=units)
+    except InputError as exc:
+        return exc.field
+    return None
+
+
+@pytest.mark.parametrize("units", list(rules.RECORD_UNITS))
+def test_the_largest_sample_is_stated_per_unit_as_the_reader_enforces_it(units: str) -> None:
+    top = rules.accel_max(units)
+    assert math.isclose(top * rules.RECORD_UNITS[units], rules.ACCEL_MAX_G * rules.G)
+    for accel, ok in (
+        ([top, -top], True),
+        ([0.0, math.nextafter(top, math.inf)], False),
+        ([math.nextafter(-top, -math.inf), 0.0], False),
+    ):
+        doc = {"accel": accel, "dt": 0.01, "units": units}
+        assert _valid(RecordSamples, doc) is ok, (units, accel)
+        assert _read(accel, 0.01, units) == (None if ok else "record"), (units, accel)
+    assert (
+        f"{top:.6g} {units}"
+        in RecordSamples.model_json_schema()["properties"]["accel"]["description"]
+    )
+
+
+@pytest.mark.parametrize(
+    ("dt", "ok"),
+    [
+        (rules.DT_RANGE_S[0], True),
+        (rules.DT_RANGE_S[1], True),
+        (math.nextafter(rules.DT_RANGE_S[0], 0.0), False),
+        (math.nextafter(rules.DT_RANGE_S[1], math.inf), False),
+        (5e-324, False),
+    ],
+)
+def test_the_time_step_range_is_stated_as_the_reader_enforces_it(dt: float, ok: bool) -> None:
+    doc = {"accel": [0.0, 0.1], "dt": dt, "units": "g"}
+    assert _valid(RecordSamples, doc) is ok
+    assert _read([0.0, 0.1], dt, "g") == (None if ok else "dt")
+    assert "[1e-06, 1]" in RecordSamples.model_json_schema()["properties"]["dt"]["description"]
+
+
+HEIGHT_CASES = [
+    (Eq28Request, {"method": "eq28", "sa_g": 0.2, "pga_g": 0.1, "h": 4.6, "h_e": 4.5}, "h"),
+    (Eq28Request, {"method": "eq28", "sa_g": 0.2, "pga_g": 0.1, "h": 4.6, "h_e": 4.5}, "h_e"),
+    (Ec8Request, {"method": "ec8", "z": 4.0, "H": 12.0, "T_a": 0.0, "T_1": 0.5}, "H"),
+    (NzsRequest, {"method": "nzs", "h_i": 4.6, "h_n": 9.0}, "h_n"),
+]
+
+
+@pytest.mark.parametrize(("model", "doc", "key"), HEIGHT_CASES)
+def test_the_tallest_height_is_stated_as_the_codes_enforce_it(
+    model: type[BaseModel], doc: dict[str, Any], key: str
+) -> None:
+    top = rules.BUILDING_HEIGHT_MAX_M
+    assert codes.BUILDING_HEIGHT_MAX_M == top
+    for value, ok in ((top, True), (math.nextafter(top, math.inf), False)):
+        body = {**doc, key: value}
+        assert _valid(model, body) is ok, body
+        try:
+            doc_out = scale_factor_doc(model.model_validate(body), DEFAULT_LIMITS)
+        except InputError as exc:
+            assert not ok and exc.field == key, exc
+        else:
+            assert ok and doc_out["value"] >= 1.0
+    assert "at most 1000 m" in model.model_json_schema()["properties"][key]["description"]
+
+
+@pytest.mark.parametrize(
+    ("given", "missing"),
+    [
+        ({"eta_to_negative": 0.5, "eta": 0.6}, "eta_to_positive"),
+        ({"eta_to_positive": 0.7, "eta": 0.6}, "eta_to_negative"),
+        ({"eta_to_negative": 0.5, "eta_to_positive": 0.7}, "eta"),
+        ({"eta_source": "user"}, "eta"),
+    ],
+)
+def test_the_restitutions_that_go_together_are_stated_as_the_file_enforces_them(
+    given: dict[str, Any], missing: str
+) -> None:
+    mech = {"id": "W1", "p_eq": 2.0, "lam": 0.2, **given}
+    assert not _valid(ConstantsFile, {"mechanisms": [mech]})
+    with pytest.raises(ValidationError, match=missing):
+        ConstantsFile.model_validate({"mechanisms": [mech]})
+    full = {"id": "W1", "p_eq": 2.0, "lam": 0.2, "eta": 0.6, "eta_to_negative": 0.5}
+    full["eta_to_positive"] = 0.7
+    assert _valid(ConstantsFile, {"mechanisms": [full]})
+    ConstantsFile.model_validate({"mechanisms": [full]})
+
+
+@pytest.mark.parametrize(
+    ("f_n", "ok"),
+    [
+        (rules.F_N_RANGE[0], True),
+        (rules.F_N_RANGE[1], True),
+        (math.nextafter(rules.F_N_RANGE[0], 0.0), False),
+        (math.nextafter(rules.F_N_RANGE[1], math.inf), False),
+        (5e-324, False),
+    ],
+)
+def test_the_natural_frequency_range_is_stated_as_the_service_enforces_it(
+    f_n: float, ok: bool
+) -> None:
+    body = {**_eq28([0.0, 0.3, -0.2, 0.1]), "f_n": f_n}
+    assert _valid(Eq28Request, body) is ok
+    try:
+        doc = scale_factor_doc(Eq28Request.model_validate(body), DEFAULT_LIMITS)
+    except InputError as exc:
+        assert not ok and exc.field == "f_n", exc
+    else:
+        assert ok and doc["value"] >= 1.0 and math.isclose(doc["inputs"]["T_n"], 1 / f_n)
