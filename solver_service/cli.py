@@ -943,7 +943,7 @@ def library_build(
     n_omega: int = typer.Option(400, "--n-omega", help="Omega points, log-spaced in [0.05, 50]."),
     eta_step: float = typer.Option(0.02, "--eta-step", help="Step of eta in [0, 1]."),
 ) -> None:
-    """Compute A_min(Omega; eta) for eta in [0, 1] and the one-sided curve (about 10 s)."""
+    """Compute A_min(Omega; eta) for eta in [0, 1] and the one-sided curve (about 4 s)."""
     import numpy as np
     from rich.console import Console
     from rich.progress import Progress

@@ -39,7 +39,7 @@ NOT_RUN_OPTIONS = {
 #: Commands that are not run, with the reason.
 NOT_RUN_COMMANDS = {
     "serve": "serves until stopped (the service tests start it on a free port)",
-    "library build": "rewrites the library shipped in the package and takes about 10 s "
+    "library build": "rewrites the library shipped in the package and takes about 4 s "
     "(tests/solver_core/test_envelope.py rebuilds a sample of it)",
 }
 #: Options whose value is a file the command writes (not an input that must exist).
