@@ -20,7 +20,6 @@ Python 3.9-clean: imported by Rhino 8.
 """
 
 import json
-import math
 import os
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Sequence
@@ -31,7 +30,7 @@ from rhino_plugin.mechanisms.build import constants_from_spec
 from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.io import save_constants
-from shared_schema.rules import quantity_problem
+from shared_schema.rules import check_number, quantity_problem
 from shared_schema.spec import TRIBUTARY_DEFAULT, parse_spec
 
 __all__ = [
@@ -82,14 +81,10 @@ def _number(
         value = float(answer.strip() if isinstance(answer, str) else answer)
     except (TypeError, ValueError):
         raise InputError(f"{what} must be a number, got {answer!r}", where) from None
-    if not math.isfinite(value):
-        raise InputError(f"{what} must be finite, got {answer!r}", where)
-    if above is not None and not value > above:
-        raise InputError(f"{what} must be > {above:g}, got {value:g}", where)
-    if at_least is not None and value < at_least:
-        raise InputError(f"{what} must be >= {at_least:g}, got {value:g}", where)
-    if at_most is not None and value > at_most:
-        raise InputError(f"{what} must be <= {at_most:g}, got {value:g}", where)
+    try:
+        value = check_number(value, where, above=above, at_least=at_least, at_most=at_most)
+    except InputError as err:
+        raise InputError(f"{what} {err.reason}", where) from None
     if kind is not None and value != 0.0:
         problem = quantity_problem(value, kind)
         if problem is not None:
