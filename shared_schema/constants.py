@@ -81,6 +81,7 @@ __all__ = [
     "Units",
     "VirtualWork",
     "input_error_from_validation",
+    "json_document",
     "parse_constants",
     "validation_lines",
 ]
@@ -859,6 +860,26 @@ def input_error_from_validation(exc: ValidationError, data: Any = None) -> Input
     return InputError("\n".join([errors[0][1], *lines[1:]]), errors[0][0] or None)
 
 
+def json_document(text: str) -> Any:
+    """Decode JSON text; malformed or too deeply nested text is an ``InputError``.
+
+    Examples
+    --------
+    >>> json_document('{"a": [1, 2]}')
+    {'a': [1, 2]}
+    >>> json_document("[" * 5000 + "]" * 5000)
+    Traceback (most recent call last):
+    ...
+    shared_schema.errors.InputError: invalid JSON: nested deeper than 1000 levels
+    """
+    try:
+        return json.loads(text)
+    except ValueError as exc:
+        raise InputError(f"invalid JSON: {exc}") from None
+    except RecursionError:
+        raise InputError(f"invalid JSON: nested deeper than {MAX_JSON_DEPTH} levels") from None
+
+
 def parse_constants(source: Union[str, bytes, Mapping[str, Any], Sequence[Any]]) -> ConstantsFile:
     """Validate a kinematic-constants file given as JSON text or as plain Python data.
 
@@ -889,12 +910,7 @@ def parse_constants(source: Union[str, bytes, Mapping[str, Any], Sequence[Any]])
         return source
     if isinstance(source, (str, bytes)):
         text = source.decode("utf-8-sig") if isinstance(source, bytes) else source
-        try:
-            data = json.loads(text)
-        except ValueError as exc:
-            raise InputError(f"invalid JSON: {exc}") from None
-        except RecursionError:
-            raise InputError(f"invalid JSON: nested deeper than {MAX_JSON_DEPTH} levels") from None
+        data = json_document(text)
         if isinstance(data, list):
             text = '{"mechanisms": ' + text + "}"
             data = {"mechanisms": data}

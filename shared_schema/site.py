@@ -15,13 +15,11 @@ mechanisms above ground; the optional ``project`` section fills the report's fir
 The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` forms.
 """
 
-import json
 from typing import Any, Literal, Mapping, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from shared_schema.constants import input_error_from_validation
-from shared_schema.errors import InputError
+from shared_schema.constants import input_error_from_validation, json_document
 
 __all__ = [
     "SITE_SCHEMA_VERSION",
@@ -210,10 +208,7 @@ def parse_site(source: Union[str, bytes, Mapping[str, Any]]) -> SiteFile:
         return source
     if isinstance(source, (str, bytes)):
         text = source.decode("utf-8-sig") if isinstance(source, bytes) else source
-        try:
-            data = json.loads(text)
-        except ValueError as exc:
-            raise InputError(f"invalid JSON: {exc}") from None
+        data = json_document(text)
         try:
             return SiteFile.model_validate_json(text)
         except ValidationError as exc:

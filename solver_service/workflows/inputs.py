@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional, Union
@@ -16,7 +15,7 @@ from rhino_plugin.mechanisms.build import (
     failures_error,
 )
 from rhino_plugin.scenes import read_scene
-from shared_schema.constants import ConstantsFile
+from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.errors import InputError
 from shared_schema.io import load_constants
 from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, check_file, check_positive
@@ -87,9 +86,9 @@ def _spec_rows(path: Path, text: str) -> list[tuple[str, dict[str, Any]]]:
     """``(row label, fields)`` of a record-spec file: JSON list of objects or CSV with header."""
     if path.suffix.lower() == ".json":
         try:
-            doc = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InputError(f"{path.name} is not valid JSON: {exc}", "record_spec") from None
+            doc = json_document(text)
+        except InputError as exc:
+            raise InputError(f"{path.name}: {exc.reason}", "record_spec") from None
         if not isinstance(doc, list) or not all(isinstance(r, dict) for r in doc):
             raise InputError(f"{path.name}: expected a JSON list of objects", "record_spec")
         return [(f"record_spec[{i}]", dict(r)) for i, r in enumerate(doc)]

@@ -61,3 +61,6 @@ def test_invalid_site_names_the_field(hazard: dict, field: str) -> None:
 def test_malformed_json_is_an_input_error() -> None:
     with pytest.raises(InputError, match="invalid JSON"):
         parse_site("{")
+    # a nest past Python's recursion limit was a RecursionError traceback (rockmech check)
+    with pytest.raises(InputError, match="nested deeper than 1000 levels"):
+        parse_site('{"a":' * 5000 + "1" + "}" * 5000)

@@ -73,6 +73,18 @@ def test_bad_record_specs_name_row_and_column(tmp_path: Path, text: str, match: 
     assert err.value.field == "record_spec"
 
 
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [("[{", r"records.json: invalid JSON"), ("[" * 5000 + "]" * 5000, "nested deeper than 1000")],
+)
+def test_bad_json_record_specs_are_named(tmp_path: Path, text: str, match: str) -> None:
+    spec = tmp_path / "records.json"
+    spec.write_text(text)
+    with pytest.raises(InputError, match=match) as err:
+        read_record_spec(spec)
+    assert err.value.field == "record_spec"
+
+
 def test_read_record_passes_channel_and_component(formats_dir: Path) -> None:
     assert read_record(formats_dir / DMG, channel=2).metadata["component"] == "UP"
     assert read_record(formats_dir / GEONET, component="S74E").metadata["channel"] == 2
