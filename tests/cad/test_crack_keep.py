@@ -6,26 +6,18 @@ Reference: Housner's block (theory §2.1), lam = atan(b/h) of the part kept.
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 from pathlib import Path
 from typing import Any
 
 import pytest
+from cad_scenes import BUILD
 
 from rhino_plugin.mechanisms.build import constants_from_spec
 from rhino_plugin.scene_3dm import Scene
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.spec import parse_spec
-
-REPO = Path(__file__).resolve().parents[2]
-_spec = importlib.util.spec_from_file_location(
-    "build_scenes_crack", REPO / "examples/scenes/build_scenes.py"
-)
-assert _spec is not None and _spec.loader is not None
-BUILD: Any = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(BUILD)
 
 
 def wall(tmp_path: Path) -> Scene:

@@ -7,13 +7,13 @@ error; now every mechanism's error is reported at once, and ``rockmech constants
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 from pathlib import Path
 from typing import Any
 
 import pytest
+from cad_scenes import BUILD
 from typer.testing import CliRunner
 
 from rhino_plugin.mechanisms.build import constants_from_spec
@@ -21,14 +21,6 @@ from rhino_plugin.scene_3dm import Scene
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.spec import parse_spec
 from solver_service.cli import app
-
-REPO = Path(__file__).resolve().parents[2]
-_spec = importlib.util.spec_from_file_location(
-    "build_scenes_errors", REPO / "examples/scenes/build_scenes.py"
-)
-assert _spec is not None and _spec.loader is not None
-BUILD: Any = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(BUILD)
 
 
 def write_scene(path: Path) -> Path:

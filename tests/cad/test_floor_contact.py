@@ -6,12 +6,12 @@ example scenes are written with an absolute tolerance of 0.1 mm.
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 from typing import Any
 
 import pytest
+from cad_scenes import BUILD
 
 from rhino_plugin.mechanisms.build import constants_from_spec
 from rhino_plugin.scene_3dm import Scene
@@ -19,13 +19,6 @@ from shared_schema.errors import GeometryError
 from shared_schema.spec import parse_spec
 
 G = 9.80665
-REPO = Path(__file__).resolve().parents[2]
-_spec = importlib.util.spec_from_file_location(
-    "build_scenes_floor", REPO / "examples/scenes/build_scenes.py"
-)
-assert _spec is not None and _spec.loader is not None
-BUILD: Any = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(BUILD)
 
 
 def scene_with_floor(tmp_path: Path, dz: float) -> Scene:

@@ -12,7 +12,6 @@ projection; so exactly ``K = M g R cos t``, ``Q = M R``, ``phi_cr = alpha`` and
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 from pathlib import Path
@@ -20,19 +19,12 @@ from typing import Any
 
 import numpy as np
 import pytest
+from cad_scenes import BUILD
 
 from rhino_plugin.mechanisms.build import MAX_AXIS_TILT, constants_from_spec
 from rhino_plugin.scene_3dm import Scene
 from shared_schema.errors import GeometryError
 from shared_schema.spec import parse_spec
-
-REPO = Path(__file__).resolve().parents[2]
-_spec = importlib.util.spec_from_file_location(
-    "build_scenes_tilt", REPO / "examples/scenes/build_scenes.py"
-)
-assert _spec is not None and _spec.loader is not None
-BUILD: Any = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(BUILD)
 
 B, L, H = 0.5, 1.0, 3.0
 FACES = np.array(

@@ -8,13 +8,13 @@ equivalent block (theta_cr = alpha, p_eq = p sqrt((1 + 2 gamma)/(1 + 3 gamma))) 
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 from pathlib import Path
 from typing import Any, Callable
 
 import pytest
+from cad_scenes import BUILD
 
 from rhino_plugin.mechanisms.build import constants_from_spec
 from rhino_plugin.scene_3dm import Scene
@@ -22,13 +22,6 @@ from shared_schema.errors import InputError
 from shared_schema.spec import parse_spec
 
 G = 9.80665
-REPO = Path(__file__).resolve().parents[2]
-_spec = importlib.util.spec_from_file_location(
-    "build_scenes_plane", REPO / "examples/scenes/build_scenes.py"
-)
-assert _spec is not None and _spec.loader is not None
-BUILD: Any = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(BUILD)
 
 
 def frame(b: Any) -> None:

@@ -17,7 +17,6 @@ towards collapse is negative in ``negative.M_F``.
 from __future__ import annotations
 
 import cmath
-import importlib.util
 import json
 import math
 from pathlib import Path
@@ -25,6 +24,7 @@ from typing import Any, Callable
 
 import numpy as np
 import pytest
+from cad_scenes import BUILD
 from scipy.optimize import brentq, fsolve
 
 from rhino_plugin.mechanisms.build import constants_from_spec
@@ -32,13 +32,6 @@ from rhino_plugin.scene_3dm import Scene
 from shared_schema.spec import parse_spec
 
 G = 9.80665
-REPO = Path(__file__).resolve().parents[2]
-_spec = importlib.util.spec_from_file_location(
-    "build_scenes_neg", REPO / "examples/scenes/build_scenes.py"
-)
-assert _spec is not None and _spec.loader is not None
-BUILD: Any = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(BUILD)
 
 
 def scene_of(tmp_path: Path, fill: Callable[[Any], None]) -> Scene:

@@ -8,13 +8,13 @@ beyond their admissible range are refused, in the spec itself (``shared_schema.r
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 from pathlib import Path
 from typing import Any
 
 import pytest
+from cad_scenes import BUILD
 
 from rhino_plugin.mechanisms.build import constants_from_spec
 from rhino_plugin.scene_3dm import Scene
@@ -24,13 +24,6 @@ from shared_schema.spec import parse_spec
 pytest.importorskip("rhino3dm")
 
 G = 9.80665
-REPO = Path(__file__).resolve().parents[2]
-_spec = importlib.util.spec_from_file_location(
-    "build_scenes_plausible", REPO / "examples/scenes/build_scenes.py"
-)
-assert _spec is not None and _spec.loader is not None
-BUILD: Any = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(BUILD)
 
 
 def wall_scene(tmp_path: Path, units: str = "Meters", scale: float = 1.0) -> Scene:

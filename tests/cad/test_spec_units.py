@@ -7,13 +7,13 @@ alpha = atan(b/h) and p_eq = sqrt(3 g / (4 R)) for a 0.5 m x 3 m wall.
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 from pathlib import Path
 from typing import Any
 
 import pytest
+from cad_scenes import BUILD
 
 from rhino_plugin.mechanisms.build import constants_from_spec
 from rhino_plugin.scene_3dm import Scene
@@ -21,13 +21,6 @@ from shared_schema.errors import GeometryError
 from shared_schema.spec import parse_spec
 
 G = 9.80665
-REPO = Path(__file__).resolve().parents[2]
-_spec = importlib.util.spec_from_file_location(
-    "build_scenes_units", REPO / "examples/scenes/build_scenes.py"
-)
-assert _spec is not None and _spec.loader is not None
-BUILD: Any = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(BUILD)
 
 
 def mm_wall(tmp_path: Path) -> Scene:

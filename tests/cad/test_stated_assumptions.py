@@ -7,12 +7,12 @@ documented as required but derived without a word; N defaulted to half the slab'
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 from typing import Any, Callable
 
 import pytest
+from cad_scenes import BUILD
 
 from rhino_plugin.mechanisms.build import constants_from_spec
 from rhino_plugin.scene_3dm import Scene
@@ -20,13 +20,6 @@ from shared_schema.errors import InputError
 from shared_schema.spec import parse_spec
 
 G = 9.80665
-REPO = Path(__file__).resolve().parents[2]
-_spec = importlib.util.spec_from_file_location(
-    "build_scenes_assumptions", REPO / "examples/scenes/build_scenes.py"
-)
-assert _spec is not None and _spec.loader is not None
-BUILD: Any = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(BUILD)
 
 
 def scene_of(tmp_path: Path, fill: Callable[[Any], None]) -> Scene:
