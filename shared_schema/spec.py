@@ -192,51 +192,39 @@ class Crack(BaseModel):
         return self
 
 
-class Floor(BaseModel):
+class _Slab(BaseModel):
+    """Objects of one density whose weight and inertia the wall carries a share of."""
+
+    model_config = _STRICT
+    objects: List[Selector] = Field(min_length=1)
+    density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
+    tributary: float = Field(
+        default=TRIBUTARY_DEFAULT, gt=0, le=1, description="Share carried by the wall."
+    )
+
+    @field_validator("density")
+    @classmethod
+    def _check_density(cls, value: Optional[float]) -> Optional[float]:
+        return _in_range(value, "density")
+
+    @field_validator("objects")
+    @classmethod
+    def _check_objects(cls, value: Optional[List[Selector]]) -> Optional[List[Selector]]:
+        return value if value is None else _once(value)
+
+
+class Floor(_Slab):
     """A floor: classified load-bearing or not from how it meets the wall.
 
     ``tributary`` is the share of its weight and inertia the wall carries (0.5: a floor
     spanning between the wall and one parallel support).
     """
 
-    model_config = _STRICT
-    objects: List[Selector] = Field(min_length=1)
-    density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
-    tributary: float = Field(
-        default=TRIBUTARY_DEFAULT, gt=0, le=1, description="Share carried by the wall."
-    )
 
-    @field_validator("density")
-    @classmethod
-    def _check_density(cls, value: Optional[float]) -> Optional[float]:
-        return _in_range(value, "density")
-
-    @field_validator("objects")
-    @classmethod
-    def _check_objects(cls, value: Optional[List[Selector]]) -> Optional[List[Selector]]:
-        return value if value is None else _once(value)
-
-
-class Roof(BaseModel):
+class Roof(_Slab):
     """A pitched roof: weight share on the wall and thrust from its bounding box (§5)."""
 
-    model_config = _STRICT
-    objects: List[Selector] = Field(min_length=1)
-    density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
-    tributary: float = Field(
-        default=TRIBUTARY_DEFAULT, gt=0, le=1, description="Share carried by the wall."
-    )
     tied: bool = Field(default=False, description="Tied truss (no thrust on the wall).")
-
-    @field_validator("density")
-    @classmethod
-    def _check_density(cls, value: Optional[float]) -> Optional[float]:
-        return _in_range(value, "density")
-
-    @field_validator("objects")
-    @classmethod
-    def _check_objects(cls, value: Optional[List[Selector]]) -> Optional[List[Selector]]:
-        return value if value is None else _once(value)
 
 
 class Vault(BaseModel):
