@@ -12,7 +12,6 @@ import numpy as np
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
-from shared_schema.rules import G
 
 from ..core.amplification import pulse_scale_factor
 from ..core.envelope import (
@@ -116,7 +115,7 @@ def model_pulse_doc(
         Overturning verdict (default ``exact`` for pulses).
     """
     model.require_eta()
-    exc = Pulse(a_p=a_p_g * G, f_p=f_p, shape=shape)
+    exc = Pulse.from_g(a_p_g, f_p, shape)
     res = simulate(model, exc, criterion=criterion)
     pos = model.positive
     return {
