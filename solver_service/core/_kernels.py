@@ -76,6 +76,12 @@ try:  # numba is optional: without it the same code runs as plain Python.
         }  # not in numba's type stubs
         return _numba.njit(cache=True, nogil=True, **options)(fn)
 
+    def _inline(fn):
+        # The small helpers of the per-sample and per-impact paths, inlined where they are
+        # called (numba IR): a call with array arguments costs more than their arithmetic.
+        options: dict[str, Any] = {"_nrt": False, "error_model": "numpy", "inline": "always"}
+        return _numba.njit(cache=True, nogil=True, **options)(fn)
+
     _prange: Any = _numba.prange
     JIT = True
 except ImportError:  # pragma: no cover - exercised through the python backend
@@ -85,6 +91,7 @@ except ImportError:  # pragma: no cover - exercised through the python backend
 
     _jit_parallel = _jit
     _leaf = _jit
+    _inline = _jit
     _prange = range
     JIT = False
 
@@ -187,7 +194,7 @@ ST_UPLIFT_T = NOUT + 11
 NST = NOUT + 12
 
 
-@_leaf
+@_inline
 def _accel(cell, t):
     """Ground acceleration of a cell (rows ``CELL_ROWS``) and its rate at absolute time ``t``."""
     if cell[0] == 0:
@@ -196,7 +203,7 @@ def _accel(cell, t):
     return cell[1] * math.sin(arg), cell[1] * cell[2] * math.cos(arg)
 
 
-@_leaf
+@_inline
 def _side(s):
     """Row of the ``sides`` array for side ``s`` (+1: 0, -1: 1)."""
     return 0 if s > 0.0 else 1
@@ -224,7 +231,7 @@ def _anchor(fl, cell, sides, s, ta, xa, va):
 SHORT_U2 = 2.5e-3
 
 
-@_leaf
+@_inline
 def _series(u2):
     """Return ``(ps, pc)``: ``sinh(u) - u = u**3 ps`` and ``cosh(u) - 1 = u**2 pc``.
 
@@ -256,7 +263,7 @@ def _series(u2):
     return ps, pc
 
 
-@_leaf
+@_inline
 def _flow_coeffs(p, tau):
     """Coefficients of the closed-form flow over ``tau`` [s] on a side of frequency ``p``.
 
@@ -291,7 +298,7 @@ def _cov_coeffs(p, tau):
     return a * a, 2.0 * a * b, b * b, a * c, a * d + b * c, b * d, c * c, 2.0 * c * d, d * d
 
 
-@_leaf
+@_inline
 def _state(fl, tau):
     """State ``(x, x', x'', x''')`` at ``ta + tau`` from the anchor of the flight ``fl``."""
     ks = fl[FL_KS]
@@ -333,7 +340,7 @@ def _state(fl, tau):
     return x, v, acc, jerk
 
 
-@_leaf
+@_inline
 def _sgn(z):
     if z > 0.0:
         return 1.0
@@ -342,7 +349,7 @@ def _sgn(z):
     return 0.0
 
 
-@_leaf
+@_inline
 def _component(which, target, fl, t):
     """Return function ``which`` (0: x - target, 1: x', 2: x''), 2 derivatives, |3rd| bound.
 
@@ -596,7 +603,7 @@ def _uplift_time(cell, ks, s, t, tb):
     return min(x, hi)
 
 
-@_leaf
+@_inline
 def _cap_cov(pxx, pxv, pvv, p):
     """Clip the error covariance to the physical span of the motion (``ERR_CAP``)."""
     xcap = ERR_CAP * ERR_CAP
@@ -605,13 +612,13 @@ def _cap_cov(pxx, pxv, pvv, p):
         pxx = xcap
     if not pvv <= vcap:
         pvv = vcap
-    lim = math.sqrt(pxx * pvv)
-    if not abs(pxv) <= lim:
+    if not pxv * pxv <= pxx * pvv:  # Cauchy-Schwarz, checked without the square root
+        lim = math.sqrt(pxx * pvv)
         pxv = lim if pxv > 0.0 else -lim
     return pxx, pxv, pvv
 
 
-@_leaf
+@_inline
 def _set_cov(st, pxx, pxv, pvv, p):
     """Store the error covariance, clipped (``_cap_cov``)."""
     pxx, pxv, pvv = _cap_cov(pxx, pxv, pvv, p)
@@ -788,10 +795,155 @@ def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, acc_a, trace):
     return -1.0
 
 
-@_leaf
+@_inline
 def _eta_into(rules, s_new):
     """Restitution of a two-sided impact after which the body rocks on side ``s_new``."""
     return rules[RULE_ETA] if s_new > 0.0 else rules[RULE_ETA_NEG]
+
+
+#: Relative widening of the speed bounds of a closed chattering sequence at each bounce:
+#: far above the rounding of the speeds the event path computes, far below the width of
+#: the bounds themselves.
+CLOSE_MARGIN = 1e-9
+#: Most bounces a chattering sequence is followed through by its bounds (else not closed).
+CLOSE_MAXITER = 10_000
+
+
+@_leaf
+def _chatter_rate(rules, sides, row, row_new):
+    """Ratio of the speeds leaving and reaching an impact from side ``row`` into ``row_new``."""
+    if rules[RULE_ONE_SIDED] != 0.0:
+        return abs(rules[RULE_ETA])
+    s_new = 1.0 if row_new == 0 else -1.0
+    return _eta_into(rules, s_new) * (sides[row, SIDE_PHIOV] / sides[row_new, SIDE_PHIOV])
+
+
+@_leaf
+def _chatter_precheck(sides, rules, row, u0, a_max, j_max, t_left):
+    """Return False when the sequence from ``u0`` is unlikely to close (``_chatter_count``).
+
+    Cheap tests, so that the bounds are followed only when they can succeed: the drive below
+    uplift on both sides and the first bounce within ``t_left`` (necessary), then estimates
+    with the mean rate per bounce: the speeds contracting, the geometric duration within
+    ``t_left`` and the count not near a rounding edge (the estimated width of the bounds
+    against the distance to the rest speed, in bounces).
+    """
+    p = sides[row, SIDE_P]
+    p2 = p * p
+    delta = 1.0 - sides[row, SIDE_KS] * a_max
+    if not (delta > 0.0 and 1.0 - sides[1 - row, SIDE_KS] * a_max > 0.0):
+        return False
+    if 2.0 * u0 > t_left * p2 * delta or not u0 * u0 < 0.5 * p2 * delta * delta:
+        return False
+    mu = delta - u0 * u0 / (p2 * delta)
+    dq = sides[row, SIDE_KS] * j_max
+    g = (4.0 / 3.0) * dq / (p2 * mu * mu)
+    # The mean rate per bounce (two-sided: the two directions in turn).
+    row_new = row if rules[RULE_ONE_SIDED] != 0.0 else 1 - row
+    c = math.sqrt(
+        _chatter_rate(rules, sides, row, row_new) * _chatter_rate(rules, sides, row_new, row)
+    )
+    rate = c * (1.0 + 0.5 * g * u0)
+    if not (0.0 < c and rate < 1.0):
+        return False
+    duration = 2.0 * u0 / (p2 * mu * (1.0 - rate))
+    if duration > t_left:
+        return False
+    # The restoring drive varies by this fraction over the sequence; the bounds on the
+    # energy the drive's rate feeds in differ by about twice that.
+    spread = (dq * duration + u0 * u0 / (p2 * mu)) / mu
+    per_bounce = -math.log(c)
+    width = (2.0 * g * u0 * spread / (1.0 - rate) + 4.0 * CLOSE_MARGIN / (1.0 - c)) / per_bounce
+    pos = math.log(u0 / (rules[RULE_V_REST] * p)) / per_bounce
+    frac = pos - math.floor(pos)
+    return width < 0.25 and 2.0 * width < frac < 1.0 - 2.0 * width
+
+
+@_leaf
+def _chatter_count(st, cell, sides, rules, t, s, u0):
+    """Impacts still to count before a chattering sequence comes to rest, or -1 (theory §10.5).
+
+    The body leaves ``x = 0`` at time ``t`` on side ``s`` at speed ``u0`` inside the linear
+    cell ``cell``, where ``q = ks a`` is linear with rate ``dq = ks a'``. On side ``s``,
+    ``y = s x >= 0`` obeys ``y'' = -R`` with ``R = p**2 (1 + s q - y)``, and the energy
+    ``E = y'**2/2 + p**2 (1 + s q) y - p**2 y**2/2`` changes at the rate ``p**2 s dq y``.
+    Each bounce is followed with bounds: its start time within ``[t + e_lo, t + e_hi]``,
+    its launch speed within ``[u_lo, u_hi]``; from them ``R`` within ``[R_min, R_max]``
+    (``q`` over the times the bounce can span, ``y`` below its excursion bound
+    ``u**2/(2 R_min)``), its duration within ``[2 u/R_max, 2 u/R_min]`` and, as ``y`` lies
+    between the parabolas ``u t - R t**2/2``, its integral within ``2 u**3/(3 R**2)`` at the
+    two ``R``: the speed at its return is ``u sqrt(1 + k u)``, ``k = 4 p**2 s dq/(3 R**2)``.
+    The restitution of each impact carries the bounds to the next bounce. Returns the number
+    of impacts that arrive at or above the rest speed before one leaves below it (the event
+    path's count), when every such comparison comes out the same at both bounds, the bounces
+    end within the cell (where the drive cannot lift the body: the rest that follows holds to
+    the cell's end), their excursions stay below the peak so far and the impact cap is not
+    reached. Otherwise -1: the event path follows the bounces.
+    """
+    if cell[0] != 0:
+        return -1
+    a_t = cell[1] + cell[2] * (t - cell[4])
+    a_e = cell[1] + cell[2] * (cell[5] - cell[4])
+    a_max = max(abs(a_t), abs(a_e))
+    t_left = cell[5] - t
+    row = _side(s)
+    if not _chatter_precheck(sides, rules, row, u0, a_max, abs(cell[2]), t_left):
+        return -1
+    one_sided = rules[RULE_ONE_SIDED] != 0.0
+    top = min(st[OUT_PEAK], 1.0) - BOUND_MARGIN
+    u_hi = u0 * (1.0 + CLOSE_MARGIN)
+    u_lo = u0 * (1.0 - CLOSE_MARGIN)
+    e_lo = 0.0
+    e_hi = 0.0
+    n = 0
+    for _ in range(CLOSE_MAXITER):
+        sgn = 1.0 if row == 0 else -1.0
+        p = sides[row, SIDE_P]
+        p2 = p * p
+        ks = sides[row, SIDE_KS]
+        # Crude bounds first (drive over the rest of the cell), then over this bounce's span.
+        delta = 1.0 - ks * a_max
+        x_crude = u_hi * u_hi / (p2 * delta)
+        if not x_crude < 0.5 * delta:
+            return -1
+        tau_crude = 2.0 * u_hi / (p2 * (delta - x_crude))
+        sq_a = sgn * ks * (a_t + cell[2] * e_lo)
+        sq_b = sgn * ks * (a_t + cell[2] * min(e_hi + tau_crude, t_left))
+        r_max = p2 * (1.0 + max(sq_a, sq_b))
+        r_min = p2 * (1.0 + min(sq_a, sq_b)) - p2 * x_crude
+        x_hi = u_hi * u_hi / (2.0 * r_min)
+        e_lo += 2.0 * u_lo / r_max
+        e_hi += 2.0 * u_hi / r_min
+        if not x_hi < top or e_hi > t_left:
+            return -1
+        k = (4.0 / 3.0) * p2 * sgn * ks * cell[2]
+        k_hi = k / (r_min * r_min if k > 0.0 else r_max * r_max)
+        k_lo = k / (r_max * r_max if k > 0.0 else r_min * r_min)
+        if not (abs(k_hi * u_hi) < 0.5 and abs(k_lo * u_hi) < 0.5):
+            return -1
+        # Speeds reaching the impact that ends this bounce.
+        hi = u_hi * math.sqrt(1.0 + k_hi * u_hi) * (1.0 + CLOSE_MARGIN)
+        lo = u_lo * math.sqrt(1.0 + k_lo * u_lo) * (1.0 - CLOSE_MARGIN)
+        thr = rules[RULE_V_REST] * p
+        counted = hi >= thr
+        if counted != (lo >= thr):
+            return -1
+        if counted:
+            n += 1
+        row_new = row if one_sided else 1 - row
+        rate = _chatter_rate(rules, sides, row, row_new)
+        u_hi = rate * hi * (1.0 + CLOSE_MARGIN)
+        u_lo = rate * lo * (1.0 - CLOSE_MARGIN)
+        row = row_new
+        thr = rules[RULE_V_REST] * sides[row, SIDE_P]
+        rests = u_hi < thr
+        if rests != (u_lo < thr):
+            return -1
+        if rests:
+            if st[OUT_N_IMPACTS] + n >= rules[RULE_MAX_IMPACTS]:
+                return -1
+            return n
+    return -1
 
 
 @_leaf
@@ -824,6 +976,17 @@ def _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log):
         st[OUT_N_IMPACTS] += 1
         if st[OUT_N_IMPACTS] >= rules[RULE_MAX_IMPACTS]:
             st[OUT_STATUS] = -1
+    if not ends_in_rest and st[OUT_STATUS] == 0.0 and log.shape[1] + trace.shape[1] == 0:
+        # A chattering sequence that surely ends in rest within the cell is closed at once
+        # (``_chatter_count``); an impact log or a time series, when asked for, shows every
+        # bounce instead.
+        n_more = _chatter_count(st, cell, sides, rules, t, s_new, abs(v_new))
+        if n_more >= 0:
+            st[OUT_N_IMPACTS] += n_more
+            st[OUT_N_RESTS] += 1
+            st[ST_UPLIFT_T] = math.nan
+            _set_rest(st)
+            return
     if ends_in_rest:
         st[OUT_N_RESTS] += 1
         # Rest rule (ends Zeno sequences, theory §10). A null excursion right after uplift
@@ -1146,7 +1309,7 @@ def _propagator(prop, sides, h):
             prop[row, PROP_COV + r] = cov[r]
 
 
-@_leaf
+@_inline
 def _fast_rest(st, ksp, ksn, j, a_lo, a_hi, one_sided):
     """Return True when run ``j`` at rest stays at rest through a linear cell (no uplift).
 
@@ -1164,7 +1327,7 @@ def _fast_rest(st, ksp, ksn, j, a_lo, a_hi, one_sided):
 BOUND_MARGIN = 1e-12
 
 
-@_leaf
+@_inline
 def _no_event(s, xa, va, xb, vb, q0, q1, h, p, peak):
     """Return True when a flight of ``h`` [s] from ``(xa, va)`` to ``(xb, vb)`` has no event.
 
@@ -1198,7 +1361,7 @@ def _no_event(s, xa, va, xb, vb, q0, q1, h, p, peak):
     return low > BOUND_MARGIN
 
 
-@_leaf
+@_inline
 def _fast_flight(st, ksp, ksn, j, cell, props, w):
     """Advance run ``j`` in flight through a linear cell when no event can lie inside it.
 
