@@ -859,6 +859,78 @@ def _chatter_precheck(sides, rules, row, u0, a_max, j_max, t_left):
     return width < 0.25 and 2.0 * width < frac < 1.0 - 2.0 * width
 
 
+#: The cell-wide bounds take over a closed chattering sequence once they widen its speed
+#: bounds by at most this fraction over all the bounces left (``_chatter_tail``).
+CLOSE_TAIL = 1e-4
+
+
+@_leaf
+def _tail_gain(sides, row, a_max, slope):
+    """Bound ``g`` on the speed change of a bounce on side ``row``: ``|z| <= g u`` [s/rad].
+
+    From the cell-wide bounds of ``_chatter_count``: ``R >= p**2 delta/2`` and
+    ``|k| = 4 p**2 ks |a'|/3``, so ``|z| = |k| u/R**2 <= 16 ks |a'| u/(3 p**2 delta**2)``.
+    """
+    p2 = sides[row, SIDE_P] * sides[row, SIDE_P]
+    delta = 1.0 - sides[row, SIDE_KS] * a_max
+    return (16.0 / 3.0) * sides[row, SIDE_KS] * abs(slope) / (p2 * delta * delta)
+
+
+@_leaf
+def _chatter_tail(st, sides, rules, a_max, slope, row, u_lo, u_hi, t_left):
+    """``_chatter_count`` on from a bounce leaving on side ``row``, with cell-wide bounds.
+
+    Each bounce lasts at most ``4 u/(p**2 delta)``, rises at most ``u**2/(p**2 delta)`` and
+    returns at ``u sqrt(1 + z)``, ``|z| <= g u`` (``_tail_gain``): no division per bounce.
+    ``t_left`` is the time left in the cell [s]. Returns the impacts still counted, or -1.
+    """
+    one_sided = rules[RULE_ONE_SIDED] != 0.0
+    top = min(st[OUT_PEAK], 1.0) - BOUND_MARGIN
+    d_0 = 1.0 - sides[0, SIDE_KS] * a_max
+    d_1 = 1.0 - sides[1, SIDE_KS] * a_max
+    inv_0 = 1.0 / (sides[0, SIDE_P] * sides[0, SIDE_P] * d_0)
+    inv_1 = 1.0 / (sides[1, SIDE_P] * sides[1, SIDE_P] * d_1)
+    g_0 = _tail_gain(sides, 0, a_max, slope)
+    g_1 = _tail_gain(sides, 1, a_max, slope)
+    thr_0 = rules[RULE_V_REST] * sides[0, SIDE_P]
+    thr_1 = rules[RULE_V_REST] * sides[1, SIDE_P]
+    rate_0 = _chatter_rate(rules, sides, 0, 0 if one_sided else 1)
+    rate_1 = _chatter_rate(rules, sides, 1, 1 if one_sided else 0)
+    n = 0
+    elapsed = 0.0
+    for _ in range(CLOSE_MAXITER):
+        inv = inv_0 if row == 0 else inv_1
+        x = u_hi * u_hi * inv
+        elapsed += 4.0 * u_hi * inv
+        z = (g_0 if row == 0 else g_1) * u_hi
+        if not (x < top and x < 0.5 * (d_0 if row == 0 else d_1)):
+            return -1
+        if not (elapsed <= t_left and z <= 0.5):
+            return -1
+        hi = u_hi * (1.0 + 0.5 * z) * (1.0 + CLOSE_MARGIN)
+        lo = u_lo * (1.0 - 0.5 * z - 0.5 * z * z) * (1.0 - CLOSE_MARGIN)
+        thr = thr_0 if row == 0 else thr_1
+        counted = hi >= thr
+        if counted != (lo >= thr):
+            return -1
+        if counted:
+            n += 1
+        rate = rate_0 if row == 0 else rate_1
+        u_hi = rate * hi * (1.0 + CLOSE_MARGIN)
+        u_lo = rate * lo * (1.0 - CLOSE_MARGIN)
+        if not one_sided:
+            row = 1 - row
+        thr = thr_0 if row == 0 else thr_1
+        rests = u_hi < thr
+        if rests != (u_lo < thr):
+            return -1
+        if rests:
+            if st[OUT_N_IMPACTS] + n >= rules[RULE_MAX_IMPACTS]:
+                return -1
+            return n
+    return -1
+
+
 @_leaf
 def _chatter_count(st, cell, sides, rules, t, s, u0):
     """Impacts still to count before a chattering sequence comes to rest, or -1 (theory §10.5).
@@ -896,34 +968,48 @@ def _chatter_count(st, cell, sides, rules, t, s, u0):
     e_lo = 0.0
     e_hi = 0.0
     n = 0
+    # Below this speed the cell-wide bounds alone decide the rest (``_chatter_tail``): the
+    # speed bounds then widen by at most CLOSE_TAIL over all the bounces left.
+    rate_max = max(
+        _chatter_rate(rules, sides, 0, 0 if one_sided else 1),
+        _chatter_rate(rules, sides, 1, 1 if one_sided else 0),
+    )
+    gain = max(_tail_gain(sides, 0, a_max, cell[2]), _tail_gain(sides, 1, a_max, cell[2]))
+    u_tail = CLOSE_TAIL * (1.0 - rate_max) / gain if gain > 0.0 else math.inf
     for _ in range(CLOSE_MAXITER):
+        if u_hi < u_tail:
+            tail = _chatter_tail(st, sides, rules, a_max, cell[2], row, u_lo, u_hi, t_left - e_hi)
+            return -1 if tail < 0 else n + tail
         sgn = 1.0 if row == 0 else -1.0
         p = sides[row, SIDE_P]
         p2 = p * p
-        ks = sides[row, SIDE_KS]
-        # Crude bounds first (drive over the rest of the cell), then over this bounce's span.
-        delta = 1.0 - ks * a_max
-        x_crude = u_hi * u_hi / (p2 * delta)
-        if not x_crude < 0.5 * delta:
+        sks = sgn * sides[row, SIDE_KS]
+        # Crude bounds first (drive over the rest of the cell: y <= x_crude <= delta/2, so
+        # R >= p**2 delta/2 and the bounce lasts at most 4 u/(p**2 delta)), then over the
+        # times this bounce can span.
+        p2d = p2 * (1.0 - sgn * sks * a_max)
+        x_crude = u_hi * u_hi / p2d
+        if not x_crude < 0.5 * (1.0 - sgn * sks * a_max):
             return -1
-        tau_crude = 2.0 * u_hi / (p2 * (delta - x_crude))
-        sq_a = sgn * ks * (a_t + cell[2] * e_lo)
-        sq_b = sgn * ks * (a_t + cell[2] * min(e_hi + tau_crude, t_left))
+        sq_a = sks * (a_t + cell[2] * e_lo)
+        sq_b = sks * (a_t + cell[2] * min(e_hi + 4.0 * u_hi / p2d, t_left))
         r_max = p2 * (1.0 + max(sq_a, sq_b))
-        r_min = p2 * (1.0 + min(sq_a, sq_b)) - p2 * x_crude
-        x_hi = u_hi * u_hi / (2.0 * r_min)
-        e_lo += 2.0 * u_lo / r_max
-        e_hi += 2.0 * u_hi / r_min
-        if not x_hi < top or e_hi > t_left:
+        r_min = p2 * (1.0 + min(sq_a, sq_b) - x_crude)
+        inv_min = 1.0 / r_min
+        inv_max = 1.0 / r_max
+        e_lo += 2.0 * u_lo * inv_max
+        e_hi += 2.0 * u_hi * inv_min
+        if not (0.5 * u_hi * u_hi * inv_min < top and e_hi <= t_left):
             return -1
-        k = (4.0 / 3.0) * p2 * sgn * ks * cell[2]
-        k_hi = k / (r_min * r_min if k > 0.0 else r_max * r_max)
-        k_lo = k / (r_max * r_max if k > 0.0 else r_min * r_min)
-        if not (abs(k_hi * u_hi) < 0.5 and abs(k_lo * u_hi) < 0.5):
+        k = (4.0 / 3.0) * p2 * sks * cell[2]
+        z_hi = k * u_hi * (inv_min * inv_min if k > 0.0 else inv_max * inv_max)
+        z_lo = k * u_lo * (inv_max * inv_max if k > 0.0 else inv_min * inv_min)
+        if not (abs(z_hi) <= 0.5 and abs(z_lo) <= 0.5):
             return -1
-        # Speeds reaching the impact that ends this bounce.
-        hi = u_hi * math.sqrt(1.0 + k_hi * u_hi) * (1.0 + CLOSE_MARGIN)
-        lo = u_lo * math.sqrt(1.0 + k_lo * u_lo) * (1.0 - CLOSE_MARGIN)
+        # Speeds reaching the impact that ends this bounce: u sqrt(1 + z), with
+        # 1 + z/2 - z**2/2 <= sqrt(1 + z) <= 1 + z/2 for |z| <= 1/2.
+        hi = u_hi * (1.0 + 0.5 * z_hi) * (1.0 + CLOSE_MARGIN)
+        lo = u_lo * (1.0 + 0.5 * z_lo - 0.5 * z_lo * z_lo) * (1.0 - CLOSE_MARGIN)
         thr = rules[RULE_V_REST] * p
         counted = hi >= thr
         if counted != (lo >= thr):
