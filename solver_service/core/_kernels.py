@@ -1535,31 +1535,40 @@ def _doze_table(cells, rules):
 
 
 @_leaf
-def _doze(st, ksp, ksn, asleep, neg, pos, fast, one_sided, t_start):
+def _doze(st, ksp, ksn, asleep, neg, pos, fast, one_sided, t_start, awake, slow):
     """Wake the runs asleep (time ``t_start`` [s]); put to sleep those no cell can lift.
 
     At rest, a run sleeps through a stretch when no cell of it can lift it. The test is
     ``_fast_rest``'s on the stretch's extremes ``neg``, ``pos`` [m/s²]; the product with
-    ``ks > 0`` keeps the order, so it decides as the per-cell tests would.
+    ``ks > 0`` keeps the order, so it decides as the per-cell tests would. Returns the
+    number of runs left awake and still running, listed first in ``awake``; the others are
+    not ``slow``.
     """
+    n_awake = 0
     for j in range(st.shape[1]):
         if asleep[j]:
             st[ST_T, j] = t_start
+        running = st[OUT_STATUS, j] == 0.0
         asleep[j] = (
             fast
-            and st[OUT_STATUS, j] == 0.0
+            and running
             and st[ST_MODE, j] == REST
             and ksp[j] * neg <= 1.0
             and (one_sided or ksn[j] * pos <= 1.0)
         )
+        slow[j] = False
+        if running and not asleep[j]:
+            awake[n_awake] = j
+            n_awake += 1
+    return n_awake
 
 
 @_leaf
-def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow, asleep):
-    """One sample interval for every run of a block; mark in ``slow`` the runs it cannot do.
+def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow, awake, n_awake):
+    """One sample interval for the runs listed awake; mark in ``slow`` the runs it cannot do.
 
-    Returns the number of runs left to the event path. Runs that end (status != 0) and runs
-    asleep (``_doze``) are skipped.
+    Returns the number of runs left to the event path. Runs that end (status != 0) are
+    skipped, and those asleep are not listed (``_doze``).
     """
     n_slow = 0
     ce = cell[5]
@@ -1567,9 +1576,10 @@ def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow, asleep):
     a_b = cell[1] + cell[2] * (cell[5] - cell[4])
     a_lo = min(a_t, a_b)
     a_hi = max(a_t, a_b)
-    for j in range(st.shape[1]):
+    for i in range(n_awake):
+        j = awake[i]
         slow[j] = False
-        if asleep[j] or st[OUT_STATUS, j] != 0.0:
+        if st[OUT_STATUS, j] != 0.0:
             continue
         if st[ST_MODE, j] == REST:
             done = _fast_rest(st, ksp, ksn, j, a_lo, a_hi, one_sided)
@@ -1643,10 +1653,15 @@ def _simulate_block(cells, width_of, widths, params, scales, v_rest_rel, max_imp
     log = np.empty((4, 0))
     neg, pos, fast = _doze_table(cells, rules)
     asleep = np.zeros(k, dtype=np.bool_)
+    awake = np.empty(k, dtype=np.int64)
+    n_awake = k
     for i in range(cells.shape[1]):
         if i % DOZE == 0:
             b = i // DOZE
-            _doze(st, ksp, ksn, asleep, neg[b], pos[b], fast[b], one_sided, cells[4, i])
+            t_b = cells[4, i]
+            n_awake = _doze(
+                st, ksp, ksn, asleep, neg[b], pos[b], fast[b], one_sided, t_b, awake, slow
+            )
         for r in range(len(CELL_ROWS)):
             cell[r] = cells[r, i]
         n_slow = k
@@ -1655,12 +1670,12 @@ def _simulate_block(cells, width_of, widths, params, scales, v_rest_rel, max_imp
             if not have[w]:
                 _propagator(props[w], sides[0], widths[w])
                 have[w] = True
-            n_slow = _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow, asleep)
+            n_slow = _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow, awake, n_awake)
         else:
             slow[:] = True
         if n_slow > 0:
             _event_path(st, sides, slow, cell, rules, st1, sides1, fl, trace, log)
-    _doze(st, ksp, ksn, asleep, 0.0, 0.0, False, one_sided, cells[5, cells.shape[1] - 1])
+    _doze(st, ksp, ksn, asleep, 0.0, 0.0, False, one_sided, cells[5, -1], awake, slow)
     out = np.empty((k, NOUT))
     for j in range(k):
         _load_run(st1, sides1, st, sides, j)
