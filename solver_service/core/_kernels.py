@@ -859,6 +859,32 @@ def _chatter_precheck(sides, rules, row, u0, a_max, j_max, t_left):
     return width < 0.25 and 2.0 * width < frac < 1.0 - 2.0 * width
 
 
+@_inline
+def _bounded_impact(st, rules, lo, hi, thr_in, rate, thr_out, n):
+    """One impact of a sequence being closed, reached at a speed within ``[lo, hi]``.
+
+    ``thr_in`` and ``thr_out`` are the rest speeds of the sides before and after it,
+    ``rate`` the ratio of the speeds leaving and reaching it, ``n`` the impacts counted so
+    far. Returns ``(done, u_lo, u_hi, n)``: the bounds on the speed leaving it and the count
+    with it; ``done`` is 1 when the sequence ends in rest here, 0 when it goes on, and -1
+    when a comparison of the event path (counted, ends in rest) differs at the two bounds or
+    the impact cap would be reached.
+    """
+    counted = hi >= thr_in
+    u_hi = rate * hi * (1.0 + CLOSE_MARGIN)
+    u_lo = rate * lo * (1.0 - CLOSE_MARGIN)
+    rests = u_hi < thr_out
+    if counted != (lo >= thr_in) or rests != (u_lo < thr_out):
+        return -1, u_lo, u_hi, n
+    if counted:
+        n += 1
+    if not rests:
+        return 0, u_lo, u_hi, n
+    if st[OUT_N_IMPACTS] + n >= rules[RULE_MAX_IMPACTS]:
+        return -1, u_lo, u_hi, n
+    return 1, u_lo, u_hi, n
+
+
 #: The cell-wide bounds take over a closed chattering sequence once they widen its speed
 #: bounds by at most this fraction over all the bounces left (``_chatter_tail``).
 CLOSE_TAIL = 1e-4
@@ -909,25 +935,14 @@ def _chatter_tail(st, sides, rules, a_max, slope, row, u_lo, u_hi, t_left):
             return -1
         hi = u_hi * (1.0 + 0.5 * z) * (1.0 + CLOSE_MARGIN)
         lo = u_lo * (1.0 - 0.5 * z - 0.5 * z * z) * (1.0 - CLOSE_MARGIN)
-        thr = thr_0 if row == 0 else thr_1
-        counted = hi >= thr
-        if counted != (lo >= thr):
-            return -1
-        if counted:
-            n += 1
+        row_new = row if one_sided else 1 - row
+        thr_in = thr_0 if row == 0 else thr_1
+        thr_out = thr_0 if row_new == 0 else thr_1
         rate = rate_0 if row == 0 else rate_1
-        u_hi = rate * hi * (1.0 + CLOSE_MARGIN)
-        u_lo = rate * lo * (1.0 - CLOSE_MARGIN)
-        if not one_sided:
-            row = 1 - row
-        thr = thr_0 if row == 0 else thr_1
-        rests = u_hi < thr
-        if rests != (u_lo < thr):
-            return -1
-        if rests:
-            if st[OUT_N_IMPACTS] + n >= rules[RULE_MAX_IMPACTS]:
-                return -1
-            return n
+        done, u_lo, u_hi, n = _bounded_impact(st, rules, lo, hi, thr_in, rate, thr_out, n)
+        if done != 0:
+            return n if done > 0 else -1
+        row = row_new
     return -1
 
 
@@ -1010,25 +1025,14 @@ def _chatter_count(st, cell, sides, rules, t, s, u0):
         # 1 + z/2 - z**2/2 <= sqrt(1 + z) <= 1 + z/2 for |z| <= 1/2.
         hi = u_hi * (1.0 + 0.5 * z_hi) * (1.0 + CLOSE_MARGIN)
         lo = u_lo * (1.0 + 0.5 * z_lo - 0.5 * z_lo * z_lo) * (1.0 - CLOSE_MARGIN)
-        thr = rules[RULE_V_REST] * p
-        counted = hi >= thr
-        if counted != (lo >= thr):
-            return -1
-        if counted:
-            n += 1
         row_new = row if one_sided else 1 - row
+        thr_in = rules[RULE_V_REST] * p
+        thr_out = rules[RULE_V_REST] * sides[row_new, SIDE_P]
         rate = _chatter_rate(rules, sides, row, row_new)
-        u_hi = rate * hi * (1.0 + CLOSE_MARGIN)
-        u_lo = rate * lo * (1.0 - CLOSE_MARGIN)
+        done, u_lo, u_hi, n = _bounded_impact(st, rules, lo, hi, thr_in, rate, thr_out, n)
+        if done != 0:
+            return n if done > 0 else -1
         row = row_new
-        thr = rules[RULE_V_REST] * sides[row, SIDE_P]
-        rests = u_hi < thr
-        if rests != (u_lo < thr):
-            return -1
-        if rests:
-            if st[OUT_N_IMPACTS] + n >= rules[RULE_MAX_IMPACTS]:
-                return -1
-            return n
     return -1
 
 
