@@ -1211,6 +1211,14 @@ def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
                 _record_turn(st, fl, acc_a, jerk_a, tau_imp, trace)
             _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log)
             return False
+        if trace.shape[1] == 0:
+            # No return in this step: when the bounds of the batch path show that no event
+            # lies in it either, the general search would only find the turning point, which
+            # a run without a time series does not record.
+            xb, vb, _ab, _jb = _state(fl, big_h)
+            if _no_event(s, xa, va, xb, vb, ks * a_a, ks * ad_a, big_h, p, st[OUT_PEAK]):
+                _advance(st, fl, xb, vb, tb, cell[6], trace)
+                return True
     nz, z1, z2, xb, vb = _velocity_zeros(fl, acc_a, jerk_a, big_h, sig_a, qd_sign)
     tau_imp = _scan_pieces(st, fl, nz, z1, z2, xb, big_h, acc_a, trace)
     if tau_imp >= 0.0:
