@@ -23,7 +23,11 @@ piece, stopped by an a-priori bound on the next correction (one or two closed-fo
 evaluations). No grazing impact is missed. A flight that leaves an impact in a linear cell
 (chattering) takes a shorter route (``_short_return``, the same with or without a trace):
 the return found from the Taylor start is the first one because ``x'`` changes sign once
-before it, and the maximum-principle bound shows that the flight cannot raise the peak.
+before it, and the maximum-principle bound shows that the flight cannot raise the peak; when
+the return is not in the step, the batch path's no-event bound (below) may show that nothing
+happens in it. A chattering sequence proved to end in rest within its cell, with a known
+number of impacts and no new peak, is closed at once (``_chatter_count``, theory §10.5),
+unless a time series or an impact log asks for every bounce.
 
 Layout. One run carries small arrays instead of long argument lists: ``sides`` (p, ks,
 phi_ov of each side, ``SIDE_*``), ``rules`` (restitution, one-sided, rest rule, impact cap,
