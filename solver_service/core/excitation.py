@@ -98,6 +98,33 @@ class Pulse:
         return np.where(inside, self.a_p * np.sin(self.omega_p * tt + self.phase), 0.0)
 
 
+def check_finite_samples(a: NDArray[np.float64], field: str, where: str = "") -> None:
+    """Refuse an acceleration history with a non-finite sample.
+
+    Parameters
+    ----------
+    a : (n,) float
+        The samples [m/s² or the record's units].
+    field : str
+        The input field the error names (``record``, ``acc``).
+    where : str
+        What to name before the message (a file), or nothing.
+
+    Raises
+    ------
+    InputError
+        Naming the first non-finite sample, its value and how many there are.
+    """
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        prefix = f"{where}: " if where else ""
+        raise InputError(
+            f"{prefix}sample {int(bad[0])} is not finite ({float(a[bad[0]])}); "
+            f"{bad.size} non-finite sample(s) in all",
+            field,
+        )
+
+
 @dataclass(frozen=True)
 class SampledAccel:
     """A uniformly sampled ground acceleration, linear between samples.
@@ -123,13 +150,7 @@ class SampledAccel:
         a = np.ascontiguousarray(self.acc, dtype=float)
         if a.ndim != 1 or a.size < 2:
             raise InputError(f"needs at least 2 samples, got {a.size}", "record")
-        bad = np.flatnonzero(~np.isfinite(a))
-        if bad.size:
-            raise InputError(
-                f"sample {int(bad[0])} is not finite ({a[bad[0]]!r}); "
-                f"{bad.size} non-finite sample(s) in all",
-                "record",
-            )
+        check_finite_samples(a, "record")
         if isinstance(self.dt, bool) or not (math.isfinite(float(self.dt)) and self.dt > 0):
             raise InputError(f"must be finite and > 0, got {self.dt!r}", "dt")
         t0 = float(self.t0)

@@ -52,7 +52,7 @@ from shared_schema.rules import (
     check_file,
 )
 
-from .excitation import SampledAccel
+from .excitation import SampledAccel, check_finite_samples
 from .formats import READERS, Channel, channel_list, select_channel
 from .formats import detect as detect_strong_motion
 from .formats._text import units_or_none
@@ -168,13 +168,7 @@ def _to_float(token: str, where: str, raw: str) -> float:
 def _check_samples(a: NDArray[np.float64], name: str) -> None:
     if a.size < 2:
         raise InputError(f"{name}: needs at least 2 samples, got {a.size}", "record")
-    bad = np.flatnonzero(~np.isfinite(a))
-    if bad.size:
-        raise InputError(
-            f"{name}: sample {int(bad[0])} is not finite ({float(a[bad[0]])}); "
-            f"{bad.size} non-finite sample(s) in all",
-            "record",
-        )
+    check_finite_samples(a, "record", name)
 
 
 def _sampled(a: NDArray[np.float64], units: str, dt: Any, name: str) -> SampledAccel:

@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.errors import InputError
 
+from .excitation import check_finite_samples
 from .model import G
 
 __all__ = ["BACKENDS", "Spectrum", "response_spectrum"]
@@ -61,9 +62,7 @@ def _check_inputs(
         raise InputError(f"must be numbers, got {acc!r}", "acc") from exc
     if a.ndim != 1 or a.size < 2:
         raise InputError(f"must be a 1-D array of at least 2 samples, got shape {a.shape}", "acc")
-    bad = np.flatnonzero(~np.isfinite(a))
-    if bad.size:
-        raise InputError(f"sample {int(bad[0])} is not finite ({a[bad[0]]!r})", "acc")
+    check_finite_samples(a, "acc")
     if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)):
         raise InputError(f"must be a number, got {dt!r}", "dt")
     if not (math.isfinite(float(dt)) and dt > 0.0):

@@ -12,6 +12,7 @@ from scipy.integrate import solve_ivp
 
 from shared_schema.errors import InputError
 from solver_service.core import spectra
+from solver_service.core.excitation import SampledAccel
 from solver_service.core.model import G
 from solver_service.core.records import GroundMotion
 from solver_service.core.spectra import _recurrence, response_spectrum
@@ -171,3 +172,17 @@ def test_invalid_inputs_name_the_field(kwargs: dict[str, object], field: str) ->
 
 def test_doctests() -> None:
     assert doctest.testmod(spectra).failed == 0
+
+
+def test_a_non_finite_sample_is_named_alike_everywhere() -> None:
+    # One check (excitation.check_finite_samples) for records, spectra and SampledAccel:
+    # plain numbers in the message, the first bad sample and the count.
+    acc = [0.0, 1.0, float("inf"), float("nan")]
+    with pytest.raises(InputError) as spec_err:
+        response_spectrum(acc, 0.01, [0.5])
+    with pytest.raises(InputError) as rec_err:
+        SampledAccel(np.array(acc), 0.01)
+    for err, field in ((spec_err, "acc"), (rec_err, "record")):
+        assert err.value.field == field
+        assert "sample 2 is not finite (inf); 2 non-finite sample(s) in all" in str(err.value)
+        assert "np.float64" not in str(err.value)
