@@ -69,7 +69,20 @@ from api_helpers import Server, start_server
 #: Test cases per operation and phase.
 MAX_EXAMPLES = 30
 #: Operations checked for positive-data acceptance too (the others: module docstring).
-POSITIVE_DATA_OPERATIONS = ("pulse", "scale-factor", "health", r"schema/kinematic-constants\.json")
+POSITIVE_DATA_OPERATIONS = (
+    "pulse",
+    "scale-factor",
+    "envelope",
+    "history",
+    "spectrum",
+    "report",
+    "check",
+    "assess",
+    "health",
+    r"schema/kinematic-constants\.json",
+)
+#: The server's compute budget per request [s] (the hooks read it too: the work estimates).
+COMPUTE_TIMEOUT_S = 5
 #: The server's ``ROCKMECH_MAX_SAMPLES`` (the hooks read it: a record's work bound).
 MAX_SAMPLES = 50_000
 #: The hooks module: positive cases that break a rule JSON Schema cannot state are dropped.
@@ -92,7 +105,9 @@ checks.positive_data_acceptance.enabled = true
 @pytest.fixture(scope="module")
 def fuzz_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
     with start_server(
-        tmp_path_factory.mktemp("fuzz"), compute_timeout_s=5, max_samples=MAX_SAMPLES
+        tmp_path_factory.mktemp("fuzz"),
+        compute_timeout_s=COMPUTE_TIMEOUT_S,
+        max_samples=MAX_SAMPLES,
     ) as srv:
         yield srv
 
@@ -128,6 +143,7 @@ def test_schemathesis_finds_no_failures(fuzz_server: Server, tmp_path: Path) -> 
         **os.environ,
         "SCHEMATHESIS_HOOKS": HOOKS,
         "ROCKMECH_MAX_SAMPLES": str(MAX_SAMPLES),
+        "ROCKMECH_COMPUTE_TIMEOUT_S": str(COMPUTE_TIMEOUT_S),
         "PYTHONPATH": os.pathsep.join(
             [str(here), str(here.parents[1]), os.environ.get("PYTHONPATH", "")]
         ),
