@@ -233,7 +233,8 @@ class VirtualWork(BaseModel):
     Notes
     -----
     ``S² <= mass * J`` (Cauchy-Schwarz), i.e. the participating mass fraction
-    ``e* = S² / (mass J)`` is at most 1; a file that breaks it is rejected.
+    ``e* = S² / (mass J)`` is at most 1; a file that breaks it is rejected, and so is one
+    whose ``M* = S²/J`` or ``e*`` is not finite and > 0 in double precision.
     """
 
     model_config = ConfigDict(
@@ -271,6 +272,18 @@ class VirtualWork(BaseModel):
 
     @model_validator(mode="after")
     def _check_bound(self) -> "VirtualWork":
+        # The code check divides by both (core.kinematic.participating_mass): issue #19,
+        # S = 1e-200 made e* = 0 and the check a ZeroDivisionError.
+        m_star = self.S * self.S / self.J
+        e_star = m_star / self.mass
+        if not (math.isfinite(m_star) and m_star > 0.0 and math.isfinite(e_star) and e_star > 0.0):
+            raise _error(
+                "S",
+                f"M* = S^2/J = {m_star!r} and e* = M*/mass = {e_star!r} must be finite and "
+                f"> 0: S = {self.S!r}, J = {self.J!r}, mass = {self.mass!r} are out of any "
+                "physical range (overflow or underflow)",
+                "non_finite_constant",
+            )
         if self.S * self.S > self.mass * self.J * (1.0 + VIRTUAL_WORK_RTOL):
             raise _error(
                 "J",

@@ -106,6 +106,31 @@ def test_bad_site_is_422_naming_the_field_as_rockmech_does(
     assert err["detail"] == "site: " + cli_error("check", str(GEOMETRY), str(bad))
 
 
+@pytest.mark.parametrize(
+    "virtual_work",
+    [
+        {"alpha0": 0.1, "mass": 72522.0, "S": 1e-200, "J": 1.8e6},  # S^2 underflows: e* = 0
+        {"alpha0": 0.1, "mass": 1e300, "S": 1e200, "J": 1e100},  # S^2 and mass J overflow
+    ],
+)
+def test_virtual_work_out_of_double_range_is_422_as_rockmech_says(
+    client: httpx.Client, tmp_path: Path, virtual_work: dict[str, float]
+) -> None:
+    # issue #19: a participating mass fraction e* = S^2/(mass J) of 0 was a 500
+    # (ZeroDivisionError in the linear check), inf/inf a NaN.
+    constants = _json(GEOMETRY)
+    constants["mechanisms"][0]["positive"]["virtual_work"] = virtual_work
+    res = client.post("/api/v1/check", json={"constants": constants, "site": _json(NTC)})
+    assert res.status_code == 422, res.text
+    err = res.json()
+    assert err["field"] == "constants.mechanisms[0] (id 'F1').positive.virtual_work.S"
+    assert "out of any physical range" in err["detail"]
+    bad = tmp_path / "constants.json"
+    bad.write_text(json.dumps(constants))
+    message = cli_error("check", str(bad), str(NTC))
+    assert err["detail"] == "constants: " + message.removeprefix(f"{bad}: ")
+
+
 def test_constants_without_virtual_work_answer_rows_that_say_why(client: httpx.Client) -> None:
     res = client.post("/api/v1/check", json={"constants": _json(SHORT), "site": _json(NTC)})
     assert res.status_code == 200, res.text
