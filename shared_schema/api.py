@@ -213,6 +213,14 @@ _TWO_SIDED_ETA: Dict[str, Any] = {
 #: of a pulse request): an envelope's ``Omega = 2 pi f_p / p_eq`` and a time history's steps
 #: stay finite. Derived from a physical form they are checked by the service alone.
 TIME_DOMAIN_RANGES: Dict[str, Tuple[float, float]] = {"p_eq": P_EQ_RANGE, "lam": LAM_RANGE}
+#: Plausible amplification data of a mechanism for time-domain work, as ``/scale-factor``
+#: takes them: ``f_n`` [Hz] in ``F_N_RANGE`` (``T_n = 1/f_n`` and ``f_p/f_n`` stay finite),
+#: heights ``h`` and ``h_e`` [m] at most ``BUILDING_HEIGHT_MAX_M``.
+AMPLIFICATION_RANGES: Dict[str, Tuple[float, float]] = {
+    "f_n": F_N_RANGE,
+    "h": (0.0, BUILDING_HEIGHT_MAX_M),
+    "h_e": (0.0, BUILDING_HEIGHT_MAX_M),
+}
 
 _SIDE_RANGES = {
     "properties": {
@@ -227,6 +235,12 @@ _PLAUSIBLE_SIDES: Dict[str, Any] = {
                     **_SIDE_RANGES["properties"],
                     "positive": _SIDE_RANGES,
                     "negative": _SIDE_RANGES,
+                    "amplification": {
+                        "properties": {
+                            key: {"minimum": lo, "maximum": hi}
+                            for key, (lo, hi) in AMPLIFICATION_RANGES.items()
+                        }
+                    },
                 }
             }
         }
@@ -234,14 +248,38 @@ _PLAUSIBLE_SIDES: Dict[str, Any] = {
 }
 
 
+#: What the constants of a time-domain request need, in words.
+_TIME_DOMAIN_CONSTANTS = (
+    "The kinematic-constants file; each side's p_eq [rad/s] and lam [-] (given or derived) "
+    f"in the ranges of a pulse, [{P_EQ_RANGE[0]:g}, {P_EQ_RANGE[1]:g}] and "
+    f"[{LAM_RANGE[0]:g}, {LAM_RANGE[1]:g}]; amplification f_n in [{F_N_RANGE[0]:g}, "
+    f"{F_N_RANGE[1]:g}] Hz, h and h_e at most {BUILDING_HEIGHT_MAX_M:g} m; eta for every "
+    "two-sided mechanism."
+)
+
+
+#: What the constants of an assessment need, in words (a mechanism without eta gets its
+#: code checks and a note instead of time histories).
+_ASSESS_CONSTANTS = _TIME_DOMAIN_CONSTANTS.replace("; eta for every two-sided mechanism", "")
+
+
 def _constants_need_eta(schema: Dict[str, Any]) -> None:
-    """State in the schema what time-domain constants need: ``eta``, plausible p_eq and lam."""
+    """State in the schema what time-domain constants need: ``eta``, plausible values."""
     prop = schema["properties"]["constants"]
     schema["properties"]["constants"] = {"allOf": [prop, _TWO_SIDED_ETA, _PLAUSIBLE_SIDES]}
 
 
+def _plausible_constants(schema: Dict[str, Any]) -> None:
+    """State in the schema the plausible values of an assessment's constants (eta optional)."""
+    prop = schema["properties"]["constants"]
+    schema["properties"]["constants"] = {"allOf": [prop, _PLAUSIBLE_SIDES]}
+
+
 def time_domain_problem(cf: ConstantsFile) -> Optional[Tuple[str, str]]:
-    """Return ``(field, message)`` of the first side outside ``TIME_DOMAIN_RANGES``, or None.
+    """Return ``(field, message)`` of the first value out of its time-domain range, or None.
+
+    The ranges: ``AMPLIFICATION_RANGES`` of a mechanism's amplification data, then
+    ``TIME_DOMAIN_RANGES`` of each side.
 
     Parameters
     ----------
@@ -255,6 +293,15 @@ def time_domain_problem(cf: ConstantsFile) -> Optional[Tuple[str, str]]:
     'mechanisms[0].positive.p_eq'
     """
     for i, mech in enumerate(cf.mechanisms):
+        amp = mech.amplification
+        for key, (lo, hi) in [] if amp is None else AMPLIFICATION_RANGES.items():
+            value = getattr(amp, key)
+            if not lo <= value <= hi:
+                return (
+                    f"mechanisms[{i}].amplification.{key}",
+                    f"must be in [{lo:g}, {hi:g}] for a time-domain analysis (a plausible "
+                    f"range, as for a scale factor), got {value!r} (mechanism {mech.id!r})",
+                )
         for which in ("positive", "negative"):
             side = getattr(mech, which)
             for key, (lo, hi) in [] if side is None else TIME_DOMAIN_RANGES.items():
@@ -411,10 +458,7 @@ class EnvelopeRequest(BaseModel):
         strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
     )
 
-    constants: ConstantsFile = Field(
-        description="The kinematic-constants file; each side's p_eq and lam (given or "
-        "derived) in the ranges of a pulse."
-    )
+    constants: ConstantsFile = Field(description=_TIME_DOMAIN_CONSTANTS)
     f_min: float = _frequency("Lowest pulse frequency", 0.1)
     f_max: float = _frequency("Highest pulse frequency", 10.0, "> f_min, ")
     n: JsonInt = Field(
@@ -499,10 +543,7 @@ class HistoryRequest(HistoryOptions):
         strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
     )
 
-    constants: ConstantsFile = Field(
-        description="The kinematic-constants file; each side's p_eq and lam (given or "
-        "derived) in the ranges of a pulse."
-    )
+    constants: ConstantsFile = Field(description=_TIME_DOMAIN_CONSTANTS)
     record: RecordSamples = Field(description="The ground motion.")
 
     _plausible = field_validator("constants")(classmethod(_time_domain_constants))
@@ -643,10 +684,7 @@ class ReportRequest(ReportOptions):
         strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_report_schema
     )
 
-    constants: ConstantsFile = Field(
-        description="The kinematic-constants file; each side's p_eq and lam (given or "
-        "derived) in the ranges of a pulse."
-    )
+    constants: ConstantsFile = Field(description=_TIME_DOMAIN_CONSTANTS)
     record: Optional[RecordSamples] = Field(
         None, description="A ground motion for time histories and its spectrum."
     )
@@ -680,13 +718,10 @@ class AssessRequest(BaseModel):
     """Code checks beside rocking dynamics on records scaled to the site (``rockmech assess``)."""
 
     model_config = ConfigDict(
-        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_plausible_constants
     )
 
-    constants: ConstantsFile = Field(
-        description="The kinematic-constants file; each side's p_eq and lam (given or "
-        "derived) in the ranges of a pulse."
-    )
+    constants: ConstantsFile = Field(description=_ASSESS_CONSTANTS)
     site: SiteFile = Field(description="The site file (SITE.json): hazard, FC, q, building.")
     records: List[RecordSamples] = Field(
         min_length=1,

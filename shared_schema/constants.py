@@ -477,6 +477,14 @@ def _derive_side(side: SideConstants, which: str) -> SideConstants:
                 "any physical range (overflow)",
                 "non_finite_constant",
             )
+    if not derived["p_eq"] > 0.0:
+        # issue #19: K/I0 below the smallest double made p_eq 0, which no file may hold.
+        raise _error(
+            "p_eq",
+            f"sqrt(K/I0) = {derived['p_eq']!r} is not > 0: the inputs K = {side.K:g}, "
+            f"I0 = {side.I0:g} are out of any physical range (underflow)",
+            "non_finite_constant",
+        )
     for key, formula in (
         ("lam", f"(K*phi_cr {sign} M_F)/(g*Q)"),
         ("phi_ov", f"phi_cr {sign} M_F/K"),

@@ -51,9 +51,11 @@ from shared_schema.api import (
     SpectrumRequest,
 )
 from shared_schema.errors import InputError
-from solver_service.api.estimates import check_job
+from solver_service.api.estimates import check_job, check_total_steps
 from solver_service.api.jobs import (
     _history_work,
+    _library,
+    _record_steps,
     check_record_work,
     history_options,
     motion_from_params,
@@ -68,10 +70,13 @@ from solver_service.api.jobspec import (
     SpectrumJob,
 )
 from solver_service.api.settings import Settings
+from solver_service.core.amplification import pulse_scale_factor
 from solver_service.core.exact import MAX_AMPLITUDE_RATIO
 from solver_service.core.model import G
 from solver_service.core.spectra import STEPS_PER_PERIOD
 from solver_service.report.html import SPECTRUM_PERIODS
+from solver_service.workflows.assess import BAND_POINTS, check_doc, matching_band
+from solver_service.workflows.documents import frequency_grid
 from solver_service.workflows.limits import WORK_PER_SAMPLE
 from solver_service.workflows.scaling import _factor_groups
 
@@ -79,6 +84,11 @@ from solver_service.workflows.scaling import _factor_groups
 MAX_SAMPLES = int(os.environ["ROCKMECH_MAX_SAMPLES"])
 #: The server's limits and budget, from the same ``ROCKMECH_*`` variables as the server's.
 LIMITS = Settings().limits()
+#: The service refuses up front only work that cannot finish within its budget at ten times
+#: the fastest rate measured (``api.estimates``), and stops the rest at the budget with 503;
+#: positive cases are kept within the budget at half the measured rate (a loaded machine).
+LOADED_RATE = 20
+LOADED_LIMITS = {**LIMITS, "budget_s": LIMITS["budget_s"] / LOADED_RATE}
 
 
 def _number(body: dict[str, Any], key: str) -> float | None:
@@ -155,8 +165,13 @@ def _work_ok(job: Any) -> bool:
     """
     try:
         check_job(job, LIMITS)
+        check_job(job, LOADED_LIMITS)
     except InputError:
         return False
+    if isinstance(job, (EnvelopeJob, ReportJob)) and not _scale_factors_ok(job):
+        return False
+    if isinstance(job, (AssessJob, AssessHtmlJob)):
+        return _assess_spectra_ok(job)
     record = getattr(job, "record", None)
     if record is None:
         return True
@@ -174,6 +189,58 @@ def _work_ok(job: Any) -> bool:
     except InputError:
         return False
     return isinstance(job, SpectrumJob) or _amplitude_ok(job, motion)
+
+
+def _scale_factors_ok(job: Any) -> bool:
+    """Return False when a pulse's scale factor up the structure is refused or not finite.
+
+    ``core.envelope.mechanism_envelope`` needs ``SF(f_p) = hypot(1, R h/h_e)`` finite at
+    every frequency (the library's, or ``core.amplification.pulse_scale_factor``, which
+    refuses ``f_p/f_n`` below ``RATIO_MIN``): ``h/h_e`` overflows for an ``h_e`` below about
+    1e-305 m; both are ratios of two fields the schema cannot bound.
+    """
+    f_p = frequency_grid(job.f_min, job.f_max, job.n)
+    for mech in job.constants.mechanisms:
+        amp = mech.amplification
+        if amp is None:
+            continue
+        try:
+            if job.exact:
+                sf = pulse_scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
+            else:
+                sf = _library().scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
+        except InputError:
+            return False  # f_p/f_n below RATIO_MIN: the closed form's range, across fields
+        if not np.all(np.isfinite(sf)):
+            return False
+    return True
+
+
+def _assess_spectra_ok(job: Any) -> bool:
+    """Return False when an assessment's spectra exceed the work bound (``api.jobs``).
+
+    The compute process bounds the spectrum of every record down to the shortest period
+    of each mechanism's matching band (from its code check) and to ``1/f_n``, one run and
+    in total, as ``_assess_inputs`` does; the band comes from the constants and the site.
+    """
+    try:
+        rows = check_doc(job.constants, job.site)["mechanisms"]
+        motions = [motion_from_params(r, None, None, LIMITS) for r in job.records]
+    except InputError:
+        return True  # the service refuses the request itself: the check sees its answer
+    periods = [matching_band(row)[0] for row in rows]
+    periods += [1.0 / m.amplification.f_n for m in job.constants.mechanisms if m.amplification]
+    steps = 0.0
+    try:
+        for i, motion in enumerate(motions):
+            for t_lo in periods:
+                check_record_work(motion, LIMITS, t_min=t_lo)
+                steps += BAND_POINTS * _record_steps(motion, STEPS_PER_PERIOD / t_lo)
+            if steps > 0.0:
+                check_total_steps(steps, LIMITS, "the records' spectra", f"records[{i}]")
+    except InputError:
+        return False
+    return True
 
 
 def _amplitude_ok(job: Any, motion: Any) -> bool:
