@@ -1,19 +1,27 @@
 """Schemathesis hooks: the rules across fields that JSON Schema cannot state.
 
 Loaded by ``test_api_schemathesis.py`` (``SCHEMATHESIS_HOOKS``) into the ``st`` process. The
-positive-data check ("a request the schema allows must succeed") runs on ``/scale-factor``;
-the schema states every rule of that operation but these, which compare two fields or a field
-with a setting of the server, and which JSON Schema has no keyword for. Positive test cases
-that break one are dropped here; negative test cases are left as they are, so the service
-still has to refuse them. Each rule is the service's own, with its reason:
+positive-data check ("a request the schema allows must succeed") runs on every JSON
+operation; the schema states every rule but those that compare two fields, or a field with
+a setting of the server, which JSON Schema has no keyword for. Positive test cases that
+break one are dropped here; negative test cases are left as they are, so the service still
+has to refuse them. Each rule is the service's own, called or mirrored, with its reason:
 
-- ``ec8``: ``z <= H`` (``core.codes.sf_ec8``; EN 1998-1 §4.3.5.2 has no element above the
-  building), ``nzs``: ``h_i <= h_n`` (``core.codes.sf_nzs``; NZS 1170.5 §8.3 likewise);
-- ``eq28`` from a record: at most ``ROCKMECH_MAX_SAMPLES`` samples, and the spectrum at
-  ``T_n = 1/f_n`` within the work bound: ``(samples - 1) * max(1, ceil(STEPS_PER_PERIOD *
-  f_n * dt))`` closed-form steps at most ``WORK_PER_SAMPLE * ROCKMECH_MAX_SAMPLES``
-  (``api.jobs.check_record_work``): a period far shorter than the record's time step costs
-  sub-steps on every sample.
+- ``/scale-factor`` (``scale_factor_ok``): ``ec8``: ``z <= H`` (``core.codes.sf_ec8``; EN
+  1998-1 §4.3.5.2 has no element above the building), ``nzs``: ``h_i <= h_n``
+  (``core.codes.sf_nzs``; NZS 1170.5 §8.3 likewise); ``eq28`` from a record: at most
+  ``ROCKMECH_MAX_SAMPLES`` samples, and the spectrum at ``T_n = 1/f_n`` within the work
+  bound: ``(samples - 1) * max(1, ceil(STEPS_PER_PERIOD * f_n * dt))`` closed-form steps at
+  most ``WORK_PER_SAMPLE * ROCKMECH_MAX_SAMPLES`` (``api.jobs.check_record_work``): a period
+  far shorter than the record's time step costs sub-steps on every sample.
+- the other JSON operations (``json_body_ok``): the body validated with the request model
+  as the service does, dropped only for a rule across fields (``CROSS_FIELD_RULES``); the
+  options' order (``f_min < f_max``, ``t_min < t_max``); then the server's limits and work
+  (``_work_ok``, ``_scale_factors_ok``, ``_assess_spectra_ok``, ``_amplitude_ok``).
+
+The multipart forms are excepted from the positive-data check: ``positive_data_acceptance``
+is re-registered to skip them (their uploads are random bytes, which the service rightly
+refuses); every other check still runs on them.
 
 It also mends a fault of the client (schemathesis 4.32.5): its JSON Schema generator filters
 some draws with ``jsonschema_rs`` (``_validator``: ``allOf`` branches, arrays, ``not``), and

@@ -422,3 +422,32 @@ def test_the_largest_multiple_is_stated_as_the_assessment_enforces_it() -> None:
     assert assess.check_multiples([MULTIPLE_MAX]) == [MULTIPLE_MAX]
     with pytest.raises(InputError, match="must be in"):
         assess.check_multiples([math.nextafter(MULTIPLE_MAX, math.inf)])
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "ok"),
+    [
+        ("f_n", rules.F_N_RANGE[0], True),
+        ("f_n", math.nextafter(rules.F_N_RANGE[0], 0.0), False),
+        ("f_n", math.nextafter(rules.F_N_RANGE[1], math.inf), False),
+        ("h", rules.BUILDING_HEIGHT_MAX_M, True),
+        ("h", math.nextafter(rules.BUILDING_HEIGHT_MAX_M, math.inf), False),
+        ("h_e", math.nextafter(rules.BUILDING_HEIGHT_MAX_M, math.inf), False),
+    ],
+)
+def test_time_domain_amplification_data_are_plausible_as_stated(
+    key: str, value: float, ok: bool
+) -> None:
+    amp = {"f_n": 2.0, "h": 5.0, "h_e": 10.0, key: value}
+    constants = {"mechanisms": [{**TIME_DOMAIN["mechanisms"][0], "amplification": amp}]}
+    site = {"hazard": {"code": "NTC2018", "a_g": 0.2, "F0": 2.5, "Tc_star": 0.3, "FC": 1.35}}
+    assess_body = {"constants": constants, "site": site, "records": [SPECTRUM["record"]]}
+    for model, body in ((EnvelopeRequest, {"constants": constants}), (AssessRequest, assess_body)):
+        assert _valid(model, body) is ok
+        try:
+            model.model_validate(body)
+        except ValidationError as exc:
+            assert not ok
+            assert validation_lines(exc)[0][0] == f"constants.mechanisms[0].amplification.{key}"
+        else:
+            assert ok
