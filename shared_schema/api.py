@@ -9,6 +9,16 @@ Responses mirror the JSON documents that ``rockmech ... --json`` prints. Optiona
 that do not apply are absent, not ``null``; a number is ``null`` only where its value is not
 finite (an overflow on extreme inputs, or "none up to the search limit").
 
+The published schema states every rule JSON Schema can state, so that clients learn them
+from the contract: the ranges of ``shared_schema.rules``, the options' bounds, and the rules
+across fields that ``oneOf``/``anyOf`` can say (``PULSE_ETA_RULE``, ``EQ28_RULE``,
+``RECORD_SAMPLE_RULE``, ``REPORT_RECORD_RULE``, the constants file's own). Requests that
+work in the time domain (``/envelope``, ``/history``, ``/report``, ``/assess``) also bound
+the constants by plausible ranges (``TIME_DOMAIN_RANGES``, ``AMPLIFICATION_RANGES``): stated
+for the values a file gives, enforced for the derived ones too (``time_domain_problem``),
+so that no derived value (``Omega = 2 pi f_p / p_eq``, ``T_n = 1/f_n``) overflows. Integer
+fields take a number without a fractional part (``100.0``), as JSON Schema's ``integer``.
+
 Units are SI, except where a name says otherwise (``a_p_g`` and ``pga_g`` are in g).
 Python 3.9-clean: no ``X | Y`` annotations.
 """
