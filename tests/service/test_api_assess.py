@@ -131,6 +131,14 @@ def test_virtual_work_out_of_double_range_is_422_as_rockmech_says(
     assert err["detail"] == "constants: " + message.removeprefix(f"{bad}: ")
 
 
+def test_a_record_without_a_complete_cycle_is_assessed(client: httpx.Client) -> None:
+    # issue #19: one crossing through a zero sample made the pulse search an IndexError (500).
+    record = {"accel": [0.1, 0.0, -0.1], "dt": 0.01, "units": "g", "name": "one crossing"}
+    res = client.post("/api/v1/assess", json=_assess_body(records=[record], multiples=[1.0]))
+    assert res.status_code == 200, res.text
+    assert [r["name"] for r in res.json()["records"]] == ["one crossing"]
+
+
 def test_constants_without_virtual_work_answer_rows_that_say_why(client: httpx.Client) -> None:
     res = client.post("/api/v1/check", json={"constants": _json(SHORT), "site": _json(NTC)})
     assert res.status_code == 200, res.text
