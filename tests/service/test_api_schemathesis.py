@@ -64,8 +64,9 @@ The module also mends a fault of the client that stopped some runs on ``/report`
 Found by the positive-data check and fixed in the service (regression tests beside them):
 a 500 on ``/check`` from virtual work whose ``e* = S^2/(mass J)`` underflowed to 0; a 500
 from a derived ``p_eq`` that underflowed to 0; a 500 from exact envelopes of a stiff
-structure (the pulse spectrum's ``exp`` overflowed for ``f_p/f_n`` below 4.5e-4); integral
-floats (``100.0``) refused for JSON Schema integers.
+structure (the pulse spectrum's ``exp`` overflowed for ``f_p/f_n`` below 4.5e-4); a 500
+from ``/assess`` on a record crossing zero once through a zero sample (the pulse search);
+integral floats (``100.0``) refused for JSON Schema integers.
 
 One schemathesis worker: with two, hypothesis' lambda descriptions call ``ast.parse`` from
 two threads at once, and CPython 3.11 (its AST recursion counter is shared between threads)
