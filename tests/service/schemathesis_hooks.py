@@ -92,11 +92,13 @@ from solver_service.workflows.scaling import _factor_groups
 MAX_SAMPLES = int(os.environ["ROCKMECH_MAX_SAMPLES"])
 #: The server's limits and budget, from the same ``ROCKMECH_*`` variables as the server's.
 LIMITS = Settings().limits()
-#: The service refuses up front only work that cannot finish within its budget at ten times
-#: the fastest rate measured (``api.estimates``), and stops the rest at the budget with 503;
-#: positive cases are kept within the budget at half the measured rate (a loaded machine).
-LOADED_RATE = 20
-LOADED_LIMITS = {**LIMITS, "budget_s": LIMITS["budget_s"] / LOADED_RATE}
+#: The service refuses up front only work that cannot finish within its budget at
+#: ``MAX_STEPS_PER_S``, ten times the fastest rate measured (``api.estimates``), and stops
+#: the rest at the budget with 503; positive cases are kept within the budget at this many
+#: times less, half the measured rate (the test machine is loaded).
+LOADED_SLOWDOWN = 20
+#: The server's limits with the budget at the loaded machine's rate.
+LOADED_LIMITS = {**LIMITS, "budget_s": LIMITS["budget_s"] / LOADED_SLOWDOWN}
 
 
 def _number(body: dict[str, Any], key: str) -> float | None:
