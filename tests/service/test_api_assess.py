@@ -184,10 +184,11 @@ def test_records_over_the_sample_limit_together_are_refused_up_front(
 
 
 def test_stiff_mechanism_on_a_record_is_refused_before_any_run(client: httpx.Client) -> None:
-    # p_eq dt = 20000 segments per sample over 999 intervals: past 20 x max_samples per run.
+    # p_eq dt = 1000 segments per sample over 2999 intervals: past 20 x max_samples per run
+    # (p_eq at the top of its time-domain range, dt at the top of a record's).
     body = _assess_body(
-        constants={"mechanisms": [{"id": "W1", "p_eq": 1.0e6, "lam": 0.1, "eta": 0.9}]},
-        records=[{"accel": [0.0, 0.1] * 500, "dt": 0.02, "units": "g"}],
+        constants={"mechanisms": [{"id": "W1", "p_eq": 1.0e3, "lam": 0.1, "eta": 0.9}]},
+        records=[{"accel": [0.0, 0.1] * 1500, "dt": 1.0, "units": "g"}],
     )
     res = client.post("/api/v1/assess", json=body)
     assert res.status_code == 422, res.text
