@@ -9,15 +9,27 @@ Responses mirror the JSON documents that ``rockmech ... --json`` prints. Optiona
 that do not apply are absent, not ``null``; a number is ``null`` only where its value is not
 finite (an overflow on extreme inputs, or "none up to the search limit").
 
+The published schema states every rule JSON Schema can state, so that clients learn them
+from the contract: the ranges of ``shared_schema.rules``, the options' bounds, and the rules
+across fields that ``oneOf``/``anyOf`` can say (``PULSE_ETA_RULE``, ``EQ28_RULE``,
+``RECORD_SAMPLE_RULE``, ``REPORT_RECORD_RULE``, the constants file's own). Requests that
+work in the time domain (``/envelope``, ``/history``, ``/report``, ``/assess``) also bound
+the constants by plausible ranges (``TIME_DOMAIN_RANGES``, ``AMPLIFICATION_RANGES``): stated
+for the values a file gives, enforced for the derived ones too (``time_domain_problem``),
+so that no derived value (``Omega = 2 pi f_p / p_eq``, ``T_n = 1/f_n``) overflows. Integer
+fields take a number without a fractional part (``100.0``), as JSON Schema's ``integer``.
+
 Units are SI, except where a name says otherwise (``a_p_g`` and ``pga_g`` are in g).
 Python 3.9-clean: no ``X | Y`` annotations.
 """
 
+import math
 from typing import Annotated, Any, Dict, List, Literal, Optional, Tuple, Union
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic_core import PydanticCustomError
 
-from shared_schema.constants import Amplification, ConstantsFile
+from shared_schema.constants import Amplification, ConstantsFile, JsonInt
 from shared_schema.errors import InputError
 from shared_schema.rules import (
     A_P_G_MAX,
@@ -45,9 +57,12 @@ __all__ = [
     "EQ28_RULE",
     "MAX_ASSESS_MULTIPLES",
     "MAX_ASSESS_RECORDS",
+    "MULTIPLE_MAX",
     "PULSE_ETA_RULE",
     "RECORD_SAMPLE_RULE",
     "RECORD_UNITS",
+    "REPORT_RECORD_RULE",
+    "TIME_DOMAIN_RANGES",
     "AssessRequest",
     "AssessResponse",
     "Band",
@@ -85,6 +100,7 @@ __all__ = [
     "SpectrumOptions",
     "SpectrumRequest",
     "SpectrumResponse",
+    "time_domain_problem",
 ]
 
 
@@ -94,6 +110,10 @@ _RESPONSE = ConfigDict(extra="allow")
 
 def _gt0(description: str) -> Any:
     return Field(description=description, json_schema_extra={"exclusiveMinimum": 0})
+
+
+def _gt0_default(default: Optional[float], description: str) -> Any:
+    return Field(default, description=description, json_schema_extra={"exclusiveMinimum": 0})
 
 
 def _height(description: str, *, positive: bool = True, below: str = "") -> Any:
@@ -199,10 +219,140 @@ _TWO_SIDED_ETA: Dict[str, Any] = {
 }
 
 
+#: Plausible ``p_eq`` [rad/s] and ``lam`` [-] of every side, for time-domain work (the ranges
+#: of a pulse request): an envelope's ``Omega = 2 pi f_p / p_eq`` and a time history's steps
+#: stay finite. Derived from a physical form they are checked by the service alone.
+TIME_DOMAIN_RANGES: Dict[str, Tuple[float, float]] = {"p_eq": P_EQ_RANGE, "lam": LAM_RANGE}
+#: Plausible amplification data of a mechanism for time-domain work, as ``/scale-factor``
+#: takes them: ``f_n`` [Hz] in ``F_N_RANGE`` (``T_n = 1/f_n`` and ``f_p/f_n`` stay finite),
+#: heights ``h`` and ``h_e`` [m] at most ``BUILDING_HEIGHT_MAX_M``.
+AMPLIFICATION_RANGES: Dict[str, Tuple[float, float]] = {
+    "f_n": F_N_RANGE,
+    "h": (0.0, BUILDING_HEIGHT_MAX_M),
+    "h_e": (0.0, BUILDING_HEIGHT_MAX_M),
+}
+
+_SIDE_RANGES = {
+    "properties": {
+        key: {"minimum": lo, "maximum": hi} for key, (lo, hi) in TIME_DOMAIN_RANGES.items()
+    }
+}
+_PLAUSIBLE_SIDES: Dict[str, Any] = {
+    "properties": {
+        "mechanisms": {
+            "items": {
+                "properties": {
+                    **_SIDE_RANGES["properties"],
+                    "positive": _SIDE_RANGES,
+                    "negative": _SIDE_RANGES,
+                    "amplification": {
+                        "properties": {
+                            key: {"minimum": lo, "maximum": hi}
+                            for key, (lo, hi) in AMPLIFICATION_RANGES.items()
+                        }
+                    },
+                }
+            }
+        }
+    }
+}
+
+
+#: What the constants of a time-domain request need, in words.
+_TIME_DOMAIN_CONSTANTS = (
+    "The kinematic-constants file; each side's p_eq [rad/s] and lam [-] (given or derived) "
+    f"in the ranges of a pulse, [{P_EQ_RANGE[0]:g}, {P_EQ_RANGE[1]:g}] and "
+    f"[{LAM_RANGE[0]:g}, {LAM_RANGE[1]:g}]; amplification f_n in [{F_N_RANGE[0]:g}, "
+    f"{F_N_RANGE[1]:g}] Hz, h and h_e at most {BUILDING_HEIGHT_MAX_M:g} m; eta for every "
+    "two-sided mechanism."
+)
+
+
+#: What the constants of an assessment need, in words (a mechanism without eta gets its
+#: code checks and a note instead of time histories).
+_ASSESS_CONSTANTS = _TIME_DOMAIN_CONSTANTS.replace("; eta for every two-sided mechanism", "")
+
+
 def _constants_need_eta(schema: Dict[str, Any]) -> None:
-    """State in the schema that time-domain constants give ``eta`` where needed."""
+    """State in the schema what time-domain constants need: ``eta``, plausible values."""
     prop = schema["properties"]["constants"]
-    schema["properties"]["constants"] = {"allOf": [prop, _TWO_SIDED_ETA]}
+    schema["properties"]["constants"] = {"allOf": [prop, _TWO_SIDED_ETA, _PLAUSIBLE_SIDES]}
+
+
+def _plausible_constants(schema: Dict[str, Any]) -> None:
+    """State in the schema the plausible values of an assessment's constants (eta optional)."""
+    prop = schema["properties"]["constants"]
+    schema["properties"]["constants"] = {"allOf": [prop, _PLAUSIBLE_SIDES]}
+
+
+def time_domain_problem(cf: ConstantsFile) -> Optional[Tuple[str, str]]:
+    """Return ``(field, message)`` of the first value out of its time-domain range, or None.
+
+    The ranges: ``AMPLIFICATION_RANGES`` of a mechanism's amplification data, then
+    ``TIME_DOMAIN_RANGES`` of each side.
+
+    Parameters
+    ----------
+    cf : ConstantsFile
+        A validated file (derived ``p_eq`` and ``lam`` filled in).
+
+    Examples
+    --------
+    >>> cf = ConstantsFile.model_validate({"mechanisms": [{"id": "W", "p_eq": 2e3, "lam": 0.2}]})
+    >>> time_domain_problem(cf)[0]
+    'mechanisms[0].positive.p_eq'
+    """
+    for i, mech in enumerate(cf.mechanisms):
+        amp = mech.amplification
+        for key, (lo, hi) in [] if amp is None else AMPLIFICATION_RANGES.items():
+            value = getattr(amp, key)
+            if not lo <= value <= hi:
+                return (
+                    f"mechanisms[{i}].amplification.{key}",
+                    f"must be in [{lo:g}, {hi:g}] for a time-domain analysis (a plausible "
+                    f"range, as for a scale factor), got {value!r} (mechanism {mech.id!r})",
+                )
+        for which in ("positive", "negative"):
+            side = getattr(mech, which)
+            for key, (lo, hi) in [] if side is None else TIME_DOMAIN_RANGES.items():
+                value = getattr(side, key)
+                if not lo <= value <= hi:
+                    return (
+                        f"mechanisms[{i}].{which}.{key}",
+                        f"must be in [{lo:g}, {hi:g}] for a time-domain analysis (a plausible "
+                        f"range, as for a pulse), got {value!r} (mechanism {mech.id!r})",
+                    )
+    return None
+
+
+def _time_domain_constants(cls: Any, cf: ConstantsFile) -> ConstantsFile:
+    problem = time_domain_problem(cf)
+    if problem is not None:
+        raise PydanticCustomError(
+            "implausible_constant", "{message}", {"field": problem[0], "message": problem[1]}
+        )
+    return cf
+
+
+def _frequency(description: str, default: float, rule: str = "") -> Any:
+    """Return a pulse frequency field [Hz], in ``F_P_RANGE`` (and ``rule``, told in words)."""
+    lo, hi = F_P_RANGE
+    return Field(
+        default,
+        description=f"{description} [Hz], {rule}in [{lo:g}, {hi:g}] (pulses of 1000 s down "
+        "to 1 ms).",
+        json_schema_extra={"minimum": lo, "maximum": hi},
+    )
+
+
+def _in_f_p_range(cls: Any, value: float, info: Any) -> float:
+    lo, hi = F_P_RANGE
+    if not (math.isfinite(value) and value > 0):
+        # The command line's message (documents.log_grid).
+        raise ValueError(f"must be finite and > 0, got {value!r}")
+    if not lo <= value <= hi:
+        raise ValueError(f"must be in [{lo:g}, {hi:g}] Hz (a plausible range), got {value!r}")
+    return value
 
 
 # --- requests ---------------------------------------------------------------------------------
@@ -318,27 +468,42 @@ class EnvelopeRequest(BaseModel):
         strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
     )
 
-    constants: ConstantsFile = Field(description="The kinematic-constants file.")
-    f_min: float = Field(0.1, description="Lowest pulse frequency [Hz], > 0.")
-    f_max: float = Field(10.0, description="Highest pulse frequency [Hz], > f_min.")
-    n: int = Field(200, description="Number of log-spaced frequencies, >= 2.")
+    constants: ConstantsFile = Field(description=_TIME_DOMAIN_CONSTANTS)
+    f_min: float = _frequency("Lowest pulse frequency", 0.1)
+    f_max: float = _frequency("Highest pulse frequency", 10.0, "> f_min, ")
+    n: JsonInt = Field(
+        200, description="Number of log-spaced frequencies, >= 2.", json_schema_extra={"minimum": 2}
+    )
     exact: bool = Field(
         False, description="Compute the boundaries directly instead of from the library."
     )
+
+    _plausible = field_validator("constants")(classmethod(_time_domain_constants))
+    _frequencies = field_validator("f_min", "f_max")(classmethod(_in_f_p_range))
 
 
 class BuildingOptions(BaseModel):
     """Code scale factors and displacements of time histories (``rockmech history``)."""
 
     building_height: Optional[float] = Field(
-        None, description="Height of the building H = h_n [m] (sf ec8 and nzs)."
+        None,
+        description="Height of the building H = h_n [m] (sf ec8 and nzs), > 0 and at most "
+        f"{BUILDING_HEIGHT_MAX_M:g} m.",
+        json_schema_extra={"exclusiveMinimum": 0, "maximum": BUILDING_HEIGHT_MAX_M},
     )
-    soil_factor: float = Field(1.0, description="EC8 soil factor S [-].")
-    element_period: float = Field(0.0, description="EC8 period of the element T_a [s]; 0 = rigid.")
+    soil_factor: float = Field(
+        1.0, description="EC8 soil factor S [-], > 0.", json_schema_extra={"exclusiveMinimum": 0}
+    )
+    element_period: float = Field(
+        0.0,
+        description="EC8 period of the element T_a [s], >= 0; 0 = rigid.",
+        json_schema_extra={"minimum": 0},
+    )
     at_height: Optional[float] = Field(
         None,
         description="Also report the peak displacement [m] of a point this far [m] above each "
-        "mechanism's rotation axis.",
+        "mechanism's rotation axis, > 0.",
+        json_schema_extra={"exclusiveMinimum": 0},
     )
 
 
@@ -346,7 +511,10 @@ class HistoryOptions(BuildingOptions):
     """Scale factors and verdict of time histories (``rockmech history``)."""
 
     scales: List[float] = Field(
-        [1.0], min_length=1, description="Scale factors on the record [-], each > 0."
+        [1.0],
+        min_length=1,
+        description="Scale factors on the record [-], each > 0.",
+        json_schema_extra={"items": {"type": "number", "exclusiveMinimum": 0}},
     )
     sf: str = Field(
         "none",
@@ -365,11 +533,17 @@ class HistoryOptions(BuildingOptions):
 class ReportOptions(HistoryOptions):
     """Envelope options and title of a report (``rockmech report``)."""
 
-    f_min: float = Field(0.1, description="Lowest pulse frequency of the envelopes [Hz].")
-    f_max: float = Field(10.0, description="Highest pulse frequency of the envelopes [Hz].")
-    n: int = Field(200, description="Number of log-spaced envelope frequencies, >= 2.")
+    f_min: float = _frequency("Lowest pulse frequency of the envelopes", 0.1)
+    f_max: float = _frequency("Highest pulse frequency of the envelopes", 10.0, "> f_min, ")
+    n: JsonInt = Field(
+        200,
+        description="Number of log-spaced envelope frequencies, >= 2.",
+        json_schema_extra={"minimum": 2},
+    )
     exact: bool = Field(False, description="Exact envelopes instead of the library.")
     title: Optional[str] = Field(None, max_length=200, description="Title of the report.")
+
+    _frequencies = field_validator("f_min", "f_max")(classmethod(_in_f_p_range))
 
 
 class HistoryRequest(HistoryOptions):
@@ -379,20 +553,32 @@ class HistoryRequest(HistoryOptions):
         strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
     )
 
-    constants: ConstantsFile = Field(description="The kinematic-constants file.")
+    constants: ConstantsFile = Field(description=_TIME_DOMAIN_CONSTANTS)
     record: RecordSamples = Field(description="The ground motion.")
+
+    _plausible = field_validator("constants")(classmethod(_time_domain_constants))
 
 
 class SpectrumOptions(BaseModel):
     """Spectrum and pulse-search options (``rockmech record``)."""
 
-    zeta: float = Field(0.05, description="Damping ratio of the spectrum [-], in [0, 1).")
-    t_min: float = Field(0.02, description="Shortest period of the spectrum [s], > 0.")
-    t_max: float = Field(10.0, description="Longest period of the spectrum [s], > t_min.")
-    n: int = Field(100, description="Number of log-spaced periods, >= 2.")
-    pulses: int = Field(5, description="How many of the largest sine pulses to list, >= 1.")
-    f_min: Optional[float] = Field(None, description="Pulse search: lowest f_p [Hz].")
-    f_max: Optional[float] = Field(None, description="Pulse search: highest f_p [Hz].")
+    zeta: float = Field(
+        0.05,
+        description="Damping ratio of the spectrum [-], in [0, 1).",
+        json_schema_extra={"minimum": 0, "exclusiveMaximum": 1},
+    )
+    t_min: float = _gt0_default(0.02, "Shortest period of the spectrum [s], > 0.")
+    t_max: float = _gt0_default(10.0, "Longest period of the spectrum [s], > t_min.")
+    n: JsonInt = Field(
+        100, description="Number of log-spaced periods, >= 2.", json_schema_extra={"minimum": 2}
+    )
+    pulses: JsonInt = Field(
+        5,
+        description="How many of the largest sine pulses to list, >= 1.",
+        json_schema_extra={"minimum": 1},
+    )
+    f_min: Optional[float] = _gt0_default(None, "Pulse search: lowest f_p [Hz], > 0.")
+    f_max: Optional[float] = _gt0_default(None, "Pulse search: highest f_p [Hz], >= f_min.")
 
 
 class SpectrumRequest(SpectrumOptions):
@@ -472,23 +658,56 @@ ScaleFactorRequest = Annotated[
 ]
 
 
+#: The time-history options of a report keep their defaults without a record
+#: (``report.html``: each acts on the time histories of a record).
+REPORT_RECORD_RULE: Dict[str, Any] = {
+    "anyOf": [
+        {"required": ["record"], "properties": {"record": {"type": "object"}}},
+        {
+            "properties": {
+                "scales": {"const": [1]},
+                "sf": {"const": "none"},
+                "building_height": {"type": "null"},
+                "soil_factor": {"const": 1},
+                "element_period": {"const": 0},
+                "criterion": {"type": "null"},
+                "at_height": {"type": "null"},
+            }
+        },
+    ]
+}
+
+
+def _report_schema(schema: Dict[str, Any]) -> None:
+    _constants_need_eta(schema)
+    schema.update(REPORT_RECORD_RULE)
+
+
 class ReportRequest(ReportOptions):
-    """An HTML report: constants, envelopes, and with a record its time histories and spectrum."""
+    """An HTML report: constants, envelopes, and with a record its time histories and spectrum.
+
+    Without a record, the time-history options (``scales``, ``sf``, the building's,
+    ``criterion``, ``at_height``) keep their defaults (``REPORT_RECORD_RULE``).
+    """
 
     model_config = ConfigDict(
-        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_report_schema
     )
 
-    constants: ConstantsFile = Field(description="The kinematic-constants file.")
+    constants: ConstantsFile = Field(description=_TIME_DOMAIN_CONSTANTS)
     record: Optional[RecordSamples] = Field(
         None, description="A ground motion for time histories and its spectrum."
     )
+
+    _plausible = field_validator("constants")(classmethod(_time_domain_constants))
 
 
 #: Most records of one assessment request.
 MAX_ASSESS_RECORDS = 5
 #: Most multiples of the design scale in one assessment request.
 MAX_ASSESS_MULTIPLES = 8
+#: Largest multiple of the design scale factor [-]: a hundred times the design earthquake.
+MULTIPLE_MAX = 100.0
 #: What ``/assess`` answers: the assessment document or its HTML page.
 ASSESS_FORMATS = ("json", "html")
 
@@ -508,9 +727,11 @@ class CheckRequest(BaseModel):
 class AssessRequest(BaseModel):
     """Code checks beside rocking dynamics on records scaled to the site (``rockmech assess``)."""
 
-    model_config = _REQUEST
+    model_config = ConfigDict(
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_plausible_constants
+    )
 
-    constants: ConstantsFile = Field(description="The kinematic-constants file.")
+    constants: ConstantsFile = Field(description=_ASSESS_CONSTANTS)
     site: SiteFile = Field(description="The site file (SITE.json): hazard, FC, q, building.")
     records: List[RecordSamples] = Field(
         min_length=1,
@@ -521,12 +742,18 @@ class AssessRequest(BaseModel):
         [0.5, 1.0, 1.5, 2.0],
         min_length=1,
         max_length=MAX_ASSESS_MULTIPLES,
-        description="Multiples of the design scale factor to run [-], each > 0 (1 is the "
-        "design level); at most 8.",
+        description="Multiples of the design scale factor to run [-], each in (0, "
+        f"{MULTIPLE_MAX:g}] (1 is the design level); at most {MAX_ASSESS_MULTIPLES}.",
+        # workflows.assess enforces the top, with the command line's message.
+        json_schema_extra={
+            "items": {"type": "number", "exclusiveMinimum": 0, "maximum": MULTIPLE_MAX}
+        },
     )
     format: Literal["json", "html"] = Field(
         "json", description="Answer with the assessment document (json) or its HTML page (html)."
     )
+
+    _plausible = field_validator("constants")(classmethod(_time_domain_constants))
 
 
 # --- multipart forms (the text fields next to uploaded files) ---------------------------------

@@ -46,10 +46,23 @@ The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` 
 import json
 import math
 import re
-from typing import Any, Dict, List, Literal, Mapping, Optional, Sequence, Tuple, Union, get_args
+from typing import (
+    Annotated,
+    Any,
+    Dict,
+    List,
+    Literal,
+    Mapping,
+    Optional,
+    Sequence,
+    Tuple,
+    Union,
+    get_args,
+)
 
 from pydantic import (
     BaseModel,
+    BeforeValidator,
     ConfigDict,
     Field,
     JsonValue,
@@ -74,6 +87,7 @@ __all__ = [
     "ConstantsFile",
     "EtaSource",
     "G",
+    "JsonInt",
     "Mechanism",
     "Rocking",
     "SideConstants",
@@ -84,6 +98,7 @@ __all__ = [
     "json_document",
     "parse_constants",
     "validation_lines",
+    "whole_number",
 ]
 
 #: Version of the file format written by this module.
@@ -132,6 +147,26 @@ _PHI_OV_DESCRIPTION = (
     "Overturning rotation (theory Eq. 6; §1.8 for the negative side) [rad], > 0. "
     "In the short form it defaults to lam (exact for a single block)."
 )
+
+
+def whole_number(value: Any) -> Any:
+    """Return a float without a fractional part as an int, any other value as it is.
+
+    Examples
+    --------
+    >>> whole_number(100.0), whole_number(2.5), whole_number(True)
+    (100, 2.5, True)
+    """
+    # JSON Schema's "integer" is a number without a fractional part, so 100.0 is one (draft
+    # 2020-12 §6.1.1); strict pydantic refuses a float for an int unless it is made one here.
+    if isinstance(value, float) and value.is_integer():
+        return int(value)
+    return value
+
+
+#: An integer field of a JSON document: an int, or a float without a fractional part (as
+#: JSON Schema's ``integer``); booleans, strings and fractions are still refused.
+JsonInt = Annotated[int, BeforeValidator(whole_number)]
 
 
 def _error(field: str, message: str, error_type: str = "rockmech_value") -> PydanticCustomError:
@@ -198,7 +233,8 @@ class VirtualWork(BaseModel):
     Notes
     -----
     ``S² <= mass * J`` (Cauchy-Schwarz), i.e. the participating mass fraction
-    ``e* = S² / (mass J)`` is at most 1; a file that breaks it is rejected.
+    ``e* = S² / (mass J)`` is at most 1; a file that breaks it is rejected, and so is one
+    whose ``M* = S²/J`` or ``e*`` is not finite and > 0 in double precision.
     """
 
     model_config = ConfigDict(
@@ -236,6 +272,18 @@ class VirtualWork(BaseModel):
 
     @model_validator(mode="after")
     def _check_bound(self) -> "VirtualWork":
+        # The code check divides by both (core.kinematic.participating_mass): issue #19,
+        # S = 1e-200 made e* = 0 and the check a ZeroDivisionError.
+        m_star = self.S * self.S / self.J
+        e_star = m_star / self.mass
+        if not (math.isfinite(m_star) and m_star > 0.0 and math.isfinite(e_star) and e_star > 0.0):
+            raise _error(
+                "S",
+                f"M* = S^2/J = {m_star!r} and e* = M*/mass = {e_star!r} must be finite and "
+                f"> 0: S = {self.S!r}, J = {self.J!r}, mass = {self.mass!r} are out of any "
+                "physical range (overflow or underflow)",
+                "non_finite_constant",
+            )
         if self.S * self.S > self.mass * self.J * (1.0 + VIRTUAL_WORK_RTOL):
             raise _error(
                 "J",
@@ -247,14 +295,33 @@ class VirtualWork(BaseModel):
         return self
 
 
+# JSON Schema pieces for rules across fields. A null value means "not given" in these models
+# (pydantic's None), so a rule says "is a number" or "is null or absent", never only
+# "present" (``required``/``dependentRequired`` would call a null given).
+
+
+def _numbers(*keys: str) -> Dict[str, Any]:
+    """Return the schema saying each of ``keys`` is present and a number."""
+    return {"required": list(keys), "properties": {k: {"type": "number"} for k in keys}}
+
+
+def _not_given(*keys: str) -> Dict[str, Any]:
+    """Return the schema saying each of ``keys`` is absent or null."""
+    return {"properties": {k: {"type": "null"} for k in keys}}
+
+
 def _side_schema_extra(schema: Dict[str, Any]) -> None:
     schema["description"] = (
         "Constants of one rocking side: either the physical constants I0, K, Q, phi_cr "
         "(and optionally M_F), from which p_eq, lam and phi_ov are derived, or the short form "
-        "p_eq, lam (and optionally phi_ov, default lam). When both are given they must agree "
-        "to a relative 1e-9."
+        "p_eq, lam (and optionally phi_ov, default lam; no M_F). When both are given they "
+        "must agree to a relative 1e-9."
     )
-    schema["anyOf"] = [{"required": list(_PHYSICAL_KEYS)}, {"required": ["p_eq", "lam"]}]
+    # SideConstants._check_form: all four physical constants, or none of them, no M_F, and
+    # p_eq and lam.
+    short = _not_given(*_PHYSICAL_KEYS, "M_F")
+    short["properties"].update(_numbers("p_eq", "lam")["properties"])
+    schema["oneOf"] = [_numbers(*_PHYSICAL_KEYS), {**short, "required": ["p_eq", "lam"]}]
 
 
 class SideConstants(BaseModel):
@@ -410,6 +477,14 @@ def _derive_side(side: SideConstants, which: str) -> SideConstants:
                 "any physical range (overflow)",
                 "non_finite_constant",
             )
+    if not derived["p_eq"] > 0.0:
+        # issue #19: K/I0 below the smallest double made p_eq 0, which no file may hold.
+        raise _error(
+            "p_eq",
+            f"sqrt(K/I0) = {derived['p_eq']!r} is not > 0: the inputs K = {side.K:g}, "
+            f"I0 = {side.I0:g} are out of any physical range (underflow)",
+            "non_finite_constant",
+        )
     for key, formula in (
         ("lam", f"(K*phi_cr {sign} M_F)/(g*Q)"),
         ("phi_ov", f"phi_cr {sign} M_F/K"),
@@ -495,13 +570,24 @@ def _mechanism_schema_extra(schema: Dict[str, Any]) -> None:
     for key in ("p_eq", "lam", "phi_ov"):
         props[key]["description"] += " Flat short form: describes the positive side."
     schema["required"] = [k for k in schema.get("required", []) if k != "positive"]
-    # Mechanism._fill_defaults: the two impact restitutions go together and with eta, and
-    # eta_source describes an eta.
-    schema["dependentRequired"] = {
-        "eta_to_negative": ["eta_to_positive", "eta"],
-        "eta_to_positive": ["eta_to_negative", "eta"],
-        "eta_source": ["eta"],
-    }
+    directional = _numbers("eta_to_negative", "eta_to_positive", "eta")
+    directional["properties"]["rocking"] = {"const": "two_sided"}
+    schema["allOf"] = [
+        # Mechanism._check_eta_sign: eta >= 0 two-sided (the default), <= 0 one-sided.
+        {
+            "oneOf": [
+                {"properties": {"rocking": {"const": "two_sided"}, "eta": {"minimum": 0}}},
+                {
+                    "properties": {"rocking": {"const": "one_sided"}, "eta": {"maximum": 0}},
+                    "required": ["rocking"],
+                },
+            ]
+        },
+        # Mechanism._fill_defaults: the two impact restitutions go together, with eta, for
+        # two-sided rocking only; eta_source describes an eta.
+        {"anyOf": [_not_given("eta_to_negative", "eta_to_positive"), directional]},
+        {"anyOf": [_not_given("eta_source"), _numbers("eta")]},
+    ]
     schema["oneOf"] = [
         {
             "required": ["positive"],
@@ -700,6 +786,7 @@ class Mechanism(BaseModel):
                     "eta",
                     f"eta = {self.eta!r} is not between eta_to_negative = "
                     f"{self.eta_to_negative!r} and eta_to_positive = {self.eta_to_positive!r}",
+                    "eta_not_between",
                 )
         if self.name is None:
             self.name = self.id

@@ -15,11 +15,16 @@ mechanisms above ground; the optional ``project`` section fills the report's fir
 The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` forms.
 """
 
-from typing import Any, Literal, Mapping, Optional, Union
+from typing import Annotated, Any, Literal, Mapping, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
 
-from shared_schema.constants import input_error_from_validation, json_document
+from shared_schema.constants import (
+    JsonInt,
+    input_error_from_validation,
+    json_document,
+    whole_number,
+)
 
 __all__ = [
     "SITE_SCHEMA_VERSION",
@@ -131,7 +136,9 @@ class EC8Hazard(BaseModel):
     a_gR: float = Field(gt=0, le=2, description="Reference peak ground acceleration [g].")
     importance: float = Field(1.0, gt=0, le=3, description="Importance factor gamma_I [-].")
     ground: Literal["A", "B", "C", "D", "E"] = Field("A", description="Ground type.")
-    spectrum_type: Literal[1, 2] = Field(1, description="Spectrum type 1 or 2.")
+    spectrum_type: Annotated[Literal[1, 2], BeforeValidator(whole_number)] = Field(
+        1, description="Spectrum type 1 or 2."
+    )
     FC: float = Field(ge=1, le=2, description="Confidence factor [-] (EN 1998-3 CF).")
     q: float = Field(2.0, gt=0, le=10, description="Behaviour factor q [-], default 2.")
     xi_percent: float = Field(5.0, ge=0, le=50, description="Viscous damping [%].")
@@ -158,7 +165,7 @@ class Building(BaseModel):
     )
 
     height: float = Field(gt=0, le=300, description="Height above the foundation [m].")
-    storeys: int = Field(ge=1, le=100, description="Number of storeys.")
+    storeys: JsonInt = Field(ge=1, le=100, description="Number of storeys.")
     T1: Optional[float] = Field(
         None, gt=0, le=10, description="First period [s]; default 0.05 height^0.75."
     )

@@ -15,7 +15,9 @@ interval (or a pulse of ``1/f_p`` seconds) into segments of at most ``1/p_eq`` s
 
 * a pulse: ``p_eq / f_p`` steps;
 * exact envelopes: per mechanism side (both directions for one-sided rocking) and
-  frequency, ``N_SCAN`` pulse runs of ``max(1, p_eq / f_p)`` steps;
+  frequency, ``N_SCAN`` pulse runs of ``max(1, p_eq / f_p)`` steps; with amplification
+  data, the pulse scale factor's grid points too (``scale_factor_points``, counted at
+  ``MAX_POINTS_PER_S``);
 * time histories: per mechanism side and scale factor, ``(n - 1) max(1, ceil(p_eq dt))``;
 * an assessment: the time histories of every record at every multiple (one more run per
   record for the HTML page's figures), then, once the check has given each mechanism's
@@ -41,11 +43,13 @@ from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 
 from ..workflows.limits import (  # the numbers and estimates shared with the command line
+    MAX_POINTS_PER_S,
     MAX_STEPS_PER_S,
     N_SCAN,
     WORK_PER_SAMPLE,
     envelope_steps,
     history_steps,
+    scale_factor_points,
 )
 from .jobspec import (
     AssessHtmlJob,
@@ -162,6 +166,9 @@ def _envelope(
     _check_answer(n * columns, limits, "the envelopes", "n")
     if exact:
         steps = envelope_steps(cf, f_min, f_max, n)
+        # The pulse scale factors' grid points, as steps of the same time.
+        points = scale_factor_points(cf, f_min, f_max, n)
+        steps += points * MAX_STEPS_PER_S / MAX_POINTS_PER_S
         check_total_steps(steps, limits, "the exact envelopes", "exact")
 
 

@@ -45,6 +45,7 @@ from .model import check_non_negative, check_number, check_positive
 
 __all__ = [
     "QUANTITIES",
+    "RATIO_MIN",
     "effective_height",
     "pulse_response_spectrum",
     "pulse_scale_factor",
@@ -64,6 +65,14 @@ REFINE_FRACTION = 0.9
 XTOL = 1e-14
 #: Below this ``|z|`` the exponential ``(e**z - 1)/z`` uses its Taylor series.
 EXPREL_SERIES = 1e-4
+#: Above this real part of ``(a - mu1) tau`` the divided difference ``f[a, mu1]`` is formed
+#: as ``(e^{a tau} - e^{mu1 tau})/(a - mu1)``: ``e**x`` overflows past x = 709.78, and at
+#: such ``x`` there is no cancellation to avoid (a pulse of over 700/zeta natural radians).
+EXP_DIRECT = 700.0
+#: Smallest frequency ratio ``f_p/f_n`` [-] of the closed form: the extrema in the pulse
+#: are bracketed on ``GRID_PER_PERIOD / r`` grid points (640,000 here, 0.15 s), so a
+#: smaller ratio is refused rather than allowed to take minutes and gigabytes.
+RATIO_MIN = 1e-4
 
 
 def _exprel(z: complex) -> complex:
@@ -120,7 +129,11 @@ class _Oscillator:
         """``(w, w')`` at ``0 <= tau <= T``."""
         e1 = cmath.exp(self.mu1 * tau)
         e2 = cmath.exp(self.mu2 * tau)
-        fab = e1 * tau * _exprel((self.a - self.mu1) * tau)
+        z = (self.a - self.mu1) * tau
+        if z.real > EXP_DIRECT:
+            fab = (cmath.exp(self.a * tau) - e1) / (self.a - self.mu1)
+        else:
+            fab = e1 * tau * _exprel(z)
         fbc = (e1 - e2) / (self.mu1 - self.mu2)
         g = (fab - fbc) * self.inv_am2
         # d/dtau of the divided difference is the divided difference of x e^{x tau}.
@@ -131,7 +144,11 @@ class _Oscillator:
         """``(w, w')`` on an array of times in ``[0, T]``."""
         e1 = np.exp(self.mu1 * tau)
         e2 = np.exp(self.mu2 * tau)
-        fab = e1 * tau * _exprel_array((self.a - self.mu1) * tau)
+        z = (self.a - self.mu1) * tau
+        direct = z.real > EXP_DIRECT
+        fab = e1 * tau * _exprel_array(np.where(direct, 0.0, z))
+        if direct.any():
+            fab[direct] = (np.exp(self.a * tau[direct]) - e1[direct]) / (self.a - self.mu1)
         fbc = (e1 - e2) / (self.mu1 - self.mu2)
         g = (fab - fbc) * self.inv_am2
         dg = ((self.a * fab + e1) - (self.mu1 * fbc + e2)) * self.inv_am2
@@ -282,8 +299,8 @@ def pulse_response_spectrum(
     Raises
     ------
     InputError
-        If a ratio is not finite and > 0 (field ``ratio``), or ``zeta``, ``quantity`` or
-        ``shape`` is invalid.
+        If a ratio is not finite and > 0, or below ``RATIO_MIN`` (field ``ratio``), or
+        ``zeta``, ``quantity`` or ``shape`` is invalid.
 
     Notes
     -----
@@ -305,6 +322,12 @@ def pulse_response_spectrum(
     phase = PULSE_SHAPES[shape]
     out = np.empty(r.shape, dtype=np.float64)
     flat = out.reshape(-1)
+    if r.size and float(r.min()) < RATIO_MIN:
+        raise InputError(
+            f"must be >= {RATIO_MIN:g} (a pulse at most {1 / RATIO_MIN:g} times longer than "
+            f"the natural period), got {float(r.min())!r}",
+            "ratio",
+        )
     for k, rk in enumerate(r.reshape(-1)):
         osc = _Oscillator(float(rk), z, phase)
         flat[k] = max(osc.peak_in_pulse(quantity), osc.peak_after_pulse(quantity))
@@ -394,6 +417,14 @@ def pulse_scale_factor(
     hh = check_non_negative(h, "h")
     he = check_positive(h_e, "h_e")
     fp = _positive_array(f_p, "f_p")
+    if fp.size and float(fp.min()) / fn < RATIO_MIN:
+        raise InputError(
+            f"f_p/f_n = {float(fp.min()) / fn:g} is below {RATIO_MIN:g}: the exact scale factor "
+            f"of a pulse over {1 / RATIO_MIN:g} times longer than the structure's period "
+            f"(f_n = {fn:g} Hz) is not computed; raise f_min, or use the library (whose table "
+            "takes its end value there)",
+            "f_p",
+        )
     spec = pulse_response_spectrum(fp / fn, zeta=zeta, quantity=quantity, shape=shape)
     return np.asarray(np.hypot(1.0, spec * (hh / he)), dtype=np.float64)
 

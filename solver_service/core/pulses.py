@@ -109,6 +109,10 @@ def _lobes(
     peak = np.maximum.reduceat(np.abs(acc), b[:-1] + 1)
     peak[-1] = np.max(np.abs(acc[b[-2] + 1 : b[-1] + 1]))  # reduceat's last runs to the end
     keep = (sgn != 0) | (end > start)
+    if not keep.any():
+        # One crossing through a single zero sample ([0.1, 0, -0.1]): no lobe at all.
+        empty = np.empty(0)
+        return empty, empty, empty, empty
     start, end, sgn, peak = start[keep], end[keep], sgn[keep], peak[keep]
     runs = np.flatnonzero(np.concatenate(([True], sgn[1:] != sgn[:-1])))
     run_end = np.concatenate((runs[1:], [sgn.size])) - 1

@@ -16,7 +16,7 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
-from shared_schema.api import MAX_ASSESS_MULTIPLES
+from shared_schema.api import MAX_ASSESS_MULTIPLES, MULTIPLE_MAX
 from shared_schema.constants import ConstantsFile, Mechanism, SideConstants
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.rules import check_number
@@ -53,8 +53,6 @@ BAND_DEFAULT = (0.15, 2.0)
 BAND_LOW, BAND_HIGH = 0.5, 1.5
 #: Periods in a matching band.
 BAND_POINTS = 40
-#: Largest multiple of the design scale factor [-]: a hundred times the design earthquake.
-MULTIPLE_MAX = 100.0
 
 NO_VIRTUAL_WORK = (
     "no virtual_work in the constants (short form or an older file): the code check needs "

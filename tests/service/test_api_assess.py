@@ -106,6 +106,39 @@ def test_bad_site_is_422_naming_the_field_as_rockmech_does(
     assert err["detail"] == "site: " + cli_error("check", str(GEOMETRY), str(bad))
 
 
+@pytest.mark.parametrize(
+    "virtual_work",
+    [
+        {"alpha0": 0.1, "mass": 72522.0, "S": 1e-200, "J": 1.8e6},  # S^2 underflows: e* = 0
+        {"alpha0": 0.1, "mass": 1e300, "S": 1e200, "J": 1e100},  # S^2 and mass J overflow
+    ],
+)
+def test_virtual_work_out_of_double_range_is_422_as_rockmech_says(
+    client: httpx.Client, tmp_path: Path, virtual_work: dict[str, float]
+) -> None:
+    # issue #19: a participating mass fraction e* = S^2/(mass J) of 0 was a 500
+    # (ZeroDivisionError in the linear check), inf/inf a NaN.
+    constants = _json(GEOMETRY)
+    constants["mechanisms"][0]["positive"]["virtual_work"] = virtual_work
+    res = client.post("/api/v1/check", json={"constants": constants, "site": _json(NTC)})
+    assert res.status_code == 422, res.text
+    err = res.json()
+    assert err["field"] == "constants.mechanisms[0] (id 'F1').positive.virtual_work.S"
+    assert "out of any physical range" in err["detail"]
+    bad = tmp_path / "constants.json"
+    bad.write_text(json.dumps(constants))
+    message = cli_error("check", str(bad), str(NTC))
+    assert err["detail"] == "constants: " + message.removeprefix(f"{bad}: ")
+
+
+def test_a_record_without_a_complete_cycle_is_assessed(client: httpx.Client) -> None:
+    # issue #19: one crossing through a zero sample made the pulse search an IndexError (500).
+    record = {"accel": [0.1, 0.0, -0.1], "dt": 0.01, "units": "g", "name": "one crossing"}
+    res = client.post("/api/v1/assess", json=_assess_body(records=[record], multiples=[1.0]))
+    assert res.status_code == 200, res.text
+    assert [r["name"] for r in res.json()["records"]] == ["one crossing"]
+
+
 def test_constants_without_virtual_work_answer_rows_that_say_why(client: httpx.Client) -> None:
     res = client.post("/api/v1/check", json={"constants": _json(SHORT), "site": _json(NTC)})
     assert res.status_code == 200, res.text
@@ -151,10 +184,11 @@ def test_records_over_the_sample_limit_together_are_refused_up_front(
 
 
 def test_stiff_mechanism_on_a_record_is_refused_before_any_run(client: httpx.Client) -> None:
-    # p_eq dt = 20000 segments per sample over 999 intervals: past 20 x max_samples per run.
+    # p_eq dt = 1000 segments per sample over 2999 intervals: past 20 x max_samples per run
+    # (p_eq at the top of its time-domain range, dt at the top of a record's).
     body = _assess_body(
-        constants={"mechanisms": [{"id": "W1", "p_eq": 1.0e6, "lam": 0.1, "eta": 0.9}]},
-        records=[{"accel": [0.0, 0.1] * 500, "dt": 0.02, "units": "g"}],
+        constants={"mechanisms": [{"id": "W1", "p_eq": 1.0e3, "lam": 0.1, "eta": 0.9}]},
+        records=[{"accel": [0.0, 0.1] * 1500, "dt": 1.0, "units": "g"}],
     )
     res = client.post("/api/v1/assess", json=body)
     assert res.status_code == 422, res.text

@@ -13,6 +13,7 @@ RECORD = EXAMPLES / "records" / "elcentro_NS.dat"
 WALLS = EXAMPLES / "constants" / "rect_walls.json"
 SCENE = EXAMPLES / "scenes" / "facade.3dm"
 SPEC = EXAMPLES / "specs" / "facade.spec.json"
+NTC = EXAMPLES / "sites" / "ntc_site.json"
 PULSE = {"p_eq": 2.0, "lam": 0.2, "eta": 0.9, "a_p_g": -0.61, "f_p": 1.59}
 
 
@@ -173,6 +174,22 @@ def test_invalid_constants_give_the_cli_message_with_the_field_for_the_file(
         "record": (RECORD.name, RECORD.read_bytes()),
     }
     assert _detail(client.post("/api/v1/history", files=files), 422) == expected
+
+
+def test_a_derived_p_eq_that_underflows_is_422_naming_the_side(
+    client: httpx.Client, tmp_path: Path
+) -> None:
+    # issue #19: sqrt(K/I0) = 0.0 passed, then failed the compute process's own validation
+    # of the job (p_eq > 0): a 500.
+    side = {"I0": 1e300, "K": 5e-324, "Q": 1.0, "phi_cr": 0.1}
+    doc = {"mechanisms": [{"id": "W", "p_eq": 2.0, "lam": 0.2, "negative": side}]}
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(doc))
+    expected = cli_error("check", path.name, str(NTC), cwd=tmp_path)
+    assert expected.startswith("bad.json: mechanisms[0] (id 'W').negative.p_eq: sqrt(K/I0) = 0.0")
+    res = client.post("/api/v1/check", json={"constants": doc, "site": json.loads(NTC.read_text())})
+    assert _detail(res, 422) == "constants" + expected[len("bad.json") :]
+    assert res.json()["field"] == "constants.mechanisms[0] (id 'W').negative.p_eq"
 
 
 def test_unknown_sf_gives_the_cli_message(client: httpx.Client) -> None:

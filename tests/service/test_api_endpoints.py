@@ -98,6 +98,25 @@ def test_envelope_matches_the_cli_and_has_the_critical_bands(
     }
 
 
+def test_exact_envelope_of_a_stiff_structure_matches_the_cli(
+    client: httpx.Client, tmp_path: Path
+) -> None:
+    # issue #19: f_p/f_n down to 2e-4 overflowed exp in the pulse response spectrum (a 500).
+    amp = {"f_n": 500.0, "h": 5.0, "h_e": 10.0}
+    constants = {
+        "mechanisms": [{"id": "W", "p_eq": 2.0, "lam": 0.2, "eta": 0.9, "amplification": amp}]
+    }
+    path = tmp_path / "stiff.json"
+    path.write_text(json.dumps(constants))
+    options = ["--n", "5", "--f-min", "0.1", "--f-max", "10", "--exact"]
+    cli = cli_json("envelope", str(path), "--out", str(tmp_path), *options)
+    body = {"constants": constants, "n": 5, "f_min": 0.1, "f_max": 10.0, "exact": True}
+    res = client.post("/api/v1/envelope", json=body)
+    assert res.status_code == 200, res.text
+    assert res.json() == cli
+    assert all(sf > 1.0 for sf in res.json()["mechanisms"][0]["scale_factor"])
+
+
 def test_history_upload_matches_the_cli(client: httpx.Client) -> None:
     cli = cli_json("history", str(WALLS), str(RECORD), "--scale", "0.5", "1", "2")
     files = {

@@ -197,9 +197,17 @@ def test_no_temporary_file_survives_a_worker_killed_mid_upload(faulty: Server) -
 
 
 def test_work_that_cannot_finish_in_the_budget_is_refused_at_once(faulty: Server) -> None:
-    stiff = {"id": "S", "p_eq": 1e6, "lam": 0.2, "rocking": "one_sided", "eta": -0.5}
+    # The stiffest side and the longest pulses the schema allows: 300 * 2 * (1e6 + 9.1e5)
+    # steps, past MAX_STEPS_PER_S x the 20 s budget.
+    stiff = {"id": "S", "p_eq": 1e3, "lam": 0.2, "rocking": "one_sided", "eta": -0.5}
     start = time.monotonic()
-    body = {"constants": {"mechanisms": [stiff]}, "exact": True, "n": 2}
+    body = {
+        "constants": {"mechanisms": [stiff]},
+        "exact": True,
+        "n": 2,
+        "f_min": 0.001,
+        "f_max": 0.0011,
+    }
     res = httpx.post(f"{faulty.url}/api/v1/envelope", json=body, timeout=60)
     assert res.status_code == 422, res.text
     assert "ROCKMECH_COMPUTE_TIMEOUT_S" in res.json()["detail"]
@@ -214,11 +222,12 @@ def test_work_that_cannot_finish_in_the_budget_is_refused_at_once(faulty: Server
 
 def test_the_envelope_estimate_uses_the_solvers_scan() -> None:
     assert N_SCAN == envelope.N_SCAN
-    # p_eq = 1e6 at 0.1 and 10 Hz, both pulse directions: 300 * 2 * (1e7 + 1e5) steps.
-    stiff = {"id": "S", "p_eq": 1e6, "lam": 0.2, "rocking": "one_sided", "eta": -0.5}
-    job = EnvelopeJob.model_validate({"constants": {"mechanisms": [stiff]}, "exact": True, "n": 2})
-    with pytest.raises(InputError, match=r"6\.06e\+09 closed-form steps"):
-        check_job(job, {"max_samples": 10**6, "max_mechanisms": 10, "budget_s": 30.0})
+    # p_eq = 1e3 at 0.001 and 0.002 Hz, both pulse directions: 300 * 2 * (1e6 + 5e5) steps.
+    stiff = {"id": "S", "p_eq": 1e3, "lam": 0.2, "rocking": "one_sided", "eta": -0.5}
+    body = {"constants": {"mechanisms": [stiff]}, "exact": True, "n": 2}
+    job = EnvelopeJob.model_validate({**body, "f_min": 0.001, "f_max": 0.002})
+    with pytest.raises(InputError, match=r"9e\+08 closed-form steps"):
+        check_job(job, {"max_samples": 10**6, "max_mechanisms": 10, "budget_s": 10.0})
 
 
 def test_many_json_values_are_refused_before_decoding(faulty: Server) -> None:

@@ -16,13 +16,29 @@ from pydantic import BaseModel, ValidationError
 from typer.testing import CliRunner
 
 from shared_schema import rules
-from shared_schema.api import Ec8Request, Eq28Request, NzsRequest, PulseRequest, RecordSamples
-from shared_schema.constants import ConstantsFile
+from shared_schema.api import (
+    MULTIPLE_MAX,
+    AssessRequest,
+    Ec8Request,
+    EnvelopeRequest,
+    Eq28Request,
+    HistoryRequest,
+    NzsRequest,
+    PulseRequest,
+    RecordSamples,
+    ReportRequest,
+    SpectrumRequest,
+    time_domain_problem,
+)
+from shared_schema.constants import ConstantsFile, validation_lines
 from shared_schema.errors import InputError
-from solver_service.api.jobs import scale_factor_doc
+from shared_schema.site import SiteFile
+from solver_service.api.jobs import history_options, scale_factor_doc
 from solver_service.cli import app
 from solver_service.core import codes, exact
 from solver_service.core.records import GroundMotion
+from solver_service.report.html import check_history_options
+from solver_service.workflows import assess
 from solver_service.workflows.limits import DEFAULT_LIMITS, WORK_PER_SAMPLE
 
 runner = CliRunner()
@@ -223,3 +239,215 @@ def test_the_natural_frequency_range_is_stated_as_the_service_enforces_it(
         assert not ok and exc.field == "f_n", exc
     else:
         assert ok and doc["value"] >= 1.0 and math.isclose(doc["inputs"]["T_n"], 1 / f_n)
+
+
+# --- the constants file's rules across fields, stated null-aware (null means "not given") ---
+
+MECHANISM_RULE_CASES = [
+    ({"eta_to_negative": None}, True),
+    ({"eta": 0.6, "eta_to_negative": 0.5, "eta_to_positive": None}, False),
+    ({"eta": None, "eta_to_negative": 0.5, "eta_to_positive": 0.7}, False),
+    ({"eta": 0.6, "eta_to_negative": 0.5, "eta_to_positive": 0.7}, True),
+    ({"rocking": "one_sided", "eta": -0.5, "eta_to_negative": 0.5, "eta_to_positive": 0.7}, False),
+    ({"eta_source": None}, True),
+    ({"eta_source": "user", "eta": None}, False),
+    ({"rocking": "one_sided", "eta": 0.5}, False),
+    ({"rocking": "one_sided", "eta": -0.5}, True),
+    ({"rocking": "two_sided", "eta": -0.5}, False),
+    ({"eta": -0.5}, False),
+    ({"rocking": "one_sided", "eta": None}, True),
+]
+
+
+@pytest.mark.parametrize(("given", "ok"), MECHANISM_RULE_CASES)
+def test_the_restitution_rules_are_stated_as_the_file_enforces_them_with_nulls(
+    given: dict[str, Any], ok: bool
+) -> None:
+    doc = {"mechanisms": [{"id": "W1", "p_eq": 2.0, "lam": 0.2, **given}]}
+    assert _valid(ConstantsFile, doc) is ok
+    try:
+        ConstantsFile.model_validate(doc)
+    except ValidationError:
+        assert not ok
+    else:
+        assert ok
+
+
+PHYSICAL = {"I0": 2.0, "K": 8.0, "Q": 1.0, "phi_cr": 0.2}
+SIDE_FORM_CASES = [
+    (PHYSICAL, True),
+    ({**PHYSICAL, "M_F": 0.5}, True),
+    ({**PHYSICAL, "Q": None}, False),
+    ({"I0": 2.0, "p_eq": 2.0, "lam": 0.2}, False),
+    ({"I0": None, "K": None, "Q": None, "phi_cr": None, "p_eq": 2.0, "lam": 0.2}, True),
+    ({"I0": None, "K": None, "Q": None, "phi_cr": None}, False),
+    ({"p_eq": 2.0, "lam": 0.2, "M_F": 1.0}, False),
+    ({"p_eq": 2.0, "lam": 0.2, "M_F": None}, True),
+    ({"p_eq": 2.0, "lam": None}, False),
+]
+
+
+@pytest.mark.parametrize(("side", "ok"), SIDE_FORM_CASES)
+def test_the_two_forms_of_a_side_are_stated_as_the_file_enforces_them(
+    side: dict[str, Any], ok: bool
+) -> None:
+    doc = {"mechanisms": [{"id": "W1", "positive": side}]}
+    assert _valid(ConstantsFile, doc) is ok
+    try:
+        ConstantsFile.model_validate(doc)
+    except ValidationError:
+        assert not ok
+    else:
+        assert ok
+
+
+@pytest.mark.parametrize(
+    ("value", "ok"), [(100, True), (100.0, True), (2.5, False), (True, False), ("3", False)]
+)
+def test_an_integer_written_with_a_point_is_an_integer_as_json_schema_says(
+    value: object, ok: bool
+) -> None:
+    site = {"hazard": {"code": "NTC2018", "a_g": 0.2, "F0": 2.5, "Tc_star": 0.3, "FC": 1.35}}
+    doc = {**site, "building": {"height": 12.0, "storeys": value}}
+    assert _valid(SiteFile, doc) is ok
+    assert _valid(SpectrumRequest, {**SPECTRUM, "n": value}) is ok
+    for model, body in ((SiteFile, doc), (SpectrumRequest, {**SPECTRUM, "n": value})):
+        try:
+            model.model_validate_json(json.dumps(body))
+        except ValidationError:
+            assert not ok
+        else:
+            assert ok
+
+
+SPECTRUM = {"record": {"accel": [0.0, 0.1, -0.1], "dt": 0.01, "units": "g"}}
+TIME_DOMAIN = {"mechanisms": [{"id": "W1", "p_eq": 2.0, "lam": 0.2, "eta": 0.9}]}
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "ok"),
+    [
+        ("p_eq", rules.P_EQ_RANGE[0], True),
+        ("p_eq", rules.P_EQ_RANGE[1], True),
+        ("p_eq", 5e-324, False),
+        ("p_eq", math.nextafter(rules.P_EQ_RANGE[1], math.inf), False),
+        ("lam", rules.LAM_RANGE[1], True),
+        ("lam", math.nextafter(rules.LAM_RANGE[0], 0.0), False),
+    ],
+)
+def test_time_domain_constants_are_plausible_as_stated(key: str, value: float, ok: bool) -> None:
+    flat = {"mechanisms": [{**TIME_DOMAIN["mechanisms"][0], key: value}]}
+    side = {"id": "W1", "eta": 0.9, "positive": {"p_eq": 2.0, "lam": 0.2, key: value}}
+    for constants in (flat, {"mechanisms": [side]}):
+        body = {"constants": constants}
+        assert _valid(EnvelopeRequest, body) is ok
+        try:
+            EnvelopeRequest.model_validate(body)
+        except ValidationError as exc:
+            assert not ok
+            (path, message), *_ = validation_lines(exc)
+            assert path == f"constants.mechanisms[0].positive.{key}", path
+            assert f"got {value!r}" in message and "plausible" in message
+        else:
+            assert ok
+
+
+def test_a_physical_form_outside_the_time_domain_range_is_refused_naming_the_side() -> None:
+    # p_eq = sqrt(K/I0) = 2e3 rad/s: derived, so the schema cannot state it.
+    side = {"I0": 1.0, "K": 4e6, "Q": 1e6, "phi_cr": 0.1}
+    cf = ConstantsFile.model_validate(
+        {"mechanisms": [{"id": "W", "negative": side, **TIME_DOMAIN["mechanisms"][0]}]}
+    )
+    assert time_domain_problem(cf) == (
+        "mechanisms[0].negative.p_eq",
+        "must be in [0.01, 1000] for a time-domain analysis (a plausible range, as for a "
+        "pulse), got 2000.0 (mechanism 'W1')",
+    )
+    with pytest.raises(ValidationError) as info:
+        HistoryRequest.model_validate({"constants": cf.model_dump(exclude_none=True), **SPECTRUM})
+    assert validation_lines(info.value)[0][0] == "constants.mechanisms[0].negative.p_eq"
+
+
+@pytest.mark.parametrize(
+    ("value", "ok"),
+    [(rules.F_P_RANGE[0], True), (rules.F_P_RANGE[1], True), (5e-324, False), (1e300, False)],
+)
+def test_envelope_frequencies_are_in_the_pulse_range_as_stated(value: float, ok: bool) -> None:
+    for model in (EnvelopeRequest, ReportRequest):
+        for key in ("f_min", "f_max"):
+            body = {"constants": TIME_DOMAIN, key: value}
+            assert _valid(model, body) is ok
+            try:
+                model.model_validate(body)
+            except ValidationError as exc:
+                assert not ok and validation_lines(exc)[0][0] == key
+            else:
+                assert ok
+
+
+REPORT_OPTIONS = [
+    ({}, True),
+    ({"scales": [1.0]}, True),
+    ({"scales": [2.0]}, False),
+    ({"sf": "eq28"}, False),
+    ({"criterion": "exact"}, False),
+    ({"criterion": None, "at_height": None, "building_height": None}, True),
+    ({"at_height": 1.0}, False),
+    ({"building_height": 10.0}, False),
+    ({"soil_factor": 1.2}, False),
+    ({"element_period": 0.0, "soil_factor": 1}, True),
+    ({"element_period": 0.1}, False),
+]
+
+
+@pytest.mark.parametrize(("options", "ok"), REPORT_OPTIONS)
+def test_a_report_without_a_record_keeps_the_history_options_as_stated(
+    options: dict[str, Any], ok: bool
+) -> None:
+    body = {"constants": TIME_DOMAIN, **options}
+    assert _valid(ReportRequest, body) is ok
+    assert _valid(ReportRequest, {**body, "record": SPECTRUM["record"]})
+    request = ReportRequest.model_validate(body)
+    try:
+        check_history_options(request.scales, history_options(request), None)
+    except InputError as exc:
+        assert not ok and exc.field in {*options, "building"}, exc
+    else:
+        assert ok
+
+
+def test_the_largest_multiple_is_stated_as_the_assessment_enforces_it() -> None:
+    items = AssessRequest.model_json_schema()["properties"]["multiples"]["items"]
+    assert items["maximum"] == MULTIPLE_MAX == assess.MULTIPLE_MAX
+    assert assess.check_multiples([MULTIPLE_MAX]) == [MULTIPLE_MAX]
+    with pytest.raises(InputError, match="must be in"):
+        assess.check_multiples([math.nextafter(MULTIPLE_MAX, math.inf)])
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "ok"),
+    [
+        ("f_n", rules.F_N_RANGE[0], True),
+        ("f_n", math.nextafter(rules.F_N_RANGE[0], 0.0), False),
+        ("f_n", math.nextafter(rules.F_N_RANGE[1], math.inf), False),
+        ("h", rules.BUILDING_HEIGHT_MAX_M, True),
+        ("h", math.nextafter(rules.BUILDING_HEIGHT_MAX_M, math.inf), False),
+        ("h_e", math.nextafter(rules.BUILDING_HEIGHT_MAX_M, math.inf), False),
+    ],
+)
+def test_time_domain_amplification_data_are_plausible_as_stated(
+    key: str, value: float, ok: bool
+) -> None:
+    amp = {"f_n": 2.0, "h": 5.0, "h_e": 10.0, key: value}
+    constants = {"mechanisms": [{**TIME_DOMAIN["mechanisms"][0], "amplification": amp}]}
+    site = {"hazard": {"code": "NTC2018", "a_g": 0.2, "F0": 2.5, "Tc_star": 0.3, "FC": 1.35}}
+    assess_body = {"constants": constants, "site": site, "records": [SPECTRUM["record"]]}
+    for model, body in ((EnvelopeRequest, {"constants": constants}), (AssessRequest, assess_body)):
+        assert _valid(model, body) is ok
+        try:
+            model.model_validate(body)
+        except ValidationError as exc:
+            assert not ok
+            assert validation_lines(exc)[0][0] == f"constants.mechanisms[0].amplification.{key}"
+        else:
+            assert ok

@@ -153,6 +153,27 @@ def test_long_pulse_is_quasi_static() -> None:
     assert float(pulse_response_spectrum(0.01, quantity="relative")) < 0.011
 
 
+@pytest.mark.parametrize(("ratio", "zeta"), [(2e-4, 0.05), (5e-3, 0.99)])
+def test_a_pulse_long_enough_to_overflow_exp_is_still_exact(ratio: float, zeta: float) -> None:
+    # zeta tau reaches 1571 and 1244 in the pulse: e**x overflowed past 709.78 (issue #19,
+    # an OverflowError, a 500 from the service's exact envelopes for f_n = 500 Hz).
+    ref = reference_peaks(1.0, ratio, 1.0, zeta, "sine")
+    for quantity in ("pseudo", "relative"):
+        got = float(pulse_response_spectrum(ratio, zeta=zeta, quantity=quantity))
+        assert got == pytest.approx(ref[quantity], rel=1e-6), quantity
+    assert float(pulse_response_spectrum(ratio, zeta=zeta)) == pytest.approx(1.0, abs=2 * ratio)
+
+
+def test_a_ratio_below_the_closed_forms_range_is_refused_naming_it() -> None:
+    with pytest.raises(InputError, match=r"must be >= 0\.0001") as err:
+        pulse_response_spectrum([1.0, 5e-5])
+    assert err.value.field == "ratio"
+    with pytest.raises(InputError, match="raise f_min, or use the library") as err:
+        pulse_scale_factor([0.01, 1.0], f_n=1000.0, h=3.0, h_e=2.0)
+    assert err.value.field == "f_p"
+    assert float(pulse_response_spectrum(amplification.RATIO_MIN)) == pytest.approx(1.0, abs=1e-6)
+
+
 def test_short_pulse_response_vanishes_like_two_pi_over_r_squared() -> None:
     # r -> inf: the pulse has zero net impulse and leaves u = 2 pi a_p/(omega_n² r²) at rest.
     r = 1e3

@@ -116,6 +116,17 @@ def test_zero_padding_and_touching_zeros() -> None:
     assert p.f_p == pytest.approx(10.0)
 
 
+@pytest.mark.parametrize("acc", [[0.1, 0.0, -0.1], [0.0, 0.1, 0.0, -0.1]])
+def test_one_crossing_through_a_zero_sample_holds_no_cycle(acc: list[float]) -> None:
+    # issue #19: the crossing's lobe had zero length and was dropped, leaving nothing to
+    # group: an IndexError (a 500 from /assess), not the record's own message.
+    accel = SampledAccel(np.array(acc), 0.01)
+    assert extract_pulses(accel) == []
+    with pytest.raises(InputError, match="no complete acceleration cycle") as err:
+        largest_pulse(accel)
+    assert err.value.field == "record"
+
+
 def test_bad_input() -> None:
     acc = SampledAccel(np.sin(np.linspace(0, 20, 500)), 0.01)
     with pytest.raises(InputError, match="f_min"):

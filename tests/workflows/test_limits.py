@@ -9,8 +9,8 @@ import pytest
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
+from solver_service.core import amplification, exact
 from solver_service.core import envelope as core_envelope
-from solver_service.core import exact
 from solver_service.workflows import limits
 
 
@@ -30,6 +30,22 @@ def _walls(*p_eqs: float) -> ConstantsFile:
 def test_copied_numbers_match_the_solver() -> None:
     assert limits.N_SCAN == core_envelope.N_SCAN
     assert limits.P_EQ_PLAUSIBLE == exact.P_EQ_PLAUSIBLE
+    assert limits.SPECTRUM_GRID_PER_PERIOD == amplification.GRID_PER_PERIOD
+
+
+def test_scale_factor_points_equal_the_direct_sum() -> None:
+    amp = {"f_n": 5.0, "h": 3.0, "h_e": 6.0}
+    cf = ConstantsFile.model_validate(
+        {
+            "mechanisms": [
+                {"id": "A", "p_eq": 2.0, "lam": 0.2, "amplification": amp},
+                {"id": "G", "p_eq": 2.0, "lam": 0.2},
+            ]
+        }
+    )
+    f = np.geomspace(0.1, 10.0, 50)
+    direct = (limits.SPECTRUM_GRID_PER_PERIOD * np.maximum(1.0, 5.0 / f)).sum()
+    assert limits.scale_factor_points(cf, 0.1, 10.0, 50) == pytest.approx(direct, rel=1e-9)
 
 
 def test_envelope_steps_equal_the_direct_sum() -> None:
