@@ -59,6 +59,8 @@ import numpy as np
 from shared_schema.rules import G
 
 _NO_JIT = globals().get("_NO_JIT", False)
+#: numba options of the helpers that allocate nothing (not in numba's type stubs).
+_LEAF_OPTIONS: dict[str, Any] = {"_nrt": False, "error_model": "numpy"}
 
 try:  # numba is optional: without it the same code runs as plain Python.
     if _NO_JIT:
@@ -74,17 +76,12 @@ try:  # numba is optional: without it the same code runs as plain Python.
     def _leaf(fn):
         # Helpers that allocate nothing run without the reference counting of their array
         # arguments, which would otherwise cost more than the arithmetic of a step.
-        options: dict[str, Any] = {
-            "_nrt": False,
-            "error_model": "numpy",
-        }  # not in numba's type stubs
-        return _numba.njit(cache=True, nogil=True, **options)(fn)
+        return _numba.njit(cache=True, nogil=True, **_LEAF_OPTIONS)(fn)
 
     def _inline(fn):
         # The small helpers of the per-sample and per-impact paths, inlined where they are
         # called (numba IR): a call with array arguments costs more than their arithmetic.
-        options: dict[str, Any] = {"_nrt": False, "error_model": "numpy", "inline": "always"}
-        return _numba.njit(cache=True, nogil=True, **options)(fn)
+        return _numba.njit(cache=True, nogil=True, inline="always", **_LEAF_OPTIONS)(fn)
 
     _prange: Any = _numba.prange
     JIT = True
