@@ -16,7 +16,7 @@ from pydantic import TypeAdapter, ValidationError
 
 from .problems import Problem, validation_message
 
-__all__ = ["MAX_BODY_DEPTH", "json_body", "validate_json"]
+__all__ = ["MAX_BODY_DEPTH", "json_body", "load_json", "validate_json"]
 
 #: Deepest nesting of a JSON body that is parsed [levels]: the recursion limit of pydantic's
 #: JSON parser (a test pins it), well above the few levels a request needs.
@@ -43,6 +43,33 @@ def _too_deep(exc: ValidationError) -> bool:
         e["type"] == "json_invalid" and "recursion limit" in str(e.get("msg", ""))
         for e in exc.errors(include_url=False)
     )
+
+
+#: Any JSON value, read by pydantic's parser (whose recursion limit is ``MAX_BODY_DEPTH``).
+_ANY_JSON: TypeAdapter[Any] = TypeAdapter(Any)
+
+
+def load_json(body: bytes) -> Any:
+    """Return the JSON value of ``body``, read with the depth limit of every request body.
+
+    For the routes that take JSON outside a model (Hops), so that they refuse a deep body
+    as the others do.
+
+    Raises
+    ------
+    ValueError
+        The body is not JSON, or it is nested deeper than ``MAX_BODY_DEPTH`` levels (the
+        message says which).
+    """
+    try:
+        return _ANY_JSON.validate_json(body)
+    except ValidationError as exc:
+        if _too_deep(exc):
+            raise ValueError(
+                f"the request body is nested deeper than {MAX_BODY_DEPTH} levels"
+            ) from None
+        first = exc.errors(include_url=False)[0]
+        raise ValueError(str(first.get("msg", "invalid JSON"))) from None
 
 
 def validate_json(model: Union[type[M], TypeAdapter[M]], body: bytes) -> M:

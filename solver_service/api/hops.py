@@ -35,6 +35,7 @@ from shared_schema.api import EnvelopeRequest, PulseRequest
 from shared_schema.constants import parse_constants, validation_lines
 from shared_schema.errors import InputError
 
+from .bodies import load_json
 from .jobspec import EnvelopeJob, HistoryJob, Job, PulseJob
 
 log = logging.getLogger("rockmech.hops")
@@ -320,7 +321,7 @@ class RockmechHops:
     def solve(self, uri: str, payload: bytes) -> tuple[int, bytes]:
         """Answer ``POST`` on a component URI, or on ``/solve`` with a ``pointer``."""
         try:
-            data = json.loads(payload)
+            data = load_json(payload)
             if not isinstance(data, dict):
                 raise HopsError(400, "a Hops solve request is a JSON object")
             if uri == "/solve":
@@ -353,8 +354,9 @@ class RockmechHops:
             return exc.status, self.hops._return_with_err(str(exc)).encode("utf-8")
         except ValueError as exc:  # json.JSONDecodeError and pydantic's ValidationError
             return 422, self.hops._return_with_err(_validation_text(exc)).encode("utf-8")
-        except RecursionError:
-            return 400, self.hops._return_with_err("JSON nested too deeply").encode("utf-8")
+        except RecursionError:  # an input's JSON text (the body's depth is bounded)
+            message = "an input's JSON text is nested too deeply"
+            return 422, self.hops._return_with_err(message).encode("utf-8")
         except OverflowError:
             message = "a number is out of the range of double precision"
             return 422, self.hops._return_with_err(message).encode("utf-8")

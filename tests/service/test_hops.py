@@ -185,3 +185,19 @@ def test_component_defaults_are_the_rest_defaults(client: httpx.Client) -> None:
     envelope = {p["Name"]: p for p in client.get("/hops/envelope").json()["Inputs"]}
     for name in ("f_min", "f_max", "n"):
         assert envelope[name]["Default"] == EnvelopeRequest.model_fields[name].default
+
+
+def test_a_deep_body_is_refused_as_rest_refuses_it(client: httpx.Client) -> None:
+    # The one depth limit of every JSON body (api.bodies.MAX_BODY_DEPTH); Hops answered 400
+    # "JSON nested too deeply" at about 1000 levels, and read any depth below it.
+    deep = b'{"values": ' + b"[" * 250 + b"]" * 250 + b"}"
+    headers = {"content-type": "application/json"}
+    (message,) = _errors(client.post("/hops/pulse", content=deep, headers=headers), 422)
+    rest = client.post("/api/v1/pulse", content=deep, headers=headers)
+    assert rest.status_code == 422
+    assert message == rest.json()["detail"] == "the request body is nested deeper than 200 levels"
+    # An input's own JSON text nested too deeply is refused by name too.
+    body = hops_payload(**PULSE, one_sided=False, shape="sine")
+    body["values"][0]["InnerTree"]["{0}"][0]["data"] = "[" * 5000 + "]" * 5000
+    (message,) = _errors(client.post("/hops/pulse", json=body), 422)
+    assert "nested too deeply" in message
