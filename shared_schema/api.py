@@ -303,24 +303,20 @@ def time_domain_problem(cf: ConstantsFile) -> Optional[Tuple[str, str]]:
     'mechanisms[0].positive.p_eq'
     """
     for i, mech in enumerate(cf.mechanisms):
-        amp = mech.amplification
-        for key, (lo, hi) in [] if amp is None else AMPLIFICATION_RANGES.items():
-            value = getattr(amp, key)
-            if not lo <= value <= hi:
-                return (
-                    f"mechanisms[{i}].amplification.{key}",
-                    f"must be in [{lo:g}, {hi:g}] for a time-domain analysis (a plausible "
-                    f"range, as for a scale factor), got {value!r} (mechanism {mech.id!r})",
-                )
-        for which in ("positive", "negative"):
-            side = getattr(mech, which)
-            for key, (lo, hi) in [] if side is None else TIME_DOMAIN_RANGES.items():
-                value = getattr(side, key)
+        parts = (
+            ("amplification", AMPLIFICATION_RANGES, "a scale factor"),
+            ("positive", TIME_DOMAIN_RANGES, "a pulse"),
+            ("negative", TIME_DOMAIN_RANGES, "a pulse"),
+        )
+        for part, ranges, like in parts:
+            data = getattr(mech, part)
+            for key, (lo, hi) in [] if data is None else ranges.items():
+                value = getattr(data, key)
                 if not lo <= value <= hi:
                     return (
-                        f"mechanisms[{i}].{which}.{key}",
+                        f"mechanisms[{i}].{part}.{key}",
                         f"must be in [{lo:g}, {hi:g}] for a time-domain analysis (a plausible "
-                        f"range, as for a pulse), got {value!r} (mechanism {mech.id!r})",
+                        f"range, as for {like}), got {value!r} (mechanism {mech.id!r})",
                     )
     return None
 
