@@ -153,15 +153,21 @@ def test_the_largest_sample_is_stated_per_unit_as_the_reader_enforces_it(units: 
     )
 
 
+def edge_cases(bounds: tuple[float, float]) -> list[tuple[float, bool]]:
+    """The two ends of a range (allowed), the next floats outside and the smallest float."""
+    lo, hi = bounds
+    return [
+        (lo, True),
+        (hi, True),
+        (math.nextafter(lo, 0.0), False),
+        (math.nextafter(hi, math.inf), False),
+        (5e-324, False),
+    ]
+
+
 @pytest.mark.parametrize(
     ("dt", "ok"),
-    [
-        (rules.DT_RANGE_S[0], True),
-        (rules.DT_RANGE_S[1], True),
-        (math.nextafter(rules.DT_RANGE_S[0], 0.0), False),
-        (math.nextafter(rules.DT_RANGE_S[1], math.inf), False),
-        (5e-324, False),
-    ],
+    edge_cases(rules.DT_RANGE_S),
 )
 def test_the_time_step_range_is_stated_as_the_reader_enforces_it(dt: float, ok: bool) -> None:
     doc = {"accel": [0.0, 0.1], "dt": dt, "units": "g"}
@@ -220,13 +226,7 @@ def test_the_restitutions_that_go_together_are_stated_as_the_file_enforces_them(
 
 @pytest.mark.parametrize(
     ("f_n", "ok"),
-    [
-        (rules.F_N_RANGE[0], True),
-        (rules.F_N_RANGE[1], True),
-        (math.nextafter(rules.F_N_RANGE[0], 0.0), False),
-        (math.nextafter(rules.F_N_RANGE[1], math.inf), False),
-        (5e-324, False),
-    ],
+    edge_cases(rules.F_N_RANGE),
 )
 def test_the_natural_frequency_range_is_stated_as_the_service_enforces_it(
     f_n: float, ok: bool
