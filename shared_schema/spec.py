@@ -81,13 +81,6 @@ def _in_range(value: Optional[float], kind: str, zero: bool = False) -> Optional
     return value
 
 
-def _density(value: float) -> float:
-    """Check a density [kg/m³] against ``rules.QUANTITY_RANGES["density"]``."""
-    out = _in_range(value, "density")
-    assert out is not None
-    return out
-
-
 def _repeated(selectors: List[Selector]) -> Optional[Selector]:
     """Return the first selector listed more than once, or None."""
     seen: List[Selector] = []
@@ -109,7 +102,23 @@ def _once(selectors: List[Selector]) -> List[Selector]:
     return selectors
 
 
-class DensityGroup(BaseModel):
+class _Weighed(BaseModel):
+    """Objects of one density: each object listed once, the density in its range."""
+
+    model_config = _STRICT
+
+    @field_validator("density", check_fields=False)
+    @classmethod
+    def _check_density(cls, value: Optional[float]) -> Optional[float]:
+        return _in_range(value, "density")
+
+    @field_validator("objects", check_fields=False)
+    @classmethod
+    def _check_objects(cls, value: Optional[List[Selector]]) -> Optional[List[Selector]]:
+        return value if value is None else _once(value)
+
+
+class DensityGroup(_Weighed):
     """Objects of one material.
 
     Attributes
@@ -122,20 +131,9 @@ class DensityGroup(BaseModel):
         Material name for reports (e.g. "stone", "bronze").
     """
 
-    model_config = _STRICT
     objects: List[Selector] = Field(min_length=1, description="Object selectors.")
     density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
     label: Optional[str] = Field(default=None, description="Material name for reports.")
-
-    @field_validator("density")
-    @classmethod
-    def _check_density(cls, value: float) -> float:
-        return _density(value)
-
-    @field_validator("objects")
-    @classmethod
-    def _check_objects(cls, value: List[Selector]) -> List[Selector]:
-        return _once(value)
 
 
 class Axis(BaseModel):
@@ -192,25 +190,14 @@ class Crack(BaseModel):
         return self
 
 
-class _Slab(BaseModel):
+class _Slab(_Weighed):
     """Objects of one density whose weight and inertia the wall carries a share of."""
 
-    model_config = _STRICT
     objects: List[Selector] = Field(min_length=1)
     density: float = Field(gt=0, description="Density [kg/m^3], > 0.")
     tributary: float = Field(
         default=TRIBUTARY_DEFAULT, gt=0, le=1, description="Share carried by the wall."
     )
-
-    @field_validator("density")
-    @classmethod
-    def _check_density(cls, value: Optional[float]) -> Optional[float]:
-        return _in_range(value, "density")
-
-    @field_validator("objects")
-    @classmethod
-    def _check_objects(cls, value: Optional[List[Selector]]) -> Optional[List[Selector]]:
-        return value if value is None else _once(value)
 
 
 class Floor(_Slab):
@@ -237,7 +224,7 @@ class Vault(BaseModel):
     )
 
 
-class Overburden(BaseModel):
+class Overburden(_Weighed):
     """What loads the top of a two-block wall: objects (weight share) or a given force [N].
 
     With ``objects``, N is ``tributary`` times their weight; ``tributary`` defaults to 0.5
@@ -245,7 +232,6 @@ class Overburden(BaseModel):
     that default was used.
     """
 
-    model_config = _STRICT
     objects: Optional[List[Selector]] = Field(default=None, min_length=1)
     density: Optional[float] = Field(default=None, gt=0, description="Density [kg/m^3].")
     tributary: float = Field(
@@ -253,20 +239,10 @@ class Overburden(BaseModel):
     )
     force: Optional[float] = Field(default=None, ge=0, description="Given overburden N [N].")
 
-    @field_validator("density")
-    @classmethod
-    def _check_density(cls, value: Optional[float]) -> Optional[float]:
-        return _in_range(value, "density")
-
     @field_validator("force")
     @classmethod
     def _check_force(cls, value: Optional[float]) -> Optional[float]:
         return _in_range(value, "force", zero=True)
-
-    @field_validator("objects")
-    @classmethod
-    def _check_objects(cls, value: Optional[List[Selector]]) -> Optional[List[Selector]]:
-        return value if value is None else _once(value)
 
     @model_validator(mode="after")
     def _one_form(self) -> "Overburden":
