@@ -92,6 +92,7 @@ __all__ = [
     "ServiceUnavailable",
     "check_limit",
     "check_record_work",
+    "check_spectra_work",
     "check_work",
     "dumps",
     "history_options",
@@ -479,7 +480,25 @@ def _assess_inputs(job: AssessJob | AssessHtmlJob, limits: dict[str, Any]) -> tu
             motions.append(motion_from_params(record, None, None, limits))
         except InputError as exc:
             raise InputError(str(exc), f"records[{i}]") from None
-    rows = check_doc(cf, job.site)["mechanisms"]
+    check_spectra_work(cf, check_doc(cf, job.site)["mechanisms"], motions, limits)
+    return cf, motions
+
+
+def check_spectra_work(
+    cf: Any, rows: list[dict[str, Any]], motions: list[Any], limits: dict[str, Any]
+) -> None:
+    """Bound the spectrum work of an assessment, one record and in total.
+
+    Every record's spectrum is computed down to the shortest period of each mechanism's
+    matching band (``rows``: the mechanisms of the code check, ``check_doc``) and to
+    ``1/f_n`` of each mechanism with amplification data.
+
+    Raises
+    ------
+    InputError
+        When one record, or all of them together, would take more closed-form steps than
+        the limits allow (naming the record).
+    """
     periods = [matching_band(row)[0] for row in rows]
     periods += [1.0 / m.amplification.f_n for m in cf.mechanisms if m.amplification is not None]
     steps = 0.0
@@ -489,7 +508,6 @@ def _assess_inputs(job: AssessJob | AssessHtmlJob, limits: dict[str, Any]) -> tu
             steps += BAND_POINTS * _record_steps(motion, STEPS_PER_PERIOD / t_lo)
         if steps > 0.0:
             check_total_steps(steps, limits, "the records' spectra", f"records[{i}]")
-    return cf, motions
 
 
 def _assess(job: AssessJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:

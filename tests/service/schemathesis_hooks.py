@@ -59,12 +59,12 @@ from shared_schema.api import (
     SpectrumRequest,
 )
 from shared_schema.errors import InputError
-from solver_service.api.estimates import check_job, check_total_steps
+from solver_service.api.estimates import check_job
 from solver_service.api.jobs import (
     _history_work,
     _library,
-    _record_steps,
     check_record_work,
+    check_spectra_work,
     history_options,
     motion_from_params,
 )
@@ -83,7 +83,7 @@ from solver_service.core.exact import MAX_AMPLITUDE_RATIO
 from solver_service.core.model import G
 from solver_service.core.spectra import STEPS_PER_PERIOD
 from solver_service.report.html import SPECTRUM_PERIODS
-from solver_service.workflows.assess import BAND_POINTS, check_doc, matching_band
+from solver_service.workflows.assess import check_doc
 from solver_service.workflows.documents import frequency_grid
 from solver_service.workflows.limits import WORK_PER_SAMPLE
 from solver_service.workflows.scaling import _factor_groups
@@ -231,23 +231,16 @@ def _assess_spectra_ok(job: Any) -> bool:
 
     The compute process bounds the spectrum of every record down to the shortest period
     of each mechanism's matching band (from its code check) and to ``1/f_n``, one run and
-    in total, as ``_assess_inputs`` does; the band comes from the constants and the site.
+    in total: the service's own ``api.jobs.check_spectra_work``, with the band from the
+    constants and the site.
     """
     try:
         rows = check_doc(job.constants, job.site)["mechanisms"]
         motions = [motion_from_params(r, None, None, LIMITS) for r in job.records]
     except InputError:
         return True  # the service refuses the request itself: the check sees its answer
-    periods = [matching_band(row)[0] for row in rows]
-    periods += [1.0 / m.amplification.f_n for m in job.constants.mechanisms if m.amplification]
-    steps = 0.0
     try:
-        for i, motion in enumerate(motions):
-            for t_lo in periods:
-                check_record_work(motion, LIMITS, t_min=t_lo)
-                steps += BAND_POINTS * _record_steps(motion, STEPS_PER_PERIOD / t_lo)
-            if steps > 0.0:
-                check_total_steps(steps, LIMITS, "the records' spectra", f"records[{i}]")
+        check_spectra_work(job.constants, rows, motions, LIMITS)
     except InputError:
         return False
     return True
