@@ -152,6 +152,22 @@ class _Asker:
             at_most=1.0,
         )
 
+    def carried(self, objects: List[Any], what: str, path: str) -> Dict[str, Any]:
+        """Ask the density and the tributary share of ``objects``, which the wall carries.
+
+        For a floor, the roof or the elements carrying the overburden; returns their spec
+        entry (``objects``, ``density``, ``tributary``; ``path`` is its place in the spec).
+        """
+        density = self.number(
+            f"Density of {what} [kg/m³]",
+            "the density [kg/m³]",
+            f"{path}.density",
+            above=0.0,
+            kind="density",
+        )
+        share = self.tributary(what, f"{path}.tributary")
+        return {"objects": objects, "density": density, "tributary": share}
+
     def option(self, prompt: str, options: Sequence[str], default: int = 0) -> str:
         answer = self.prompter.get_option(prompt, list(options), default)
         if answer not in options:
@@ -311,27 +327,11 @@ def loaded_wall_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, 
             )
             if not sels:
                 break
-            density = ask.number(
-                f"Density of floor {k + 1} [kg/m³]",
-                "the density [kg/m³]",
-                f"floors[{k}].density",
-                above=0.0,
-                kind="density",
-            )
-            share = ask.tributary(f"floor {k + 1}", f"floors[{k}].tributary")
-            floors.append({"objects": sels, "density": density, "tributary": share})
+            floors.append(ask.carried(sels, f"floor {k + 1}", f"floors[{k}]"))
         mech["floors"] = floors
     if ticked.get("Roof"):
         sels = ask.objects("Select the roof", "solid", "roof.objects")
-        density = ask.number(
-            "Density of the roof [kg/m³]",
-            "the density [kg/m³]",
-            "roof.density",
-            above=0.0,
-            kind="density",
-        )
-        share = ask.tributary("the roof", "roof.tributary")
-        roof: Dict[str, Any] = {"objects": sels, "density": density, "tributary": share}
+        roof = ask.carried(sels, "the roof", "roof")
         if ask.option("Roof structure", ["Thrusting", "Tied"], 0) == "Tied":
             roof["tied"] = True
         mech["roof"] = roof
@@ -384,15 +384,7 @@ def two_block_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, An
     source = ask.option("Overburden N from", ["Objects", "Force", "None"], 0)
     if source == "Objects":
         sels = ask.objects("Select the elements carrying N", "solid", "overburden.objects")
-        density = ask.number(
-            "Density of the elements carrying N [kg/m³]",
-            "the density [kg/m³]",
-            "overburden.density",
-            above=0.0,
-            kind="density",
-        )
-        share = ask.tributary("the elements carrying N", "overburden.tributary")
-        mech["overburden"] = {"objects": sels, "density": density, "tributary": share}
+        mech["overburden"] = ask.carried(sels, "the elements carrying N", "overburden")
     elif source == "Force":
         mech["overburden"] = {
             "force": ask.number(
