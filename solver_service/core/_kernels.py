@@ -811,12 +811,15 @@ CLOSE_MAXITER = 10_000
 
 
 @_leaf
-def _chatter_rate(rules, sides, row, row_new):
-    """Ratio of the speeds leaving and reaching an impact from side ``row`` into ``row_new``."""
+def _chatter_rate(rules, sides, row):
+    """Ratio of the speeds leaving and reaching an impact that ends a flight on side ``row``.
+
+    One-sided, the body rebounds onto the same side; two-sided, it rocks on into the other.
+    """
     if rules[RULE_ONE_SIDED] != 0.0:
         return abs(rules[RULE_ETA])
-    s_new = 1.0 if row_new == 0 else -1.0
-    return _eta_into(rules, s_new) * (sides[row, SIDE_PHIOV] / sides[row_new, SIDE_PHIOV])
+    s_new = -1.0 if row == 0 else 1.0
+    return _eta_into(rules, s_new) * (sides[row, SIDE_PHIOV] / sides[1 - row, SIDE_PHIOV])
 
 
 @_leaf
@@ -840,10 +843,7 @@ def _chatter_precheck(sides, rules, row, u0, a_max, j_max, t_left):
     dq = sides[row, SIDE_KS] * j_max
     g = (4.0 / 3.0) * dq / (p2 * mu * mu)
     # The mean rate per bounce (two-sided: the two directions in turn).
-    row_new = row if rules[RULE_ONE_SIDED] != 0.0 else 1 - row
-    c = math.sqrt(
-        _chatter_rate(rules, sides, row, row_new) * _chatter_rate(rules, sides, row_new, row)
-    )
+    c = math.sqrt(_chatter_rate(rules, sides, row) * _chatter_rate(rules, sides, 1 - row))
     rate = c * (1.0 + 0.5 * g * u0)
     if not (0.0 < c and rate < 1.0):
         return False
@@ -921,8 +921,8 @@ def _chatter_tail(st, sides, rules, a_max, slope, row, u_lo, u_hi, t_left):
     g_1 = _tail_gain(sides, 1, a_max, slope)
     thr_0 = rules[RULE_V_REST] * sides[0, SIDE_P]
     thr_1 = rules[RULE_V_REST] * sides[1, SIDE_P]
-    rate_0 = _chatter_rate(rules, sides, 0, 0 if one_sided else 1)
-    rate_1 = _chatter_rate(rules, sides, 1, 1 if one_sided else 0)
+    rate_0 = _chatter_rate(rules, sides, 0)
+    rate_1 = _chatter_rate(rules, sides, 1)
     n = 0
     elapsed = 0.0
     for _ in range(CLOSE_MAXITER):
@@ -986,10 +986,9 @@ def _chatter_count(st, cell, sides, rules, t, s, u0):
     n = 0
     # Below this speed the cell-wide bounds alone decide the rest (``_chatter_tail``): the
     # speed bounds then widen by at most CLOSE_TAIL over all the bounces left.
-    rate_max = max(
-        _chatter_rate(rules, sides, 0, 0 if one_sided else 1),
-        _chatter_rate(rules, sides, 1, 1 if one_sided else 0),
-    )
+    rate_0 = _chatter_rate(rules, sides, 0)
+    rate_1 = _chatter_rate(rules, sides, 1)
+    rate_max = max(rate_0, rate_1)
     gain = max(_tail_gain(sides, 0, a_max, cell[2]), _tail_gain(sides, 1, a_max, cell[2]))
     u_tail = CLOSE_TAIL * (1.0 - rate_max) / gain if gain > 0.0 else math.inf
     for _ in range(CLOSE_MAXITER):
@@ -1029,7 +1028,7 @@ def _chatter_count(st, cell, sides, rules, t, s, u0):
         row_new = row if one_sided else 1 - row
         thr_in = rules[RULE_V_REST] * p
         thr_out = rules[RULE_V_REST] * sides[row_new, SIDE_P]
-        rate = _chatter_rate(rules, sides, row, row_new)
+        rate = rate_0 if row == 0 else rate_1
         done, u_lo, u_hi, n = _bounded_impact(st, rules, lo, hi, thr_in, rate, thr_out, n)
         if done != 0:
             return n if done > 0 else -1
