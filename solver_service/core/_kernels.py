@@ -473,15 +473,15 @@ def _side_sign_left(v, acc, jerk):
 
 
 @_leaf
-def _velocity_zeros(fl, aa, ja, big_h, sig_a, qd_sign):
-    """Interior zeros of x' on ``(0, big_h)``: returns ``(n, z1, z2, x(big_h), x'(big_h))``.
+def _velocity_zeros(fl, aa, ja, big_h, sig_a, qd_sign, vb, ab, jb):
+    """Interior zeros of x' on ``(0, big_h)``: returns ``(n, z1, z2)``.
 
     ``aa``, ``ja`` are x'' and x''' at the anchor (Taylor starts of the searches) and
     ``sig_a`` the sign of x' just after it; ``qd_sign`` the constant sign of q' on the
-    stretch (0 when q is constant). See the module docstring.
+    stretch (0 when q is constant); ``vb``, ``ab``, ``jb`` are x', x'' and x''' at
+    ``big_h``. See the module docstring.
     """
     va = fl[FL_VA]
-    xb, vb, ab, jb = _state(fl, big_h)
     sig_b = _side_sign_left(vb, ab, jb)
     n = 0
     z1 = 0.0
@@ -506,7 +506,7 @@ def _velocity_zeros(fl, aa, ja, big_h, sig_a, qd_sign):
             z1 = _root(1, 0.0, fl, 0.0, m, sig_a, va, vm, t1)
             t2 = _taylor_start(vm, am, jm, m, m, big_h)
             z2 = _root(1, 0.0, fl, m, big_h, hump, vm, vb, t2)
-    return n, z1, z2, xb, vb
+    return n, z1, z2
 
 
 @_leaf
@@ -1200,6 +1200,7 @@ def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
     acc_a = p * p * (xa - s - ks * a_a)
     jerk_a = p * p * (va - ks * ad_a)
     sig_a = _side_sign_right(va, acc_a, jerk_a)
+    leaving = False
     if xa == 0.0 and va == 0.0:
         sig_a = s  # uplift: the drive exceeds the threshold, motion is outward
     elif xa == 0.0 and s * va > 0.0 and cell[0] == 0:
@@ -1211,15 +1212,16 @@ def _flight_step(st, fl, cell, sides, rules, tb, t_sub0, trace, log):
                 _record_turn(st, fl, acc_a, jerk_a, tau_imp, trace)
             _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log)
             return False
-        if trace.shape[1] == 0:
-            # No return in this step: when the bounds of the batch path show that no event
-            # lies in it either, the general search would only find the turning point, which
-            # a run without a time series does not record.
-            xb, vb, _ab, _jb = _state(fl, big_h)
-            if _no_event(s, xa, va, xb, vb, ks * a_a, ks * ad_a, big_h, p, st[OUT_PEAK]):
-                _advance(st, fl, xb, vb, tb, cell[6], trace)
-                return True
-    nz, z1, z2, xb, vb = _velocity_zeros(fl, acc_a, jerk_a, big_h, sig_a, qd_sign)
+        leaving = True
+    xb, vb, ab, jb = _state(fl, big_h)
+    if leaving and trace.shape[1] == 0:
+        # No return in this step: when the bounds of the batch path show that no event lies
+        # in it either, the general search would only find the turning point, which a run
+        # without a time series does not record.
+        if _no_event(s, xa, va, xb, vb, ks * a_a, ks * ad_a, big_h, p, st[OUT_PEAK]):
+            _advance(st, fl, xb, vb, tb, cell[6], trace)
+            return True
+    nz, z1, z2 = _velocity_zeros(fl, acc_a, jerk_a, big_h, sig_a, qd_sign, vb, ab, jb)
     tau_imp = _scan_pieces(st, fl, nz, z1, z2, xb, big_h, acc_a, trace)
     if tau_imp >= 0.0:
         _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log)
