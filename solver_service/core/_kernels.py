@@ -41,12 +41,13 @@ Helpers that allocate nothing are compiled without reference counting (``_leaf``
 passing arrays to them costs nothing.
 
 Batch path (``simulate_grid``). Scales are run in blocks as a structure of arrays
-(``_simulate_block``). For a linear cell of one closed-form segment, the flow over the
-cell width is computed once per side and width (``_propagator``: the record's few distinct
-widths, not per sample or run), and ``_no_event`` decides from the two ends of the step,
-with the maximum-principle bounds above, that no event lies inside; only the runs where
-one may lie take the event path, with the same arithmetic, so a batch gives the numbers
-of single runs bit for bit.
+(``_simulate_block``), one stretch of ``DOZE`` cells at a time, each run through the whole
+stretch before the next (its state in registers, its branches predictable). For a linear
+cell of one closed-form segment, the flow over the cell width is computed once per side
+and width (``_propagator``: the record's few distinct widths, not per sample or run), and
+``_no_event`` decides from the two ends of the step, with the maximum-principle bounds
+above, that no event lies inside; only a cell where one may lie takes the event path, with
+the same arithmetic, so a batch gives the numbers of single runs bit for bit.
 
 The same source runs uncompiled (``exact.kernels("python")``) as the pure-numpy path.
 """
@@ -1066,7 +1067,12 @@ def _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log):
         st[OUT_N_IMPACTS] += 1
         if st[OUT_N_IMPACTS] >= rules[RULE_MAX_IMPACTS]:
             st[OUT_STATUS] = -1
-    if not ends_in_rest and st[OUT_STATUS] == 0.0 and log.shape[1] + trace.shape[1] == 0:
+    if (
+        not ends_in_rest
+        and st[OUT_STATUS] == 0.0
+        and log.shape[1] + trace.shape[1] == 0
+        and 2.0 * abs(v_new) <= (cell[5] - t) * p_new * p_new
+    ):
         # A chattering sequence that surely ends in rest within the cell is closed at once
         # (``_chatter_count``); an impact log or a time series, when asked for, shows every
         # bounce instead.
@@ -1461,78 +1467,22 @@ def _no_event(s, xa, va, xb, vb, q0, q1, h, p, peak):
     return low > BOUND_MARGIN
 
 
-@_inline
-def _fast_flight(st, ksp, ksn, j, cell, props, w):
-    """Advance run ``j`` in flight through a linear cell when no event can lie inside it.
-
-    The cheap bound (``_no_event``) decides from the two ends of the step, computed with
-    the precomputed propagator, bit for bit the arithmetic of ``_flight_step``. Returns
-    False (nothing changed) when an event may lie in the cell.
-    """
-    s = st[ST_S, j]
-    row = 0 if s > 0.0 else 1
-    ks = ksp[j] if s > 0.0 else ksn[j]
-    c0 = cell[1]
-    c1 = cell[2]
-    h = cell[5] - cell[4]
-    xa = st[ST_X, j]
-    va = st[ST_V, j]
-    q0 = ks * (c0 + c1 * (cell[4] - cell[4]))
-    q1 = ks * c1
-    a = xa - s - q0
-    xb = (
-        xa
-        + a * props[w, row, PROP_CHM1]
-        + va * props[w, row, PROP_SHP]
-        - q1 * props[w, row, PROP_SMP]
-    )
-    vb = va + (va - q1) * props[w, row, PROP_CHM1] + a * props[w, row, PROP_PSH]
-    p = props[w, row, PROP_P]
-    if not _no_event(s, xa, va, xb, vb, q0, q1, h, p, st[OUT_PEAK, j]):
-        return False
-    st[OUT_N_STEPS, j] += 1
-    pxx = st[ST_PXX, j]
-    sx = s * xb
-    if sx > st[OUT_PEAK, j]:
-        st[OUT_PEAK, j] = sx
-        st[OUT_T_PEAK, j] = cell[4] + h
-        st[ST_VAR_PEAK, j] = pxx
-    pxv = st[ST_PXV, j]
-    pvv = st[ST_PVV, j]
-    ex = EPS * (abs(xa) + abs(xb) + 1.0 + abs(ks * c0))
-    ev = ex * p
-    k = PROP_COV
-    nxx = props[w, row, k] * pxx + props[w, row, k + 1] * pxv + props[w, row, k + 2] * pvv + ex * ex
-    nxv = props[w, row, k + 3] * pxx + props[w, row, k + 4] * pxv + props[w, row, k + 5] * pvv
-    nvv = (
-        props[w, row, k + 6] * pxx
-        + props[w, row, k + 7] * pxv
-        + props[w, row, k + 8] * pvv
-        + ev * ev
-    )
-    pxx, pxv, pvv = _cap_cov(nxx, nxv, nvv, p)
-    st[ST_PXX, j] = pxx
-    st[ST_PXV, j] = pxv
-    st[ST_PVV, j] = pvv
-    st[ST_X, j] = xb
-    st[ST_V, j] = vb
-    return True
-
-
 #: Cells per stretch over which a run at rest that cannot lift off anywhere is left asleep
 #: (``_doze``): its uplift test is skipped for the whole stretch.
-DOZE = 16
+DOZE = 64
 
 
 @_jit
 def _doze_table(cells, rules):
-    """Per stretch of ``DOZE`` cells: largest ``-a`` and ``a`` at the cell ends, fast or not.
+    """Which cells take the batch fast path, and per stretch of ``DOZE`` cells the drive.
 
-    Returns ``(neg, pos, fast)``: the extremes [m/s²] and whether every cell of the stretch
-    is linear and of one closed-form segment (the batch fast path).
+    Returns ``(fast_of, neg, pos, fast)``: per cell, whether it is linear and of one
+    closed-form segment (``fast_of``); per stretch, the largest ``-a`` and ``a`` at the
+    cell ends [m/s²] and whether every cell of it is fast.
     """
     n = cells.shape[1]
     nb = (n + DOZE - 1) // DOZE
+    fast_of = np.empty(n, dtype=np.bool_)
     neg = np.full(nb, -np.inf)
     pos = np.full(nb, -np.inf)
     fast = np.ones(nb, dtype=np.bool_)
@@ -1543,20 +1493,20 @@ def _doze_table(cells, rules):
         a_b = cell[1] + cell[2] * (cell[5] - cell[4])
         neg[b] = max(neg[b], -min(a_t, a_b))
         pos[b] = max(pos[b], max(a_t, a_b))
-        if not (cell[0] == 0 and _n_segments(cell, rules) == 1):
+        fast_of[i] = cell[0] == 0 and _n_segments(cell, rules) == 1
+        if not fast_of[i]:
             fast[b] = False
-    return neg, pos, fast
+    return fast_of, neg, pos, fast
 
 
 @_leaf
-def _doze(st, ksp, ksn, asleep, neg, pos, fast, one_sided, t_start, awake, slow):
+def _doze(st, ksp, ksn, asleep, neg, pos, fast, one_sided, t_start, awake):
     """Wake the runs asleep (time ``t_start`` [s]); put to sleep those no cell can lift.
 
     At rest, a run sleeps through a stretch when no cell of it can lift it. The test is
     ``_fast_rest``'s on the stretch's extremes ``neg``, ``pos`` [m/s²]; the product with
     ``ks > 0`` keeps the order, so it decides as the per-cell tests would. Returns the
-    number of runs left awake and still running, listed first in ``awake``; the others are
-    not ``slow``.
+    number of runs left awake and still running, listed first in ``awake``.
     """
     n_awake = 0
     for j in range(st.shape[1]):
@@ -1570,41 +1520,10 @@ def _doze(st, ksp, ksn, asleep, neg, pos, fast, one_sided, t_start, awake, slow)
             and ksp[j] * neg <= 1.0
             and (one_sided or ksn[j] * pos <= 1.0)
         )
-        slow[j] = False
         if running and not asleep[j]:
             awake[n_awake] = j
             n_awake += 1
     return n_awake
-
-
-@_leaf
-def _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow, awake, n_awake):
-    """One sample interval for the runs listed awake; mark in ``slow`` the runs it cannot do.
-
-    Returns the number of runs left to the event path. Runs that end (status != 0) are
-    skipped, and those asleep are not listed (``_doze``).
-    """
-    n_slow = 0
-    ce = cell[5]
-    a_t = cell[1] + cell[2] * (cell[4] - cell[4])
-    a_b = cell[1] + cell[2] * (cell[5] - cell[4])
-    a_lo = min(a_t, a_b)
-    a_hi = max(a_t, a_b)
-    for i in range(n_awake):
-        j = awake[i]
-        slow[j] = False
-        if st[OUT_STATUS, j] != 0.0:
-            continue
-        if st[ST_MODE, j] == REST:
-            done = _fast_rest(st, ksp, ksn, j, a_lo, a_hi, one_sided)
-        else:
-            done = _fast_flight(st, ksp, ksn, j, cell, props, w)
-        if done:
-            st[ST_T, j] = ce
-        else:
-            slow[j] = True
-            n_slow += 1
-    return n_slow
 
 
 @_leaf
@@ -1624,14 +1543,105 @@ def _store_run(st, st1, j):
         st[r, j] = st1[r]
 
 
+@_inline
+def _fly(st, ksp, ksn, j, cells, i, i1, fast_of, width_of, props):
+    """Fly run ``j`` through the fast cells from ``i`` on; return the first cell not done.
+
+    The run goes on while no event can lie in the cell, up to ``i1`` (returned when every
+    cell is done). In each cell the cheap bound (``_no_event``) decides from the two ends
+    of the step, computed with the propagator of the cell's width, bit for bit the
+    arithmetic of ``_flight_step``. The run state is held in locals meanwhile.
+    """
+    s = st[ST_S, j]
+    row = 0 if s > 0.0 else 1
+    ks = ksp[j] if s > 0.0 else ksn[j]
+    xa = st[ST_X, j]
+    va = st[ST_V, j]
+    pxx = st[ST_PXX, j]
+    pxv = st[ST_PXV, j]
+    pvv = st[ST_PVV, j]
+    peak = st[OUT_PEAK, j]
+    t_peak = st[OUT_T_PEAK, j]
+    var_peak = st[ST_VAR_PEAK, j]
+    i0 = i
+    while i < i1 and fast_of[i]:
+        w = width_of[i]
+        c0 = cells[1, i]
+        c1 = cells[2, i]
+        h = cells[5, i] - cells[4, i]
+        q0 = ks * (c0 + c1 * (cells[4, i] - cells[4, i]))
+        q1 = ks * c1
+        a = xa - s - q0
+        xb = (
+            xa
+            + a * props[w, row, PROP_CHM1]
+            + va * props[w, row, PROP_SHP]
+            - q1 * props[w, row, PROP_SMP]
+        )
+        vb = va + (va - q1) * props[w, row, PROP_CHM1] + a * props[w, row, PROP_PSH]
+        p = props[w, row, PROP_P]
+        if not _no_event(s, xa, va, xb, vb, q0, q1, h, p, peak):
+            break
+        sx = s * xb
+        if sx > peak:
+            peak = sx
+            t_peak = cells[4, i] + h
+            var_peak = pxx
+        ex = EPS * (abs(xa) + abs(xb) + 1.0 + abs(ks * c0))
+        ev = ex * p
+        k = PROP_COV
+        cov = props[w, row]
+        nxx = cov[k] * pxx + cov[k + 1] * pxv + cov[k + 2] * pvv + ex * ex
+        nxv = cov[k + 3] * pxx + cov[k + 4] * pxv + cov[k + 5] * pvv
+        nvv = cov[k + 6] * pxx + cov[k + 7] * pxv + cov[k + 8] * pvv + ev * ev
+        pxx, pxv, pvv = _cap_cov(nxx, nxv, nvv, p)
+        xa = xb
+        va = vb
+        i += 1
+    if i > i0:
+        st[OUT_N_STEPS, j] += i - i0
+        st[ST_X, j] = xa
+        st[ST_V, j] = va
+        st[ST_PXX, j] = pxx
+        st[ST_PXV, j] = pxv
+        st[ST_PVV, j] = pvv
+        st[OUT_PEAK, j] = peak
+        st[OUT_T_PEAK, j] = t_peak
+        st[ST_VAR_PEAK, j] = var_peak
+        st[ST_T, j] = cells[5, i - 1]
+    return i
+
+
 @_leaf
-def _event_path(st, sides, slow, cell, rules, st1, sides1, fl, trace, log):
-    """Integrate through ``cell`` the runs of a block marked in ``slow`` (``_run_cell``)."""
-    for j in range(st.shape[1]):
-        if slow[j] and st[OUT_STATUS, j] == 0.0:
-            _load_run(st1, sides1, st, sides, j)
-            _run_cell(st1, fl, cell, sides1, rules, trace, log)
-            _store_run(st, st1, j)
+def _run_stretch(
+    st, j, ksp, ksn, cells, i0, i1, fast_of, width_of, props, sides, rules, scratch, trace, log
+):
+    """Integrate run ``j`` of a block through the cells ``i0`` to ``i1 - 1``.
+
+    Fast cells (``fast_of``) in flight go through ``_fly`` and at rest through
+    ``_fast_rest``; a cell in which an event may lie, and every other cell, takes the event
+    path (``_run_cell``) on a copy of the run in the ``scratch`` arrays ``(st1, sides1,
+    fl)``.
+    """
+    one_sided = rules[RULE_ONE_SIDED] != 0.0
+    st1, sides1, fl = scratch
+    i = i0
+    while i < i1 and st[OUT_STATUS, j] == 0.0:
+        if st[ST_MODE, j] == FLIGHT:
+            i = _fly(st, ksp, ksn, j, cells, i, i1, fast_of, width_of, props)
+            if i == i1:
+                break
+        elif fast_of[i]:
+            a_t = cells[1, i]
+            a_b = cells[1, i] + cells[2, i] * (cells[5, i] - cells[4, i])
+            if _fast_rest(st, ksp, ksn, j, min(a_t, a_b), max(a_t, a_b), one_sided):
+                st[ST_T, j] = cells[5, i]
+                i += 1
+                continue
+        _load_run(st1, sides1, st, sides, j)
+        _run_cell(st1, fl, cells[:, i], sides1, rules, trace, log)
+        _store_run(st, st1, j)
+        i += 1
 
 
 @_jit
@@ -1639,12 +1649,14 @@ def _simulate_block(cells, width_of, widths, params, scales, v_rest_rel, max_imp
     """Run one mechanism at every scale of ``scales`` together; return (k, NOUT).
 
     Structure of arrays: ``st[:, j]`` is the run state of scale ``j``. ``widths`` are the
-    distinct cell widths [s] and ``width_of[i]`` the one of cell ``i``. Each linear cell
-    short enough for one closed-form segment goes through ``_fast_cell`` with the
+    distinct cell widths [s] and ``width_of[i]`` the one of cell ``i``. The cells are taken
+    in stretches of ``DOZE``; in each, every run awake (``_doze``) goes through the whole
+    stretch before the next (``_run_stretch``), its state held in registers while no event
+    lies in its cells. Each linear cell short enough for one closed-form segment uses the
     propagator of its width (computed once per side and width, not per sample or run); the
     runs in which an event may lie, and every other cell, take the event path
-    (``_run_cell``) with the same arithmetic, so the results are those of
-    ``simulate_cells`` bit for bit.
+    (``_run_cell``) with the same arithmetic, so the results are those of ``simulate_cells``
+    bit for bit.
     """
     k = scales.shape[0]
     st = np.empty((NST, k))
@@ -1656,41 +1668,46 @@ def _simulate_block(cells, width_of, widths, params, scales, v_rest_rel, max_imp
     ksp = sides[:, 0, SIDE_KS].copy()
     ksn = sides[:, 1, SIDE_KS].copy()
     one_sided = rules[RULE_ONE_SIDED] != 0.0
+    fast_of, neg, pos, fast = _doze_table(cells, rules)
     props = np.empty((widths.shape[0], 2, NPROP))
     have = np.zeros(widths.shape[0], dtype=np.bool_)
-    slow = np.ones(k, dtype=np.bool_)
-    cell = np.empty(len(CELL_ROWS))
-    st1 = np.empty(NST)
-    sides1 = np.empty((2, NSIDE))
-    fl = np.empty(NFL)
+    for i in range(cells.shape[1]):
+        w = width_of[i]
+        if fast_of[i] and not have[w]:
+            _propagator(props[w], sides[0], widths[w])
+            have[w] = True
+    scratch = (np.empty(NST), np.empty((2, NSIDE)), np.empty(NFL))
     trace = np.empty((2, 0))
     log = np.empty((4, 0))
-    neg, pos, fast = _doze_table(cells, rules)
     asleep = np.zeros(k, dtype=np.bool_)
     awake = np.empty(k, dtype=np.int64)
-    n_awake = k
-    for i in range(cells.shape[1]):
-        if i % DOZE == 0:
-            b = i // DOZE
-            t_b = cells[4, i]
-            n_awake = _doze(
-                st, ksp, ksn, asleep, neg[b], pos[b], fast[b], one_sided, t_b, awake, slow
+    for b in range(neg.shape[0]):
+        i0 = b * DOZE
+        i1 = min(i0 + DOZE, cells.shape[1])
+        n_awake = _doze(
+            st, ksp, ksn, asleep, neg[b], pos[b], fast[b], one_sided, cells[4, i0], awake
+        )
+        for ia in range(n_awake):
+            _run_stretch(
+                st,
+                awake[ia],
+                ksp,
+                ksn,
+                cells,
+                i0,
+                i1,
+                fast_of,
+                width_of,
+                props,
+                sides,
+                rules,
+                scratch,
+                trace,
+                log,
             )
-        for r in range(len(CELL_ROWS)):
-            cell[r] = cells[r, i]
-        n_slow = k
-        if cell[0] == 0 and _n_segments(cell, rules) == 1:
-            w = width_of[i]
-            if not have[w]:
-                _propagator(props[w], sides[0], widths[w])
-                have[w] = True
-            n_slow = _fast_cell(st, ksp, ksn, cell, props, w, one_sided, slow, awake, n_awake)
-        else:
-            slow[:] = True
-        if n_slow > 0:
-            _event_path(st, sides, slow, cell, rules, st1, sides1, fl, trace, log)
-    _doze(st, ksp, ksn, asleep, 0.0, 0.0, False, one_sided, cells[5, -1], awake, slow)
+    _doze(st, ksp, ksn, asleep, 0.0, 0.0, False, one_sided, cells[5, -1], awake)
     out = np.empty((k, NOUT))
+    st1, sides1, _fl = scratch
     for j in range(k):
         _load_run(st1, sides1, st, sides, j)
         if st1[OUT_STATUS] == 0.0 and st1[ST_MODE] == FLIGHT:
@@ -1735,6 +1752,45 @@ def simulate_cells_logged(cells, params, scale, x0, v_rest_rel, max_impacts, tra
     return _simulate(cells, sides, rules, x0, trace, log)
 
 
+#: Most distinct cell widths looked up one by one (``_width_table``); more are sorted.
+LINEAR_WIDTHS = 64
+
+
+@_jit
+def _width_table(cells):
+    """Distinct cell widths [s] and the index of each cell's width among them.
+
+    A record has a few distinct widths (its sampling interval, rounded): each cell's is
+    looked up among those found so far, starting with the previous cell's; past
+    ``LINEAR_WIDTHS`` of them, they are sorted instead.
+    """
+    n = cells.shape[1]
+    found = np.empty(LINEAR_WIDTHS)
+    width_of = np.empty(n, dtype=np.int64)
+    nw = 0
+    last = 0
+    for i in range(n):
+        h = cells[5, i] - cells[4, i]
+        if nw > 0 and found[last] == h:
+            width_of[i] = last
+            continue
+        last = -1
+        for w in range(nw):
+            if found[w] == h:
+                last = w
+                break
+        if last < 0:
+            if nw == LINEAR_WIDTHS:
+                all_widths = cells[5] - cells[4]
+                widths = np.unique(all_widths)
+                return widths, np.searchsorted(widths, all_widths)
+            found[nw] = h
+            last = nw
+            nw += 1
+        width_of[i] = last
+    return found[:nw].copy(), width_of
+
+
 @_jit_parallel
 def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
     """Run every mechanism (rows of ``params``) at every scale; return (m, k, NOUT).
@@ -1747,9 +1803,7 @@ def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
     m = params.shape[0]
     nk = scales.shape[0]
     nb = (nk + BLOCK - 1) // BLOCK
-    cell_widths = cells[5] - cells[4]
-    widths = np.unique(cell_widths)
-    width_of = np.searchsorted(widths, cell_widths)
+    widths, width_of = _width_table(cells)
     out = np.empty((m, nk, NOUT))
     for ib in _prange(m * nb):
         i = ib // nb
@@ -1767,9 +1821,7 @@ def simulate_grid_serial(cells, params, scales, v_rest_rel, max_impacts):
     m = params.shape[0]
     nk = scales.shape[0]
     nb = (nk + BLOCK - 1) // BLOCK
-    cell_widths = cells[5] - cells[4]
-    widths = np.unique(cell_widths)
-    width_of = np.searchsorted(widths, cell_widths)
+    widths, width_of = _width_table(cells)
     out = np.empty((m, nk, NOUT))
     for ib in range(m * nb):
         i = ib // nb

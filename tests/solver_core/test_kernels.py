@@ -51,6 +51,22 @@ def test_batch_path_equals_event_path_bit_for_bit(elcentro_path) -> None:  # typ
     assert batch.n_impacts.sum() > 1000  # the comparison covers many events
 
 
+def test_batch_path_with_cells_of_several_segments(elcentro_path) -> None:  # type: ignore[no-untyped-def]
+    # p dt > MAX_PH: every record cell takes several closed-form segments, so no cell is
+    # fast and each goes through the event path, stretch after stretch (the body rocks,
+    # then overturns at the largest scale).
+    rec = GroundMotion.from_two_column(elcentro_path).accel
+    stiff = RockingModel.symmetric(60.0, 0.25, 0.9, name="stiff")
+    scales = np.array([0.5, 0.8, 1.0, 1.2])
+    batch = simulate_batch([stiff, MODELS[0]], rec, scales)
+    for i, model in enumerate([stiff, MODELS[0]]):
+        for j, sc in enumerate(scales):
+            one = simulate(model, rec, scale=float(sc))
+            for field in FIELDS:
+                assert getattr(batch, field)[i, j] == getattr(one, field), (model.name, j, field)
+    assert batch.n_impacts[0].sum() > 0
+
+
 def test_dense_and_plain_runs_agree(elcentro_path) -> None:  # type: ignore[no-untyped-def]
     # Dense runs locate every turning point; plain runs may skip those the bound clears.
     rec = GroundMotion.from_two_column(elcentro_path).accel
