@@ -38,6 +38,8 @@ import sys
 import threading
 import time
 import warnings
+import weakref
+from collections import OrderedDict
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from types import ModuleType
@@ -73,6 +75,8 @@ Excitation = Union[Pulse, SampledAccel]
 V_REST_REL = 1e-9
 #: Pulses whose cells ``simulate`` keeps for reuse.
 PULSE_CELLS_CACHE = 256
+#: Records whose cells ``simulate`` and ``simulate_batch`` keep (the last used ones).
+RECORD_CELLS_CACHE = 4
 #: Default impact cap per simulation.
 MAX_IMPACTS = 1_000_000
 #: Kernel back ends: numba-compiled, or the same source as plain Python.
@@ -236,6 +240,44 @@ def _pulse_cells_shared(pulse: Pulse, per_quarter: int, t_extra: float) -> Cells
     return _pulse_cells(pulse, per_quarter, t_extra)
 
 
+_record_memo: OrderedDict[int, tuple[weakref.ref[SampledAccel], Cells]] = OrderedDict()
+_record_memo_lock = threading.Lock()
+
+
+def _record_cells_shared(rec: SampledAccel) -> Cells:
+    """``_record_cells`` (no extra time) memoised for ``simulate`` and ``simulate_batch``.
+
+    Repeated runs on one record (levels, mechanisms, scales) skip building them: a
+    ``SampledAccel`` is immutable (frozen, its samples read-only). Kept for the last
+    ``RECORD_CELLS_CACHE`` records, keyed by identity and checked through a weak reference
+    (a reused identity is rebuilt); the kernels never write to the cells, which are never
+    handed to callers, who get fresh ones from ``cells_for``.
+    """
+    key = id(rec)
+    with _record_memo_lock:
+        hit = _record_memo.get(key)
+        if hit is not None and hit[0]() is rec:
+            _record_memo.move_to_end(key)
+            return hit[1]
+    cells = _record_cells(rec, 0.0)
+    with _record_memo_lock:
+        _record_memo[key] = (weakref.ref(rec), cells)
+        _record_memo.move_to_end(key)
+        while len(_record_memo) > RECORD_CELLS_CACHE:
+            _record_memo.popitem(last=False)
+    return cells
+
+
+def _shared_cells(excitation: Excitation, dense: bool, t_extra: float) -> Cells:
+    """``cells_for`` for the solver's own use: memoised where possible, never handed out."""
+    if isinstance(excitation, Pulse):
+        per_quarter = DENSE_PER_QUARTER if dense else 1
+        return _pulse_cells_shared(excitation, per_quarter, float(t_extra))
+    if isinstance(excitation, SampledAccel) and t_extra <= 0.0:
+        return _record_cells_shared(excitation)
+    return cells_for(excitation, dense=dense, t_extra=t_extra)
+
+
 def _pulse_cells(pulse: Pulse, per_quarter: int, t_extra: float) -> Cells:
     # Quarter periods hold every extremum of both shapes on a boundary, so the
     # acceleration is monotone in each cell (built in the kernels: a few microseconds
@@ -373,11 +415,7 @@ def simulate(
         raise InputError(f"must be finite and >= 0, got {t_extra!r}", "t_extra")
     if int(max_impacts) < 1:
         raise InputError(f"must be >= 1, got {max_impacts!r}", "max_impacts")
-    if isinstance(excitation, Pulse):
-        per_quarter = DENSE_PER_QUARTER if dense else 1
-        cells = _pulse_cells_shared(excitation, per_quarter, float(t_extra))
-    else:
-        cells = cells_for(excitation, dense=dense, t_extra=t_extra)
+    cells = _shared_cells(excitation, dense, t_extra)
     pos, neg = model.positive, model.neg
     check_range(
         max(pos.p_eq, neg.p_eq),
@@ -607,11 +645,12 @@ def simulate_batch(
     sc = np.atleast_1d(np.asarray(scales, dtype=float))
     if sc.ndim != 1 or sc.size == 0:
         raise InputError("needs at least one scale factor", "scales")
-    for j, value in enumerate(sc):
-        check_positive(float(value), f"scales[{j}]")
+    bad = np.flatnonzero(~(np.isfinite(sc) & (sc > 0.0)))
+    if bad.size:
+        check_positive(float(sc[bad[0]]), f"scales[{bad[0]}]")
     params = np.stack([_params(m) for m in models])
     crit = _criterion(criterion, excitation)
-    cells = cells_for(excitation)
+    cells = _shared_cells(excitation, False, 0.0)
     check_range(
         max(max(m.positive.p_eq, m.neg.p_eq) for m in models),
         min(min(m.positive.lam, m.neg.lam) for m in models),

@@ -274,6 +274,27 @@ def test_batch_equals_single_runs(elcentro_path) -> None:  # type: ignore[no-unt
     assert len(rows) == 6 and rows[0]["mechanism"] == "a" and rows[3]["scale"] == 0.5
 
 
+def test_records_made_one_after_another_are_never_confused() -> None:
+    # simulate and simulate_batch keep the cells of the records last used, keyed by identity:
+    # a new record (often at a freed record's address) must get its own. Each run is
+    # compared with a run on a record just built from the same samples.
+    rng = np.random.default_rng(3)
+    model = RockingModel.symmetric(2.0, 0.15, 0.9)
+    for k in range(12):
+        acc = G * 0.4 * np.sin(np.arange(800) * (0.02 + 0.01 * k)) * rng.uniform(0.5, 1.5)
+        res = simulate_batch([model], SampledAccel(acc, 0.01), [1.0, 2.0])
+        fresh = [simulate(model, SampledAccel(acc.copy(), 0.01), scale=sc) for sc in (1.0, 2.0)]
+        assert res.peak_ratio[0].tolist() == [r.peak_ratio for r in fresh]
+        assert res.n_impacts[0].tolist() == [r.n_impacts for r in fresh]
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), float("inf")])
+def test_bad_batch_scale_names_its_index(bad: float) -> None:
+    with pytest.raises(InputError) as err:
+        simulate_batch([RockingModel.symmetric(2.0, 0.2, 0.9)], zeros(1.0), [1.0, 2.0, bad])
+    assert err.value.field == "scales[2]"
+
+
 def test_strong_pulse_collapses_with_status_1() -> None:
     res = simulate(RockingModel.symmetric(P, LAM, 0.9), pulse(20.0, 2.0))
     assert res.status == 1 and res.success and res.collapsed and res.peak_ratio == 1.0
