@@ -275,8 +275,10 @@ def reading(res: dict[str, Any]) -> str:
     return (
         "Reading: a run at rest costs the kernel "
         f"{res['ns_rest']:.2f} ns per sample (the uplift test; {res['resting_runs']} of the "
-        f"{n} runs never lift off), a flight step without an event a few ns (the per-width "
-        "propagator and the no-event bound, the error covariance carried with it); the rest is "
+        f"{n} runs never lift off). The batch takes each run through a stretch of "
+        f"{_kernels.DOZE} samples before the next, its state held in registers while no event "
+        "lies in a sample, so a flight step without an event costs a few ns: the per-width "
+        "propagator, the no-event bound and the error covariance carried with it. The rest is "
         f"the events. The {moving} runs that rock have about {res['impacts'] / moving:.0f} "
         f"impacts each, {100 * share:.0f} % of them arriving at below "
         f"{CHATTER_SPEED:g} p: the chattering of a body coming to rest, each bounce smaller by "
@@ -291,9 +293,9 @@ def reading(res: dict[str, Any]) -> str:
         "carries the saltation of the error covariance. The minimal stepper flips a sign at "
         "the sample instead, finds no turning point between samples and carries no error "
         "estimate; the remaining gap is the price of the exact events: the turning points "
-        "and impacts of the rocking itself (event path: one run state copied out and back, "
-        "the closed form evaluated at each root iterate) and the first bounces of each "
-        "chattering sequence, before its closing can be proved within the sample interval."
+        "and impacts of the rocking itself (the event path copies the run's state out and "
+        "back and evaluates the closed form at each root iterate) and the first bounces of "
+        "each chattering sequence, before its closing can be proved within the sample interval."
     )
 
 
