@@ -1075,7 +1075,8 @@ def _impact(st, fl, cell, tau_imp, sides, rules, tb, t_sub0, trace, log):
     ):
         # A chattering sequence that surely ends in rest within the cell is closed at once
         # (``_chatter_count``); an impact log or a time series, when asked for, shows every
-        # bounce instead.
+        # bounce instead. Its first bounce lasts at least 2 u/p**2: when that does not fit in
+        # the cell, the sequence is not bounded.
         n_more = _chatter_count(st, cell, sides, rules, t, s_new, abs(v_new))
         if n_more >= 0:
             st[OUT_N_IMPACTS] += n_more
@@ -1467,8 +1468,9 @@ def _no_event(s, xa, va, xb, vb, q0, q1, h, p, peak):
     return low > BOUND_MARGIN
 
 
-#: Cells per stretch over which a run at rest that cannot lift off anywhere is left asleep
-#: (``_doze``): its uplift test is skipped for the whole stretch.
+#: Cells per stretch of the batch path: each run awake goes through a stretch before the
+#: next run; a run at rest that cannot lift off anywhere in it is left asleep (``_doze``),
+#: its uplift test skipped for the whole stretch.
 DOZE = 64
 
 
@@ -1565,21 +1567,16 @@ def _fly(st, ksp, ksn, j, cells, i, i1, fast_of, width_of, props):
     var_peak = st[ST_VAR_PEAK, j]
     i0 = i
     while i < i1 and fast_of[i]:
-        w = width_of[i]
         c0 = cells[1, i]
         c1 = cells[2, i]
         h = cells[5, i] - cells[4, i]
         q0 = ks * (c0 + c1 * (cells[4, i] - cells[4, i]))
         q1 = ks * c1
         a = xa - s - q0
-        xb = (
-            xa
-            + a * props[w, row, PROP_CHM1]
-            + va * props[w, row, PROP_SHP]
-            - q1 * props[w, row, PROP_SMP]
-        )
-        vb = va + (va - q1) * props[w, row, PROP_CHM1] + a * props[w, row, PROP_PSH]
-        p = props[w, row, PROP_P]
+        pr = props[width_of[i], row]
+        xb = xa + a * pr[PROP_CHM1] + va * pr[PROP_SHP] - q1 * pr[PROP_SMP]
+        vb = va + (va - q1) * pr[PROP_CHM1] + a * pr[PROP_PSH]
+        p = pr[PROP_P]
         if not _no_event(s, xa, va, xb, vb, q0, q1, h, p, peak):
             break
         sx = s * xb
@@ -1590,10 +1587,9 @@ def _fly(st, ksp, ksn, j, cells, i, i1, fast_of, width_of, props):
         ex = EPS * (abs(xa) + abs(xb) + 1.0 + abs(ks * c0))
         ev = ex * p
         k = PROP_COV
-        cov = props[w, row]
-        nxx = cov[k] * pxx + cov[k + 1] * pxv + cov[k + 2] * pvv + ex * ex
-        nxv = cov[k + 3] * pxx + cov[k + 4] * pxv + cov[k + 5] * pvv
-        nvv = cov[k + 6] * pxx + cov[k + 7] * pxv + cov[k + 8] * pvv + ev * ev
+        nxx = pr[k] * pxx + pr[k + 1] * pxv + pr[k + 2] * pvv + ex * ex
+        nxv = pr[k + 3] * pxx + pr[k + 4] * pxv + pr[k + 5] * pvv
+        nvv = pr[k + 6] * pxx + pr[k + 7] * pxv + pr[k + 8] * pvv + ev * ev
         pxx, pxv, pvv = _cap_cov(nxx, nxv, nvv, p)
         xa = xb
         va = vb
