@@ -3,9 +3,8 @@
 ``boundary_grids`` runs the scan-and-bisect of ``_kernels.boundary_grid`` for several curves
 (each its own restitution, one-sided flag and pulse direction) in one parallel loop over
 every (curve, Omega) pair, so that all threads share the work of all curves (no thread idle
-at the end of each curve). Each pair is searched with exactly the arithmetic of
-``boundary_grid`` (the same scan, the same bisection, the same ``_kernels.pulse_collapses``),
-so the edges are those of ``boundary_grid`` bit for bit.
+at the end of each curve). Each pair is searched by the same ``_kernels._search`` as
+``boundary_grid``, so the edges are those of ``boundary_grid`` bit for bit.
 
 Restitution-free outcomes. The restitution enters a run only at an impact (and in the
 analytic free tail only after one). A two-sided run with ``eta = 0`` that overturns without
@@ -19,67 +18,19 @@ them again; the outcome, and so every edge, is the same bit for bit.
 Without numba the same source runs as plain Python, like ``_kernels``.
 """
 
+import math
+
 import numpy as np
 
 from ._kernels import (
-    OUT_N_IMPACTS,
-    OUT_N_RESTS,
-    _jit,
+    GOLDEN,
+    KNOWN_FILL,
+    KNOWN_IGNORE,
+    KNOWN_USE,
     _jit_parallel,
     _prange,
-    pulse_collapses,
-    pulse_work,
+    _search,
 )
-
-#: Golden-ratio conjugate: the visiting order of the (curve, Omega) pairs.
-GOLDEN = 0.6180339887498949
-#: What ``_search`` does with its ``known`` row: nothing, take its True entries as overturned
-#: without a run, or fill it with the restitution-free outcomes (the ``eta = 0`` probe).
-KNOWN_IGNORE = 0
-KNOWN_USE = 1
-KNOWN_FILL = 2
-
-
-@_jit
-def _scan_point(amp, om, phase, work, known, j, mode):
-    """Outcome at scan point ``j``, using or filling ``known[j]`` as ``mode`` says."""
-    if mode == KNOWN_USE and known[j]:
-        return True
-    out = pulse_collapses(amp, om, phase, 1, work)
-    if mode == KNOWN_FILL:
-        st = work[3]
-        known[j] = out and st[OUT_N_IMPACTS] == 0.0 and st[OUT_N_RESTS] == 0.0
-    return out
-
-
-@_jit
-def _search(eta, one_sided, sign, om, phase, a_scan, rtol, v_rest_rel, edges_row, known, mode):
-    """Scan and bisect the outcome in A at one Omega; return (n_edges, collapsed at first).
-
-    ``edges_row`` (max_edges,) receives the first edges; the count may exceed its size.
-    ``known`` (n_scan,) and ``mode``: see ``KNOWN_*``.
-    """
-    max_edges = edges_row.shape[0]
-    work = pulse_work(eta, one_sided, v_rest_rel, 1)
-    prev = _scan_point(sign * a_scan[0], om, phase, work, known, 0, mode)
-    first = prev
-    ne = 0
-    for j in range(1, a_scan.shape[0]):
-        cur = _scan_point(sign * a_scan[j], om, phase, work, known, j, mode)
-        if cur != prev:
-            lo = a_scan[j - 1]
-            hi = a_scan[j]
-            while hi - lo > rtol * hi:
-                mid = 0.5 * (lo + hi)
-                if pulse_collapses(sign * mid, om, phase, 1, work) == prev:
-                    lo = mid
-                else:
-                    hi = mid
-            if ne < max_edges:
-                edges_row[ne] = 0.5 * (lo + hi)
-            ne += 1
-            prev = cur
-    return ne, first
 
 
 @_jit_parallel
@@ -110,6 +61,7 @@ def probe_grid(omegas, sign, phase, a_scan, rtol, max_edges, v_rest_rel):
             edges[i],
             known[i],
             KNOWN_FILL,
+            math.nan,
         )
         n_edges[i] = ne
         first[i] = f
@@ -170,6 +122,7 @@ def boundary_grids(
             edges[c, i],
             known[i],
             KNOWN_USE if use_known[c] else KNOWN_IGNORE,
+            math.nan,
         )
         n_edges[c, i] = ne
         first[c, i] = f

@@ -1787,6 +1787,18 @@ def _width_table(cells):
     return found[:nw].copy(), width_of
 
 
+@_jit
+def _grid_task(out, task, cells, width_of, widths, params, scales, v_rest_rel, max_impacts):
+    """Task ``task`` of ``simulate_grid``: one mechanism at one block of ``BLOCK`` scales."""
+    nb = (scales.shape[0] + BLOCK - 1) // BLOCK
+    i = task // nb
+    lo = (task % nb) * BLOCK
+    hi = min(lo + BLOCK, scales.shape[0])
+    out[i, lo:hi, :] = _simulate_block(
+        cells, width_of, widths, params[i], scales[lo:hi], v_rest_rel, max_impacts
+    )
+
+
 @_jit_parallel
 def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
     """Run every mechanism (rows of ``params``) at every scale; return (m, k, NOUT).
@@ -1794,38 +1806,24 @@ def simulate_grid(cells, params, scales, v_rest_rel, max_impacts):
     ``params[i] = (p_pos, p_neg, lam_pos, lam_neg, phiov_pos, phiov_neg, eta, one_sided)``,
     optionally followed by ``eta_to_negative, eta_to_positive`` (``simulate_cells``).
     The work is split in tasks of one mechanism × up to ``BLOCK`` scales
-    (``_simulate_block``), run in parallel; the distinct cell widths are found once.
+    (``_grid_task``), run in parallel; the distinct cell widths are found once.
     """
-    m = params.shape[0]
-    nk = scales.shape[0]
-    nb = (nk + BLOCK - 1) // BLOCK
     widths, width_of = _width_table(cells)
-    out = np.empty((m, nk, NOUT))
-    for ib in _prange(m * nb):
-        i = ib // nb
-        lo = (ib % nb) * BLOCK
-        hi = min(lo + BLOCK, nk)
-        out[i, lo:hi, :] = _simulate_block(
-            cells, width_of, widths, params[i], scales[lo:hi], v_rest_rel, max_impacts
-        )
+    out = np.empty((params.shape[0], scales.shape[0], NOUT))
+    n_tasks = params.shape[0] * ((scales.shape[0] + BLOCK - 1) // BLOCK)
+    for task in _prange(n_tasks):
+        _grid_task(out, task, cells, width_of, widths, params, scales, v_rest_rel, max_impacts)
     return out
 
 
 @_jit
 def simulate_grid_serial(cells, params, scales, v_rest_rel, max_impacts):
     """``simulate_grid`` on the calling thread only (for callers that run many in threads)."""
-    m = params.shape[0]
-    nk = scales.shape[0]
-    nb = (nk + BLOCK - 1) // BLOCK
     widths, width_of = _width_table(cells)
-    out = np.empty((m, nk, NOUT))
-    for ib in range(m * nb):
-        i = ib // nb
-        lo = (ib % nb) * BLOCK
-        hi = min(lo + BLOCK, nk)
-        out[i, lo:hi, :] = _simulate_block(
-            cells, width_of, widths, params[i], scales[lo:hi], v_rest_rel, max_impacts
-        )
+    out = np.empty((params.shape[0], scales.shape[0], NOUT))
+    n_tasks = params.shape[0] * ((scales.shape[0] + BLOCK - 1) // BLOCK)
+    for task in range(n_tasks):
+        _grid_task(out, task, cells, width_of, widths, params, scales, v_rest_rel, max_impacts)
     return out
 
 
@@ -1894,6 +1892,61 @@ def pulse_work(eta, one_sided, v_rest_rel, quarter_cells, eta_neg=math.nan):
     return cells, sides, rules, np.empty(NST), np.empty(NFL), np.empty((2, 0)), np.empty((4, 0))
 
 
+#: What ``_search`` does with its ``known`` row: nothing, take its True entries as overturned
+#: without a run, or fill it with the restitution-free outcomes (the ``eta = 0`` probe).
+KNOWN_IGNORE = 0
+KNOWN_USE = 1
+KNOWN_FILL = 2
+
+
+#: Golden-ratio conjugate: the visiting order of the Omega of a boundary search.
+GOLDEN = 0.6180339887498949
+
+
+@_jit
+def _scan_point(amp, om, phase, work, known, j, mode):
+    """Outcome at scan point ``j``, using or filling ``known[j]`` as ``mode`` says."""
+    if mode == KNOWN_USE and known[j]:
+        return True
+    out = pulse_collapses(amp, om, phase, 1, work)
+    if mode == KNOWN_FILL:
+        st = work[3]
+        known[j] = out and st[OUT_N_IMPACTS] == 0.0 and st[OUT_N_RESTS] == 0.0
+    return out
+
+
+@_jit
+def _search(
+    eta, one_sided, sign, om, phase, a_scan, rtol, v_rest_rel, edges_row, known, mode, eta_neg
+):
+    """Scan and bisect the outcome in A at one Omega; return (n_edges, collapsed at first).
+
+    ``edges_row`` (max_edges,) receives the first edges; the count may exceed its size.
+    ``known`` (n_scan,) and ``mode``: see ``KNOWN_*``; ``eta_neg`` as in ``pulse_work``.
+    """
+    max_edges = edges_row.shape[0]
+    work = pulse_work(eta, one_sided, v_rest_rel, 1, eta_neg)
+    prev = _scan_point(sign * a_scan[0], om, phase, work, known, 0, mode)
+    first = prev
+    ne = 0
+    for j in range(1, a_scan.shape[0]):
+        cur = _scan_point(sign * a_scan[j], om, phase, work, known, j, mode)
+        if cur != prev:
+            lo = a_scan[j - 1]
+            hi = a_scan[j]
+            while hi - lo > rtol * hi:
+                mid = 0.5 * (lo + hi)
+                if pulse_collapses(sign * mid, om, phase, 1, work) == prev:
+                    lo = mid
+                else:
+                    hi = mid
+            if ne < max_edges:
+                edges_row[ne] = 0.5 * (lo + hi)
+            ne += 1
+            prev = cur
+    return ne, first
+
+
 @_jit_parallel
 def boundary_grid(
     omegas, eta, one_sided, sign, phase, a_scan, rtol, max_edges, v_rest_rel, eta_neg=math.nan
@@ -1913,28 +1966,22 @@ def boundary_grid(
     first = np.zeros(n_om, dtype=np.bool_)
     # Static chunks of the parallel loop would give one thread the slow, low Omega: visit the
     # Omega in golden-ratio order, so that every contiguous chunk samples the whole range.
-    order = np.argsort((np.arange(n_om) * 0.6180339887498949) % 1.0)
+    order = np.argsort((np.arange(n_om) * GOLDEN) % 1.0)
+    no_known = np.zeros(0, dtype=np.bool_)
     for c in _prange(n_om):
         i = order[c]
-        work = pulse_work(eta, one_sided, v_rest_rel, 1, eta_neg)
-        om = omegas[i]
-        prev = pulse_collapses(sign * a_scan[0], om, phase, 1, work)
-        first[i] = prev
-        ne = 0
-        for j in range(1, a_scan.shape[0]):
-            cur = pulse_collapses(sign * a_scan[j], om, phase, 1, work)
-            if cur != prev:
-                lo = a_scan[j - 1]
-                hi = a_scan[j]
-                while hi - lo > rtol * hi:
-                    mid = 0.5 * (lo + hi)
-                    if pulse_collapses(sign * mid, om, phase, 1, work) == prev:
-                        lo = mid
-                    else:
-                        hi = mid
-                if ne < max_edges:
-                    edges[i, ne] = 0.5 * (lo + hi)
-                ne += 1
-                prev = cur
-        n_edges[i] = ne
+        n_edges[i], first[i] = _search(
+            eta,
+            one_sided,
+            sign,
+            omegas[i],
+            phase,
+            a_scan,
+            rtol,
+            v_rest_rel,
+            edges[i],
+            no_known,
+            KNOWN_IGNORE,
+            eta_neg,
+        )
     return edges, n_edges, first
