@@ -158,7 +158,14 @@ def check_record_work(
         check_work(steps, limits, f"the spectrum down to T = {t_min:g} s", "record")
 
 
-def _history_work(cf: Any, motion: Any, sf: str, limits: dict[str, Any], n_scales: int = 1) -> None:
+def check_history_work(
+    cf: Any, motion: Any, sf: str, limits: dict[str, Any], n_scales: int = 1
+) -> None:
+    """Bound the work of time histories of every mechanism of ``cf`` at ``n_scales`` levels.
+
+    The integrator's segments per sample (the largest ``p_eq``), the closed-form steps in
+    all, and with the eq. 28 scale factor the spectrum down to each ``1/f_n``.
+    """
     sides = [s for m in cf.mechanisms for s in (m.positive, m.negative) if s is not None]
     check_record_work(motion, limits, p_max=max(s.p_eq for s in sides))
     steps = history_steps(cf, motion.accel.n, motion.dt, n_scales)
@@ -169,7 +176,8 @@ def _history_work(cf: Any, motion: Any, sf: str, limits: dict[str, Any], n_scale
                 check_record_work(motion, limits, t_min=1.0 / mech.amplification.f_n)
 
 
-def _library() -> Any:
+def shared_library() -> Any:
+    """Return the shipped overturning library, loaded once per process."""
     global _LIBRARY
     if _LIBRARY is None:
         _LIBRARY = OverturningLibrary.load()
@@ -293,7 +301,7 @@ def _grid(f_min: float, f_max: float, n: int, limits: dict[str, Any]) -> Any:
 def _envelope(job: EnvelopeJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     f_p = _grid(job.f_min, job.f_max, job.n, limits)
     cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
-    doc, _ = envelope_doc(cf, f_p, exact=job.exact, library=None if job.exact else _library())
+    doc, _ = envelope_doc(cf, f_p, exact=job.exact, library=None if job.exact else shared_library())
     return dumps(doc)
 
 
@@ -312,7 +320,7 @@ def _history(job: HistoryJob, blobs: list[bytes], limits: dict[str, Any]) -> byt
     scales = _scales(job.scales, limits)
     cf = _constants(_constants_source(job.constants, blobs), job.constants_label, limits)
     motion = motion_from_params(job.record, job.upload, _blob(blobs), limits)
-    _history_work(cf, motion, job.sf, limits, len(scales))
+    check_history_work(cf, motion, job.sf, limits, len(scales))
     return dumps(history_doc(cf, motion, scales, **history_options(job)))
 
 
@@ -438,7 +446,7 @@ def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes
         motion = motion_from_params(
             job.record, job.upload, _blob(blobs) if has_upload else None, limits
         )
-        _history_work(cf, motion, job.sf, limits, len(scales))
+        check_history_work(cf, motion, job.sf, limits, len(scales))
         check_record_work(motion, limits, t_min=SPECTRUM_PERIODS[0])
         if has_upload:
             rec_raw = _blob(blobs)
@@ -457,7 +465,7 @@ def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes
         title=job.title or "",
         sources=sources,
         request={k: getattr(job, k) for k in REPORT_KEYS},
-        library=None if job.exact else _library(),
+        library=None if job.exact else shared_library(),
     )
     return html.encode("utf-8")
 
@@ -541,7 +549,7 @@ def _warmup(job: WarmupJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes
     acc = 3.0 * np.sin(np.linspace(0.0, 6.0, 61))
     simulate_batch([model], SampledAccel(acc, 0.01), [1.0])
     response_spectrum(acc, 0.01, [0.5])
-    _library()
+    shared_library()
     return dumps({"ok": True})
 
 

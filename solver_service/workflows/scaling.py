@@ -23,6 +23,7 @@ __all__ = [
     "SF_METHODS",
     "Building",
     "dense_runs",
+    "factor_groups",
     "mechanism_scale_factor",
     "option_notes",
     "run_scaled",
@@ -127,7 +128,7 @@ def mechanism_scale_factor(
     )
 
 
-def _factor_groups(
+def factor_groups(
     cf: ConstantsFile, motion: Any, sf: str, building: Building
 ) -> tuple[dict[str, Any], dict[float, list[int]]]:
     """Scale-factor records per mechanism id, and the mechanisms (indices) per factor."""
@@ -166,7 +167,7 @@ def run_scaled(
         Which mechanisms (indices into ``cf.mechanisms``) each batch ran; the batch's
         ``scales`` are the effective ones (user scale times factor).
     """
-    factors, groups = _factor_groups(cf, motion, sf, building)
+    factors, groups = factor_groups(cf, motion, sf, building)
     batches = []
     for factor, members in groups.items():
         effective = [s * factor for s in scales]

@@ -61,12 +61,12 @@ from shared_schema.api import (
 from shared_schema.errors import InputError
 from solver_service.api.estimates import check_job
 from solver_service.api.jobs import (
-    _history_work,
-    _library,
+    check_history_work,
     check_record_work,
     check_spectra_work,
     history_options,
     motion_from_params,
+    shared_library,
 )
 from solver_service.api.jobspec import (
     AssessHtmlJob,
@@ -86,7 +86,7 @@ from solver_service.report.html import SPECTRUM_PERIODS
 from solver_service.workflows.assess import check_doc
 from solver_service.workflows.documents import frequency_grid
 from solver_service.workflows.limits import WORK_PER_SAMPLE
-from solver_service.workflows.scaling import _factor_groups
+from solver_service.workflows.scaling import factor_groups
 
 #: The server's ``ROCKMECH_MAX_SAMPLES`` (the test passes it in the environment).
 MAX_SAMPLES = int(os.environ["ROCKMECH_MAX_SAMPLES"])
@@ -193,7 +193,7 @@ def _work_ok(job: Any) -> bool:
         if isinstance(job, SpectrumJob):
             check_record_work(motion, LIMITS, t_min=job.t_min)
         else:
-            _history_work(job.constants, motion, job.sf, LIMITS, len(job.scales))
+            check_history_work(job.constants, motion, job.sf, LIMITS, len(job.scales))
             if isinstance(job, ReportJob):
                 check_record_work(motion, LIMITS, t_min=SPECTRUM_PERIODS[0])
     except InputError:
@@ -218,7 +218,7 @@ def _scale_factors_ok(job: Any) -> bool:
             if job.exact:
                 sf = pulse_scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
             else:
-                sf = _library().scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
+                sf = shared_library().scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
         except InputError:
             return False  # f_p/f_n below RATIO_MIN: the closed form's range, across fields
         if not np.all(np.isfinite(sf)):
@@ -255,7 +255,7 @@ def _amplitude_ok(job: Any, motion: Any) -> bool:
     """
     cf = job.constants
     try:
-        _, groups = _factor_groups(cf, motion, job.sf, history_options(job)["building"])
+        _, groups = factor_groups(cf, motion, job.sf, history_options(job)["building"])
     except InputError:
         return True  # the service refuses the options itself: the check sees its answer
     peak = float(np.max(np.abs(motion.accel.acc)))
