@@ -862,29 +862,36 @@ def _chatter_precheck(sides, rules, row, u0, a_max, j_max, t_left):
 
 
 @_inline
-def _bounded_impact(st, rules, lo, hi, thr_in, rate, thr_out, n):
-    """One impact of a sequence being closed, reached at a speed within ``[lo, hi]``.
+def _bounded_impact(st, sides, rules, row, u_lo, u_hi, z_lo, z_hi, rate, n):
+    """Bound the impact that ends a bounce on side ``row`` of a sequence being closed.
 
-    ``thr_in`` and ``thr_out`` are the rest speeds of the sides before and after it,
-    ``rate`` the ratio of the speeds leaving and reaching it, ``n`` the impacts counted so
-    far. Returns ``(done, u_lo, u_hi, n)``: the bounds on the speed leaving it and the count
-    with it; ``done`` is 1 when the sequence ends in rest here, 0 when it goes on, and -1
-    when a comparison of the event path (counted, ends in rest) differs at the two bounds or
-    the impact cap would be reached.
+    The bounce left at a speed within ``[u_lo, u_hi]`` and returns at ``u sqrt(1 + z)``,
+    ``z`` within ``[z_lo, z_hi]`` (``|z| <= 1/2``); ``rate`` is the ratio of the speeds
+    leaving and reaching the impact, ``n`` the impacts counted so far. Returns ``(done,
+    u_lo, u_hi, n, row)``: the bounds on the speed leaving it, the count with it and the
+    side it leaves on; ``done`` is 1 when the sequence ends in rest here, 0 when it goes
+    on, and -1 when a comparison of the event path (counted, ends in rest) differs at the
+    two bounds or the impact cap would be reached.
     """
+    # 1 + z/2 - z**2/2 <= sqrt(1 + z) <= 1 + z/2 for |z| <= 1/2.
+    hi = u_hi * (1.0 + 0.5 * z_hi) * (1.0 + CLOSE_MARGIN)
+    lo = u_lo * (1.0 + 0.5 * z_lo - 0.5 * z_lo * z_lo) * (1.0 - CLOSE_MARGIN)
+    row_new = row if rules[RULE_ONE_SIDED] != 0.0 else 1 - row
+    thr_in = rules[RULE_V_REST] * sides[row, SIDE_P]
+    thr_out = rules[RULE_V_REST] * sides[row_new, SIDE_P]
     counted = hi >= thr_in
     u_hi = rate * hi * (1.0 + CLOSE_MARGIN)
     u_lo = rate * lo * (1.0 - CLOSE_MARGIN)
     rests = u_hi < thr_out
     if counted != (lo >= thr_in) or rests != (u_lo < thr_out):
-        return -1, u_lo, u_hi, n
+        return -1, u_lo, u_hi, n, row_new
     if counted:
         n += 1
     if not rests:
-        return 0, u_lo, u_hi, n
+        return 0, u_lo, u_hi, n, row_new
     if st[OUT_N_IMPACTS] + n >= rules[RULE_MAX_IMPACTS]:
-        return -1, u_lo, u_hi, n
-    return 1, u_lo, u_hi, n
+        return -1, u_lo, u_hi, n, row_new
+    return 1, u_lo, u_hi, n, row_new
 
 
 #: The cell-wide bounds take over a closed chattering sequence once they widen its speed
@@ -912,7 +919,6 @@ def _chatter_tail(st, sides, rules, a_max, slope, row, u_lo, u_hi, t_left):
     returns at ``u sqrt(1 + z)``, ``|z| <= g u`` (``_tail_gain``): no division per bounce.
     ``t_left`` is the time left in the cell [s]. Returns the impacts still counted, or -1.
     """
-    one_sided = rules[RULE_ONE_SIDED] != 0.0
     top = min(st[OUT_PEAK], 1.0) - BOUND_MARGIN
     d_0 = 1.0 - sides[0, SIDE_KS] * a_max
     d_1 = 1.0 - sides[1, SIDE_KS] * a_max
@@ -920,8 +926,6 @@ def _chatter_tail(st, sides, rules, a_max, slope, row, u_lo, u_hi, t_left):
     inv_1 = 1.0 / (sides[1, SIDE_P] * sides[1, SIDE_P] * d_1)
     g_0 = _tail_gain(sides, 0, a_max, slope)
     g_1 = _tail_gain(sides, 1, a_max, slope)
-    thr_0 = rules[RULE_V_REST] * sides[0, SIDE_P]
-    thr_1 = rules[RULE_V_REST] * sides[1, SIDE_P]
     rate_0 = _chatter_rate(rules, sides, 0)
     rate_1 = _chatter_rate(rules, sides, 1)
     n = 0
@@ -935,16 +939,12 @@ def _chatter_tail(st, sides, rules, a_max, slope, row, u_lo, u_hi, t_left):
             return -1
         if not (elapsed <= t_left and z <= 0.5):
             return -1
-        hi = u_hi * (1.0 + 0.5 * z) * (1.0 + CLOSE_MARGIN)
-        lo = u_lo * (1.0 - 0.5 * z - 0.5 * z * z) * (1.0 - CLOSE_MARGIN)
-        row_new = row if one_sided else 1 - row
-        thr_in = thr_0 if row == 0 else thr_1
-        thr_out = thr_0 if row_new == 0 else thr_1
         rate = rate_0 if row == 0 else rate_1
-        done, u_lo, u_hi, n = _bounded_impact(st, rules, lo, hi, thr_in, rate, thr_out, n)
+        done, u_lo, u_hi, n, row = _bounded_impact(
+            st, sides, rules, row, u_lo, u_hi, -z, z, rate, n
+        )
         if done != 0:
             return n if done > 0 else -1
-        row = row_new
     return -1
 
 
@@ -978,7 +978,6 @@ def _chatter_count(st, cell, sides, rules, t, s, u0):
     row = _side(s)
     if not _chatter_precheck(sides, rules, row, u0, a_max, abs(cell[2]), t_left):
         return -1
-    one_sided = rules[RULE_ONE_SIDED] != 0.0
     top = min(st[OUT_PEAK], 1.0) - BOUND_MARGIN
     u_hi = u0 * (1.0 + CLOSE_MARGIN)
     u_lo = u0 * (1.0 - CLOSE_MARGIN)
@@ -1022,18 +1021,12 @@ def _chatter_count(st, cell, sides, rules, t, s, u0):
         z_lo = k * u_lo * (inv_max * inv_max if k > 0.0 else inv_min * inv_min)
         if not (abs(z_hi) <= 0.5 and abs(z_lo) <= 0.5):
             return -1
-        # Speeds reaching the impact that ends this bounce: u sqrt(1 + z), with
-        # 1 + z/2 - z**2/2 <= sqrt(1 + z) <= 1 + z/2 for |z| <= 1/2.
-        hi = u_hi * (1.0 + 0.5 * z_hi) * (1.0 + CLOSE_MARGIN)
-        lo = u_lo * (1.0 + 0.5 * z_lo - 0.5 * z_lo * z_lo) * (1.0 - CLOSE_MARGIN)
-        row_new = row if one_sided else 1 - row
-        thr_in = rules[RULE_V_REST] * p
-        thr_out = rules[RULE_V_REST] * sides[row_new, SIDE_P]
         rate = rate_0 if row == 0 else rate_1
-        done, u_lo, u_hi, n = _bounded_impact(st, rules, lo, hi, thr_in, rate, thr_out, n)
+        done, u_lo, u_hi, n, row = _bounded_impact(
+            st, sides, rules, row, u_lo, u_hi, z_lo, z_hi, rate, n
+        )
         if done != 0:
             return n if done > 0 else -1
-        row = row_new
     return -1
 
 
