@@ -21,7 +21,7 @@ WORKDIR /app
 # created empty for that install and removed after it. Versions come from pyproject.toml's
 # ranges (ghhops-server is pinned there), hence no pins on this line.
 COPY pyproject.toml README.md LICENSE ./
-COPY rockmech/_version.py ./rockmech/_version.py
+COPY shared_schema/version.py ./shared_schema/version.py
 # hadolint ignore=DL3013
 RUN python -c "import pathlib, tomllib; t = tomllib.load(open('pyproject.toml', 'rb'))['tool']['setuptools']; [pathlib.Path(t['package-dir'].get(p, p.replace('.', '/'))).mkdir(parents=True, exist_ok=True) for p in t['packages']]" \
     && pip install ".[${EXTRAS}]" \

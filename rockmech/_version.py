@@ -1,7 +1,5 @@
-"""The version of rockmech: the one place it is written (pyproject.toml reads it from here).
+"""The version of rockmech (written once, in ``shared_schema.version``)."""
 
-The Rhino package files keep copies that tools read as text (``rhino_plugin/manifest.yml``,
-``rhino_plugin/rockmech.rhproj``); a test checks that they agree with this one.
-"""
+from shared_schema.version import __version__
 
-__version__ = "0.1.0"
+__all__ = ["__version__"]

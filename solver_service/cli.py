@@ -23,12 +23,12 @@ import typer
 from typer.core import TyperGroup, TyperOption
 
 from rhino_plugin.mechanisms.build import MechanismFailure
-from rockmech._version import __version__
 from shared_schema.atomic import remove_stale_temps
 from shared_schema.errors import RockmechError
 from shared_schema.extras import MissingExtra, extra_for, require
 from shared_schema.io import save_constants
 from shared_schema.rules import CRITERIA, PULSE_SHAPES, RECORD_FORMATS, RECORD_UNITS, SF_METHODS
+from shared_schema.version import __version__
 
 from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
 from .core.model import check_positive
@@ -174,6 +174,11 @@ def _fail(message: str) -> NoReturn:
 def _note(message: str) -> None:
     """Print a warning or note on stderr, so that stdout holds only results."""
     typer.echo(message, err=True)
+
+
+def _out_note(message: str) -> None:
+    """Print a note about the output folder (a swap ended for a killed run, a file kept)."""
+    _note(f"note: {message}")
 
 
 def _skipped_notes(doc: dict[str, Any]) -> None:
@@ -519,7 +524,7 @@ def history(
     runs = len(scales) * len(cf.mechanisms)
     with _status(f"history: {runs} runs of {motion.name}"):
         if out is not None:
-            with run_folder(out) as tmp:
+            with run_folder(out, on_note=_out_note) as tmp:
                 doc = write_history(cf, motion, scales, tmp, **options)
         else:
             doc = history_doc(cf, motion, scales, **options)
@@ -594,7 +599,7 @@ def record_info(
             motion, periods, zeta, n_pulses=pulses, f_min=f_min, f_max=f_max
         )
     if out is not None:
-        with run_folder(out) as tmp:
+        with run_folder(out, on_note=_out_note) as tmp:
             write_record(motion, doc, spectrum, found, tmp)
     if as_json:
         _print_json(doc)
@@ -728,7 +733,7 @@ def ida(
             jobs=jobs,
         )
     if out is not None:
-        with run_folder(out) as tmp:
+        with run_folder(out, on_note=_out_note) as tmp:
             write_ida(doc, tmp, title=f"Fragility: {constants.name}")
     _skipped_notes(doc)
     if as_json:
@@ -872,7 +877,7 @@ def envelope(
     kind = "exact envelopes" if exact else "envelopes"
     with (
         _status(f"{kind}: {len(cf.mechanisms)} mechanisms x {n} frequencies"),
-        run_folder(out) as tmp,
+        run_folder(out, on_note=_out_note) as tmp,
     ):
         doc = write_envelope(
             cf,
@@ -982,7 +987,7 @@ def demo(
     ),
 ) -> None:
     """Run the bundled example: rectangular walls on El Centro 1940, exact integration."""
-    with run_folder(out) as tmp:
+    with run_folder(out, on_note=_out_note) as tmp:
         written = run_demo(tmp, record, on_skip=lambda note: _note(f"note: {note}"))
     paths = {kind: out / path.relative_to(tmp) for kind, path in written.items()}
     for kind, path in paths.items():

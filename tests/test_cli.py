@@ -836,7 +836,12 @@ def test_full_disk_and_permission_errors_are_one_line(
     monkeypatch.setattr(outputs, "write_atomic", full)
     res = runner.invoke(app, _writing_commands(tmp_path / "ida")["ida"])
     assert res.exit_code == 2 and "the disk is full" in res.stderr.splitlines()[-1], res.output
-    assert sorted(p.name for p in tmp_path.iterdir()) == []  # no half run, no temp folder
+    # No half run and no stage left: the folder holds only rockmech's lock.
+    assert [str(p.relative_to(tmp_path)) for p in sorted(tmp_path.rglob("*"))] == [
+        "ida",
+        "ida/.rockmech",
+        "ida/.rockmech/lock",
+    ]
 
     def denied(path: object, data: object) -> None:
         raise PermissionError(errno.EACCES, "Permission denied", str(path))
@@ -849,7 +854,7 @@ def test_full_disk_and_permission_errors_are_one_line(
     assert res.stderr.strip() == f"error: out: {tmp_path / 'c.json'}: permission denied"
 
 
-def test_a_run_killed_mid_write_leaves_the_old_run_whole(
+def test_a_run_stopped_mid_write_leaves_the_old_run_whole(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     from solver_service.workflows import outputs
@@ -857,8 +862,8 @@ def test_a_run_killed_mid_write_leaves_the_old_run_whole(
     out = tmp_path / "run"
     argv = ["history", str(WALLS), str(RECORD), "--scale", "0.5", "--out", str(out)]
     assert runner.invoke(app, argv).exit_code == 0
-    (out / "note.txt").write_text("from the old run")
-    old = {p.name: p.read_bytes() for p in out.iterdir()}
+    (out / "note.txt").write_text("the user's own")
+    old = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
 
     def killed(*args: object, **kwargs: object) -> None:
         raise KeyboardInterrupt  # the JSON and one plot are written, the record plot is not
@@ -867,27 +872,26 @@ def test_a_run_killed_mid_write_leaves_the_old_run_whole(
     res = runner.invoke(app, [*argv[:-3], "1", "2", "--out", str(out)])
     assert isinstance(res.exception, KeyboardInterrupt) or res.exit_code != 0
     monkeypatch.undo()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]  # no temp folder left
-    assert {p.name: p.read_bytes() for p in out.iterdir()} == old
-
-    # A run whose process died mid-write left its folder: the next run removes it, and
-    # replaces the old run whole (the old run's stray file goes with it).
-    dead = subprocess.run(
-        [sys.executable, "-c", "import os; print(os.getpid())"],
-        capture_output=True,
-        text=True,
-        check=True,
-    )
-    stale = tmp_path / f".run.{int(dead.stdout)}.tmp"
-    stale.mkdir()
-    (stale / ".history.json.abc.tmp").write_text("half")
-    assert runner.invoke(app, argv).exit_code == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]
+    assert sorted(p.name for p in (out / ".rockmech").iterdir()) == ["lock", "manifest.json"]
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == old
+
+    # A run whose process died mid-write left its stage: the next run removes it and
+    # replaces its own outputs; the user's file stays.
+    stale = out / ".rockmech" / "stage-1-dead"
+    stale.mkdir()
+    (stale / ".lock").write_bytes(b"")
+    (stale / "history.json").write_text("half")
+    assert runner.invoke(app, argv).exit_code == 0
     assert sorted(p.name for p in out.iterdir()) == [
+        ".rockmech",
         "history.json",
         "history.png",
         "history_record.png",
+        "note.txt",
     ]
+    assert (out / "note.txt").read_text() == "the user's own"
+    assert sorted(p.name for p in (out / ".rockmech").iterdir()) == ["lock", "manifest.json"]
 
 
 def test_size_limits_name_the_option_and_no_limits_lifts_them(

@@ -110,7 +110,7 @@ def test_version_is_written_once_and_the_rhino_copies_agree() -> None:
     project = PYPROJECT["project"]
     assert "version" not in project and project["dynamic"] == ["version"]
     attr = PYPROJECT["tool"]["setuptools"]["dynamic"]["version"]["attr"]
-    assert attr == "rockmech._version.__version__"
+    assert attr == "shared_schema.version.__version__"
     version = rockmech.__version__
     assert version.count(".") == 2 and all(p.isdigit() for p in version.split("."))
     rhproj = json.loads((ROOT / "rhino_plugin" / "rockmech.rhproj").read_text())

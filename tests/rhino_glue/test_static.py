@@ -261,10 +261,10 @@ def test_constants_under_a_real_python_39(cli_constants: Any) -> None:
 
 def _project_version() -> str:
     # The one source of the version (pyproject.toml reads it from there too).
-    for line in (ROOT / "rockmech" / "_version.py").read_text().splitlines():
+    for line in (ROOT / "shared_schema" / "version.py").read_text().splitlines():
         if line.startswith("__version__ = "):
             return line.split('"')[1]
-    raise AssertionError("no __version__ in rockmech/_version.py")
+    raise AssertionError("no __version__ in shared_schema/version.py")
 
 
 def test_rhproj_lists_every_command_and_the_libraries() -> None:
