@@ -20,7 +20,7 @@ demo: $(STAMP)
 
 ## The whole test suite: lint, format check, types, schema drift, then pytest.
 test: lint typecheck schema
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n auto
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
