@@ -245,12 +245,14 @@ def _status(message: str) -> Iterator[None]:
         yield
 
 
+def _record_warning(note: str) -> None:
+    """Print a record's warning (``read_record``'s ``on_warning``) on stderr."""
+    _note(f"warning: record: {note}")
+
+
 def _read_record(path: Path, *args: Any) -> GroundMotion:
     """Read a record as every command does, with its warnings on stderr."""
-    motion = read_record(path, *args)
-    for note in motion.warnings:
-        _note(f"warning: record: {note}")
-    return motion
+    return read_record(path, *args, on_warning=_record_warning)
 
 
 def _choices(values: Iterable[str]) -> str:
@@ -702,7 +704,8 @@ def ida(
         check_folder_target(out)
     cf = read_constants(constants)
     motions = [_read_record(p, record_format, units, dt, channel, component) for p in records or []]
-    motions += [spec.read() for spec in (read_record_spec(record_spec) if record_spec else [])]
+    specs = read_record_spec(record_spec) if record_spec else []
+    motions += [spec.read(on_warning=_record_warning) for spec in specs]
     if not motions:
         _fail("records: give record files or --record-spec")
     _limit(no_limits, cf, scales=len(levels), record=_record_size(motions), records=len(motions))
@@ -1178,7 +1181,7 @@ def assess(
     multiple = check_multiples(multiple)
     check_file_target(out)
     cf, site_file = read_constants(constants), read_site(site)
-    motions = [read_record(r, record_format, units, dt) for r in record]
+    motions = [_read_record(r, record_format, units, dt) for r in record]
     sources = [
         input_source("constants", constants.name, constants.read_bytes()),
         input_source("site", site.name, site.read_bytes()),

@@ -487,7 +487,9 @@ def _assess_inputs(job: AssessJob | AssessHtmlJob, limits: dict[str, Any]) -> tu
         try:
             motions.append(motion_from_params(record, None, None, limits))
         except InputError as exc:
-            raise InputError(str(exc), f"records[{i}]") from None
+            # the samples' own field: a sample beyond ACCEL_MAX_G is records[i].accel
+            part = {None: "", "record": ".accel"}.get(exc.field, f".{exc.field}")
+            raise InputError(exc.reason, f"records[{i}]{part}") from None
     check_spectra_work(cf, check_doc(cf, job.site)["mechanisms"], motions, limits)
     return cf, motions
 

@@ -399,7 +399,8 @@ def assessment_doc(
     Returns
     -------
     dict
-        ``check_doc``'s keys and ``records``; each mechanism row gains ``dynamics`` (per
+        ``check_doc``'s keys and ``records`` (name, PGA, dt, duration and, where there
+        are any, the record's ``warnings``); each mechanism row gains ``dynamics`` (per
         record: the design scale factor and band, per multiple the peak ratio and verdict,
         the first multiple that overturns, ``survives_design``) and ``envelope`` (the
         envelope and each record's largest pulse at design scale with the margin
@@ -430,8 +431,16 @@ def assessment_doc(
                 dyn.append({"record": motion.name, "note": f"not run: {exc}"})
         row["dynamics"] = dyn
         row["envelope"] = _envelope_margin(mech, motions, designs, freq)
+    # a record's warnings (implausible PGA or time step, naming the units read) go with it
     doc["records"] = [
-        {"name": m.name, "pga_g": m.pga_g, "dt": m.dt, "duration": m.duration} for m in motions
+        {
+            "name": m.name,
+            "pga_g": m.pga_g,
+            "dt": m.dt,
+            "duration": m.duration,
+            **({"warnings": m.warnings} if m.warnings else {}),
+        }
+        for m in motions
     ]
     doc["multiples"] = list(multiples)
     return doc

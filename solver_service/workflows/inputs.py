@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional, Union
@@ -44,8 +45,15 @@ def read_record(
     dt: Optional[float] = None,
     channel: Union[int, str, None] = None,
     component: Optional[str] = None,
+    *,
+    on_warning: Optional[Callable[[str], None]] = None,
 ) -> GroundMotion:
     """Read a record as ``rockmech`` does: format detected, a two-column file in g by default.
+
+    The one place every front end reads a record file: each warning of the record (an
+    implausible PGA or time step naming the units read, a shifted time axis, a header that
+    could not be checked) is passed to ``on_warning`` as it is read, and stays in
+    ``motion.warnings`` for the documents.
 
     Parameters
     ----------
@@ -55,13 +63,19 @@ def read_record(
         As ``GroundMotion.from_file``; ``units`` defaults to g for a two-column file (the
         t [s], a [g] convention of the bundled record); ``channel`` or ``component`` choose
         one channel of a file with several (DMG V2, GeoNet V2A).
+    on_warning : callable, optional
+        Called with each warning (the CLI prints ``warning: record: ...`` on stderr).
     """
     fmt = fmt or detect_format(path)
     if units is None and fmt == "two_column":
         units = "g"
-    return GroundMotion.from_file(
+    motion = GroundMotion.from_file(
         path, format=fmt, units=units, dt=dt, channel=channel, component=component
     )
+    if on_warning is not None:
+        for note in motion.warnings:
+            on_warning(note)
+    return motion
 
 
 @dataclass(frozen=True)
@@ -75,10 +89,16 @@ class RecordSpec:
     channel: Optional[str] = None
     component: Optional[str] = None
 
-    def read(self) -> GroundMotion:
-        """Read the record (``read_record``)."""
+    def read(self, on_warning: Optional[Callable[[str], None]] = None) -> GroundMotion:
+        """Read the record (``read_record``; its warnings to ``on_warning``)."""
         return read_record(
-            self.file, self.format, self.units, self.dt, self.channel, self.component
+            self.file,
+            self.format,
+            self.units,
+            self.dt,
+            self.channel,
+            self.component,
+            on_warning=on_warning,
         )
 
 

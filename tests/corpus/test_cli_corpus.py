@@ -67,6 +67,8 @@ RECORD_FILES: dict[str, Any] = {
     ),
     "one_column.txt": "\n".join(f"{a:.6e}" for a in A_G) + "\n",
     "bad.csv": "t,a\n0,0.1\n0.01,abc\n",
+    # a record in g listed as cm/s2 (#25: the warning reaches every command)
+    "spec_cm.csv": "file,units\ngood.dat,cm/s2\n",
 }
 
 #: Constants files (JSON text) written into the case's folder.
@@ -276,7 +278,7 @@ def _cases() -> list[Case]:
 
     hist = ["history", "{c:ok.json}", "{r:good.dat}"]
     for name in RECORD_FILES:
-        if name == "good.dat":
+        if name in ("good.dat", "spec_cm.csv"):
             continue
         expect, fld, problem, xf = "error", "", ".", ""
         if name in ("tiny_g.dat", "huge_g.dat", "coarse_dt.dat"):
@@ -609,6 +611,23 @@ def _cases() -> list[Case]:
             r"\(0, 100\], got -1",
         ),
         Case(
+            # #25: a record in g read as cm/s2 gets the warning history gives, naming the units
+            "assess-record-in-g-read-as-cm-s2",
+            ["assess", "{c:ok.json}", str(SITE), "--record", "{r:good.dat}"]
+            + ["--units", "cm/s2", "-o", "{tmp}/a.html", "--multiple", "1"],
+            "warn",
+            "",
+            r"warning: record: PGA 0\.000306 g is outside the plausible range .*"
+            r"\(read in cm/s2\); check the units",
+        ),
+        Case(
+            "ida-record-spec-in-g-read-as-cm-s2",
+            ["ida", "{c:ok.json}", "--record-spec", "{r:spec_cm.csv}", "--scales", "1"],
+            "warn",
+            "",
+            r"warning: record: PGA 0\.000306 g is outside .*\(read in cm/s2\)",
+        ),
+        Case(
             "assess-multiple-too-many",
             ["assess", str(CHURCH_GEOMETRY), str(SITE), "-o", "{tmp}/a.html"]
             + [a for k in range(9) for a in ("--multiple", str(k + 1))],
@@ -681,6 +700,9 @@ def _compiled_kernels(tmp_path_factory: pytest.TempPathFactory) -> None:
         ["history", "{c:ok.json}", "{r:good.dat}", "--json"],
         ["record", "{r:good.dat}", "--json", "--n", "5"],
         ["envelope", "{c:ok.json}", "--out", "{tmp}/env", "--n", "5", "--exact"],
+        # the report's imports (jinja2, matplotlib) load once here, not in a timed case
+        ["assess", "{c:ok.json}", str(SITE), "--record", "{r:good.dat}", "-o", "{tmp}/a.html"]
+        + ["--multiple", "1"],
     ):
         res = runner.invoke(app, _materialise(argv, tmp))
         assert res.exit_code == 0, res.output
