@@ -613,8 +613,10 @@ def _cases() -> list[Case]:
         Case(
             # #25: a record in g read as cm/s2 gets the warning history gives, naming the units
             "assess-record-in-g-read-as-cm-s2",
-            ["assess", "{c:ok.json}", str(SITE), "--record", "{r:good.dat}"]
-            + ["--units", "cm/s2", "-o", "{tmp}/a.html", "--multiple", "1"],
+            [
+                *("assess", "{c:ok.json}", str(SITE), "--record", "{r:good.dat}"),
+                *("--units", "cm/s2", "-o", "{tmp}/a.html", "--multiple", "1"),
+            ],
             "warn",
             "",
             r"warning: record: PGA 0\.000306 g is outside the plausible range .*"
@@ -701,8 +703,10 @@ def _compiled_kernels(tmp_path_factory: pytest.TempPathFactory) -> None:
         ["record", "{r:good.dat}", "--json", "--n", "5"],
         ["envelope", "{c:ok.json}", "--out", "{tmp}/env", "--n", "5", "--exact"],
         # the report's imports (jinja2, matplotlib) load once here, not in a timed case
-        ["assess", "{c:ok.json}", str(SITE), "--record", "{r:good.dat}", "-o", "{tmp}/a.html"]
-        + ["--multiple", "1"],
+        [
+            *("assess", "{c:ok.json}", str(SITE), "--record", "{r:good.dat}"),
+            *("-o", "{tmp}/a.html", "--multiple", "1"),
+        ],
     ):
         res = runner.invoke(app, _materialise(argv, tmp))
         assert res.exit_code == 0, res.output
