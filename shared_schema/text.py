@@ -14,11 +14,12 @@ Python 3.9-clean, no third-party imports (every floor may import it).
 """
 
 import codecs
+import re
 from typing import Optional, Tuple
 
 from shared_schema.errors import InputError
 
-__all__ = ["BINARY_SIGNATURES", "decode_text", "empty_problem"]
+__all__ = ["BINARY_SIGNATURES", "decimal_point", "decode_text", "delimiter_of", "empty_problem"]
 
 #: Start of a file -> what it most likely is, for the message on a binary file.
 BINARY_SIGNATURES: Tuple[Tuple[bytes, str], ...] = (
@@ -31,6 +32,7 @@ BINARY_SIGNATURES: Tuple[Tuple[bytes, str], ...] = (
     (b"\xff\xd8\xff", "a JPEG image"),
     (b"3D Geometry File Format", "a Rhino .3dm model"),
 )
+_DECIMAL_COMMA = re.compile(r"[-+]?\d*,\d+(?:[EeDd][-+]?\d+)?")
 #: Byte-order marks read, longest first (a UTF-32 LE mark starts with the UTF-16 LE one).
 _BOMS = (
     (codecs.BOM_UTF32_LE, "utf-32-le"),
@@ -136,3 +138,35 @@ def _not_text(raw: bytes, at: int, name: str, what: str, hint: str) -> str:
         f"does not allow (the file is in another encoding, such as Windows-1252): expected "
         f"{what}; save it again as UTF-8 text"
     )
+
+
+def delimiter_of(first_row: str) -> str:
+    r"""Return the cell separator of a delimited text file from its first (header) row.
+
+    A comma, unless the row has a semicolon (a European spreadsheet's CSV, which writes
+    decimal commas) or a tab (Excel's "Unicode Text") and no comma: neither is ever part of
+    a number or of a comma-separated header.
+
+    Examples
+    --------
+    >>> delimiter_of("t [s];acc [g]"), delimiter_of("id\tp_eq"), delimiter_of("t,a")
+    (';', '\t', ',')
+    """
+    if "," not in first_row:
+        for sep in (";", "\t"):
+            if sep in first_row:
+                return sep
+    return ";" if ";" in first_row else ","
+
+
+def decimal_point(cell: str) -> str:
+    """Return a cell with a decimal comma (``"0,01"``) written with a point; others as is.
+
+    Only for files whose cells a semicolon separates (see :func:`delimiter_of`).
+
+    Examples
+    --------
+    >>> decimal_point("-2,5e-01"), decimal_point("W1"), decimal_point("1.5")
+    ('-2.5e-01', 'W1', '1.5')
+    """
+    return cell.replace(",", ".") if _DECIMAL_COMMA.fullmatch(cell.strip()) else cell

@@ -51,7 +51,7 @@ from shared_schema.rules import (
     accel_max,
     check_file,
 )
-from shared_schema.text import decode_text
+from shared_schema.text import decimal_point, decode_text, delimiter_of
 
 from .excitation import SampledAccel, check_finite_samples
 from .formats import READERS, Channel, channel_list, select_channel
@@ -109,7 +109,6 @@ _UNITS_HINT = "give units: " + ", ".join(list(RECORD_UNITS)[:-1]) + f" or {list(
 #: Units of a time column a CSV header may name; only seconds are read.
 _SECONDS = {"s", "sec", "secs", "second", "seconds"}
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?"
-_DECIMAL_COMMA = re.compile(r"[-+]?\d*,\d+(?:[EeDd][-+]?\d+)?")
 _DATE = re.compile(r"\d{1,2}/\d{1,2}/\d{2,4}")
 
 PathLike = Union[str, Path]
@@ -697,11 +696,11 @@ class GroundMotion:
         if not lines:
             raise InputError(f"{p.name}: needs at least 2 samples, got 0", "record")
         # A CSV from a European spreadsheet separates cells with ';' and may write decimal
-        # commas; a ';' is never part of a number or of a comma-separated header.
-        delimiter = ";" if ";" in lines[0][2] else ","
+        # commas (shared_schema.text.delimiter_of).
+        delimiter = delimiter_of(lines[0][2])
         rows = [(n, raw, next(csv.reader([ln], delimiter=delimiter))) for n, raw, ln in lines]
         if delimiter == ";":
-            rows = [(n, raw, [_decimal_point(c) for c in cells]) for n, raw, cells in rows]
+            rows = [(n, raw, [decimal_point(c) for c in cells]) for n, raw, cells in rows]
         first = [c.strip() for c in rows[0][2]]
         try:
             [float(c) for c in first]
@@ -773,11 +772,6 @@ class GroundMotion:
         }
         meta.update(_time_origin(t0, p.name))
         return cls(_sampled(a, units, dt, p.name), p.stem, meta)
-
-
-def _decimal_point(cell: str) -> str:
-    """``"0,01"`` -> ``"0.01"`` (a decimal comma, in a ';'-separated CSV); other cells as is."""
-    return cell.replace(",", ".") if _DECIMAL_COMMA.fullmatch(cell.strip()) else cell
 
 
 def _time_origin(t0: float, name: str) -> dict[str, Any]:

@@ -11,6 +11,9 @@ with the issue class, so that each flips to a failure of the marker once fixed.
 
 from __future__ import annotations
 
+import csv
+import functools
+import io
 import json
 import re
 from pathlib import Path
@@ -100,6 +103,47 @@ CONSTANTS_FILES: dict[str, Any] = {
     "amp_bad.json": json.dumps(
         {"mechanisms": [{**_W, "amplification": {"f_n": -1.0, "h_e": 4.0, "h": 3.0}}]}
     ),
+}
+
+
+WALLS_CSV = (EXAMPLES / "constants" / "walls.csv").read_text(encoding="utf-8")
+
+
+def _semicolon(text: str) -> str:
+    """The table as a European spreadsheet writes it: ';' between cells, decimal commas."""
+    rows = list(csv.reader(io.StringIO(text)))
+    out = io.StringIO()
+    writer = csv.writer(out, delimiter=";", lineterminator="\n")
+    for row in rows:
+        writer.writerow([c.replace(".", ",") if re.fullmatch(r"-?\d+\.\d+", c) else c for c in row])
+    return out.getvalue()
+
+
+@functools.cache
+def _workbook(notes_first: bool) -> bytes:
+    """walls.csv as an .xlsx workbook; with ``notes_first`` the table is on sheet 2."""
+    import openpyxl  # the tables extra, part of the dev install
+
+    book = openpyxl.Workbook()
+    sheet = book.active
+    if notes_first:
+        sheet.title = "Notes"
+        sheet.append(["Walls of the church, from the 2024 survey"])
+        sheet = book.create_sheet("Walls")
+    for row in csv.reader(io.StringIO(WALLS_CSV)):
+        sheet.append([float(c) if re.fullmatch(r"-?\d+(\.\d+)?", c) else (c or None) for c in row])
+    out = io.BytesIO()
+    book.save(out)
+    return out.getvalue()
+
+
+#: Constants tables written into the case's folder: name -> text, bytes or a maker of bytes.
+TABLE_FILES: dict[str, Any] = {
+    "walls_utf16.csv": WALLS_CSV.encode("utf-16"),
+    "walls_semicolon.csv": _semicolon(WALLS_CSV),
+    "walls_empty.csv": "",
+    "walls_sheet2.xlsx": lambda: _workbook(True),
+    "walls_xlsx_named.csv": lambda: _workbook(False),
 }
 
 
@@ -566,6 +610,37 @@ def _cases() -> list[Case]:
             r"> 0",
         ),
     ]
+    table = ["constants-table", "-o", "{tmp}/t.json"]
+    cases += [
+        # #25: a UTF-16 table (was a traceback), a European CSV, empty and binary tables, and
+        # a workbook whose table is on its second sheet
+        *(
+            Case(f"table-{k}", [*table, f"{{c:walls_{k}.csv}}"], "ok", check=_four_mechanisms)
+            for k in ("utf16", "semicolon")
+        ),
+        Case(
+            "table-empty",
+            [*table, "{c:walls_empty.csv}"],
+            "error",
+            "table",
+            r"walls_empty\.csv is empty \(0 bytes\): expected a constants table as CSV text",
+        ),
+        Case(
+            "table-workbook-named-csv",
+            [*table, "{c:walls_xlsx_named.csv}"],
+            "error",
+            "table",
+            r"is not a text file \(it starts like .*Excel .*name it \.xlsx",
+        ),
+        Case(
+            "table-on-sheet-2",
+            [*table, "{c:walls_sheet2.xlsx}"],
+            "error",
+            "table",
+            r"sheet 1 'Notes' has no header row naming an 'id' column, and sheet 2 'Walls' has "
+            r"one: move 'Walls' to the front",
+        ),
+    ]
     cases += [
         Case(
             "constants-missing-scene",
@@ -669,6 +744,11 @@ def _cases() -> list[Case]:
     return cases
 
 
+def _four_mechanisms(out: Any) -> bool:
+    """``constants-table`` read walls.csv's four mechanisms."""
+    return "4 mechanism(s)" in str(out)
+
+
 CASES = _cases()
 
 
@@ -679,8 +759,9 @@ def _materialise(argv: list[str], tmp: Path) -> list[str]:
             path.write_bytes(text)
         else:
             path.write_text(text)
-    for name, text in CONSTANTS_FILES.items():
+    for name, text in {**CONSTANTS_FILES, **TABLE_FILES}.items():
         path = tmp / name
+        text = text() if callable(text) else text
         if isinstance(text, bytes):
             path.write_bytes(text)
         else:
