@@ -21,6 +21,7 @@ from shared_schema.errors import InputError
 from shared_schema.io import load_constants
 from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, check_file, check_positive
 from shared_schema.spec import parse_spec
+from shared_schema.text import decode_text
 
 from ..core.records import GroundMotion, detect_format
 from .tables import constants_from_table, is_table
@@ -34,6 +35,8 @@ __all__ = [
     "read_record_spec",
 ]
 
+#: What a record-spec file must be, for the messages on empty or binary files.
+RECORD_SPEC_EXPECTED = "a list of records (CSV with a header row 'file,format,units,...', or JSON)"
 #: Columns (CSV) or keys (JSON) of a record-spec file; only ``file`` is required.
 SPEC_FIELDS = ("file", "format", "units", "dt", "channel", "component")
 
@@ -145,7 +148,8 @@ def read_record_spec(path: Path) -> list[RecordSpec]:
         number, or an unknown format or units; the message names the row and the column.
     """
     check_file(path, "record_spec")
-    rows = _spec_rows(path, path.read_text(encoding="utf-8"))
+    text = decode_text(path.read_bytes(), path.name, "record_spec", RECORD_SPEC_EXPECTED)
+    rows = _spec_rows(path, text)
     if not rows:
         raise InputError(f"{path.name} lists no records", "record_spec")
     specs = []
@@ -200,10 +204,15 @@ def read_constants(path: Path) -> ConstantsFile:
     return load_constants(path)
 
 
+#: What a mechanism spec must be, for the messages on empty, binary or non-JSON files.
+SPEC_EXPECTED = 'a mechanism spec (JSON, {"mechanisms": [...]})'
+
+
 def _spec_and_scene(scene: Path, spec: Path, units: Optional[str]) -> tuple[Any, Any]:
     for label, path in (("scene", scene), ("spec", spec)):
         check_file(path, label)
-    return parse_spec(spec.read_bytes(), spec.name), read_scene(scene, units=units)
+    text = decode_text(spec.read_bytes(), spec.name, "spec", SPEC_EXPECTED)
+    return parse_spec(text, spec.name), read_scene(scene, units=units)
 
 
 def constants_from_files(scene: Path, spec: Path, units: Optional[str] = None) -> ConstantsFile:

@@ -33,6 +33,7 @@ RECT = EXAMPLES / "constants" / "rect_walls.json"
 CHURCH = EXAMPLES / "constants" / "church.json"
 CHURCH_GEOMETRY = EXAMPLES / "constants" / "church_geometry.json"
 SITE = EXAMPLES / "sites" / "ntc_site.json"
+SCENE = EXAMPLES / "scenes" / "rect_wall.3dm"
 runner = CliRunner()
 
 
@@ -100,6 +101,8 @@ CONSTANTS_FILES: dict[str, Any] = {
     "rocking_bad.json": json.dumps({"mechanisms": [{**_W, "rocking": "three_sided"}]}),
     "no_eta.json": json.dumps({"mechanisms": [{k: v for k, v in _W.items() if k != "eta"}]}),
     "utf16.json": json.dumps({"mechanisms": [_W]}).encode("utf-16"),
+    "empty.json": "",
+    "binary.json": bytes(range(256)) * 4,
     "amp_bad.json": json.dumps(
         {"mechanisms": [{**_W, "amplification": {"f_n": -1.0, "h_e": 4.0, "h": 3.0}}]}
     ),
@@ -455,6 +458,15 @@ def _cases() -> list[Case]:
             fld, problem = "eta", "restitution|needs|eta"
         if name == "p_huge.json":
             fld, problem = "p_eq", "range|<=|at most|too"
+        # #25: a file's encoding and emptiness are said in words (UTF-16 JSON is read)
+        if name == "utf16.json":
+            expect = "ok"
+        if name == "empty.json":
+            problem = r"the file is empty \(0 bytes\): expected a kinematic-constants file"
+        if name == "binary.json":
+            problem = r"is not a text file \(binary data .*expected a kinematic-constants file"
+        if name == "not_json.json":
+            problem = r"invalid JSON at line 1, column 2: .*the file is not JSON .*or is cut short"
         cases.append(
             Case(
                 f"history-constants-{name}",
@@ -608,6 +620,44 @@ def _cases() -> list[Case]:
             "error",
             "timeout",
             r"> 0",
+        ),
+    ]
+    cases += [
+        Case(
+            "check-site-empty",
+            ["check", str(CHURCH_GEOMETRY), "{c:empty.json}"],
+            "error",
+            "site",
+            r"empty\.json is empty \(0 bytes\): expected a site file \(JSON",
+        ),
+        Case(
+            # a table where the site file goes: not JSON, said so
+            "check-site-is-csv",
+            ["check", str(CHURCH_GEOMETRY), "{c:walls_semicolon.csv}"],
+            "error",
+            "site",
+            r"invalid JSON at line 1, column 1: .*\(a CSV or a workbook\?\).*expected a site",
+        ),
+        Case(
+            "constants-spec-empty",
+            ["constants", str(SCENE), "{c:empty.json}", "-o", "{tmp}/o.json"],
+            "error",
+            "spec",
+            r"empty\.json is empty \(0 bytes\): expected a mechanism spec \(JSON",
+        ),
+        Case(
+            "constants-spec-binary",
+            ["constants", str(SCENE), "{c:binary.json}", "-o", "{tmp}/o.json"],
+            "error",
+            "spec",
+            r"binary\.json is not a text file .*expected a mechanism spec",
+        ),
+        Case(
+            "ida-record-spec-empty",
+            ["ida", "{c:ok.json}", "--record-spec", "{c:empty.json}", "--scales", "1"],
+            "error",
+            "record_spec",
+            r"empty\.json is empty \(0 bytes\): expected a list of records",
         ),
     ]
     table = ["constants-table", "-o", "{tmp}/t.json"]
