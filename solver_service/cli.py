@@ -801,6 +801,11 @@ def constants(
         )
         for failure in failures:
             typer.echo(f"  {failure.message}", err=True)
+    # each mechanism's warnings (mesh repairs, implausible sizes) on stderr, --json or not
+    for m in cf.mechanisms:
+        notes = (m.provenance or {}).get("warnings") or []
+        for note in notes if isinstance(notes, list) else []:
+            _mechanism_warning(m.id, str(note))
     if as_json:
         _print_json(json.loads(cf.model_dump_json(exclude_none=True)))
         if failures:
@@ -811,9 +816,6 @@ def constants(
     for m in cf.mechanisms:
         side = m.positive
         rows.append([m.id, _g4(side.p_eq), _g4(side.lam), _g4(side.phi_ov), _g4(m.eta)])
-        notes = (m.provenance or {}).get("warnings") or []
-        for note in notes if isinstance(notes, list) else []:
-            _mechanism_warning(m.id, str(note))
     headers = ["mechanism", "p_eq [rad/s]", "lam [-]", "phi_ov [rad]", "eta [-]"]
     for line in _table(headers, rows):
         typer.echo(line)
