@@ -78,8 +78,10 @@ def read_scene(
             "rockmech reads " + ", ".join("." + e for e in SCENE_FORMATS),
             "scene",
         )
-    is_bytes = isinstance(source, (bytes, bytearray, memoryview))
-    size = len(source) if is_bytes else (os.path.getsize(source) if os.path.isfile(source) else 1)
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        size = len(source)
+    else:
+        size = os.path.getsize(source) if os.path.isfile(source) else 1
     if size == 0:
         raise InputError(
             f"{os.path.basename(label)} is empty (0 bytes): expected a scene (a Rhino .3dm model, "
