@@ -19,6 +19,7 @@ import numpy as np
 
 from rhino_plugin.geometry.mesh import TriMesh
 from rhino_plugin.geometry.topology import orient_outward, weld
+from rhino_plugin.geometry.validate import REPAIRS_KEY
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.rules import COORDINATE_LIMIT, body_size_note
 
@@ -205,11 +206,7 @@ class BaseScene:
                 f"{np.atleast_2d(a)[k].tolist()} (NaN or infinite); repair or re-export it"
             )
         if a.size and float(np.abs(a).max()) > COORDINATE_LIMIT:
-            raise GeometryError(
-                f"{what}: a coordinate of {float(np.abs(a).max()):g} {self.units} is beyond the "
-                f"largest magnitude accepted, {COORDINATE_LIMIT:g} {self.units}; check the "
-                "file's units, or move the model near the origin"
-            )
+            raise GeometryError(f"{what}: {_far_coordinates(a, self.units)}")
         if num != 1.0:
             a = a * num
         if den != 1.0:
@@ -274,6 +271,12 @@ def solid_mesh(
 ) -> TriMesh:
     """Weld, orient outward and check a triangle mesh of a scene object.
 
+    Merging coincident vertices changes no geometry and is not reported (an STL file or a
+    Rhino render mesh repeats every corner); the repairs that change the mesh, degenerate
+    faces removed and faces reversed (an inward-facing mesh, or an inconsistent winding),
+    are listed in the mesh's ``meta[REPAIRS_KEY]``, which ``check_solid`` reports as
+    warnings naming the object (docs/geometry.md).
+
     Parameters
     ----------
     v : (n, 3) float
@@ -290,15 +293,68 @@ def solid_mesh(
     GeometryError
         No faces, or not closed when ``require_closed``.
     """
+    name = obj.name or obj.label()
+    n_given = int(np.asarray(f).reshape(-1, 3).shape[0])
     v, f = weld(v, f)
     if f.shape[0] == 0:
         raise GeometryError(f"{obj.label()}: the {obj.kind} has no faces")
-    f, closed, n_open = orient_outward(v, f)
+    repairs = []
+    if f.shape[0] < n_given:
+        # faces with a repeated vertex once coincident vertices are merged: zero area
+        repairs.append(
+            f"{name}: removed {n_given - f.shape[0]} degenerate faces (zero area: two of "
+            "their corners coincide)"
+        )
+    oriented, closed, n_open = orient_outward(v, f)
     if require_closed and not closed:
         raise GeometryError(
             f"{obj.label()}: the {obj.kind} is not a closed solid ({n_open} open or "
             "non-manifold edges); close it in Rhino (Cap, Join, or MeshRepair / FillMeshHoles)"
         )
-    return TriMesh(
-        v, f, obj.name or obj.label(), {"id": obj.id, "layer": obj.layer, "kind": obj.kind}
+    n_flipped = int(np.count_nonzero(np.any(oriented != f, axis=1)))
+    if n_flipped == f.shape[0]:
+        repairs.append(
+            f"{name}: faced inward (inside out); all {n_flipped} faces were reversed to face "
+            "outward"
+        )
+    elif n_flipped:
+        repairs.append(
+            f"{name}: {n_flipped} of its {f.shape[0]} faces were reversed to make the winding "
+            "consistent and outward"
+        )
+    meta: Dict[str, Any] = {"id": obj.id, "layer": obj.layer, "kind": obj.kind}
+    if repairs:
+        meta[REPAIRS_KEY] = repairs
+    return TriMesh(v, oriented, name, meta)
+
+
+#: An object whose size is below this share of its distance from the origin is taken to be
+#: placed in georeferenced coordinates (UTM, a national grid) rather than read in a wrong unit.
+GEOREFERENCED_RATIO = 1e-3
+
+
+def _far_coordinates(a: np.ndarray, units: str) -> str:
+    """Say why coordinates beyond ``COORDINATE_LIMIT`` are refused, and what to do.
+
+    A small object far from the origin is georeferenced (a scan in UTM or national-grid
+    coordinates): the fix is a local origin, not another unit. A large one was most likely
+    read in the wrong unit.
+    """
+    pts = np.atleast_2d(a)
+    far = float(np.abs(pts).max())
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    size = float(np.linalg.norm(hi - lo))
+    said = (
+        f"a coordinate of {far:g} {units} is beyond the largest magnitude accepted, "
+        f"{COORDINATE_LIMIT:g} {units}"
     )
+    if size <= GEOREFERENCED_RATIO * far:
+        centre = ", ".join(f"{c:.0f}" for c in np.round(0.5 * (lo + hi), -1 if far > 1e4 else 0))
+        return (
+            f"{said}, but the object is only {size:.4g} {units} across: its coordinates are "
+            f"georeferenced (UTM, a national grid), not in a wrong unit. Move the model to a "
+            f"local origin before reading it, subtracting about ({centre}) {units} (Rhino: "
+            "Move; CloudCompare: Edit > Apply transformation), and give the spec's points in "
+            "that local frame"
+        )
+    return f"{said}; check the file's units, or move the model near the origin"

@@ -166,16 +166,24 @@ class MeshScene(BaseScene):
             )
         long, (num, den) = unit_ratio(units, name)
         stem = os.path.splitext(os.path.basename(name))[0] or "mesh"
+        base = os.path.basename(name)
+        data = bytes(data)
+        if not data.strip():
+            raise InputError(
+                f"{base} is {'empty (0 bytes)' if not data else 'blank'}: expected a .{ext} "
+                "scan mesh; check that it was saved or copied completely",
+                "scene",
+            )
+        if ext == "ply":
+            _check_ply(data, base)
         try:
-            parts, repeated = _load(bytes(data), ext, stem)
+            parts, repeated = _load(data, ext, stem)
         except InputError:
             raise
         except Exception as exc:  # trimesh raises many kinds on bad input
-            raise InputError(
-                f"cannot read {os.path.basename(name)} as a .{ext} mesh ({type(exc).__name__}: "
-                f"{exc})",
-                "scene",
-            ) from None
+            raise InputError(_unreadable(data, ext, base, exc), "scene") from None
+        for part_name, v, f in parts:
+            _check_indices(v, f, part_name, base, one_based=ext == "obj")
         objects = [
             SceneObject(id=f"{nm}#{k}", name=nm, layer="", kind="mesh", geometry=(v, f))
             for k, (nm, v, f) in enumerate(parts)
@@ -283,3 +291,108 @@ def _vertices(v: Any) -> np.ndarray:
 
 def _faces(f: Any) -> np.ndarray:
     return np.ascontiguousarray(np.asarray(f, dtype=np.int64).reshape(-1, 3))
+
+
+#: PLY element names -> plural words for messages.
+_PLY_WORDS = {"vertex": "vertices", "face": "faces", "edge": "edges"}
+
+
+def _ply_header(data: bytes, name: str) -> Tuple[str, List[Tuple[str, int]], int]:
+    """Return the format, elements ``(name, count)`` and data start of a PLY header.
+
+    Raises
+    ------
+    InputError
+        No ``ply`` first line or ``end_header``, or an ``element`` line without a count.
+    """
+    end = data.find(b"end_header")
+    if not data.startswith(b"ply") or end < 0:
+        raise InputError(
+            f"{name} is not a PLY file: a PLY file starts with the line 'ply' and its header "
+            "ends with 'end_header'; export the mesh again as PLY",
+            "scene",
+        )
+    fmt, elements = "", []
+    for line in data[:end].decode("ascii", "replace").splitlines():
+        words = line.split()
+        if words[:1] == ["format"] and len(words) > 1:
+            fmt = words[1]
+        elif words[:1] == ["element"]:
+            if len(words) != 3 or not words[2].isdigit():
+                raise InputError(
+                    f"{name}: PLY header line {line.strip()!r} must read 'element <name> "
+                    "<count>'; export the mesh again",
+                    "scene",
+                )
+            elements.append((words[1], int(words[2])))
+    start = data.find(b"\n", end)
+    return fmt, elements, (len(data) if start < 0 else start + 1)
+
+
+def _promised(elements: List[Tuple[str, int]]) -> str:
+    """``12 vertices and 20 faces``: what a PLY header promises."""
+    said = [f"{n} {_PLY_WORDS.get(e, e)}" for e, n in elements]
+    return " and ".join([", ".join(said[:-1]), said[-1]] if len(said) > 1 else said)
+
+
+def _check_ply(data: bytes, name: str) -> None:
+    """Refuse an ASCII PLY whose data lines are not the count its header promises.
+
+    trimesh reads such a file without a word: surplus vertices become faces' numbers, or a
+    face too many is dropped (``element face 13`` over 12 faces gives a mesh with 12).
+    Binary PLY is checked by trimesh's length test (see :func:`_unreadable`).
+    """
+    fmt, elements, start = _ply_header(data, name)
+    if fmt != "ascii":
+        return
+    lines = sum(1 for line in data[start:].splitlines() if line.strip())
+    want = sum(n for _, n in elements)
+    if lines != want:
+        raise InputError(
+            f"{name}: the PLY header promises {_promised(elements)} ({want} data lines), but "
+            f"the file has {lines} data lines: it is truncated or its header was edited; "
+            "export the mesh again",
+            "scene",
+        )
+
+
+def _unreadable(data: bytes, ext: str, name: str, exc: Exception) -> str:
+    """Return the message for a scan file trimesh could not read."""
+    if ext == "ply" and "length" in str(exc):
+        _, elements, start = _ply_header(data, name)
+        return (
+            f"{name}: the PLY header promises {_promised(elements)}, but the {len(data) - start} "
+            "bytes of binary data after it do not hold that many: the file is truncated or its "
+            "header was edited; export the mesh again"
+        )
+    if ext == "obj" and isinstance(exc, IndexError):
+        n_vertices = len(re.findall(rb"^[ \t]*v[ \t]", data, re.M))
+        faces = re.findall(rb"^[ \t]*f[ \t]+([^\r\n]*)", data, re.M)
+        refs = [int(r) for line in faces for r in re.findall(rb"(?:^|\s)(-?\d+)", line)]
+        bad = next((r for r in refs if r == 0 or abs(r) > n_vertices), None)
+        if bad is not None:
+            return (
+                f"{name}: a face refers to vertex {bad}, but the file defines {n_vertices} "
+                f"vertices ('v' lines, numbered from 1): the file is truncated or its faces "
+                "come from another file; export the mesh again"
+            )
+    return f"cannot read {name} as a .{ext} mesh ({type(exc).__name__}: {exc})"
+
+
+def _check_indices(
+    v: np.ndarray, f: np.ndarray, part: str, name: str, one_based: bool = False
+) -> None:
+    """Refuse faces that name a vertex the file does not have (trimesh keeps them)."""
+    if f.size == 0:
+        return
+    lo, hi = int(f.min()), int(f.max())
+    if lo < 0 or hi >= len(v):
+        bad = lo if lo < 0 else hi
+        shown = bad + 1 if one_based else bad
+        numbering = "numbered from 1" if one_based else "numbered from 0"
+        raise InputError(
+            f"{name}: a face of {part!r} refers to vertex {shown}, but it has {len(v)} "
+            f"vertices ({numbering}): the file is truncated or its faces come from another "
+            "file; export the mesh again",
+            "scene",
+        )

@@ -78,6 +78,17 @@ def read_scene(
             "rockmech reads " + ", ".join("." + e for e in SCENE_FORMATS),
             "scene",
         )
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        size = len(source)
+    else:
+        size = os.path.getsize(source) if os.path.isfile(source) else 1
+    if size == 0:
+        raise InputError(
+            f"{os.path.basename(label)} is empty (0 bytes): expected a scene (a Rhino .3dm model, "
+            "or a .ply, .obj, .stl or .off scan mesh); check that it was saved or copied "
+            "completely",
+            "scene",
+        )
     if ext != "3dm":
         if isinstance(source, (bytes, bytearray, memoryview)):
             return MeshScene.from_bytes(bytes(source), label, units=units)

@@ -1025,7 +1025,10 @@ class CheckResponse(BaseModel):
 class AssessResponse(CheckResponse):
     """The assessment document (``rockmech assess --json``)."""
 
-    records: List[Dict[str, Any]] = Field(description="The records: name, pga_g, dt, duration.")
+    records: List[Dict[str, Any]] = Field(
+        description="The records: name, pga_g, dt, duration, and warnings (an implausible PGA "
+        "or time step, naming the units read) where there are any."
+    )
     multiples: List[Optional[float]] = Field(description="Multiples of the design scale run.")
 
 

@@ -959,8 +959,15 @@ def json_document(text: str) -> Any:
     ...
     shared_schema.errors.InputError: invalid JSON: nested deeper than 1000 levels
     """
+    if not text.strip():
+        raise InputError("invalid JSON: there is no document, only blank space") from None
     try:
         return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InputError(
+            f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}; the file is "
+            "not JSON (a CSV or a workbook?) or is cut short"
+        ) from None
     except ValueError as exc:
         raise InputError(f"invalid JSON: {exc}") from None
     except RecursionError:

@@ -12,13 +12,21 @@ from pathlib import Path
 from shared_schema.atomic import PathLike, write_atomic
 from shared_schema.constants import ConstantsFile, parse_constants
 from shared_schema.errors import InputError
+from shared_schema.text import decode_text
 
 __all__ = [
+    "CONSTANTS_EXPECTED",
     "load_constants",
     "parse_constants",
     "save_constants",
     "write_atomic",
 ]
+
+
+#: What a constants file must be, for the messages on empty or binary files.
+CONSTANTS_EXPECTED = (
+    'a kinematic-constants file (JSON, {"mechanisms": [...]}; or a constants table, .csv or .xlsx)'
+)
 
 
 def load_constants(path: PathLike) -> ConstantsFile:
@@ -28,8 +36,8 @@ def load_constants(path: PathLike) -> ConstantsFile:
     ----------
     path : str or os.PathLike
         A JSON file: an object ``{"schema_version": ..., "mechanisms": [...]}`` (only
-        ``mechanisms`` is required) or a bare list of mechanisms. A UTF-8 byte-order mark
-        is allowed.
+        ``mechanisms`` is required) or a bare list of mechanisms; UTF-8 (a byte-order mark
+        is allowed) or UTF-16 with one (``shared_schema.text.decode_text``).
 
     Returns
     -------
@@ -39,9 +47,9 @@ def load_constants(path: PathLike) -> ConstantsFile:
     Raises
     ------
     InputError
-        If the file is missing or unreadable, is not JSON, or holds invalid values. The
-        message starts with the file name; for invalid values it then names the mechanism
-        and the field, e.g. ``walls.json: mechanisms[1] (id 'W2').positive.p_eq: ...``.
+        If the file is missing, unreadable, empty or binary, is not JSON, or holds invalid
+        values. The message starts with the file name; for invalid values it then names the
+        mechanism and the field, e.g. ``walls.json: mechanisms[1] (id 'W2').positive.p_eq: ...``.
     """
     file = Path(path)
     try:
@@ -50,10 +58,7 @@ def load_constants(path: PathLike) -> ConstantsFile:
         raise InputError("constants file not found", str(file)) from None
     except OSError as exc:
         raise InputError(f"cannot read constants file: {exc.strerror or exc}", str(file)) from exc
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise InputError(f"constants file is not UTF-8 text: {exc}", str(file)) from exc
+    text = decode_text(raw, "the file", str(file), CONSTANTS_EXPECTED)
     try:
         return parse_constants(text)
     except InputError as exc:

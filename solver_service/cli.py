@@ -245,12 +245,14 @@ def _status(message: str) -> Iterator[None]:
         yield
 
 
+def _record_warning(note: str) -> None:
+    """Print a record's warning (``read_record``'s ``on_warning``) on stderr."""
+    _note(f"warning: record: {note}")
+
+
 def _read_record(path: Path, *args: Any) -> GroundMotion:
     """Read a record as every command does, with its warnings on stderr."""
-    motion = read_record(path, *args)
-    for note in motion.warnings:
-        _note(f"warning: record: {note}")
-    return motion
+    return read_record(path, *args, on_warning=_record_warning)
 
 
 def _choices(values: Iterable[str]) -> str:
@@ -702,7 +704,8 @@ def ida(
         check_folder_target(out)
     cf = read_constants(constants)
     motions = [_read_record(p, record_format, units, dt, channel, component) for p in records or []]
-    motions += [spec.read() for spec in (read_record_spec(record_spec) if record_spec else [])]
+    specs = read_record_spec(record_spec) if record_spec else []
+    motions += [spec.read(on_warning=_record_warning) for spec in specs]
     if not motions:
         _fail("records: give record files or --record-spec")
     _limit(no_limits, cf, scales=len(levels), record=_record_size(motions), records=len(motions))
@@ -798,6 +801,11 @@ def constants(
         )
         for failure in failures:
             typer.echo(f"  {failure.message}", err=True)
+    # each mechanism's warnings (mesh repairs, implausible sizes) on stderr, --json or not
+    for m in cf.mechanisms:
+        notes = (m.provenance or {}).get("warnings") or []
+        for note in notes if isinstance(notes, list) else []:
+            _mechanism_warning(m.id, str(note))
     if as_json:
         _print_json(json.loads(cf.model_dump_json(exclude_none=True)))
         if failures:
@@ -808,9 +816,6 @@ def constants(
     for m in cf.mechanisms:
         side = m.positive
         rows.append([m.id, _g4(side.p_eq), _g4(side.lam), _g4(side.phi_ov), _g4(m.eta)])
-        notes = (m.provenance or {}).get("warnings") or []
-        for note in notes if isinstance(notes, list) else []:
-            _mechanism_warning(m.id, str(note))
     headers = ["mechanism", "p_eq [rad/s]", "lam [-]", "phi_ov [rad]", "eta [-]"]
     for line in _table(headers, rows):
         typer.echo(line)
@@ -1178,7 +1183,7 @@ def assess(
     multiple = check_multiples(multiple)
     check_file_target(out)
     cf, site_file = read_constants(constants), read_site(site)
-    motions = [read_record(r, record_format, units, dt) for r in record]
+    motions = [_read_record(r, record_format, units, dt) for r in record]
     sources = [
         input_source("constants", constants.name, constants.read_bytes()),
         input_source("site", site.name, site.read_bytes()),

@@ -67,6 +67,27 @@ def test_church_table_round_trips_to_the_same_constants_as_its_json(tmp_path: Pa
     assert load_constants(out).model_dump_json() == reference.model_dump_json()
 
 
+def test_utf16_and_semicolon_tables_give_the_same_constants(tmp_path: Path) -> None:
+    # Excel's "Unicode Text" is UTF-16; a European Excel writes ';' and decimal commas (#25)
+    text = (EXAMPLES / "walls.csv").read_text(encoding="utf-8")
+    want = constants_from_table(EXAMPLES / "walls.csv").model_dump()
+    utf16 = tmp_path / "walls_utf16.csv"
+    utf16.write_bytes(text.encode("utf-16"))
+    rows = list(csv.reader(text.splitlines()))
+    semi = tmp_path / "walls_semicolon.csv"
+    with semi.open("w", newline="", encoding="utf-8") as f:
+        writer = csv.writer(f, delimiter=";")
+        for row in rows:
+            writer.writerow([c.replace(".", ",") if c[:1].isdigit() else c for c in row])
+    assert "2,210517525" in semi.read_text() and "0.25 m" in semi.read_text()
+    for path in (utf16, semi):
+        assert constants_from_table(path).model_dump() == want, path.name
+    # a text cell that looks like a decimal comma stays text (only numeric columns convert)
+    semi.write_text("id;p_eq;lam;eta\n1,5;2,5;0,2;0,9\n", encoding="utf-8")
+    mech = constants_from_table(semi).mechanisms[0]
+    assert (mech.id, mech.positive.p_eq, mech.positive.lam) == ("1,5", 2.5, 0.2)
+
+
 def test_physical_constants_round_trip_and_are_checked_for_consistency(tmp_path: Path) -> None:
     doc = json.loads((EXAMPLES / "rect_walls.json").read_text())
     for mech in doc["mechanisms"]:

@@ -217,7 +217,10 @@ def run_history(
     """Time histories of every mechanism at every scale factor (``rockmech history``)."""
     from pathlib import Path
 
-    motion = read_record(Path(record), units=units)
+    notes: List[str] = []
+    motion = read_record(Path(record), units=units, on_warning=notes.append)
+    # the record's warnings (implausible PGA or time step, naming the units read) come first
+    said = [f"  warning: record: {note}" for note in notes]
     os.makedirs(out_dir, exist_ok=True)
     json_path = os.path.join(out_dir, f"{stem}.json")
     if client is not None:
@@ -230,12 +233,12 @@ def run_history(
         payload = {"constants": _constants_json(cf), "record": samples, "scales": list(scales)}
         doc = client.post("history", payload)
         write_atomic(json_path, json.dumps(doc, indent=2) + "\n")
-        return AnalysisResult("History", doc, _history_lines(doc), None, [json_path])
+        return AnalysisResult("History", doc, said + _history_lines(doc), None, [json_path])
 
     doc = write_history(cf, motion, list(scales), Path(out_dir), stem=stem, title=motion.name)
     plot = os.path.join(out_dir, f"{stem}.png")
     files = [json_path, plot, os.path.join(out_dir, f"{stem}_record.png")]
-    return AnalysisResult("History", doc, _history_lines(doc), plot, files)
+    return AnalysisResult("History", doc, said + _history_lines(doc), plot, files)
 
 
 def run_pulse(

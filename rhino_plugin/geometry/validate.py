@@ -62,8 +62,11 @@ from .topology import (
     shell_labels,
 )
 
-__all__ = ["check_solid", "shell_labels"]
+__all__ = ["REPAIRS_KEY", "check_solid", "shell_labels"]
 
+#: Key of ``TriMesh.meta`` under which a reader lists the repairs it made before the check
+#: (``rhino_plugin.scene_base.solid_mesh``); ``check_solid`` reports them with its own.
+REPAIRS_KEY = "repairs"
 #: |volume| below this × (bounding-box diagonal)³ counts as zero [-].
 ZERO_VOLUME_RTOL = 1e-12
 #: A hole is filled when its loop deviates from its plane by less than this × its size [-].
@@ -505,7 +508,8 @@ def check_solid(mesh: TriMesh, *, repair: bool = True) -> Tuple[TriMesh, List[st
     mesh : TriMesh
         The valid solid: the input object itself when nothing was changed.
     warnings : list of str
-        One human-readable line per repair, each starting with the mesh name.
+        One human-readable line per repair, each starting with the mesh name: those the
+        scene reader made (listed in ``mesh.meta[REPAIRS_KEY]``) first, then this check's.
 
     Raises
     ------
@@ -542,8 +546,10 @@ def check_solid(mesh: TriMesh, *, repair: bool = True) -> Tuple[TriMesh, List[st
         raise GeometryError(f"{name}: has non-finite vertex coordinates")
     if faces.min() < 0 or faces.max() >= n:
         raise GeometryError(f"{name}: has face indices outside 0..{n - 1}")
-    notes: List[str] = []
-    changed = False
+    # repairs the scene reader already made (welding, winding, inward shells: solid_mesh)
+    meta = dict(mesh.meta)
+    notes: List[str] = list(meta.pop(REPAIRS_KEY, ()))
+    changed = bool(notes)
 
     good = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2])
     good &= faces[:, 2] != faces[:, 0]
@@ -577,6 +583,6 @@ def check_solid(mesh: TriMesh, *, repair: bool = True) -> Tuple[TriMesh, List[st
         vertices, checked = vertices[used], remap[checked]
         notes.append(f"{name}: removed {n_unused} unused vertices")
         changed = True
-    out = mesh if not changed else TriMesh(vertices, checked, name, dict(mesh.meta))
+    out = mesh if not changed else TriMesh(vertices, checked, name, meta)
     _remember(out, clean=True)
     return out, notes

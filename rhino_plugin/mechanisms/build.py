@@ -337,6 +337,27 @@ def _units_hint(spec_file: Any, scene: Any) -> str:
     )
 
 
+def _body_size_note(spec: Any, scene: Any) -> Optional[str]:
+    """Return the size warning of a mechanism's body (``scene.size_note``) without its id.
+
+    Where the axis, a crack or a hinge misses a body of kilometres or millimetres, the
+    scene's length unit is the likely cause, so the error says it (#25).
+    """
+    groups = list(spec.groups or []) + [g for block in spec.blocks or [] for g in block]
+    ids = []
+    for group in groups:
+        for sel in group.objects:
+            try:
+                ids += [obj.id for obj in scene.find(sel)]
+            except RockmechError:
+                continue  # a selector error is reported by the builder
+    try:
+        note = scene.size_note(ids, spec.id) if ids else None
+    except RockmechError:
+        return None  # the body's own defect is the builder's error to report
+    return note.split(": ", 1)[1] if note else None
+
+
 #: Words of the geometry errors that an axis, crack or hinge far from the body gives.
 FAR_FROM_BODY = ("does not touch the body", "misses the body", "not at the body's base")
 
@@ -392,9 +413,13 @@ def constants_and_failures(
             failures.append(MechanismFailure(spec.id, InputError(err.reason, field or spec.id)))
             continue
         except GeometryError as exc:
-            # A body far from the written points most often means points in another unit.
+            # A body far from the written points most often means points in another unit:
+            # the scene's (a body of kilometres: a mm scan read as m), else the spec's.
             far = any(words in str(exc) for words in FAR_FROM_BODY)
-            if far and _written_points(given):
+            size = _body_size_note(spec, scene) if far else None
+            if size is not None:
+                exc = GeometryError(f"{exc} ({size})")
+            elif far and _written_points(given):
                 exc = GeometryError(str(exc) + _units_hint(spec_file, scene))
             failures.append(MechanismFailure(spec.id, exc))
             continue

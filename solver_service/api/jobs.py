@@ -38,8 +38,10 @@ from shared_schema.api import (
 from shared_schema.constants import ConstantsFile, parse_constants
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import MissingExtra
+from shared_schema.io import CONSTANTS_EXPECTED
 from shared_schema.rules import CRITERIA, F_N_RANGE, SF_METHODS, check_choice
 from shared_schema.spec import parse_spec
+from shared_schema.text import decode_text
 
 from ..core import codes
 from ..core.envelope import OverturningLibrary
@@ -59,7 +61,7 @@ from ..workflows.documents import (
     record_analysis,
 )
 from ..workflows.documents import pulse_doc as doc
-from ..workflows.inputs import read_record
+from ..workflows.inputs import SPEC_EXPECTED, read_record
 from ..workflows.outputs import finite_json
 from ..workflows.scaling import Building
 from .errors import error_body
@@ -187,11 +189,8 @@ def shared_library() -> Any:
 def _constants(data: Any, label: str, limits: dict[str, Any]) -> Any:
     """Validate a constants file given as data (JSON body) or bytes (upload)."""
     if isinstance(data, bytes):
-        try:
-            text = data.decode("utf-8-sig")
-        except UnicodeDecodeError as exc:
-            raise InputError(f"constants file is not UTF-8 text: {exc}", label) from exc
-        data = text
+        # empty, binary and non-UTF-8 uploads are said as the CLI says them
+        data = decode_text(data, "the upload", label, CONSTANTS_EXPECTED)
     try:
         cf = parse_constants(data)
     except InputError as exc:
@@ -390,7 +389,7 @@ def _scene_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) 
     scene_name = safe_filename(job.scene_name, "scene.3dm")
     spec_name = safe_filename(job.spec_name, "spec.json")
     scene_bytes, spec_bytes = blobs
-    spec_file = parse_spec(spec_bytes, spec_name)
+    spec_file = parse_spec(decode_text(spec_bytes, spec_name, "spec", SPEC_EXPECTED), spec_name)
     if spec_file.thrust_table is not None:
         raise InputError(
             f"{spec_name}: the service takes no file paths from clients; remove thrust_table "
@@ -487,7 +486,9 @@ def _assess_inputs(job: AssessJob | AssessHtmlJob, limits: dict[str, Any]) -> tu
         try:
             motions.append(motion_from_params(record, None, None, limits))
         except InputError as exc:
-            raise InputError(str(exc), f"records[{i}]") from None
+            # the samples' own field: a sample beyond ACCEL_MAX_G is records[i].accel
+            part = {None: "", "record": ".accel"}.get(exc.field, f".{exc.field}")
+            raise InputError(exc.reason, f"records[{i}]{part}") from None
     check_spectra_work(cf, check_doc(cf, job.site)["mechanisms"], motions, limits)
     return cf, motions
 

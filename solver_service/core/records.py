@@ -51,6 +51,7 @@ from shared_schema.rules import (
     accel_max,
     check_file,
 )
+from shared_schema.text import decimal_point, decode_text, delimiter_of
 
 from .excitation import SampledAccel, check_finite_samples
 from .formats import READERS, Channel, channel_list, select_channel
@@ -78,6 +79,16 @@ PGA_PLAUSIBLE_G = (0.001, 5.0)
 DT_PLAUSIBLE_S = (1e-4, 0.1)
 #: Relative tolerance on the spacing of time stamps read from a file.
 DT_RTOL = 1e-6
+#: What a record file must be, for the messages on empty or binary files.
+RECORD_EXPECTED = (
+    "a ground-motion record as text (AT2, two columns, one column, CSV, or the ASCII file of "
+    "a strong-motion database: ESM, K-NET, COSMOS, DMG, GeoNet)"
+)
+#: What to do with a binary record.
+RECORD_BINARY_HINT = (
+    "rockmech reads no binary format (SAC, miniSEED, .xlsx): export the record as text, "
+    "e.g. a CSV with a header 't [s],acc [g]'"
+)
 #: Record formats ``GroundMotion.from_file`` reads (``shared_schema.rules``).
 FORMATS = RECORD_FORMATS
 #: File extensions (lower case) that fix the format.
@@ -141,11 +152,13 @@ def _check_dt(dt: Any) -> float:
 
 
 def _read_text(path: PathLike) -> tuple[Path, str]:
+    """Return a record file and its text (``decode_text``: empty, binary files refused)."""
     p = check_file(path, "record")
     try:
-        return p, p.read_text(encoding="utf-8", errors="strict")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read record file {p}: {exc}", "record") from exc
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read record file {p}: {exc.strerror or exc}", "record") from exc
+    return p, decode_text(raw, p.name, "record", RECORD_EXPECTED, RECORD_BINARY_HINT)
 
 
 def _data_lines(text: str) -> list[tuple[int, str, str]]:
@@ -679,9 +692,15 @@ class GroundMotion:
             if time_column is not None:
                 raise InputError("give either a time column or dt, not both", "dt")
         p, text = _read_text(path)
-        rows = [(n, raw, next(csv.reader([ln]))) for n, raw, ln in _data_lines(text)]
-        if not rows:
+        lines = _data_lines(text)
+        if not lines:
             raise InputError(f"{p.name}: needs at least 2 samples, got 0", "record")
+        # A CSV from a European spreadsheet separates cells with ';' and may write decimal
+        # commas (shared_schema.text.delimiter_of).
+        delimiter = delimiter_of(lines[0][2])
+        rows = [(n, raw, next(csv.reader([ln], delimiter=delimiter))) for n, raw, ln in lines]
+        if delimiter == ";":
+            rows = [(n, raw, [decimal_point(c) for c in cells]) for n, raw, cells in rows]
         first = [c.strip() for c in rows[0][2]]
         try:
             [float(c) for c in first]
@@ -744,6 +763,7 @@ class GroundMotion:
         meta = {
             "source": p.name,
             "format": "csv",
+            "delimiter": delimiter,
             "units": units,
             "npts": int(a.size),
             "time_column": header[it] if (it is not None and names) else it,
@@ -779,6 +799,7 @@ def plausibility_warnings(motion: GroundMotion) -> list[str]:
     """
     units = motion.metadata.get("units")
     read_in = f"read in {units}" if units else "units not stated"
+    dt_from = _dt_source(motion.metadata)
     notes = []
     pga_g = motion.pga_g
     lo, hi = PGA_PLAUSIBLE_G
@@ -791,9 +812,34 @@ def plausibility_warnings(motion: GroundMotion) -> list[str]:
     if not dt_lo <= motion.dt <= dt_hi:
         notes.append(
             f"time step dt = {motion.dt:.3g} s is outside the plausible range "
-            f"[{dt_lo:g}, {dt_hi:g}] s ({read_in}); check the time units or --dt"
+            f"[{dt_lo:g}, {dt_hi:g}] s (read as seconds from {dt_from}); check the time units "
+            "(ms written as s?) or the time step given"
         )
     return notes
+
+
+#: Where each format's time step comes from, for the plausibility warning.
+_DT_SOURCES = {
+    "at2": "the AT2 header's DT",
+    "two_column": "the time column",
+    "one_column": "the time step given (dt, --dt)",
+    "esm": "the header's SAMPLING_INTERVAL_S",
+    "knet": "1 / the header's Sampling Freq(Hz)",
+    "cosmos": "real header 62 (in ms)",
+    "dmg": "the 'POINTS OF ACCEL DATA EQUALLY SPACED AT' line",
+    "geonet": "the header's sampling interval (row 7, field 6)",
+    "samples": "dt",
+}
+
+
+def _dt_source(meta: dict[str, Any]) -> str:
+    """Where a record's time step was read from (a header field, a column, or given)."""
+    fmt = meta.get("format")
+    if fmt == "csv":
+        return (
+            "the time column" if meta.get("time_column") is not None else _DT_SOURCES["one_column"]
+        )
+    return _DT_SOURCES.get(str(fmt), "the time step given")
 
 
 def detect_format(p: Path) -> str:

@@ -19,8 +19,9 @@ import numpy as np
 from shared_schema.api import MAX_ASSESS_MULTIPLES, MULTIPLE_MAX
 from shared_schema.constants import ConstantsFile, Mechanism, SideConstants
 from shared_schema.errors import InputError, RockmechError
-from shared_schema.rules import check_number
+from shared_schema.rules import check_file, check_number
 from shared_schema.site import SiteFile, parse_site
+from shared_schema.text import decode_text
 
 from ..core.exact import simulate
 from ..core.hazard import ElasticSpectrum, ec8_spectrum, ntc_spectrum
@@ -61,11 +62,20 @@ NO_VIRTUAL_WORK = (
 )
 
 
+#: What a site file must be, for the messages on empty, binary or non-JSON files.
+SITE_EXPECTED = 'a site file (JSON, {"hazard": {...}, "building": {...}})'
+
+
 def read_site(path: Path) -> SiteFile:
-    """Read and validate a site file; a missing file names ``site``."""
-    if not path.is_file():
-        raise InputError(f"file not found: {path}", "site")
-    return parse_site(path.read_bytes())
+    """Read and validate a site file; errors about the file itself name ``site``."""
+    check_file(path, "site")
+    text = decode_text(path.read_bytes(), path.name, "site", SITE_EXPECTED)
+    try:
+        return parse_site(text)
+    except InputError as exc:
+        if exc.field:
+            raise
+        raise InputError(f"{path.name}: {exc.reason}; expected {SITE_EXPECTED}", "site") from None
 
 
 def site_spectrum(site: SiteFile) -> ElasticSpectrum:
@@ -399,7 +409,8 @@ def assessment_doc(
     Returns
     -------
     dict
-        ``check_doc``'s keys and ``records``; each mechanism row gains ``dynamics`` (per
+        ``check_doc``'s keys and ``records`` (name, PGA, dt, duration and, where there
+        are any, the record's ``warnings``); each mechanism row gains ``dynamics`` (per
         record: the design scale factor and band, per multiple the peak ratio and verdict,
         the first multiple that overturns, ``survives_design``) and ``envelope`` (the
         envelope and each record's largest pulse at design scale with the margin
@@ -430,8 +441,16 @@ def assessment_doc(
                 dyn.append({"record": motion.name, "note": f"not run: {exc}"})
         row["dynamics"] = dyn
         row["envelope"] = _envelope_margin(mech, motions, designs, freq)
+    # a record's warnings (implausible PGA or time step, naming the units read) go with it
     doc["records"] = [
-        {"name": m.name, "pga_g": m.pga_g, "dt": m.dt, "duration": m.duration} for m in motions
+        {
+            "name": m.name,
+            "pga_g": m.pga_g,
+            "dt": m.dt,
+            "duration": m.duration,
+            **({"warnings": m.warnings} if m.warnings else {}),
+        }
+        for m in motions
     ]
     doc["multiples"] = list(multiples)
     return doc

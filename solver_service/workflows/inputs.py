@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional, Union
@@ -20,6 +21,7 @@ from shared_schema.errors import InputError
 from shared_schema.io import load_constants
 from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, check_file, check_positive
 from shared_schema.spec import parse_spec
+from shared_schema.text import decode_text
 
 from ..core.records import GroundMotion, detect_format
 from .tables import constants_from_table, is_table
@@ -33,6 +35,8 @@ __all__ = [
     "read_record_spec",
 ]
 
+#: What a record-spec file must be, for the messages on empty or binary files.
+RECORD_SPEC_EXPECTED = "a list of records (CSV with a header row 'file,format,units,...', or JSON)"
 #: Columns (CSV) or keys (JSON) of a record-spec file; only ``file`` is required.
 SPEC_FIELDS = ("file", "format", "units", "dt", "channel", "component")
 
@@ -44,8 +48,15 @@ def read_record(
     dt: Optional[float] = None,
     channel: Union[int, str, None] = None,
     component: Optional[str] = None,
+    *,
+    on_warning: Optional[Callable[[str], None]] = None,
 ) -> GroundMotion:
     """Read a record as ``rockmech`` does: format detected, a two-column file in g by default.
+
+    The one place every front end reads a record file: each warning of the record (an
+    implausible PGA or time step naming the units read, a shifted time axis, a header that
+    could not be checked) is passed to ``on_warning`` as it is read, and stays in
+    ``motion.warnings`` for the documents.
 
     Parameters
     ----------
@@ -55,13 +66,19 @@ def read_record(
         As ``GroundMotion.from_file``; ``units`` defaults to g for a two-column file (the
         t [s], a [g] convention of the bundled record); ``channel`` or ``component`` choose
         one channel of a file with several (DMG V2, GeoNet V2A).
+    on_warning : callable, optional
+        Called with each warning (the CLI prints ``warning: record: ...`` on stderr).
     """
     fmt = fmt or detect_format(path)
     if units is None and fmt == "two_column":
         units = "g"
-    return GroundMotion.from_file(
+    motion = GroundMotion.from_file(
         path, format=fmt, units=units, dt=dt, channel=channel, component=component
     )
+    if on_warning is not None:
+        for note in motion.warnings:
+            on_warning(note)
+    return motion
 
 
 @dataclass(frozen=True)
@@ -75,10 +92,16 @@ class RecordSpec:
     channel: Optional[str] = None
     component: Optional[str] = None
 
-    def read(self) -> GroundMotion:
-        """Read the record (``read_record``)."""
+    def read(self, on_warning: Optional[Callable[[str], None]] = None) -> GroundMotion:
+        """Read the record (``read_record``; its warnings to ``on_warning``)."""
         return read_record(
-            self.file, self.format, self.units, self.dt, self.channel, self.component
+            self.file,
+            self.format,
+            self.units,
+            self.dt,
+            self.channel,
+            self.component,
+            on_warning=on_warning,
         )
 
 
@@ -125,7 +148,8 @@ def read_record_spec(path: Path) -> list[RecordSpec]:
         number, or an unknown format or units; the message names the row and the column.
     """
     check_file(path, "record_spec")
-    rows = _spec_rows(path, path.read_text(encoding="utf-8"))
+    text = decode_text(path.read_bytes(), path.name, "record_spec", RECORD_SPEC_EXPECTED)
+    rows = _spec_rows(path, text)
     if not rows:
         raise InputError(f"{path.name} lists no records", "record_spec")
     specs = []
@@ -180,10 +204,15 @@ def read_constants(path: Path) -> ConstantsFile:
     return load_constants(path)
 
 
+#: What a mechanism spec must be, for the messages on empty, binary or non-JSON files.
+SPEC_EXPECTED = 'a mechanism spec (JSON, {"mechanisms": [...]})'
+
+
 def _spec_and_scene(scene: Path, spec: Path, units: Optional[str]) -> tuple[Any, Any]:
     for label, path in (("scene", scene), ("spec", spec)):
         check_file(path, label)
-    return parse_spec(spec.read_bytes(), spec.name), read_scene(scene, units=units)
+    text = decode_text(spec.read_bytes(), spec.name, "spec", SPEC_EXPECTED)
+    return parse_spec(text, spec.name), read_scene(scene, units=units)
 
 
 def constants_from_files(scene: Path, spec: Path, units: Optional[str] = None) -> ConstantsFile:

@@ -1,7 +1,9 @@
 """Constants tables: one mechanism per row, as papers print them, into a constants file.
 
-A table is a ``.csv`` file or the first sheet of an ``.xlsx`` workbook (read with openpyxl,
-the ``tables`` extra). The first non-blank row names the columns; each further row is one
+A table is a ``.csv`` file (UTF-8 or UTF-16; cells separated by commas, or by semicolons with
+decimal commas as European spreadsheets write them, or by tabs) or the first sheet of an
+``.xlsx`` workbook (read with openpyxl, the ``tables`` extra; a table on another sheet is named
+in the error). The first non-blank row names the columns; each further row is one
 mechanism. Column names are matched without case, spaces or a trailing unit in brackets
 (``p_eq [rad/s]``, ``f_n (Hz)``); a unit in brackets must be the column's SI unit, or ``deg``
 for the angles ``phi_ov``/``phi_cr`` (converted to rad).
@@ -27,6 +29,7 @@ from typing import Any, Optional
 
 from shared_schema.constants import ConstantsFile, parse_constants
 from shared_schema.errors import InputError
+from shared_schema.text import decimal_point, decode_text, delimiter_of
 
 __all__ = ["COLUMNS", "TABLE_SUFFIXES", "XLSX_HINT", "constants_from_table", "is_table"]
 
@@ -58,6 +61,12 @@ COLUMNS: dict[str, tuple[tuple[str, ...], Optional[str]]] = {
 ALIASES = {"lambda": "lam", "λ": "lam", "η": "eta", "p": "p_eq", "i0": "I0", "k": "K"}
 #: Table file suffixes (lower case) that commands take where a constants JSON is expected.
 TABLE_SUFFIXES = (".csv", ".xlsx")
+#: What a CSV table must be, for the messages on empty or binary files.
+CSV_EXPECTED = (
+    "a constants table as CSV text (a header row naming the columns, then a mechanism a row)"
+)
+#: What to do with a binary ``.csv``.
+CSV_BINARY_HINT = "if it is an Excel workbook, name it .xlsx; else save the sheet as CSV UTF-8"
 #: What to run when openpyxl is missing.
 XLSX_HINT = "pip install 'rockmech[tables]'  (or: pip install openpyxl)"
 #: Unit spellings accepted in brackets, folded, per SI unit.
@@ -104,10 +113,33 @@ def _column(title: str, col: int) -> tuple[str, float]:
     return name, 1.0
 
 
-def _read_csv(path: Path) -> list[tuple[int, list[Any]]]:
-    text = path.read_text(encoding="utf-8-sig")
-    rows = list(csv.reader(io.StringIO(text)))
-    return [(n, cells) for n, cells in enumerate(rows, start=1)]
+def _read_csv(path: Path) -> tuple[list[tuple[int, list[Any]]], bool]:
+    """Rows of a CSV table (UTF-8 or UTF-16; cells separated by ',', ';' or a tab).
+
+    Returns the numbered rows and whether numbers may have decimal commas: a ';'-separated
+    table is a European spreadsheet's CSV, which writes them.
+    """
+    text = decode_text(path.read_bytes(), path.name, "table", CSV_EXPECTED, CSV_BINARY_HINT)
+    first = next((ln for ln in text.splitlines() if ln.strip()), "")
+    delimiter = delimiter_of(first)
+    rows = list(csv.reader(io.StringIO(text), delimiter=delimiter))
+    return [(n, cells) for n, cells in enumerate(rows, start=1)], delimiter == ";"
+
+
+def _has_table(rows: Any) -> bool:
+    """Tell a sheet whose first non-blank row names an ``id`` column (a table's header)."""
+    for row in rows:
+        if not all(_blank(c) for c in row):
+            return any(_column_name(str(c)) == "id" for c in row if not _blank(c))
+    return False
+
+
+def _column_name(title: str) -> Optional[str]:
+    """Return the canonical column of a header cell, or None where it names none."""
+    try:
+        return _column(title, 0)[0]
+    except InputError:
+        return None
 
 
 def _read_xlsx(path: Path) -> list[tuple[int, list[Any]]]:
@@ -120,24 +152,38 @@ def _read_xlsx(path: Path) -> list[tuple[int, list[Any]]]:
         book = openpyxl.load_workbook(path, read_only=True, data_only=True)
     except Exception as exc:  # openpyxl raises many kinds for a damaged workbook
         raise InputError(f"cannot read {path.name} as .xlsx: {exc}", "table") from None
-    sheet = book.worksheets[0]
-    rows = [(n, list(r)) for n, r in enumerate(sheet.iter_rows(values_only=True), start=1)]
-    book.close()
-    return rows
+    try:
+        sheets = [(ws.title, list(ws.iter_rows(values_only=True))) for ws in book.worksheets]
+    finally:
+        book.close()
+    title, first = sheets[0]
+    if not _has_table(first):
+        others = [(k, t) for k, (t, rows) in enumerate(sheets[1:], start=2) if _has_table(rows)]
+        if others:
+            k, other = others[0]
+            raise InputError(
+                f"{path.name}: the table is read from the first sheet, but sheet 1 {title!r} has "
+                f"no header row naming an 'id' column, and sheet {k} {other!r} has one: move "
+                f"{other!r} to the front of the workbook (or save it as CSV)",
+                "table",
+            )
+    return [(n, list(r)) for n, r in enumerate(first, start=1)]
 
 
 def _blank(cell: Any) -> bool:
     return cell is None or (isinstance(cell, str) and not cell.strip())
 
 
-def _number(cell: Any, where: str) -> float:
+def _number(cell: Any, where: str, decimal_comma: bool = False) -> float:
+    """Return a numeric cell's value; ``decimal_comma`` reads ``0,25`` as 0.25 (a ';' table)."""
     if isinstance(cell, bool):
         raise InputError(f"{where}: must be a number, got {cell!r}", "table")
     if isinstance(cell, (int, float)):
         value = float(cell)
     else:
+        text = decimal_point(str(cell)) if decimal_comma else str(cell)
         try:
-            value = float(str(cell).strip())
+            value = float(text.strip())
         except ValueError:
             raise InputError(f"{where}: not a number: {str(cell).strip()!r}", "table") from None
     if not math.isfinite(value):
@@ -192,7 +238,7 @@ def constants_from_table(path: Path) -> ConstantsFile:
     suffix = path.suffix.lower()
     if suffix not in TABLE_SUFFIXES:
         raise InputError(f"{path.name}: a table is .csv or .xlsx, got {suffix!r}", "table")
-    rows = _read_csv(path) if suffix == ".csv" else _read_xlsx(path)
+    rows, decimal_comma = _read_csv(path) if suffix == ".csv" else (_read_xlsx(path), False)
     rows = [(n, cells) for n, cells in rows if not all(_blank(c) for c in cells)]
     if not rows:
         raise InputError(f"{path.name} is empty", "table")
@@ -236,7 +282,7 @@ def constants_from_table(path: Path) -> ConstantsFile:
             if unit is None:
                 value: Any = str(cell).strip()
             else:
-                value = _number(cell, cell_where) * factor
+                value = _number(cell, cell_where, decimal_comma) * factor
             target = mech
             for key in where[:-1]:
                 target = target.setdefault(key, {})

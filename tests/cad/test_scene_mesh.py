@@ -173,7 +173,7 @@ def test_scan_from_bytes_is_read_like_the_file(files: Dict[str, Path]) -> None:
         read_scene(data)
     with pytest.raises(InputError, match=r"unknown scene format \.dwg; rockmech reads \.3dm"):
         read_scene(data, name="upload.dwg")
-    with pytest.raises(InputError, match=r"cannot read junk\.ply as a \.ply mesh") as exc:
+    with pytest.raises(InputError, match=r"junk\.ply is not a PLY file: a PLY file starts") as exc:
         read_scene(b"not a ply at all", name="junk.ply", units="mm")
     assert exc.value.field == "scene"
 

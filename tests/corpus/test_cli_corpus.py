@@ -12,6 +12,9 @@ once fixed.
 
 from __future__ import annotations
 
+import csv
+import functools
+import io
 import json
 import re
 from pathlib import Path
@@ -31,6 +34,7 @@ RECT = EXAMPLES / "constants" / "rect_walls.json"
 CHURCH = EXAMPLES / "constants" / "church.json"
 CHURCH_GEOMETRY = EXAMPLES / "constants" / "church_geometry.json"
 SITE = EXAMPLES / "sites" / "ntc_site.json"
+SCENE = EXAMPLES / "scenes" / "rect_wall.3dm"
 runner = CliRunner()
 
 
@@ -68,6 +72,8 @@ RECORD_FILES: dict[str, Any] = {
     ),
     "one_column.txt": "\n".join(f"{a:.6e}" for a in A_G) + "\n",
     "bad.csv": "t,a\n0,0.1\n0.01,abc\n",
+    # a record in g listed as cm/s2 (#25: the warning reaches every command)
+    "spec_cm.csv": "file,units\ngood.dat,cm/s2\n",
 }
 
 #: Constants files (JSON text) written into the case's folder.
@@ -96,9 +102,52 @@ CONSTANTS_FILES: dict[str, Any] = {
     "rocking_bad.json": json.dumps({"mechanisms": [{**_W, "rocking": "three_sided"}]}),
     "no_eta.json": json.dumps({"mechanisms": [{k: v for k, v in _W.items() if k != "eta"}]}),
     "utf16.json": json.dumps({"mechanisms": [_W]}).encode("utf-16"),
+    "empty.json": "",
+    "binary.json": bytes(range(256)) * 4,
     "amp_bad.json": json.dumps(
         {"mechanisms": [{**_W, "amplification": {"f_n": -1.0, "h_e": 4.0, "h": 3.0}}]}
     ),
+}
+
+
+WALLS_CSV = (EXAMPLES / "constants" / "walls.csv").read_text(encoding="utf-8")
+
+
+def _semicolon(text: str) -> str:
+    """The table as a European spreadsheet writes it: ';' between cells, decimal commas."""
+    rows = list(csv.reader(io.StringIO(text)))
+    out = io.StringIO()
+    writer = csv.writer(out, delimiter=";", lineterminator="\n")
+    for row in rows:
+        writer.writerow([c.replace(".", ",") if re.fullmatch(r"-?\d+\.\d+", c) else c for c in row])
+    return out.getvalue()
+
+
+@functools.cache
+def _workbook(notes_first: bool) -> bytes:
+    """walls.csv as an .xlsx workbook; with ``notes_first`` the table is on sheet 2."""
+    import openpyxl  # the tables extra, part of the dev install
+
+    book = openpyxl.Workbook()
+    sheet = book.active
+    if notes_first:
+        sheet.title = "Notes"
+        sheet.append(["Walls of the church, from the 2024 survey"])
+        sheet = book.create_sheet("Walls")
+    for row in csv.reader(io.StringIO(WALLS_CSV)):
+        sheet.append([float(c) if re.fullmatch(r"-?\d+(\.\d+)?", c) else (c or None) for c in row])
+    out = io.BytesIO()
+    book.save(out)
+    return out.getvalue()
+
+
+#: Constants tables written into the case's folder: name -> text, bytes or a maker of bytes.
+TABLE_FILES: dict[str, Any] = {
+    "walls_utf16.csv": WALLS_CSV.encode("utf-16"),
+    "walls_semicolon.csv": _semicolon(WALLS_CSV),
+    "walls_empty.csv": "",
+    "walls_sheet2.xlsx": lambda: _workbook(True),
+    "walls_xlsx_named.csv": lambda: _workbook(False),
 }
 
 
@@ -277,7 +326,7 @@ def _cases() -> list[Case]:
 
     hist = ["history", "{c:ok.json}", "{r:good.dat}"]
     for name in RECORD_FILES:
-        if name == "good.dat":
+        if name in ("good.dat", "spec_cm.csv"):
             continue
         expect, fld, problem, xf = "error", "", ".", ""
         if name in ("tiny_g.dat", "huge_g.dat", "coarse_dt.dat"):
@@ -410,6 +459,15 @@ def _cases() -> list[Case]:
             fld, problem = "eta", "restitution|needs|eta"
         if name == "p_huge.json":
             fld, problem = "p_eq", "range|<=|at most|too"
+        # #25: a file's encoding and emptiness are said in words (UTF-16 JSON is read)
+        if name == "utf16.json":
+            expect = "ok"
+        if name == "empty.json":
+            problem = r"the file is empty \(0 bytes\): expected a kinematic-constants file"
+        if name == "binary.json":
+            problem = r"is not a text file \(binary data .*expected a kinematic-constants file"
+        if name == "not_json.json":
+            problem = r"invalid JSON at line 1, column 2: .*the file is not JSON .*or is cut short"
         cases.append(
             Case(
                 f"history-constants-{name}",
@@ -567,6 +625,75 @@ def _cases() -> list[Case]:
     ]
     cases += [
         Case(
+            "check-site-empty",
+            ["check", str(CHURCH_GEOMETRY), "{c:empty.json}"],
+            "error",
+            "site",
+            r"empty\.json is empty \(0 bytes\): expected a site file \(JSON",
+        ),
+        Case(
+            # a table where the site file goes: not JSON, said so
+            "check-site-is-csv",
+            ["check", str(CHURCH_GEOMETRY), "{c:walls_semicolon.csv}"],
+            "error",
+            "site",
+            r"invalid JSON at line 1, column 1: .*\(a CSV or a workbook\?\).*expected a site",
+        ),
+        Case(
+            "constants-spec-empty",
+            ["constants", str(SCENE), "{c:empty.json}", "-o", "{tmp}/o.json"],
+            "error",
+            "spec",
+            r"empty\.json is empty \(0 bytes\): expected a mechanism spec \(JSON",
+        ),
+        Case(
+            "constants-spec-binary",
+            ["constants", str(SCENE), "{c:binary.json}", "-o", "{tmp}/o.json"],
+            "error",
+            "spec",
+            r"binary\.json is not a text file .*expected a mechanism spec",
+        ),
+        Case(
+            "ida-record-spec-empty",
+            ["ida", "{c:ok.json}", "--record-spec", "{c:empty.json}", "--scales", "1"],
+            "error",
+            "record_spec",
+            r"empty\.json is empty \(0 bytes\): expected a list of records",
+        ),
+    ]
+    table = ["constants-table", "-o", "{tmp}/t.json"]
+    cases += [
+        # #25: a UTF-16 table (was a traceback), a European CSV, empty and binary tables, and
+        # a workbook whose table is on its second sheet
+        *(
+            Case(f"table-{k}", [*table, f"{{c:walls_{k}.csv}}"], "ok", check=_four_mechanisms)
+            for k in ("utf16", "semicolon")
+        ),
+        Case(
+            "table-empty",
+            [*table, "{c:walls_empty.csv}"],
+            "error",
+            "table",
+            r"walls_empty\.csv is empty \(0 bytes\): expected a constants table as CSV text",
+        ),
+        Case(
+            "table-workbook-named-csv",
+            [*table, "{c:walls_xlsx_named.csv}"],
+            "error",
+            "table",
+            r"is not a text file \(it starts like .*Excel .*name it \.xlsx",
+        ),
+        Case(
+            "table-on-sheet-2",
+            [*table, "{c:walls_sheet2.xlsx}"],
+            "error",
+            "table",
+            r"sheet 1 'Notes' has no header row naming an 'id' column, and sheet 2 'Walls' has "
+            r"one: move 'Walls' to the front",
+        ),
+    ]
+    cases += [
+        Case(
             "constants-missing-scene",
             ["constants", "{tmp}/no.3dm", "{tmp}/no.json", "-o", "{tmp}/o.json"],
             "error",
@@ -610,6 +737,25 @@ def _cases() -> list[Case]:
             r"\(0, 100\], got -1",
         ),
         Case(
+            # #25: a record in g read as cm/s2 gets the warning history gives, naming the units
+            "assess-record-in-g-read-as-cm-s2",
+            [
+                *("assess", "{c:ok.json}", str(SITE), "--record", "{r:good.dat}"),
+                *("--units", "cm/s2", "-o", "{tmp}/a.html", "--multiple", "1"),
+            ],
+            "warn",
+            "",
+            r"warning: record: PGA 0\.000306 g is outside the plausible range .*"
+            r"\(read in cm/s2\); check the units",
+        ),
+        Case(
+            "ida-record-spec-in-g-read-as-cm-s2",
+            ["ida", "{c:ok.json}", "--record-spec", "{r:spec_cm.csv}", "--scales", "1"],
+            "warn",
+            "",
+            r"warning: record: PGA 0\.000306 g is outside .*\(read in cm/s2\)",
+        ),
+        Case(
             "assess-multiple-too-many",
             ["assess", str(CHURCH_GEOMETRY), str(SITE), "-o", "{tmp}/a.html"]
             + [a for k in range(9) for a in ("--multiple", str(k + 1))],
@@ -649,6 +795,11 @@ def _cases() -> list[Case]:
     return cases
 
 
+def _four_mechanisms(out: Any) -> bool:
+    """``constants-table`` read walls.csv's four mechanisms."""
+    return "4 mechanism(s)" in str(out)
+
+
 CASES = _cases()
 
 
@@ -659,8 +810,9 @@ def _materialise(argv: list[str], tmp: Path) -> list[str]:
             path.write_bytes(text)
         else:
             path.write_text(text)
-    for name, text in CONSTANTS_FILES.items():
+    for name, text in {**CONSTANTS_FILES, **TABLE_FILES}.items():
         path = tmp / name
+        text = text() if callable(text) else text
         if isinstance(text, bytes):
             path.write_bytes(text)
         else:
@@ -682,6 +834,11 @@ def _compiled_kernels(tmp_path_factory: pytest.TempPathFactory) -> None:
         ["history", "{c:ok.json}", "{r:good.dat}", "--json"],
         ["record", "{r:good.dat}", "--json", "--n", "5"],
         ["envelope", "{c:ok.json}", "--out", "{tmp}/env", "--n", "5", "--exact"],
+        # the report's imports (jinja2, matplotlib) load once here, not in a timed case
+        [
+            *("assess", "{c:ok.json}", str(SITE), "--record", "{r:good.dat}"),
+            *("-o", "{tmp}/a.html", "--multiple", "1"),
+        ],
     ):
         res = runner.invoke(app, _materialise(argv, tmp))
         assert res.exit_code == 0, res.output

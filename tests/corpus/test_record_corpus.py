@@ -442,6 +442,50 @@ SYNTH: list[tuple[Any, ...]] = [
     ),
     # any format
     ("empty-file", "r.dat", "", [], "error", "record", "empty|no samples"),
+    # #25: empty, binary and other-encoding files say what was expected and what to do
+    ("empty-csv", "r.csv", "", [], "error", "record", r"r\.csv is empty \(0 bytes\): expected"),
+    ("empty-at2", "r.AT2", "\n\n", [], "error", "record", "holds only blank space: expected"),
+    (
+        "binary-record",
+        "r.dat",
+        JUNK,
+        [],
+        "error",
+        "record",
+        r"r\.dat is not a text file \(binary data .*export the record as text",
+    ),
+    (
+        "xlsx-record",
+        "r.xlsx",
+        b"PK\x03\x04" + JUNK,
+        [],
+        "error",
+        "record",
+        r"not a text file \(it starts like .*Excel .*workbook.*export the record as text",
+    ),
+    (
+        "csv-windows-1252",
+        "r.csv",
+        ("# station in Montréal\n" + _csv()).encode("cp1252"),
+        [],
+        "error",
+        "record",
+        r"not UTF-8 text: byte \d+ \(line 1\).*Windows-1252.*save it again as UTF-8",
+    ),
+    ("csv-utf16", "r.csv", _csv().encode("utf-16"), [], "ok", "", "", "", _n_is(N)),
+    # a European spreadsheet's CSV: ';' between cells, decimal commas
+    ("csv-semicolon", "r.csv", _csv().replace(",", ";"), [], "ok", "", "", "", _n_is(N)),
+    (
+        "csv-semicolon-decimal-comma",
+        "r.csv",
+        _csv().replace(",", ";").replace(".", ","),
+        [],
+        "ok",
+        "",
+        "",
+        "",
+        _pga_is(PGA),
+    ),
     ("format-unknown", "r.dat", _two(), ["--format", "mp3"], "error", "format", "at2|csv"),
     (
         "units-with-at2",
@@ -602,6 +646,228 @@ for _name, (_fmt, _pick) in REAL.items():
         )
 
 
+def _sub(old: str, new: str) -> Callable[[str], str]:
+    """A mutation replacing the first ``old`` by ``new`` (which must be there)."""
+
+    def mutate(text: str) -> str:
+        assert old in text, old
+        return text.replace(old, new, 1)
+
+    return mutate
+
+
+def _subs(*pairs: tuple[str, str]) -> Callable[[str], str]:
+    def mutate(text: str) -> str:
+        for old, new in pairs:
+            text = _sub(old, new)(text)
+        return text
+
+    return mutate
+
+
+def _cosmos_short_real_header(text: str) -> str:
+    """The COSMOS file with a real header of 40 values on 8 lines (its last 12 lines cut)."""
+    lines = text.splitlines(keepends=True)
+    k = next(i for i, ln in enumerate(lines) if "Real-header values follow" in ln)
+    lines[k] = "  40 Real-header values follow on   8 lines, Format= (5F15.6)\n"
+    return "".join(lines[: k + 9] + lines[k + 21 :])
+
+
+def _cosmos_real_lines_missing(text: str) -> str:
+    """The COSMOS file with 3 of its 20 real-header lines gone (the count line unchanged)."""
+    lines = text.splitlines(keepends=True)
+    k = next(i for i, ln in enumerate(lines) if "Real-header values follow" in ln)
+    return "".join(lines[: k + 18] + lines[k + 21 :])
+
+
+KNET = "CHB0031412312349.NS"
+COSMOS = "us1000hyfh_akbmrp_AKBMR--n.1000hyfh.BNZ.--.acc.V2c"
+ESM = "HI.ARS1..HNE.D.20190728.160908.C.ACC.ASC"
+GEONET = "20180212_211557_WPWS_20.V2A"
+#: #25: every header value a reader uses, checked against the data it describes.
+REAL_CASES += [
+    (
+        "knet-scale-divides-by-zero",
+        KNET,
+        _sub("7845(gal)/8223790", "7845(gal)/0"),
+        [],
+        "error",
+        "record",
+        r"Scale Factor '7845\(gal\)/0' divides by 0 counts; correct it",
+    ),
+    (
+        # x10 with no peak to check it: a 3.49 g record on which every wall overturns
+        "knet-scale-x10-max-acc-empty",
+        KNET,
+        _subs(("7845(gal)/8223790", "78450(gal)/8223790"), ("8.131", "")),
+        [],
+        "error",
+        "record",
+        r"full scale of 78450 gal \(80 g\), outside \[980\.665, 9806\.65\] gal",
+    ),
+    (
+        "knet-scale-negative",
+        KNET,
+        _sub("7845(gal)/8223790", "-7845(gal)/8223790"),
+        [],
+        "error",
+        "record",
+        r"Scale Factor '-7845\(gal\)/8223790' is negative or zero, which would flip",
+    ),
+    (
+        "knet-scale-counts-x10",
+        KNET,
+        _sub("7845(gal)/8223790", "7845(gal)/822379"),
+        [],
+        "error",
+        "record",
+        r"822379 counts at full scale, outside \[2097152, 16777216\]",
+    ),
+    (
+        "knet-count-beyond-full-scale",
+        KNET,
+        _subs(("    3742     3738", " 9999999     3738"), ("8.131", "")),
+        [],
+        "error",
+        "record",
+        r"count 0 is 9999999, beyond the recorder's full scale of 8223790 counts",
+    ),
+    (
+        "knet-max-acc-empty",
+        KNET,
+        _sub("8.131", ""),
+        [],
+        "warn",
+        "",
+        r"'Max\. Acc\. \(gal\)' is empty, so the Scale Factor .* could not be checked",
+    ),
+    (
+        "knet-freq-zero",
+        KNET,
+        _sub("100Hz", "0Hz"),
+        [],
+        "error",
+        "record",
+        r"Sampling Freq\(Hz\) is 0 Hz, outside \[1, 1e\+06\] Hz",
+    ),
+    (
+        "cosmos-data-format-zero",
+        COSMOS,
+        _sub("Format=(1E15.6)", "Format=(0E15.6)"),
+        [],
+        "error",
+        "record",
+        r"gives 0 values a line .*at least 1 value a line",
+    ),
+    (
+        "cosmos-integer-format-zero",
+        COSMOS,
+        _sub("Format= (10I8)", "Format= (0I8)"),
+        [],
+        "error",
+        "record",
+        r"line 14: .*gives 0 values a line",
+    ),
+    (
+        "cosmos-short-real-header",
+        COSMOS,
+        _cosmos_short_real_header,
+        [],
+        "error",
+        "record",
+        r"the real header has 40 values, but the COSMOS V2 format has 100 .*62 sampling",
+    ),
+    (
+        "cosmos-real-header-lines-missing",
+        COSMOS,
+        _cosmos_real_lines_missing,
+        [],
+        "error",
+        "record",
+        r"real header line 4[0-9]: not a number",
+    ),
+    (
+        "cosmos-approx-secs",
+        COSMOS,
+        _sub("approx  210 secs", "approx  300 secs"),
+        [],
+        "error",
+        "record",
+        r"says approx 300 secs, but 42000 points at real header 62's 5 ms last 210 s",
+    ),
+    (
+        "cosmos-length-mismatch",
+        COSMOS,
+        _sub("210.000000      -6.851512", "250.000000      -6.851512"),
+        [],
+        "error",
+        "record",
+        r"real header 63 \(length\) is 250\.000000 s, but 42000 samples at 0\.005 s last 210",
+    ),
+    (
+        "cosmos-interval-zero",
+        COSMOS,
+        _sub("       5.000000     210.000000", "       0.000000     210.000000"),
+        [],
+        "error",
+        "record",
+        r"real header 62 \(sampling interval\) must be > 0 ms, got 0",
+    ),
+    (
+        "esm-duration-mismatch",
+        ESM,
+        _sub("DURATION_S: 95.640", "DURATION_S: 120.000"),
+        [],
+        "error",
+        "record",
+        r"DURATION_S is 120\.000 s, but 19128 samples at 0\.005 s last 95\.64 s",
+    ),
+    (
+        "esm-ndata-fraction",
+        ESM,
+        _sub("NDATA: 19128", "NDATA: 19128.5"),
+        [],
+        "error",
+        "record",
+        r"NDATA must be a whole number >= 2, got 19128\.5",
+    ),
+    (
+        # the time step's warning names seconds and the header field, not the cm/s2 units
+        "esm-dt-coarse",
+        ESM,
+        _subs(
+            ("SAMPLING_INTERVAL_S: 0.005000", "SAMPLING_INTERVAL_S: 0.500000"),
+            ("DURATION_S: 95.640", "DURATION_S: 9564.000"),
+        ),
+        [],
+        "warn",
+        "",
+        r"time step dt = 0\.5 s(?![^\n]*cm/s2)[^\n]*read as seconds from the header's "
+        r"SAMPLING_INTERVAL_S",
+    ),
+    (
+        "geonet-points-text",
+        GEONET,
+        _sub("Number of points  5800", "Number of points  5900"),
+        ["--channel", "1"],
+        "error",
+        "record",
+        r"says 'Number of points 5900', but the numeric header .* says 5800",
+    ),
+    (
+        "geonet-interval-text",
+        GEONET,
+        _sub("data at 0.020 sec intervals", "data at 0.010 sec intervals"),
+        ["--channel", "1"],
+        "error",
+        "record",
+        r"data at 0\.010 sec intervals, but the numeric header .* says 0\.02 s",
+    ),
+]
+#: The #25 header cases that ``history`` runs too (a wrong scale overturns every wall).
+HISTORY_HEADER = ("knet-scale-x10-max-acc-empty", "knet-max-acc-empty", "esm-dt-coarse")
+
+
 def _synth_case(row: tuple[Any, ...], command: str) -> Case:
     cid, name, _content, extra, expect, fld, problem = row[:7]
     xfail = row[7] if len(row) > 7 else ""
@@ -631,7 +897,11 @@ SYNTH_ROWS = {row[0]: row for row in SYNTH}
 REAL_ROWS = {row[0]: row for row in REAL_CASES}
 #: ``history`` runs a subset: the defects of each format that a user meets most.
 HISTORY_SYNTH = [r for r in SYNTH if not r[0].endswith(("-as-csv", "-text", "-dt-given-too"))]
-HISTORY_REAL = [r for r in REAL_CASES if r[0].endswith(("-good", "-truncated", "-nan-sample"))]
+HISTORY_REAL = [
+    r
+    for r in REAL_CASES
+    if r[0].endswith(("-good", "-truncated", "-nan-sample")) or r[0] in HISTORY_HEADER
+]
 CASES = (
     [_synth_case(r, "record") for r in SYNTH]
     + [_synth_case(r, "history") for r in HISTORY_SYNTH]

@@ -723,3 +723,45 @@ def test_the_body_depth_limit_is_the_json_parsers(depth: int) -> None:
 
 def test_rest_corpus_is_large() -> None:
     assert len(CASES) >= 100
+
+
+#: #25: a record's plausibility on ``/assess``, as ``rockmech assess`` checks a record file.
+ASSESS_BASE: dict[str, Any] = {
+    "constants": WALLS,
+    "site": json.loads((REPO / "examples" / "sites" / "ntc_site.json").read_text()),
+    "multiples": [1.0],
+}
+
+
+@pytest.mark.parametrize(
+    ("pga_g", "status", "expect"),
+    [
+        # implausible (wrong units, or a scaled copy): assessed, with the warning naming them
+        (342.0, 200, r"^PGA 342 g is outside the plausible range \[0\.001, 5\] g \(read in g\)"),
+        # impossible (above ACCEL_MAX_G in the record's units): 422 naming the samples
+        (5000.0, 422, r"above the largest acceleration a record may hold \(1000 g"),
+    ],
+)
+def test_assess_checks_each_record_as_the_cli_does(
+    client: httpx.Client, pga_g: float, status: int, expect: str
+) -> None:
+    record = {**RECORD, "accel": [round(a / 0.3 * pga_g, 6) for a in RECORD["accel"]]}
+    res = client.post(
+        "/api/v1/assess", json={**ASSESS_BASE, "records": [record]}, timeout=CASE_SECONDS + 5
+    )
+    assert res.status_code == status, res.text[:500]
+    doc = res.json()
+    if status == 200:
+        warnings = doc["records"][0]["warnings"]
+        assert len(warnings) == 1 and re.search(expect, warnings[0]), warnings
+        # and the assessment page states it beside the records
+        page = client.post(
+            "/api/v1/assess",
+            json={**ASSESS_BASE, "records": [record], "format": "html"},
+            timeout=CASE_SECONDS + 5,
+        )
+        assert page.status_code == 200, page.text[:500]
+        assert re.search(r"record record: " + expect[1:], page.text), page.text[:2000]
+    else:
+        assert doc["field"] == "records[0].accel", doc
+        assert re.search(expect, doc["detail"]), doc

@@ -180,6 +180,51 @@ def _obj_two_named_wall(tmp: Path) -> Path:
     return path
 
 
+def _ply_edited(old: bytes, new: bytes, encoding: str = "ascii") -> Writer:
+    """The wall as a PLY file (``encoding`` ascii or binary) with its header edited."""
+
+    def write(tmp: Path) -> Path:
+        path = tmp / "wall.ply"
+        data = trimesh.Trimesh(WALL[0], WALL[1], process=False).export(
+            file_type="ply", encoding=encoding
+        )
+        data = data.encode() if isinstance(data, str) else data
+        assert old in data, old
+        path.write_bytes(data.replace(old, new, 1))
+        return path
+
+    return write
+
+
+def _obj_face_out_of_range(tmp: Path) -> Path:
+    path = tmp / "wall.obj"
+    v, f = WALL
+    lines = [f"v {x} {y} {z}" for x, y, z in v.tolist()]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in f.tolist()]
+    lines[-1] = "f 1 2 99"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _degenerate(mesh: Mesh) -> Mesh:
+    """The mesh with two zero-area faces added (a repeated corner each)."""
+    return mesh[0], np.vstack([mesh[1], [[0, 0, 1], [2, 3, 3]]])
+
+
+def _two_faces_flipped(mesh: Mesh) -> Mesh:
+    f = mesh[1].copy()
+    f[[0, 5]] = f[[0, 5]][:, ::-1]
+    return mesh[0], f
+
+
+#: A georeferenced position (UTM zone 33N easting and northing, height) [m].
+UTM = np.array([500000.0, 4649776.0, 120.0])
+
+
+def _moved(mesh: Mesh, by: Any) -> Mesh:
+    return mesh[0] + np.asarray(by, dtype=float), mesh[1]
+
+
 SPEC_3DM = {
     "mechanisms": [
         {
@@ -208,6 +253,14 @@ SPEC_SCAN_ANY = {
 }
 
 
+#: The wall 1 m off the origin, in mm, with its axis written in m (its base edge at x = 1.5 m).
+SPEC_SCAN_OFFSET = {
+    "mechanisms": [
+        {**SPEC_SCAN["mechanisms"][0], "axis": {"start": [1.5, 0.0, 0.0], "end": [1.5, 1.0, 0.0]}}
+    ]
+}
+
+
 def _right_wall(d: Any) -> bool:
     """The answer of the 0.5 x 3 m wall: p_eq and alpha."""
     side = d["mechanisms"][0]["positive"]
@@ -217,7 +270,16 @@ def _right_wall(d: Any) -> bool:
 #: (id, writer, spec, extra argv, expect, field, problem[, xfail[, isolate]])
 SCENE_CASES: list[tuple[Any, ...]] = [
     ("3dm-good-mesh", _3dm(_wall_scene), SPEC_3DM, [], "ok", "", ""),
-    ("3dm-inverted-mesh", _3dm(lambda: _wall_scene(_inverted(WALL))), SPEC_3DM, [], "ok", "", ""),
+    (
+        # #25: the repair the docs promise is said, in the constants file's warnings too
+        "3dm-inverted-mesh",
+        _3dm(lambda: _wall_scene(_inverted(WALL))),
+        SPEC_3DM,
+        [],
+        "warn",
+        "",
+        r"warning: W: wall: faced inward \(inside out\); all 12 faces were reversed",
+    ),
     ("3dm-empty-file", _bytes("scene.3dm", lambda t: b""), SPEC_3DM, [], "error", "scene", "."),
     (
         "3dm-random-bytes",
@@ -537,6 +599,118 @@ SCENE_CASES += [
 ]
 
 
+SCENE_CASES += [
+    # #25: scan files that promise what they do not hold, and units that do not fit
+    (
+        "scan-obj-face-index-out-of-range",
+        _obj_face_out_of_range,
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "scene",
+        r"wall\.obj: a face refers to vertex 99, but the file defines 8 vertices .*export",
+    ),
+    (
+        "scan-ply-header-more-vertices",
+        _ply_edited(b"element vertex 8", b"element vertex 12"),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "scene",
+        r"the PLY header promises 12 vertices and 12 faces \(24 data lines\), but the file has "
+        r"20 data lines: it is truncated or its header was edited",
+    ),
+    (
+        # was read as 12 faces without a word
+        "scan-ply-header-more-faces",
+        _ply_edited(b"element face 12", b"element face 13"),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "scene",
+        r"promises 8 vertices and 13 faces \(21 data lines\), but the file has 20",
+    ),
+    (
+        "scan-ply-binary-header-more-vertices",
+        _ply_edited(b"element vertex 8", b"element vertex 9", "binary"),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "scene",
+        r"promises 9 vertices and 12 faces, but the \d+ bytes of binary data after it",
+    ),
+    (
+        # a mm scan read as m: the axis misses a body of kilometres, and the error says why
+        "scan-ply-mm-read-as-m-axis-misses",
+        _scan("ply", _moved(WALL, (1.0, 0.0, 0.0)), 1000.0),
+        SPEC_SCAN_OFFSET,
+        ["--units", "m"],
+        "error",
+        "W",
+        r"the axis does not touch the body .*3202 m across as read in meters.*if the file is in "
+        r"mm, give units mm \(--units mm\)",
+    ),
+    (
+        "scan-ply-mm-offset",
+        _scan("ply", _moved(WALL, (1.0, 0.0, 0.0)), 1000.0),
+        SPEC_SCAN_OFFSET,
+        ["--units", "mm"],
+        "ok",
+        "",
+        "",
+    ),
+    (
+        "scan-ply-georeferenced",
+        _scan("ply", _moved(WALL, UTM)),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "wall",
+        r"4\.64978e\+06 meters is beyond .* but the object is only 3\.202 meters across: its "
+        r"coordinates are georeferenced .*Move the model to a local origin .*subtracting about "
+        r"\(500000, 4649780, 120\) meters",
+    ),
+    (
+        "scan-ply-inward",
+        _scan("ply", _inverted(WALL)),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "warn",
+        "",
+        r"warning: W: wall: faced inward \(inside out\); all 12 faces were reversed",
+    ),
+    (
+        "scan-ply-inconsistent-winding",
+        _scan("ply", _two_faces_flipped(WALL)),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "warn",
+        "",
+        r"warning: W: wall: 2 of its 12 faces were reversed to make the winding consistent",
+    ),
+    (
+        "scan-stl-degenerate-faces",
+        _scan("stl", _degenerate(WALL)),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "warn",
+        "",
+        r"warning: W: wall: removed 2 degenerate faces \(zero area",
+    ),
+]
+
+
+def _right_wall_said(pattern: str) -> Callable[[Any], bool]:
+    """The right wall, with the repair warning in the constants file (provenance) too."""
+
+    def check(d: Any) -> bool:
+        notes = d["mechanisms"][0]["provenance"].get("warnings", [])
+        said = any(re.search(pattern.split("W: ", 1)[1], n) for n in notes)
+        return _right_wall(d) and said
+
+    return check
+
+
 def _case(row: tuple[Any, ...]) -> Case:
     cid, _w, _spec, extra, expect, fld, problem = row[:7]
     xfail = row[7] if len(row) > 7 else ""
@@ -546,6 +720,10 @@ def _case(row: tuple[Any, ...]) -> Case:
     if expect == "ok":
         argv.append("--json")
         check = _right_wall
+    elif expect == "warn" and "W: " in problem:
+        # a repaired mesh: the right answer, and the repair in the file's warnings
+        argv.append("--json")
+        check = _right_wall_said(problem)
     return Case(cid, argv, expect, fld, problem, check=check, xfail=xfail, isolate=isolate)
 
 

@@ -69,6 +69,15 @@ def test_local_history_equals_the_cli(tmp_path: Path) -> None:
     assert len(result.summary) == len(want_rows)
 
 
+def test_history_states_the_record_warning_first(tmp_path: Path) -> None:
+    # El Centro (in g) read as cm/s2: PGA 0.000356 g, the warning the CLI prints (#25)
+    cf = load_constants_files([str(WALLS)])
+    result = run_history(cf, str(RECORD), units="cm/s2", scales=[1.0], out_dir=str(tmp_path))
+    assert result.summary[0].startswith("  warning: record: PGA 0.000356 g is outside"), result
+    assert "(read in cm/s2)" in result.summary[0]
+    assert len(result.summary) == 1 + len(result.doc["results"])
+
+
 def test_local_pulse_equals_the_cli() -> None:
     cf = load_constants_files([str(WALLS)])
     mech = cf.mechanisms[0]

@@ -38,7 +38,7 @@ def test_units_are_converted_to_si(tmp_path: Path, units: str, factor: float) ->
         ("0 0.1\n0.04 0.2\n0.02 0.3\n", "strictly increasing"),
         ("0 0.1\n0.02 0.2\n0.05 0.3\n", "not uniform"),
         ("0 0.1\n", "at least 2 samples"),
-        ("", "at least 2 samples"),
+        ("", r"is empty \(0 bytes\): expected a ground-motion record"),
         ("0 0.1 7\n0.02 0.2 7\n", "expected 2 columns"),
         ("0 0.1\n0.02 abc\n", "not a number"),
     ],
@@ -226,7 +226,7 @@ def test_csv_without_time_column_uses_dt(tmp_path: Path) -> None:
         ("t,a\n0,1\n0.1\n", {}, "record", "line 3: expected 2 columns"),
         ("t,a\n0,1\n0.1,x\n", {}, "record", "line 3: not a number"),
         ("t,a\n", {}, "record", "at least 2 samples"),
-        ("", {}, "record", "at least 2 samples"),
+        ("", {}, "record", r"is empty \(0 bytes\)"),
         ("t,a\n0,1\n0.1,2\n", {"dt": -1.0}, "dt", "> 0"),
     ],
 )
@@ -367,12 +367,16 @@ def test_an_implausible_record_gets_a_warning_naming_its_units(
     path = tmp_path / "rec.dat"
     np.savetxt(path, np.column_stack([t, amplitude * np.sin(t)]))
     motion = GroundMotion.from_file(path, units=units)
+    # the PGA warning names the acceleration units read; the time step's names seconds and
+    # where the step came from, never the acceleration units (#25)
+    said = f"read in {units}" if expect == "PGA" else "read as seconds from the time column"
     if expect is None:
         assert motion.warnings == []
     else:
-        assert any(expect in w and f"read in {units}" in w for w in motion.warnings), (
-            motion.warnings
-        )
+        notes = [w for w in motion.warnings if w.startswith(expect) or f"{expect} =" in w]
+        assert notes and all(said in w for w in notes), motion.warnings
+        if expect == "dt":
+            assert not any(f"read in {units}" in w for w in notes), notes
 
 
 def test_a_record_starting_before_zero_is_refused_by_the_solver_view() -> None:

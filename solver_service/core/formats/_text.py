@@ -20,6 +20,7 @@ from shared_schema.errors import InputError
 __all__ = [
     "Channel",
     "check_count",
+    "check_duration",
     "check_peak",
     "decimals",
     "first_number",
@@ -153,6 +154,29 @@ def check_count(values: NDArray[np.float64], npts: int, name: str) -> None:
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
         raise InputError(f"{name}: sample {int(bad[0])} is not finite", "record")
+
+
+def check_duration(stated: str, npts: int, dt: float, name: str, label: str) -> float:
+    """Check a header's record length [s] against its sample count and time step.
+
+    Headers write the length as ``npts x dt`` or ``(npts - 1) x dt``; either is accepted
+    within half a unit of the printed value's last digit (and ``PEAK_RTOL``).
+
+    Raises
+    ------
+    InputError
+        The stated length is neither (field ``record``, naming ``label`` and both values).
+    """
+    value = number(stated, f"{name} {label}")
+    tol = 0.5 * 10.0 ** (-decimals(stated)) + PEAK_RTOL * abs(value)
+    if min(abs(value - npts * dt), abs(value - (npts - 1) * dt)) > tol:
+        raise InputError(
+            f"{name}: {label} is {stated.strip()} s, but {npts} samples at {dt:g} s last "
+            f"{npts * dt:.10g} s: the header's sample count, time step or length was edited "
+            "or the file is damaged; download it again",
+            "record",
+        )
+    return value
 
 
 def decimals(token: str) -> int:

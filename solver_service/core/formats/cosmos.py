@@ -9,9 +9,12 @@ Velocity or displacement channels in the same file are skipped.
 Notes
 -----
 Fields used (1-based as in the COSMOS format document, v1.20): integer 1 processing stage
-(2 = corrected), 2 data type (1 = acceleration), 3 units code (2 g, 4 cm/s², 10 gal,
-11 mg, 7 in/s²); real 62 sampling interval [ms], 64 peak value and 65 its time [s]; -999 is
-"unknown". Reference: COSMOS Strong Motion Data Format, v1.20 (2001); ``gmprocess.io.cosmos``.
+(2 = corrected), 2 data type (1 = acceleration); the data line's units code (2 g, 4 cm/s²,
+10 gal, 11 mg, 7 in/s²); real 62 sampling interval [ms], 63 series length [s], 64 peak value
+and 65 its time [s]; -999 is "unknown". Every one is checked against the data: each block's
+Fortran format against its count and lines, the count against the samples, the length and
+the data line's ``approx ... secs`` against count x interval, the peak against the samples.
+Reference: COSMOS Strong Motion Data Format, v1.20 (2001); ``gmprocess.io.cosmos``.
 """
 
 from __future__ import annotations
@@ -20,7 +23,15 @@ import re
 
 from shared_schema.errors import InputError
 
-from ._text import Channel, check_count, check_peak, fixed_width_values, units_from_text
+from ._text import (
+    Channel,
+    check_count,
+    check_duration,
+    check_peak,
+    fixed_width_values,
+    number,
+    units_from_text,
+)
 
 __all__ = ["read", "sniff"]
 
@@ -34,6 +45,13 @@ _BLOCK = re.compile(
     r"Format\s*=\s*\((\d+)[IFE](\d+)(?:\.(\d+))?",
     re.IGNORECASE,
 )
+#: Fields of each header that the reader uses: the last one (1-based) and what they are.
+_USED = {"integer": 2, "real": 65}
+_USED_NAMES = {
+    "integer": "processing stage and data type",
+    "real": "62 sampling interval, 63 series length, 64 peak and 65 its time",
+}
+_APPROX = re.compile(r"approx\s+([-+0-9.Ee]+)\s*sec", re.IGNORECASE)
 _COMMENTS = re.compile(r"^\s*(\d+)\s+Comment line\(s\) follow", re.IGNORECASE)
 _DATA = re.compile(
     r"^\s*(\d+)\s+(\w+)\s+pts,.*units\s*=\s*([^(,]*)\((\d+)\)\s*,\s*"
@@ -48,12 +66,54 @@ def sniff(head: str) -> bool:
     return _FIRST.search(first) is not None
 
 
+def _layout(text: str, count: int, per_line: int, width: int, nlines: int, where: str) -> None:
+    """Refuse a Fortran format ``(nFw.d)`` that cannot lay ``count`` values on ``nlines`` lines.
+
+    Raises
+    ------
+    InputError
+        ``n`` or ``w`` is 0, or ``nlines`` is not the lines that ``count`` values take at
+        ``n`` a line (field ``record``, quoting the line).
+    """
+    if per_line < 1 or width < 1:
+        raise InputError(
+            f"{where}: {text.strip()!r} gives {per_line} values a line of {width} characters; "
+            "a COSMOS format has at least 1 value a line, at least 1 character wide (e.g. "
+            "(5F15.6)); the header was edited or the file is damaged",
+            "record",
+        )
+    need = -(-count // per_line)
+    if nlines != need:
+        raise InputError(
+            f"{where}: {text.strip()!r}: {count} values at {per_line} a line take {need} lines, "
+            f"not {nlines}; the header was edited or the file is damaged",
+            "record",
+        )
+
+
 def _block(lines: list[str], i: int, name: str, kind: str) -> tuple[list[float], int, int]:
     """Read an integer or real header block at line index ``i``: values, next index, decimals."""
     match = _BLOCK.match(lines[i]) if i < len(lines) else None
     if match is None or match.group(2).lower() != kind:
         raise InputError(f"{name} line {i + 1}: expected the COSMOS {kind}-header line", "record")
-    count, nlines, width = int(match.group(1)), int(match.group(3)), int(match.group(5))
+    count, nlines = int(match.group(1)), int(match.group(3))
+    per_line, width = int(match.group(4)), int(match.group(5))
+    where = f"{name} line {i + 1}"
+    _layout(lines[i], count, per_line, width, nlines, where)
+    used = _USED[kind]
+    if count < used:
+        raise InputError(
+            f"{where}: the {kind} header has {count} values, but the COSMOS V2 format has "
+            f"100 and rockmech reads fields 1 to {used} ({_USED_NAMES[kind]}); the header "
+            "is cut short or the file is damaged",
+            "record",
+        )
+    if i + 1 + nlines > len(lines):
+        raise InputError(
+            f"{where}: the {kind} header takes {nlines} lines, but the file ends after "
+            f"{len(lines) - i - 1}; the file is truncated",
+            "record",
+        )
     rows = [(k + 1, lines[k]) for k in range(i + 1, i + 1 + nlines)]
     values = fixed_width_values(rows, width, count, f"{name} {kind} header")
     return [float(v) for v in values], i + 1 + nlines, int(match.group(6) or 0)
@@ -92,6 +152,9 @@ def read(text: str, name: str) -> list[Channel]:
             raise InputError(f"{name} line {i + 1}: expected the data line", "record")
         npts, width = int(data.group(1)), int(data.group(6))
         per_line = int(data.group(5))
+        where_line = f"{name} line {i + 1}"
+        _layout(lines[i], npts, per_line, width, -(-npts // max(per_line, 1)), where_line)
+        approx = _APPROX.search(lines[i])
         nrows = -(-npts // per_line)
         rows = [(k + 1, lines[k]) for k in range(i + 1, min(i + 1 + nrows, len(lines)))]
         i += 1 + nrows
@@ -114,9 +177,19 @@ def read(text: str, name: str) -> list[Channel]:
             raise InputError(
                 f"{where}: units {data.group(3).strip()!r} disagree with code {code}", "record"
             )
-        if reals[61] == UNKNOWN or reals[61] <= 0:
+        if reals[61] == UNKNOWN:
             raise InputError(f"{where}: real header 62 (sampling interval) is unknown", "record")
+        if reals[61] <= 0:
+            raise InputError(
+                f"{where}: real header 62 (sampling interval) must be > 0 ms, got "
+                f"{reals[61]:g}; the header was edited or the file is damaged",
+                "record",
+            )
         dt = reals[61] / 1000.0
+        if reals[62] != UNKNOWN:
+            check_duration(f"{reals[62]:.{digits}f}", npts, dt, where, "real header 63 (length)")
+        if approx is not None:
+            _check_approx(approx.group(1), npts, dt, where)
         values = fixed_width_values(rows, width, npts, where)
         check_count(values, npts, where)
         stated = None if reals[63] == UNKNOWN else f"{reals[63]:.{digits}f}"
@@ -141,3 +214,16 @@ def read(text: str, name: str) -> list[Channel]:
     if not channels:
         raise InputError(f"{name}: no acceleration channel in this COSMOS file", "record")
     return channels
+
+
+def _check_approx(stated: str, npts: int, dt: float, where: str) -> None:
+    """Check the data line's ``approx 210 secs`` against ``npts`` x ``dt`` (to 1 s or 1 %)."""
+    value = number(stated, f"{where} approx secs")
+    length = npts * dt
+    if abs(value - length) > max(1.0, 0.01 * length):
+        raise InputError(
+            f"{where}: the data line says approx {stated} secs, but {npts} points at real "
+            f"header 62's {dt * 1000.0:g} ms last {length:.6g} s: the point count, the sampling "
+            "interval or the file was edited; download it again",
+            "record",
+        )

@@ -13,7 +13,7 @@ import numpy as np
 from shared_schema.errors import InputError
 from shared_schema.rules import RECORD_UNITS
 
-from ._text import Channel, check_count, check_peak, number, units_from_text
+from ._text import Channel, check_count, check_duration, check_peak, number, units_from_text
 
 __all__ = ["read", "sniff"]
 
@@ -35,7 +35,8 @@ def read(text: str, name: str) -> list[Channel]:
     ------
     InputError
         A header key missing or unparsable, not an acceleration record, unknown units, a
-        sample count other than ``NDATA`` or a peak other than ``PGA_CM/S^2``.
+        sample count other than ``NDATA``, a ``DURATION_S`` other than ``NDATA`` x
+        ``SAMPLING_INTERVAL_S``, or a peak other than ``PGA_CM/S^2``.
     """
     lines = text.splitlines()
     header: dict[str, str] = {}
@@ -60,7 +61,12 @@ def read(text: str, name: str) -> list[Channel]:
     dt = number(need("SAMPLING_INTERVAL_S"), f"{name} SAMPLING_INTERVAL_S")
     if dt <= 0:
         raise InputError(f"{name}: SAMPLING_INTERVAL_S must be > 0, got {dt}", "record")
-    npts = int(number(need("NDATA"), f"{name} NDATA"))
+    ndata = number(need("NDATA"), f"{name} NDATA")
+    if ndata != int(ndata) or ndata < 2:
+        raise InputError(f"{name}: NDATA must be a whole number >= 2, got {ndata:g}", "record")
+    npts = int(ndata)
+    if header.get("DURATION_S"):
+        check_duration(header["DURATION_S"], npts, dt, name, "DURATION_S")
     units = units_from_text(need("UNITS"), f"{name} UNITS")
     samples = [
         number(tok, f"{name} line {k}")

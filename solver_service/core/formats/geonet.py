@@ -10,7 +10,8 @@ Notes
 -----
 Header fields used (0-based row, column of the 10 x 10 block): (3, 3), (3, 4), (3, 5) the
 acceleration, velocity and displacement counts; (6, 5) the sampling interval [s]. Samples
-are in mm/s². Reference: GeoNet strong-motion file formats
+are in mm/s². The text header's ``Number of points`` and ``data at ... sec intervals`` are
+checked against the numeric header. Reference: GeoNet strong-motion file formats
 (https://www.geonet.org.nz/data/supplementary/strong_motion_file_formats) and
 ``gmprocess.io.geonet``.
 """
@@ -21,7 +22,16 @@ import re
 
 from shared_schema.errors import InputError
 
-from ._text import Channel, check_count, check_peak, fixed_width_values, units_from_text
+from ._text import (
+    PEAK_RTOL,
+    Channel,
+    check_count,
+    check_peak,
+    decimals,
+    fixed_width_values,
+    number,
+    units_from_text,
+)
 
 __all__ = ["read", "sniff"]
 
@@ -32,6 +42,8 @@ HEADER_ROWS = 10
 #: Numbers per line and characters per number (Fortran 10F8.x).
 PER_LINE, FIELD_WIDTH = 10, 8
 _PEAK = re.compile(r"^Acceleration:\s*peak\s+([-+0-9.Ee]+)\s+(\S+)", re.IGNORECASE)
+_POINTS = re.compile(r"^Number of points\s+(\d+)", re.IGNORECASE)
+_INTERVAL = re.compile(r"data at\s+([-+0-9.Ee]+)\s+sec intervals", re.IGNORECASE)
 _COMPONENT = re.compile(r"^Component\s+(\S+)\s*(.*)$", re.IGNORECASE)
 
 
@@ -63,10 +75,19 @@ def read(text: str, name: str) -> list[Channel]:
         text_header = lines[i : i + TEXT_LINES]
         rows = [(k + 1, lines[k]) for k in range(i + TEXT_LINES, i + TEXT_LINES + HEADER_ROWS)]
         head = fixed_width_values(rows, FIELD_WIDTH, HEADER_ROWS * PER_LINE, f"{where} header")
-        n_acc, n_vel, n_disp = (int(head[3 * PER_LINE + c]) for c in (3, 4, 5))
+        counts = [float(head[3 * PER_LINE + c]) for c in (3, 4, 5)]
+        bad = next((c for c in counts if c != int(c) or c < 0), None)
+        if bad is not None:
+            raise InputError(
+                f"{where}: the header's sample counts (row 4, fields 4-6) must be whole numbers "
+                f">= 0, got {bad:g}; the header was edited or the file is damaged",
+                "record",
+            )
+        n_acc, n_vel, n_disp = (int(c) for c in counts)
         dt = float(head[6 * PER_LINE + 5])
         if dt <= 0:
             raise InputError(f"{where}: header sampling interval must be > 0, got {dt}", "record")
+        _check_text_header(text_header, n_acc, dt, where)
         peak_line = _PEAK.match(text_header[13])
         if peak_line is None:
             raise InputError(f"{where}: no 'Acceleration: peak' line", "record")
@@ -94,3 +115,31 @@ def read(text: str, name: str) -> list[Channel]:
     if not channels:
         raise InputError(f"{name}: no GeoNet component", "record")
     return channels
+
+
+def _check_text_header(text_header: list[str], n_acc: int, dt: float, where: str) -> None:
+    """Check the text header's ``Number of points`` and ``data at 0.020 sec intervals``.
+
+    They state the count and the time step that the numeric header gives the reader; a
+    disagreement means an edited or damaged header (lines a file lacks are not checked).
+    """
+    for line in text_header:
+        points = _POINTS.match(line)
+        if points is not None and int(points.group(1)) != n_acc:
+            raise InputError(
+                f"{where}: the text header says 'Number of points {points.group(1)}', but the "
+                f"numeric header (row 4, field 4) says {n_acc}; the header was edited or the "
+                "file is damaged",
+                "record",
+            )
+        interval = _INTERVAL.search(line)
+        if interval is not None:
+            stated = interval.group(1)
+            tol = 0.5 * 10.0 ** (-decimals(stated)) + PEAK_RTOL * dt
+            if abs(number(stated, f"{where} interval") - dt) > tol:
+                raise InputError(
+                    f"{where}: the text header says data at {stated} sec intervals, but the "
+                    f"numeric header (row 7, field 6) says {dt:g} s; the header was edited or "
+                    "the file is damaged",
+                    "record",
+                )
