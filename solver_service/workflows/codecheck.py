@@ -281,13 +281,14 @@ def _free_standing(
             w, sources["W"] = rho * G, "the geometry's density × g"
     e = opts.E or site.local_mechanisms.E
     sources["E"] = f"site {where}.E" if opts.E else "site local_mechanisms.E"
+    given = {"kappa": kappa, "L": L, "t": t, "W": w, "E": e}
     free = FreeStanding(
         kappa=kappa,
         L=L,
         t=t,
         W=w,
         E=e,
-        sources={k: v for k, v in sources.items() if k == "kappa" or locals().get(k) is not None},
+        sources={k: v for k, v in sources.items() if given[k] is not None},
     )
     if free.missing:
         info["missing"] = free.missing
