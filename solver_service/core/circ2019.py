@@ -103,6 +103,9 @@ RECORD_POINTS = 40
 #: 0 to PEAK_SCAN_S [s] in PEAK_SCAN_POINTS (the code spectra peak on their plateau, far
 #: below 6 s; a floor spectrum peaks near its building's period).
 PEAK_SCAN_S, PEAK_SCAN_POINTS = 6.0, 1201
+#: The demand spectrum reported in ADRS form: ADRS_POINTS log-spaced periods from ADRS_T_MIN
+#: to the larger of ADRS_T_MAX and 1.5 T of the limit state [s].
+ADRS_T_MIN, ADRS_T_MAX, ADRS_POINTS = 0.02, 6.0, 120
 #: Points of the reported capacity curve.
 CURVE_POINTS = 201
 
@@ -704,6 +707,14 @@ def _limit_state(
             out["a_g_capacity"] = ratio_sld * a_g
     out["capacity_ratio"] = ratio
     out["passes"] = bool(ratio >= 1.0) if evaluated else None
+    # The demand spectrum in ADRS form (for the report's plot): d(T) and a = d (2π/T)².
+    t = np.geomspace(ADRS_T_MIN, max(ADRS_T_MAX, 1.5 * period), ADRS_POINTS)
+    d_spec, _ = demand.displacement(t, xi_percent)
+    out["adrs"] = {
+        "T": t.tolist(),
+        "d": d_spec.tolist(),
+        "a": (d_spec * (2.0 * math.pi / t) ** 2).tolist(),
+    }
     out["clauses"] = {k: CL_LS[k] for k in out if k in CL_LS}
     if rec_v is None:
         out["clauses"].pop("demand_records", None)
