@@ -183,8 +183,9 @@ def check_site_inputs(cf: ConstantsFile, site: SiteFile) -> None:
     ------
     InputError
         ``local_mechanisms.mechanisms`` names a mechanism the constants do not have; or the
-        site's ``building.T1`` differs by more than ``T1_TOLERANCE`` from a mechanism's
-        ``1/f_n`` (one T1 decides the check: remove one or make them agree).
+        site's ``building.T1`` differs by more than ``T1_TOLERANCE`` from the ``1/f_n`` of a
+        mechanism above ground that the check can run on (one T1 decides the check: remove
+        one or make them agree).
     """
     ids = {m.id for m in cf.mechanisms}
     for key in site.local_mechanisms.mechanisms:
@@ -197,8 +198,10 @@ def check_site_inputs(cf: ConstantsFile, site: SiteFile) -> None:
     if b is None or b.T1 is None:
         return
     for m in cf.mechanisms:
-        if m.amplification is None:
+        if m.amplification is None or m.amplification.h <= 0.0:
             continue
+        if all(side.virtual_work is None for _, side in _sides(m)):
+            continue  # its check does not run: T1 is not used for it
         t_fn = 1.0 / m.amplification.f_n
         if abs(t_fn - b.T1) > T1_TOLERANCE * b.T1:
             raise InputError(
