@@ -51,7 +51,7 @@ LIMIT_STATES = ("SLO", "SLD", "SLV", "SLC")
 LimitState = Literal["SLO", "SLD", "SLV", "SLC"]
 
 
-def _no_duplicate_limit_state(main: str, others: Optional[Mapping[str, Any]]) -> None:
+def _no_duplicate_limit_state(main: str, others: Optional[Mapping[Any, Any]]) -> None:
     """Refuse ``limit_states`` repeating the limit state the main hazard already gives."""
     if others and main in others:
         raise PydanticCustomError(

@@ -64,6 +64,8 @@ __all__ = [
     "KAPPA_CANTILEVER",
     "KAPPA_SIMPLY_SUPPORTED",
     "Q_DEFAULT",
+    "RECORD_POINTS",
+    "T_RECORD_MIN",
     "XI_SLC",
     "XI_SLD",
     "XI_SLV",
@@ -648,12 +650,14 @@ def _record_demand(
         periods = np.array([t_hi])
     else:
         periods = np.geomspace(lo, t_hi, RECORD_POINTS)
-    rows = []
+    rows: list[dict[str, Any]] = []
+    largest = 0.0
     for rec in records:
         disp, _ = rec.displacement(periods, xi_percent)
         k = int(np.argmax(disp))
+        largest = max(largest, float(disp[k]))
         rows.append({"record": rec.label, "demand": float(disp[k]), "at_T": float(periods[k])})
-    return max(r["demand"] for r in rows), rows
+    return largest, rows
 
 
 def _limit_state(

@@ -162,7 +162,7 @@ def floor_acceleration(se_ground: GroundSpectrum, model: FloorModel) -> dict[str
 
 def _peak_factor(model: FloorModel, xi_percent: float) -> float:
     # [C7.2.6], [C7.2.9]: 1.1 ξ_k^-0.5 η(ξ), ξ_k as a fraction, η of the mechanism's ξ.
-    return PEAK_FACTOR * model.xi_k_fraction**-0.5 * damping_eta(xi_percent)
+    return float(PEAK_FACTOR * model.xi_k_fraction**-0.5 * damping_eta(xi_percent))
 
 
 def floor_spectrum(

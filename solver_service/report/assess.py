@@ -169,8 +169,7 @@ def _plot_capacity(lin: dict[str, Any], non: dict[str, Any], spectrum: Any, path
                 ls="--",
                 lw=1.0,
                 label=(
-                    f"d_{name} = {ls['d']:.3g} m: {word}, ratio "
-                    f"{ls['capacity_ratio']:.3g}{bound}"
+                    f"d_{name} = {ls['d']:.3g} m: {word}, ratio {ls['capacity_ratio']:.3g}{bound}"
                 ),
             )
             ax.plot([ls["d"]], [ls["a"]], "s", color=color, ms=5)
@@ -257,9 +256,9 @@ def _check_rows(check: dict[str, Any]) -> list[dict[str, str]]:
             ("a_y", "a_y", "m/s²"),
         ):
             add(label, key, unit)
+    units = {"T1": "s", "T_k": "s", "xi_k_percent": "%", "a_Z_g": "g", "Se_Tk_g": "g"}
     for key, value in (check.get("floor") or {}).items():
-        unit = {"T1": "s", "T_k": "s", "xi_k_percent": "%", "a_Z_g": "g", "Se_Tk_g": "g"}
-        rows.append(_row(f"floor {key}", value, unit.get(key, "-"), cl.get(f"floor.{key}", "")))
+        rows.append(_row(f"floor {key}", value, units.get(key, "-"), cl.get(f"floor.{key}", "")))
     if "SLV" not in check:  # the linear check
         add("q", "q", "-")
         rows.append(

@@ -16,7 +16,7 @@ other are refused (``check_site_inputs``).
 from __future__ import annotations
 
 import math
-from typing import Any, Optional, Sequence
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
@@ -330,7 +330,8 @@ def _tie_terms(mech: Mechanism, side: SideConstants) -> Optional[dict[str, Any]]
     pos = geo.get("positive") if isinstance(geo, dict) else None
     if not isinstance(loaded, dict) or not isinstance(pos, dict):
         return None
-    ties = [e for e in loaded.get("elements") or [] if isinstance(e, dict)]
+    elements = loaded.get("elements")
+    ties = [e for e in (elements if isinstance(elements, list) else []) if isinstance(e, dict)]
     ties = [e for e in ties if e.get("kind") == "tie_bar"]
     if not ties:
         return None
@@ -358,7 +359,7 @@ def _tie_terms(mech: Mechanism, side: SideConstants) -> Optional[dict[str, Any]]
     work_tie = 0.0
     listed = []
     for e in ties:
-        force = float(e.get("force_N", 0.0))
+        force = _number(e, "force_N") or 0.0
         z, horiz = plane(np.asarray(e.get("at_m"), dtype=float))
         x = float(np.dot(horiz, inward))
         m_f_tie += -force * (z * math.cos(a_c) + x * math.sin(a_c))
@@ -498,11 +499,15 @@ class _Context:
         self.main = main
         self.t1: Optional[float] = None
         self.t1_source: Optional[str] = None
-        if site.building is not None or any(m.amplification for m in cf.mechanisms):
+        try:
             self.t1, self.t1_source = building_period(site, cf)
+        except InputError:
+            pass  # no building and no (single) 1/f_n: the demand at height needs a building
+        if site.building is None and self.t1 is not None:
+            self.t1_source = (self.t1_source or "") + "; the demand at height needs a building"
 
     def limit_states(self) -> dict[str, Any]:
-        out = {}
+        out: dict[str, Any] = {}
         for name, sp in (("SLV", self.slv if self.slv_given else None), ("SLC", self.slc)):
             if sp is None:
                 out[name] = None
@@ -618,11 +623,14 @@ def _side_checks_2009(
     b = ctx.site.building
     bld = None if b is None or ctx.t1 is None else Building(b.height, int(b.storeys), ctx.t1)
     hz = ctx.site.hazard
-    out = []
-    for run in (
+    phi_ov = side.phi_ov
+    assert phi_ov is not None  # filled in by validation
+    runs: list[Callable[[], dict[str, Any]]] = [
         lambda: linear_check(vw, ctx.slv, FC=hz.FC, q=hz.q, Z=z, building=bld),
-        lambda: nonlinear_check(vw, side.phi_ov, ctx.slv, FC=hz.FC, Z=z, building=bld),
-    ):
+        lambda: nonlinear_check(vw, phi_ov, ctx.slv, FC=hz.FC, Z=z, building=bld),
+    ]
+    out = []
+    for run in runs:
         try:
             res = run()
             res["status"] = "ok"
