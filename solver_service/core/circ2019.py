@@ -725,6 +725,45 @@ def _limit_state(
     return out
 
 
+def _thresholds(
+    curve: CapacityCurve, instability_rotation: Optional[float]
+) -> tuple[tuple[float, str], tuple[float, str], list[str]]:
+    """Return ``(d_SLV, rule)``, ``(d_SLC, rule)`` and notes (§C8.7.1.2.1.6)."""
+    notes: list[str] = []
+    d0 = curve.d0
+    candidates = [(D_SLV_FRACTION * d0, "0.4 d0 (C8.7.1.2.1.6)")]
+    if curve.before is not None:
+        d_b = curve.before[2] * curve.d_per_rad
+        drop = float(
+            curve._rigid(np.array([d_b * (1 - 1e-12)]))[0] - curve._rigid(np.array([d_b]))[0]
+        )
+        peak = curve.peak()
+        if drop > BREAK_DROP_FRACTION * peak:
+            candidates.append(
+                (
+                    d_b,
+                    "the ties break (C8.7.1.2.1.6: capacity loss "
+                    f"{drop / peak:.0%} of the peak > 50 %)",
+                )
+            )
+        else:
+            notes.append(
+                f"the ties break at d = {d_b:.4g} m with a capacity loss of {drop / peak:.0%} of "
+                "the peak (not more than 50 %): not an SLV threshold (C8.7.1.2.1.6)"
+            )
+    d_slv, rule_slv = min(candidates)
+    slc_candidates = [(D_SLC_FRACTION * d0, "0.6 d0 (C8.7.1.2.1.6)")]
+    if instability_rotation is not None:
+        slc_candidates.append(
+            (
+                check_positive(instability_rotation, "instability_rotation") * curve.d_per_rad,
+                "local instability (C8.7.1.2.1.6, given)",
+            )
+        )
+    d_slc, rule_slc = min(slc_candidates)
+    return (d_slv, rule_slv), (d_slc, rule_slc), notes
+
+
 def nonlinear_check_2019(
     vw: VirtualWork,
     curve: CapacityCurve,
@@ -778,38 +817,8 @@ def nonlinear_check_2019(
     """
     _, e_star = participating_mass(vw)
     a_g_slv = check_positive(a_g_slv, "a_g")
-    notes: list[str] = []
     d0 = curve.d0
-    candidates = [(D_SLV_FRACTION * d0, "0.4 d0 (C8.7.1.2.1.6)")]
-    if curve.before is not None:
-        d_b = curve.before[2] * curve.d_per_rad
-        drop = float(
-            curve._rigid(np.array([d_b * (1 - 1e-12)]))[0] - curve._rigid(np.array([d_b]))[0]
-        )
-        peak = curve.peak()
-        if drop > BREAK_DROP_FRACTION * peak:
-            candidates.append(
-                (
-                    d_b,
-                    "the ties break (C8.7.1.2.1.6: capacity loss "
-                    f"{drop / peak:.0%} of the peak > 50 %)",
-                )
-            )
-        else:
-            notes.append(
-                f"the ties break at d = {d_b:.4g} m with a capacity loss of {drop / peak:.0%} of "
-                "the peak (not more than 50 %): not an SLV threshold (C8.7.1.2.1.6)"
-            )
-    d_slv, rule_slv = min(candidates)
-    slc_candidates = [(D_SLC_FRACTION * d0, "0.6 d0 (C8.7.1.2.1.6)")]
-    if instability_rotation is not None:
-        slc_candidates.append(
-            (
-                check_positive(instability_rotation, "instability_rotation") * curve.d_per_rad,
-                "local instability (C8.7.1.2.1.6, given)",
-            )
-        )
-    d_slc, rule_slc = min(slc_candidates)
+    (d_slv, rule_slv), (d_slc, rule_slc), notes = _thresholds(curve, instability_rotation)
     t0 = curve.T0 or 0.0
     # a_g,SLD on the SLV spectrum (for the lower bound of C8.7.1.2.1.8).
     dem_act, act_rule, _ = _activation_demand(demand_slv, free)
