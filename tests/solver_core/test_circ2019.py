@@ -486,3 +486,53 @@ def test_issue_t1_and_long_period_numbers_with_the_2009_forms() -> None:
     assert out[None]["demand_height"] == pytest.approx(0.0922, abs=1e-4)
     assert out[0.6]["demand_height"] == pytest.approx(0.1653, abs=1e-4)
     assert out[0.6]["demand"] == pytest.approx(0.1653, abs=1e-4)  # the 2009 governing 0.165
+
+
+# --- the records' demand, C8.7.1.2.1.8 --------------------------------------------------
+
+
+def test_records_demand_is_the_largest_over_t0_to_t_slv() -> None:
+    """A record with its energy at 0.8 s: the largest S_De over [T0, T_SLV] is there."""
+    from solver_service.core.circ2019 import (
+        RECORD_POINTS,
+        CapacityCurve,
+        CodeDemand,
+        FreeStanding,
+        RecordDemand,
+        nonlinear_check_2019,
+    )
+    from solver_service.core.kinematic import VirtualWork
+    from solver_service.core.spectra import response_spectrum
+
+    b, h, m = 0.5, 6.0, RHO * 0.5 * 6.0 * 4.0
+    vw = VirtualWork(b / h, m, m * h / 2, m * h * h / 3)
+    free = FreeStanding(6.2, L=h, t=b, W=RHO * G, E=E_MASONRY)
+    curve = CapacityCurve(0.75, FC, 2 * h / 3, b / h, math.atan(b / h), T0=free.T0)
+    dt = 0.01
+    t = np.arange(0.0, 12.0, dt)
+    # Ten cycles of a cosine under a Hann window: no velocity drift, so the long periods see
+    # only the small ground displacement.
+    window = np.where(t < 8.0, np.sin(math.pi * t / 8.0) ** 2, 0.0)
+    acc = 0.2 * G * np.cos(2 * math.pi * t / 0.8) * window
+    record = RecordDemand(acc, dt, 1.0, "cosine 0.8 s")
+    out = nonlinear_check_2019(
+        vw,
+        curve,
+        CodeDemand(ntc_spectrum(A_G, F0, TC_STAR, soil="C")),
+        a_g_slv=A_G,
+        free=free,
+        records=[record],
+    )
+    slv = out["SLV"]
+    t0 = free.T0
+    assert t0 is not None
+    # The same grid by hand: RECORD_POINTS log-spaced periods from T0 to T_SLV, ξ = 8 %.
+    periods = np.geomspace(t0, slv["T_SLV"], RECORD_POINTS)
+    sd = response_spectrum(acc, dt, periods, 0.08).sd
+    assert slv["demand_records"] == pytest.approx(float(np.max(sd)), rel=1e-12)
+    assert slv["records"][0]["at_T"] == pytest.approx(0.8, rel=0.1)
+    assert t0 < 0.8 < slv["T_SLV"]  # inside [T0, T_SLV]
+    # The criterion matters: at T_SLV alone the record gives far less.
+    at_t_slv = float(response_spectrum(acc, dt, [slv["T_SLV"]], 0.08).sd[0])
+    assert slv["demand_records"] > 3.0 * at_t_slv
+    assert slv["demand"] == max(slv["demand_code"], slv["demand_records"])
