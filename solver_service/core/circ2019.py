@@ -155,6 +155,8 @@ CL_LS = {
     "a_g_capacity": _C + "C8.7.1.2.1.8 (the a_g that brings the mechanism to d)",
     "a_g_SLD": _C + "C8.7.1.2.1.5 (activation, spectrum shape held)",
     "capacity_ratio": _C + "C8.7.1.2.1.8: a_g,X/a_g (a_g,SLV not below a_g,SLD)",
+    "records": _C + "C8.7.1.2.1.8: each record's largest S_De over [T0, T] and where",
+    "adrs": _C + "C8.7.1.2.1.8: the demand spectrum of demand_rule, d and a = d (2π/T)²",
 }
 
 
@@ -720,6 +722,7 @@ def _limit_state(
         "a": (d_spec * (2.0 * math.pi / t) ** 2).tolist(),
     }
     out["clauses"] = {k: CL_LS[k] for k in out if k in CL_LS}
+    out["clauses"]["a_g_SLD"] = CL_LS["a_g_SLD"]
     if rec_v is None:
         out["clauses"].pop("demand_records", None)
     return out
@@ -899,7 +902,9 @@ def nonlinear_check_2019(
         if yp is not None:
             out["d_y"], out["a_y"] = yp
             clauses.update({"d_y": CL["d_y"], "a_y": CL["a_y"]})
+    clauses["curve"] = CL_LS["a"] + " with d = φ J/S; [C8.7.1.6] for a free-standing element"
     if curve.before is not None:
+        clauses["ties_curve"] = _C + "C8.7.1.2.1.6: the ties' line until their failure rotation"
         out["ties_curve"] = {
             "alpha0": curve.before[0],
             "phi0": curve.before[1],

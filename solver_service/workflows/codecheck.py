@@ -368,6 +368,15 @@ def _tie_terms(mech: Mechanism, side: SideConstants) -> Optional[dict[str, Any]]
     alpha0_without = vw.alpha0 + work_tie / (G * vw.S)
     phi0_without = side.phi_cr - (side.M_F - m_f_tie) / side.K
     return {
+        "clauses": {
+            "M_F_ties": "theory Eq. 15: Σ -F (z cos α_c + x sin α_c) of the tie-bars",
+            "M_F_without": "theory Eq. 15 without the tie-bars",
+            "alpha0_with": "Circ. 2019 [C8.7.1.1] with every action",
+            "alpha0_without": "Circ. 2019 [C8.7.1.1] without the tie-bars (-F z each)",
+            "phi0_with": "theory §1.7 Eq. 6 with every static force",
+            "phi0_without": "theory §1.7 Eq. 6 without the tie-bars (C8.7.1.2.1.6)",
+            "phi0_no_static_forces": "theory §1.7 Eq. 6 with M_F = 0 (φ_cr)",
+        },
         "ties": listed,
         "M_F_ties": m_f_tie,
         "M_F_without": side.M_F - m_f_tie,
@@ -708,6 +717,39 @@ def _governing(rows: list[dict[str, Any]]) -> Optional[str]:
     return min(ratios, key=lambda p: p[0])[1]["id"] if ratios else None
 
 
+def _site_clauses(code: str) -> dict[str, str]:
+    """Return the clause of each number of the document's ``site`` section."""
+    both = {
+        "FC": "Circ. 2019 C8.7.1.2.1.3 (the confidence factor of the knowledge level)",
+        "q": "Circ. 2019 C8.7.1.2.1.7 (q = 2 unless evaluated)",
+    }
+    if code == "NTC2018":
+        return {
+            **both,
+            "S": "NTC 2018 §3.2.3.2.1 [3.2.3]: S = S_S S_T (Tab. 3.2.IV, 3.2.V)",
+            "eta": "NTC 2018 [3.2.4] (the plotted spectrum's damping)",
+            "F": "NTC 2018 §3.2.3.2.1: F0 of the hazard",
+            "T_B": "NTC 2018 [3.2.6]",
+            "T_C": "NTC 2018 [3.2.5] (C_C of Tab. 3.2.IV)",
+            "T_D": "NTC 2018 [3.2.7]",
+            "pga_g": "NTC 2018 [3.2.2] at T = 0: a_g S",
+            "T1": "site building.T1, else Circ. 2019 [C7.3.2] (see T1_source)",
+            "spectrum": "NTC 2018 [3.2.2] and [3.2.10]-[3.2.11] at the hazard's damping",
+        }
+    return {
+        **both,
+        "S": "EN 1998-1 Tables 3.2-3.3 (cross-checked, theory §11.4)",
+        "eta": "EN 1998-1 Eq. 3.6",
+        "F": "EN 1998-1 §3.2.2.2: 2.5",
+        "T_B": "EN 1998-1 Tables 3.2-3.3",
+        "T_C": "EN 1998-1 Tables 3.2-3.3",
+        "T_D": "EN 1998-1 Tables 3.2-3.3",
+        "pga_g": "EN 1998-1 §3.2.2.2: a_g S, a_g = γ_I a_gR",
+        "T1": "site building.T1, else Circ. 2019 [C7.3.2] (see T1_source)",
+        "spectrum": "EN 1998-1 Eqs. 3.2-3.5, 3.7 and Annex A",
+    }
+
+
 def check_doc(cf: ConstantsFile, site: SiteFile) -> dict[str, Any]:
     """Code checks of every mechanism of ``cf`` on ``site`` (theory §11).
 
@@ -776,6 +818,7 @@ def check_doc(cf: ConstantsFile, site: SiteFile) -> dict[str, Any]:
                 else ""
             ),
             "building": None if site.building is None else site.building.model_dump(),
+            "clauses": _site_clauses(hz.code),
         },
         "spectrum": {
             "T": t.tolist(),
