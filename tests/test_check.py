@@ -81,6 +81,8 @@ def test_above_ground_without_building_is_incomplete_not_silent() -> None:
     # One T1 rule: no building.T1 in the site, so Circolare 2019 [C7.3.2], not 1/f_n.
     assert row["T1"] == pytest.approx(0.05 * 9.0**0.75, rel=1e-12)
     assert "[C7.3.2]" in row["T1_source"]
+    # The constants' f_n (the dynamics' period) is not the check's: the row says so.
+    assert "1/f_n = 0.5 s" in row["linear"]["note"] and "building.T1" in row["linear"]["note"]
     floor = row["linear"]["floor"]
     assert floor["psi"] == pytest.approx(6.0 / 9.0) and floor["gamma"] == pytest.approx(9 / 7)
     assert isinstance(row["linear"]["passes"], bool)

@@ -558,6 +558,14 @@ def _side_checks_2019(
         return _not_run(lin_m, str(exc)), _not_run(lin_m, str(exc))
     if floor_note:
         extra_notes.append(floor_note)
+    amp = mech.amplification
+    if floor is not None and amp is not None and ctx.t1 is not None:
+        t_fn = 1.0 / amp.f_n
+        if abs(t_fn - ctx.t1) > T1_TOLERANCE * ctx.t1:
+            extra_notes.append(
+                f"the constants' 1/f_n = {t_fn:.4g} s (the dynamics' Eq. 28) is not the check's "
+                f"T1 = {ctx.t1:.4g} s ({ctx.t1_source}); give building.T1 to use one period"
+            )
     complete = floor_note is None and ctx.slv_given
     if not ctx.slv_given:
         extra_notes.append(
