@@ -886,6 +886,10 @@ def nonlinear_check_2019(
         "notes": notes,
     }
     clauses = {k: CL[k] for k in ("alpha0", "e_star", "FC", "a0_star", "d_per_rad", "phi0", "d0")}
+    clauses["alpha0"] = (
+        _C + "C8.7.1.2.1.1 [C8.7.1.1] of the actions kept in the curve (C8.7.1.2.1.6)"
+    )
+    clauses["a0_star"] = CL["a0_star"] + ", every action (activation, for a_g,SLD)"
     clauses.update(
         {
             "demand_activation": CL["demand_activation"],

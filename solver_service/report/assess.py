@@ -238,11 +238,12 @@ def _check_rows(check: dict[str, Any]) -> list[dict[str, str]]:
             clauses = cl if source is None else src.get("clauses", {})
             rows.append(_row(label, src[key], unit, clauses.get(key, "")))
 
-    add("α0", "alpha0", "-")
+    nonlinear = "SLV" in check
+    add("α0 of the capacity curve" if nonlinear else "α0", "alpha0", "-")
     add("M*", "M_star", "kg")
     add("e*", "e_star", "-")
     add("FC", "FC", "-")
-    add("a0* = α0 g/(e* FC)", "a0_star", "m/s²")
+    add("a0* at activation" if nonlinear else "a0* = α0 g/(e* FC)", "a0_star", "m/s²")
     if check.get("free_standing"):
         for label, key, unit in (
             ("κ", "kappa", "-"),
