@@ -8,16 +8,21 @@ The hazard is given by the building code that defines it:
   and the spectrum type 1 or 2.
 
 Both carry the parameters of the code's kinematic check (docs/theory.md §11): the
-knowledge-level confidence factor ``FC`` and the behaviour factor ``q`` (default 2). The
-optional ``building`` section (height, storeys, first period) serves the demand on
-mechanisms above ground; the optional ``project`` section fills the report's first page.
+knowledge-level confidence factor ``FC`` and the behaviour factor ``q`` (default 2), and may
+give the hazard of other limit states (``limit_states``: SLD, SLC). The optional
+``building`` section (height, storeys, first period, damping, period lengthening) serves the
+demand on mechanisms above ground; the optional ``local_mechanisms`` section holds the
+choices the Circolare 2019 leaves to the engineer (method, damping of the mechanisms, the
+free-standing elements' data, the ties); the optional ``project`` section fills the
+report's first page.
 
 The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` forms.
 """
 
-from typing import Annotated, Any, Literal, Mapping, Optional, Union
+from typing import Annotated, Any, Dict, Literal, Mapping, Optional, Union
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
+from pydantic_core import PydanticCustomError
 
 from shared_schema.constants import (
     JsonInt,
@@ -27,14 +32,71 @@ from shared_schema.constants import (
 )
 
 __all__ = [
+    "LIMIT_STATES",
     "SITE_SCHEMA_VERSION",
     "Building",
     "EC8Hazard",
+    "EC8LimitState",
+    "LocalMechanisms",
+    "MechanismOptions",
     "NTCHazard",
+    "NTCLimitState",
     "Project",
     "SiteFile",
     "parse_site",
 ]
+
+#: The limit states of NTC 2018 §3.2.1 (Tab. 3.2.I), by which the hazard is given.
+LIMIT_STATES = ("SLO", "SLD", "SLV", "SLC")
+LimitState = Literal["SLO", "SLD", "SLV", "SLC"]
+
+
+def _no_duplicate_limit_state(main: str, others: Optional[Mapping[Any, Any]]) -> None:
+    """Refuse ``limit_states`` repeating the limit state the main hazard already gives."""
+    if others and main in others:
+        raise PydanticCustomError(
+            "duplicate_limit_state",
+            "{message}",
+            {
+                "field": f"limit_states.{main}",
+                "message": (
+                    f"the hazard's own parameters are the {main} ones; give limit_states "
+                    "only for the other limit states"
+                ),
+            },
+        )
+
+
+class NTCLimitState(BaseModel):
+    """NTC 2018 hazard parameters of one more limit state (§3.2, Tab. 3.2.I).
+
+    The soil and topographic categories are the site's (``NTCHazard``).
+    """
+
+    model_config = ConfigDict(
+        strict=True,
+        extra="forbid",
+        allow_inf_nan=False,
+        json_schema_extra={"description": "a_g, F0, T_C* of one more limit state (NTC 2018)."},
+    )
+
+    a_g: float = Field(gt=0, le=2, description="Ground acceleration on type A ground [g].")
+    F0: float = Field(gt=0, le=10, description="Maximum spectral amplification F0 [-].")
+    Tc_star: float = Field(gt=0, le=5, description="T_C* [s].")
+
+
+class EC8LimitState(BaseModel):
+    """EN 1998-1 reference ground acceleration of one more limit state (return period)."""
+
+    model_config = ConfigDict(
+        strict=True,
+        extra="forbid",
+        allow_inf_nan=False,
+        json_schema_extra={"description": "a_gR of one more limit state (EN 1998-1)."},
+    )
+
+    a_gR: float = Field(gt=0, le=2, description="Reference peak ground acceleration [g].")
+
 
 #: Version of the site-file format written by this module.
 SITE_SCHEMA_VERSION = "1.0"
@@ -80,7 +142,10 @@ class NTCHazard(BaseModel):
     q : float
         Behaviour factor of the linear kinematic check [-], > 0; default 2.
     xi_percent : float
-        Viscous damping of the spectrum [%], >= 0; default 5.
+        Viscous damping of the spectrum [%], >= 0; default 5 (the plotted spectrum and the
+        records' matching; the checks use the dampings of ``LocalMechanisms``).
+    limit_states : dict, optional
+        ``a_g``, ``F0``, ``T_C*`` of other limit states, keyed SLO, SLD, SLV, SLC.
     """
 
     model_config = ConfigDict(
@@ -102,6 +167,18 @@ class NTCHazard(BaseModel):
     FC: float = Field(ge=1, le=2, description="Confidence factor FC [-] (LC1 1.35 ... LC3 1).")
     q: float = Field(2.0, gt=0, le=10, description="Behaviour factor q [-], default 2.")
     xi_percent: float = Field(5.0, ge=0, le=50, description="Viscous damping [%].")
+    limit_states: Optional[Dict[LimitState, NTCLimitState]] = Field(
+        None,
+        description=(
+            "a_g, F0, T_C* of other limit states (e.g. SLC for the collapse check, SLD), "
+            "besides the one of limit_state."
+        ),
+    )
+
+    @model_validator(mode="after")
+    def _other_limit_states(self) -> "NTCHazard":
+        _no_duplicate_limit_state(self.limit_state, self.limit_states)
+        return self
 
 
 class EC8Hazard(BaseModel):
@@ -123,6 +200,8 @@ class EC8Hazard(BaseModel):
         Behaviour factor of the linear kinematic check [-]; default 2.
     xi_percent : float
         Viscous damping [%]; default 5.
+    limit_states : dict, optional
+        ``a_gR`` of other limit states, keyed SLO, SLD, SLC (``a_gR`` is the SLV's).
     """
 
     model_config = ConfigDict(
@@ -142,6 +221,18 @@ class EC8Hazard(BaseModel):
     FC: float = Field(ge=1, le=2, description="Confidence factor [-] (EN 1998-3 CF).")
     q: float = Field(2.0, gt=0, le=10, description="Behaviour factor q [-], default 2.")
     xi_percent: float = Field(5.0, ge=0, le=50, description="Viscous damping [%].")
+    limit_states: Optional[Dict[LimitState, EC8LimitState]] = Field(
+        None,
+        description=(
+            "a_gR of other limit states (SLD, SLC), besides the SLV of a_gR; the Circolare's "
+            "limit-state names are used since its checks are applied."
+        ),
+    )
+
+    @model_validator(mode="after")
+    def _other_limit_states(self) -> "EC8Hazard":
+        _no_duplicate_limit_state("SLV", self.limit_states)
+        return self
 
 
 class Building(BaseModel):
@@ -154,7 +245,15 @@ class Building(BaseModel):
     storeys : int
         Number of storeys, >= 1.
     T1 : float, optional
-        First period [s]; default ``0.05 height^0.75`` (NTC 2018 §7.3.3.2, masonry).
+        First period [s]; default ``C1 height^(3/4)`` with ``C1 = 0.050`` (Circolare 2019
+        [C7.3.2], masonry).
+    xi_percent : float
+        Equivalent viscous damping ``ξ_k`` of the building in the floor spectrum [%]
+        (Circolare 2019 [C7.2.6]-[C7.2.7]); default 5. §C8.7.1.2.1.4 recalls 10-20 % for a
+        masonry building at the ultimate limit state.
+    period_elongation : float
+        ``T_k / T1`` in the floor spectrum, >= 1; default 1. §C8.7.1.2.1.4 recalls 1.5-2 at
+        the ultimate limit state.
     """
 
     model_config = ConfigDict(
@@ -167,7 +266,147 @@ class Building(BaseModel):
     height: float = Field(gt=0, le=300, description="Height above the foundation [m].")
     storeys: JsonInt = Field(ge=1, le=100, description="Number of storeys.")
     T1: Optional[float] = Field(
-        None, gt=0, le=10, description="First period [s]; default 0.05 height^0.75."
+        None,
+        gt=0,
+        le=10,
+        description="First period [s]; default 0.050 height^0.75 (Circolare 2019 [C7.3.2]).",
+    )
+    xi_percent: float = Field(
+        5.0,
+        gt=0,
+        le=30,
+        description="Damping xi_k of the building in the floor spectrum [%] (Circ. 2019 C7.2.3).",
+    )
+    period_elongation: float = Field(
+        1.0,
+        ge=1,
+        le=3,
+        description="T_k/T1 in the floor spectrum (Circ. 2019 C8.7.1.2.1.4: 1.5-2 at the ULS).",
+    )
+
+
+class MechanismOptions(BaseModel):
+    """The engineer's choices for one mechanism of the code check (Circolare 2019 §C8.7.1).
+
+    Attributes
+    ----------
+    free_standing : bool, optional
+        Whether the element is free to vibrate before it activates (§C8.7.1.2.1.3:
+        parapets, free-standing portions of façades, pinnacles); default by typology
+        (single-block or user-defined mechanisms rocking two-sided are).
+    kappa : float, optional
+        κ of [C8.7.1.7] [-]; default 6.2 (cantilever), 2.2 for a two-block strip.
+    L, t : float, optional
+        Length (height) and thickness of the element [m]; default from the geometry.
+    unit_weight : float, optional
+        Unit weight of the masonry [N/m³]; default from the geometry's density.
+    E : float, optional
+        Elastic modulus of the masonry [Pa] (Tab. C8.5.I); default ``LocalMechanisms.E``.
+    ties : str, optional
+        ``"verified"`` (the ties are verified to hold up to collapse: d0 with them) or
+        ``"not_verified"`` (default: d0 without them, §C8.7.1.2.1.6).
+    tie_failure_rotation : float, optional
+        Rotation at which the ties break [rad] (their elongation at failure over their
+        height): until then the curve has them.
+    instability_rotation : float, optional
+        Rotation at which the mechanism becomes locally unstable [rad] (beam unseating,
+        vault collapse): a candidate for d_SLC.
+    """
+
+    model_config = ConfigDict(
+        strict=True,
+        extra="forbid",
+        allow_inf_nan=False,
+        json_schema_extra={"description": "Choices for one mechanism (Circolare 2019 §C8.7.1)."},
+    )
+
+    free_standing: Optional[bool] = Field(
+        None, description="Free to vibrate before activation (C8.7.1.2.1.3); default by typology."
+    )
+    kappa: Optional[float] = Field(
+        None, gt=0, le=20, description="kappa of [C8.7.1.7]; default 6.2 (2.2 two-block)."
+    )
+    L: Optional[float] = Field(None, gt=0, le=300, description="Length of the element [m].")
+    t: Optional[float] = Field(None, gt=0, le=20, description="Thickness of the element [m].")
+    unit_weight: Optional[float] = Field(
+        None, gt=0, le=100000, description="Unit weight of the masonry [N/m³]."
+    )
+    E: Optional[float] = Field(
+        None, gt=0, le=1e12, description="Elastic modulus of the masonry [Pa] (Tab. C8.5.I)."
+    )
+    ties: Optional[Literal["verified", "not_verified"]] = Field(
+        None, description="Whether the ties are verified to hold up to collapse (C8.7.1.2.1.6)."
+    )
+    tie_failure_rotation: Optional[float] = Field(
+        None, gt=0, le=1.5, description="Rotation at which the ties break [rad]."
+    )
+    instability_rotation: Optional[float] = Field(
+        None, gt=0, le=1.5, description="Rotation of local instability, for d_SLC [rad]."
+    )
+
+    @model_validator(mode="after")
+    def _verified_ties_do_not_break(self) -> "MechanismOptions":
+        if self.ties == "verified" and self.tie_failure_rotation is not None:
+            raise PydanticCustomError(
+                "verified_ties_break",
+                "{message}",
+                {
+                    "field": "tie_failure_rotation",
+                    "message": (
+                        "ties verified to hold up to collapse have no failure rotation: set "
+                        "ties to not_verified or drop tie_failure_rotation"
+                    ),
+                },
+            )
+        return self
+
+
+class LocalMechanisms(BaseModel):
+    """The choices the Circolare 2019 §C8.7.1 leaves to the engineer, with its defaults.
+
+    Attributes
+    ----------
+    method : str
+        ``"circ2019"`` (default: Circolare 21 gennaio 2019 n. 7 §C8.7.1) or ``"circ2009"``
+        (the Circolare 617/2009 C8A.4 forms, kept for comparison).
+    xi_SLV_percent, xi_SLC_percent : float
+        Equivalent viscous damping of the mechanism [%]: 8 and 10 (§C8.7.1.2.1.8).
+    E : float, optional
+        Elastic modulus of the masonry [Pa] for the free-standing elements' T0 ([C8.7.1.7],
+        Tab. C8.5.I); without it T0 is unknown and the spectrum's peak is used.
+    unit_weight : float, optional
+        Unit weight of the masonry [N/m³] where the geometry gives no density.
+    mechanisms : dict
+        ``MechanismOptions`` by mechanism id.
+    """
+
+    model_config = ConfigDict(
+        strict=True,
+        extra="forbid",
+        allow_inf_nan=False,
+        json_schema_extra={
+            "description": "Choices of the local-mechanism check (Circolare 2019 §C8.7.1)."
+        },
+    )
+
+    method: Literal["circ2019", "circ2009"] = Field(
+        "circ2019",
+        description="circ2019 (Circolare 2019 §C8.7.1) or circ2009 (the 2009 C8A.4 forms).",
+    )
+    xi_SLV_percent: float = Field(
+        8.0, gt=0, le=30, description="Damping of the mechanism at SLV [%] (C8.7.1.2.1.8: 8)."
+    )
+    xi_SLC_percent: float = Field(
+        10.0, gt=0, le=30, description="Damping of the mechanism at SLC [%] (C8.7.1.2.1.8: 10)."
+    )
+    E: Optional[float] = Field(
+        None, gt=0, le=1e12, description="Elastic modulus of the masonry [Pa] (Tab. C8.5.I)."
+    )
+    unit_weight: Optional[float] = Field(
+        None, gt=0, le=100000, description="Unit weight of the masonry [N/m³]."
+    )
+    mechanisms: Dict[str, MechanismOptions] = Field(
+        default_factory=dict, description="Choices per mechanism id."
     )
 
 
@@ -199,6 +438,10 @@ class SiteFile(BaseModel):
     )
     building: Optional[Building] = Field(
         None, description="The building (mechanisms above ground)."
+    )
+    local_mechanisms: LocalMechanisms = Field(
+        default_factory=LocalMechanisms,
+        description="Choices of the local-mechanism check (Circolare 2019 §C8.7.1).",
     )
 
 

@@ -1124,16 +1124,20 @@ def check(
     site: Path = typer.Argument(..., help="Site file (SITE.json): hazard, FC, q, building."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
-    """Code checks (NTC 2018 / Circolare §C8.7.1, linear and nonlinear) of every mechanism."""
+    """Code checks of every mechanism (Circolare 2019 §C8.7.1: linear SLV, nonlinear SLV/SLC)."""
     doc = check_doc(read_constants(constants), read_site(site))
     if as_json:
         _print_json(doc)
         return
     s = doc["site"]
+    typer.echo(f"method: {doc['method']['name']}: {doc['method']['standard']}")
     typer.echo(f"{s['code']}: a_g S = {s['pga_g']:.4f} g, FC = {s['FC']:g}, q = {s['q']:g}")
+    if s.get("T1") is not None:
+        typer.echo(f"T1 = {s['T1']:.4g} s ({s['T1_source']})")
+    period = "T_SLV s" if doc["method"]["name"] == "circ2019" else "Ts s"
     typer.echo(
         f"{'mechanism':<10}{'alpha0':>9}{'e*':>8}{'a0* m/s2':>10}{'demand':>9}{'linear':>8}"
-        f"{'du* m':>9}{'demand':>9}{'Ts s':>7}{'nonlinear':>11}"
+        f"{'d m':>9}{'demand':>9}{period:>8}{'nonlinear':>11}"
     )
     for row in doc["mechanisms"]:
         lin, non = row["linear"], row["nonlinear"]
@@ -1145,16 +1149,30 @@ def check(
         else:
             left = f"{'-':>9}{'-':>8}{'-':>10}{'-':>9}{_verdict(lin):>8}"
         if non.get("status") == "ok":
-            right = (
-                f"{non['du_star']:>9.4g}{non['demand']:>9.4g}{non['Ts']:>7.3g}{_verdict(non):>11}"
-            )
+            d = non.get("d_SLV", non.get("du_star"))
+            t = non.get("T_SLV", non.get("Ts"))
+            right = f"{_num(d, 9)}{_num(non.get('demand'), 9)}{_num(t, 8, 3)}{_verdict(non):>11}"
         else:
-            right = f"{'-':>9}{'-':>9}{'-':>7}{_verdict(non):>11}"
+            right = f"{'-':>9}{'-':>9}{'-':>8}{_verdict(non):>11}"
         typer.echo(f"{row['id']:<10}" + left + right)
-        for note in {lin.get("note"), non.get("note")} - {None, ""}:
+        slc = non.get("SLC") if non.get("status") == "ok" else None
+        if slc is not None:
+            state = {True: "pass", False: "FAIL", None: "not evaluated"}[slc["passes"]]
+            typer.echo(
+                f"  {row['id']}: SLC d = {slc['d']:.4g} m, demand = {slc['demand']:.4g} m, "
+                f"T_SLC = {slc['T_SLC']:.3g} s, a_g,SLC = {slc['a_g_capacity']:.4g} g: {state}"
+            )
+        for note in sorted({lin.get("note"), non.get("note")} - {None, ""}):
             typer.echo(f"  note: {row['id']}: {note}")
     if doc["governing"] is not None:
         typer.echo(f"governing mechanism: {doc['governing']}")
+
+
+def _num(value: Any, width: int, digits: int = 4) -> str:
+    """Return a number right-aligned in ``width`` to ``digits`` figures ("-" for None)."""
+    if value is None:
+        return f"{'-':>{width}}"
+    return f"{value:>{width}.{digits}g}"
 
 
 @app.command()

@@ -1,4 +1,8 @@
-"""`rockmech check` and the check document: verdicts, notes instead of aborts, JSON names."""
+"""`rockmech check` and the check document: verdicts, notes instead of aborts, JSON names.
+
+The numbers of the Circolare 2019 checks are worked by hand in
+``tests/solver_core/test_circ2019.py``; here: what reaches the user, end to end.
+"""
 
 import json
 import math
@@ -52,25 +56,36 @@ def test_check_doc_block_and_short_form_note() -> None:
     lin = w1["linear"]
     assert lin["e_star"] == pytest.approx(0.75, abs=1e-12)
     assert lin["a0_star"] == pytest.approx((0.5 / 3.0) * G / (0.75 * 1.35), rel=1e-12)
-    assert lin["demand_ground"] == pytest.approx(0.25 * 1.34 * G / 2.0, rel=1e-12)
+    # A two-sided user-defined block is free-standing by default (C8.7.1.2.1.3) and, with no
+    # E, L, t or unit weight, T0 is unknown: the demand is the spectrum's peak a_g S F0.
+    assert w1["free_standing"]["value"] is True
+    assert lin["T0"] is None and "T0 unknown" in lin["demand_rule"]
+    assert lin["demand_activation"] == pytest.approx(0.25 * 1.34 * 2.4 * G, rel=1e-9)
     assert w1["passes"] == (lin["passes"] and w1["nonlinear"]["passes"])
     # The short-form mechanism gets a note, never an abort.
     assert s1["linear"]["status"] == "not_run" and "virtual_work" in s1["linear"]["note"]
     assert s1["passes"] is None
     assert doc["governing"] == "W1"
+    assert doc["method"]["name"] == "circ2019"
 
 
 def test_above_ground_without_building_is_incomplete_not_silent() -> None:
     data = block_file(amplification={"f_n": 2.0, "h_e": 6.0, "h": 6.0})
     doc = check_doc(parse_constants(data), parse_site(NTC_SITE))
-    lin = doc["mechanisms"][0]["linear"]
+    lin, non = doc["mechanisms"][0]["linear"], doc["mechanisms"][0]["nonlinear"]
     assert lin["passes"] is None and "building" in lin["note"]
+    assert non["passes"] is None and non["SLV"]["passes"] is None
     site = dict(NTC_SITE, building={"height": 9.0, "storeys": 3})
     doc = check_doc(parse_constants(data), parse_site(site))
-    lin = doc["mechanisms"][0]["linear"]
-    assert lin["T1"] == pytest.approx(0.5)  # 1/f_n of the mechanism
-    assert lin["psi"] == pytest.approx(6.0 / 9.0) and lin["gamma"] == pytest.approx(9 / 7)
-    assert isinstance(lin["passes"], bool)
+    row = doc["mechanisms"][0]
+    # One T1 rule: no building.T1 in the site, so Circolare 2019 [C7.3.2], not 1/f_n.
+    assert row["T1"] == pytest.approx(0.05 * 9.0**0.75, rel=1e-12)
+    assert "[C7.3.2]" in row["T1_source"]
+    # The constants' f_n (the dynamics' period) is not the check's: the row says so.
+    assert "1/f_n = 0.5 s" in row["linear"]["note"] and "building.T1" in row["linear"]["note"]
+    floor = row["linear"]["floor"]
+    assert floor["psi"] == pytest.approx(6.0 / 9.0) and floor["gamma"] == pytest.approx(9 / 7)
+    assert isinstance(row["linear"]["passes"], bool)
 
 
 def test_cli_check_table_and_json(tmp_path: Path) -> None:
@@ -80,10 +95,67 @@ def test_cli_check_table_and_json(tmp_path: Path) -> None:
     res = runner.invoke(app, ["check", str(cpath), str(spath)])
     assert res.exit_code == 0, res.output
     assert "W1" in res.output and "S1" in res.output and "note: S1" in res.output
+    assert "T_SLV" in res.output and "Circolare 21 gennaio 2019" in res.output
+    assert "W1: SLC" in res.output
     res = runner.invoke(app, ["check", str(cpath), str(spath), "--json"])
     doc = json.loads(res.output)
-    assert set(doc["mechanisms"][0]["linear"]) >= {"alpha0", "M_star", "e_star", "a0_star"}
-    assert set(doc["mechanisms"][0]["nonlinear"]) >= {"d0_star", "du_star", "Ts", "passes"}
+    lin, non = doc["mechanisms"][0]["linear"], doc["mechanisms"][0]["nonlinear"]
+    assert set(lin) >= {"alpha0", "M_star", "e_star", "a0_star", "a_g_SLV", "clauses"}
+    assert set(non) >= {"d0", "d_SLV", "T_SLV", "passes", "SLV", "SLC", "clauses"}
+    assert "[C8.7.1.10]" in non["clauses"]["T_SLV"]
+    assert "[C8.7.1.11]" in non["SLC"]["clauses"]["T_SLC"]
+
+
+def test_cli_check_2009_forms_on_request(tmp_path: Path) -> None:
+    cpath, spath = tmp_path / "c.json", tmp_path / "site.json"
+    cpath.write_text(json.dumps(block_file()), encoding="utf-8")
+    site = dict(NTC_SITE, local_mechanisms={"method": "circ2009"})
+    spath.write_text(json.dumps(site), encoding="utf-8")
+    res = runner.invoke(app, ["check", str(cpath), str(spath), "--json"])
+    doc = json.loads(res.output)
+    assert doc["method"]["name"] == "circ2009" and "2009" in doc["method"]["standard"]
+    lin = doc["mechanisms"][0]["linear"]
+    assert lin["method"] == "circ2009" and "2019" not in lin["standard"]
+    # The 2009 ground demand a_g S / q.
+    assert lin["demand_ground"] == pytest.approx(0.25 * 1.34 * G / 2.0, rel=1e-12)
+
+
+def test_cli_refuses_a_t1_conflict_and_unknown_ids(tmp_path: Path) -> None:
+    cpath, spath = tmp_path / "c.json", tmp_path / "site.json"
+    cpath.write_text(
+        json.dumps(block_file(amplification={"f_n": 3.1, "h_e": 6.0, "h": 6.0})), encoding="utf-8"
+    )
+    spath.write_text(
+        json.dumps(dict(NTC_SITE, building={"height": 12.0, "storeys": 4, "T1": 0.6})),
+        encoding="utf-8",
+    )
+    res = runner.invoke(app, ["check", str(cpath), str(spath)])
+    assert res.exit_code == 2 and "error: building.T1:" in res.output
+    assert "Traceback" not in res.output
+    spath.write_text(
+        json.dumps(dict(NTC_SITE, local_mechanisms={"mechanisms": {"Z9": {}}})), encoding="utf-8"
+    )
+    res = runner.invoke(app, ["check", str(cpath), str(spath)])
+    assert res.exit_code == 2 and "local_mechanisms.mechanisms.Z9" in res.output
+
+
+def test_slc_is_checked_where_the_site_gives_its_hazard() -> None:
+    site = json.loads(json.dumps(NTC_SITE))
+    site["hazard"]["limit_states"] = {"SLC": {"a_g": 0.32, "F0": 2.45, "Tc_star": 0.32}}
+    doc = check_doc(parse_constants(block_file()), parse_site(site))
+    row = doc["mechanisms"][0]
+    slc = row["nonlinear"]["SLC"]
+    assert slc["a_g"] == pytest.approx(0.32) and isinstance(slc["passes"], bool)
+    assert row["passes_SLC"] == slc["passes"]
+    assert doc["site"]["limit_states"]["SLC"]["source"] == "hazard.limit_states.SLC"
+    # The SLC demand is the SLC spectrum's at 10 %: soil C with a_g = 0.32 g, F0 = 2.45.
+    s_s = min(max(1.70 - 0.60 * 2.45 * 0.32, 1.0), 1.5)
+    t_c = 1.05 * 0.32**-0.33 * 0.32
+    t_d = 4 * 0.32 + 1.6
+    t = slc["T_SLC"]
+    assert t_c < t < t_d
+    want = 0.32 * s_s * (10 / 15) ** 0.5 * 2.45 * t_c / t * G * t**2 / (4 * math.pi**2)
+    assert slc["demand"] == pytest.approx(want, rel=1e-12)
 
 
 def test_cli_check_bad_site_names_the_field(tmp_path: Path) -> None:
@@ -110,8 +182,8 @@ def test_ec8_site_says_which_method_it_applies() -> None:
     doc = check_doc(parse_constants(block_file()), site)
     assert "EN 1998-1" in doc["site"]["method_note"]
     lin = doc["mechanisms"][0]["linear"]
-    # EC8 ground A, type 1: S = 1, so the ground demand is a_g g / q.
-    assert lin["demand_ground"] == pytest.approx(0.2 * G / 2.0, rel=1e-12)
+    # EC8 ground A, type 1: S = 1; free-standing with T0 unknown: the plateau a_g S 2.5.
+    assert lin["demand_activation"] == pytest.approx(0.2 * 2.5 * G, rel=1e-12)
     assert lin["a0_star"] == pytest.approx((0.5 / 3.0) * G / (0.75 * 1.2), rel=1e-12)
 
 

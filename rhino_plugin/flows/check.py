@@ -2,8 +2,9 @@
 
 Runs ``solver_service.workflows.assess.check_doc`` through the Python API or, with a service
 URL, ``POST <url>/api/v1/check`` with ``{"constants": ..., "site": ...}`` (the same JSON as
-the files). The summary has one line per mechanism: its linear and nonlinear verdicts with
-their capacity/demand ratios, or why a check did not run.
+the files). The summary has one line per mechanism: its linear and nonlinear verdicts (the
+Circolare 2019's SLV checks, and the SLC where the site gives its hazard) with their
+capacity/demand ratios, or why a check did not run.
 
 Python 3.9-clean: imported by Rhino 8.
 """
@@ -39,7 +40,11 @@ def check_lines(doc: Dict[str, Any]) -> List[str]:
     lines: List[str] = []
     for row in doc.get("mechanisms") or []:
         lin, non = row["linear"], row["nonlinear"]
-        lines.append("{}: linear {}, nonlinear {}".format(row["id"], _cell(lin), _cell(non)))
+        line = "{}: linear {}, nonlinear {}".format(row["id"], _cell(lin), _cell(non))
+        slc = non.get("SLC") if non.get("status") == "ok" else None
+        if slc is not None and slc.get("passes") is not None:
+            line += ", SLC {}".format(_cell(dict(slc, status="ok")))
+        lines.append(line)
         for note in sorted({lin.get("note") or "", non.get("note") or ""} - {""}):
             lines.append(f"  note: {note}")
     if doc.get("governing"):

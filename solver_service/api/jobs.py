@@ -44,6 +44,7 @@ from shared_schema.spec import parse_spec
 from shared_schema.text import decode_text
 
 from ..core import codes
+from ..core.circ2019 import RECORD_POINTS, T_RECORD_MIN
 from ..core.envelope import OverturningLibrary
 from ..core.exact import simulate, simulate_batch
 from ..core.excitation import Pulse, SampledAccel
@@ -499,8 +500,10 @@ def check_spectra_work(
     """Bound the spectrum work of an assessment, one record and in total.
 
     Every record's spectrum is computed down to the shortest period of each mechanism's
-    matching band (``rows``: the mechanisms of the code check, ``check_doc``) and to
-    ``1/f_n`` of each mechanism with amplification data.
+    matching band (``rows``: the mechanisms of the code check, ``check_doc``), over the
+    periods of the records' demand in the nonlinear checks (``[T0, T_SLV]``, ``[T0, T_SLC]``
+    from ``T_RECORD_MIN``, Circolare 2019 §C8.7.1.2.1.8) and at ``1/f_n`` of each mechanism
+    with amplification data.
 
     Raises
     ------
@@ -508,13 +511,24 @@ def check_spectra_work(
         When one record, or all of them together, would take more closed-form steps than
         the limits allow (naming the record).
     """
-    periods = [matching_band(row)[0] for row in rows]
-    periods += [1.0 / m.amplification.f_n for m in cf.mechanisms if m.amplification is not None]
+    # (shortest period [s], periods computed): the matching bands, the records' demand of
+    # the nonlinear checks over [T0, T_SLV] and [T0, T_SLC] (twice over at height, where
+    # the floor spectrum also needs the records' ground spectrum), and 1/f_n.
+    grids = [(matching_band(row)[0], BAND_POINTS) for row in rows]
+    for row in rows:
+        for side in (row.get("sides") or {}).values():
+            non = side.get("nonlinear") or {}
+            if non.get("status") != "ok" or non.get("method") != "circ2019" or "SLV" not in non:
+                continue
+            t_lo = max(non.get("T0") or 0.0, T_RECORD_MIN)
+            per = RECORD_POINTS * (2 if row.get("Z", 0.0) > 0.0 else 1)
+            grids += [(min(t_lo, non["SLV"]["T_SLV"]), per), (min(t_lo, non["SLC"]["T_SLC"]), per)]
+    grids += [(1.0 / m.amplification.f_n, 1) for m in cf.mechanisms if m.amplification]
     steps = 0.0
     for i, motion in enumerate(motions):
-        for t_lo in periods:
+        for t_lo, count in grids:
             check_record_work(motion, limits, t_min=t_lo)
-            steps += BAND_POINTS * _record_steps(motion, STEPS_PER_PERIOD / t_lo)
+            steps += count * _record_steps(motion, STEPS_PER_PERIOD / t_lo)
         if steps > 0.0:
             check_total_steps(steps, limits, "the records' spectra", f"records[{i}]")
 

@@ -19,7 +19,7 @@ T_B, T_C, T_D : corner periods [s]; T_E, T_F : displacement-spectrum corner peri
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -34,6 +34,7 @@ __all__ = [
     "NTC_SOIL",
     "NTC_TOPOGRAPHY",
     "ElasticSpectrum",
+    "damping_eta",
     "ec8_spectrum",
     "ntc_spectrum",
 ]
@@ -63,7 +64,7 @@ EC8_TABLE: dict[tuple[int, str], tuple[float, float, float, float]] = {
     (2, "E"): (1.60, 0.05, 0.25, 1.2),
 }
 #: Displacement-spectrum corner periods (T_E, T_F) [s] per ground type (NTC 2018
-#: Tab. 3.2.VIII; EN 1998-1 Annex A, Table A.1).
+#: Tab. 3.2.VII; EN 1998-1 Annex A, Table A.1).
 DISPLACEMENT_CORNERS: dict[str, tuple[float, float]] = {
     "A": (4.5, 10.0),
     "B": (5.0, 10.0),
@@ -73,12 +74,20 @@ DISPLACEMENT_CORNERS: dict[str, tuple[float, float]] = {
 }
 #: Lower bound of the damping correction eta (both codes).
 ETA_MIN = 0.55
-#: Ground displacement factor: d_g = 0.025 a_g S T_C T_D (NTC Eq. 3.2.13, EC8 Eq. 3.12).
+#: Ground displacement factor: d_g = 0.025 a_g S T_C T_D (NTC 2018 [3.2.12], EC8 Eq. 3.12).
 DG_FACTOR = 0.025
 
 
-def _damping_eta(xi_percent: float) -> float:
-    # NTC Eq. 3.2.6 / EC8 Eq. 3.6: eta = sqrt(10 / (5 + xi)) >= 0.55, xi in percent.
+def damping_eta(xi_percent: float) -> float:
+    """Damping correction ``eta = sqrt(10 / (5 + xi)) >= 0.55``, ``xi`` in percent (-).
+
+    NTC 2018 [3.2.4] ("ξ (espresso in percentuale)"), EN 1998-1 Eq. 3.6.
+
+    Examples
+    --------
+    >>> round(damping_eta(8.0), 6)
+    0.877058
+    """
     xi = check_non_negative(xi_percent, "xi_percent")
     return max(math.sqrt(10.0 / (5.0 + xi)), ETA_MIN)
 
@@ -127,12 +136,27 @@ class ElasticSpectrum:
         """Design ground displacement ``0.025 a_g S T_C T_D`` [m]."""
         return DG_FACTOR * self.a_g * G * self.S * self.T_C * self.T_D
 
+    def with_damping(self, xi_percent: float) -> ElasticSpectrum:
+        """Return the same spectrum for another viscous damping ``xi_percent`` [%] (``eta`` only).
+
+        Examples
+        --------
+        >>> sp = ntc_spectrum(0.25, 2.4, 0.3, soil="C")
+        >>> round(sp.with_damping(8.0).eta, 6)
+        0.877058
+        """
+        return replace(
+            self,
+            eta=damping_eta(xi_percent),
+            params={**self.params, "xi_percent": float(xi_percent)},
+        )
+
     def Se(self, T: ArrayLike) -> NDArray[np.float64]:
         """Elastic spectral acceleration [g] at periods ``T`` [s] (>= 0).
 
         Notes
         -----
-        NTC 2018 Eq. 3.2.2 / EN 1998-1 Eqs. 3.2-3.5 with the plateau factor ``F``::
+        NTC 2018 [3.2.2] / EN 1998-1 Eqs. 3.2-3.5 with the plateau factor ``F``::
 
             0 <= T < T_B:    a_g S eta F [T/T_B + (1 - T/T_B)/(eta F)]
             T_B <= T < T_C:  a_g S eta F
@@ -160,7 +184,8 @@ class ElasticSpectrum:
 
         Notes
         -----
-        NTC 2018 Eqs. 3.2.12-3.2.13 / EN 1998-1 Eq. 3.7 and Annex A::
+        NTC 2018 [3.2.10]-[3.2.11] (§3.2.3.2.3) and [3.2.12] (d_g, §3.2.3.3) / EN 1998-1
+        Eq. 3.7 and Annex A::
 
             T <= T_E:         S_e(T) g (T / 2 pi)²
             T_E < T <= T_F:   d_g' [eta F + (1 - eta F)(T - T_E)/(T_F - T_E)]
@@ -210,8 +235,9 @@ def ntc_spectrum(
 
     Notes
     -----
-    ``S = S_S S_T``; ``S_S = clip(a - b F0 a_g)`` and ``C_C = f (T_C*)^e`` (Tab. 3.2.IV);
-    ``T_C = C_C T_C*``, ``T_B = T_C / 3``, ``T_D = 4 a_g + 1.6`` (``a_g`` in g).
+    ``S = S_S S_T`` [3.2.3]; ``S_S = clip(a - b F0 a_g)`` and ``C_C = f (T_C*)^e``
+    (Tab. 3.2.IV); ``T_C = C_C T_C*`` [3.2.5], ``T_B = T_C / 3`` [3.2.6],
+    ``T_D = 4 a_g + 1.6`` [3.2.7] (``a_g`` in g); ``eta`` [3.2.4].
 
     Examples
     --------
@@ -234,7 +260,7 @@ def ntc_spectrum(
     s_t = NTC_TOPOGRAPHY[topography]
     t_c = c_c * Tc_star
     t_e, t_f = DISPLACEMENT_CORNERS[soil]
-    eta = _damping_eta(xi_percent)
+    eta = damping_eta(xi_percent)
     return ElasticSpectrum(
         code="NTC2018",
         a_g=a_g,
@@ -307,7 +333,7 @@ def ec8_spectrum(
         code="EC8",
         a_g=a_g,
         S=s,
-        eta=_damping_eta(xi_percent),
+        eta=damping_eta(xi_percent),
         F=2.5,
         T_B=t_b,
         T_C=t_c,

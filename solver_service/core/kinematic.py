@@ -1,8 +1,13 @@
-"""The code's kinematic checks of a local mechanism (NTC 2018 / Circolare; theory §11).
+"""The 2009 forms of the kinematic checks (Circolare 617/2009 C8A.4; theory §11.8).
+
+Kept for comparison only (``local_mechanisms.method: "circ2009"``); the checks rockmech
+runs by default are the Circolare 2019's (``core.circ2019``). Also the virtual-work
+quantities both use (``VirtualWork``, ``participating_mass``; theory §11.1).
 
 Pure numerics: the virtual-work quantities of a mechanism side (``alpha0``, ``mass``, ``S``,
-``J``; theory §11.1) and an elastic spectrum (``hazard.ElasticSpectrum``) in, a check
-record out, each field named as the Circolare names it.
+``J``) and an elastic spectrum (``hazard.ElasticSpectrum``) in, a check record out, each
+field named as the 2009 Circolare names it. These forms were written from memory of the
+2009 text, not read in it (theory §11.8).
 
 Notation (theory §11)
 ---------------------
@@ -40,11 +45,11 @@ __all__ = [
     "participating_mass",
 ]
 
-#: Circolare C8A.4.2.3 (2009) / §C8.7.1 (2019): ultimate displacement du* = 0.4 d0*.
+#: Circolare 617/2009 C8A.4 (from memory): ultimate displacement du* = 0.4 d0*.
 DU_FRACTION = 0.4
 #: ... and the secant point ds* = 0.4 du* that defines the period Ts.
 DS_FRACTION = 0.4
-#: Damping term of the floor-displacement demand (Circolare C8A.4.10): 0.02 Ts/T1.
+#: Damping term of the floor-displacement demand (Circolare 617/2009 C8A.4.10): 0.02 Ts/T1.
 FLOOR_DAMPING_TERM = 0.02
 #: Points of the reported capacity curve.
 CURVE_POINTS = 41
@@ -79,7 +84,7 @@ class VirtualWork:
 
 @dataclass(frozen=True)
 class Building:
-    """The building a mechanism sits in, for the demand above ground (theory §11.2).
+    """The building a mechanism sits in, for the 2009 demand above ground (theory §11.8).
 
     Attributes
     ----------
@@ -114,8 +119,8 @@ def participating_mass(vw: VirtualWork) -> tuple[float, float]:
 
     Notes
     -----
-    Circolare C8A.4.3-4 (2009), §C8.7.1 (2019): ``M* = (sum P δx)² / (g sum P δx²)``, i.e.
-    ``S² / J``, and ``e* = g M* / sum P = M* / mass``.
+    Circolare 2019 [C8.7.1.5] (and the 2009 C8A.4.3-4): ``e* = (Σ P δx)²/(Σ P Σ P δx²)``,
+    i.e. ``S²/(mass J)``, and ``M* = e* Σ P/g = S²/J``.
 
     Examples
     --------
@@ -147,7 +152,7 @@ def linear_check(
     Z: float = 0.0,
     building: Optional[Building] = None,
 ) -> dict[str, Any]:
-    """Linear kinematic analysis, ultimate limit state (SLV) check (theory §11.2).
+    """Linear kinematic analysis, SLV, in the 2009 forms (theory §11.8).
 
     Parameters
     ----------
@@ -184,7 +189,7 @@ def linear_check(
     a0_star = vw.alpha0 * G / (e_star * FC)
     demand_ground = spectrum.pga * G / q
     out: dict[str, Any] = {
-        "method": "NTC 2018 / Circolare §C8.7.1: linear kinematic analysis (SLV)",
+        "method": "Circolare 617/2009 C8A.4: linear kinematic analysis (SLV), 2009 forms",
         "alpha0": vw.alpha0,
         "M_star": m_star,
         "e_star": e_star,
@@ -227,7 +232,7 @@ def nonlinear_check(
     Z: float = 0.0,
     building: Optional[Building] = None,
 ) -> dict[str, Any]:
-    """Nonlinear kinematic analysis, ultimate limit state (SLV) check (theory §11.3).
+    """Nonlinear kinematic analysis, SLV, in the 2009 forms (theory §11.8).
 
     Parameters
     ----------
@@ -280,7 +285,7 @@ def nonlinear_check(
     d = np.linspace(0.0, d0_star, CURVE_POINTS)
     alpha = vw.alpha0 * (1.0 - d / d0_star)
     out: dict[str, Any] = {
-        "method": "NTC 2018 / Circolare §C8.7.1: nonlinear kinematic analysis (SLV)",
+        "method": "Circolare 617/2009 C8A.4: nonlinear kinematic analysis (SLV), 2009 forms",
         "FC": FC,
         "e_star": e_star,
         "a0_star": a0_star,

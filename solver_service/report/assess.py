@@ -117,28 +117,222 @@ def _plot_spectrum(spectrum: Any, path: Path) -> Path:
         plt.close(fig)
 
 
-def _plot_capacity(non: dict[str, Any], spectrum: Any, path: Path) -> Path:
-    """Capacity curve a*(d*) over the site spectrum in acceleration-displacement form."""
+def _plot_capacity(lin: dict[str, Any], non: dict[str, Any], spectrum: Any, path: Path) -> Path:
+    """Plot the checks on the capacity curve in ADRS form: capacity, demand, verdict of each.
+
+    Circolare 2019: the capacity curve ``a(d)``; the demand spectra of the SLV and SLC
+    (the mechanism's damping, at its height) with their demand points at ``T_SLV`` and
+    ``T_SLC``; the limit displacements ``d_SLV`` and ``d_SLC``; the linear check's capacity
+    ``a0*`` against its demand ``demand_activation / q``. The legend gives each verdict.
+    The 2009 forms: the curve, ``d_u*`` and the demand over the 5 % site spectrum.
+    """
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(6.5, 3.6))
-    t = np.linspace(0.02, 6.0, 600)
-    ax.plot(spectrum.SDe(t), spectrum.Se(t) * G, color="0.5", lw=1.0, label="site spectrum (ADRS)")
-    ax.plot(non["curve"]["d_star"], non["curve"]["a_star"], color="k", lw=1.5, label="capacity")
-    ax.axvline(non["du_star"], color="tab:blue", ls="--", lw=1, label="d_u* = 0.4 d_0*")
-    ax.axvline(non["demand"], color="crimson", ls="--", lw=1, label="demand Δ_d")
-    ax.plot([0.0, non["ds_star"]], [0.0, non["as_star"]], color="tab:green", lw=0.8)
-    ax.plot([non["ds_star"]], [non["as_star"]], "o", color="tab:green", label="secant (T_s)")
-    ax.set_xlim(0.0, 1.15 * max(non["d0_star"], non["demand"]))
-    ax.set_ylim(0.0, 1.2 * non["a0_star"])
-    ax.set_xlabel("d* [m]")
-    ax.set_ylabel("a* [m/s²]")
+    fig, ax = plt.subplots(figsize=(6.8, 3.9))
+    d_cur = non["curve"].get("d", non["curve"].get("d_star"))
+    a_cur = non["curve"].get("a", non["curve"].get("a_star"))
+    ax.plot(d_cur, a_cur, color="k", lw=1.6, label="capacity a(d)")
+    if non.get("method") == "circ2019" and "SLV" in non:
+        tops = [max(a_cur)]
+        for name, color in (("SLV", "crimson"), ("SLC", "tab:purple")):
+            ls = non[name]
+            adrs = ls["adrs"]
+            word = _word(ls["passes"])
+            ax.plot(
+                adrs["d"],
+                adrs["a"],
+                color=color,
+                lw=0.9,
+                alpha=0.7,
+                label=f"{name} demand spectrum (ξ = {ls['xi_percent']:g} %)",
+            )
+            t = ls[f"T_{name}"]
+            a_dem = ls["demand_code"] * (2.0 * math.pi / t) ** 2
+            ax.plot(
+                [ls["demand_code"]],
+                [a_dem],
+                "o",
+                color=color,
+                label=f"{name} code demand {ls['demand_code']:.3g} m at T = {t:.3g} s",
+            )
+            if ls.get("demand_records") is not None:
+                ax.plot(
+                    [ls["demand_records"]],
+                    [a_dem],
+                    "x",
+                    color=color,
+                    label=f"{name} records' demand {ls['demand_records']:.3g} m",
+                )
+            bound = " (a_g,SLD bound)" if ls.get("lower_bound_applied") else ""
+            ax.axvline(
+                ls["d"],
+                color=color,
+                ls="--",
+                lw=1.0,
+                label=(
+                    f"d_{name} = {ls['d']:.3g} m: {word}, ratio {ls['capacity_ratio']:.3g}{bound}"
+                ),
+            )
+            ax.plot([ls["d"]], [ls["a"]], "s", color=color, ms=5)
+            tops.append(a_dem)
+        if lin.get("status") == "ok":
+            ax.axhline(
+                lin["a0_star"],
+                color="tab:blue",
+                lw=0.9,
+                label=f"linear: a0* = {lin['a0_star']:.3g} m/s²",
+            )
+            ax.axhline(
+                lin["demand"],
+                color="tab:blue",
+                ls=":",
+                lw=1.0,
+                label=f"linear demand/q = {lin['demand']:.3g}: {_word(lin['passes'])}",
+            )
+            tops += [lin["a0_star"], lin["demand"]]
+        d_top = max(non["d0"], non["SLV"]["demand"], non["SLC"]["demand"], non["SLC"]["d"])
+        d_top = min(d_top, 3.0 * max(non["d0"], non["SLC"]["d"]))
+        ax.set_xlim(0.0, 1.2 * d_top)
+        ax.set_ylim(0.0, 1.25 * max(tops))
+    else:
+        t = np.linspace(0.02, 6.0, 600)
+        ax.plot(
+            spectrum.SDe(t), spectrum.Se(t) * G, color="0.5", lw=1.0, label="site spectrum (5 %)"
+        )
+        ax.axvline(non["du_star"], color="tab:blue", ls="--", lw=1, label="d_u* = 0.4 d_0* (2009)")
+        ax.axvline(
+            non["demand"], color="crimson", ls="--", lw=1, label=f"demand: {_word(non['passes'])}"
+        )
+        ax.set_xlim(0.0, 1.15 * max(non["d0_star"], non["demand"]))
+        ax.set_ylim(0.0, 1.2 * non["a0_star"])
+    ax.set_xlabel("d [m]")
+    ax.set_ylabel("a [m/s²]")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=6, loc="upper right")
     fig.tight_layout()
     try:
         return _save_atomic(fig, path)
     finally:
         plt.close(fig)
+
+
+def _word(passes: Any) -> str:
+    return {True: "passes", False: "fails", None: "not evaluated"}[passes]
+
+
+def _row(label: str, value: Any, unit: str, clause: str) -> dict[str, str]:
+    return {"label": label, "value": sig(value), "unit": unit, "clause": clause}
+
+
+def _check_rows(check: dict[str, Any]) -> list[dict[str, str]]:
+    """Return the worked-out rows of a check: quantity, value, unit and the clause of each."""
+    if check.get("status") != "ok":
+        return []
+    cl = check.get("clauses", {})
+    if check.get("method") != "circ2019":
+        return _rows_2009(check)
+    rows: list[dict[str, str]] = []
+
+    def add(label: str, key: str, unit: str, source: Optional[dict[str, Any]] = None) -> None:
+        src = check if source is None else source
+        if src.get(key) is not None:
+            clauses = cl if source is None else src.get("clauses", {})
+            rows.append(_row(label, src[key], unit, clauses.get(key, "")))
+
+    nonlinear = "SLV" in check
+    add("α0 of the capacity curve" if nonlinear else "α0", "alpha0", "-")
+    add("M*", "M_star", "kg")
+    add("e*", "e_star", "-")
+    add("FC", "FC", "-")
+    add("a0* at activation" if nonlinear else "a0* = α0 g/(e* FC)", "a0_star", "m/s²")
+    if check.get("free_standing"):
+        for label, key, unit in (
+            ("κ", "kappa", "-"),
+            ("L", "L", "m"),
+            ("t", "t", "m"),
+            ("λ = L/t", "lambda", "-"),
+            ("W", "W", "N/m³"),
+            ("E", "E", "Pa"),
+            ("T0", "T0", "s"),
+            ("d_y", "d_y", "m"),
+            ("a_y", "a_y", "m/s²"),
+        ):
+            add(label, key, unit)
+    units = {"T1": "s", "T_k": "s", "xi_k_percent": "%", "a_Z_g": "g", "Se_Tk_g": "g"}
+    for key, value in (check.get("floor") or {}).items():
+        rows.append(_row(f"floor {key}", value, units.get(key, "-"), cl.get(f"floor.{key}", "")))
+    if "SLV" not in check:  # the linear check
+        add("q", "q", "-")
+        rows.append(
+            _row(
+                "activation demand",
+                check["demand_activation"],
+                "m/s²",
+                f"{cl.get('demand_activation', '')}; {check.get('demand_rule', '')}",
+            )
+        )
+        add("a_g,SLD", "a_g_SLD", "g")
+        add("a_g,SLV = q a_g,SLD", "a_g_SLV", "g")
+        add("a_g (SLV hazard)", "a_g", "g")
+        add("a_g,SLV / a_g", "capacity_ratio", "-")
+        return rows
+    ties = check.get("ties") or {}
+    if ties.get("present"):
+        rows.append(
+            {
+                "label": "ties",
+                "value": ties.get("treatment", ""),
+                "unit": "",
+                "clause": ties.get("rule", ""),
+            }
+        )
+        for label, key in (("φ0 with the ties", "phi0_with"), ("φ0 without", "phi0_without")):
+            rows.append(_row(label, ties[key], "rad", "theory §1.7 Eq. 6; C8.7.1.2.1.6"))
+    add("J/S (d per unit rotation)", "d_per_rad", "m/rad")
+    add("φ0", "phi0", "rad")
+    add("d0", "d0", "m")
+    for name in ("SLV", "SLC"):
+        ls = check[name]
+        lcl = ls.get("clauses", {})
+        rows.append(_row(f"d_{name}", ls["d"], "m", f"{lcl.get('d', '')}: {ls['d_rule']}"))
+        add(f"a(d_{name})", "a", "m/s²", ls)
+        add(f"T_{name}", f"T_{name}", "s", ls)
+        add(f"ξ ({name})", "xi_percent", "%", ls)
+        rows.append(
+            _row(
+                f"demand {name} (code)",
+                ls["demand_code"],
+                "m",
+                f"{lcl.get('demand_code', '')}: {ls['demand_rule']}",
+            )
+        )
+        add(f"demand {name} (records)", "demand_records", "m", ls)
+        add(f"a_g,{name} (capacity)", "a_g_capacity", "g", ls)
+        add("a_g,SLD (lower bound)", "a_g_SLD", "g", ls)
+        add(f"a_g ({name} hazard)", "a_g", "g", ls)
+        add(f"a_g,{name} / a_g", "capacity_ratio", "-", ls)
+    return rows
+
+
+def _rows_2009(check: dict[str, Any]) -> list[dict[str, str]]:
+    src = "Circolare 617/2009 C8A.4 (2009 forms, from memory; for comparison)"
+    rows = []
+    per = "m" if "du_star" in check else "m/s²"
+    for label, key, unit in (
+        ("α0", "alpha0", "-"),
+        ("M*", "M_star", "kg"),
+        ("e*", "e_star", "-"),
+        ("a0*", "a0_star", "m/s²"),
+        ("demand at ground", "demand_ground", per),
+        ("d0*", "d0_star", "m"),
+        ("du* = 0.4 d0*", "du_star", "m"),
+        ("Ts", "Ts", "s"),
+        ("demand at height", "demand_height", per),
+        ("demand", "demand", per),
+        ("capacity/demand", "capacity_ratio", "-"),
+    ):
+        if check.get(key) is not None:
+            rows.append(_row(label, check[key], unit, src))
+    return rows
 
 
 def _plot_envelope(env: dict[str, Any], path: Path) -> Path:
@@ -439,13 +633,18 @@ def render_assessment(
             mech = by_id[row["id"]]
             non = row["nonlinear"]
             figs = []
-            if non.get("status") == "ok":
+            if non.get("status") == "ok" and non.get("curve"):
                 figs.append(
                     _embed(
                         functools.partial(
-                            _plot_capacity, non, spectrum, folder / f"{row['id']}_capacity.png"
+                            _plot_capacity,
+                            row["linear"],
+                            non,
+                            spectrum,
+                            folder / f"{row['id']}_capacity.png",
                         ),
-                        f"{row['id']}: capacity curve and site spectrum (NTC nonlinear check)",
+                        f"{row['id']}: the checks on the capacity curve (ADRS): capacity, "
+                        "demand and verdict of each (Circ. 2019 C8.7.1.2.1.7-8)",
                     )
                 )
             env_doc = row.get("envelope") or {}
@@ -460,9 +659,12 @@ def render_assessment(
                     )
                 )
             figs.extend(_history_figures(mech, row, motions, folder))
+            circ2019 = doc.get("method", {}).get("name") == "circ2019"
             cells = {
-                "linear": _verdict_cell(row["linear"], "a0*/demand"),
-                "nonlinear": _verdict_cell(row["nonlinear"], "du*/demand"),
+                "linear": _verdict_cell(row["linear"], "a_g,SLV/a_g" if circ2019 else "a0*/demand"),
+                "nonlinear": _verdict_cell(
+                    row["nonlinear"], "a_g,SLV/a_g" if circ2019 else "du*/demand"
+                ),
                 "dynamics": _dynamics_cell(row),
                 "margin": _margin_cell(row),
             }
@@ -474,6 +676,8 @@ def render_assessment(
                     "constants": _constants_rows(mech),
                     "figures": figs,
                     "cells": cells,
+                    "linear_rows": _check_rows(row["linear"]),
+                    "nonlinear_rows": _check_rows(row["nonlinear"]),
                 }
             )
     project = site.project.model_dump()
@@ -482,6 +686,7 @@ def render_assessment(
         "project": project,
         "generated": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
         "site": doc["site"],
+        "method": doc.get("method", {}),
         "site_rows": _table_of(doc["site"]["params"]),
         "hazard_rows": _table_of(site.hazard.model_dump()),
         "building_rows": _table_of(site.building.model_dump()) if site.building else [],

@@ -1,9 +1,10 @@
 """The code checks beside rocking dynamics: the check document and the assessment document.
 
-``check_doc`` runs, for every mechanism of a constants file and every stored side, the
-linear and nonlinear kinematic checks of NTC 2018 / Circolare §C8.7.1 (docs/theory.md §11)
-against the site's elastic spectrum (SITE.json). ``assessment_doc`` adds, per mechanism,
-the rocking dynamics on records scaled to the site spectrum and the pulse-envelope margin;
+``check_doc`` (``workflows.codecheck``) runs, for every mechanism of a constants file and
+every stored side, the linear and nonlinear checks of the Circolare 21 gennaio 2019 n. 7
+§C8.7.1 (docs/theory.md §11) against the site's elastic spectrum (SITE.json).
+``assessment_doc`` adds, per mechanism, the records' demand of §C8.7.1.2.1.8, the rocking
+dynamics on records scaled to the site spectrum and the pulse-envelope margin;
 ``solver_service.report.assess`` renders it. A mechanism that cannot run an analysis gets a
 note in its row; it never stops the others.
 """
@@ -17,24 +18,31 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 from shared_schema.api import MAX_ASSESS_MULTIPLES, MULTIPLE_MAX
-from shared_schema.constants import ConstantsFile, Mechanism, SideConstants
+from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.rules import check_file, check_number
 from shared_schema.site import SiteFile, parse_site
 from shared_schema.text import decode_text
 
 from ..core.exact import simulate
-from ..core.hazard import ElasticSpectrum, ec8_spectrum, ntc_spectrum
-from ..core.kinematic import Building, VirtualWork, linear_check, nonlinear_check
+from ..core.hazard import ElasticSpectrum
 from ..core.pulses import largest_pulse
 from ..core.spectra import response_spectrum
 from .adapter import to_rocking_model
+from .codecheck import (
+    NO_VIRTUAL_WORK,
+    T1_COEFFICIENT,
+    check_doc,
+    recheck_with_records,
+    site_spectrum,
+)
 from .documents import envelope_doc, log_grid
 from .scaling import mechanism_scale_factor
 
 __all__ = [
     "BAND_DEFAULT",
     "MULTIPLE_MAX",
+    "NO_VIRTUAL_WORK",
     "T1_COEFFICIENT",
     "assessment_doc",
     "check_doc",
@@ -45,21 +53,13 @@ __all__ = [
     "site_spectrum",
 ]
 
-#: NTC 2018 §7.3.3.2: T1 = C1 H^(3/4) with C1 = 0.050 for masonry buildings.
-T1_COEFFICIENT = 0.05
-#: Period band [s] for matching a record to the site spectrum when a mechanism has no Ts
+#: Period band [s] for matching a record to the site spectrum when a mechanism has no T_SLV
 #: (NTC 2018 §3.2.3.6's default band for spectrum compatibility).
 BAND_DEFAULT = (0.15, 2.0)
-#: The band around a mechanism's secant period Ts: [BAND_LOW Ts, BAND_HIGH Ts].
+#: The band around a mechanism's period T_SLV: [BAND_LOW T_SLV, BAND_HIGH T_SLV].
 BAND_LOW, BAND_HIGH = 0.5, 1.5
 #: Periods in a matching band.
 BAND_POINTS = 40
-
-NO_VIRTUAL_WORK = (
-    "no virtual_work in the constants (short form or an older file): the code check needs "
-    "the masses' virtual displacements; compute the constants from the geometry with "
-    "`rockmech constants`"
-)
 
 
 #: What a site file must be, for the messages on empty, binary or non-JSON files.
@@ -76,160 +76,6 @@ def read_site(path: Path) -> SiteFile:
         if exc.field:
             raise
         raise InputError(f"{path.name}: {exc.reason}; expected {SITE_EXPECTED}", "site") from None
-
-
-def site_spectrum(site: SiteFile) -> ElasticSpectrum:
-    """Return the site's elastic spectrum (NTC 2018 §3.2.3.2 or EN 1998-1 §3.2.2.2)."""
-    hz = site.hazard
-    if hz.code == "NTC2018":
-        return ntc_spectrum(hz.a_g, hz.F0, hz.Tc_star, hz.soil, hz.topography, hz.xi_percent)
-    return ec8_spectrum(hz.a_gR, hz.importance, hz.ground, hz.spectrum_type, hz.xi_percent)
-
-
-def _building(site: SiteFile, mech: Mechanism) -> tuple[Optional[Building], str]:
-    """Return the building for a mechanism's height demand and where T1 came from."""
-    b = site.building
-    if b is None:
-        return None, ""
-    if mech.amplification is not None:
-        return Building(b.height, b.storeys, 1.0 / mech.amplification.f_n), "1/f_n of the mechanism"
-    if b.T1 is not None:
-        return Building(b.height, b.storeys, b.T1), "site building.T1"
-    return (
-        Building(b.height, b.storeys, T1_COEFFICIENT * b.height**0.75),
-        "0.05 H^0.75 (NTC 2018 §7.3.3.2)",
-    )
-
-
-def _sides(mech: Mechanism) -> list[tuple[str, SideConstants]]:
-    out = [("positive", mech.positive)]
-    if mech.negative is not None and not mech.one_sided:
-        out.append(("negative", mech.negative))
-    return out
-
-
-def _not_run(method: str, note: str) -> dict[str, Any]:
-    return {"method": method, "passes": None, "note": note, "status": "not_run"}
-
-
-def _side_checks(
-    side: SideConstants, spectrum: ElasticSpectrum, site: SiteFile, z: float, bld: Any
-) -> tuple[dict[str, Any], dict[str, Any]]:
-    lin_m = "NTC 2018 / Circolare §C8.7.1: linear kinematic analysis (SLV)"
-    non_m = "NTC 2018 / Circolare §C8.7.1: nonlinear kinematic analysis (SLV)"
-    if side.virtual_work is None:
-        return _not_run(lin_m, NO_VIRTUAL_WORK), _not_run(non_m, NO_VIRTUAL_WORK)
-    v = side.virtual_work
-    vw = VirtualWork(v.alpha0, v.mass, v.S, v.J)
-    hz = site.hazard
-    try:
-        lin = linear_check(vw, spectrum, FC=hz.FC, q=hz.q, Z=z, building=bld)
-        lin["status"] = "ok"
-    except RockmechError as exc:
-        lin = _not_run(lin_m, str(exc))
-    try:
-        assert side.phi_ov is not None  # filled in by validation
-        non = nonlinear_check(vw, side.phi_ov, spectrum, FC=hz.FC, Z=z, building=bld)
-        non["status"] = "ok"
-    except RockmechError as exc:
-        non = _not_run(non_m, str(exc))
-    return lin, non
-
-
-def _worst(checks: Sequence[dict[str, Any]]) -> dict[str, Any]:
-    """Return the governing side: the lowest capacity ratio among the checks that ran."""
-    ran = [c for c in checks if c.get("status") == "ok"]
-    if not ran:
-        return checks[0]
-    return min(ran, key=lambda c: c["capacity_ratio"])
-
-
-def check_doc(cf: ConstantsFile, site: SiteFile) -> dict[str, Any]:
-    """Code checks of every mechanism of ``cf`` on ``site`` (theory §11).
-
-    Parameters
-    ----------
-    cf : ConstantsFile
-        Mechanisms; those with ``virtual_work`` per side can be checked.
-    site : SiteFile
-        Hazard, FC, q and the building.
-
-    Returns
-    -------
-    dict
-        ``site`` (the code, the spectrum's parameters and corner periods), ``spectrum``
-        (``T`` [s], ``Se_g`` [g], ``SDe_m`` [m] for plotting), ``mechanisms`` (per
-        mechanism: ``id``, ``name``, ``Z`` [m] and its source, per side ``linear`` and
-        ``nonlinear``, the governing ``linear`` and ``nonlinear`` and ``passes``), and
-        ``governing`` (the id with the lowest capacity ratio, or None).
-    """
-    spectrum = site_spectrum(site)
-    t = np.linspace(0.0, 4.0, 161)
-    rows: list[dict[str, Any]] = []
-    for mech in cf.mechanisms:
-        if mech.amplification is not None:
-            z, z_source = mech.amplification.h, "amplification.h"
-        else:
-            z, z_source = 0.0, "ground level (the constants give no amplification.h)"
-        bld, t1_source = _building(site, mech)
-        sides: dict[str, Any] = {}
-        for name, side in _sides(mech):
-            lin, non = _side_checks(side, spectrum, site, z, bld)
-            sides[name] = {"linear": lin, "nonlinear": non}
-        lin_g = _worst([s["linear"] for s in sides.values()])
-        non_g = _worst([s["nonlinear"] for s in sides.values()])
-        verdicts = [c["passes"] for c in (lin_g, non_g) if c.get("status") == "ok"]
-        rows.append(
-            {
-                "id": mech.id,
-                "name": mech.name,
-                "typology": mech.typology,
-                "rocking": mech.rocking,
-                "Z": z,
-                "Z_source": z_source,
-                "T1_source": t1_source or None,
-                "sides": sides,
-                "linear": lin_g,
-                "nonlinear": non_g,
-                "passes": None if not verdicts or None in verdicts else all(verdicts),
-            }
-        )
-    ratios = [
-        (min(c["capacity_ratio"] for c in (r["linear"], r["nonlinear"]) if c["status"] == "ok"), r)
-        for r in rows
-        if any(c.get("status") == "ok" for c in (r["linear"], r["nonlinear"]))
-    ]
-    governing = min(ratios, key=lambda p: p[0])[1]["id"] if ratios else None
-    hz = site.hazard
-    return {
-        "site": {
-            "code": hz.code,
-            "params": spectrum.params,
-            "S": spectrum.S,
-            "eta": spectrum.eta,
-            "F": spectrum.F,
-            "T_B": spectrum.T_B,
-            "T_C": spectrum.T_C,
-            "T_D": spectrum.T_D,
-            "pga_g": spectrum.pga,
-            "FC": hz.FC,
-            "q": hz.q,
-            "method_note": (
-                "the Circolare's kinematic checks applied to the EN 1998-1 spectrum "
-                "(EN 1998-3 has no kinematic check of its own)"
-                if hz.code == "EC8"
-                else ""
-            ),
-            "building": None if site.building is None else site.building.model_dump(),
-        },
-        "spectrum": {
-            "T": t.tolist(),
-            "Se_g": spectrum.Se(t).tolist(),
-            "SDe_m": spectrum.SDe(t).tolist(),
-        },
-        "mechanisms": rows,
-        "governing": governing,
-    }
 
 
 def record_scale_factor(
@@ -274,12 +120,14 @@ def record_scale_factor(
 def matching_band(row: dict[str, Any]) -> tuple[float, float]:
     """Periods [s] over which records are matched to the site spectrum for one mechanism.
 
-    ``[BAND_LOW Ts, BAND_HIGH Ts]`` from the row's nonlinear check (``check_doc``), else
+    ``[BAND_LOW T, BAND_HIGH T]`` around the period of the row's nonlinear check
+    (``check_doc``: ``T_SLV`` of the Circolare 2019, ``Ts`` of the 2009 forms), else
     ``BAND_DEFAULT``.
     """
     non = row["nonlinear"]
-    if non.get("status") == "ok" and math.isfinite(non["Ts"]):
-        return BAND_LOW * non["Ts"], BAND_HIGH * non["Ts"]
+    period = non.get("T_SLV", non.get("Ts")) if non.get("status") == "ok" else None
+    if isinstance(period, (int, float)) and math.isfinite(period) and period > 0.0:
+        return BAND_LOW * period, BAND_HIGH * period
     return BAND_DEFAULT
 
 
@@ -398,8 +246,9 @@ def assessment_doc(
         As ``check_doc``.
     motions : sequence of GroundMotion
         Records; each is scaled per mechanism to the site spectrum over the mechanism's band
-        (``[0.5 Ts, 1.5 Ts]`` from the nonlinear check, else ``BAND_DEFAULT``) and, above
-        ground, amplified by Eq. 28; then run at ``multiples`` of that design scale.
+        (``[0.5 T_SLV, 1.5 T_SLV]`` from the nonlinear check, else ``BAND_DEFAULT``); at that
+        design scale it adds its demand to the nonlinear check (§C8.7.1.2.1.8) and, above
+        ground amplified by Eq. 28, it is run at ``multiples`` of that design scale.
     multiples : sequence of float
         Multiples of the design scale factor to run (1 is the design level): 1 to 8, each in
         ``(0, MULTIPLE_MAX]`` (``check_multiples``).
@@ -420,8 +269,25 @@ def assessment_doc(
     doc = check_doc(cf, site)
     spectrum = site_spectrum(site)
     freq = np.asarray(f_p if f_p is not None else log_grid(0.1, 10.0, 120), dtype=float)
-    for row, mech in zip(doc["mechanisms"], cf.mechanisms):
+    # The design scale of each record per mechanism (its band comes from the code check).
+    matched: list[list[Any]] = []
+    for row in doc["mechanisms"]:
         band = matching_band(row)
+        per_record: list[Any] = []
+        for motion in motions:
+            try:
+                per_record.append(record_scale_factor(motion, spectrum, band))
+            except RockmechError as exc:
+                per_record.append(exc)
+        matched.append(per_record)
+    # C8.7.1.2.1.8: with records, the demand is also their largest S_De over [T0, T_SLV].
+    recheck_with_records(
+        doc,
+        cf,
+        site,
+        [[(m, d["value"]) for m, d in zip(motions, per) if isinstance(d, dict)] for per in matched],
+    )
+    for row, mech, per_record in zip(doc["mechanisms"], cf.mechanisms, matched):
         try:
             model = to_rocking_model(mech)
         except RockmechError as exc:
@@ -431,13 +297,16 @@ def assessment_doc(
             continue
         dyn: list[dict[str, Any]] = []
         designs: list[Optional[float]] = []
-        for motion in motions:
+        for motion, design in zip(motions, per_record):
+            if not isinstance(design, dict):
+                designs.append(None)
+                dyn.append({"record": motion.name, "note": f"not run: {design}"})
+                continue
             try:
-                design = record_scale_factor(motion, spectrum, band)
                 designs.append(design["value"])
                 dyn.append(_record_runs(model, mech, motion, design, multiples))
             except RockmechError as exc:
-                designs.append(None)
+                designs[-1] = None
                 dyn.append({"record": motion.name, "note": f"not run: {exc}"})
         row["dynamics"] = dyn
         row["envelope"] = _envelope_margin(mech, motions, designs, freq)

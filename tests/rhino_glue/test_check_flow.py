@@ -19,7 +19,11 @@ def test_code_check_flow_matches_the_workflow_and_summarises_each_mechanism() ->
     assert result.doc == check_doc(cf, site)
     lines = result.summary
     assert [ln.split(":")[0] for ln in lines[:4]] == ["F1", "F2", "A1", "T1"]
-    assert lines[0].startswith("F1: linear FAILS (") and "nonlinear passes" in lines[0]
+    # The tied façade fails both: its ties are not verified up to collapse (d0 without them).
+    assert lines[0].startswith("F1: linear FAILS (") and "nonlinear FAILS (" in lines[0]
+    assert lines[-2].startswith("T1: linear passes (") and "nonlinear passes (" in lines[-2]
+    # The example site gives the SLC hazard: the collapse check is in each line.
+    assert ", SLC FAILS (" in lines[0] and ", SLC passes (" in lines[-2]
     assert lines[-1] == f"governing mechanism: {result.doc['governing']}"
 
 

@@ -15,9 +15,12 @@ has to refuse them. Each rule is the service's own, called or mirrored, with its
   most ``WORK_PER_SAMPLE * ROCKMECH_MAX_SAMPLES`` (``api.jobs.check_record_work``): a period
   far shorter than the record's time step costs sub-steps on every sample.
 - the other JSON operations (``json_body_ok``): the body validated with the request model
-  as the service does, dropped only for a rule across fields (``CROSS_FIELD_RULES``); the
-  options' order (``f_min < f_max``, ``t_min < t_max``); then the server's limits and work
-  (``_work_ok``, ``_scale_factors_ok``, ``_assess_spectra_ok``, ``_amplitude_ok``).
+  as the service does, dropped only for a rule across fields (``CROSS_FIELD_RULES``); for
+  ``/check`` and ``/assess`` the site's choices against the constants
+  (``workflows.codecheck.check_site_inputs``: the mechanism ids it names exist; its
+  ``building.T1`` agrees with the ``1/f_n`` of a mechanism above ground that is checked);
+  the options' order (``f_min < f_max``, ``t_min < t_max``); then the server's limits and
+  work (``_work_ok``, ``_scale_factors_ok``, ``_assess_spectra_ok``, ``_amplitude_ok``).
 
 The multipart forms are excepted from the positive-data check: ``positive_data_acceptance``
 is re-registered to skip them (their uploads are random bytes, which the service rightly
@@ -84,6 +87,7 @@ from solver_service.core.model import G
 from solver_service.core.spectra import STEPS_PER_PERIOD
 from solver_service.report.html import SPECTRUM_PERIODS
 from solver_service.workflows.assess import check_doc
+from solver_service.workflows.codecheck import check_site_inputs
 from solver_service.workflows.documents import frequency_grid
 from solver_service.workflows.limits import WORK_PER_SAMPLE
 from solver_service.workflows.scaling import factor_groups
@@ -145,6 +149,8 @@ CROSS_FIELD_RULES = frozenset(
         "duplicate_id",  # unique mechanism ids
         "eta_not_between",  # eta between eta_to_negative and eta_to_positive
         "implausible_constant",  # p_eq and lam derived from a physical form in range
+        "duplicate_limit_state",  # site: limit_states repeating the hazard's own limit state
+        "verified_ties_break",  # site: ties verified up to collapse with a failure rotation
     }
 )
 
@@ -281,6 +287,13 @@ def json_body_ok(operation: str, body: Any) -> bool:
     except ValidationError as exc:
         return not any(err["type"] in CROSS_FIELD_RULES for err in exc.errors())
     fields = dict(request)
+    if operation in ("check", "assess"):
+        # The site's choices against the constants: known mechanism ids, one T1 (the site's
+        # building.T1 against the 1/f_n of a mechanism above ground that can be checked).
+        try:
+            check_site_inputs(request.constants, request.site)
+        except InputError:
+            return False
     # log_grid: f_min < f_max, t_min < t_max; extract_pulses: f_min <= f_max.
     if operation == "spectrum":
         if not _ordered(request.t_min, request.t_max):

@@ -231,3 +231,33 @@ def test_code_check_flow_reports_the_services_refusal(server: Any) -> None:
     with pytest.raises(InputError, match=want) as err:
         run_check(cf, site, client=ServiceClient(server.url))
     assert err.value.field == "service"
+
+
+def test_site_contradicting_the_constants_is_422_as_rockmech_says(
+    client: httpx.Client, tmp_path: Path
+) -> None:
+    # The site's building.T1 (0.6 s) against the two-block wall's 1/f_n (0.32 s): one first
+    # period decides the check (Circolare 2019 [C7.3.2], docs/theory.md §11.5).
+    constants = _json(GEOMETRY)
+    constants["mechanisms"][3]["amplification"] = {"f_n": 3.1, "h_e": 3.0, "h": 3.0}
+    res = client.post("/api/v1/check", json={"constants": constants, "site": _json(NTC)})
+    assert res.status_code == 422, res.text
+    err = res.json()
+    bad = tmp_path / "constants.json"
+    bad.write_text(json.dumps(constants))
+    message = cli_error("check", str(bad), str(NTC))
+    assert message.startswith("building.T1: ")
+    assert err["field"].endswith("building.T1")
+    assert message.split(": ", 1)[1] in err["detail"]
+
+
+def test_assess_adds_the_records_demand_to_the_nonlinear_check(client: httpx.Client) -> None:
+    # Circolare 2019 §C8.7.1.2.1.8: with records, the largest spectral displacement over
+    # [T0, T_SLV] at the design scale; the larger of it and the code spectrum's governs.
+    res = client.post("/api/v1/assess", json=_assess_body(multiples=[1.0]))
+    assert res.status_code == 200, res.text
+    for row in res.json()["mechanisms"]:
+        slv = row["nonlinear"]["SLV"]
+        assert slv["demand_records"] is not None and slv["records"][0]["at_T"] <= slv["T_SLV"]
+        assert slv["demand"] == max(slv["demand_code"], slv["demand_records"])
+        assert "[C8.7.1.10]" in slv["clauses"]["T_SLV"]

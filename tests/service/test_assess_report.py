@@ -73,6 +73,34 @@ def test_short_form_church_gets_notes_in_every_row_not_an_abort() -> None:
     assert "eta" in f1["envelope"]["note"]
 
 
+def test_each_number_of_the_worked_checks_names_its_clause() -> None:
+    cf = parse_constants(CHURCH_GEOMETRY.read_bytes())
+    site = parse_site(NTC_SITE.read_bytes())
+    doc = assessment_doc(cf, site, [], multiples=(1.0,))
+    text = render_assessment(doc, cf, site, [])
+    tables = re.findall(r'<table class="worked">(.*?)</table>', text, flags=re.S)
+    assert len(tables) == 2 * len(cf.mechanisms)  # linear and nonlinear, per mechanism
+    for table in tables:
+        rows = re.findall(
+            r"<tr><td>(.*?)</td><td class=\"n\">(.*?)</td><td>(.*?)</td>"
+            r'<td class="note">(.*?)</td></tr>',
+            table,
+            flags=re.S,
+        )
+        assert rows, table[:200]
+        for label, _, _, clause in rows:
+            assert clause.strip(), f"{label} has no clause"
+    assert "[C8.7.1.10]" in text and "[C8.7.1.11]" in text and "[C8.7.1.8]" in text
+    assert "Circolare 21 gennaio 2019 n. 7" in text
+    # The checks are drawn on the capacity curve (ADRS) for every mechanism.
+    assert text.count("<figcaption>" + "F1: the checks on the capacity curve (ADRS)") == 1
+    assert text.count("the checks on the capacity curve (ADRS)") == 2 * len(
+        cf.mechanisms
+    )  # alt too
+    # F1's ties are not verified: the report says so and d0 is without them.
+    assert "ties not verified" in text
+
+
 def test_project_fields_are_escaped_and_a_user_template_wins(tmp_path: Path) -> None:
     cf = parse_constants(CHURCH_GEOMETRY.read_bytes())
     data = json.loads(NTC_SITE.read_text(encoding="utf-8"))

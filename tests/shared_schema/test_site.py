@@ -64,3 +64,64 @@ def test_malformed_json_is_an_input_error() -> None:
     # a nest past Python's recursion limit was a RecursionError traceback (rockmech check)
     with pytest.raises(InputError, match="nested deeper than 1000 levels"):
         parse_site('{"a":' * 5000 + "1" + "}" * 5000)
+
+
+def test_other_limit_states_and_the_checks_choices_are_read() -> None:
+    site = parse_site(
+        {
+            "hazard": {
+                "code": "NTC2018",
+                "a_g": 0.26,
+                "F0": 2.36,
+                "Tc_star": 0.35,
+                "FC": 1.35,
+                "limit_states": {"SLC": {"a_g": 0.33, "F0": 2.41, "Tc_star": 0.36}},
+            },
+            "building": {"height": 12.0, "storeys": 4, "xi_percent": 10.0},
+            "local_mechanisms": {
+                "E": 1.5e9,
+                "mechanisms": {"W1": {"free_standing": True, "ties": "verified"}},
+            },
+        }
+    )
+    assert site.hazard.limit_states is not None and site.hazard.limit_states["SLC"].a_g == 0.33
+    assert site.building is not None and site.building.period_elongation == 1.0
+    lm = site.local_mechanisms
+    assert (lm.method, lm.xi_SLV_percent, lm.xi_SLC_percent) == ("circ2019", 8.0, 10.0)
+    assert lm.mechanisms["W1"].ties == "verified"
+
+
+@pytest.mark.parametrize(
+    ("extra", "field"),
+    [
+        (
+            {
+                "hazard": {
+                    "code": "EC8",
+                    "a_gR": 0.2,
+                    "FC": 1.2,
+                    "limit_states": {"SLV": {"a_gR": 0.3}},
+                }
+            },
+            "hazard.EC8.limit_states.SLV",
+        ),
+        (
+            {
+                "local_mechanisms": {
+                    "mechanisms": {"F1": {"ties": "verified", "tie_failure_rotation": 0.01}}
+                }
+            },
+            "local_mechanisms.mechanisms.F1.tie_failure_rotation",
+        ),
+        ({"local_mechanisms": {"method": "circ2008"}}, "local_mechanisms.method"),
+        (
+            {"building": {"height": 9.0, "storeys": 3, "period_elongation": 0.5}},
+            "building.period_elongation",
+        ),
+    ],
+)
+def test_invalid_choices_name_the_field(extra: dict, field: str) -> None:
+    data = {"hazard": {"code": "EC8", "a_gR": 0.2, "FC": 1.2}, **extra}
+    with pytest.raises(InputError) as err:
+        parse_site(json.dumps(data))
+    assert err.value.field == field

@@ -37,7 +37,7 @@ def _json_or_html(model: Any) -> dict[Any, Any]:
 
 @router.post(
     "/check",
-    summary="Code checks (NTC 2018 / Circolare §C8.7.1) of every mechanism on a site",
+    summary="Code checks (Circolare 2019 §C8.7.1, NTC 2018) of every mechanism on a site",
     response_model=None,
     responses=responses(CheckResponse),
     openapi_extra=body_doc(CheckRequest, None),
