@@ -44,7 +44,7 @@ import threading
 import time
 import uuid
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import CancelledError, ThreadPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
@@ -102,6 +102,12 @@ SCHEMES = ("tcp", "tls", "ws", "wss")
 PEAKS_FILE = "ida_peaks.parquet"
 #: Rows of the peaks file gathered before they are written as one row group.
 ROW_GROUP_ROWS = 1 << 20
+#: Tasks a Dask worker holds per thread (one running, the next ones ready).
+IN_FLIGHT = 2
+#: Times a task lost with a worker is run again before the run stops.
+RETRIES = 3
+#: Interval at which a Dask run reads the list of workers again [s].
+REFRESH_S = 1.0
 #: Prepared constants kept per process (a Dask worker keeps those of its latest runs).
 SETUPS_KEPT = 4
 
@@ -564,11 +570,15 @@ class _Totals:
         n = max(len(self.timing), 1)
         overhead = (busy - kernel_s + gaps) / n
         task = busy / n
+        starts = [start for _, start, _, _ in self.timing] or [0.0]
+        ends = [end for _, _, end, _ in self.timing] or [0.0]
         return {
             "lanes": len(lanes),
             "task_s": task,
             "overhead_per_task_s": overhead,
             "overhead_fraction": overhead / task if task > 0 else 0.0,
+            "gap_per_task_s": gaps / n,
+            "span_s": max(ends) - min(starts),
         }
 
 
@@ -606,6 +616,19 @@ def worker_version() -> str:
     return __version__
 
 
+def _wait_for_workers(client: Any, address: str, timeout: float, left: str) -> None:
+    """Wait up to ``timeout`` [s] for a worker; else an error naming ``left`` (work left)."""
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except (OSError, TimeoutError) as exc:
+        raise InputError(
+            f"no worker {'is left on' if left else 'joined'} the Dask scheduler at {address} "
+            f"within {timeout:g} s{f' ({left})' if left else ''}; start workers with "
+            f"`dask worker {address}`",
+            "scheduler",
+        ) from exc
+
+
 def _cluster_threads(client: Any, address: str, timeout: float) -> tuple[int, int]:
     """(workers, threads) of the cluster, once one worker is there and all run this rockmech.
 
@@ -615,14 +638,7 @@ def _cluster_threads(client: Any, address: str, timeout: float) -> tuple[int, in
         No worker within ``timeout``, a worker that cannot import rockmech, or one with
         another version (field ``scheduler``).
     """
-    try:
-        client.wait_for_workers(1, timeout=timeout)
-    except (OSError, TimeoutError) as exc:
-        raise InputError(
-            f"no worker joined the Dask scheduler at {address} within {timeout:g} s; start "
-            f"workers with `dask worker {address}`",
-            "scheduler",
-        ) from exc
+    _wait_for_workers(client, address, timeout, "")
     try:
         versions = client.run(worker_version)
     except Exception as exc:  # any failure on a worker: one line, not a traceback
@@ -670,36 +686,153 @@ def _run_local(
             raise
 
 
+class _DaskFeed:
+    """Tasks fed to the workers as they free up: each holds ``IN_FLIGHT`` per thread.
+
+    A task goes to the worker with the most free places, and its records are scattered to
+    that worker just before (once per worker: the blocks of levels of a long record that
+    land on the same worker share them); a finished task frees its place there, so a slow
+    worker gets fewer tasks, and records are in the cluster's memory only while their tasks
+    are. Workers that join during the run get tasks from then on (the list of workers is
+    read again every ``REFRESH_S``).
+    """
+
+    def __init__(
+        self,
+        client: Any,
+        distributed: Any,
+        ctx: dict[str, Any],
+        records: list[tuple[int, Any, float, str]],
+        packs: list[list[int]],
+        tasks: list[Task],
+    ) -> None:
+        self.client, self.distributed = client, distributed
+        self.records, self.packs, self.n = records, packs, len(tasks)
+        self.retries: dict[Task, int] = {}
+        self.queue = list(enumerate(tasks))[::-1]  # popped from the end: longest first
+        self.left = [0] * len(packs)
+        for task in tasks:
+            self.left[task.pack] += 1
+        self.held: dict[tuple[int, str], Any] = {}  # (pack, worker) -> scattered records
+        self.places: dict[str, int] = {}  # worker -> free places
+        self.running: dict[str, tuple[Task, str, Any]] = {}  # key -> (task, worker, future)
+        self.done = distributed.as_completed()
+        self.refreshed = -math.inf
+        # In a list: a dict given alone would be scattered as one key per entry.
+        [self.shared] = client.scatter([ctx], broadcast=True, hash=False)
+
+    def refresh(self) -> None:
+        """Read the workers again: new ones get places, those gone lose theirs."""
+        if time.monotonic() - self.refreshed < REFRESH_S:
+            return
+        self.refreshed = time.monotonic()
+        threads = self.client.nthreads()
+        for worker, n in threads.items():
+            if worker not in self.places:
+                self.places[worker] = IN_FLIGHT * int(n)
+        for worker in set(self.places) - set(threads):
+            del self.places[worker]
+
+    def fill(self) -> None:
+        """Submit tasks, longest first, while a worker has a free place."""
+        while self.queue and self.places:
+            worker = max(self.places, key=lambda w: self.places[w])
+            if self.places[worker] <= 0:
+                return
+            k, task = self.queue.pop()
+            held = self.held.get((task.pack, worker))
+            if held is None:
+                data = [self.records[i] for i in self.packs[task.pack]]
+                [held] = self.client.scatter([data], workers=[worker], hash=False)
+                self.held[(task.pack, worker)] = held
+            future = self.client.submit(
+                run_task,
+                self.shared,
+                held,
+                task.lo,
+                task.hi,
+                workers=[worker],
+                allow_other_workers=True,  # a worker that leaves does not strand its tasks
+                pure=False,
+                priority=self.n - k,
+            )
+            self.places[worker] -= 1
+            self.running[future.key] = (task, worker, future)
+            self.done.add(future)
+
+    def finish(self, future: Any) -> Optional[dict[str, Any]]:
+        """Take a finished task's result; free its place; release records no task needs.
+
+        A task lost with a worker (its records went with it, or the worker died while
+        running it) is queued again, up to ``RETRIES`` times: None is returned for it.
+        """
+        task, worker, _ = self.running.pop(future.key)
+        if worker in self.places:
+            self.places[worker] += 1
+        try:
+            part: dict[str, Any] = future.result()
+        except (CancelledError, self.distributed.KilledWorker) as exc:
+            self.held.pop((task.pack, worker), None)
+            self.retries[task] = self.retries.get(task, 0) + 1
+            if self.retries[task] > RETRIES:
+                raise InputError(
+                    f"a task was lost {RETRIES + 1} times with the workers that ran it "
+                    f"({type(exc).__name__}: {exc}); check that the workers stay up",
+                    "scheduler",
+                ) from exc
+            self.queue.append((-1, task))  # next to start, first on its worker
+            self.places.pop(worker, None)  # until the next refresh finds it alive
+            return None
+        self.left[task.pack] -= 1
+        if self.left[task.pack] == 0:
+            for key in [key for key in self.held if key[0] == task.pack]:
+                del self.held[key]
+        return part
+
+    def cancel(self) -> None:
+        """Cancel what this run has on the cluster: its tasks and its data."""
+        futures = [f for *_, f in self.running.values()] + [*self.held.values(), self.shared]
+        with contextlib.suppress(Exception):  # a lost connection: the scheduler drops them
+            self.client.cancel(futures, force=True)
+
+
 def _run_dask(
     client: Any,
     distributed: Any,
+    address: str,
+    timeout: float,
     ctx: dict[str, Any],
     records: list[tuple[int, Any, float, str]],
     packs: list[list[int]],
     tasks: list[Task],
     on_part: Callable[[dict[str, Any]], None],
 ) -> None:
-    """Run the tasks on the cluster: shared data broadcast, records scattered, each once."""
-    sent: list[Any] = []
+    """Run the tasks on the cluster: constants broadcast, records scattered, each once."""
+    feed: Optional[_DaskFeed] = None
     try:
-        shared = client.scatter(ctx, broadcast=True, hash=False)
-        sent.append(shared)
-        groups = client.scatter([[records[i] for i in p] for p in packs], hash=False)
-        sent.extend(groups)
-        n = len(tasks)
-        futures = [
-            client.submit(run_task, shared, groups[t.pack], t.lo, t.hi, pure=False, priority=n - k)
-            for k, t in enumerate(tasks)
-        ]
-        sent.extend(futures)
         with client.as_current():
-            for future in distributed.as_completed(futures):
-                on_part(future.result())
+            feed = _DaskFeed(client, distributed, ctx, records, packs, tasks)
+            feed.refresh()
+            feed.fill()
+            while True:
+                for future in feed.done:
+                    part = feed.finish(future)
+                    if part is not None:
+                        on_part(part)
+                    feed.refresh()
+                    feed.fill()
+                if not feed.queue:
+                    break
+                # Tasks left and none running: the workers left (or lost tasks); wait for one.
+                _wait_for_workers(client, address, timeout, f"{len(feed.queue)} tasks to run")
+                feed.refreshed = -math.inf
+                feed.refresh()
+                feed.fill()
     except BaseException:
         # Stopped (time limit, Ctrl+C, a task's error): nothing of this run stays queued
         # or running on the cluster.
-        with contextlib.suppress(Exception):  # a lost connection: the scheduler drops them
-            client.cancel(sent, force=True)
+        if feed is not None:
+            feed.cancel()
         raise
 
 
@@ -727,7 +860,7 @@ def _collect(
     try:
         n_workers, n_threads = _cluster_threads(client, scheduler, timeout)
         packs, tasks = plan_tasks(costs, n_levels, task_s or task_seconds(sum(costs), n_threads))
-        _run_dask(client, distributed, ctx, records, packs, tasks, on_part)
+        _run_dask(client, distributed, scheduler, timeout, ctx, records, packs, tasks, on_part)
     finally:
         client.close()
     backend = {"kind": "dask", "scheduler": scheduler, "n_workers": n_workers}
@@ -808,10 +941,12 @@ def run_ida(
         ``first_overturning_level`` (per record) and ``fragility`` (median, beta), plus
         ``runs``, ``runtime_s``, ``compute_s`` (inside the kernels, all tasks),
         ``max_error_estimate`` and ``backend``: ``kind``, ``jobs`` or the Dask ``scheduler``,
-        ``n_workers`` and ``threads``, the number of ``tasks``, the mean ``task_s`` and the
-        mean ``overhead_per_task_s`` (time in a task outside the kernels, plus the gaps
-        between consecutive tasks on a worker thread) and its ``overhead_fraction`` of the
-        task time. With ``peaks``, ``peaks`` (``file``, ``rows``).
+        ``n_workers`` and ``threads``, the number of ``tasks`` and worker threads that ran
+        them (``lanes``), the mean ``task_s``, the mean ``overhead_per_task_s`` (time in a
+        task outside the kernels, plus the gap before the next task on the same worker
+        thread) and its ``overhead_fraction`` of the task time, the gap alone
+        (``gap_per_task_s``) and ``span_s``, from the first task's start to the last one's
+        end (on the workers' clocks). With ``peaks``, ``peaks`` (``file``, ``rows``).
 
     Raises
     ------
@@ -868,6 +1003,8 @@ def run_ida(
             writer.abort()
         raise
     wall = time.perf_counter() - start
+    if totals.runs_done != totals.n_runs:  # every run is in exactly one finished task
+        raise RuntimeError(f"IDA ran {totals.runs_done} of {totals.n_runs} runs")
     doc = _document(cf, motions, lv, im, totals)
     doc.update(runtime_s=wall, compute_s=totals.kernel_s)
     doc["backend"] = {**backend, **totals.task_stats()}

@@ -365,3 +365,27 @@ def test_a_mechanism_without_eta_is_skipped_with_a_note_not_fatal(
     assert res.exit_code == 0, res.output
     assert "warning: F1 skipped" in res.stderr
     assert f"x {len(church.mechanisms) - 1} mechanisms" in res.stdout
+
+
+def test_a_worker_lost_during_the_run_costs_its_tasks_not_the_run(
+    mixed: list[GroundMotion],
+) -> None:
+    distributed = pytest.importorskip("distributed")
+    cf = load_constants(CONSTANTS)
+    local = run_ida(cf, mixed, LEVELS, jobs=1)
+    killed: list[int] = []
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        nanny = next(iter(cluster.workers.values()))
+
+        def kill_one(done: int, total: int) -> None:
+            if done and not killed:  # after the first task: the others are on the workers
+                killed.append(nanny.process.process.pid)
+                os.kill(killed[0], 9)
+
+        remote = run_ida(
+            cf, mixed, LEVELS, scheduler=cluster.scheduler_address, task_s=1e-9, progress=kill_one
+        )
+    assert killed
+    assert _results(remote) == _results(local)
