@@ -32,7 +32,9 @@ first task's start to its last task's end: connecting, checking the workers, bro
 the constants, scattering the records, gathering the last result). The tasks are list-
 scheduled, longest first as ``run_ida`` submits them, on ``MODEL_WORKERS`` lanes, each
 taking its measured time plus the gap; the fixed cost is added. Threads on the same machine
-get the same schedule with the local gap and fixed cost; as the model gives every lane a
+get the same schedule with the local gap and fixed cost. On Dask, lane ``j`` starts only
+once the client has sent it its first task, ``(j + 1)`` times the client's time to scatter
+one task's records (measured), and no task starts before it is sent. As the model gives every lane a
 core of its own, it leaves out what the cores share (memory bandwidth, the clock a chip
 holds with all cores busy) and, for threads, the GIL, which the Python part of each task
 (its time outside the kernels) holds: the threads' time is also bounded below by the sum
@@ -133,12 +135,30 @@ def task_times(calls: list[tuple[float, int]]) -> list[float]:
     return [b[0] - a[0] for a, b in zip(calls, calls[1:])]
 
 
-def list_schedule(durations: list[float], lanes: int) -> float:
-    """Makespan [s] of list scheduling ``durations`` in order on ``lanes`` lanes."""
-    heap = [0.0] * lanes
-    for d in durations:
-        heapq.heappush(heap, heapq.heappop(heap) + d)
+def list_schedule(durations: list[float], lanes: int, feed_s: float = 0.0) -> float:
+    """Return the makespan [s] of list scheduling ``durations``, in order, on ``lanes`` lanes.
+
+    Lane ``j`` gets its first task ``(j + 1) feed_s`` after the start (the client sends the
+    first tasks one by one), and no task starts before the client has sent it.
+    """
+    heap = [(j + 1) * feed_s for j in range(lanes)]
+    heapq.heapify(heap)
+    for k, d in enumerate(durations):
+        free = heapq.heappop(heap)
+        heapq.heappush(heap, max(free, (k + 1) * feed_s) + d)
     return max(heap)
+
+
+def feed_seconds(client: Any, records: list[Any], packs: list[list[int]]) -> float:
+    """Return the client's time to scatter one task's records to a worker [s] (mean of 20)."""
+    worker = next(iter(client.nthreads()))
+    sample = packs[: min(20, len(packs))]
+    t0 = time.perf_counter()
+    for pack in sample:
+        data = [(i, records[i].accel.acc, float(records[i].dt), records[i].name) for i in pack]
+        [future] = client.scatter([data], workers=[worker], hash=False)
+        del future
+    return (time.perf_counter() - t0) / len(sample)
 
 
 def main(argv: Optional[list[str]] = None) -> int:
@@ -167,7 +187,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     n_runs = n_rec * N_LEVELS * len(cf.mechanisms)
     costs = record_costs(cf, records, N_LEVELS)
     model_task_s = task_seconds(sum(costs), MODEL_WORKERS)
-    _, model_tasks = plan_tasks(costs, N_LEVELS, model_task_s)
+    model_packs, model_tasks = plan_tasks(costs, N_LEVELS, model_task_s)
     print(
         f"{n_rec} records ({min(lengths)}-{max(lengths)} samples) x {N_LEVELS} levels x "
         f"{len(cf.mechanisms)} mechanisms = {n_runs} runs; {cores} cores; best of {REPEATS}"
@@ -197,6 +217,7 @@ def main(argv: Optional[list[str]] = None) -> int:
             dask = best_run(
                 lambda note, a=address: run_ida(cf, records, levels, scheduler=a), client
             )
+            feed_s = feed_seconds(client, records, model_packs)
         rows.append({"case": f"Dask, {n} worker{'s' * (n > 1)} x 1 thread", "n": n, **dask})
         print(f"Dask {n}: {fmt_time(dask['wall'])}")
 
@@ -212,7 +233,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     fixed_dask = dask_all["wall"] - dask_backend["span_s"]
     fixed_local = threads["wall"] - local_backend["span_s"]
     gap_dask, gap_local = dask_backend["gap_per_task_s"], local_backend["gap_per_task_s"]
-    span_dask = list_schedule([d + gap_dask for d in durations], MODEL_WORKERS)
+    span_dask = list_schedule([d + gap_dask for d in durations], MODEL_WORKERS, feed_s)
     span_local = list_schedule([d + gap_local for d in durations], MODEL_WORKERS)
     t_model_dask = fixed_dask + span_dask
     t_model_threads = fixed_local + span_local
@@ -283,6 +304,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         f"gap between tasks on a worker thread: Dask {fmt_time(gap_dask)}, threads "
         f"{fmt_time(gap_local)}",
         f"fixed cost of a run: Dask {fmt_time(fixed_dask)}, threads {fmt_time(fixed_local)}",
+        f"client's time to send one task's records to a worker: {fmt_time(feed_s)} (the "
+        f"first task of worker j starts (j + 1) times that after the start; the client can "
+        f"send {1 / feed_s:.0f} tasks/s, the {MODEL_WORKERS} workers need "
+        f"{MODEL_WORKERS / float(np.mean(durations)):.0f})",
         f"Python outside the kernels (holds the GIL), all tasks: {fmt_time(python_s)}",
         f"list schedule on {MODEL_WORKERS} lanes: Dask {fmt_time(span_dask)} + "
         f"{fmt_time(fixed_dask)} = {fmt_time(t_model_dask)}; threads {fmt_time(span_local)} "
