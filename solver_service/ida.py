@@ -10,9 +10,12 @@ to give every worker ``TASKS_PER_WORKER`` such tasks gets shorter ones (not belo
 
 * **locally**, on ``jobs`` threads (by default one per core the process may use);
 * **on a dask.distributed cluster**, when a scheduler address is given. The constants and
-  options travel to every worker once (broadcast), the records once, in the groups the tasks
-  use (scattered; a worker that needs a group another one holds fetches it once), and each
-  task carries only their keys and its block of levels.
+  options travel to every worker once (broadcast); each worker thread holds ``IN_FLIGHT``
+  tasks, and a task's records are scattered to the worker that runs it just before it is
+  sent, once per worker, and released when their tasks are done (``_DaskFeed``); a task
+  carries only their keys and its block of levels. A worker that finishes gets the next
+  task, so slow and fast machines share the work by their speed; a task lost with a worker
+  runs again.
 
 Either way a task runs the **single-threaded** batch kernel (it releases the GIL): a worker
 that runs ``k`` tasks at once (``k`` threads) uses ``k`` cores, and workers never start
@@ -796,6 +799,14 @@ class _DaskFeed:
             self.client.cancel(futures, force=True)
 
 
+class _OnPart(Exception):
+    """An error of the caller's handling of a result, carried past the connection's errors."""
+
+    def __init__(self, error: OSError) -> None:
+        super().__init__(str(error))
+        self.error = error
+
+
 def _run_dask(
     client: Any,
     distributed: Any,
@@ -818,7 +829,10 @@ def _run_dask(
                 for future in feed.done:
                     part = feed.finish(future)
                     if part is not None:
-                        on_part(part)
+                        try:
+                            on_part(part)
+                        except OSError as exc:  # writing the peaks, not the connection
+                            raise _OnPart(exc) from exc
                     feed.refresh()
                     feed.fill()
                 if not feed.queue:
@@ -828,6 +842,17 @@ def _run_dask(
                 feed.refreshed = -math.inf
                 feed.refresh()
                 feed.fill()
+    except _OnPart as wrapped:
+        if feed is not None:
+            feed.cancel()
+        raise wrapped.error from None
+    except (OSError, TimeoutError) as exc:  # the connection to the scheduler was lost
+        if feed is not None:
+            feed.cancel()
+        raise InputError(
+            f"lost the connection to the Dask scheduler at {address} during the run ({exc})",
+            "scheduler",
+        ) from exc
     except BaseException:
         # Stopped (time limit, Ctrl+C, a task's error): nothing of this run stays queued
         # or running on the cluster.
