@@ -734,10 +734,11 @@ def ida(
         bar.update(task, completed=done, total=total)
 
     try:
-        # The output folder's stage is open during the run: --peaks streams into it, and a
-        # stopped run leaves the folder as it was.
+        # With --peaks the output folder's stage is open during the run (the peaks stream
+        # into it); a stopped run leaves the folder as it was.
         with contextlib.ExitStack() as stack:
-            stage = None if out is None else stack.enter_context(run_folder(out, on_note=_out_note))
+            folder = functools.partial(run_folder, on_note=_out_note)
+            stage = stack.enter_context(folder(out)) if out is not None and peaks else None
             with bar:
                 doc = run_ida(
                     cf,
@@ -751,12 +752,13 @@ def ida(
                     progress=advance,
                     timeout=check_positive(timeout, "timeout"),
                     jobs=jobs,
-                    peaks=stage / PEAKS_FILE if stage is not None and peaks else None,
+                    peaks=None if stage is None else stage / PEAKS_FILE,
                 )
-            if stage is not None:
+            if out is not None:
+                stage = stage or stack.enter_context(folder(out))
                 write_ida(doc, stage, title=f"Fragility: {constants.name}")
     except KeyboardInterrupt:
-        where = "its tasks on the cluster were cancelled" if scheduler else "no task is left running"
+        where = "its tasks on the cluster were cancelled" if scheduler else "no task is left"
         done = f"{seen[0]} of {seen[1]}" if seen[1] else "0"
         _note(f"interrupted: stopped after {done} runs; {where}; nothing written")
         raise typer.Exit(code=130) from None
