@@ -245,7 +245,7 @@ def main(argv: Optional[list[str]] = None) -> int:
         "",
         f"Warm-up excluded: {fmt_time(warm)}. Scaling efficiency = t(1 thread) / (2 t(2 "
         "threads)). `run_ida` groups the work into tasks of about a second by the work "
-        "estimate (several records each; fewer seconds where that leaves under four tasks "
+        "estimate (several records each; fewer seconds where that leaves under eight tasks "
         "per worker thread), started longest first; each record in a task is one compiled "
         "batch over all mechanisms x its levels on the single-threaded kernel, which "
         "releases the GIL, and the task hands back counts. The Dask run sends the same kind "

@@ -90,8 +90,9 @@ CONNECT_TIMEOUT_S = 10.0
 TASK_S = 1.0
 #: Shortest task aimed at [s] where a run is cut finer to balance the workers.
 MIN_TASK_S = 0.2
-#: Tasks per worker thread aimed at, where the run is long enough (load balance).
-TASKS_PER_WORKER = 4
+#: Tasks per worker thread aimed at, where the run is long enough: task times vary by a
+#: factor of several around the estimate, and the last tasks to finish set the run's end.
+TASKS_PER_WORKER = 8
 #: Closed-form steps of the work estimate (``limits.history_steps``) per second of a task
 #: on one core. The estimate counts every sample of every run, while runs at rest cost a
 #: fraction of a step per sample and runs that overturn stop early: on the benchmark IDA
@@ -362,7 +363,7 @@ def task_seconds(total_s: float, n_workers: int) -> float:
     Examples
     --------
     >>> task_seconds(1000.0, 16), task_seconds(32.0, 16), task_seconds(1.0, 16)
-    (1.0, 0.5, 0.2)
+    (1.0, 0.25, 0.2)
     """
     return min(TASK_S, max(MIN_TASK_S, total_s / (TASKS_PER_WORKER * max(n_workers, 1))))
 
@@ -399,7 +400,7 @@ def plan_tasks(
     >>> packs
     [[1], [2, 0, 3]]
     >>> [(t.pack, t.lo, t.hi) for t in tasks]
-    [(1, 0, 10), (0, 0, 3), (0, 3, 6), (0, 6, 10)]
+    [(0, 6, 10), (1, 0, 10), (0, 0, 3), (0, 3, 6)]
     """
     order = sorted(range(len(costs)), key=lambda i: -costs[i])
     packs: list[list[int]] = []

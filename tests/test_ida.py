@@ -133,7 +133,7 @@ def test_plan_covers_every_run_once_in_tasks_of_the_aimed_size() -> None:
                 assert len(blocks) == 1 and (blocks[0].lo, blocks[0].hi) == (0, n_lev)
                 assert blocks[0].cost_s >= task_s or k == len(packs) - 1
     assert task_seconds(1e4, 16) == TASK_S and task_seconds(1.0, 16) == MIN_TASK_S
-    assert task_seconds(32.0, 16) == pytest.approx(0.5)  # 4 tasks per worker thread
+    assert task_seconds(32.0, 16) == pytest.approx(0.25)  # 8 tasks per worker thread
 
 
 @pytest.mark.parametrize(("jobs", "task_s"), [(1, 1e-9), (3, 1e-9), (3, 0.002), (2, 1e9)])
