@@ -80,6 +80,8 @@ TARGET_DASK_VS_THREADS = 1.10
 TARGET_OVERHEAD = 0.05
 #: Targets of the model: efficiency against one thread on ``MODEL_WORKERS`` workers.
 TARGET_MODEL_EFFICIENCY = 0.75
+#: Seconds the Dask cluster is left idle to measure its own background CPU.
+IDLE_S = 5.0
 #: What must not differ between two runs of the same IDA.
 RESULT_KEYS = ("intensity", "records", "criterion", "mechanisms", "runs", "max_error_estimate")
 
@@ -218,6 +220,9 @@ def main(argv: Optional[list[str]] = None) -> int:
                 lambda note, a=address: run_ida(cf, records, levels, scheduler=a), client
             )
             feed_s = feed_seconds(client, records, model_packs)
+            c0 = cpu_seconds(client)
+            time.sleep(IDLE_S)
+            idle_cpu = (cpu_seconds(client) - c0) / IDLE_S  # cores Dask keeps busy, idle
         rows.append({"case": f"Dask, {n} worker{'s' * (n > 1)} x 1 thread", "n": n, **dask})
         print(f"Dask {n}: {fmt_time(dask['wall'])}")
 
@@ -309,6 +314,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         f"send {1 / feed_s:.0f} tasks/s, the {MODEL_WORKERS} workers need "
         f"{MODEL_WORKERS / float(np.mean(durations)):.0f})",
         f"Python outside the kernels (holds the GIL), all tasks: {fmt_time(python_s)}",
+        f"Dask's own background CPU (heartbeats, the workers' profilers; the {cores}-worker "
+        f"cluster left idle {IDLE_S:g} s): {100 * idle_cpu:.1f} % of a core, "
+        f"{fmt_time(idle_cpu * dask_all['wall'])} over the {cores}-worker run (its extra CPU "
+        f"over one thread: {fmt_time(dask_all['cpu'] - one['cpu'])})",
         f"list schedule on {MODEL_WORKERS} lanes: Dask {fmt_time(span_dask)} + "
         f"{fmt_time(fixed_dask)} = {fmt_time(t_model_dask)}; threads {fmt_time(span_local)} "
         f"+ {fmt_time(fixed_local)} = {fmt_time(t_model_threads)}",
