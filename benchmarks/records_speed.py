@@ -14,7 +14,8 @@ What is measured
    ``cpu2 / cpu1`` (1 = running on two threads costs no extra work) and ``cpu2 / 2`` (the
    wall time with two free cores and perfect balance) stay informative.
 2. The same run on a dask.distributed ``LocalCluster`` (2 worker processes, 1 thread each),
-   in the same process run; the overhead is the difference. Cluster start-up is timed apart.
+   in the same process run; the overhead is the difference. Cluster start-up is timed apart
+   (``benchmarks/cluster.py`` compares the paths on a run 20 times larger).
    The two results must be identical.
 3. The response spectrum: ``response_spectrum`` at 100 log-spaced periods (0.02-10 s, 5 %)
    on a ``SPECTRUM_SAMPLES``-sample record; best of ``REPEATS``. Target <=
@@ -243,14 +244,16 @@ def main(argv: Optional[list[str]] = None) -> int:
         md_table(headers, rows),
         "",
         f"Warm-up excluded: {fmt_time(warm)}. Scaling efficiency = t(1 thread) / (2 t(2 "
-        "threads)). The local run cuts the work into tasks of (record x block of levels), at "
-        "least four per worker thread (here one per record: 100 records are plenty), started "
-        "longest first on a thread pool; each task is one compiled batch over all mechanisms "
-        "x its levels, and the kernels release the GIL. The Dask run maps the same "
-        f"`run_record` over the same kind of tasks ({local['backend']['tasks']} locally, "
-        f"{remote['backend']['tasks']} on Dask); its overhead is serialising each task and the "
-        "constants to the workers and gathering the results, measured in the same process "
-        "run as the local one.",
+        "threads)). `run_ida` groups the work into tasks of about a second by the work "
+        "estimate (several records each; fewer seconds where that leaves under eight tasks "
+        "per worker thread), started longest first; each record in a task is one compiled "
+        "batch over all mechanisms x its levels on the single-threaded kernel, which "
+        "releases the GIL, and the task hands back counts. The Dask run sends the same kind "
+        f"of tasks ({local['backend']['tasks']} locally, {remote['backend']['tasks']} on "
+        "Dask) to the workers as they free up, the constants broadcast once and each task's "
+        "records scattered to its worker; its overhead (connecting, checking the workers, "
+        "sending the records, gathering the counts) is measured in the same process run as "
+        "the local one. `benchmarks/cluster.py` measures the paths at 10^6 runs.",
         "",
         f"Load average (1, 5, 15 min) before / after: 1 thread {load_one}; 2 threads "
         f"{load_two}. CPU time is `time.process_time` (all threads of the process): the "

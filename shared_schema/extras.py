@@ -2,7 +2,8 @@
 
 ``pip install rockmech`` gives the solver, the command line and its plots. Heavy or
 specialised parts come with extras: ``geometry`` (reading ``.3dm`` scenes, mesh cuts and
-contact polygons), ``service`` (the REST service and Hops), ``dask`` (``ida --scheduler``).
+contact polygons), ``service`` (the REST service and Hops), ``dask`` (``ida --scheduler``),
+``parquet`` (``ida --peaks``).
 Code that needs one of them imports it through :func:`require`, which raises
 :class:`MissingExtra` naming the module and the exact install line. The command line turns
 that into exit status 2 and the line on stderr; the REST service into a 501 answer with the
@@ -34,6 +35,7 @@ EXTRAS: Dict[str, str] = {
     "werkzeug": "service",
     "dask": "dask",
     "distributed": "dask",
+    "pyarrow": "parquet",
 }
 
 

@@ -34,7 +34,7 @@ from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
 from .core.model import check_positive
 from .core.records import GroundMotion
 from .demo import run_demo
-from .ida import IM_MEASURES, parse_levels, run_ida
+from .ida import IM_MEASURES, PEAKS_FILE, parse_levels, run_ida
 from .report.html import build_report, input_source, write_report
 from .workflows.assess import check_doc, check_multiples, read_site
 from .workflows.documents import (
@@ -689,6 +689,11 @@ def ida(
     out: Optional[Path] = typer.Option(
         None, "--out", help="Folder for ida.json, ida.csv and ida.png (fragility curves)."
     ),
+    peaks: bool = typer.Option(
+        False,
+        "--peaks",
+        help=f"Also write every run's peak to {PEAKS_FILE} in --out (needs the parquet extra).",
+    ),
     no_limits: bool = _NO_LIMITS_OPT,
     time_limit: float = _TIME_LIMIT_OPT,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
@@ -702,6 +707,10 @@ def ida(
     _limit(no_limits, scales=len(levels))
     if out is not None:
         check_folder_target(out)
+    if peaks:
+        if out is None:
+            _fail(f"peaks: --peaks writes {PEAKS_FILE} into the --out folder; give --out DIR")
+        require("pyarrow.parquet", "parquet", "for ida --peaks")
     cf = read_constants(constants)
     motions = [_read_record(p, record_format, units, dt, channel, component) for p in records or []]
     specs = read_record_spec(record_spec) if record_spec else []
@@ -720,34 +729,57 @@ def ida(
         disable=not show,
         transient=True,
     )
-    with bar:
-        task = bar.add_task("records", total=len(motions))
-        doc = run_ida(
-            cf,
-            motions,
-            levels,
-            im=im,
-            sf=sf,
-            building=Building(building_height, soil_factor, element_period),
-            criterion=criterion,
-            scheduler=scheduler,
-            progress=lambda done, total: bar.update(task, completed=done),
-            timeout=check_positive(timeout, "timeout"),
-            jobs=jobs,
-        )
-    if out is not None:
-        with run_folder(out, on_note=_out_note) as tmp:
-            write_ida(doc, tmp, title=f"Fragility: {constants.name}")
+    task = bar.add_task("runs", total=None)
+    seen = [0, 0]  # runs done, runs in all
+
+    def advance(done: int, total: int) -> None:
+        seen[:] = [done, total]
+        bar.update(task, completed=done, total=total)
+
+    try:
+        # With --peaks the output folder's stage is open during the run (the peaks stream
+        # into it); a stopped run leaves the folder as it was.
+        with contextlib.ExitStack() as stack:
+            folder = functools.partial(run_folder, on_note=_out_note)
+            stage = stack.enter_context(folder(out)) if out is not None and peaks else None
+            with bar:
+                doc = run_ida(
+                    cf,
+                    motions,
+                    levels,
+                    im=im,
+                    sf=sf,
+                    building=Building(building_height, soil_factor, element_period),
+                    criterion=criterion,
+                    scheduler=scheduler,
+                    progress=advance,
+                    timeout=check_positive(timeout, "timeout"),
+                    jobs=jobs,
+                    peaks=None if stage is None else stage / PEAKS_FILE,
+                )
+            if out is not None:
+                stage = stage or stack.enter_context(folder(out))
+                write_ida(doc, stage, title=f"Fragility: {constants.name}")
+    except KeyboardInterrupt:
+        where = "its tasks on the cluster were cancelled" if scheduler else "no task is left"
+        done = f"{seen[0]} of {seen[1]}" if seen[1] else "0"
+        _note(f"interrupted: stopped after {done} runs; {where}; nothing written")
+        raise typer.Exit(code=130) from None
     _skipped_notes(doc)
     if as_json:
         _print_json(doc)
         return
     backend = doc["backend"]
-    where = "locally" if backend["kind"] == "local" else f"on Dask at {backend['scheduler']}"
+    where = (
+        f"locally on {backend['jobs']} threads"
+        if backend["kind"] == "local"
+        else f"on Dask at {backend['scheduler']} ({backend['threads']} worker threads)"
+    )
     typer.echo(
         f"{doc['runs']} runs ({len(motions)} records x {len(levels)} levels x "
-        f"{len(doc['mechanisms'])} mechanisms) {where} in {doc['runtime_s']:.2f} s; "
-        f"largest error estimate {doc['max_error_estimate']:.1e}"
+        f"{len(doc['mechanisms'])} mechanisms) {where} in {doc['runtime_s']:.2f} s "
+        f"({backend['tasks']} tasks, overhead {100 * backend['overhead_fraction']:.1f} % of "
+        f"task time); largest error estimate {doc['max_error_estimate']:.1e}"
     )
     unit = doc["intensity"]["units"]
     rows, notes = [], []
@@ -759,7 +791,9 @@ def ida(
     for line in _table(["mechanism", f"median [{unit}]", "beta [-]"], rows) + notes:
         typer.echo(line)
     if out is not None:
-        typer.echo(f"wrote {out / 'ida.json'}, ida.csv, ida.png")
+        typer.echo(
+            f"wrote {out / 'ida.json'}, ida.csv, ida.png" + (f", {PEAKS_FILE}" if peaks else "")
+        )
 
 
 @app.command()

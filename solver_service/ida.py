@@ -1,15 +1,35 @@
 """Incremental dynamic analysis: many records × many intensities × many mechanisms.
 
-The unit of work is one record at a block of intensity levels (``run_record``): every
-mechanism at every level of the block in one compiled batch (``exact.simulate_batch``).
-``run_ida`` cuts the work into tasks of (record × block of levels), enough for every worker
-to get several, and runs them longest first, in-process on ``jobs`` threads (by default one
-per core the process may use; the kernels release the GIL), or maps the same function over
-the tasks on a dask.distributed cluster when a scheduler address is given (only plain data,
-arrays and the function's import path travel to the workers). The results do not depend on
-the cutting or the order: every run is independent. The fraction of records that overturn
-each mechanism at each level is then fitted with a lognormal fragility curve
-(``core.fragility``).
+The unit of work is one record at a block of intensity levels: every mechanism at every
+level of the block in one compiled batch (``exact.simulate_batch``). ``run_ida`` groups
+these units into **tasks of about** ``TASK_S`` **seconds** by the work estimate the size
+limits already use (``workflows.limits.history_steps``, at ``TASK_STEPS_PER_S``): several
+short records in one task, or one long record cut into blocks of levels. A run too small
+to give every worker ``TASKS_PER_WORKER`` such tasks gets shorter ones (not below
+``MIN_TASK_S``), so that every worker has work to balance. The tasks start longest first:
+
+* **locally**, on ``jobs`` threads (by default one per core the process may use);
+* **on a dask.distributed cluster**, when a scheduler address is given. The constants and
+  options travel to every worker once (broadcast); each worker thread holds ``IN_FLIGHT``
+  tasks, and a task's records are scattered to the worker that runs it just before it is
+  sent, once per worker, and released when their tasks are done (``_DaskFeed``); a task
+  carries only their keys and its block of levels. A worker that finishes gets the next
+  task, so slow and fast machines share the work by their speed; a task lost with a worker
+  runs again.
+
+Either way a task runs the **single-threaded** batch kernel (it releases the GIL): a worker
+that runs ``k`` tasks at once (``k`` threads) uses ``k`` cores, and workers never start
+numba threads of their own on top, so they never oversubscribe the cores.
+
+Each task **reduces its runs** before they travel back: per mechanism and level the number
+of its records that overturn, per record the first level that overturns each mechanism,
+the largest error estimate and the number of incomplete runs. Sums of integers, minima and
+maxima are exact in any order, so the document is the same, bit for bit, on every path and
+every cutting of the work (tested). The fraction of records that overturn each mechanism
+at each level is then fitted with a lognormal fragility curve (``core.fragility``). The
+per-run peaks come back only when asked (``peaks``): they are streamed into a Parquet file
+as the tasks finish (``pyarrow``, the ``parquet`` extra), so memory holds one task's runs,
+not the whole analysis.
 
 Intensity measures: ``"scale"`` (the levels are scale factors on every record, [-]) or
 ``"pga"`` (the levels are target peak ground accelerations [g]; each record is scaled to
@@ -18,36 +38,171 @@ them).
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
+import secrets
+import socket
+import threading
 import time
+import uuid
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import CancelledError, ThreadPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Optional
 
 import numpy as np
 
+from shared_schema.atomic import temp_name
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 from shared_schema.extras import require
+from shared_schema.version import __version__
 
 from .core.exact import single_threaded
 from .core.fragility import fit_lognormal
-from .core.model import check_positive
+from .core.model import RockingModel, check_positive
 from .core.records import GroundMotion
 from .workflows.adapter import to_rocking_model
 from .workflows.documents import time_domain_mechanisms
+from .workflows.limits import P_EQ_PLAUSIBLE, history_steps
 from .workflows.scaling import Building, run_scaled
 
-__all__ = ["IM_MEASURES", "ida_csv", "parse_levels", "run_ida", "run_record"]
+__all__ = [
+    "IM_MEASURES",
+    "PEAKS_FILE",
+    "Task",
+    "ida_csv",
+    "parse_levels",
+    "plan_tasks",
+    "run_ida",
+    "run_record",
+    "run_task",
+]
 
 #: Intensity measures and their units.
 IM_MEASURES = {"scale": "-", "pga": "g"}
 
-#: Seconds to wait for a Dask scheduler before giving up.
+#: Seconds to wait for a Dask scheduler, and for its first worker, before giving up.
 CONNECT_TIMEOUT_S = 10.0
-#: Tasks per worker aimed at when records are cut into blocks of levels (load balance).
-TASKS_PER_WORKER = 4
+#: Work of one task aimed at [s]: per-task costs (a few ms on Dask) stay under 1 % of it.
+TASK_S = 1.0
+#: Shortest task aimed at [s] where a run is cut finer to balance the workers.
+MIN_TASK_S = 0.2
+#: Tasks per worker thread aimed at, where the run is long enough: task times vary by a
+#: factor of several around the estimate, and the last tasks to finish set the run's end.
+TASKS_PER_WORKER = 8
+#: Closed-form steps of the work estimate (``limits.history_steps``) per second of a task
+#: on one core. The estimate counts every sample of every run, while runs at rest cost a
+#: fraction of a step per sample and runs that overturn stop early: on the benchmark IDA
+#: (``benchmarks/cluster.py``, which prints the rate it measures) it runs at about 1e8 per
+#: second on one core of the 2-core machine of docs/benchmarks.md. A slower machine gets
+#: longer tasks; the results do not depend on the cutting.
+TASK_STEPS_PER_S = 1.0e8
+#: Address schemes of a Dask scheduler that rockmech connects to.
+SCHEMES = ("tcp", "tls", "ws", "wss")
+#: Name of the per-run peaks file the command line writes into ``--out`` (``--peaks``).
+PEAKS_FILE = "ida_peaks.parquet"
+#: Rows of the peaks file gathered before they are written as one row group.
+ROW_GROUP_ROWS = 1 << 20
+#: Tasks a Dask worker holds per thread (one running, the next ones ready).
+IN_FLIGHT = 2
+#: Times a task lost with a worker is run again before the run stops.
+RETRIES = 3
+#: Interval at which a Dask run reads the list of workers again [s].
+REFRESH_S = 1.0
+#: Prepared constants kept per process (a Dask worker keeps those of its latest runs).
+SETUPS_KEPT = 4
+
+
+@dataclass(frozen=True)
+class _Setup:
+    """What every task of one run shares, prepared once per process (``_setup``)."""
+
+    cf: ConstantsFile
+    models: list[RockingModel]
+    levels: list[float]
+    im: str
+    sf: str
+    building: Building
+    criterion: Optional[str]
+    peaks: bool
+
+    @classmethod
+    def build(
+        cls,
+        constants: dict[str, Any],
+        levels: Sequence[float],
+        im: str,
+        options: Optional[dict[str, Any]],
+        peaks: bool = False,
+    ) -> _Setup:
+        opts = dict(options or {})
+        cf = ConstantsFile.model_validate(constants)
+        return cls(
+            cf=cf,
+            models=[to_rocking_model(m) for m in cf.mechanisms],
+            levels=[float(v) for v in levels],
+            im=im,
+            sf=opts.get("sf", "none"),
+            building=Building(**opts.get("building", {})),
+            criterion=opts.get("criterion"),
+            peaks=peaks,
+        )
+
+
+_SETUPS: dict[str, _Setup] = {}
+_SETUPS_LOCK = threading.Lock()
+
+
+def _setup(ctx: dict[str, Any]) -> _Setup:
+    """Return the prepared constants of run ``ctx["token"]``, validated once per process."""
+    with _SETUPS_LOCK:
+        found = _SETUPS.get(ctx["token"])
+        if found is None:
+            found = _Setup.build(
+                ctx["constants"], ctx["levels"], ctx["im"], ctx["options"], ctx["peaks"]
+            )
+            _SETUPS[ctx["token"]] = found
+            while len(_SETUPS) > SETUPS_KEPT:
+                del _SETUPS[next(iter(_SETUPS))]
+        return found
+
+
+def _run_one(
+    setup: _Setup, acc: np.ndarray[Any, Any], dt: float, name: str, levels: Sequence[float]
+) -> dict[str, Any]:
+    """One record against every mechanism at ``levels`` (see ``run_record``)."""
+    motion = GroundMotion.from_samples(acc, dt, name=name)
+    if setup.im == "pga":
+        scales = [level / motion.pga_g for level in levels]
+    else:
+        scales = list(levels)
+    factors, batches = run_scaled(
+        setup.cf, setup.models, motion, scales, setup.sf, setup.building, setup.criterion
+    )
+    shape = (len(setup.models), len(scales))
+    out = {
+        "overturned": np.zeros(shape, dtype=bool),
+        "peak_ratio": np.zeros(shape),
+        "error_estimate": np.zeros(shape),
+        "status": np.zeros(shape, dtype=np.int64),
+    }
+    for members, batch in batches:
+        for key in out:
+            out[key][members] = getattr(batch, key)
+    return {
+        **out,
+        "name": name,
+        "pga_g": motion.pga_g,
+        "dt_s": dt,
+        "n_samples": len(acc),
+        "scale_factors": {k: float(v["value"]) for k, v in factors.items()},
+        "criterion": batches[0][1].criterion,
+        "method": batches[0][1].method,
+        "runtime_s": sum(b.runtime_s for _, b in batches),
+    }
 
 
 def run_record(
@@ -85,43 +240,88 @@ def run_record(
         (mechanisms × levels), ``scale_factors`` per mechanism id, ``pga_g`` and
         ``runtime_s``.
     """
-    opts = dict(options or {})
-    cf = ConstantsFile.model_validate(constants)
-    motion = GroundMotion.from_samples(acc, dt, name=name)
-    if im == "pga":
-        scales = [level / motion.pga_g for level in levels]
-    else:
-        scales = list(levels)
-    models = [to_rocking_model(m) for m in cf.mechanisms]
-    factors, batches = run_scaled(
-        cf,
-        models,
-        motion,
-        scales,
-        opts.get("sf", "none"),
-        Building(**opts.get("building", {})),
-        opts.get("criterion"),
-    )
-    shape = (len(models), len(scales))
-    out = {
-        "overturned": np.zeros(shape, dtype=bool),
-        "peak_ratio": np.zeros(shape),
-        "error_estimate": np.zeros(shape),
-        "status": np.zeros(shape, dtype=np.int64),
-    }
-    for members, batch in batches:
-        for key in out:
-            out[key][members] = getattr(batch, key)
+    return _run_one(_Setup.build(constants, levels, im, options), acc, dt, name, levels)
+
+
+def run_task(
+    ctx: dict[str, Any],
+    pack: Sequence[tuple[int, np.ndarray[Any, Any], float, str]],
+    lo: int,
+    hi: int,
+    stop: Optional[threading.Event] = None,
+) -> dict[str, Any]:
+    """One task: every record of ``pack`` at levels ``[lo, hi)``, its runs reduced.
+
+    Runs the single-threaded batch kernel on the calling thread, one record after the other.
+
+    Parameters
+    ----------
+    ctx : dict
+        The run's shared data: ``token``, ``constants`` (JSON data), ``levels`` (all of
+        them, ascending), ``im``, ``options`` and ``peaks`` (bool).
+    pack : sequence of (int, ndarray, float, str)
+        ``(record index, acceleration [m/s²], dt [s], name)`` of each record.
+    lo, hi : int
+        The block of levels, ``0 <= lo < hi <= len(levels)``.
+    stop : threading.Event, optional
+        Set by a stopped local run: the task ends after the record it is on.
+
+    Returns
+    -------
+    dict
+        ``records`` (indices), ``lo``, ``hi``, ``counts`` ((m, hi - lo) records that
+        overturn), ``first`` ((records, m) index of the first level in the block that
+        overturns, ``len(levels)`` where none does), ``max_error``, ``incomplete``,
+        ``factors`` (per record, only in the block that starts at level 0), ``criterion``,
+        ``method``, ``peaks`` (``peak_ratio``, ``overturned``, ``error_estimate``,
+        ``status`` as (records, m, hi - lo) arrays, or None) and the timing: ``kernel_s``
+        (inside the batches), ``start``, ``end`` (``time.time()`` of this process) and
+        ``lane`` (host, process and thread).
+    """
+    start = time.time()
+    setup = _setup(ctx)
+    levels = setup.levels[lo:hi]
+    n_mech, none = len(setup.models), len(setup.levels)
+    counts = np.zeros((n_mech, hi - lo), dtype=np.int64)
+    first = np.full((len(pack), n_mech), none, dtype=np.int64)
+    max_error, incomplete, kernel_s = 0.0, 0, 0.0
+    factors: Optional[list[dict[str, float]]] = [] if lo == 0 else None
+    peaks: dict[str, list[Any]] = {k: [] for k in ("peak_ratio", "overturned", "error_estimate")}
+    peaks["status"] = []
+    criterion = method = ""
+    with single_threaded():
+        for j, (_, acc, dt, name) in enumerate(pack):
+            if stop is not None and stop.is_set():
+                break
+            res = _run_one(setup, acc, dt, name, levels)
+            over = res["overturned"]
+            counts += over
+            first[j] = np.where(over.any(axis=1), lo + over.argmax(axis=1), none)
+            max_error = float(np.maximum(max_error, np.max(res["error_estimate"])))
+            incomplete += int(np.count_nonzero(res["status"] < 0))
+            kernel_s += res["runtime_s"]
+            criterion, method = res["criterion"], res["method"]
+            if factors is not None:
+                factors.append(res["scale_factors"])
+            if setup.peaks:
+                for key, rows in peaks.items():
+                    rows.append(res[key])
     return {
-        **out,
-        "name": name,
-        "pga_g": motion.pga_g,
-        "dt_s": dt,
-        "n_samples": len(acc),
-        "scale_factors": {k: float(v["value"]) for k, v in factors.items()},
-        "criterion": batches[0][1].criterion,
-        "method": batches[0][1].method,
-        "runtime_s": sum(b.runtime_s for _, b in batches),
+        "records": [int(index) for index, *_ in pack],
+        "lo": lo,
+        "hi": hi,
+        "counts": counts,
+        "first": first,
+        "max_error": max_error,
+        "incomplete": incomplete,
+        "factors": factors,
+        "criterion": criterion,
+        "method": method,
+        "peaks": {k: np.stack(v) for k, v in peaks.items()} if setup.peaks else None,
+        "kernel_s": kernel_s,
+        "start": start,
+        "end": time.time(),
+        "lane": f"{socket.gethostname()}:{os.getpid()}:{threading.get_ident()}",
     }
 
 
@@ -134,44 +334,110 @@ def _levels(levels: Sequence[float]) -> list[float]:
     return sorted(out)
 
 
-def _dask_client(distributed: Any, address: str, timeout: float) -> Any:
-    try:
-        return distributed.Client(address, timeout=timeout, set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise InputError(
-            f"cannot reach the Dask scheduler at {address} within {timeout:g} s ({exc})",
-            "scheduler",
-        ) from exc
+@dataclass(frozen=True)
+class Task:
+    """One task of a run: the records of pack ``pack`` at levels ``[lo, hi)``.
 
-
-def level_blocks(n_records: int, n_levels: int, n_workers: int) -> list[tuple[int, int]]:
-    """Cut the levels into blocks ``[lo, hi)`` so that records × blocks >= 4 × workers.
-
-    One worker gets one block per record.
-
-    Parameters
+    Attributes
     ----------
-    n_records, n_levels, n_workers : int
-        Records, intensity levels and workers (threads or Dask worker threads), each >= 1.
+    pack : int
+        Index into the packs of ``plan_tasks`` (a group of records).
+    lo, hi : int
+        Block of intensity levels.
+    cost_s : float
+        Its work by the estimate [s].
+    """
 
-    Returns
-    -------
-    list of (int, int)
-        Contiguous blocks covering ``range(n_levels)``, sizes equal to within one level.
+    pack: int
+    lo: int
+    hi: int
+    cost_s: float
+
+
+def task_seconds(total_s: float, n_workers: int) -> float:
+    """Work per task aimed at [s] for ``total_s`` seconds of work on ``n_workers`` threads.
+
+    ``TASK_S``, or less where that leaves fewer than ``TASKS_PER_WORKER`` tasks per worker
+    thread, down to ``MIN_TASK_S``.
 
     Examples
     --------
-    >>> level_blocks(100, 50, 2)
-    [(0, 50)]
-    >>> level_blocks(1, 10, 2)
-    [(0, 1), (1, 2), (2, 3), (3, 5), (5, 6), (6, 7), (7, 8), (8, 10)]
+    >>> task_seconds(1000.0, 16), task_seconds(32.0, 16), task_seconds(1.0, 16)
+    (1.0, 0.25, 0.2)
     """
-    if n_workers <= 1:
-        return [(0, n_levels)]  # one worker: nothing to balance
-    want = -(-TASKS_PER_WORKER * n_workers // max(n_records, 1))
-    n_blocks = max(1, min(n_levels, want))
-    bounds = [b * n_levels // n_blocks for b in range(n_blocks + 1)]
-    return list(zip(bounds[:-1], bounds[1:]))
+    return min(TASK_S, max(MIN_TASK_S, total_s / (TASKS_PER_WORKER * max(n_workers, 1))))
+
+
+def plan_tasks(
+    costs: Sequence[float], n_levels: int, task_s: float
+) -> tuple[list[list[int]], list[Task]]:
+    """Cut a run into tasks of about ``task_s`` seconds; longest first.
+
+    Records are taken by decreasing cost. One that costs more than ``task_s`` at all levels
+    forms a pack of its own, cut into that many blocks of levels (sizes equal to within one
+    level); the others are gathered, in that order, into packs of at least ``task_s`` each
+    (the last one may be shorter), each run at all levels in one task.
+
+    Parameters
+    ----------
+    costs : sequence of float
+        Estimated work of each record at all ``n_levels`` levels [s], each >= 0.
+    n_levels : int
+        Intensity levels, >= 1.
+    task_s : float
+        Work per task aimed at [s], > 0.
+
+    Returns
+    -------
+    packs : list of list of int
+        Record indices of each pack.
+    tasks : list of Task
+        Every (pack, level block) by decreasing ``cost_s`` (ties in pack order).
+
+    Examples
+    --------
+    >>> packs, tasks = plan_tasks([0.3, 2.5, 0.4, 0.2], 10, 1.0)
+    >>> packs
+    [[1], [2, 0, 3]]
+    >>> [(t.pack, t.lo, t.hi) for t in tasks]
+    [(0, 6, 10), (1, 0, 10), (0, 0, 3), (0, 3, 6)]
+    """
+    order = sorted(range(len(costs)), key=lambda i: -costs[i])
+    packs: list[list[int]] = []
+    tasks: list[Task] = []
+    group: list[int] = []
+    group_cost = 0.0
+
+    def close_group() -> None:
+        nonlocal group, group_cost
+        if group:
+            packs.append(group)
+            tasks.append(Task(len(packs) - 1, 0, n_levels, group_cost))
+        group, group_cost = [], 0.0
+
+    for i in order:
+        if costs[i] > task_s:
+            packs.append([i])
+            n_blocks = min(n_levels, math.ceil(costs[i] / task_s))
+            bounds = [b * n_levels // n_blocks for b in range(n_blocks + 1)]
+            for lo, hi in zip(bounds[:-1], bounds[1:]):
+                tasks.append(Task(len(packs) - 1, lo, hi, costs[i] * (hi - lo) / n_levels))
+            continue
+        group.append(i)
+        group_cost += costs[i]
+        if group_cost >= task_s:
+            close_group()
+    close_group()
+    tasks.sort(key=lambda t: -t.cost_s)  # stable: ties keep their order
+    return packs, tasks
+
+
+def record_costs(cf: ConstantsFile, motions: Sequence[Any], n_levels: int) -> list[float]:
+    """Estimated work of each record at ``n_levels`` levels [s] (``TASK_STEPS_PER_S``)."""
+    return [
+        history_steps(cf, len(m.accel.acc), m.dt, n_levels, p_max=P_EQ_PLAUSIBLE) / TASK_STEPS_PER_S
+        for m in motions
+    ]
 
 
 def available_cores() -> int:
@@ -181,112 +447,461 @@ def available_cores() -> int:
     return os.cpu_count() or 1
 
 
-def _run_serial(payload: dict[str, Any]) -> dict[str, Any]:
-    """``run_record`` with the batch kernels confined to the calling thread."""
-    with single_threaded():
-        return run_record(**payload)
+class _PeakWriter:
+    """Per-run peaks streamed into a Parquet file, one row per record × mechanism × level.
 
-
-def _merge(parts: list[dict[str, Any]]) -> dict[str, Any]:
-    """Join the results of one record's level blocks (in level order) into one result."""
-    out = dict(parts[0])
-    for key in ("overturned", "peak_ratio", "error_estimate", "status"):
-        out[key] = np.concatenate([p[key] for p in parts], axis=1)
-    out["runtime_s"] = sum(p["runtime_s"] for p in parts)
-    return out
-
-
-def _tasks(payloads: list[dict[str, Any]], n_workers: int) -> list[tuple[int, dict[str, Any]]]:
-    """(record index, payload for one block of levels) for every task."""
-    levels = payloads[0]["levels"]
-    blocks = level_blocks(len(payloads), len(levels), n_workers)
-    return [
-        (i, {**p, "levels": p["levels"][lo:hi]})
-        for i, p in enumerate(payloads)
-        for lo, hi in blocks
-    ]
-
-
-def _longest_first(tasks: list[tuple[int, dict[str, Any]]]) -> list[int]:
-    """Task indices by decreasing work (samples × levels): the longest tasks start first.
-
-    Greedy longest-first scheduling leaves the workers at most one short task apart at the
-    end, where the submission order would leave them up to one long task apart.
+    Written under a temporary name beside the target (``shared_schema.atomic.temp_name``)
+    and renamed over it when complete; removed if the run stops.
     """
-    cost = [len(p["acc"]) * len(p["levels"]) for _, p in tasks]
-    return sorted(range(len(tasks)), key=lambda k: -cost[k])
+
+    def __init__(
+        self, path: Path, records: list[str], mechanisms: list[str], levels: list[float], im: str
+    ) -> None:
+        self.pa = require("pyarrow", "parquet", "for the per-run peaks of ida")
+        self.pq = require("pyarrow.parquet", "parquet", "for the per-run peaks of ida")
+        self.path = path
+        self.tmp = path.parent / temp_name(path.name, os.getpid(), secrets.token_hex(4))
+        self.records = self.pa.array(records, type=self.pa.string())
+        self.mechanisms = self.pa.array(mechanisms, type=self.pa.string())
+        self.levels = np.asarray(levels)
+        pa = self.pa
+        dictionary = pa.dictionary(pa.int32(), pa.string())
+        self.schema = pa.schema(
+            [
+                ("record", pa.int32()),
+                ("record_name", dictionary),
+                ("mechanism", dictionary),
+                ("level", pa.float64()),
+                ("peak_ratio", pa.float64()),
+                ("overturned", pa.bool_()),
+                ("error_estimate", pa.float64()),
+                ("status", pa.int8()),
+            ],
+            metadata={"intensity_measure": im, "units": IM_MEASURES[im], "rockmech": __version__},
+        )
+        self.writer = self.pq.ParquetWriter(str(self.tmp), self.schema, compression="zstd")
+        self.buffer: list[Any] = []
+        self.buffered = 0
+        self.rows = 0
+
+    def add(self, part: dict[str, Any]) -> None:
+        """Add the runs of one task (``run_task`` with peaks)."""
+        pa, peaks = self.pa, part["peaks"]
+        n_rec, n_mech, n_lev = peaks["peak_ratio"].shape
+        record = np.repeat(np.asarray(part["records"][:n_rec], dtype=np.int32), n_mech * n_lev)
+        mech = np.tile(np.repeat(np.arange(n_mech, dtype=np.int32), n_lev), n_rec)
+        level = np.tile(self.levels[part["lo"] : part["hi"]], n_rec * n_mech)
+        columns = [
+            pa.array(record),
+            pa.DictionaryArray.from_arrays(pa.array(record), self.records),
+            pa.DictionaryArray.from_arrays(pa.array(mech), self.mechanisms),
+            pa.array(level),
+            pa.array(peaks["peak_ratio"].ravel()),
+            pa.array(peaks["overturned"].ravel()),
+            pa.array(peaks["error_estimate"].ravel()),
+            pa.array(peaks["status"].ravel().astype(np.int8)),
+        ]
+        self.buffer.append(pa.Table.from_arrays(columns, schema=self.schema))
+        self.buffered += record.size
+        if self.buffered >= ROW_GROUP_ROWS:
+            self._flush()
+
+    def _flush(self) -> None:
+        if self.buffer:
+            self.writer.write_table(self.pa.concat_tables(self.buffer))
+            self.rows += self.buffered
+            self.buffer, self.buffered = [], 0
+
+    def close(self) -> int:
+        """Write what is left, rename the file into place; return the number of rows."""
+        self._flush()
+        self.writer.close()
+        with open(self.tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(self.tmp, self.path)
+        return self.rows
+
+    def abort(self) -> None:
+        """Close and remove the unfinished file."""
+        try:
+            self.writer.close()
+        finally:
+            self.tmp.unlink(missing_ok=True)
 
 
-def _gather(
-    tasks: list[tuple[int, dict[str, Any]]],
-    n_records: int,
-    finished: Callable[[], Any],
-    progress: Optional[Callable[[int, int], None]],
-) -> list[dict[str, Any]]:
-    """Collect task results as ``finished()`` yields ``(task index, result)``; merge per record."""
-    parts: list[list[Any]] = [[] for _ in range(n_records)]
-    left = [0] * n_records
-    for rec, _ in tasks:
-        left[rec] += 1
-    done = 0
-    for k, result in finished():
-        rec = tasks[k][0]
-        parts[rec].append((k, result))
-        left[rec] -= 1
-        if left[rec] == 0:
-            done += 1
-            if progress is not None:
-                progress(done, n_records)
-    return [_merge([r for _, r in sorted(p, key=lambda kr: kr[0])]) for p in parts]
+class _Totals:
+    """The reduction of a run's tasks: counts, first levels, error estimates, timing."""
+
+    def __init__(self, n_records: int, n_mech: int, n_levels: int, n_runs: int) -> None:
+        self.counts = np.zeros((n_mech, n_levels), dtype=np.int64)
+        self.first = np.full((n_records, n_mech), n_levels, dtype=np.int64)
+        self.factors: list[dict[str, float]] = [{} for _ in range(n_records)]
+        self.max_error = 0.0
+        self.incomplete = 0
+        self.kernel_s = 0.0
+        self.criteria: set[str] = set()
+        self.methods: set[str] = set()
+        self.timing: list[tuple[str, float, float, float]] = []
+        self.runs_done = 0
+        self.n_runs = n_runs
+
+    def add(self, part: dict[str, Any]) -> None:
+        lo, hi, idx = part["lo"], part["hi"], part["records"]
+        self.counts[:, lo:hi] += part["counts"]
+        self.first[idx] = np.minimum(self.first[idx], part["first"])
+        if part["factors"] is not None:
+            for i, factors in zip(idx, part["factors"]):
+                self.factors[i] = factors
+        self.max_error = float(np.maximum(self.max_error, part["max_error"]))
+        self.incomplete += part["incomplete"]
+        self.kernel_s += part["kernel_s"]
+        self.criteria.add(part["criterion"])
+        self.methods.add(part["method"])
+        self.timing.append((part["lane"], part["start"], part["end"], part["kernel_s"]))
+        self.runs_done += len(idx) * self.counts.shape[0] * (hi - lo)
+
+    def task_stats(self) -> dict[str, Any]:
+        """Mean task time and per-task overhead [s] (see ``run_ida``)."""
+        lanes: dict[str, list[tuple[float, float, float]]] = {}
+        for lane, start, end, kernel in self.timing:
+            lanes.setdefault(lane, []).append((start, end, kernel))
+        busy = gaps = kernel_s = 0.0
+        for runs in lanes.values():
+            runs.sort()
+            busy += sum(end - start for start, end, _ in runs)
+            kernel_s += sum(k for *_, k in runs)
+            gaps += sum(max(0.0, b[0] - a[1]) for a, b in zip(runs, runs[1:]))
+        n = max(len(self.timing), 1)
+        overhead = (busy - kernel_s + gaps) / n
+        task = busy / n
+        starts = [start for _, start, _, _ in self.timing] or [0.0]
+        ends = [end for _, _, end, _ in self.timing] or [0.0]
+        return {
+            "lanes": len(lanes),
+            "task_s": task,
+            "overhead_per_task_s": overhead,
+            "overhead_fraction": overhead / task if task > 0 else 0.0,
+            "gap_per_task_s": gaps / n,
+            "span_s": max(ends) - min(starts),
+        }
+
+
+def _check_address(address: str) -> None:
+    """Refuse a scheduler address that is not ``scheme://host:port`` (or ``host:port``)."""
+    scheme, sep, rest = address.partition("://")
+    if not sep:
+        scheme, rest = "tcp", address
+    host, colon, port = rest.rpartition(":")
+    problem = ""
+    if scheme not in SCHEMES:
+        problem = f"unknown scheme {scheme!r} (use one of {', '.join(SCHEMES)})"
+    elif not colon or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        problem = "it needs a host and a port number 1-65535"
+    if problem:
+        raise InputError(
+            f"expected a Dask scheduler address like tcp://host:8786, got {address!r}: {problem}",
+            "scheduler",
+        )
+
+
+def _dask_client(distributed: Any, address: str, timeout: float) -> Any:
+    _check_address(address)
+    try:
+        return distributed.Client(address, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise InputError(
+            f"cannot reach the Dask scheduler at {address} within {timeout:g} s ({exc})",
+            "scheduler",
+        ) from exc
+
+
+def worker_version() -> str:
+    """Return this process's rockmech version (asked of every Dask worker before a run)."""
+    return __version__
+
+
+def _wait_for_workers(client: Any, address: str, timeout: float, left: str) -> None:
+    """Wait up to ``timeout`` [s] for a worker; else an error naming ``left`` (work left)."""
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except (OSError, TimeoutError) as exc:
+        raise InputError(
+            f"no worker {'is left on' if left else 'joined'} the Dask scheduler at {address} "
+            f"within {timeout:g} s{f' ({left})' if left else ''}; start workers with "
+            f"`dask worker {address}`",
+            "scheduler",
+        ) from exc
+
+
+def _cluster_threads(client: Any, address: str, timeout: float) -> tuple[int, int]:
+    """(workers, threads) of the cluster, once one worker is there and all run this rockmech.
+
+    Raises
+    ------
+    InputError
+        No worker within ``timeout``, a worker that cannot import rockmech, or one with
+        another version (field ``scheduler``).
+    """
+    _wait_for_workers(client, address, timeout, "")
+    try:
+        versions = client.run(worker_version)
+    except Exception as exc:  # any failure on a worker: one line, not a traceback
+        raise InputError(
+            f"the Dask workers at {address} cannot run rockmech ({type(exc).__name__}: {exc}); "
+            f"install rockmech {__version__} with the dask extra on every worker",
+            "scheduler",
+        ) from exc
+    other = {w: v for w, v in versions.items() if v != __version__}
+    if other:
+        worker, version = sorted(other.items())[0]
+        raise InputError(
+            f"worker {worker} runs rockmech {version}, this machine {__version__} "
+            f"({len(other)} of {len(versions)} workers differ); install the same version on "
+            "every worker",
+            "scheduler",
+        )
+    threads = client.nthreads()
+    return len(threads), sum(int(n) for n in threads.values())
+
+
+def _run_local(
+    ctx: dict[str, Any],
+    records: list[tuple[int, Any, float, str]],
+    packs: list[list[int]],
+    tasks: list[Task],
+    jobs: int,
+    on_part: Callable[[dict[str, Any]], None],
+) -> None:
+    """Run the tasks on ``jobs`` threads of this process, longest first."""
+    stop = threading.Event()
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = [
+            pool.submit(run_task, ctx, [records[i] for i in packs[t.pack]], t.lo, t.hi, stop)
+            for t in tasks
+        ]
+        try:
+            for future in as_completed(futures):
+                on_part(future.result())
+        except BaseException:
+            # Stopped (time limit, Ctrl+C, an error): drop the queued tasks; the running ones
+            # end after their current record, and the pool waits for them.
+            stop.set()
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+
+
+class _DaskFeed:
+    """Tasks fed to the workers as they free up: each holds ``IN_FLIGHT`` per thread.
+
+    A task goes to the worker with the most free places, and its records are scattered to
+    that worker just before (once per worker: the blocks of levels of a long record that
+    land on the same worker share them); a finished task frees its place there, so a slow
+    worker gets fewer tasks, and records are in the cluster's memory only while their tasks
+    are. Workers that join during the run get tasks from then on (the list of workers is
+    read again every ``REFRESH_S``).
+    """
+
+    def __init__(
+        self,
+        client: Any,
+        distributed: Any,
+        ctx: dict[str, Any],
+        records: list[tuple[int, Any, float, str]],
+        packs: list[list[int]],
+        tasks: list[Task],
+    ) -> None:
+        self.client, self.distributed = client, distributed
+        self.records, self.packs, self.n = records, packs, len(tasks)
+        self.retries: dict[Task, int] = {}
+        self.queue = list(enumerate(tasks))[::-1]  # popped from the end: longest first
+        self.left = [0] * len(packs)
+        for task in tasks:
+            self.left[task.pack] += 1
+        self.held: dict[tuple[int, str], Any] = {}  # (pack, worker) -> scattered records
+        self.places: dict[str, int] = {}  # worker -> free places
+        self.running: dict[str, tuple[Task, str, Any]] = {}  # key -> (task, worker, future)
+        self.done = distributed.as_completed()
+        self.refreshed = -math.inf
+        # In a list: a dict given alone would be scattered as one key per entry.
+        [self.shared] = client.scatter([ctx], broadcast=True, hash=False)
+
+    def refresh(self) -> None:
+        """Read the workers again: new ones get places, those gone lose theirs."""
+        if time.monotonic() - self.refreshed < REFRESH_S:
+            return
+        self.refreshed = time.monotonic()
+        threads = self.client.nthreads()
+        for worker, n in threads.items():
+            if worker not in self.places:
+                self.places[worker] = IN_FLIGHT * int(n)
+        for worker in set(self.places) - set(threads):
+            del self.places[worker]
+
+    def fill(self) -> None:
+        """Submit tasks, longest first, while a worker has a free place."""
+        while self.queue and self.places:
+            worker = max(self.places, key=lambda w: self.places[w])
+            if self.places[worker] <= 0:
+                return
+            k, task = self.queue.pop()
+            held = self.held.get((task.pack, worker))
+            if held is None:
+                data = [self.records[i] for i in self.packs[task.pack]]
+                [held] = self.client.scatter([data], workers=[worker], hash=False)
+                self.held[(task.pack, worker)] = held
+            future = self.client.submit(
+                run_task,
+                self.shared,
+                held,
+                task.lo,
+                task.hi,
+                workers=[worker],
+                allow_other_workers=True,  # a worker that leaves does not strand its tasks
+                pure=False,
+                priority=self.n - k,
+            )
+            self.places[worker] -= 1
+            self.running[future.key] = (task, worker, future)
+            self.done.add(future)
+
+    def finish(self, future: Any) -> Optional[dict[str, Any]]:
+        """Take a finished task's result; free its place; release records no task needs.
+
+        A task lost with a worker (its records went with it, or the worker died while
+        running it) is queued again, up to ``RETRIES`` times: None is returned for it.
+        """
+        task, worker, _ = self.running.pop(future.key)
+        if worker in self.places:
+            self.places[worker] += 1
+        try:
+            part: dict[str, Any] = future.result()
+        except (CancelledError, self.distributed.KilledWorker) as exc:
+            self.held.pop((task.pack, worker), None)
+            self.retries[task] = self.retries.get(task, 0) + 1
+            if self.retries[task] > RETRIES:
+                raise InputError(
+                    f"a task was lost {RETRIES + 1} times with the workers that ran it "
+                    f"({type(exc).__name__}: {exc}); check that the workers stay up",
+                    "scheduler",
+                ) from exc
+            self.queue.append((-1, task))  # next to start, first on its worker
+            self.places.pop(worker, None)  # until the next refresh finds it alive
+            return None
+        self.left[task.pack] -= 1
+        if self.left[task.pack] == 0:
+            for key in [key for key in self.held if key[0] == task.pack]:
+                del self.held[key]
+        return part
+
+    def cancel(self) -> None:
+        """Cancel what this run has on the cluster: its tasks and its data."""
+        futures = [f for *_, f in self.running.values()] + [*self.held.values(), self.shared]
+        with contextlib.suppress(Exception):  # a lost connection: the scheduler drops them
+            self.client.cancel(futures, force=True)
+
+
+class _OnPart(Exception):
+    """An error of the caller's handling of a result, carried past the connection's errors."""
+
+    def __init__(self, error: OSError) -> None:
+        super().__init__(str(error))
+        self.error = error
+
+
+def _run_dask(
+    client: Any,
+    distributed: Any,
+    address: str,
+    timeout: float,
+    ctx: dict[str, Any],
+    records: list[tuple[int, Any, float, str]],
+    packs: list[list[int]],
+    tasks: list[Task],
+    on_part: Callable[[dict[str, Any]], None],
+) -> None:
+    """Run the tasks on the cluster: constants broadcast, records scattered, each once."""
+    feed: Optional[_DaskFeed] = None
+    try:
+        with client.as_current():
+            feed = _DaskFeed(client, distributed, ctx, records, packs, tasks)
+            feed.refresh()
+            feed.fill()
+            while True:
+                for future in feed.done:
+                    part = feed.finish(future)
+                    if part is not None:
+                        try:
+                            on_part(part)
+                        except OSError as exc:  # writing the peaks, not the connection
+                            raise _OnPart(exc) from exc
+                    feed.refresh()
+                    feed.fill()
+                if not feed.queue:
+                    break
+                # Tasks left and none running: the workers left (or lost tasks); wait for one.
+                _wait_for_workers(client, address, timeout, f"{len(feed.queue)} tasks to run")
+                feed.refreshed = -math.inf
+                feed.refresh()
+                feed.fill()
+    except _OnPart as wrapped:
+        if feed is not None:
+            feed.cancel()
+        raise wrapped.error from None
+    except (OSError, TimeoutError) as exc:  # the connection to the scheduler was lost
+        if feed is not None:
+            feed.cancel()
+        raise InputError(
+            f"lost the connection to the Dask scheduler at {address} during the run ({exc})",
+            "scheduler",
+        ) from exc
+    except BaseException:
+        # Stopped (time limit, Ctrl+C, a task's error): nothing of this run stays queued
+        # or running on the cluster.
+        if feed is not None:
+            feed.cancel()
+        raise
 
 
 def _collect(
-    payloads: list[dict[str, Any]],
+    ctx: dict[str, Any],
+    motions: Sequence[Any],
+    costs: list[float],
     scheduler: Optional[str],
-    progress: Optional[Callable[[int, int], None]],
     timeout: float,
     jobs: Optional[int],
-) -> tuple[list[dict[str, Any]], dict[str, Any]]:
-    """Run the (record × level block) tasks locally or on Dask; results in record order."""
+    task_s: Optional[float],
+    on_part: Callable[[dict[str, Any]], None],
+) -> dict[str, Any]:
+    """Plan the tasks for the workers there are and run them locally or on Dask."""
+    records = [(i, m.accel.acc, float(m.dt), m.name) for i, m in enumerate(motions)]
+    n_levels = len(ctx["levels"])
     if scheduler is None:
         n_jobs = jobs if jobs is not None else available_cores()
-        tasks = _tasks(payloads, n_jobs)
-        with ThreadPoolExecutor(max_workers=n_jobs) as pool:
-            pending = {pool.submit(_run_serial, tasks[k][1]): k for k in _longest_first(tasks)}
-
-            def finished_local() -> Any:
-                for future in as_completed(pending):
-                    yield pending[future], future.result()
-
-            try:
-                results = _gather(tasks, len(payloads), finished_local, progress)
-            except BaseException:
-                # Stopped (time limit, Ctrl+C): drop the queued tasks, wait for the running ones.
-                pool.shutdown(wait=False, cancel_futures=True)
-                raise
-        return results, {"kind": "local", "jobs": n_jobs, "tasks": len(tasks)}
+        packs, tasks = plan_tasks(costs, n_levels, task_s or task_seconds(sum(costs), n_jobs))
+        _run_local(ctx, records, packs, tasks, n_jobs, on_part)
+        return {"kind": "local", "jobs": n_jobs, "tasks": len(tasks)}
     # Checked before anything else touches dask: a missing extra names its install line.
     distributed = require("dask.distributed", "dask", "for ida --scheduler")
     client = _dask_client(distributed, scheduler, timeout)
     try:
-        workers = client.scheduler_info().get("workers", {})
-        n_workers = len(workers)
-        n_threads = sum(int(w.get("nthreads", 1)) for w in workers.values()) or 1
-        tasks = _tasks(payloads, n_threads)
-        order = _longest_first(tasks)
-        futures = [client.submit(run_record, **tasks[k][1], pure=False) for k in order]
-        index = {f.key: k for k, f in zip(order, futures)}
-
-        def finished_dask() -> Any:
-            with client.as_current():
-                for future in distributed.as_completed(futures):
-                    yield index[future.key], future.result()
-
-        results = _gather(tasks, len(payloads), finished_dask, progress)
+        n_workers, n_threads = _cluster_threads(client, scheduler, timeout)
+        packs, tasks = plan_tasks(costs, n_levels, task_s or task_seconds(sum(costs), n_threads))
+        _run_dask(client, distributed, scheduler, timeout, ctx, records, packs, tasks, on_part)
     finally:
         client.close()
     backend = {"kind": "dask", "scheduler": scheduler, "n_workers": n_workers}
-    return results, {**backend, "tasks": len(tasks)}
+    return {**backend, "threads": n_threads, "tasks": len(tasks)}
+
+
+def _check_options(im: str, motions: Sequence[Any], jobs: Optional[int], task_s: Any) -> None:
+    if im not in IM_MEASURES:
+        raise InputError(f"must be one of {list(IM_MEASURES)}, got {im!r}", "im")
+    if len(motions) == 0:
+        raise InputError("needs at least one record", "records")
+    if jobs is not None and (isinstance(jobs, bool) or int(jobs) != jobs or jobs < 1):
+        raise InputError(f"must be a whole number >= 1, got {jobs!r}", "jobs")
+    if task_s is not None:
+        check_positive(task_s, "task_s")
 
 
 def run_ida(
@@ -302,6 +917,8 @@ def run_ida(
     progress: Optional[Callable[[int, int], None]] = None,
     timeout: float = CONNECT_TIMEOUT_S,
     jobs: Optional[int] = None,
+    peaks: Optional[Path] = None,
+    task_s: Optional[float] = None,
 ) -> dict[str, Any]:
     """Incremental dynamic analysis with lognormal fragility fits, as a JSON-ready document.
 
@@ -325,107 +942,147 @@ def run_ida(
     scheduler : str, optional
         Address of a dask.distributed scheduler (``tcp://host:8786``); None runs locally.
     progress : callable, optional
-        Called as ``progress(records_done, n_records)``.
+        Called as ``progress(runs_done, n_runs)`` after each task.
     timeout : float
-        Seconds to wait for the scheduler [s].
+        Seconds to wait for the scheduler, and for its first worker [s].
     jobs : int, optional
         Threads of the local run (default: one per core this process may use,
-        ``available_cores``); ignored on Dask.
+        ``available_cores``); ignored on Dask, where each worker runs as many tasks at once
+        as it has threads.
+    peaks : Path, optional
+        Parquet file to write the per-run peaks to (needs ``pyarrow``, the ``parquet``
+        extra): one row per record × mechanism × level with ``record`` (index into the
+        document's ``records``), ``record_name``, ``mechanism``, ``level``, ``peak_ratio``,
+        ``overturned``, ``error_estimate`` and ``status``, in the order the tasks finish.
+        Written under a temporary name and renamed when complete. None: the runs are
+        reduced to the counts on the workers and no peak travels.
+    task_s : float, optional
+        Work per task aimed at [s] (default ``task_seconds``); the results do not depend
+        on it.
 
     Returns
     -------
     dict
         ``intensity``, ``records``, per mechanism ``n_overturned``, ``fraction``,
         ``first_overturning_level`` (per record) and ``fragility`` (median, beta), plus
-        ``runs``, ``runtime_s``, ``max_error_estimate`` and ``backend`` (``kind``, and
-        ``jobs`` or the Dask ``scheduler`` and ``n_workers``, and the number of ``tasks``).
+        ``runs``, ``runtime_s``, ``compute_s`` (inside the kernels, all tasks),
+        ``max_error_estimate`` and ``backend``: ``kind``, ``jobs`` or the Dask ``scheduler``,
+        ``n_workers`` and ``threads``, the number of ``tasks`` and worker threads that ran
+        them (``lanes``), the mean ``task_s``, the mean ``overhead_per_task_s`` (time in a
+        task outside the kernels, plus the gap before the next task on the same worker
+        thread) and its ``overhead_fraction`` of the task time, the gap alone
+        (``gap_per_task_s``) and ``span_s``, from the first task's start to the last one's
+        end (on the workers' clocks). With ``peaks``, ``peaks`` (``file``, ``rows``).
 
     Raises
     ------
     InputError
-        No records, a bad level, an unknown ``im``, or an unreachable scheduler (field
-        ``scheduler``, with the address).
+        No records, a bad level, an unknown ``im``, a bad ``jobs`` or ``task_s``, or a
+        scheduler that is malformed, unreachable, without workers or with workers that run
+        another rockmech (field ``scheduler``, with the address).
+    MissingExtra
+        ``scheduler`` without dask.distributed, ``peaks`` without pyarrow.
     """
-    if im not in IM_MEASURES:
-        raise InputError(f"must be one of {list(IM_MEASURES)}, got {im!r}", "im")
-    if len(motions) == 0:
-        raise InputError("needs at least one record", "records")
+    _check_options(im, motions, jobs, task_s)
     lv = _levels(levels)
-    if jobs is not None and (isinstance(jobs, bool) or int(jobs) != jobs or jobs < 1):
-        raise InputError(f"must be a whole number >= 1, got {jobs!r}", "jobs")
     building = building or Building()
     cf, skipped = time_domain_mechanisms(cf)
     for mech in cf.mechanisms:
         to_rocking_model(mech).require_eta()
-    constants = cf.model_dump(mode="json", exclude_none=True)
-    options = {
-        "sf": sf,
-        "building": {
-            "height": building.height,
-            "soil_factor": building.soil_factor,
-            "element_period": building.element_period,
+    names = [str(m.name) for m in motions]
+    ids = [m.id for m in cf.mechanisms]
+    writer = None if peaks is None else _PeakWriter(Path(peaks), names, ids, lv, im)
+    ctx = {
+        "token": uuid.uuid4().hex,
+        "constants": cf.model_dump(mode="json", exclude_none=True),
+        "levels": lv,
+        "im": im,
+        "options": {
+            "sf": sf,
+            "building": {
+                "height": building.height,
+                "soil_factor": building.soil_factor,
+                "element_period": building.element_period,
+            },
+            "criterion": criterion,
         },
-        "criterion": criterion,
+        "peaks": writer is not None,
     }
-    payloads = [
-        {
-            "constants": constants,
-            "acc": m.accel.acc,
-            "dt": m.dt,
-            "name": m.name,
-            "levels": lv,
-            "im": im,
-            "options": options,
-        }
-        for m in motions
-    ]
+    totals = _Totals(len(motions), len(ids), len(lv), len(motions) * len(ids) * len(lv))
+
+    def on_part(part: dict[str, Any]) -> None:
+        totals.add(part)
+        if writer is not None:
+            writer.add(part)
+        if progress is not None:
+            progress(totals.runs_done, totals.n_runs)
+
     start = time.perf_counter()
-    results, backend = _collect(payloads, scheduler, progress, timeout, jobs)
+    if progress is not None:
+        progress(0, totals.n_runs)
+    try:
+        costs = record_costs(cf, motions, len(lv))
+        backend = _collect(ctx, motions, costs, scheduler, timeout, jobs, task_s, on_part)
+        rows = None if writer is None else writer.close()
+    except BaseException:
+        if writer is not None:
+            writer.abort()
+        raise
     wall = time.perf_counter() - start
-    overturned = np.stack([r["overturned"] for r in results])  # (records, mechs, levels)
-    counts = overturned.sum(axis=0)
-    n_rec = len(results)
-    mechanisms = []
-    for i, mech in enumerate(cf.mechanisms):
-        first = []
-        for r in results:
-            hit = np.flatnonzero(r["overturned"][i])
-            first.append(lv[int(hit[0])] if hit.size else None)
-        entry: dict[str, Any] = {
-            "id": mech.id,
-            "n_overturned": [int(c) for c in counts[i]],
-            "fraction": [float(c) / n_rec for c in counts[i]],
-            "first_overturning_level": first,
-            "fragility": fit_lognormal(lv, counts[i], n_rec).to_dict(),
-        }
-        factors = [r["scale_factors"].get(mech.id) for r in results]
-        if any(f is not None for f in factors):
-            entry["scale_factors"] = factors
-        mechanisms.append(entry)
-    status = np.stack([r["status"] for r in results])
-    doc: dict[str, Any] = {
-        "intensity": {"measure": im, "units": IM_MEASURES[im], "levels": lv},
-        "records": [
-            {"name": r["name"], "pga_g": r["pga_g"], "dt_s": r["dt_s"], "n_samples": r["n_samples"]}
-            for r in results
-        ],
-        "criterion": results[0]["criterion"],
-        "method": results[0]["method"],
-        "mechanisms": mechanisms,
-        "runs": int(overturned.size),
-        "runtime_s": wall,
-        "compute_s": float(sum(r["runtime_s"] for r in results)),
-        "max_error_estimate": float(max(np.max(r["error_estimate"]) for r in results)),
-        "backend": backend,
-    }
+    if totals.runs_done != totals.n_runs:  # every run is in exactly one finished task
+        raise RuntimeError(f"IDA ran {totals.runs_done} of {totals.n_runs} runs")
+    doc = _document(cf, motions, lv, im, totals)
+    doc.update(runtime_s=wall, compute_s=totals.kernel_s)
+    doc["backend"] = {**backend, **totals.task_stats()}
+    if writer is not None:
+        doc["peaks"] = {"file": Path(peaks or "").name, "rows": rows}
     if sf != "none":
         doc["scale_factor_method"] = sf
-    incomplete = int(np.count_nonzero(status < 0))
-    if incomplete:
-        doc["incomplete_runs"] = incomplete
+    if totals.incomplete:
+        doc["incomplete_runs"] = totals.incomplete
     if skipped:
         doc["skipped"] = skipped
     return doc
+
+
+def _document(
+    cf: ConstantsFile, motions: Sequence[Any], lv: list[float], im: str, totals: _Totals
+) -> dict[str, Any]:
+    """Build the IDA document from the reduced runs (counts, first levels, fits)."""
+    n_rec = len(motions)
+    mechanisms = []
+    for i, mech in enumerate(cf.mechanisms):
+        counts = totals.counts[i]
+        entry: dict[str, Any] = {
+            "id": mech.id,
+            "n_overturned": [int(c) for c in counts],
+            "fraction": [float(c) / n_rec for c in counts],
+            "first_overturning_level": [
+                lv[int(k)] if k < len(lv) else None for k in totals.first[:, i]
+            ],
+            "fragility": fit_lognormal(lv, counts, n_rec).to_dict(),
+        }
+        factors = [f.get(mech.id) for f in totals.factors]
+        if any(f is not None for f in factors):
+            entry["scale_factors"] = factors
+        mechanisms.append(entry)
+    return {
+        "intensity": {"measure": im, "units": IM_MEASURES[im], "levels": lv},
+        "records": [
+            {
+                "name": m.name,
+                "pga_g": m.pga_g,
+                "dt_s": float(m.dt),
+                "n_samples": len(m.accel.acc),
+            }
+            for m in motions
+        ],
+        "criterion": ", ".join(sorted(totals.criteria)),
+        "method": ", ".join(sorted(totals.methods)),
+        "mechanisms": mechanisms,
+        "runs": totals.n_runs,
+        "max_error_estimate": totals.max_error,
+    }
 
 
 def ida_csv(doc: dict[str, Any]) -> str:

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import json
+import math
 import os
+import random
 import socket
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -14,22 +17,27 @@ from typer.testing import CliRunner
 
 from shared_schema.errors import InputError
 from shared_schema.io import load_constants
+from solver_service import ida
 from solver_service.cli import app
 from solver_service.core.exact import simulate
 from solver_service.core.records import GroundMotion
 from solver_service.ida import (
-    _longest_first,
-    _tasks,
+    MIN_TASK_S,
+    PEAKS_FILE,
+    TASK_S,
     available_cores,
-    level_blocks,
     parse_levels,
+    plan_tasks,
     run_ida,
+    task_seconds,
 )
 from solver_service.workflows.adapter import models_from_file
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 CONSTANTS = EXAMPLES / "constants" / "rect_walls.json"
 LEVELS = [0.2, 0.5, 1.0, 2.0, 3.5]
+#: What a document holds that depends on the path and the cutting: timing and the backend.
+TIMING = {"runtime_s", "compute_s", "backend"}
 runner = CliRunner()
 
 
@@ -45,19 +53,47 @@ def motions(elcentro_path: Path) -> list[GroundMotion]:
     ]
 
 
+@pytest.fixture(scope="module")
+def mixed(motions: list[GroundMotion]) -> list[GroundMotion]:
+    """Records of 1/4, full and 1/2 length and the three full ones: packs of unequal records."""
+    acc, dt = motions[0].accel.acc, motions[0].dt
+    return [
+        GroundMotion.from_samples(acc[: acc.size // 4], dt, name="quarter"),
+        *motions,
+        GroundMotion.from_samples(acc[: acc.size // 2], dt, name="half"),
+    ]
+
+
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
 
 
+def _results(doc: dict[str, Any]) -> dict[str, Any]:
+    """The document without its timing and backend: what must not depend on the path."""
+    return {k: v for k, v in doc.items() if k not in TIMING}
+
+
+def _peak_rows(path: Path) -> list[tuple[Any, ...]]:
+    """The rows of a peaks file, sorted by (record, mechanism, level)."""
+    pq = pytest.importorskip("pyarrow.parquet")
+    table = pq.read_table(path).to_pydict()
+    rows = list(zip(*(table[k] for k in table)))
+    return sorted(rows, key=lambda r: (r[0], r[2], r[3]))
+
+
 def test_local_ida_counts_equal_direct_simulations(motions: list[GroundMotion]) -> None:
     cf = load_constants(CONSTANTS)
-    seen: list[int] = []
-    doc = run_ida(cf, motions, LEVELS[::-1], progress=lambda done, total: seen.append(done))
-    assert seen == [1, 2, 3]
+    seen: list[tuple[int, int]] = []
+    doc = run_ida(
+        cf, motions, LEVELS[::-1], progress=lambda done, total: seen.append((done, total))
+    )
+    n_runs = len(motions) * len(LEVELS) * len(cf.mechanisms)
+    assert seen[0] == (0, n_runs) and seen[-1] == (n_runs, n_runs)
+    assert [d for d, _ in seen] == sorted(d for d, _ in seen)
     assert doc["intensity"] == {"measure": "scale", "units": "-", "levels": LEVELS}
-    assert doc["runs"] == len(motions) * len(LEVELS) * len(cf.mechanisms)
+    assert doc["runs"] == n_runs
     for model, mech in zip(models_from_file(cf), doc["mechanisms"]):
         verdicts = np.array(
             [[simulate(model, m.accel, scale=s).overturned for s in LEVELS] for m in motions]
@@ -66,64 +102,52 @@ def test_local_ida_counts_equal_direct_simulations(motions: list[GroundMotion]) 
         assert mech["fraction"] == pytest.approx(verdicts.mean(axis=0).tolist())
         for row, first in zip(verdicts, mech["first_overturning_level"]):
             assert first == (LEVELS[int(np.argmax(row))] if row.any() else None)
-    assert doc["backend"]["kind"] == "local" and doc["backend"]["jobs"] == available_cores()
+    backend = doc["backend"]
+    assert backend["kind"] == "local" and backend["jobs"] == available_cores()
+    assert backend["tasks"] >= 1 and 0 < backend["task_s"] and backend["overhead_per_task_s"] >= 0
     assert 1 <= available_cores() <= (os.cpu_count() or 1)
     assert "scale_factors" not in doc["mechanisms"][0]
 
 
-def test_level_blocks_cover_the_levels_and_spread_the_work() -> None:
-    assert level_blocks(1, 10, 1) == [(0, 10)]
-    for n_rec, n_lev, n_work in [(100, 50, 2), (1, 10, 2), (3, 5, 8), (2, 1, 16), (7, 13, 3)]:
-        blocks = level_blocks(n_rec, n_lev, n_work)
-        assert [lo for lo, _ in blocks] == sorted({lo for lo, _ in blocks})
-        assert blocks[0][0] == 0 and blocks[-1][1] == n_lev
-        assert all(b[1] == c[0] for b, c in zip(blocks, blocks[1:]))
-        sizes = [hi - lo for lo, hi in blocks]
-        assert min(sizes) >= 1 and max(sizes) - min(sizes) <= 1
-        assert n_rec * len(blocks) >= min(4 * n_work, n_rec * n_lev)
-    assert level_blocks(100, 50, 2) == [(0, 50)]  # enough records: one task per record
+def test_plan_covers_every_run_once_in_tasks_of_the_aimed_size() -> None:
+    rng = random.Random(7)
+    for n_rec, n_lev, task_s in [(50, 20, 1.0), (3, 50, 0.1), (1, 7, 1e-9), (40, 1, 0.5)]:
+        costs = [rng.uniform(0.0, 3.0) * rng.choice([0.01, 1.0]) for _ in range(n_rec)]
+        packs, tasks = plan_tasks(costs, n_lev, task_s)
+        assert sorted(i for p in packs for i in p) == list(range(n_rec))  # each record once
+        cover = np.zeros((n_rec, n_lev), dtype=int)
+        for t in tasks:
+            assert 0 <= t.lo < t.hi <= n_lev
+            for i in packs[t.pack]:
+                cover[i, t.lo : t.hi] += 1
+        assert (cover == 1).all()  # every run in exactly one task
+        assert [t.cost_s for t in tasks] == sorted((t.cost_s for t in tasks), reverse=True)
+        assert sum(t.cost_s for t in tasks) == pytest.approx(sum(costs))
+        for k, pack in enumerate(packs):
+            blocks = [t for t in tasks if t.pack == k]
+            if len(pack) == 1 and costs[pack[0]] > task_s:  # a long record: cut into levels
+                assert len(blocks) == min(n_lev, math.ceil(costs[pack[0]] / task_s))
+                sizes = [t.hi - t.lo for t in blocks]
+                assert max(sizes) - min(sizes) <= 1
+            else:  # short records gathered into one task of at least task_s (the last: less)
+                assert len(blocks) == 1 and (blocks[0].lo, blocks[0].hi) == (0, n_lev)
+                assert blocks[0].cost_s >= task_s or k == len(packs) - 1
+    assert task_seconds(1e4, 16) == TASK_S and task_seconds(1.0, 16) == MIN_TASK_S
+    assert task_seconds(32.0, 16) == pytest.approx(0.25)  # 8 tasks per worker thread
 
 
-def test_local_ida_is_the_same_on_any_number_of_threads(motions: list[GroundMotion]) -> None:
-    cf = load_constants(CONSTANTS)
-    one = run_ida(cf, motions[:1], LEVELS, jobs=1)
-    many = run_ida(cf, motions[:1], LEVELS, jobs=3)
-    assert one["backend"]["tasks"] == 1 and many["backend"]["tasks"] == len(LEVELS)
-    for key in ("intensity", "records", "mechanisms", "runs", "max_error_estimate"):
-        assert one[key] == many[key], key
-    model = models_from_file(cf)[1]
-    peaks = [simulate(model, motions[0].accel, scale=s).overturned for s in LEVELS]
-    assert many["mechanisms"][1]["n_overturned"] == [int(p) for p in peaks]
-    with pytest.raises(InputError, match="jobs"):
-        run_ida(cf, motions[:1], LEVELS, jobs=0)
-
-
-def test_longest_tasks_start_first_and_results_keep_record_order(
-    motions: list[GroundMotion],
+@pytest.mark.parametrize(("jobs", "task_s"), [(1, 1e-9), (3, 1e-9), (3, 0.002), (2, 1e9)])
+def test_results_are_identical_on_every_cutting_and_number_of_threads(
+    mixed: list[GroundMotion], jobs: int, task_s: float
 ) -> None:
-    # Records of 1/4, full and 1/2 length: the full one is submitted first, yet the document
-    # lists the records in the order given, with the numbers of a one-thread run.
-    acc, dt = motions[0].accel.acc, motions[0].dt
-    cut = [
-        GroundMotion.from_samples(acc[: acc.size // 4], dt, name="quarter"),
-        GroundMotion.from_samples(acc, dt, name="full"),
-        GroundMotion.from_samples(acc[: acc.size // 2], dt, name="half"),
-    ]
-    payloads = [{"acc": m.accel.acc, "levels": LEVELS} for m in cut]
-    tasks = _tasks(payloads, 2)
-    assert len(tasks) == 9  # 3 records x 3 level blocks (1, 2 and 2 levels)
-    order = _longest_first(tasks)
-    assert sorted(order) == list(range(9))
-    work = [tasks[k][1]["acc"].size * len(tasks[k][1]["levels"]) for k in order]
-    assert work == sorted(work, reverse=True)
-    assert [tasks[k][0] for k in order[:3]] == [1, 1, 1]  # the full record's blocks first
-    assert tasks[order[-1]][0] == 0  # the quarter record's one-level block last
     cf = load_constants(CONSTANTS)
-    one = run_ida(cf, cut, LEVELS, jobs=1)
-    two = run_ida(cf, cut, LEVELS, jobs=2)
-    assert [r["name"] for r in two["records"]] == ["quarter", "full", "half"]
-    for key in ("records", "mechanisms", "max_error_estimate"):
-        assert one[key] == two[key], key
+    reference = run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9)  # one task, one thread
+    assert reference["backend"]["tasks"] == 1
+    doc = run_ida(cf, mixed, LEVELS, jobs=jobs, task_s=task_s)
+    if task_s < 1e-6:  # every record cut into single levels
+        assert doc["backend"]["tasks"] == len(mixed) * len(LEVELS)
+    assert [r["name"] for r in doc["records"]] == [m.name for m in mixed]
+    assert _results(doc) == _results(reference)  # counts bit for bit; fits hence identical
 
 
 def test_pga_intensity_scales_each_record_to_the_level(motions: list[GroundMotion]) -> None:
@@ -139,24 +163,89 @@ def test_pga_intensity_scales_each_record_to_the_level(motions: list[GroundMotio
     assert doc["mechanisms"][0]["n_overturned"] == expected
 
 
-def test_dask_local_cluster_gives_the_local_numbers(motions: list[GroundMotion]) -> None:
-    distributed = pytest.importorskip("distributed")
+def test_peaks_file_holds_every_run_as_a_direct_simulation_gives_it(
+    mixed: list[GroundMotion], tmp_path: Path
+) -> None:
+    pq = pytest.importorskip("pyarrow.parquet")
     cf = load_constants(CONSTANTS)
-    local = run_ida(cf, motions, LEVELS)
+    path = tmp_path / "peaks.parquet"
+    doc = run_ida(cf, mixed, LEVELS, jobs=2, task_s=1e-9, peaks=path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["peaks.parquet"]  # no temp left
+    n_runs = len(mixed) * len(cf.mechanisms) * len(LEVELS)
+    assert doc["peaks"] == {"file": "peaks.parquet", "rows": n_runs}
+    table = pq.read_table(path)
+    assert table.num_rows == n_runs and table.schema.metadata[b"intensity_measure"] == b"scale"
+    rows = _peak_rows(path)
+    models = models_from_file(cf)
+    ids = [m.id for m in cf.mechanisms]
+    for record, name, mech, level, peak, over, err, status in rows:
+        assert name == mixed[record].name
+        direct = simulate(models[ids.index(mech)], mixed[record].accel, scale=level)
+        assert peak == pytest.approx(direct.peak_ratio, rel=1e-12, abs=1e-15)
+        assert over == direct.overturned and status == direct.status
+        assert 0 <= err <= doc["max_error_estimate"]
+    for j, mech in enumerate(doc["mechanisms"]):
+        for k, level in enumerate(LEVELS):
+            hits = [r for r in rows if r[2] == ids[j] and r[3] == level and r[5]]
+            assert len(hits) == mech["n_overturned"][k]
+    # Another cutting, the same rows (in another order).
+    again = tmp_path / "again.parquet"
+    run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9, peaks=again)
+    assert _peak_rows(again) == rows
+
+
+def test_a_stopped_run_leaves_no_peaks_file(motions: list[GroundMotion], tmp_path: Path) -> None:
+    pytest.importorskip("pyarrow")
+    cf = load_constants(CONSTANTS)
+
+    def stop(done: int, total: int) -> None:
+        if done:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_ida(
+            cf, motions, LEVELS, jobs=2, task_s=1e-9, peaks=tmp_path / "p.parquet", progress=stop
+        )
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_dask_local_cluster_gives_the_local_numbers_on_every_cutting(
+    mixed: list[GroundMotion], tmp_path: Path
+) -> None:
+    distributed = pytest.importorskip("distributed")
+    pytest.importorskip("pyarrow")
+    cf = load_constants(CONSTANTS)
+    local = run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9, peaks=tmp_path / "local.parquet")
     with distributed.LocalCluster(
         n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
     ) as cluster:
-        remote = run_ida(cf, motions, LEVELS, scheduler=cluster.scheduler_address)
-        # One record: the levels are cut into blocks so both workers get work.
-        single = run_ida(cf, motions[:1], LEVELS, scheduler=cluster.scheduler_address)
+        address = cluster.scheduler_address
+        remote = run_ida(cf, mixed, LEVELS, scheduler=address, peaks=tmp_path / "dask.parquet")
+        # Single levels: tasks share the scattered records (each fetched once per worker).
+        cut = run_ida(cf, mixed, LEVELS, scheduler=address, task_s=1e-9)
     assert remote["backend"]["kind"] == "dask"
-    assert remote["backend"]["n_workers"] == 2
-    for key in ("intensity", "records", "mechanisms", "runs", "max_error_estimate", "criterion"):
-        assert remote[key] == local[key], key
-    assert single["backend"]["tasks"] == len(LEVELS) > len(single["records"])
-    local_single = run_ida(cf, motions[:1], LEVELS, jobs=1)
-    for key in ("intensity", "records", "mechanisms", "runs", "max_error_estimate", "criterion"):
-        assert single[key] == local_single[key], key
+    assert remote["backend"]["n_workers"] == 2 and remote["backend"]["threads"] == 2
+    assert cut["backend"]["tasks"] == len(mixed) * len(LEVELS)
+    assert remote.pop("peaks") == {"file": "dask.parquet", "rows": local.pop("peaks")["rows"]}
+    assert _results(remote) == _results(local) == _results(cut)
+    assert _peak_rows(tmp_path / "dask.parquet") == _peak_rows(tmp_path / "local.parquet")
+
+
+def test_a_scheduler_without_workers_or_with_another_rockmech_is_a_clear_error(
+    motions: list[GroundMotion], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    distributed = pytest.importorskip("distributed")
+    cf = load_constants(CONSTANTS)
+    with distributed.LocalCluster(n_workers=0, dashboard_address=None) as cluster:
+        address = cluster.scheduler_address
+        with pytest.raises(InputError, match=f"no worker joined the Dask scheduler at {address}"):
+            run_ida(cf, motions[:1], [1.0], scheduler=address, timeout=1.0)
+    with distributed.LocalCluster(
+        n_workers=1, processes=False, protocol="tcp", dashboard_address=None
+    ) as cluster:
+        monkeypatch.setattr(ida, "worker_version", lambda: "0.0.1")
+        with pytest.raises(InputError, match=r"runs rockmech 0\.0\.1, this machine"):
+            run_ida(cf, motions[:1], [1.0], scheduler=cluster.scheduler_address)
 
 
 def test_unreachable_scheduler_is_a_clear_error_not_a_hang(motions: list[GroundMotion]) -> None:
@@ -175,12 +264,41 @@ def test_unreachable_scheduler_is_a_clear_error_not_a_hang(motions: list[GroundM
     assert res.exit_code == 2 and address in res.stderr and "scheduler" in res.stderr
 
 
-def test_cli_ida_writes_json_csv_and_plot(tmp_path: Path, elcentro_path: Path) -> None:
+@pytest.mark.parametrize(
+    ("address", "problem"),
+    [
+        ("not-a-url", "it needs a host and a port number"),
+        ("tcp://host", "it needs a host and a port number"),
+        ("tcp://host:0", "it needs a host and a port number"),
+        ("host:99999", "it needs a host and a port number"),
+        ("tcp://:8786", "it needs a host and a port number"),
+        ("udp://host:8786", "unknown scheme 'udp'"),
+    ],
+)
+def test_a_malformed_scheduler_address_is_refused_before_any_connection(
+    motions: list[GroundMotion], address: str, problem: str
+) -> None:
+    pytest.importorskip("distributed")
+    start = time.perf_counter()
+    with pytest.raises(InputError, match="expected a Dask scheduler address") as err:
+        run_ida(load_constants(CONSTANTS), motions[:1], [1.0], scheduler=address)
+    assert err.value.field == "scheduler" and problem in str(err.value)
+    assert time.perf_counter() - start < 5.0  # no connection tried, no timeout waited
+
+
+@pytest.mark.parametrize("address", ["tcp://sched.example:8786", "10.0.0.5:8786", "tls://h:1"])
+def test_well_formed_addresses_pass_the_address_check(address: str) -> None:
+    ida._check_address(address)
+
+
+def test_cli_ida_writes_json_csv_plot_and_peaks(tmp_path: Path, elcentro_path: Path) -> None:
+    pytest.importorskip("pyarrow")
+    (tmp_path / "notes.txt").write_text("mine")
     res = runner.invoke(
         app,
         [
             *("ida", str(CONSTANTS), str(elcentro_path), str(elcentro_path)),
-            *("--scales", "0.3:3:6", "--out", str(tmp_path), "--no-progress"),
+            *("--scales", "0.3:3:6", "--out", str(tmp_path), "--no-progress", "--peaks"),
         ],
     )
     assert res.exit_code == 0, res.output
@@ -189,7 +307,11 @@ def test_cli_ida_writes_json_csv_and_plot(tmp_path: Path, elcentro_path: Path) -
     csv = (tmp_path / "ida.csv").read_text().splitlines()
     assert csv[0] == "scale_-,fraction_W1,fraction_W2,fraction_F1" and len(csv) == 7
     assert (tmp_path / "ida.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert "median" in res.stdout
+    rows = _peak_rows(tmp_path / PEAKS_FILE)
+    assert len(rows) == doc["runs"] == 2 * 6 * 3 and doc["peaks"]["rows"] == doc["runs"]
+    assert (tmp_path / "notes.txt").read_text() == "mine"
+    assert "median" in res.stdout and f"ida.png, {PEAKS_FILE}" in res.stdout
+    assert "locally on" in res.stdout and "tasks, overhead" in res.stdout
 
 
 @pytest.mark.parametrize(
@@ -201,6 +323,8 @@ def test_cli_ida_writes_json_csv_and_plot(tmp_path: Path, elcentro_path: Path) -
         (["--scales", "1", "--im", "pgv"], "im: must be one of"),
         (["--scales", "1", "--timeout", "0"], "timeout"),
         (["--scales", "1", "--jobs", "0"], "jobs: must be a whole number >= 1"),
+        (["--scales", "1", "--peaks"], "peaks: --peaks writes ida_peaks.parquet into the --out"),
+        (["--scales", "1", "--scheduler", "not-a-url"], "scheduler: expected a Dask scheduler"),
     ],
 )
 def test_cli_ida_bad_input(args: list[str], message: str) -> None:
@@ -241,3 +365,27 @@ def test_a_mechanism_without_eta_is_skipped_with_a_note_not_fatal(
     assert res.exit_code == 0, res.output
     assert "warning: F1 skipped" in res.stderr
     assert f"x {len(church.mechanisms) - 1} mechanisms" in res.stdout
+
+
+def test_a_worker_lost_during_the_run_costs_its_tasks_not_the_run(
+    mixed: list[GroundMotion],
+) -> None:
+    distributed = pytest.importorskip("distributed")
+    cf = load_constants(CONSTANTS)
+    local = run_ida(cf, mixed, LEVELS, jobs=1)
+    killed: list[int] = []
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        nanny = next(iter(cluster.workers.values()))
+
+        def kill_one(done: int, total: int) -> None:
+            if done and not killed:  # after the first task: the others are on the workers
+                killed.append(nanny.process.process.pid)
+                os.kill(killed[0], 9)
+
+        remote = run_ida(
+            cf, mixed, LEVELS, scheduler=cluster.scheduler_address, task_s=1e-9, progress=kill_one
+        )
+    assert killed
+    assert _results(remote) == _results(local)
