@@ -61,6 +61,7 @@ from typing import (
 )
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -74,7 +75,16 @@ from pydantic import (
 from pydantic_core import PydanticCustomError
 
 from shared_schema.errors import InputError
-from shared_schema.rules import G, eta_problem
+from shared_schema.rules import (
+    PRINTABLE_PATTERN,
+    ROTATION_MAX,
+    SCHEMA_VERSION_PATTERN,
+    G,
+    control_character,
+    eta_problem,
+    rotation_problem,
+    schema_version_problem,
+)
 
 __all__ = [
     "CONSISTENCY_RTOL",
@@ -89,6 +99,7 @@ __all__ = [
     "G",
     "JsonInt",
     "Mechanism",
+    "SchemaVersion",
     "Rocking",
     "SideConstants",
     "Typology",
@@ -144,7 +155,8 @@ _LAM_DESCRIPTION = (
     "fraction of g (theory Eq. 5; §1.8 for the negative side) [-], > 0."
 )
 _PHI_OV_DESCRIPTION = (
-    "Overturning rotation (theory Eq. 6; §1.8 for the negative side) [rad], > 0. "
+    "Overturning rotation (theory Eq. 6; §1.8 for the negative side) [rad], in (0, pi/2] "
+    "(a rocking body on its side; degrees are refused). "
     "In the short form it defaults to lam (exact for a single block)."
 )
 
@@ -167,6 +179,25 @@ def whole_number(value: Any) -> Any:
 #: An integer field of a JSON document: an int, or a float without a fractional part (as
 #: JSON Schema's ``integer``); booleans, strings and fractions are still refused.
 JsonInt = Annotated[int, BeforeValidator(whole_number)]
+
+
+def _schema_version(value: str) -> str:
+    problem = schema_version_problem(value)
+    if problem is not None:
+        raise PydanticCustomError("schema_version", "{message}", {"message": problem})
+    return value
+
+
+#: A file's format version, ``1.<minor>`` (``rules.SCHEMA_VERSION_PATTERN``): the schema
+#: states the pattern, a wrong value is told in words, never by quoting the regex (#25).
+SchemaVersion = Annotated[str, AfterValidator(_schema_version)]
+
+
+def schema_version_field(default: str, description: str) -> Any:
+    """Return the ``schema_version`` field of a file model (pattern stated in the schema)."""
+    return Field(
+        default, description=description, json_schema_extra={"pattern": SCHEMA_VERSION_PATTERN}
+    )
 
 
 def _error(field: str, message: str, error_type: str = "rockmech_value") -> PydanticCustomError:
@@ -387,7 +418,9 @@ class SideConstants(BaseModel):
     phi_cr: Optional[float] = Field(
         None,
         gt=0,
-        description="Critical rotation (unstable equilibrium under gravity alone) [rad], > 0.",
+        description="Critical rotation (unstable equilibrium under gravity alone) [rad], in "
+        "(0, pi/2].",
+        json_schema_extra={"maximum": ROTATION_MAX},
     )
     M_F: Optional[float] = Field(
         None,
@@ -401,7 +434,9 @@ class SideConstants(BaseModel):
     )
     p_eq: Optional[float] = Field(None, gt=0, description=_P_EQ_DESCRIPTION)
     lam: Optional[float] = Field(None, gt=0, description=_LAM_DESCRIPTION)
-    phi_ov: Optional[float] = Field(None, gt=0, description=_PHI_OV_DESCRIPTION)
+    phi_ov: Optional[float] = Field(
+        None, gt=0, description=_PHI_OV_DESCRIPTION, json_schema_extra={"maximum": ROTATION_MAX}
+    )
     virtual_work: Optional[VirtualWork] = Field(
         None,
         description=(
@@ -409,6 +444,15 @@ class SideConstants(BaseModel):
             "S, J); optional, in either form."
         ),
     )
+
+    @field_validator("phi_cr", "phi_ov")
+    @classmethod
+    def _check_rotation(cls, value: Optional[float]) -> Optional[float]:
+        # issue #25: degrees written as radians (phi_ov = 5) were taken as 286 deg.
+        problem = None if value is None else rotation_problem(value)
+        if problem is not None:
+            raise PydanticCustomError("rotation_too_large", "{message}", {"message": problem})
+        return value
 
     @model_validator(mode="after")
     def _check_form(self) -> "SideConstants":
@@ -564,7 +608,10 @@ def _mechanism_schema_extra(schema: Dict[str, Any]) -> None:
     props["lam"] = {"type": "number", "exclusiveMinimum": 0, "description": _LAM_DESCRIPTION}
     # As inside a side, null means "not given" (lam is used).
     props["phi_ov"] = {
-        "anyOf": [{"type": "number", "exclusiveMinimum": 0}, {"type": "null"}],
+        "anyOf": [
+            {"type": "number", "exclusiveMinimum": 0, "maximum": ROTATION_MAX},
+            {"type": "null"},
+        ],
         "description": _PHI_OV_DESCRIPTION,
     }
     for key in ("p_eq", "lam", "phi_ov"):
@@ -647,8 +694,16 @@ class Mechanism(BaseModel):
         json_schema_extra=_mechanism_schema_extra,
     )
 
-    id: str = Field(min_length=1, description="Unique identifier of the mechanism in the file.")
-    name: Optional[str] = Field(None, description="Descriptive name; defaults to id.")
+    id: str = Field(
+        min_length=1,
+        description="Unique identifier of the mechanism in the file (printable text).",
+        json_schema_extra={"pattern": PRINTABLE_PATTERN},
+    )
+    name: Optional[str] = Field(
+        None,
+        description="Descriptive name (printable text); defaults to id.",
+        json_schema_extra={"pattern": PRINTABLE_PATTERN},
+    )
     typology: Typology = Field("user_defined", description="Typology of the mechanism.")
     rocking: Rocking = Field(
         "two_sided",
@@ -751,6 +806,22 @@ class Mechanism(BaseModel):
             raise PydanticCustomError("eta_sign", problem)
         return eta
 
+    @field_validator("id", "name")
+    @classmethod
+    def _check_printable(cls, value: Optional[str]) -> Optional[str]:
+        # issue #25: a line break or escape code in an id broke the terminal tables.
+        bad = None if value is None else control_character(value)
+        if bad is not None:
+            raise PydanticCustomError(
+                "control_character",
+                "{message}",
+                {
+                    "message": f"must be printable text, got the control character {bad} in "
+                    f"{value!r}; ids and names go into tables and file names"
+                },
+            )
+        return value
+
     @field_validator("geometry", "provenance")
     @classmethod
     def _check_finite(cls, value: Optional[Dict[str, JsonValue]]) -> Optional[Dict[str, JsonValue]]:
@@ -829,10 +900,8 @@ class ConstantsFile(BaseModel):
         },
     )
 
-    schema_version: str = Field(
-        SCHEMA_VERSION,
-        pattern=r"^1\.[0-9]+$",
-        description="Version of the file format, '1.<minor>'.",
+    schema_version: SchemaVersion = schema_version_field(
+        SCHEMA_VERSION, "Version of the file format, '1.<minor>'."
     )
     units: Units = Field(
         default_factory=Units, description="SI units of the quantities (fixed, informative)."

@@ -15,16 +15,27 @@ mechanisms above ground; the optional ``project`` section fills the report's fir
 The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` forms.
 """
 
-from typing import Annotated, Any, Literal, Mapping, Optional, Union
+from typing import Annotated, Any, Literal, Mapping, Optional, Tuple, Union
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+)
+from pydantic_core import PydanticCustomError
 
 from shared_schema.constants import (
     JsonInt,
+    SchemaVersion,
     input_error_from_validation,
     json_document,
+    schema_version_field,
     whole_number,
 )
+from shared_schema.rules import BEHAVIOUR_FACTOR_RANGE, DAMPING_PERCENT_RANGE, range_problem
 
 __all__ = [
     "SITE_SCHEMA_VERSION",
@@ -38,6 +49,57 @@ __all__ = [
 
 #: Version of the site-file format written by this module.
 SITE_SCHEMA_VERSION = "1.0"
+
+
+def _in_range(bounds: Tuple[float, float], unit: str, why: str) -> Any:
+    """A check that a number lies in ``bounds`` (``rules``), told with the range and ``why``."""
+
+    def check(value: float) -> float:
+        problem = range_problem(value, bounds, unit, why)
+        if problem is not None:
+            raise PydanticCustomError("out_of_range", "{message}", {"message": problem})
+        return value
+
+    return AfterValidator(check)
+
+
+#: The behaviour factor ``q`` [-] in ``rules.BEHAVIOUR_FACTOR_RANGE`` (#25: 0.5 was taken).
+BehaviourFactor = Annotated[
+    float,
+    _in_range(
+        BEHAVIOUR_FACTOR_RANGE,
+        "",
+        "the behaviour factor divides the elastic demand (a_g S / q), so q < 1 would raise "
+        "it above the elastic spectrum; the Circolare takes q = 2",
+    ),
+]
+#: The damping ``xi_percent`` [%] in ``rules.DAMPING_PERCENT_RANGE`` (#25: 0.05 was taken).
+DampingPercent = Annotated[
+    float,
+    _in_range(
+        DAMPING_PERCENT_RANGE,
+        "%",
+        "xi_percent is the viscous damping in percent, not a fraction: write 5 for 5 %",
+    ),
+]
+
+
+def _q_field() -> Any:
+    lo, hi = BEHAVIOUR_FACTOR_RANGE
+    return Field(
+        2.0,
+        description=f"Behaviour factor q [-], in [{lo:g}, {hi:g}]; default 2.",
+        json_schema_extra={"minimum": lo, "maximum": hi},
+    )
+
+
+def _xi_field() -> Any:
+    lo, hi = DAMPING_PERCENT_RANGE
+    return Field(
+        5.0,
+        description=f"Viscous damping [%] (5 means 5 %), in [{lo:g}, {hi:g}]; default 5.",
+        json_schema_extra={"minimum": lo, "maximum": hi},
+    )
 
 
 class Project(BaseModel):
@@ -78,9 +140,9 @@ class NTCHazard(BaseModel):
     FC : float
         Confidence factor of the knowledge level [-], >= 1 (LC1 1.35, LC2 1.2, LC3 1).
     q : float
-        Behaviour factor of the linear kinematic check [-], > 0; default 2.
+        Behaviour factor of the linear kinematic check [-], in [1, 10]; default 2.
     xi_percent : float
-        Viscous damping of the spectrum [%], >= 0; default 5.
+        Viscous damping of the spectrum [%], in [1, 50] (5 means 5 %); default 5.
     """
 
     model_config = ConfigDict(
@@ -100,8 +162,8 @@ class NTCHazard(BaseModel):
         "SLV", description="Limit state of a_g, F0, Tc_star (the checks are the SLV ones)."
     )
     FC: float = Field(ge=1, le=2, description="Confidence factor FC [-] (LC1 1.35 ... LC3 1).")
-    q: float = Field(2.0, gt=0, le=10, description="Behaviour factor q [-], default 2.")
-    xi_percent: float = Field(5.0, ge=0, le=50, description="Viscous damping [%].")
+    q: BehaviourFactor = _q_field()
+    xi_percent: DampingPercent = _xi_field()
 
 
 class EC8Hazard(BaseModel):
@@ -120,9 +182,9 @@ class EC8Hazard(BaseModel):
     FC : float
         Confidence factor [-], >= 1 (EN 1998-3 CF: KL1 1.35, KL2 1.2, KL3 1).
     q : float
-        Behaviour factor of the linear kinematic check [-]; default 2.
+        Behaviour factor of the linear kinematic check [-], in [1, 10]; default 2.
     xi_percent : float
-        Viscous damping [%]; default 5.
+        Viscous damping [%], in [1, 50] (5 means 5 %); default 5.
     """
 
     model_config = ConfigDict(
@@ -140,8 +202,8 @@ class EC8Hazard(BaseModel):
         1, description="Spectrum type 1 or 2."
     )
     FC: float = Field(ge=1, le=2, description="Confidence factor [-] (EN 1998-3 CF).")
-    q: float = Field(2.0, gt=0, le=10, description="Behaviour factor q [-], default 2.")
-    xi_percent: float = Field(5.0, ge=0, le=50, description="Viscous damping [%].")
+    q: BehaviourFactor = _q_field()
+    xi_percent: DampingPercent = _xi_field()
 
 
 class Building(BaseModel):
@@ -190,8 +252,8 @@ class SiteFile(BaseModel):
         },
     )
 
-    schema_version: str = Field(
-        SITE_SCHEMA_VERSION, pattern=r"^1\.[0-9]+$", description="Format version '1.<minor>'."
+    schema_version: SchemaVersion = schema_version_field(
+        SITE_SCHEMA_VERSION, "Format version '1.<minor>'."
     )
     project: Project = Field(default_factory=Project, description="Project fields.")
     hazard: Union[NTCHazard, EC8Hazard] = Field(
