@@ -41,8 +41,8 @@ __all__ = [
     "F_P_RANGE",
     "LAM_RANGE",
     "LENGTH_UNITS",
-    "PULSE_SHAPES",
     "PRINTABLE_PATTERN",
+    "PULSE_SHAPES",
     "P_EQ_RANGE",
     "QUANTITY_RANGES",
     "RECORD_FORMATS",
@@ -67,6 +67,7 @@ __all__ = [
     "coordinate_problem",
     "eta_problem",
     "eta_range",
+    "printable",
     "quantity_note",
     "quantity_problem",
     "range_problem",
@@ -247,8 +248,7 @@ def schema_version_problem(value: str) -> Optional[str]:
     newer = re.match(r"^([0-9]+)\.[0-9]+$", value)
     hint = "; a newer format: update rockmech" if newer and int(newer.group(1)) > 1 else ""
     return (
-        "must look like 1.0 (format 1.<minor>; this rockmech reads 1.x files), "
-        f"got {value!r}{hint}"
+        f"must look like 1.0 (format 1.<minor>; this rockmech reads 1.x files), got {value!r}{hint}"
     )
 
 
@@ -270,6 +270,20 @@ def control_character(text: str) -> Optional[str]:
         if _CONTROL.match(ch):
             return repr(ch)
     return None
+
+
+def printable(text: str) -> str:
+    r"""Return ``text`` with each control character written as its Python escape.
+
+    For names printed on a terminal (tables, progress lines): nothing a file or a file name
+    holds can break a line or send codes to the terminal.
+
+    Examples
+    --------
+    >>> print(printable("W1\n\x1b[31mW2"))
+    W1\n\x1b[31mW2
+    """
+    return _CONTROL.sub(lambda m: repr(m.group())[1:-1], text)
 
 
 def accel_max(units: str) -> float:

@@ -52,7 +52,7 @@ SITE_SCHEMA_VERSION = "1.0"
 
 
 def _in_range(bounds: Tuple[float, float], unit: str, why: str) -> Any:
-    """A check that a number lies in ``bounds`` (``rules``), told with the range and ``why``."""
+    """Return a check that a number lies in ``bounds``, telling the range and ``why``."""
 
     def check(value: float) -> float:
         problem = range_problem(value, bounds, unit, why)

@@ -20,7 +20,7 @@ from shared_schema.api import MAX_ASSESS_MULTIPLES, MULTIPLE_MAX
 from shared_schema.constants import ConstantsFile, Mechanism, SideConstants
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.rules import check_number
-from shared_schema.site import SiteFile, parse_site
+from shared_schema.site import SiteFile
 
 from ..core.exact import simulate
 from ..core.hazard import ElasticSpectrum, ec8_spectrum, ntc_spectrum
@@ -29,6 +29,7 @@ from ..core.pulses import largest_pulse
 from ..core.spectra import response_spectrum
 from .adapter import to_rocking_model
 from .documents import envelope_doc, log_grid
+from .inputs import read_site_file
 from .scaling import mechanism_scale_factor
 
 __all__ = [
@@ -62,10 +63,8 @@ NO_VIRTUAL_WORK = (
 
 
 def read_site(path: Path) -> SiteFile:
-    """Read and validate a site file; a missing file names ``site``."""
-    if not path.is_file():
-        raise InputError(f"file not found: {path}", "site")
-    return parse_site(path.read_bytes())
+    """Read and validate a site file (``inputs.read_site_file``); errors name ``site``."""
+    return read_site_file(path)
 
 
 def site_spectrum(site: SiteFile) -> ElasticSpectrum:
