@@ -84,22 +84,22 @@ DampingPercent = Annotated[
 ]
 
 
-def _q_field() -> Any:
-    lo, hi = BEHAVIOUR_FACTOR_RANGE
+def _ranged_field(default: float, bounds: Tuple[float, float], what: str) -> Any:
+    """Return a field whose schema states ``bounds`` (the check is the type's)."""
+    lo, hi = bounds
     return Field(
-        2.0,
-        description=f"Behaviour factor q [-], in [{lo:g}, {hi:g}]; default 2.",
+        default,
+        description=f"{what}, in [{lo:g}, {hi:g}]; default {default:g}.",
         json_schema_extra={"minimum": lo, "maximum": hi},
     )
+
+
+def _q_field() -> Any:
+    return _ranged_field(2.0, BEHAVIOUR_FACTOR_RANGE, "Behaviour factor q [-]")
 
 
 def _xi_field() -> Any:
-    lo, hi = DAMPING_PERCENT_RANGE
-    return Field(
-        5.0,
-        description=f"Viscous damping [%] (5 means 5 %), in [{lo:g}, {hi:g}]; default 5.",
-        json_schema_extra={"minimum": lo, "maximum": hi},
-    )
+    return _ranged_field(5.0, DAMPING_PERCENT_RANGE, "Viscous damping [%] (5 means 5 %)")
 
 
 class Project(BaseModel):
