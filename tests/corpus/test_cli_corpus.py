@@ -101,7 +101,6 @@ CONSTANTS_FILES: dict[str, Any] = {
 }
 
 
-
 def _site(**hazard: Any) -> str:
     site = json.loads(SITE.read_text())
     site["hazard"].update(hazard)
@@ -952,8 +951,16 @@ def test_report_states_every_skipped_mechanism(tmp_path: Path) -> None:
     """``report --record`` leaves out a mechanism without eta: the page says which and why."""
     case = Case(
         "report-skipped-mechanism",
-        ["report", "{c:skip_one.json}", "--record", "{r:good.dat}", "-o", "{tmp}/r.html"]
-        + ["--n", "20"],
+        [
+            "report",
+            "{c:skip_one.json}",
+            "--record",
+            "{r:good.dat}",
+            "--n",
+            "20",
+            "-o",
+            "{r:r.html}",
+        ],
         "warn",
         "",
         r"warning: F1 skipped: a time history of a one-sided mechanism needs a coefficient of "
