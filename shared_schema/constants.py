@@ -156,7 +156,8 @@ _LAM_DESCRIPTION = (
 )
 _PHI_OV_DESCRIPTION = (
     "Overturning rotation (theory Eq. 6; §1.8 for the negative side) [rad], in (0, pi/2] "
-    "(a rocking body on its side; degrees are refused). "
+    "(a rocking body on its side; degrees are refused), given or defaulted; derived from the "
+    "physical form it is not bounded. "
     "In the short form it defaults to lam (exact for a single block)."
 )
 
@@ -341,6 +342,14 @@ def _not_given(*keys: str) -> Dict[str, Any]:
     return {"properties": {k: {"type": "null"} for k in keys}}
 
 
+#: SideConstants._check_form: in the short form phi_ov, given or defaulted to lam, is at most
+#: pi/2 (the physical form derives it).
+_SHORT_ROTATION: List[Dict[str, Any]] = [
+    {"properties": {"phi_ov": {"type": "number", "maximum": ROTATION_MAX}}, "required": ["phi_ov"]},
+    {"properties": {"phi_ov": {"type": "null"}, "lam": {"maximum": ROTATION_MAX}}},
+]
+
+
 def _side_schema_extra(schema: Dict[str, Any]) -> None:
     schema["description"] = (
         "Constants of one rocking side: either the physical constants I0, K, Q, phi_cr "
@@ -352,7 +361,10 @@ def _side_schema_extra(schema: Dict[str, Any]) -> None:
     # p_eq and lam.
     short = _not_given(*_PHYSICAL_KEYS, "M_F")
     short["properties"].update(_numbers("p_eq", "lam")["properties"])
-    schema["oneOf"] = [_numbers(*_PHYSICAL_KEYS), {**short, "required": ["p_eq", "lam"]}]
+    schema["oneOf"] = [
+        _numbers(*_PHYSICAL_KEYS),
+        {**short, "required": ["p_eq", "lam"], "anyOf": _SHORT_ROTATION},
+    ]
 
 
 class SideConstants(BaseModel):
@@ -434,9 +446,7 @@ class SideConstants(BaseModel):
     )
     p_eq: Optional[float] = Field(None, gt=0, description=_P_EQ_DESCRIPTION)
     lam: Optional[float] = Field(None, gt=0, description=_LAM_DESCRIPTION)
-    phi_ov: Optional[float] = Field(
-        None, gt=0, description=_PHI_OV_DESCRIPTION, json_schema_extra={"maximum": ROTATION_MAX}
-    )
+    phi_ov: Optional[float] = Field(None, gt=0, description=_PHI_OV_DESCRIPTION)
     virtual_work: Optional[VirtualWork] = Field(
         None,
         description=(
@@ -445,10 +455,10 @@ class SideConstants(BaseModel):
         ),
     )
 
-    @field_validator("phi_cr", "phi_ov")
+    @field_validator("phi_cr")
     @classmethod
     def _check_rotation(cls, value: Optional[float]) -> Optional[float]:
-        # issue #25: degrees written as radians (phi_ov = 5) were taken as 286 deg.
+        # issue #25: degrees written as radians (phi_cr = 5) were taken as 286 deg.
         problem = None if value is None else rotation_problem(value)
         if problem is not None:
             raise PydanticCustomError("rotation_too_large", "{message}", {"message": problem})
@@ -479,6 +489,23 @@ class SideConstants(BaseModel):
                     "give either the physical constants I0, K, Q and phi_cr, or p_eq and lam "
                     f"(short form); {key} is missing",
                     "missing_constant",
+                )
+        # issue #25: degrees written as radians (phi_ov = 5) were taken as 286 deg. The
+        # physical form derives phi_ov (Eq. 6, a linearisation that static forces may carry
+        # past pi/2); its phi_cr is checked instead.
+        if self.phi_ov is not None:
+            problem = rotation_problem(self.phi_ov)
+            if problem is not None:
+                raise _error("phi_ov", problem, "rotation_too_large")
+        else:
+            assert self.lam is not None
+            if self.lam > ROTATION_MAX:
+                raise _error(
+                    "lam",
+                    f"phi_ov defaults to lam (exact for a single block, whose lam is its angle "
+                    f"alpha < pi/2), and lam = {self.lam!r} is above pi/2 = {ROTATION_MAX:.5g} "
+                    "rad: give phi_ov [rad] for this side",
+                    "rotation_too_large",
                 )
         return self
 
@@ -609,7 +636,7 @@ def _mechanism_schema_extra(schema: Dict[str, Any]) -> None:
     # As inside a side, null means "not given" (lam is used).
     props["phi_ov"] = {
         "anyOf": [
-            {"type": "number", "exclusiveMinimum": 0, "maximum": ROTATION_MAX},
+            {"type": "number", "exclusiveMinimum": 0},
             {"type": "null"},
         ],
         "description": _PHI_OV_DESCRIPTION,
@@ -640,7 +667,7 @@ def _mechanism_schema_extra(schema: Dict[str, Any]) -> None:
             "required": ["positive"],
             "not": {"anyOf": [{"required": [k]} for k in FLAT_SIDE_KEYS]},
         },
-        {"required": ["p_eq", "lam"], "not": {"required": ["positive"]}},
+        {"required": ["p_eq", "lam"], "not": {"required": ["positive"]}, "anyOf": _SHORT_ROTATION},
     ]
 
 

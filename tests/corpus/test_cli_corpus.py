@@ -87,7 +87,8 @@ CONSTANTS_FILES: dict[str, Any] = {
     "p_bool.json": json.dumps({"mechanisms": [{**_W, "p_eq": True}]}),
     "p_huge.json": json.dumps({"mechanisms": [{**_W, "p_eq": 1e200}]}),
     "lam_zero.json": json.dumps({"mechanisms": [{**_W, "lam": 0.0}]}),
-    "lam_big.json": json.dumps({"mechanisms": [{**_W, "lam": 5.0}]}),
+    # phi_ov given: without it phi_ov = lam = 5 rad is refused (#25, "lam_above_pi_2.json")
+    "lam_big.json": json.dumps({"mechanisms": [{**_W, "lam": 5.0, "phi_ov": 1.0}]}),
     "nan_text.json": '{"mechanisms": [{"id": "W", "rocking": "two_sided", "p_eq": NaN, '
     '"lam": 0.2, "eta": 0.9}]}',
     "dup_id.json": json.dumps({"mechanisms": [_W, _W]}),
@@ -117,6 +118,7 @@ RANGE_FILES: dict[str, Any] = {
     "site_version_regex.json": json.dumps({**json.loads(SITE.read_text()), "schema_version": "v1"}),
     "phi_ov_degrees.json": json.dumps({"mechanisms": [{**_W, "phi_ov": 5.0}]}),
     "phi_ov_half_pi.json": json.dumps({"mechanisms": [{**_W, "phi_ov": 1.5707963267948966}]}),
+    "lam_above_pi_2.json": json.dumps({"mechanisms": [{**_W, "lam": 5.0}]}),
     "p_1e300.json": json.dumps({"mechanisms": [{**_W, "p_eq": 1e300}]}),
     "id_newline.json": json.dumps({"mechanisms": [{**_W, "id": "W\nfake row  1  yes"}]}),
     "id_escape.json": json.dumps({"mechanisms": [{**_W, "id": "W\u001b[31m"}]}),
@@ -187,6 +189,13 @@ def _range_cases() -> list[Case]:
             "error",
             r"positive\.phi_ov",
             r"at most pi/2 = 1\.5708 rad .* got 5 rad = 286\.5 deg; the value is in radians",
+        ),
+        Case(
+            "history-lam-above-pi-2-without-phi-ov",
+            ["history", "{c:lam_above_pi_2.json}", "{r:good.dat}"],
+            "error",
+            r"positive\.lam",
+            r"phi_ov defaults to lam .* lam = 5\.0 is above pi/2 = 1\.5708 rad: give phi_ov",
         ),
         Case(
             "envelope-phi-ov-pi-over-2-is-the-bound",
