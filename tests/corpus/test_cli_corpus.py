@@ -342,7 +342,7 @@ def _range_cases() -> list[Case]:
         # a user's template: a syntax error is one line naming the file and the line
         Case(
             "assess-template-syntax-error",
-            ["assess", church, site, *assess_out, "--template-dir", "{tmp}/tpl"],
+            ["assess", "{c:ok.json}", site, *assess_out, "--template-dir", "{tmp}/tpl"],
             "error",
             "template_dir",
             r"tpl/assess\.html\.j2, line 3: unexpected '}'$",
@@ -350,7 +350,7 @@ def _range_cases() -> list[Case]:
         ),
         Case(
             "assess-template-undefined-name",
-            ["assess", church, site, *assess_out, "--template-dir", "{tmp}/tpl"],
+            ["assess", "{c:ok.json}", site, *assess_out, "--template-dir", "{tmp}/tpl"],
             "error",
             "template_dir",
             r"tpl/assess\.html\.j2, line 2: 'nosuch' is undefined$",
