@@ -8,7 +8,8 @@ A :class:`Case` is one ``rockmech`` command line and the answer it must get:
 - ``warn``: exit status 0 and a warning on stderr matching the pattern;
 - ``partial``: exit status 1 (``--keep-going``: some mechanisms failed, named on stderr).
 
-Any traceback, any other exit status, or a case over ``CASE_SECONDS`` fails.
+Any traceback or any other exit status fails; a case that may hang runs in a child process
+killed after ``HANG_SECONDS`` (a hang check, not a speed limit).
 """
 
 from __future__ import annotations
@@ -18,7 +19,6 @@ import json
 import re
 import subprocess
 import sys
-import time
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -29,8 +29,8 @@ from typer.testing import CliRunner
 
 from solver_service.cli import app
 
-#: Longest a case may take [s].
-CASE_SECONDS = 10.0
+#: A case that may hang is taken to hang after this long [s] (far above any real answer).
+HANG_SECONDS = 300.0
 
 runner = CliRunner()
 
@@ -46,7 +46,7 @@ class Case:
     problem: str = ""  # regex on stderr (error, warn, partial)
     check: Optional[Callable[[Any], bool]] = None
     xfail: str = ""
-    #: Run in a child process killed after ``CASE_SECONDS`` (cases that may hang).
+    #: Run in a child process killed after ``HANG_SECONDS`` (cases that may hang).
     isolate: bool = False
     #: Files the case writes into its folder before running: name -> text or bytes.
     files: dict[str, Any] = dataclasses.field(default_factory=dict)
@@ -63,25 +63,24 @@ def params(cases: list[Case]) -> list[Any]:
 
 
 def _run_isolated(argv: list[str]) -> tuple[int, str, str]:
-    """Run ``rockmech`` in a child process, killed after ``CASE_SECONDS``."""
+    """Run ``rockmech`` in a child process, killed after ``HANG_SECONDS``."""
     code = "import sys; from solver_service.cli import app; app(sys.argv[1:])"
     try:
         proc = subprocess.run(
             [sys.executable, "-c", code, *argv],
             capture_output=True,
             text=True,
-            timeout=CASE_SECONDS,
+            timeout=HANG_SECONDS,
             check=False,
         )
     except subprocess.TimeoutExpired:
-        pytest.fail(f"no answer within {CASE_SECONDS:g} s (a hang)")
+        pytest.fail(f"no answer within {HANG_SECONDS:g} s (a hang)")
     assert "Traceback" not in proc.stderr, proc.stderr
     return proc.returncode, proc.stdout, proc.stderr
 
 
 def run_case(case: Case, argv: list[str]) -> tuple[str, str]:
     """Run ``rockmech ARGV`` and assert the case's answer; return (stdout, stderr)."""
-    t0 = time.perf_counter()
     if case.isolate:
         exit_code, stdout, stderr = _run_isolated(argv)
     else:
@@ -96,8 +95,6 @@ def run_case(case: Case, argv: list[str]) -> tuple[str, str]:
         if res.exception is not None and not isinstance(res.exception, SystemExit):
             raise AssertionError(f"traceback: {res.exception!r}\n{res.output}") from res.exception
         exit_code, stdout, stderr = res.exit_code, res.stdout, res.stderr
-    elapsed = time.perf_counter() - t0
-    assert elapsed < CASE_SECONDS, f"took {elapsed:.1f} s"
     assert "Traceback" not in stderr, stderr
     if case.expect == "error":
         assert exit_code == 2, f"exit {exit_code}\n{stdout}\n{stderr}"

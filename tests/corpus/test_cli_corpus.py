@@ -4,9 +4,10 @@ Every case runs the real ``rockmech`` command in-process through the corpus's sh
 (``corpus_case.run_case``): ``error`` is exit status 2 and one line
 ``error: <field>: <what is wrong>`` on stderr, click's usage errors included; ``ok`` exit 0
 (and, where given, a check of the JSON answer); ``warn`` exit 0 and a warning on stderr. Any
-traceback, a RuntimeWarning reaching the user, any other exit status, or a case over
-``CASE_SECONDS`` fails. Cases the current code still answers wrongly are ``xfail(strict=True)``
-with the issue class, so that each flips to a failure of the marker once fixed.
+traceback, a RuntimeWarning reaching the user, or any other exit status fails (cases that may
+hang run in a child process with a hang timeout). Cases the current code still answers wrongly
+are ``xfail(strict=True)`` with the issue class, so that each flips to a failure of the marker
+once fixed.
 """
 
 from __future__ import annotations

@@ -2,8 +2,8 @@
 
 Every case sends one bad request to pulse, envelope, history, spectrum, scale-factor or report
 and asserts the exact status and that the answer (``detail``, or ``field``) names the field and
-the problem. Any 5xx, or an answer slower than ``CASE_SECONDS``, fails. Cases the service still
-answers wrongly are strict-xfail with their #14 class.
+the problem. Any 5xx fails, and so does no answer within ``HANG_SECONDS`` (a hang check). Cases
+the service still answers wrongly are strict-xfail with their #14 class.
 """
 
 from __future__ import annotations
@@ -11,7 +11,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import re
-import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
@@ -33,8 +32,8 @@ CHURCH_GEOMETRY: dict[str, Any] = json.loads(
     (REPO / "examples" / "constants" / "church_geometry.json").read_text()
 )
 SITE: dict[str, Any] = json.loads((REPO / "examples" / "sites" / "ntc_site.json").read_text())
-#: Longest a case may take [s].
-CASE_SECONDS = 10.0
+#: A request with no answer after this long is taken to hang [s] (far above any real answer).
+HANG_SECONDS = 300.0
 
 _T = np.arange(400) * 0.01
 RECORD: dict[str, Any] = {
@@ -748,7 +747,7 @@ def _send(client: httpx.Client, case: Rest) -> httpx.Response:
         content = case.content
     else:
         content = json.dumps(_apply(BODIES[case.endpoint], case.change)).encode()
-    return client.post(url, content=content, headers=headers, timeout=CASE_SECONDS + 5)
+    return client.post(url, content=content, headers=headers, timeout=HANG_SECONDS)
 
 
 @pytest.mark.parametrize(
@@ -761,11 +760,8 @@ def _send(client: httpx.Client, case: Rest) -> httpx.Response:
     ],
 )
 def test_rest_case(case: Rest, client: httpx.Client) -> None:
-    t0 = time.perf_counter()
     res = _send(client, case)
-    elapsed = time.perf_counter() - t0
     assert res.status_code < 500, f"{res.status_code}: {res.text[:500]}"
-    assert elapsed < CASE_SECONDS, f"took {elapsed:.1f} s"
     assert res.status_code == case.status, f"{res.status_code}: {res.text[:500]}"
     if case.status == 200:
         return

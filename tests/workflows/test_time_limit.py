@@ -23,8 +23,10 @@ def _spin(seconds: float) -> None:
 def test_a_block_past_its_limit_is_stopped_near_the_limit() -> None:
     start = time.monotonic()
     with pytest.raises(TimeLimitExceeded) as exc, time_limit(0.2):
-        _spin(5.0)
-    assert 0.2 <= time.monotonic() - start < 1.0
+        _spin(120.0)
+    # Stopped by the limit, not by the end of the block (no speed limit: a loaded machine
+    # may be slow to deliver the signal).
+    assert 0.2 <= time.monotonic() - start < 60.0
     assert str(exc.value) == (
         "time-limit: the run did not finish within its time limit of 0.2 s; give "
         "--time-limit with more seconds, or --no-limits to lift it"
@@ -69,8 +71,8 @@ def test_the_limit_waits_for_the_jit_compiler_to_return() -> None:
     start = time.monotonic()
     with pytest.raises(TimeLimitExceeded), time_limit(0.1):
         scope["compile_kernel"]()
-        _spin(5.0)
-    assert 0.4 <= time.monotonic() - start < 1.2
+        _spin(120.0)
+    assert 0.4 <= time.monotonic() - start < 60.0
 
 
 def test_an_exception_wrapping_the_limit_is_reported_as_the_limit() -> None:
