@@ -61,6 +61,7 @@ from typing import (
 )
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -74,7 +75,16 @@ from pydantic import (
 from pydantic_core import PydanticCustomError
 
 from shared_schema.errors import InputError
-from shared_schema.rules import G, eta_problem
+from shared_schema.rules import (
+    PRINTABLE_PATTERN,
+    ROTATION_MAX,
+    SCHEMA_VERSION_PATTERN,
+    G,
+    control_character,
+    eta_problem,
+    rotation_problem,
+    schema_version_problem,
+)
 
 __all__ = [
     "CONSISTENCY_RTOL",
@@ -90,6 +100,7 @@ __all__ = [
     "JsonInt",
     "Mechanism",
     "Rocking",
+    "SchemaVersion",
     "SideConstants",
     "Typology",
     "Units",
@@ -144,7 +155,9 @@ _LAM_DESCRIPTION = (
     "fraction of g (theory Eq. 5; §1.8 for the negative side) [-], > 0."
 )
 _PHI_OV_DESCRIPTION = (
-    "Overturning rotation (theory Eq. 6; §1.8 for the negative side) [rad], > 0. "
+    "Overturning rotation (theory Eq. 6; §1.8 for the negative side) [rad], in (0, pi/2] "
+    "(a rocking body on its side; degrees are refused), given or defaulted; derived from the "
+    "physical form it is not bounded. "
     "In the short form it defaults to lam (exact for a single block)."
 )
 
@@ -167,6 +180,25 @@ def whole_number(value: Any) -> Any:
 #: An integer field of a JSON document: an int, or a float without a fractional part (as
 #: JSON Schema's ``integer``); booleans, strings and fractions are still refused.
 JsonInt = Annotated[int, BeforeValidator(whole_number)]
+
+
+def _schema_version(value: str) -> str:
+    problem = schema_version_problem(value)
+    if problem is not None:
+        raise PydanticCustomError("schema_version", "{message}", {"message": problem})
+    return value
+
+
+#: A file's format version, ``1.<minor>`` (``rules.SCHEMA_VERSION_PATTERN``): the schema
+#: states the pattern, a wrong value is told in words, never by quoting the regex (#25).
+SchemaVersion = Annotated[str, AfterValidator(_schema_version)]
+
+
+def schema_version_field(default: str, description: str) -> Any:
+    """Return the ``schema_version`` field of a file model (pattern stated in the schema)."""
+    return Field(
+        default, description=description, json_schema_extra={"pattern": SCHEMA_VERSION_PATTERN}
+    )
 
 
 def _error(field: str, message: str, error_type: str = "rockmech_value") -> PydanticCustomError:
@@ -310,6 +342,14 @@ def _not_given(*keys: str) -> Dict[str, Any]:
     return {"properties": {k: {"type": "null"} for k in keys}}
 
 
+#: SideConstants._check_form: in the short form phi_ov, given or defaulted to lam, is at most
+#: pi/2 (the physical form derives it).
+_SHORT_ROTATION: List[Dict[str, Any]] = [
+    {"properties": {"phi_ov": {"type": "number", "maximum": ROTATION_MAX}}, "required": ["phi_ov"]},
+    {"properties": {"phi_ov": {"type": "null"}, "lam": {"maximum": ROTATION_MAX}}},
+]
+
+
 def _side_schema_extra(schema: Dict[str, Any]) -> None:
     schema["description"] = (
         "Constants of one rocking side: either the physical constants I0, K, Q, phi_cr "
@@ -321,7 +361,10 @@ def _side_schema_extra(schema: Dict[str, Any]) -> None:
     # p_eq and lam.
     short = _not_given(*_PHYSICAL_KEYS, "M_F")
     short["properties"].update(_numbers("p_eq", "lam")["properties"])
-    schema["oneOf"] = [_numbers(*_PHYSICAL_KEYS), {**short, "required": ["p_eq", "lam"]}]
+    schema["oneOf"] = [
+        _numbers(*_PHYSICAL_KEYS),
+        {**short, "required": ["p_eq", "lam"], "anyOf": _SHORT_ROTATION},
+    ]
 
 
 class SideConstants(BaseModel):
@@ -387,7 +430,9 @@ class SideConstants(BaseModel):
     phi_cr: Optional[float] = Field(
         None,
         gt=0,
-        description="Critical rotation (unstable equilibrium under gravity alone) [rad], > 0.",
+        description="Critical rotation (unstable equilibrium under gravity alone) [rad], in "
+        "(0, pi/2].",
+        json_schema_extra={"maximum": ROTATION_MAX},
     )
     M_F: Optional[float] = Field(
         None,
@@ -409,6 +454,15 @@ class SideConstants(BaseModel):
             "S, J); optional, in either form."
         ),
     )
+
+    @field_validator("phi_cr")
+    @classmethod
+    def _check_rotation(cls, value: Optional[float]) -> Optional[float]:
+        # issue #25: degrees written as radians (phi_cr = 5) were taken as 286 deg.
+        problem = None if value is None else rotation_problem(value)
+        if problem is not None:
+            raise PydanticCustomError("rotation_too_large", "{message}", {"message": problem})
+        return value
 
     @model_validator(mode="after")
     def _check_form(self) -> "SideConstants":
@@ -435,6 +489,23 @@ class SideConstants(BaseModel):
                     "give either the physical constants I0, K, Q and phi_cr, or p_eq and lam "
                     f"(short form); {key} is missing",
                     "missing_constant",
+                )
+        # issue #25: degrees written as radians (phi_ov = 5) were taken as 286 deg. The
+        # physical form derives phi_ov (Eq. 6, a linearisation that static forces may carry
+        # past pi/2); its phi_cr is checked instead.
+        if self.phi_ov is not None:
+            problem = rotation_problem(self.phi_ov)
+            if problem is not None:
+                raise _error("phi_ov", problem, "rotation_too_large")
+        else:
+            assert self.lam is not None
+            if self.lam > ROTATION_MAX:
+                raise _error(
+                    "lam",
+                    f"phi_ov defaults to lam (exact for a single block, whose lam is its angle "
+                    f"alpha < pi/2), and lam = {self.lam!r} is above pi/2 = {ROTATION_MAX:.5g} "
+                    "rad: give phi_ov [rad] for this side",
+                    "rotation_too_large",
                 )
         return self
 
@@ -564,7 +635,10 @@ def _mechanism_schema_extra(schema: Dict[str, Any]) -> None:
     props["lam"] = {"type": "number", "exclusiveMinimum": 0, "description": _LAM_DESCRIPTION}
     # As inside a side, null means "not given" (lam is used).
     props["phi_ov"] = {
-        "anyOf": [{"type": "number", "exclusiveMinimum": 0}, {"type": "null"}],
+        "anyOf": [
+            {"type": "number", "exclusiveMinimum": 0},
+            {"type": "null"},
+        ],
         "description": _PHI_OV_DESCRIPTION,
     }
     for key in ("p_eq", "lam", "phi_ov"):
@@ -593,7 +667,7 @@ def _mechanism_schema_extra(schema: Dict[str, Any]) -> None:
             "required": ["positive"],
             "not": {"anyOf": [{"required": [k]} for k in FLAT_SIDE_KEYS]},
         },
-        {"required": ["p_eq", "lam"], "not": {"required": ["positive"]}},
+        {"required": ["p_eq", "lam"], "not": {"required": ["positive"]}, "anyOf": _SHORT_ROTATION},
     ]
 
 
@@ -647,8 +721,16 @@ class Mechanism(BaseModel):
         json_schema_extra=_mechanism_schema_extra,
     )
 
-    id: str = Field(min_length=1, description="Unique identifier of the mechanism in the file.")
-    name: Optional[str] = Field(None, description="Descriptive name; defaults to id.")
+    id: str = Field(
+        min_length=1,
+        description="Unique identifier of the mechanism in the file (printable text).",
+        json_schema_extra={"pattern": PRINTABLE_PATTERN},
+    )
+    name: Optional[str] = Field(
+        None,
+        description="Descriptive name (printable text); defaults to id.",
+        json_schema_extra={"pattern": PRINTABLE_PATTERN},
+    )
     typology: Typology = Field("user_defined", description="Typology of the mechanism.")
     rocking: Rocking = Field(
         "two_sided",
@@ -751,6 +833,22 @@ class Mechanism(BaseModel):
             raise PydanticCustomError("eta_sign", problem)
         return eta
 
+    @field_validator("id", "name")
+    @classmethod
+    def _check_printable(cls, value: Optional[str]) -> Optional[str]:
+        # issue #25: a line break or escape code in an id broke the terminal tables.
+        bad = None if value is None else control_character(value)
+        if bad is not None:
+            raise PydanticCustomError(
+                "control_character",
+                "{message}",
+                {
+                    "message": f"must be printable text, got the control character {bad} in "
+                    f"{value!r}; ids and names go into tables and file names"
+                },
+            )
+        return value
+
     @field_validator("geometry", "provenance")
     @classmethod
     def _check_finite(cls, value: Optional[Dict[str, JsonValue]]) -> Optional[Dict[str, JsonValue]]:
@@ -829,10 +927,8 @@ class ConstantsFile(BaseModel):
         },
     )
 
-    schema_version: str = Field(
-        SCHEMA_VERSION,
-        pattern=r"^1\.[0-9]+$",
-        description="Version of the file format, '1.<minor>'.",
+    schema_version: SchemaVersion = schema_version_field(
+        SCHEMA_VERSION, "Version of the file format, '1.<minor>'."
     )
     units: Units = Field(
         default_factory=Units, description="SI units of the quantities (fixed, informative)."

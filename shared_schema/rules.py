@@ -20,6 +20,7 @@ What lives here
 import math
 import numbers
 import os
+import re
 from pathlib import Path
 from typing import Dict, NamedTuple, Optional, Sequence, Tuple, Union
 
@@ -29,21 +30,26 @@ __all__ = [
     "ACCEL_MAX_G",
     "ACCEL_MIN",
     "A_P_G_MAX",
+    "BEHAVIOUR_FACTOR_RANGE",
     "BODY_SIZE_PLAUSIBLE",
     "BUILDING_HEIGHT_MAX_M",
     "COORDINATE_LIMIT",
     "CRITERIA",
+    "DAMPING_PERCENT_RANGE",
     "DT_RANGE_S",
     "F_N_RANGE",
     "F_P_RANGE",
     "LAM_RANGE",
     "LENGTH_UNITS",
+    "PRINTABLE_PATTERN",
     "PULSE_SHAPES",
     "P_EQ_RANGE",
     "QUANTITY_RANGES",
     "RECORD_FORMATS",
     "RECORD_UNITS",
     "ROCKING_KINDS",
+    "ROTATION_MAX",
+    "SCHEMA_VERSION_PATTERN",
     "SF_METHODS",
     "TYPOLOGIES",
     "G",
@@ -57,11 +63,16 @@ __all__ = [
     "check_number",
     "check_positive",
     "check_quantity",
+    "control_character",
     "coordinate_problem",
     "eta_problem",
     "eta_range",
+    "printable",
     "quantity_note",
     "quantity_problem",
+    "range_problem",
+    "rotation_problem",
+    "schema_version_problem",
 ]
 
 #: Standard gravity [m/s²].
@@ -146,6 +157,133 @@ DT_RANGE_S: Tuple[float, float] = (1e-6, 1.0)
 #: Largest acceleration [g] a record may hold: 200 times the strongest ground motion
 #: recorded (about 5 g); beyond it the numbers are wrong units, not an earthquake.
 ACCEL_MAX_G = 1e3
+
+# Ranges of the site file's check parameters (``shared_schema.site``; the REST service's
+# ``/check`` and ``/assess`` take the same model, so both front ends share them; issue #25).
+
+#: Behaviour factor ``q`` [-] of the code's linear kinematic check (docs/theory.md §11.2,
+#: demand ``a_g S / q``; the Circolare takes q = 2). Below 1 the demand would exceed the
+#: elastic spectrum (q = 0.5 quadruples the demand of q = 2), which no code allows; 10 is
+#: far above any behaviour factor of masonry.
+BEHAVIOUR_FACTOR_RANGE: Tuple[float, float] = (1.0, 10.0)
+#: Viscous damping ``xi_percent`` [%] of the site's elastic spectrum (docs/theory.md §11.4,
+#: ``eta = sqrt(10/(5 + xi))``), in percent: 5 means 5 %. No masonry building damps less
+#: than 1 % (cracked masonry: 3-10 %), and every damping written as a fraction (0.05 for
+#: 5 %) falls below 1, where it would read as 0.05 % (eta = 1.41, a demand 41 % too high):
+#: refused, not warned. Above 50 % the codes' correction has long reached its floor 0.55.
+DAMPING_PERCENT_RANGE: Tuple[float, float] = (1.0, 50.0)
+#: Largest rotation [rad] of a rocking body: a block rotated by pi/2 lies on its side, so
+#: an overturning or critical rotation (``phi_ov``, ``phi_cr``) above it is no rocking
+#: angle; degrees written as radians (a wall's 5-30 deg) all fall above it.
+ROTATION_MAX = math.pi / 2
+#: Text without control characters (``control_character``), as a JSON Schema pattern.
+PRINTABLE_PATTERN = "^[^\\u0000-\\u001f\\u007f-\\u009f\\u2028\\u2029]*$"
+# The same characters, for Python.
+_CONTROL = re.compile("[\u0000-\u001f\u007f-\u009f\u2028\u2029]")
+#: Format versions of the constants and site files this version reads: ``1.<minor>``.
+SCHEMA_VERSION_PATTERN = r"^1\.[0-9]+$"
+
+
+def range_problem(
+    value: float, bounds: Tuple[float, float], unit: str = "", why: str = ""
+) -> Optional[str]:
+    """Return why a finite ``value`` is outside the closed range ``bounds``, or None.
+
+    Parameters
+    ----------
+    value : float
+        The value, finite.
+    bounds : (float, float)
+        Lowest and highest admissible value.
+    unit : str
+        Unit for the message (``"%"``); none for a pure number.
+    why : str
+        What the range means, appended to the message.
+
+    Examples
+    --------
+    >>> range_problem(0.5, BEHAVIOUR_FACTOR_RANGE)
+    'must be in [1, 10], got 0.5'
+    >>> range_problem(2.0, BEHAVIOUR_FACTOR_RANGE) is None
+    True
+    """
+    lo, hi = bounds
+    if lo <= value <= hi:
+        return None
+    u = f" {unit}" if unit else ""
+    return f"must be in [{lo:g}, {hi:g}]{u}, got {value!r}" + (f": {why}" if why else "")
+
+
+def rotation_problem(value: float) -> Optional[str]:
+    """Return why a rotation [rad] is above ``ROTATION_MAX``, naming the unit, or None.
+
+    Examples
+    --------
+    >>> rotation_problem(5.0)[-54:]
+    'the value is in radians: if it is 5 deg, write 0.08727'
+    >>> rotation_problem(0.2) is None
+    True
+    """
+    if value <= ROTATION_MAX:
+        return None
+    return (
+        f"must be at most pi/2 = {ROTATION_MAX:.5g} rad (a rocking body on its side), got "
+        f"{value:g} rad = {math.degrees(value):.4g} deg; the value is in radians: if it is "
+        f"{value:g} deg, write {math.radians(value):.4g}"
+    )
+
+
+def schema_version_problem(value: str) -> Optional[str]:
+    """Return why a file's ``schema_version`` is not one this version reads, or None.
+
+    Examples
+    --------
+    >>> schema_version_problem("v1")
+    "must look like 1.0 (format 1.<minor>; this rockmech reads 1.x files), got 'v1'"
+    >>> schema_version_problem("1.3") is None
+    True
+    """
+    if re.match(SCHEMA_VERSION_PATTERN, value):
+        return None
+    newer = re.match(r"^([0-9]+)\.[0-9]+$", value)
+    hint = "; a newer format: update rockmech" if newer and int(newer.group(1)) > 1 else ""
+    return (
+        f"must look like 1.0 (format 1.<minor>; this rockmech reads 1.x files), got {value!r}{hint}"
+    )
+
+
+def control_character(text: str) -> Optional[str]:
+    r"""Return the first control character of ``text`` as Python writes it, or None.
+
+    Line breaks, tabs, escape sequences and the other control characters (C0, DEL, C1 and
+    the Unicode line and paragraph separators) in a name would break a terminal table or
+    send codes to the terminal; names must be printable (``PRINTABLE_PATTERN``).
+
+    Examples
+    --------
+    >>> control_character("W1\nW2")
+    "'\\n'"
+    >>> control_character("façade W1") is None
+    True
+    """
+    for ch in text:
+        if _CONTROL.match(ch):
+            return repr(ch)
+    return None
+
+
+def printable(text: str) -> str:
+    r"""Return ``text`` with each control character written as its Python escape.
+
+    For names printed on a terminal (tables, progress lines): nothing a file or a file name
+    holds can break a line or send codes to the terminal.
+
+    Examples
+    --------
+    >>> print(printable("W1\n\x1b[31mW2"))
+    W1\n\x1b[31mW2
+    """
+    return _CONTROL.sub(lambda m: repr(m.group())[1:-1], text)
 
 
 def accel_max(units: str) -> float:

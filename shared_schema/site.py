@@ -19,17 +19,28 @@ report's first page.
 The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` forms.
 """
 
-from typing import Annotated, Any, Dict, Literal, Mapping, Optional, Union
+from typing import Annotated, Any, Dict, Literal, Mapping, Optional, Tuple, Union
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    model_validator,
+)
 from pydantic_core import PydanticCustomError
 
 from shared_schema.constants import (
     JsonInt,
+    SchemaVersion,
     input_error_from_validation,
     json_document,
+    schema_version_field,
     whole_number,
 )
+from shared_schema.rules import BEHAVIOUR_FACTOR_RANGE, DAMPING_PERCENT_RANGE, range_problem
 
 __all__ = [
     "LIMIT_STATES",
@@ -102,6 +113,57 @@ class EC8LimitState(BaseModel):
 SITE_SCHEMA_VERSION = "1.0"
 
 
+def _in_range(bounds: Tuple[float, float], unit: str, why: str) -> Any:
+    """Return a check that a number lies in ``bounds``, telling the range and ``why``."""
+
+    def check(value: float) -> float:
+        problem = range_problem(value, bounds, unit, why)
+        if problem is not None:
+            raise PydanticCustomError("out_of_range", "{message}", {"message": problem})
+        return value
+
+    return AfterValidator(check)
+
+
+#: The behaviour factor ``q`` [-] in ``rules.BEHAVIOUR_FACTOR_RANGE`` (#25: 0.5 was taken).
+BehaviourFactor = Annotated[
+    float,
+    _in_range(
+        BEHAVIOUR_FACTOR_RANGE,
+        "",
+        "the behaviour factor divides the elastic demand (a_g S / q), so q < 1 would raise "
+        "it above the elastic spectrum; the Circolare takes q = 2",
+    ),
+]
+#: The damping ``xi_percent`` [%] in ``rules.DAMPING_PERCENT_RANGE`` (#25: 0.05 was taken).
+DampingPercent = Annotated[
+    float,
+    _in_range(
+        DAMPING_PERCENT_RANGE,
+        "%",
+        "xi_percent is the viscous damping in percent, not a fraction: write 5 for 5 %",
+    ),
+]
+
+
+def _ranged_field(default: float, bounds: Tuple[float, float], what: str) -> Any:
+    """Return a field whose schema states ``bounds`` (the check is the type's)."""
+    lo, hi = bounds
+    return Field(
+        default,
+        description=f"{what}, in [{lo:g}, {hi:g}]; default {default:g}.",
+        json_schema_extra={"minimum": lo, "maximum": hi},
+    )
+
+
+def _q_field() -> Any:
+    return _ranged_field(2.0, BEHAVIOUR_FACTOR_RANGE, "Behaviour factor q [-]")
+
+
+def _xi_field(default: float = 5.0, what: str = "Viscous damping [%] (5 means 5 %)") -> Any:
+    return _ranged_field(default, DAMPING_PERCENT_RANGE, what)
+
+
 class Project(BaseModel):
     """Who and what the assessment is for (all optional, shown on the report's first page)."""
 
@@ -140,10 +202,11 @@ class NTCHazard(BaseModel):
     FC : float
         Confidence factor of the knowledge level [-], >= 1 (LC1 1.35, LC2 1.2, LC3 1).
     q : float
-        Behaviour factor of the linear kinematic check [-], > 0; default 2.
+        Behaviour factor of the linear kinematic check [-], in [1, 10]; default 2.
     xi_percent : float
-        Viscous damping of the spectrum [%], >= 0; default 5 (the plotted spectrum and the
-        records' matching; the checks use the dampings of ``LocalMechanisms``).
+        Viscous damping of the spectrum [%], in [1, 50] (5 means 5 %); default 5 (the
+        plotted spectrum and the records' matching; the checks use the dampings of
+        ``LocalMechanisms``).
     limit_states : dict, optional
         ``a_g``, ``F0``, ``T_C*`` of other limit states, keyed SLO, SLD, SLV, SLC.
     """
@@ -165,8 +228,8 @@ class NTCHazard(BaseModel):
         "SLV", description="Limit state of a_g, F0, Tc_star (the checks are the SLV ones)."
     )
     FC: float = Field(ge=1, le=2, description="Confidence factor FC [-] (LC1 1.35 ... LC3 1).")
-    q: float = Field(2.0, gt=0, le=10, description="Behaviour factor q [-], default 2.")
-    xi_percent: float = Field(5.0, ge=0, le=50, description="Viscous damping [%].")
+    q: BehaviourFactor = _q_field()
+    xi_percent: DampingPercent = _xi_field()
     limit_states: Optional[Dict[LimitState, NTCLimitState]] = Field(
         None,
         description=(
@@ -197,9 +260,9 @@ class EC8Hazard(BaseModel):
     FC : float
         Confidence factor [-], >= 1 (EN 1998-3 CF: KL1 1.35, KL2 1.2, KL3 1).
     q : float
-        Behaviour factor of the linear kinematic check [-]; default 2.
+        Behaviour factor of the linear kinematic check [-], in [1, 10]; default 2.
     xi_percent : float
-        Viscous damping [%]; default 5.
+        Viscous damping [%], in [1, 50] (5 means 5 %); default 5.
     limit_states : dict, optional
         ``a_gR`` of other limit states, keyed SLO, SLD, SLC (``a_gR`` is the SLV's).
     """
@@ -219,8 +282,8 @@ class EC8Hazard(BaseModel):
         1, description="Spectrum type 1 or 2."
     )
     FC: float = Field(ge=1, le=2, description="Confidence factor [-] (EN 1998-3 CF).")
-    q: float = Field(2.0, gt=0, le=10, description="Behaviour factor q [-], default 2.")
-    xi_percent: float = Field(5.0, ge=0, le=50, description="Viscous damping [%].")
+    q: BehaviourFactor = _q_field()
+    xi_percent: DampingPercent = _xi_field()
     limit_states: Optional[Dict[LimitState, EC8LimitState]] = Field(
         None,
         description=(
@@ -271,11 +334,8 @@ class Building(BaseModel):
         le=10,
         description="First period [s]; default 0.050 height^0.75 (Circolare 2019 [C7.3.2]).",
     )
-    xi_percent: float = Field(
-        5.0,
-        gt=0,
-        le=30,
-        description="Damping xi_k of the building in the floor spectrum [%] (Circ. 2019 C7.2.3).",
+    xi_percent: DampingPercent = _xi_field(
+        5.0, "Damping xi_k of the building in the floor spectrum [%] (Circ. 2019 C7.2.3)"
     )
     period_elongation: float = Field(
         1.0,
@@ -393,11 +453,11 @@ class LocalMechanisms(BaseModel):
         "circ2019",
         description="circ2019 (Circolare 2019 §C8.7.1) or circ2009 (the 2009 C8A.4 forms).",
     )
-    xi_SLV_percent: float = Field(
-        8.0, gt=0, le=30, description="Damping of the mechanism at SLV [%] (C8.7.1.2.1.8: 8)."
+    xi_SLV_percent: DampingPercent = _xi_field(
+        8.0, "Damping of the mechanism at SLV [%] (C8.7.1.2.1.8: 8)"
     )
-    xi_SLC_percent: float = Field(
-        10.0, gt=0, le=30, description="Damping of the mechanism at SLC [%] (C8.7.1.2.1.8: 10)."
+    xi_SLC_percent: DampingPercent = _xi_field(
+        10.0, "Damping of the mechanism at SLC [%] (C8.7.1.2.1.8: 10)"
     )
     E: Optional[float] = Field(
         None, gt=0, le=1e12, description="Elastic modulus of the masonry [Pa] (Tab. C8.5.I)."
@@ -429,8 +489,8 @@ class SiteFile(BaseModel):
         },
     )
 
-    schema_version: str = Field(
-        SITE_SCHEMA_VERSION, pattern=r"^1\.[0-9]+$", description="Format version '1.<minor>'."
+    schema_version: SchemaVersion = schema_version_field(
+        SITE_SCHEMA_VERSION, "Format version '1.<minor>'."
     )
     project: Project = Field(default_factory=Project, description="Project fields.")
     hazard: Union[NTCHazard, EC8Hazard] = Field(

@@ -26,7 +26,13 @@ from pydantic import (
 
 from shared_schema.constants import Amplification, validation_lines
 from shared_schema.errors import InputError
-from shared_schema.rules import coordinate_problem, eta_problem, quantity_note, quantity_problem
+from shared_schema.rules import (
+    control_character,
+    coordinate_problem,
+    eta_problem,
+    quantity_note,
+    quantity_problem,
+)
 
 __all__ = [
     "SPEC_VERSION",
@@ -366,6 +372,15 @@ class MechanismSpec(BaseModel):
     @classmethod
     def _check_f_mt(cls, value: Optional[float]) -> Optional[float]:
         return _in_range(value, "tensile_strength", zero=True)
+
+    @field_validator("id", "name")
+    @classmethod
+    def _check_printable(cls, value: Optional[str]) -> Optional[str]:
+        # issue #25: the id becomes the constants file's (printable text, as it checks)
+        bad = None if value is None else control_character(value)
+        if bad is not None:
+            raise ValueError(f"must be printable text, got the control character {bad}")
+        return value
 
     @model_validator(mode="after")
     def _consistent(self) -> "MechanismSpec":

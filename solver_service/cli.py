@@ -27,7 +27,14 @@ from shared_schema.atomic import remove_stale_temps
 from shared_schema.errors import RockmechError
 from shared_schema.extras import MissingExtra, extra_for, require
 from shared_schema.io import save_constants
-from shared_schema.rules import CRITERIA, PULSE_SHAPES, RECORD_FORMATS, RECORD_UNITS, SF_METHODS
+from shared_schema.rules import (
+    CRITERIA,
+    PULSE_SHAPES,
+    RECORD_FORMATS,
+    RECORD_UNITS,
+    SF_METHODS,
+    printable,
+)
 from shared_schema.version import __version__
 
 from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
@@ -45,6 +52,7 @@ from .workflows.documents import (
     pulse_doc,
     record_analysis,
     record_pulse_doc,
+    time_domain_mechanisms,
 )
 from .workflows.inputs import (
     constants_from_files,
@@ -63,7 +71,7 @@ from .workflows.limits import time_limit as run_time_limit
 from .workflows.outputs import finite_json, write_envelope, write_history, write_ida, write_record
 from .workflows.rundir import check_file_target, check_folder_target, os_reason, run_folder
 from .workflows.scaling import Building
-from .workflows.tables import constants_from_table
+from .workflows.tables import checked_table
 
 # typer re-exports click's exceptions, and newer typer vendors click (``typer._click``): the
 # classes are taken from the module typer's own BadParameter comes from.
@@ -236,12 +244,14 @@ def _status(message: str) -> Iterator[None]:
     """Show a spinner with ``message`` on stderr while the block runs, on a terminal only."""
     # rich is imported here: only a terminal run draws a spinner.
     from rich.console import Console
+    from rich.markup import escape
 
     console = Console(stderr=True)
     if not console.is_terminal:
         yield
         return
-    with console.status(message):
+    # A record's or mechanism's name is shown as written, never read as rich markup (#25).
+    with console.status(escape(printable(message))):
         yield
 
 
@@ -269,8 +279,11 @@ def _table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
     """Lines of an aligned text table at most ``TABLE_WIDTH`` wide.
 
     The first column (names) is left-aligned and, only if the table would be too wide,
-    shortened with ``...``; the other columns are right-aligned.
+    shortened with ``...``; the other columns are right-aligned. A control character in a
+    cell is printed as its escape (``rules.printable``), so no name breaks a row (#25).
     """
+    headers = [printable(h) for h in headers]
+    rows = [[printable(c) for c in r] for r in rows]
     widths = [max([len(h)] + [len(r[i]) for r in rows]) for i, h in enumerate(headers)]
     spare = TABLE_WIDTH - (sum(widths) + 2 * (len(widths) - 1))
     if spare < 0:
@@ -514,7 +527,7 @@ def history(
     _limit(no_limits, scales=len(scales))
     if out is not None:
         check_folder_target(out)
-    cf = read_constants(constants)
+    cf = read_constants(constants, time_domain=True)
     motion = _read_record(record, record_format, units, dt, channel, component)
     _limit(no_limits, cf, scales=len(scales), record=_record_size([motion]))
     options: dict[str, Any] = {
@@ -711,7 +724,7 @@ def ida(
         if out is None:
             _fail(f"peaks: --peaks writes {PEAKS_FILE} into the --out folder; give --out DIR")
         require("pyarrow.parquet", "parquet", "for ida --peaks")
-    cf = read_constants(constants)
+    cf = read_constants(constants, time_domain=True)
     motions = [_read_record(p, record_format, units, dt, channel, component) for p in records or []]
     specs = read_record_spec(record_spec) if record_spec else []
     motions += [spec.read(on_warning=_record_warning) for spec in specs]
@@ -865,7 +878,10 @@ def constants_table(
 ) -> None:
     """Turn a table of mechanisms (id, p_eq, lam, eta, f_n, h_e, h...) into a constants file."""
     check_file_target(output, "output")
-    cf = constants_from_table(table)
+    cf, range_error = checked_table(table)
+    if range_error is not None:
+        # a constants file may hold it; the time-domain commands (and REST) refuse it
+        _note(f"warning: {range_error}; envelope, history, ida, report and assess refuse it")
     save_constants(output, cf)
     typer.echo(f"wrote {output}: {len(cf.mechanisms)} mechanism(s) from {table.name}")
 
@@ -905,7 +921,7 @@ def envelope(
     _limit(no_limits, envelope=(f_min, f_max, n, False))
     f_p = frequency_grid(f_min, f_max, n)
     check_folder_target(out)
-    cf = read_constants(constants)
+    cf = read_constants(constants, time_domain=True)
     _limit(no_limits, cf, envelope=(f_min, f_max, n, exact))
     pulse = None
     if record is not None:
@@ -1086,7 +1102,7 @@ def report(
     check_file_target(out)
     _limit(no_limits, scales=len(scales), envelope=(f_min, f_max, n, False))
     f_p = frequency_grid(f_min, f_max, n)
-    cf = read_constants(constants)
+    cf = read_constants(constants, time_domain=True)
     sources = [input_source("constants", constants.name, constants.read_bytes())]
     motion = None
     if record is not None:
@@ -1115,6 +1131,9 @@ def report(
             sources=sources,
             request=options,
         )
+    if motion is not None:
+        # the page lists them too; say so here as history does
+        _skipped_notes({"skipped": time_domain_mechanisms(cf)[1]})
     typer.echo(f"wrote {write_report(out, text)}")
 
 
@@ -1234,7 +1253,7 @@ def assess(
 
     multiple = check_multiples(multiple)
     check_file_target(out)
-    cf, site_file = read_constants(constants), read_site(site)
+    cf, site_file = read_constants(constants, time_domain=True), read_site(site)
     motions = [_read_record(r, record_format, units, dt) for r in record]
     sources = [
         input_source("constants", constants.name, constants.read_bytes()),

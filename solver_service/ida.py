@@ -41,6 +41,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import re
 import secrets
 import socket
 import threading
@@ -1101,7 +1102,8 @@ def parse_levels(text: str) -> list[float]:
     Raises
     ------
     InputError
-        Text that is neither form (field ``scales``).
+        Text that is neither form, or a list with an empty item (``0.5,,1``: the position is
+        named, never skipped); field ``scales``.
     """
     try:
         if ":" in text:
@@ -1110,9 +1112,17 @@ def parse_levels(text: str) -> list[float]:
             if count < 2 or not (0 < float(lo) < float(hi)) or not math.isfinite(float(hi)):
                 raise ValueError
             return [float(v) for v in np.geomspace(float(lo), float(hi), count)]
-        return [float(v) for v in text.replace(" ", ",").split(",") if v]
+        items = re.split(r"\s*,\s*|\s+", text.strip()) if text.strip() else []
+        empty = [k for k, item in enumerate(items, start=1) if not item]
+        if not empty:
+            return [float(v) for v in items]
     except ValueError:
         raise InputError(
             f"expected a list like 0.1,0.2,0.5 or a log range start:stop:n, got {text!r}",
             "scales",
         ) from None
+    # issue #25: "0.5,,1" was read as 0.5,1
+    raise InputError(
+        f"item {empty[0]} of {text!r} is empty; give one number between each two commas",
+        "scales",
+    )

@@ -282,6 +282,16 @@ def nonlinear_check(
     as_star = a0_star * (1.0 - ds_star / d0_star)
     ts = 2.0 * math.pi * math.sqrt(ds_star / as_star)
     demand_ground = float(spectrum.SDe([ts])[0])
+    if not (math.isfinite(a0_star) and math.isfinite(d0_star) and ts > 0.0 and demand_ground > 0):
+        # issue #25: extreme virtual-work quantities (a mass of 1e308 kg, phi0 of 1e-29 rad)
+        # gave an infinite a0*, a zero secant period and demand, and a division by zero
+        raise InputError(
+            f"the capacity curve is out of any physical range (a0* = {a0_star:g} m/s², "
+            f"d0* = {d0_star:g} m, Ts = {ts:g} s from alpha0 = {vw.alpha0:g}, e* = "
+            f"{e_star:g}, J/S = {vw.J / vw.S:g} m, phi0 = {phi0:g} rad); check the side's "
+            "virtual_work and phi_ov",
+            "virtual_work",
+        )
     d = np.linspace(0.0, d0_star, CURVE_POINTS)
     alpha = vw.alpha0 * (1.0 - d / d0_star)
     out: dict[str, Any] = {

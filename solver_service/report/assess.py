@@ -588,6 +588,54 @@ def _environment(template_dir: Optional[Path]) -> Any:
     return env
 
 
+def _template_error(exc: BaseException, template_dir: Optional[Path]) -> Optional[InputError]:
+    """Return a one-line error naming a user template's file and line, or None (#25).
+
+    ``exc`` is raised while loading or rendering the template: a jinja2 syntax error carries
+    its file and line; any other error is placed by the template frame in its traceback
+    (jinja2 rewrites tracebacks so that they show template lines). An error whose file is
+    not in ``template_dir`` (the packaged template) is none of the user's: None.
+    """
+    if template_dir is None:
+        return None
+    if isinstance(exc, UnicodeDecodeError):
+        return InputError(f"a template in {template_dir} is not UTF-8 text: {exc}", "template_dir")
+    filename = getattr(exc, "filename", None)
+    lineno = getattr(exc, "lineno", None)
+    if not isinstance(filename, str) or not isinstance(lineno, int):
+        filename, lineno = None, None
+        tb = exc.__traceback__
+        while tb is not None:
+            code = tb.tb_frame.f_code.co_filename
+            if Path(code).parent == template_dir or Path(code).suffix == ".j2":
+                filename, lineno = code, tb.tb_lineno
+            tb = tb.tb_next
+    if filename is None or Path(filename).resolve().parent != template_dir.resolve():
+        return None
+    what = getattr(exc, "message", None) or str(exc) or type(exc).__name__
+    if type(exc).__name__ in ("TemplateNotFound", "TemplatesNotFound"):
+        what = f"includes {what}, which is neither in {template_dir} nor a packaged template"
+    where = f"{filename}, line {lineno}" if lineno else filename
+    return InputError(f"{where}: {what.splitlines()[0] if what else ''}", "template_dir")
+
+
+def _render(template_dir: Optional[Path], context: Optional[dict[str, Any]] = None) -> str:
+    """Load the template (and render it with ``context``), a user template's error in one line.
+
+    Without ``context`` the template is only loaded and compiled, so that a syntax error in
+    a user's template is found before the analysis runs.
+    """
+    env = _environment(template_dir)
+    try:
+        template = env.get_template(TEMPLATE_NAME)
+        return "" if context is None else str(template.render(**context))
+    except Exception as exc:  # a user's template can raise anything jinja2 or Python can
+        error = _template_error(exc, template_dir)
+        if error is None:
+            raise
+        raise error from None
+
+
 def render_assessment(
     doc: dict[str, Any],
     cf: ConstantsFile,
@@ -618,7 +666,7 @@ def render_assessment(
     str
         The HTML page.
     """
-    env = _environment(template_dir)
+    _render(template_dir)  # a user template's syntax error before any figure is drawn
     spectrum = site_spectrum(site)
     by_id = {m.id: m for m in cf.mechanisms}
     with tempfile.TemporaryDirectory(prefix="rockmech-assess-") as tmp:
@@ -700,7 +748,7 @@ def render_assessment(
         "options_rows": _table_of(options or {}),
         "versions_rows": _table_of(_versions()),
     }
-    return str(env.get_template(TEMPLATE_NAME).render(**context))
+    return _render(template_dir, context)
 
 
 def assess_report(
@@ -727,6 +775,7 @@ def assess_report(
     (dict, str)
         The JSON-ready document and the HTML page.
     """
+    _render(template_dir)  # a user template's syntax error before the analysis runs
     doc = assessment_doc(cf, site, motions, multiples=multiples)
     text = render_assessment(
         doc, cf, site, motions, sources=sources, options=options, template_dir=template_dir

@@ -9,7 +9,7 @@ Sections: inputs and their provenance (file names, SHA-256, sizes, the constants
 provenance, the record's metadata, the analysis options and software versions); the
 kinematic constants; the overturning envelopes with the critical bands; with a record, the
 record with its elastic spectrum and the time histories of every mechanism at every scale
-factor; and the error estimates of every result.
+factor, with every mechanism they leave out and why; and the error estimates of every result.
 
 Units: SI; pulse amplitudes and accelerations in g where the heading says so.
 """
@@ -56,7 +56,8 @@ margin-top:2rem}table{border-collapse:collapse;margin:.6rem 0;font-size:.85rem}
 th,td{border:1px solid #ddd;padding:.25rem .5rem;text-align:right}
 th{background:#f3f3f3}td.l,th.l{text-align:left}img{max-width:100%;height:auto;
 border:1px solid #eee}figure{margin:1rem 0}figcaption{font-size:.85rem;color:#555}
-.yes{color:#b00020;font-weight:600}.muted{color:#666;font-size:.85rem}
+.yes{color:#b00020;font-weight:600}.skipped{border-left:4px solid #b26a00;padding:.1rem .8rem;
+background:#fff8e6}.muted{color:#666;font-size:.85rem}
 pre{background:#f7f7f7;padding:.5rem;overflow:auto;font-size:.8rem}
 """
 
@@ -231,6 +232,21 @@ def _history_table(doc: dict[str, Any]) -> str:
             ["mechanism", "SF [-]", "method", "formula", "inputs"], sf_rows, left=1
         )
     return out
+
+
+def _skipped_section(doc: dict[str, Any]) -> str:
+    """Every mechanism the time histories left out, and why (``doc["skipped"]``; #25)."""
+    skipped = doc.get("skipped") or []
+    if not skipped:
+        return ""
+    items = "".join(
+        f"<li><strong>{_e(s['mechanism'])}</strong> skipped: {_e(s['reason'])}</li>"
+        for s in skipped
+    )
+    return (
+        f"<div class='skipped'><p>{len(skipped)} mechanism(s) left out of the time histories "
+        f"(their envelopes and constants are above):</p><ul>{items}</ul></div>"
+    )
 
 
 def _history_figures(
@@ -463,6 +479,7 @@ def build_report(
                     else ""
                 )
                 + "</p>"
+                + _skipped_section(hist)
                 + "".join(figs)
                 + _history_table(hist)
             )

@@ -20,9 +20,8 @@ import numpy as np
 from shared_schema.api import MAX_ASSESS_MULTIPLES, MULTIPLE_MAX
 from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError, RockmechError
-from shared_schema.rules import check_file, check_number
-from shared_schema.site import SiteFile, parse_site
-from shared_schema.text import decode_text
+from shared_schema.rules import check_number
+from shared_schema.site import SiteFile
 
 from ..core.exact import simulate
 from ..core.hazard import ElasticSpectrum
@@ -37,6 +36,7 @@ from .codecheck import (
     site_spectrum,
 )
 from .documents import envelope_doc, log_grid
+from .inputs import read_site_file
 from .scaling import mechanism_scale_factor
 
 __all__ = [
@@ -62,20 +62,9 @@ BAND_LOW, BAND_HIGH = 0.5, 1.5
 BAND_POINTS = 40
 
 
-#: What a site file must be, for the messages on empty, binary or non-JSON files.
-SITE_EXPECTED = 'a site file (JSON, {"hazard": {...}, "building": {...}})'
-
-
 def read_site(path: Path) -> SiteFile:
-    """Read and validate a site file; errors about the file itself name ``site``."""
-    check_file(path, "site")
-    text = decode_text(path.read_bytes(), path.name, "site", SITE_EXPECTED)
-    try:
-        return parse_site(text)
-    except InputError as exc:
-        if exc.field:
-            raise
-        raise InputError(f"{path.name}: {exc.reason}; expected {SITE_EXPECTED}", "site") from None
+    """Read and validate a site file (``inputs.read_site_file``); errors name ``site``."""
+    return read_site_file(path)
 
 
 def record_scale_factor(

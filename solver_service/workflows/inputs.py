@@ -15,11 +15,13 @@ from rhino_plugin.mechanisms.build import (
     constants_from_spec,
     failures_error,
 )
-from rhino_plugin.scenes import read_scene
+from rhino_plugin.scenes import SCENE_FORMATS, read_scene
+from shared_schema.api import time_domain_problem
 from shared_schema.constants import ConstantsFile, json_document
-from shared_schema.errors import InputError
+from shared_schema.errors import InputError, RockmechError
 from shared_schema.io import load_constants
 from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, check_file, check_positive
+from shared_schema.site import SiteFile, parse_site
 from shared_schema.spec import parse_spec
 from shared_schema.text import decode_text
 
@@ -30,9 +32,11 @@ __all__ = [
     "RecordSpec",
     "constants_from_files",
     "constants_keep_going",
+    "file_kind",
     "read_constants",
     "read_record",
     "read_record_spec",
+    "read_site_file",
 ]
 
 #: What a record-spec file must be, for the messages on empty or binary files.
@@ -192,16 +196,144 @@ def read_record_spec(path: Path) -> list[RecordSpec]:
     return specs
 
 
-def read_constants(path: Path) -> ConstantsFile:
+#: What each kind of input file is, for a message about a file given in the wrong place.
+FILE_KINDS = {
+    "constants": "a kinematic-constants file",
+    "site": "a site file (SITE.json)",
+    "spec": "a mechanism spec",
+    "scene": "a scene file",
+    "record": "a ground-motion record",
+}
+#: Keys of a spec's mechanism that a constants file's mechanism never has.
+_SPEC_KEYS = {"groups", "blocks", "axis", "hinges", "floors", "roof", "vaults", "tie_bars"}
+#: Keys of a constants file's mechanism that a spec's mechanism never has.
+_CONSTANTS_KEYS = {"positive", "negative", "p_eq", "lam", "phi_ov", "eta_source"}
+
+
+def file_kind(path: Path) -> Optional[str]:
+    """Guess which of rockmech's inputs a file is (a key of ``FILE_KINDS``), or None.
+
+    Used only to word an error once a file failed to read as what it was given for: a scene
+    by its extension, a JSON document by its top-level keys (a site file has ``hazard``; a
+    spec's mechanisms have ``groups`` or ``axis``, a constants file's ``positive`` or
+    ``p_eq``), a record by its format being recognised.
+    """
+    if path.suffix.lower().lstrip(".") in SCENE_FORMATS:
+        return "scene"
+    if is_table(path):
+        try:
+            constants_from_table(path)
+        except (OSError, RockmechError):
+            pass
+        else:
+            return "constants"
+    try:
+        doc = json_document(path.read_bytes().decode("utf-8-sig"))
+    except (OSError, UnicodeDecodeError):
+        return None
+    except InputError:
+        try:
+            detect_format(path)
+        except (OSError, RockmechError):
+            return None
+        return "record"
+    if isinstance(doc, list):
+        doc = {"mechanisms": doc}
+    if not isinstance(doc, dict):
+        return None
+    if "hazard" in doc:
+        return "site"
+    if "spec_version" in doc:
+        return "spec"
+    mechs = doc.get("mechanisms")
+    keys = set()
+    for mech in mechs if isinstance(mechs, list) else []:
+        keys |= set(mech) if isinstance(mech, dict) else set()
+    if keys & _SPEC_KEYS and not keys & _CONSTANTS_KEYS:
+        return "spec"
+    if keys & _CONSTANTS_KEYS:
+        return "constants"
+    return None
+
+
+def _wrong_file(path: Path, expected: str, where: str) -> Optional[InputError]:
+    """Return the error for a file of another kind than ``expected``, or None."""
+    kind = file_kind(path)
+    if kind is None or kind == expected:
+        return None
+    if kind in ("spec", "scene") and expected == "constants":
+        where = "compute the constants first: rockmech constants SCENE SPEC -o constants.json"
+    if kind == "record" and expected == "constants":
+        where = "the first argument is the kinematic-constants file, the records come after it"
+    return InputError(
+        f"{path.name}: this looks like {FILE_KINDS[kind]}, not {FILE_KINDS[expected]}; {where}",
+        expected,
+    )
+
+
+def read_constants(path: Path, *, time_domain: bool = False) -> ConstantsFile:
     """Read and validate a kinematic-constants file, or a constants table (``.csv``, ``.xlsx``).
 
-    Errors name ``constants`` (a JSON file) or ``table`` with the row and column (a table,
-    ``solver_service.workflows.tables``).
+    Parameters
+    ----------
+    path : Path
+        The file.
+    time_domain : bool
+        Also hold every mechanism to the ranges of a time-domain analysis (each side's
+        ``p_eq`` and ``lam``, the amplification data; ``shared_schema.api.time_domain_problem``),
+        the ranges the REST service applies to envelope, history, report and assess requests.
+
+    Raises
+    ------
+    InputError
+        Errors name ``constants`` (a JSON file) or ``table`` with the row and column (a table,
+        ``solver_service.workflows.tables``). A site file, spec or scene given instead is
+        named as such (the arguments were swapped).
     """
     check_file(path, "constants")
     if is_table(path):
-        return constants_from_table(path)
-    return load_constants(path)
+        return constants_from_table(path, time_domain=time_domain)
+    try:
+        cf = load_constants(path)
+    except InputError as exc:
+        wrong = _wrong_file(
+            path,
+            "constants",
+            "the first argument is the kinematic-constants file (check and assess take the "
+            "site file second)",
+        )
+        raise (wrong or exc) from None
+    problem = time_domain_problem(cf) if time_domain else None
+    if problem is not None:
+        raise InputError(f"{problem[0]}: {problem[1]}", str(path))
+    return cf
+
+
+#: What a site file must be, for the messages on empty, binary or non-JSON files.
+SITE_EXPECTED = 'a site file (JSON, {"hazard": {...}, "building": {...}})'
+
+
+def read_site_file(path: Path) -> SiteFile:
+    """Read and validate a site file (``shared_schema.site.SiteFile``); field ``site``.
+
+    A constants file or another of rockmech's inputs given instead is named as such (the
+    arguments of ``check`` or ``assess`` were swapped).
+    """
+    check_file(path, "site")
+    text = decode_text(path.read_bytes(), path.name, "site", SITE_EXPECTED)
+    try:
+        return parse_site(text)
+    except InputError as exc:
+        wrong = _wrong_file(
+            path,
+            "site",
+            "the second argument is the site file (check and assess take the constants file first)",
+        )
+        if wrong is not None:
+            raise wrong from None
+        if exc.field:
+            raise
+        raise InputError(f"{path.name}: {exc.reason}; expected {SITE_EXPECTED}", "site") from None
 
 
 #: What a mechanism spec must be, for the messages on empty, binary or non-JSON files.
@@ -211,6 +343,22 @@ SPEC_EXPECTED = 'a mechanism spec (JSON, {"mechanisms": [...]})'
 def _spec_and_scene(scene: Path, spec: Path, units: Optional[str]) -> tuple[Any, Any]:
     for label, path in (("scene", scene), ("spec", spec)):
         check_file(path, label)
+    scene_is_json = scene.suffix.lower() == ".json"
+    if spec.suffix.lower().lstrip(".") in SCENE_FORMATS:
+        where = (
+            "the arguments are swapped: the first is the scene (.3dm or a scan mesh), the "
+            "second the spec (JSON)"
+            if scene_is_json
+            else "the spec is a JSON file, given after the scene"
+        )
+        raise InputError(f"{spec.name}: this is {FILE_KINDS['scene']}, not a spec; {where}", "spec")
+    if scene_is_json and file_kind(scene) in ("spec", "constants", "site"):
+        what = FILE_KINDS[str(file_kind(scene))]
+        raise InputError(
+            f"{scene.name}: this looks like {what}, not a scene; the first argument is the "
+            "scene (.3dm or a scan mesh), the second the spec (JSON)",
+            "scene",
+        )
     text = decode_text(spec.read_bytes(), spec.name, "spec", SPEC_EXPECTED)
     return parse_spec(text, spec.name), read_scene(scene, units=units)
 

@@ -27,11 +27,19 @@ import re
 from pathlib import Path
 from typing import Any, Optional
 
+from shared_schema.api import time_domain_problem
 from shared_schema.constants import ConstantsFile, parse_constants
 from shared_schema.errors import InputError
 from shared_schema.text import decimal_point, decode_text, delimiter_of
 
-__all__ = ["COLUMNS", "TABLE_SUFFIXES", "XLSX_HINT", "constants_from_table", "is_table"]
+__all__ = [
+    "COLUMNS",
+    "TABLE_SUFFIXES",
+    "XLSX_HINT",
+    "checked_table",
+    "constants_from_table",
+    "is_table",
+]
 
 #: Column -> (where it goes in a mechanism, SI unit or None for text, dimensionless "-").
 COLUMNS: dict[str, tuple[tuple[str, ...], Optional[str]]] = {
@@ -212,13 +220,17 @@ def _row_error(exc: InputError, row: int, titles: dict[str, str], name: str) -> 
     return InputError(f"{name} {label}: {exc.reason}", "table")
 
 
-def constants_from_table(path: Path) -> ConstantsFile:
+def constants_from_table(path: Path, *, time_domain: bool = False) -> ConstantsFile:
     """Read a constants table (``.csv`` or ``.xlsx``) into a validated constants file.
 
     Parameters
     ----------
     path : Path
         The table; see the module docstring for its columns.
+    time_domain : bool
+        Also hold each row to the ranges of a time-domain analysis (``p_eq``, ``lam``, the
+        amplification data: ``shared_schema.api.time_domain_problem``), as a constants JSON
+        file and the REST service are for envelopes, histories, IDA, reports and assessments.
 
     Returns
     -------
@@ -232,6 +244,23 @@ def constants_from_table(path: Path) -> ConstantsFile:
         Missing file, unknown suffix, openpyxl missing for ``.xlsx`` (with the ``pip
         install`` line), an unknown column or unit, or a bad cell; every message names the
         row (as the spreadsheet numbers it) and the column. Field ``table``.
+    """
+    cf, range_error = checked_table(path)
+    if time_domain and range_error is not None:
+        raise range_error
+    return cf
+
+
+def checked_table(path: Path) -> tuple[ConstantsFile, Optional[InputError]]:
+    """Read a constants table; also return the error a time-domain analysis would give it.
+
+    Returns
+    -------
+    constants : ConstantsFile
+        As ``constants_from_table``.
+    range_error : InputError or None
+        The first value outside the ranges of a time-domain analysis, naming its row and
+        column (``shared_schema.api.time_domain_problem``), or None.
     """
     if not path.is_file():
         raise InputError(f"table file not found: {path}", "table")
@@ -302,8 +331,15 @@ def constants_from_table(path: Path) -> ConstantsFile:
     if not mechanisms:
         raise InputError(f"{path.name}: the table has a header but no mechanism rows", "table")
     try:
-        return parse_constants(json.dumps({"mechanisms": mechanisms}))
+        cf = parse_constants(json.dumps({"mechanisms": mechanisms}))
     except InputError as exc:
         index = re.match(r"mechanisms\[(\d+)\]", exc.field or "")
         row = row_numbers[int(index.group(1))] if index else head_row
         raise _row_error(exc, row, titles, path.name) from None
+    problem = time_domain_problem(cf)
+    if problem is None:
+        return cf, None
+    field, message = problem
+    index = re.match(r"mechanisms\[(\d+)\]", field)
+    row = row_numbers[int(index.group(1))] if index else head_row
+    return cf, _row_error(InputError(message, field), row, titles, path.name)

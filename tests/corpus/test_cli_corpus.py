@@ -94,7 +94,8 @@ CONSTANTS_FILES: dict[str, Any] = {
     "p_bool.json": json.dumps({"mechanisms": [{**_W, "p_eq": True}]}),
     "p_huge.json": json.dumps({"mechanisms": [{**_W, "p_eq": 1e200}]}),
     "lam_zero.json": json.dumps({"mechanisms": [{**_W, "lam": 0.0}]}),
-    "lam_big.json": json.dumps({"mechanisms": [{**_W, "lam": 5.0}]}),
+    # phi_ov given: without it phi_ov = lam = 5 rad is refused (#25, "lam_above_pi_2.json")
+    "lam_big.json": json.dumps({"mechanisms": [{**_W, "lam": 5.0, "phi_ov": 1.0}]}),
     "nan_text.json": '{"mechanisms": [{"id": "W", "rocking": "two_sided", "p_eq": NaN, '
     '"lam": 0.2, "eta": 0.9}]}',
     "dup_id.json": json.dumps({"mechanisms": [_W, _W]}),
@@ -149,6 +150,263 @@ TABLE_FILES: dict[str, Any] = {
     "walls_sheet2.xlsx": lambda: _workbook(True),
     "walls_xlsx_named.csv": lambda: _workbook(False),
 }
+
+
+def _site(**hazard: Any) -> str:
+    site = json.loads(SITE.read_text())
+    site["hazard"].update(hazard)
+    return json.dumps(site)
+
+
+#: Site files, constants files and tables of the range cases (issue #25), written beside the
+#: others into the case's folder.
+RANGE_FILES: dict[str, Any] = {
+    "site_q_half.json": _site(q=0.5),
+    "site_q_one.json": _site(q=1.0),
+    "site_xi_fraction.json": _site(xi_percent=0.05),
+    "site_xi_one.json": _site(xi_percent=1.0),
+    "site_version_regex.json": json.dumps({**json.loads(SITE.read_text()), "schema_version": "v1"}),
+    "phi_ov_degrees.json": json.dumps({"mechanisms": [{**_W, "phi_ov": 5.0}]}),
+    "phi_ov_half_pi.json": json.dumps({"mechanisms": [{**_W, "phi_ov": 1.5707963267948966}]}),
+    "lam_above_pi_2.json": json.dumps({"mechanisms": [{**_W, "lam": 5.0}]}),
+    "p_1e300.json": json.dumps({"mechanisms": [{**_W, "p_eq": 1e300}]}),
+    "id_newline.json": json.dumps({"mechanisms": [{**_W, "id": "W\nfake row  1  yes"}]}),
+    "id_escape.json": json.dumps({"mechanisms": [{**_W, "id": "W\u001b[31m"}]}),
+    "id_markup.json": json.dumps({"mechanisms": [{**_W, "id": "[red]W[/red]"}]}),
+    "version_2.json": json.dumps({"schema_version": "2.0", "mechanisms": [_W]}),
+    "skip_one.json": json.dumps(
+        {"mechanisms": [_W, {"id": "F1", "rocking": "one_sided", "p_eq": 2.0, "lam": 0.15}]}
+    ),
+    "p_1e300.csv": "id,p_eq,lam,eta\nW,1e300,0.2,0.9\n",
+    "phi_ov_degrees.csv": "id,p_eq,lam,eta,phi_ov\nW,2,0.2,0.9,5\n",
+    "phi_ov_deg_unit.csv": "id,p_eq,lam,eta,phi_ov [deg]\nW,2,0.2,0.9,5\n",
+}
+
+
+def _range_cases() -> list[Case]:
+    """Numbers that cannot be, swapped arguments and other leftovers of issue #25."""
+    church, site = str(CHURCH_GEOMETRY), str(SITE)
+    check = ["check", church]
+    assess_out = ["-o", "{tmp}/a.html"]
+    return [
+        # site files: q < 1 raised the demand, xi_percent as a fraction flipped verdicts
+        Case(
+            "check-site-q-below-1",
+            [*check, "{c:site_q_half.json}"],
+            "error",
+            r"hazard\.NTC2018\.q",
+            r"must be in \[1, 10\], got 0\.5: the behaviour factor",
+        ),
+        Case(
+            "assess-site-q-below-1",
+            ["assess", church, "{c:site_q_half.json}", *assess_out],
+            "error",
+            r"hazard\.NTC2018\.q",
+            r"\[1, 10\]",
+        ),
+        Case(
+            "check-site-q-1-is-the-bound",
+            [*check, "{c:site_q_one.json}", "--json"],
+            "ok",
+            check=lambda d: d["site"]["q"] == 1.0,
+        ),
+        Case(
+            "check-site-xi-percent-as-fraction",
+            [*check, "{c:site_xi_fraction.json}"],
+            "error",
+            r"hazard\.NTC2018\.xi_percent",
+            r"must be in \[1, 50\] %, got 0\.05: .*in percent, not a fraction: write 5 for 5 %",
+        ),
+        Case("check-site-xi-percent-1-is-the-bound", [*check, "{c:site_xi_one.json}"], "ok"),
+        Case(
+            "check-site-schema-version-in-words",
+            [*check, "{c:site_version_regex.json}"],
+            "error",
+            "schema_version",
+            r"schema_version: must look like 1\.0 \(format 1\.<minor>[^\n]*got 'v1'$",
+        ),
+        Case(
+            "history-constants-schema-version-in-words",
+            ["history", "{c:version_2.json}", "{r:good.dat}"],
+            "error",
+            "schema_version",
+            r"must look like 1\.0 [^\n^]*got '2\.0'; a newer format: update rockmech$",
+        ),
+        # constants and tables: degrees written as radians, p_eq out of the REST range
+        Case(
+            "history-phi-ov-degrees-as-radians",
+            ["history", "{c:phi_ov_degrees.json}", "{r:good.dat}"],
+            "error",
+            r"positive\.phi_ov",
+            r"at most pi/2 = 1\.5708 rad .* got 5 rad = 286\.5 deg; the value is in radians",
+        ),
+        Case(
+            "history-lam-above-pi-2-without-phi-ov",
+            ["history", "{c:lam_above_pi_2.json}", "{r:good.dat}"],
+            "error",
+            r"positive\.lam",
+            r"phi_ov defaults to lam .* lam = 5\.0 is above pi/2 = 1\.5708 rad: give phi_ov",
+        ),
+        Case(
+            "envelope-phi-ov-pi-over-2-is-the-bound",
+            ["envelope", "{c:phi_ov_half_pi.json}", "--out", "{tmp}/e", "--n", "5"],
+            "ok",
+        ),
+        Case(
+            "constants-table-phi-ov-degrees-as-radians",
+            ["constants-table", "{c:phi_ov_degrees.csv}", "-o", "{tmp}/c.json"],
+            "error",
+            "table",
+            r"row 2, column 'phi_ov': must be at most pi/2 .* if it is 5 deg, write 0\.08727",
+        ),
+        Case(
+            "envelope-table-phi-ov-in-deg-column",
+            ["envelope", "{c:phi_ov_deg_unit.csv}", "--out", "{tmp}/e", "--n", "5", "--json"],
+            "ok",
+            check=lambda d: d["mechanisms"][0]["id"] == "W",
+        ),
+        Case(
+            "envelope-table-p-eq-1e300",
+            ["envelope", "{c:p_1e300.csv}", "--out", "{tmp}/e", "--n", "5"],
+            "error",
+            "table",
+            r"p_1e300\.csv row 2, column 'p_eq': must be in \[0\.01, 1000\] for a time-domain",
+        ),
+        Case(
+            "history-table-p-eq-1e300",
+            ["history", "{c:p_1e300.csv}", "{r:good.dat}"],
+            "error",
+            "table",
+            r"row 2, column 'p_eq': must be in \[0\.01, 1000\]",
+        ),
+        Case(
+            "envelope-json-p-eq-1e300",
+            ["envelope", "{c:p_1e300.json}", "--out", "{tmp}/e", "--n", "5"],
+            "error",
+            r"mechanisms\[0\]\.positive\.p_eq",
+            r"must be in \[0\.01, 1000\] for a time-domain analysis",
+        ),
+        Case(
+            "constants-table-p-eq-1e300-warns",
+            ["constants-table", "{c:p_1e300.csv}", "-o", "{tmp}/c.json"],
+            "warn",
+            "",
+            r"row 2, column 'p_eq': must be in \[0\.01, 1000\].*envelope, history, ida, report "
+            "and assess refuse it",
+        ),
+        # ids that would break the terminal table
+        Case(
+            "history-id-with-newline",
+            ["history", "{c:id_newline.json}", "{r:good.dat}"],
+            "error",
+            r"mechanisms\[0\] \(id .*\)\.id",
+            r"must be printable text, got the control character '\\n'",
+        ),
+        Case(
+            "envelope-id-with-escape-code",
+            ["envelope", "{c:id_escape.json}", "--out", "{tmp}/e"],
+            "error",
+            r"mechanisms\[0\] \(id .*\)\.id",
+            r"control character '\\x1b'",
+        ),
+        Case(
+            "history-id-with-markup-printed-as-written",
+            ["history", "{c:id_markup.json}", "{r:good.dat}"],
+            "ok",
+            check=lambda out: "\n[red]W[/red]  " in out,
+        ),
+        Case(
+            "ida-scales-empty-item",
+            ["ida", "{c:ok.json}", "{r:good.dat}", "--scales", "0.5,,1"],
+            "error",
+            "scales",
+            r"item 2 of '0\.5,,1' is empty",
+        ),
+        Case(
+            "ida-scales-trailing-comma",
+            ["ida", "{c:ok.json}", "{r:good.dat}", "--scales", "0.5,1,"],
+            "error",
+            "scales",
+            r"item 3 of '0\.5,1,' is empty",
+        ),
+        Case(
+            "ida-scales-spaces-after-commas",
+            ["ida", "{c:ok.json}", "{r:good.dat}", "--scales", "0.5, 1", "--json"],
+            "ok",
+            check=lambda d: d["runs"] == 2,
+        ),
+        # swapped arguments
+        Case(
+            "check-arguments-swapped",
+            ["check", site, church],
+            "error",
+            "constants",
+            r"ntc_site\.json: this looks like a site file \(SITE\.json\), not a "
+            r"kinematic-constants file; the first argument is the kinematic-constants file",
+        ),
+        Case(
+            "assess-arguments-swapped",
+            ["assess", site, church, *assess_out],
+            "error",
+            "constants",
+            r"this looks like a site file .* the first argument is the kinematic-constants file",
+        ),
+        Case(
+            "check-site-given-a-constants-file",
+            ["check", church, church],
+            "error",
+            "site",
+            r"this looks like a kinematic-constants file, not a site file \(SITE\.json\); the "
+            r"second argument is the site file",
+        ),
+        Case(
+            "history-record-and-constants-swapped",
+            ["history", "{r:good.dat}", "{c:ok.json}"],
+            "error",
+            "constants",
+            r"this looks like a ground-motion record, not a kinematic-constants file; the first "
+            r"argument is the kinematic-constants file, the records come after it",
+        ),
+        Case(
+            "constants-scene-and-spec-swapped",
+            [
+                "constants",
+                str(EXAMPLES / "specs" / "rect_wall.spec.json"),
+                str(EXAMPLES / "scenes" / "rect_wall.3dm"),
+                "-o",
+                "{tmp}/c.json",
+            ],
+            "error",
+            "spec",
+            r"rect_wall\.3dm: this is a scene file, not a spec; the arguments are swapped: the "
+            r"first is the scene \(\.3dm or a scan mesh\), the second the spec \(JSON\)",
+        ),
+        Case(
+            "history-given-a-spec",
+            ["history", str(EXAMPLES / "specs" / "rect_wall.spec.json"), "{r:good.dat}"],
+            "error",
+            "constants",
+            r"this looks like a mechanism spec, not a kinematic-constants file; compute the "
+            r"constants first: rockmech constants SCENE SPEC",
+        ),
+        # a user's template: a syntax error is one line naming the file and the line
+        Case(
+            "assess-template-syntax-error",
+            ["assess", "{c:ok.json}", site, *assess_out, "--template-dir", "{tmp}/tpl"],
+            "error",
+            "template_dir",
+            r"tpl/assess\.html\.j2, line 3: unexpected '}'$",
+            files={"tpl/assess.html.j2": "<html>\n{% if x %}\n{{ title }\n</html>\n"},
+        ),
+        Case(
+            "assess-template-undefined-name",
+            ["assess", "{c:ok.json}", site, *assess_out, "--template-dir", "{tmp}/tpl"],
+            "error",
+            "template_dir",
+            r"tpl/assess\.html\.j2, line 2: 'nosuch' is undefined$",
+            files={"tpl/assess.html.j2": "<html>\n{{ nosuch.value }}\n</html>\n"},
+        ),
+    ]
 
 
 def _cases() -> list[Case]:
@@ -632,12 +890,12 @@ def _cases() -> list[Case]:
             r"empty\.json is empty \(0 bytes\): expected a site file \(JSON",
         ),
         Case(
-            # a table where the site file goes: not JSON, said so
+            # a constants table where the site file goes: named as such
             "check-site-is-csv",
             ["check", str(CHURCH_GEOMETRY), "{c:walls_semicolon.csv}"],
             "error",
             "site",
-            r"invalid JSON at line 1, column 1: .*\(a CSV or a workbook\?\).*expected a site",
+            r"walls_semicolon\.csv: this looks like a kinematic-constants file, not a site file",
         ),
         Case(
             "constants-spec-empty",
@@ -792,7 +1050,7 @@ def _cases() -> list[Case]:
             r"\(0, 1\]",
         ),
     ]
-    return cases
+    return cases + _range_cases()
 
 
 def _four_mechanisms(out: Any) -> bool:
@@ -810,7 +1068,7 @@ def _materialise(argv: list[str], tmp: Path) -> list[str]:
             path.write_bytes(text)
         else:
             path.write_text(text)
-    for name, text in {**CONSTANTS_FILES, **TABLE_FILES}.items():
+    for name, text in {**CONSTANTS_FILES, **TABLE_FILES, **RANGE_FILES}.items():
         path = tmp / name
         text = text() if callable(text) else text
         if isinstance(text, bytes):
@@ -846,8 +1104,44 @@ def _compiled_kernels(tmp_path_factory: pytest.TempPathFactory) -> None:
 
 @pytest.mark.parametrize("case", params(CASES))
 def test_cli_case(case: Case, tmp_path: Path) -> None:
+    for name, content in case.files.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(content)
     run_case(case, _materialise(case.argv, tmp_path))
 
 
 def test_corpus_is_large() -> None:
     assert len(CASES) >= 130
+
+
+def test_report_states_every_skipped_mechanism(tmp_path: Path) -> None:
+    """``report --record`` leaves out a mechanism without eta: the page says which and why."""
+    case = Case(
+        "report-skipped-mechanism",
+        [
+            "report",
+            "{c:skip_one.json}",
+            "--record",
+            "{r:good.dat}",
+            "--n",
+            "20",
+            "-o",
+            "{r:r.html}",
+        ],
+        "warn",
+        "",
+        r"warning: F1 skipped: a time history of a one-sided mechanism needs a coefficient of "
+        r"restitution \(eta\)",
+    )
+    run_case(case, _materialise(case.argv, tmp_path))
+    page = (tmp_path / "r.html").read_text()
+    assert re.search(
+        r"1 mechanism\(s\) left out of the time histories .*<li><strong>F1</strong> skipped: a "
+        r"time history of a one-sided mechanism needs a coefficient of restitution \(eta\), "
+        r"which the constants file does not give</li>",
+        page,
+    ), page[:2000]
+    # the mechanism that ran is in the history table; the skipped one is not
+    start = page.index("<h2>Time histories</h2>")
+    table = page[start : page.index("<h2>", start + 1)]
+    assert '<td class="l">W</td>' in table and '<td class="l">F1</td>' not in table

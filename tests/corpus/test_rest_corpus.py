@@ -28,6 +28,10 @@ REPO = Path(__file__).resolve().parents[2]
 WALLS: dict[str, Any] = json.loads(
     (REPO / "examples" / "constants" / "rect_walls.json").read_text()
 )
+CHURCH_GEOMETRY: dict[str, Any] = json.loads(
+    (REPO / "examples" / "constants" / "church_geometry.json").read_text()
+)
+SITE: dict[str, Any] = json.loads((REPO / "examples" / "sites" / "ntc_site.json").read_text())
 #: A request with no answer after this long is taken to hang [s] (far above any real answer).
 HANG_SECONDS = 300.0
 
@@ -45,6 +49,7 @@ BODIES: dict[str, dict[str, Any]] = {
     "spectrum": {"record": RECORD, "n": 20},
     "scale-factor": {"method": "ec8", "z": 3.0, "H": 10.0, "T_a": 0.0, "T_1": 0.5},
     "report": {"constants": WALLS, "n": 20},
+    "check": {"constants": CHURCH_GEOMETRY, "site": SITE},
 }
 
 
@@ -607,6 +612,66 @@ def _cases() -> list[Rest]:
             {"constants.mechanisms.0.id": {"a": {"b": 1}}},
             field="id",
             problem="valid string",
+        ),
+    ]
+    # numbers that cannot be (issue #25): the ranges of shared_schema.rules, as on the CLI
+    short = {"id": "W", "p_eq": 2.0, "lam": 0.2, "eta": 0.9}
+    cases += [
+        Rest(
+            "check-site-q-below-1",
+            "check",
+            {"site.hazard.q": 0.5},
+            field=r"site\.hazard\.NTC2018\.q",
+            problem=r"must be in \[1, 10\], got 0\.5: the behaviour factor divides",
+        ),
+        Rest(
+            "check-site-xi-percent-as-fraction",
+            "check",
+            {"site.hazard.xi_percent": 0.05},
+            field=r"site\.hazard\.NTC2018\.xi_percent",
+            problem=r"must be in \[1, 50\] %, got 0\.05: .*write 5 for 5 %",
+        ),
+        Rest(
+            "check-site-schema-version-in-words",
+            "check",
+            {"site.schema_version": "v1"},
+            field=r"site\.schema_version",
+            problem=r"^[^^]*must look like 1\.0 \(format 1\.<minor>; [^^]*got 'v1'$",
+        ),
+        Rest(
+            "check-constants-schema-version-in-words",
+            "check",
+            {"constants.schema_version": "2.0"},
+            field=r"constants\.schema_version",
+            problem=r"must look like 1\.0 .*got '2\.0'; a newer format: update rockmech",
+        ),
+        Rest(
+            "envelope-phi_ov-degrees-as-radians",
+            "envelope",
+            {"constants.mechanisms": [{**short, "phi_ov": 5.0}]},
+            field=r"phi_ov",
+            problem=r"at most pi/2 = 1\.5708 rad .*the value is in radians",
+        ),
+        Rest(
+            "check-phi_cr-degrees-as-radians",
+            "check",
+            {"constants.mechanisms.0.positive.phi_cr": 5.0},
+            field=r"phi_cr",
+            problem=r"at most pi/2 = 1\.5708 rad",
+        ),
+        Rest(
+            "envelope-p_eq-1e300",
+            "envelope",
+            {"constants.mechanisms": [{**short, "p_eq": 1e300}]},
+            field=r"p_eq",
+            problem=r"must be in \[0\.01, 1000\] for a time-domain analysis",
+        ),
+        Rest(
+            "envelope-id-with-newline",
+            "envelope",
+            {"constants.mechanisms.0.id": "W1\nfake row"},
+            field=r"\.id",
+            problem=r"must be printable text, got the control character '\\n'",
         ),
     ]
     # size of the body

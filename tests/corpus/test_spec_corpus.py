@@ -854,6 +854,15 @@ SPEC_CASES: list[SpecCase] = [
         "f_n|amplification",
         "greater|>",
     ),
+    # issue #25: a line break in an id broke the terminal table (and the error line)
+    (
+        "id-with-newline",
+        "rect_wall",
+        _set("m.id", "W1\nW2"),
+        "error",
+        r"mechanisms\[0\] \(id 'W1\\nW2'\)\.id",
+        r"must be printable text, got the control character '\\n'$",
+    ),
 ]
 
 

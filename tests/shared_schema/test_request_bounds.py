@@ -333,8 +333,13 @@ TIME_DOMAIN = {"mechanisms": [{"id": "W1", "p_eq": 2.0, "lam": 0.2, "eta": 0.9}]
     ],
 )
 def test_time_domain_constants_are_plausible_as_stated(key: str, value: float, ok: bool) -> None:
-    flat = {"mechanisms": [{**TIME_DOMAIN["mechanisms"][0], key: value}]}
-    side = {"id": "W1", "eta": 0.9, "positive": {"p_eq": 2.0, "lam": 0.2, key: value}}
+    # phi_ov given: it defaults to lam, which must then be an angle (at most pi/2)
+    flat = {"mechanisms": [{**TIME_DOMAIN["mechanisms"][0], "phi_ov": 0.2, key: value}]}
+    side = {
+        "id": "W1",
+        "eta": 0.9,
+        "positive": {"p_eq": 2.0, "lam": 0.2, "phi_ov": 0.2, key: value},
+    }
     for constants in (flat, {"mechanisms": [side]}):
         body = {"constants": constants}
         assert _valid(EnvelopeRequest, body) is ok

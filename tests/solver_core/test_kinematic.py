@@ -143,3 +143,14 @@ def test_ec8_type1_and_type2_plateaus() -> None:
     assert sp3.Se([0.3])[0] == pytest.approx(0.2 * 2.5 * math.sqrt(10 / 15), rel=1e-12)
     with pytest.raises(InputError):
         ec8_spectrum(0.2, 1.0, "F", 1)
+
+
+def test_a_degenerate_capacity_curve_is_an_input_error() -> None:
+    # issue #25: e* below the smallest normal double made a0* infinite, Ts zero and the
+    # demand zero: a ZeroDivisionError (500 on /check) before
+    vw = VirtualWork(alpha0=362880.0, mass=1.6895145690793514e308, S=0.001, J=2.00001)
+    sp = ntc_spectrum(0.25, 2.4, 0.3, soil="C")
+    with pytest.raises(InputError, match=r"^virtual_work: the capacity curve is out of any"):
+        nonlinear_check(vw, 2.845531763012203e-29, sp, FC=1.0)
+    # an ordinary block at the same spectrum still runs
+    assert nonlinear_check(block(0.5, 3.0), 0.165, sp, FC=1.0)["capacity_ratio"] > 0.0
