@@ -22,17 +22,25 @@ interval (or a pulse of ``1/f_p`` seconds) into segments of at most ``1/p_eq`` s
 
 Exact envelopes of a mechanism with amplification data also evaluate the pulse response
 spectrum at every frequency, on ``SPECTRUM_GRID_PER_PERIOD max(1, f_n / f_p)`` grid points
-(``scale_factor_points``), counted at ``MAX_POINTS_PER_S``.
+(``scale_factor_points``), counted at ``PULSE_POINTS_PER_CORE_S``.
 
-``MAX_STEPS_PER_S`` is about ten times the fastest rate measured (1.8e6 steps/s for
-envelope scans, 6.7e6 for time histories, on a loaded 2-core machine), so a budget check
-refuses only work that cannot finish in the budget on any machine we know.
+Elastic response spectra cut each sample interval into at most ``T / SPECTRUM_SUBSTEPS``
+long sub-steps (``spectrum_steps``), and an assessment page draws ``assess_figures``.
+
+Each kind of work has its rate per core, measured by ``benchmarks/work_rates.py`` on the job
+functions the compute processes run and recorded in ``docs/benchmarks.md`` (section
+``work_rates``; ``tests/workflows/test_work_rates.py`` checks the constants against it). Work
+is refused up front when it cannot finish within the budget even at ``RATE_MARGIN`` times
+those rates on every core of the machine (``shortest_time``): a margin for faster cores than
+the benchmark's, while the cores are counted where the work runs. What passes may still
+run past the budget on a slower or busier machine; the budget stops it there.
 """
 
 from __future__ import annotations
 
 import contextlib
 import math
+import os
 import signal
 import sys
 import threading
@@ -46,27 +54,60 @@ from shared_schema.errors import InputError
 __all__ = [
     "CLI_BUDGET_S",
     "DEFAULT_LIMITS",
-    "MAX_POINTS_PER_S",
-    "MAX_STEPS_PER_S",
+    "ENVELOPE_STEPS_PER_CORE_S",
+    "FIGURES_PER_S",
+    "HISTORY_STEPS_PER_CORE_S",
     "NO_LIMITS",
     "N_SCAN",
+    "PULSE_POINTS_PER_CORE_S",
     "P_EQ_PLAUSIBLE",
+    "RATE_MARGIN",
     "SPECTRUM_GRID_PER_PERIOD",
+    "SPECTRUM_STEPS_PER_CORE_S",
+    "SPECTRUM_SUBSTEPS",
     "TIME_LIMIT",
     "WORK_PER_SAMPLE",
     "TimeLimitExceeded",
     "active_time_limit",
     "check_count",
     "check_run",
+    "cores",
     "envelope_steps",
     "history_steps",
     "mechanism_sides",
     "scale_factor_points",
+    "shortest_time",
+    "spectrum_steps",
     "time_limit",
+    "work_words",
 ]
 
-#: Upper bound of the exact integrator's speed [closed-form steps per second] (see Notes).
-MAX_STEPS_PER_S = 5.0e7
+#: Margin of the up-front estimates over the rates below [-]: work is refused when it
+#: cannot finish within the budget even this many times faster than measured, on every
+#: core. 2: the newest desktop cores are up to about twice as fast per core as the
+#: benchmark machine's (a shared 2-core AMD EPYC); the rates are per core, so more cores
+#: are counted where the work runs (``cores``).
+RATE_MARGIN = 2.0
+#: The rates measured per core by ``benchmarks/work_rates.py``, to two significant digits
+#: [unit/s]: the work divided by the CPU time of the job (all threads), best of 3, on the
+#: benchmark machine (AMD EPYC, 2 cores); docs/benchmarks.md, section ``work_rates``, holds
+#: the run (a test checks these against its table). Exact envelopes, closed-form steps
+#: (the church's 8 mechanisms without amplification data, 200 frequencies): 2.59e6/s.
+ENVELOPE_STEPS_PER_CORE_S = 2.6e6
+#: The pulse scale factors' spectrum, grid points (``pulse_response_spectrum`` at the
+#: church's ratios): 2.14e6/s.
+PULSE_POINTS_PER_CORE_S = 2.1e6
+#: Time histories, closed-form steps (the church on El Centro at 100 scale factors: runs at
+#: rest, rocking and overturning): 7.39e7/s.
+HISTORY_STEPS_PER_CORE_S = 7.4e7
+#: Elastic response spectra, sub-steps (El Centro at 1000 periods): 1.82e8/s.
+SPECTRUM_STEPS_PER_CORE_S = 1.8e8
+#: The assessment page's figures, drawn on one thread (the church_geometry page on El
+#: Centro, 13 figures): 4.51/s.
+FIGURES_PER_S = 4.5
+#: Sub-steps per natural period of the elastic response spectrum
+#: (``core.spectra.STEPS_PER_PERIOD``; a test checks the copy).
+SPECTRUM_SUBSTEPS = 20
 #: Pulse amplitudes scanned per frequency by an exact envelope (``core.envelope.N_SCAN``;
 #: a test checks the copy).
 N_SCAN = 300
@@ -81,15 +122,12 @@ DEFAULT_LIMITS: dict[str, int] = {
     "max_answer_bytes": 64 * 1024 * 1024,
 }
 #: Work budget of one command-line run [s]: work that cannot finish in it even at
-#: ``MAX_STEPS_PER_S`` is refused (the service's budget is its compute timeout).
+#: ``RATE_MARGIN`` times the measured rates is refused (the service's budget is its compute
+#: timeout).
 CLI_BUDGET_S = 600.0
 #: Grid points per period of the exact pulse response spectrum
 #: (``core.amplification.GRID_PER_PERIOD``; a test checks the copy).
 SPECTRUM_GRID_PER_PERIOD = 64
-#: Upper bound of the rate of the exact pulse response spectrum [grid points per second]:
-#: about ten times the rate measured (64,000 points in 15 ms, 4.3e6 points/s, at
-#: ``f_p/f_n = 1e-3`` on a loaded 2-core machine).
-MAX_POINTS_PER_S = 4.0e7
 #: ``core.exact.P_EQ_PLAUSIBLE`` [rad/s] (a test checks the copy): the solver refuses a run
 #: of a stiffer side itself, naming ``p_eq`` and its valid range, so ``check_run`` leaves
 #: such sides to it rather than blaming the record.
@@ -214,6 +252,64 @@ def time_limit(seconds: Optional[float]) -> Iterator[None]:
         _active.pop()
         if outer > 0:  # an enclosing timer (a test runner's) gets its remaining time back
             timer(signal.ITIMER_REAL, max(outer - (time.monotonic() - start), 1e-3))
+
+
+def cores() -> int:
+    """Return the cores this process may run on (the compute processes' threads use them)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def shortest_time(
+    *,
+    envelope_steps: float = 0.0,
+    pulse_points: float = 0.0,
+    history_steps: float = 0.0,
+    spectrum_steps: float = 0.0,
+    figures: float = 0.0,
+) -> float:
+    """Return the least time the work can take [s].
+
+    Each kind of work at ``RATE_MARGIN`` times its measured rate per core, on every core
+    (the figures on one).
+    """
+    per_core = (
+        envelope_steps / ENVELOPE_STEPS_PER_CORE_S
+        + pulse_points / PULSE_POINTS_PER_CORE_S
+        + history_steps / HISTORY_STEPS_PER_CORE_S
+        + spectrum_steps / SPECTRUM_STEPS_PER_CORE_S
+    )
+    return (per_core / cores() + figures / FIGURES_PER_S) / RATE_MARGIN
+
+
+def work_words(
+    *,
+    envelope_steps: float = 0.0,
+    pulse_points: float = 0.0,
+    history_steps: float = 0.0,
+    spectrum_steps: float = 0.0,
+    figures: float = 0.0,
+) -> str:
+    """Return the work in words, e.g. ``3.75e+08 closed-form steps of exact envelopes``."""
+    parts = [
+        (envelope_steps, "closed-form steps of exact envelopes"),
+        (pulse_points, "grid points of pulse spectra"),
+        (history_steps, "closed-form steps of time histories"),
+        (spectrum_steps, "sub-steps of response spectra"),
+        (figures, "figures"),
+    ]
+    words = [f"{value:.3g} {what}" for value, what in parts if value > 0]
+    return " and ".join(words) if words else "no work"
+
+
+def spectrum_steps(n_samples: int, dt: float, period: float) -> float:
+    """Sub-steps of the elastic response spectrum of a record at one ``period`` [s]."""
+    per_sample = SPECTRUM_SUBSTEPS * dt / period
+    if not math.isfinite(per_sample):
+        return math.inf
+    return float(max(n_samples - 1, 0) * max(1.0, math.ceil(per_sample)))
 
 
 def _positive(*values: Any) -> bool:
@@ -341,8 +437,9 @@ def check_run(
     limits : dict, optional
         ``DEFAULT_LIMITS`` unless given.
     budget_s : float, optional
-        Work that cannot finish in this time [s] at ``MAX_STEPS_PER_S`` is refused; by
-        default the time limit of the run (``active_time_limit``).
+        Work that cannot finish in this time [s] at ``RATE_MARGIN`` times the measured
+        rates (``shortest_time``) is refused; by default the time limit of the run
+        (``active_time_limit``).
 
     Raises
     ------
@@ -356,12 +453,12 @@ def check_run(
         check_count(len(cf.mechanisms), lim["max_mechanisms"], "mechanisms", "constants")
     check_count(scales, lim["max_scales"], "scale factors", "scales")
     check_count(periods, lim["max_samples"], "periods", "n")
-    steps = 0.0
+    work = {"envelope_steps": 0.0, "history_steps": 0.0}
     if envelope is not None:
         f_min, f_max, n, exact = envelope
         check_count(n, lim["max_samples"], "frequencies", "n")
         if exact and cf is not None:
-            steps += envelope_steps(cf, f_min, f_max, n, p_max=P_EQ_PLAUSIBLE)
+            work["envelope_steps"] = envelope_steps(cf, f_min, f_max, n, p_max=P_EQ_PLAUSIBLE)
     if record is not None:
         n_samples, dt = record
         check_count(n_samples, lim["max_samples"], "record samples", "record")
@@ -376,12 +473,15 @@ def check_run(
                     "record",
                 )
             runs = max(scales, 1)
-            steps += history_steps(cf, n_samples, dt, runs, p_max=P_EQ_PLAUSIBLE) * records
-    if steps > MAX_STEPS_PER_S * budget_s:
+            steps = history_steps(cf, n_samples, dt, runs, p_max=P_EQ_PLAUSIBLE) * records
+            work["history_steps"] = steps
+    seconds = shortest_time(**work)
+    if seconds > budget_s:
         field = "record" if record is not None else "exact"
         raise InputError(
-            f"the run would take {steps:.3g} closed-form steps, more than can finish in "
-            f"{budget_s:g} s on any machine we know; ask for less work, give {TIME_LIMIT} "
+            f"the run would take {work_words(**work)}, at least {seconds:.3g} s even at "
+            f"{RATE_MARGIN:g} times the rates measured on all {cores()} cores, more than "
+            f"its time limit of {budget_s:g} s; ask for less work, give {TIME_LIMIT} "
             f"with more seconds, or {NO_LIMITS} to lift the limit",
             field,
         )
