@@ -143,7 +143,7 @@ def _chunks(data: bytes, start: int, end: int) -> Iterator[tuple[int, int, int]]
 def _flips(path: Path) -> list[int]:
     """Offsets inside the largest object data of a scene (a third, half, two thirds in)."""
     data = path.read_bytes()
-    code, lo, hi = max(
+    _, lo, hi = max(
         (c for c in _chunks(data, 32, len(data)) if c[0] == 0x0002FFFC),
         key=lambda c: c[2] - c[1],
     )
@@ -246,7 +246,8 @@ def test_a_5000_digit_number_gets_a_422_naming_its_field(svc: Server) -> None:
         content=envelope % digits,
         headers={"content-type": "application/json"},
     )
-    constants = '{"mechanisms": [{"id": "W", "p_eq": 2, "lam": %s, "eta": 0.9}]}' % digits
+    mech = '{"id": "W", "p_eq": 2, "lam": ' + digits + ', "eta": 0.9}'
+    constants = '{"mechanisms": [' + mech + "]}"
     files = {"constants": ("walls.json", constants), "record": ("r.dat", "0 0.1\n0.01 0.2\n")}
     answers["lam"] = httpx.post(f"{svc.url}/api/v1/history", files=files, timeout=60)
     tree = {"{0}": [{"type": "System.Double", "data": digits}]}
