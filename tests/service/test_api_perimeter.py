@@ -219,7 +219,8 @@ def test_an_oversized_one_column_record_is_refused_before_a_compute_process_pars
     lines = 7_500_000  # 30 MB, within the 32 MiB body limit; 15 times the sample limit
     record = b"0.1\n" * lines
     files = {"record": ("long.txt", record)}
-    res = httpx.post(f"{svc.url}/api/v1/spectrum", files=files, data={"dt": "0.01"}, timeout=120)
+    form = {"dt": "0.01", "units": "g"}
+    res = httpx.post(f"{svc.url}/api/v1/spectrum", files=files, data=form, timeout=120)
     assert res.status_code == 422, res.text
     doc = res.json()
     assert doc["field"] == "record"
