@@ -178,14 +178,22 @@ def _envelope(
     check_limit(n, limits["max_samples"], "frequencies", "n", "max_samples")
     columns = sum(4 if m.amplification is not None else 1 for m in cf.mechanisms) + 2
     _check_answer(n * columns, limits, "the envelopes", "n")
-    if exact:
-        check_time(
-            limits,
-            "the exact envelopes",
-            "exact",
-            envelope_steps=envelope_steps(cf, f_min, f_max, n),
-            pulse_points=scale_factor_points(cf, f_min, f_max, n),
+    # Mechanisms with a restitution per impact direction are computed exactly anyway.
+    what = (
+        "the exact envelopes"
+        if exact
+        else (
+            "the envelopes of the mechanisms with a restitution per impact direction (always "
+            "computed with the exact integrator)"
         )
+    )
+    check_time(
+        limits,
+        what,
+        "exact" if exact else "constants",
+        envelope_steps=envelope_steps(cf, f_min, f_max, n, exact=exact),
+        pulse_points=scale_factor_points(cf, f_min, f_max, n) if exact else 0.0,
+    )
 
 
 def _history(job: Any, cf: Optional[ConstantsFile], limits: dict[str, Any]) -> None:
