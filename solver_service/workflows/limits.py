@@ -66,6 +66,7 @@ __all__ = [
     "SPECTRUM_STEPS_PER_CORE_S",
     "SPECTRUM_SUBSTEPS",
     "TIME_LIMIT",
+    "WORK_KINDS",
     "WORK_PER_SAMPLE",
     "TimeLimitExceeded",
     "active_time_limit",
@@ -263,45 +264,48 @@ def cores() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def shortest_time(
-    *,
-    envelope_steps: float = 0.0,
-    pulse_points: float = 0.0,
-    history_steps: float = 0.0,
-    spectrum_steps: float = 0.0,
-    figures: float = 0.0,
-) -> float:
+#: The kinds of work the estimates count: (rate per core [unit/s], its words); the figures
+#: are drawn on one thread.
+WORK_KINDS: dict[str, tuple[float, str]] = {
+    "envelope_steps": (ENVELOPE_STEPS_PER_CORE_S, "closed-form steps of exact envelopes"),
+    "pulse_points": (PULSE_POINTS_PER_CORE_S, "grid points of pulse spectra"),
+    "history_steps": (HISTORY_STEPS_PER_CORE_S, "closed-form steps of time histories"),
+    "spectrum_steps": (SPECTRUM_STEPS_PER_CORE_S, "sub-steps of response spectra"),
+    "figures": (FIGURES_PER_S, "figures"),
+}
+
+
+def _kinds(work: dict[str, float]) -> list[tuple[str, float]]:
+    unknown = set(work) - set(WORK_KINDS)
+    if unknown:
+        raise TypeError(f"unknown kinds of work: {sorted(unknown)}")
+    return [(kind, float(work.get(kind, 0.0))) for kind in WORK_KINDS]
+
+
+def shortest_time(**work: float) -> float:
     """Return the least time the work can take [s].
 
-    Each kind of work at ``RATE_MARGIN`` times its measured rate per core, on every core
-    (the figures on one).
+    Parameters
+    ----------
+    **work : float
+        Work by kind (``WORK_KINDS``: ``envelope_steps``, ``pulse_points``,
+        ``history_steps``, ``spectrum_steps``, ``figures``).
+
+    Notes
+    -----
+    Each kind at ``RATE_MARGIN`` times its measured rate per core, on every core (the
+    figures on one).
     """
-    per_core = (
-        envelope_steps / ENVELOPE_STEPS_PER_CORE_S
-        + pulse_points / PULSE_POINTS_PER_CORE_S
-        + history_steps / HISTORY_STEPS_PER_CORE_S
-        + spectrum_steps / SPECTRUM_STEPS_PER_CORE_S
-    )
-    return (per_core / cores() + figures / FIGURES_PER_S) / RATE_MARGIN
+    seconds = 0.0
+    for kind, amount in _kinds(work):
+        rate = WORK_KINDS[kind][0] * RATE_MARGIN
+        seconds += amount / (rate if kind == "figures" else rate * cores())
+    return seconds
 
 
-def work_words(
-    *,
-    envelope_steps: float = 0.0,
-    pulse_points: float = 0.0,
-    history_steps: float = 0.0,
-    spectrum_steps: float = 0.0,
-    figures: float = 0.0,
-) -> str:
+def work_words(**work: float) -> str:
     """Return the work in words, e.g. ``3.75e+08 closed-form steps of exact envelopes``."""
-    parts = [
-        (envelope_steps, "closed-form steps of exact envelopes"),
-        (pulse_points, "grid points of pulse spectra"),
-        (history_steps, "closed-form steps of time histories"),
-        (spectrum_steps, "sub-steps of response spectra"),
-        (figures, "figures"),
-    ]
-    words = [f"{value:.3g} {what}" for value, what in parts if value > 0]
+    words = [f"{amount:.3g} {WORK_KINDS[kind][1]}" for kind, amount in _kinds(work) if amount > 0]
     return " and ".join(words) if words else "no work"
 
 
