@@ -13,7 +13,9 @@ import pytest
 from typer.testing import CliRunner
 
 from shared_schema.atomic import temp_name
+from shared_schema.constants import parse_constants
 from solver_service.cli import app
+from solver_service.workflows import limits
 
 pytestmark = pytest.mark.skipif(
     not hasattr(signal, "setitimer"), reason="the time limit and pid probes are POSIX-only"
@@ -37,11 +39,15 @@ def test_a_run_past_its_time_limit_stops_with_one_line_and_keeps_the_old_outputs
     )
     old = _contents(out)
     argv = ["envelope", str(WALLS), "--exact", "--n", "2000", "--out", str(out)]
-    res = runner.invoke(app, [*argv, "--time-limit", "0.5"])
+    # A limit the up-front estimate lets through (it assumes twice the measured speed),
+    # which the run itself then passes.
+    steps = limits.envelope_steps(parse_constants(WALLS.read_text()), 0.1, 10.0, 2000)
+    seconds = round(1.25 * limits.shortest_time(envelope_steps=steps), 2)
+    res = runner.invoke(app, [*argv, "--time-limit", str(seconds)])
     assert res.exit_code == 2, res.output
     assert res.stderr == (
-        "error: time-limit: the run did not finish within its time limit of 0.5 s; give "
-        "--time-limit with more seconds, or --no-limits to lift it\n"
+        f"error: time-limit: the run did not finish within its time limit of {seconds:g} s; "
+        "give --time-limit with more seconds, or --no-limits to lift it\n"
     )
     assert _contents(out) == old
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]  # no temporary folder left

@@ -483,7 +483,7 @@ def check_run(
         check_count(len(cf.mechanisms), lim["max_mechanisms"], "mechanisms", "constants")
     check_count(scales, lim["max_scales"], "scale factors", "scales")
     check_count(periods, lim["max_samples"], "periods", "n")
-    work = {"envelope_steps": 0.0, "history_steps": 0.0}
+    work = {"envelope_steps": 0.0, "pulse_points": 0.0, "history_steps": 0.0}
     if envelope is not None:
         f_min, f_max, n, exact = envelope
         check_count(n, lim["max_samples"], "frequencies", "n")
@@ -491,6 +491,7 @@ def check_run(
             work["envelope_steps"] = envelope_steps(
                 cf, f_min, f_max, n, p_max=P_EQ_PLAUSIBLE, exact=exact
             )
+            work["pulse_points"] = scale_factor_points(cf, f_min, f_max, n) if exact else 0.0
     if record is not None:
         n_samples, dt = record
         check_count(n_samples, lim["max_samples"], "record samples", "record")
