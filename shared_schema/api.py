@@ -830,7 +830,9 @@ class ErrorResponse(BaseModel):
 class HealthResponse(BaseModel):
     """Service status."""
 
-    status: Literal["ok"]
+    status: Literal["ok", "starting"] = Field(
+        description="ok: every compute process has warmed up; starting: not yet (HTTP 503)."
+    )
     version: str = Field(description="rockmech version.")
     compute_workers: int = Field(description="Compute processes ready or busy.")
     compute_timeout_s: float = Field(description="Compute time budget per request [s].")

@@ -1058,7 +1058,7 @@ def json_document(text: str) -> Any:
     if not text.strip():
         raise InputError("invalid JSON: there is no document, only blank space") from None
     try:
-        return json.loads(text)
+        return json.loads(text, parse_int=_json_int)
     except json.JSONDecodeError as exc:
         raise InputError(
             f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}; the file is "
@@ -1068,6 +1068,31 @@ def json_document(text: str) -> Any:
         raise InputError(f"invalid JSON: {exc}") from None
     except RecursionError:
         raise InputError(f"invalid JSON: nested deeper than {MAX_JSON_DEPTH} levels") from None
+
+
+def _json_invalid_fields(exc: ValidationError, data: Any) -> ValidationError:
+    """Return the errors of a JSON text field by field, when pydantic refused it whole.
+
+    Pydantic's parser refuses a number beyond double precision for the whole text ("number
+    out of range at line 1 column 4338"); its data (``json_document`` reads such a number as
+    infinity) names the field. ``exc`` itself otherwise.
+    """
+    if not any(e["type"] == "json_invalid" for e in exc.errors(include_url=False)):
+        return exc
+    try:
+        ConstantsFile.model_validate(data)
+    except ValidationError as fields:
+        return fields
+    return exc
+
+
+def _json_int(text: str) -> Union[int, float]:
+    """Read a JSON integer; one longer than Python reads as an int becomes a float.
+
+    Python refuses to read more than 4300 digits as an int; as a float such a number is
+    infinite, which the models refuse naming the field.
+    """
+    return int(text) if len(text) <= 4000 else float(text)
 
 
 def parse_constants(source: Union[str, bytes, Mapping[str, Any], Sequence[Any]]) -> ConstantsFile:
@@ -1107,7 +1132,7 @@ def parse_constants(source: Union[str, bytes, Mapping[str, Any], Sequence[Any]])
         try:
             return ConstantsFile.model_validate_json(text)
         except ValidationError as exc:
-            raise input_error_from_validation(exc, data) from exc
+            raise input_error_from_validation(_json_invalid_fields(exc, data), data) from exc
     data = {"mechanisms": list(source)} if not isinstance(source, Mapping) else source
     try:
         return ConstantsFile.model_validate(data)

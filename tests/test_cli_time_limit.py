@@ -13,7 +13,9 @@ import pytest
 from typer.testing import CliRunner
 
 from shared_schema.atomic import temp_name
+from shared_schema.constants import parse_constants
 from solver_service.cli import app
+from solver_service.workflows import limits
 
 pytestmark = pytest.mark.skipif(
     not hasattr(signal, "setitimer"), reason="the time limit and pid probes are POSIX-only"
@@ -37,11 +39,15 @@ def test_a_run_past_its_time_limit_stops_with_one_line_and_keeps_the_old_outputs
     )
     old = _contents(out)
     argv = ["envelope", str(WALLS), "--exact", "--n", "2000", "--out", str(out)]
-    res = runner.invoke(app, [*argv, "--time-limit", "0.5"])
+    # A limit the up-front estimate lets through (it assumes twice the measured speed),
+    # which the run itself then passes.
+    steps = limits.envelope_steps(parse_constants(WALLS.read_text()), 0.1, 10.0, 2000)
+    seconds = round(1.25 * limits.shortest_time(envelope_steps=steps), 2)
+    res = runner.invoke(app, [*argv, "--time-limit", str(seconds)])
     assert res.exit_code == 2, res.output
     assert res.stderr == (
-        "error: time-limit: the run did not finish within its time limit of 0.5 s; give "
-        "--time-limit with more seconds, or --no-limits to lift it\n"
+        f"error: time-limit: the run did not finish within its time limit of {seconds:g} s; "
+        "give --time-limit with more seconds, or --no-limits to lift it\n"
     )
     assert _contents(out) == old
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]  # no temporary folder left
@@ -66,10 +72,12 @@ def test_the_time_limit_sets_the_up_front_work_budget(tmp_path: Path) -> None:
     )
     out = tmp_path / "run"
     argv = ["envelope", str(stiff), "--exact", "--n", "400", "--out", str(out)]
-    res = runner.invoke(app, [*argv, "--time-limit", "1"])  # about 1.3e8 steps: over 5e7
+    # About 1.3e8 steps: 12 s at twice the measured rate on two cores.
+    res = runner.invoke(app, [*argv, "--time-limit", "1"])
     assert res.exit_code == 2
     assert res.stderr.startswith("error: exact: the run would take 1.")
-    assert "more than can finish in 1 s on any machine we know" in res.stderr
+    assert "closed-form steps of exact envelopes" in res.stderr
+    assert "more than its time limit of 1 s" in res.stderr
     assert "give --time-limit with more seconds, or --no-limits" in res.stderr
     assert not out.exists()
 

@@ -9,7 +9,8 @@ time budget becomes 503 and the server carries on.
 
 Status codes: 400 malformed body, 404 unknown path, 405 wrong method, 413 body too large,
 415 wrong content type, 422 invalid input (including size limits), 501 optional feature not
-installed, 503 time budget exceeded or no compute process free.
+installed, 503 time budget exceeded, no compute process free (or still starting), or the
+service shutting down.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from .routes import API_PREFIX, api_router
 from .routes.hops import hops_router, thread_job_runner
 from .routes.meta import rockmech_version
 from .settings import Settings
+from .shutdown import ShutdownAnswer
 
 __all__ = ["API_PREFIX", "create_app", "rockmech_version"]
 
@@ -87,6 +89,8 @@ def create_app(settings: Optional[Settings] = None) -> FastAPI:
     app.add_middleware(BodyLimit, limit=cfg.max_body_bytes, max_values=max_values)
     # Added last, so it runs first: foreign hosts and origins are refused before any body.
     app.add_middleware(HostGuard, hosts=cfg.allowed_hosts, origins=cfg.allowed_origins)
+    # Outermost: a request the shutdown cancels still gets the service's JSON error (503).
+    app.add_middleware(ShutdownAnswer, grace_s=cfg.shutdown_timeout_s)
     app.state.settings = cfg
     app.state.pool = pool
     install_handlers(app, cfg.max_body_bytes)

@@ -9,14 +9,15 @@ a body that does not fit the model gets rockmech's own message naming the field 
 from __future__ import annotations
 
 import json
-from typing import Any, TypeVar, Union
+import math
+from typing import Any, Optional, TypeVar, Union
 
 from fastapi import Depends, Request
 from pydantic import TypeAdapter, ValidationError
 
 from .problems import Problem, validation_message
 
-__all__ = ["MAX_BODY_DEPTH", "json_body", "load_json", "validate_json"]
+__all__ = ["MAX_BODY_DEPTH", "json_body", "load_json", "out_of_range", "validate_json"]
 
 #: Deepest nesting of a JSON body that is parsed [levels]: the recursion limit of pydantic's
 #: JSON parser (a test pins it), well above the few levels a request needs.
@@ -72,6 +73,73 @@ def load_json(body: bytes) -> Any:
         raise ValueError(str(first.get("msg", "invalid JSON"))) from None
 
 
+class _OutOfRange:
+    """A JSON number beyond double precision (its text kept for the message)."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+
+def _number(text: str) -> Any:
+    """Read a JSON number; one that no double can hold becomes ``_OutOfRange``.
+
+    Python's own reading would refuse an integer of more than 4300 digits with its own
+    words ("Exceeds the limit (4300 digits) for integer string conversion").
+    """
+    digits = len(text.lstrip("-"))
+    if digits > 400:  # past 1.8e308 whatever the digits, and past Python's digit limit
+        return _OutOfRange(text)
+    value = float(text)
+    return value if math.isfinite(value) else _OutOfRange(text)
+
+
+def _path(value: Any, prefix: str = "") -> Optional[tuple[str, str]]:
+    """(field path, number text) of the first ``_OutOfRange`` in ``value``."""
+    if isinstance(value, _OutOfRange):
+        return prefix, value.text
+    items = (
+        value.items()
+        if isinstance(value, dict)
+        else enumerate(value)
+        if isinstance(value, list)
+        else ()
+    )
+    for key, item in items:
+        name = (
+            f"{prefix}[{key}]"
+            if isinstance(key, int)
+            else f"{prefix}.{key}"
+            if prefix
+            else str(key)
+        )
+        found = _path(item, name)
+        if found is not None:
+            return found
+    return None
+
+
+def out_of_range(body: bytes) -> Optional[Problem]:
+    """Return the 422 for a JSON body holding a number beyond double precision.
+
+    The message names the number's field; None if the body holds none, or is not JSON.
+    """
+    try:
+        data = json.loads(body, parse_int=_number, parse_float=_number)
+    except (ValueError, RecursionError):
+        return None
+    found = _path(data)
+    if found is None:
+        return None
+    field, text = found
+    return Problem(
+        422,
+        "InputError",
+        f"{field}: the number {text} is out of the range of double "
+        "precision (magnitudes up to 1.8e308)",
+        field or None,
+    )
+
+
 def validate_json(model: Union[type[M], TypeAdapter[M]], body: bytes) -> M:
     """Validate a JSON body with ``model``; 422 with rockmech's message if it does not fit.
 
@@ -105,6 +173,10 @@ def validate_json(model: Union[type[M], TypeAdapter[M]], body: bytes) -> M:
                 "InputError",
                 f"the request body is nested deeper than {MAX_BODY_DEPTH} levels",
             ) from None
+        if any(e["type"] == "json_invalid" for e in exc.errors(include_url=False)):
+            problem = out_of_range(body)  # "number out of range at line 1 column 4311"
+            if problem is not None:
+                raise problem from None
         try:
             data = json.loads(body)
         except (ValueError, RecursionError):

@@ -17,7 +17,7 @@ interval (or a pulse of ``1/f_p`` seconds) into segments of at most ``1/p_eq`` s
 * exact envelopes: per mechanism side (both directions for one-sided rocking) and
   frequency, ``N_SCAN`` pulse runs of ``max(1, p_eq / f_p)`` steps; with amplification
   data, the pulse scale factor's grid points too (``scale_factor_points``, counted at
-  ``MAX_POINTS_PER_S``);
+  ``PULSE_POINTS_PER_CORE_S``);
 * time histories: per mechanism side and scale factor, ``(n - 1) max(1, ceil(p_eq dt))``;
 * an assessment: the time histories of every record at every multiple (one more run per
   record for the HTML page's figures), then, once the check has given each mechanism's
@@ -25,13 +25,13 @@ interval (or a pulse of ``1/f_p`` seconds) into segments of at most ``1/p_eq`` s
   record of ``(n - 1) max(1, ceil(STEPS_PER_PERIOD dt / T))`` steps each.
 
 An assessment's HTML page draws ``1 + n_mechanisms (2 + n_records)`` figures; it is refused
-when they cannot be drawn within the budget at ``MAX_FIGURES_PER_S`` or would make the page
+when they cannot be drawn within the budget at ``FIGURES_PER_S`` or would make the page
 larger than ``ROCKMECH_MAX_ANSWER_BYTES`` at ``ANSWER_BYTES_PER_FIGURE``.
 
-A job is refused when its steps exceed ``MAX_STEPS_PER_S x budget``: ``MAX_STEPS_PER_S`` is
-about ten times the fastest rate measured (1.8e6 steps/s for envelope scans, 6.7e6 for time
-histories, on a loaded 2-core machine), so only work that cannot finish in the budget on any
-machine we know is refused; the budget still catches the rest.
+A job is refused when its work cannot finish within the budget even at ``RATE_MARGIN``
+times the rates measured by ``benchmarks/work_rates.py`` on every core
+(``workflows.limits.shortest_time``; the rates and the margin, with their calibration, are
+in ``workflows.limits`` and ``docs/service.md``); the budget still catches the rest.
 """
 
 from __future__ import annotations
@@ -43,13 +43,16 @@ from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 
 from ..workflows.limits import (  # the numbers and estimates shared with the command line
-    MAX_POINTS_PER_S,
-    MAX_STEPS_PER_S,
+    FIGURES_PER_S,
     N_SCAN,
+    RATE_MARGIN,
     WORK_PER_SAMPLE,
+    cores,
     envelope_steps,
     history_steps,
     scale_factor_points,
+    shortest_time,
+    work_words,
 )
 from .jobspec import (
     AssessHtmlJob,
@@ -66,14 +69,12 @@ from .jobspec import (
 __all__ = [
     "ANSWER_BYTES_PER_FIGURE",
     "ANSWER_BYTES_PER_NUMBER",
-    "MAX_FIGURES_PER_S",
-    "MAX_STEPS_PER_S",
     "N_SCAN",
     "WORK_PER_SAMPLE",
     "assess_figures",
     "check_job",
     "check_limit",
-    "check_total_steps",
+    "check_time",
     "check_work",
     "envelope_steps",
     "history_steps",
@@ -81,11 +82,9 @@ __all__ = [
 
 #: Bytes of JSON per number in an answer (17 significant digits, sign, exponent, comma).
 ANSWER_BYTES_PER_NUMBER = 24
-#: Upper bound of the figures an assessment page draws per second: about ten times the
-#: rate measured (4.7 figures/s, 13 figures of the El Centro church page on a loaded
-#: 2-core machine), so only pages that cannot be drawn in the budget anywhere are refused.
-MAX_FIGURES_PER_S = 50.0
-#: Bytes of HTML per embedded figure (base64 PNG): 69 kB measured on the same page.
+#: Bytes of HTML per embedded figure (base64 PNG) [bytes]: 69 kB measured on the El Centro
+#: church page (``benchmarks/work_rates.py``'s), taken a little low so that only pages
+#: certainly too large are refused.
 ANSWER_BYTES_PER_FIGURE = 60_000
 
 
@@ -111,15 +110,30 @@ def check_work(steps: float, limits: dict[str, Any], what: str, field: str) -> N
         )
 
 
-def check_total_steps(steps: float, limits: dict[str, Any], what: str, field: str) -> None:
-    """Raise ``InputError`` when ``steps`` cannot be computed within the compute budget."""
+def check_time(limits: dict[str, Any], what: str, field: str, **work: float) -> None:
+    """Raise ``InputError`` when ``work`` cannot be computed within the compute budget.
+
+    Parameters
+    ----------
+    limits : dict
+        The service's limits (``budget_s``: the budget [s]; none: no check).
+    what, field : str
+        What the work is, for the message, and the field it is blamed on.
+    **work : float
+        The work by kind, as ``workflows.limits.shortest_time`` takes it.
+    """
     budget = limits.get("budget_s")
-    if budget is None or not steps > MAX_STEPS_PER_S * budget:
+    if budget is None:
+        return
+    seconds = shortest_time(**work)
+    if not seconds > budget:
         return
     raise InputError(
-        f"{what} would take {steps:.3g} closed-form steps, which cannot finish within the "
-        f"service's budget of {budget:g} s per request (ROCKMECH_COMPUTE_TIMEOUT_S); ask for "
-        "less work or run it with the rockmech command line",
+        f"{what} would take {work_words(**work)}: at least {seconds:.3g} s even at "
+        f"{RATE_MARGIN:g} times the rates measured (benchmarks/work_rates.py) on all "
+        f"{cores()} cores, past the service's budget of {budget:g} s per request "
+        "(ROCKMECH_COMPUTE_TIMEOUT_S); ask for less work or run it with the rockmech "
+        "command line",
         field,
     )
 
@@ -164,12 +178,22 @@ def _envelope(
     check_limit(n, limits["max_samples"], "frequencies", "n", "max_samples")
     columns = sum(4 if m.amplification is not None else 1 for m in cf.mechanisms) + 2
     _check_answer(n * columns, limits, "the envelopes", "n")
-    if exact:
-        steps = envelope_steps(cf, f_min, f_max, n)
-        # The pulse scale factors' grid points, as steps of the same time.
-        points = scale_factor_points(cf, f_min, f_max, n)
-        steps += points * MAX_STEPS_PER_S / MAX_POINTS_PER_S
-        check_total_steps(steps, limits, "the exact envelopes", "exact")
+    # Mechanisms with a restitution per impact direction are computed exactly anyway.
+    what = (
+        "the exact envelopes"
+        if exact
+        else (
+            "the envelopes of the mechanisms with a restitution per impact direction (always "
+            "computed with the exact integrator)"
+        )
+    )
+    check_time(
+        limits,
+        what,
+        "exact" if exact else "constants",
+        envelope_steps=envelope_steps(cf, f_min, f_max, n, exact=exact),
+        pulse_points=scale_factor_points(cf, f_min, f_max, n) if exact else 0.0,
+    )
 
 
 def _history(job: Any, cf: Optional[ConstantsFile], limits: dict[str, Any]) -> None:
@@ -181,7 +205,7 @@ def _history(job: Any, cf: Optional[ConstantsFile], limits: dict[str, Any]) -> N
     if cf is not None:
         check_work(history_steps(cf, n, dt, 1, worst=True), limits, "the time history", "record")
         steps = history_steps(cf, n, dt, len(job.scales))
-        check_total_steps(steps, limits, "the time histories", "record")
+        check_time(limits, "the time histories", "record", history_steps=steps)
 
 
 def assess_figures(n_mechanisms: int, n_records: int) -> int:
@@ -203,16 +227,18 @@ def _assess(job: Any, cf: ConstantsFile, limits: dict[str, Any], html: bool) -> 
         worst = history_steps(cf, n, dt, 1, worst=True)
         check_work(worst, limits, "the time history", f"records[{i}]")
         steps += history_steps(cf, n, dt, runs)
-    check_total_steps(steps, limits, "the time histories", "records")
+    check_time(limits, "the time histories", "records", history_steps=steps)
     if not html:
         return
     figures = assess_figures(len(cf.mechanisms), len(job.records))
     budget = limits.get("budget_s")
-    if budget is not None and figures > MAX_FIGURES_PER_S * budget:
+    if budget is not None and shortest_time(figures=figures) > budget:
         raise InputError(
-            f"the HTML page would draw {figures} figures, which cannot finish within the "
-            f"service's budget of {budget:g} s per request (ROCKMECH_COMPUTE_TIMEOUT_S); send "
-            "fewer mechanisms or records, ask for format json, or run rockmech assess",
+            f"the HTML page would draw {figures} figures: at least "
+            f"{shortest_time(figures=figures):.3g} s even at {RATE_MARGIN:g} times the "
+            f"{FIGURES_PER_S:g} figures/s measured, past the service's budget of {budget:g} s "
+            "per request (ROCKMECH_COMPUTE_TIMEOUT_S); send fewer mechanisms or records, ask "
+            "for format json, or run rockmech assess",
             "format",
         )
     size = figures * ANSWER_BYTES_PER_FIGURE

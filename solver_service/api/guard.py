@@ -9,7 +9,9 @@ answers. So:
   loopback names ``localhost``, ``127.0.0.1``, ``[::1]``), else 400;
 * a request with an ``Origin`` header (browsers send it with cross-site and POST requests)
   must come from the service's own origin or an allowed one (``ROCKMECH_ALLOWED_ORIGINS``,
-  default none), else 403.
+  default none), else 403. The loopback names (``localhost``, ``127.0.0.1``, ``[::1]``) are
+  one host: a page of the service opened as ``http://localhost:8000`` may call it as
+  ``127.0.0.1:8000`` (same scheme and port; only this machine can be either).
 
 Requests without ``Origin`` (curl, Grasshopper's Hops, scripts) are not browsers' and pass.
 ``"*"`` in either list allows any. The check runs before the body is read.
@@ -23,7 +25,10 @@ from starlette.types import ASGIApp, Receive, Scope, Send
 
 from .errors import error_body
 
-__all__ = ["HostGuard", "host_name"]
+__all__ = ["LOOPBACK", "HostGuard", "host_name", "same_origin"]
+
+#: Names of this machine's loopback interface, as a ``Host`` header or an origin gives them.
+LOOPBACK = frozenset({"localhost", "127.0.0.1", "[::1]"})
 
 
 def host_name(host: str) -> str:
@@ -38,6 +43,39 @@ def host_name(host: str) -> str:
     if host.startswith("["):
         return host.split("]", 1)[0] + "]"
     return host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+
+
+def _host_port(authority: str, scheme: str) -> tuple[str, str]:
+    """(host, port) of ``host[:port]``, the port defaulted from the scheme."""
+    authority = authority.strip().lower()
+    host = host_name(authority)
+    rest = authority[len(host) :]
+    port = rest[1:] if rest.startswith(":") else ""
+    return host, port or ("443" if scheme in ("https", "wss") else "80")
+
+
+def same_origin(origin: str, scheme: str, host: str) -> bool:
+    """Whether the browser ``origin`` is the service's own, reached as ``scheme://host``.
+
+    The loopback names count as one host (``LOOPBACK``).
+
+    Examples
+    --------
+    >>> same_origin("http://localhost:8000", "http", "127.0.0.1:8000")
+    True
+    >>> same_origin("http://localhost:8001", "http", "127.0.0.1:8000")
+    False
+    >>> same_origin("http://evil.example:8000", "http", "127.0.0.1:8000")
+    False
+    """
+    o_scheme, sep, o_authority = origin.strip().lower().rstrip("/").partition("://")
+    if not sep or o_scheme != scheme.lower():
+        return False
+    o_host, o_port = _host_port(o_authority, o_scheme)
+    s_host, s_port = _host_port(host, scheme.lower())
+    if o_port != s_port:
+        return False
+    return o_host == s_host or (o_host in LOOPBACK and s_host in LOOPBACK)
 
 
 class HostGuard:
@@ -91,8 +129,9 @@ class HostGuard:
         if origin is None or "*" in self.origins:
             return None
         origin = origin.strip().lower().rstrip("/")
-        own = f"{scope.get('scheme', 'http')}://{(host or '').strip().lower()}"
-        if origin == own or origin in self.origins:
+        if same_origin(origin, str(scope.get("scheme", "http")), host or "") or (
+            origin in self.origins
+        ):
             return None
         return 403, (
             f"requests from the web page origin {origin!r} are refused: a page in a browser "

@@ -26,6 +26,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import re
 from collections.abc import Callable
 from typing import Any, ClassVar
 
@@ -36,6 +37,7 @@ from shared_schema.constants import parse_constants, validation_lines
 from shared_schema.errors import InputError
 
 from .bodies import load_json
+from .errors import clip_echoes
 from .jobspec import EnvelopeJob, HistoryJob, Job, PulseJob
 
 log = logging.getLogger("rockmech.hops")
@@ -335,6 +337,7 @@ class RockmechHops:
             values = data.get("values")
             if not isinstance(values, list) or not all(isinstance(v, dict) for v in values):
                 raise HopsError(400, "values: a Hops solve request needs a list of inputs")
+            _refuse_numbers_out_of_range(values)
             try:
                 ok, inputs = self.hops._prepare_inputs(comp, json.dumps(data))
             except HopsError:
@@ -351,9 +354,10 @@ class RockmechHops:
             _, text = self.hops._prepare_outputs(comp, returned)
             return 200, text.encode("utf-8")
         except HopsError as exc:
-            return exc.status, self.hops._return_with_err(str(exc)).encode("utf-8")
+            return exc.status, self.hops._return_with_err(clip_echoes(str(exc))).encode("utf-8")
         except ValueError as exc:  # json.JSONDecodeError and pydantic's ValidationError
-            return 422, self.hops._return_with_err(_validation_text(exc)).encode("utf-8")
+            message = clip_echoes(_validation_text(exc))
+            return 422, self.hops._return_with_err(message).encode("utf-8")
         except RecursionError:  # an input's JSON text (the body's depth is bounded)
             message = "an input's JSON text is nested too deeply"
             return 422, self.hops._return_with_err(message).encode("utf-8")
@@ -374,6 +378,37 @@ def _constants_json(text: Any) -> Any:
         return json.loads(parse_constants(text).model_dump_json(exclude_none=True))
     except InputError as exc:
         raise InputError(str(exc), "constants") from None
+
+
+#: A number as Hops sends one in an input tree's ``data`` text.
+_NUMBER_TEXT = re.compile(r"\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*")
+
+
+def _refuse_numbers_out_of_range(values: list[dict[str, Any]]) -> None:
+    """Refuse, naming the input, a number no double can hold in a Hops input tree.
+
+    ghhops reads each item's text with ``json.loads``: Python's own message for an integer
+    of more than 4300 digits ("Exceeds the limit (4300 digits) ...") would reach the caller.
+
+    Raises
+    ------
+    HopsError
+        422 naming the input (``ParamName``).
+    """
+    for value in values:
+        tree = value.get("InnerTree")
+        if not isinstance(tree, dict):
+            continue
+        for items in tree.values():
+            for item in items if isinstance(items, list) else ():
+                data = item.get("data") if isinstance(item, dict) else None
+                if isinstance(data, str) and _NUMBER_TEXT.fullmatch(data):
+                    if not math.isfinite(float(data)):
+                        raise HopsError(
+                            422,
+                            f"{value.get('ParamName')}: the number {data.strip()} is out of "
+                            "the range of double precision (magnitudes up to 1.8e308)",
+                        )
 
 
 def _validation_text(exc: ValueError) -> str:

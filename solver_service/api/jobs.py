@@ -68,7 +68,7 @@ from ..workflows.scaling import Building
 from .errors import error_body
 from .estimates import (
     check_limit,
-    check_total_steps,
+    check_time,
     check_work,
     history_steps,
 )
@@ -87,7 +87,7 @@ from .jobspec import (
     SpectrumJob,
     WarmupJob,
 )
-from .uploads import safe_filename
+from .uploads import check_record_lines, safe_filename
 
 __all__ = [
     "JOBS",
@@ -172,7 +172,7 @@ def check_history_work(
     sides = [s for m in cf.mechanisms for s in (m.positive, m.negative) if s is not None]
     check_record_work(motion, limits, p_max=max(s.p_eq for s in sides))
     steps = history_steps(cf, motion.accel.n, motion.dt, n_scales)
-    check_total_steps(steps, limits, "the time histories", "record")
+    check_time(limits, "the time histories", "record", history_steps=steps)
     if sf == "eq28":
         for mech in cf.mechanisms:
             if mech.amplification is not None:
@@ -247,6 +247,7 @@ def motion_from_params(
         )
     if upload is None or blob is None:
         raise InputError("give a record", "record")
+    check_record_lines(blob, max_samples)  # before parsing: bounded memory
     name = safe_filename(upload.filename, "record.dat")
     with tempfile.TemporaryDirectory(prefix="rockmech-") as folder:
         path = Path(folder) / name
@@ -530,7 +531,7 @@ def check_spectra_work(
             check_record_work(motion, limits, t_min=t_lo)
             steps += count * _record_steps(motion, STEPS_PER_PERIOD / t_lo)
         if steps > 0.0:
-            check_total_steps(steps, limits, "the records' spectra", f"records[{i}]")
+            check_time(limits, "the records' spectra", f"records[{i}]", spectrum_steps=steps)
 
 
 def _assess(job: AssessJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:

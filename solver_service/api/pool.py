@@ -11,7 +11,13 @@ one worker without breaking the whole pool. Here each worker speaks framed JSON 
 stdin/stdout (``solver_service.api.worker``), and no pickle is used.
 
 Every process warms its kernels up before it takes work (numba loads them from its cache),
-so a replacement does not make the next request pay for compilation.
+so a replacement does not make the next request pay for compilation. The processes start in
+the background: the server answers at once (``/health`` says ``starting`` until every process
+has warmed up, and a request waits for a free one as for a busy pool). A process that does
+not warm up within ``startup_timeout_s`` (a busy machine, kernels still being compiled) is
+ended and started again with twice the time; one that exits while starting is started again
+after a pause (``RESTART_PAUSE_S``, doubling up to ``RESTART_PAUSE_MAX_S``). Each of these is
+one line in the log, never a traceback, and the server keeps running.
 
 Faults. A worker that dies while idle is noticed (a watcher awaits every process) and
 replaced, and a worker is checked to be alive before it is handed out. A job whose worker
@@ -52,6 +58,10 @@ STREAM_LIMIT = 1 << 20
 EXIT_GRACE_S = 2.0
 #: Seconds a client is told to wait before retrying after a worker died (``Retry-After``).
 RETRY_AFTER_S = 2
+#: First pause before a worker that exited while starting is started again [s]; it doubles
+#: on each further failure, up to ``RESTART_PAUSE_MAX_S``.
+RESTART_PAUSE_S = 1.0
+RESTART_PAUSE_MAX_S = 30.0
 
 
 class BudgetExceeded(Exception):
@@ -68,6 +78,10 @@ class WorkerLost(Exception):
 
 class _SendFailed(Exception):
     """The worker was gone before it received the whole job (safe to retry)."""
+
+
+class _StartFailed(Exception):
+    """A worker did not warm up in time, or exited while starting (the message says which)."""
 
 
 @dataclass(frozen=True)
@@ -137,6 +151,12 @@ class ComputePool:
         self._tasks: set[asyncio.Task[None]] = set()
         self._cond: Optional[asyncio.Condition] = None
         self._closing = False
+        self._started = 0  # workers of the first start that have warmed up
+
+    @property
+    def ready(self) -> bool:
+        """True once every worker of the first start has warmed up (``/health``: ``ok``)."""
+        return self._started >= self.size
 
     @property
     def alive(self) -> int:
@@ -153,10 +173,30 @@ class ComputePool:
         return self._cond
 
     async def start(self) -> None:
-        """Start every worker and wait until each has warmed up."""
-        await asyncio.gather(*(self._spawn() for _ in range(self.size)))
+        """Start every worker in the background (``ready`` says when all have warmed up)."""
+        for _ in range(self.size):
+            self._background(self._start_one(initial=True))
 
-    async def _spawn(self) -> None:
+    async def _start_one(self, initial: bool = False) -> None:
+        """Start one worker, again and again until one warms up (one log line per failure)."""
+        timeout, pause = self.startup_timeout_s, RESTART_PAUSE_S
+        while not self._closing:
+            try:
+                await self._spawn(timeout)
+            except (_StartFailed, OSError) as exc:
+                if isinstance(exc, _StartFailed) and "did not warm up" in str(exc):
+                    log.warning("%s; starting it again with %g s", exc, 2 * timeout)
+                    timeout *= 2
+                else:
+                    log.warning("%s; starting it again in %g s", exc, pause)
+                    await asyncio.sleep(pause)
+                    pause = min(2 * pause, RESTART_PAUSE_MAX_S)
+                continue
+            if initial:
+                self._started += 1
+            return
+
+    async def _spawn(self, timeout_s: float) -> None:
         tmpdir = tempfile.mkdtemp(prefix="rockmech-worker-")
         proc = await asyncio.create_subprocess_exec(
             sys.executable,
@@ -171,9 +211,24 @@ class ComputePool:
         self._all.add(worker)
         try:
             assert proc.stdout is not None
-            line = await asyncio.wait_for(proc.stdout.readline(), self.startup_timeout_s)
-            if not json.loads(line or b"{}").get("ready"):
-                raise RuntimeError(f"compute process {proc.pid} did not start")
+            try:
+                line = await asyncio.wait_for(proc.stdout.readline(), timeout_s)
+            except asyncio.TimeoutError:
+                raise _StartFailed(
+                    f"compute process {proc.pid} did not warm up within {timeout_s:g} s "
+                    "(ROCKMECH_STARTUP_TIMEOUT_S; a busy machine, or kernels being compiled)"
+                ) from None
+            try:
+                ready = bool(json.loads(line or b"{}").get("ready"))
+            except ValueError:
+                ready = False
+            if not ready:
+                with contextlib.suppress(asyncio.TimeoutError):
+                    await asyncio.wait_for(proc.wait(), EXIT_GRACE_S)
+                raise _StartFailed(
+                    f"compute process {proc.pid} stopped while starting (exit code "
+                    f"{proc.returncode}; its messages are above)"
+                )
         except BaseException:
             await self._end(worker)
             raise
@@ -217,6 +272,12 @@ class ComputePool:
                         return worker
                     self._replace(worker)
                 remaining = deadline - time.monotonic()
+                if remaining <= 0 and not self.ready:
+                    raise PoolBusy(
+                        f"the compute processes are still starting ({self.alive} of "
+                        f"{self.size} ready after {self.queue_timeout_s:g} s of waiting); "
+                        "try again in a moment"
+                    )
                 if remaining <= 0:
                     raise PoolBusy(
                         f"all {self.size} compute processes stayed busy for "
@@ -236,11 +297,7 @@ class ComputePool:
 
         async def replace() -> None:
             await self._end(worker)
-            if not self._closing:
-                try:
-                    await self._spawn()
-                except Exception:  # pragma: no cover - logged; the pool runs one short
-                    log.exception("could not start a replacement compute process")
+            await self._start_one()
 
         self._background(replace())
 

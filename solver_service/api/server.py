@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import contextlib
 import math
+import os
 import subprocess
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any, Optional
@@ -17,7 +19,15 @@ from shared_schema.errors import InputError
 from .app import create_app
 from .settings import Settings
 
-__all__ = ["background_server", "free_port", "process_rss_bytes", "run", "settings_with"]
+__all__ = [
+    "background_server",
+    "free_port",
+    "process_rss_bytes",
+    "run",
+    "serve",
+    "settings_env",
+    "settings_with",
+]
 
 
 def settings_with(**overrides: Any) -> Settings:
@@ -38,7 +48,21 @@ def settings_with(**overrides: Any) -> Settings:
 
 
 def run(settings: Settings) -> None:
-    """Serve until interrupted (uvicorn, one event loop; compute in worker processes)."""
+    """Serve until interrupted, in a fresh process that imports only what routing needs.
+
+    ``rockmech serve`` runs in the command line's process, which has imported the numerics
+    (numpy, scipy, numba: 240 MB) for the other commands. This process is replaced
+    (``os.execve``, same process id) by ``python -m solver_service.api.server`` with the
+    settings in its environment; only the compute processes load the numerics.
+    """
+    env = {**os.environ, **settings_env(settings)}
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os.execve(sys.executable, [sys.executable, "-m", __name__], env)
+
+
+def serve(settings: Settings) -> None:
+    """Serve until interrupted, in this process (uvicorn, one event loop)."""
     import uvicorn
 
     uvicorn.run(
@@ -49,6 +73,14 @@ def run(settings: Settings) -> None:
         access_log=False,
         timeout_graceful_shutdown=math.ceil(settings.shutdown_timeout_s),
     )
+
+
+def settings_env(settings: Settings) -> dict[str, str]:
+    """Return ``settings`` as ``ROCKMECH_*`` environment variables."""
+    return {
+        f"ROCKMECH_{name.upper()}": _env_value(value)
+        for name, value in settings.model_dump().items()
+    }
 
 
 def free_port() -> int:
@@ -67,6 +99,7 @@ def background_server(
     *,
     start_timeout_s: float = 120.0,
     env: Optional[dict[str, str]] = None,
+    ready: bool = True,
 ) -> Iterator[tuple[str, subprocess.Popen[bytes]]]:
     """Run ``rockmech serve`` in a child process on a free loopback port (tests, benchmarks).
 
@@ -80,6 +113,9 @@ def background_server(
         Longest wait for ``/api/v1/health`` to answer [s].
     env : dict, optional
         More environment variables for the server (e.g. ``TMPDIR``).
+    ready : bool
+        Wait until ``/api/v1/health`` says ``ok`` (every compute process has warmed up);
+        False: only until it answers (``starting`` too).
 
     Yields
     ------
@@ -87,9 +123,7 @@ def background_server(
         Base URL ``http://127.0.0.1:<port>`` and the server process; it is stopped (SIGTERM,
         then SIGKILL after 30 s) on exit.
     """
-    import os
     import signal
-    import sys
     import time
     import urllib.error
     import urllib.request
@@ -112,6 +146,9 @@ def background_server(
                 with urllib.request.urlopen(f"{url}/api/v1/health", timeout=2) as res:
                     if res.status == 200:
                         break
+            except urllib.error.HTTPError:  # 503: the compute processes are starting
+                if not ready:
+                    break
             except (urllib.error.URLError, ConnectionError, TimeoutError):
                 pass
             if time.monotonic() > deadline:
@@ -149,3 +186,7 @@ def process_rss_bytes(pid: int) -> int:
         except OSError:
             continue
     return total
+
+
+if __name__ == "__main__":  # ``run`` starts the service this way, settings in the environment
+    serve(Settings())

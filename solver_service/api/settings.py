@@ -30,7 +30,9 @@ class Settings(BaseSettings):
     queue_timeout_s : float
         Longest wait for a free compute process [s]; past it the request gets 503.
     startup_timeout_s : float
-        Longest start-up (imports and warm-up) of one compute process [s].
+        Time a compute process has to start (imports and warm-up) [s]; past it, it is
+        started again with twice the time (one log line each time; the server keeps
+        running, and ``/health`` says ``starting`` until every process is ready).
     max_body_bytes : int
         Largest request body [bytes], uploads included; larger bodies get 413.
     max_samples : int

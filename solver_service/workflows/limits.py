@@ -22,17 +22,25 @@ interval (or a pulse of ``1/f_p`` seconds) into segments of at most ``1/p_eq`` s
 
 Exact envelopes of a mechanism with amplification data also evaluate the pulse response
 spectrum at every frequency, on ``SPECTRUM_GRID_PER_PERIOD max(1, f_n / f_p)`` grid points
-(``scale_factor_points``), counted at ``MAX_POINTS_PER_S``.
+(``scale_factor_points``), counted at ``PULSE_POINTS_PER_CORE_S``.
 
-``MAX_STEPS_PER_S`` is about ten times the fastest rate measured (1.8e6 steps/s for
-envelope scans, 6.7e6 for time histories, on a loaded 2-core machine), so a budget check
-refuses only work that cannot finish in the budget on any machine we know.
+Elastic response spectra cut each sample interval into at most ``T / SPECTRUM_SUBSTEPS``
+long sub-steps (``spectrum_steps``), and an assessment page draws ``assess_figures``.
+
+Each kind of work has its rate per core, measured by ``benchmarks/work_rates.py`` on the job
+functions the compute processes run and recorded in ``docs/benchmarks.md`` (section
+``work_rates``; ``tests/workflows/test_work_rates.py`` checks the constants against it). Work
+is refused up front when it cannot finish within the budget even at ``RATE_MARGIN`` times
+those rates on every core of the machine (``shortest_time``): a margin for faster cores than
+the benchmark's, while the cores are counted where the work runs. What passes may still
+run past the budget on a slower or busier machine; the budget stops it there.
 """
 
 from __future__ import annotations
 
 import contextlib
 import math
+import os
 import signal
 import sys
 import threading
@@ -46,27 +54,62 @@ from shared_schema.errors import InputError
 __all__ = [
     "CLI_BUDGET_S",
     "DEFAULT_LIMITS",
-    "MAX_POINTS_PER_S",
-    "MAX_STEPS_PER_S",
+    "ENVELOPE_STEPS_PER_CORE_S",
+    "FIGURES_PER_S",
+    "HISTORY_STEPS_PER_CORE_S",
     "NO_LIMITS",
     "N_SCAN",
+    "PULSE_POINTS_PER_CORE_S",
     "P_EQ_PLAUSIBLE",
+    "RATE_MARGIN",
     "SPECTRUM_GRID_PER_PERIOD",
+    "SPECTRUM_STEPS_PER_CORE_S",
+    "SPECTRUM_SUBSTEPS",
     "TIME_LIMIT",
+    "WORK_KINDS",
     "WORK_PER_SAMPLE",
     "TimeLimitExceeded",
     "active_time_limit",
     "check_count",
     "check_run",
+    "cores",
+    "directional",
     "envelope_steps",
     "history_steps",
     "mechanism_sides",
     "scale_factor_points",
+    "shortest_time",
+    "spectrum_steps",
     "time_limit",
+    "work_words",
 ]
 
-#: Upper bound of the exact integrator's speed [closed-form steps per second] (see Notes).
-MAX_STEPS_PER_S = 5.0e7
+#: Margin of the up-front estimates over the rates below [-]: work is refused when it
+#: cannot finish within the budget even this many times faster than measured, on every
+#: core. 2: the newest desktop cores are up to about twice as fast per core as the
+#: benchmark machine's (a shared 2-core AMD EPYC); the rates are per core, so more cores
+#: are counted where the work runs (``cores``).
+RATE_MARGIN = 2.0
+#: The rates measured per core by ``benchmarks/work_rates.py``, to two significant digits
+#: [unit/s]: the work divided by the CPU time of the job (all threads), best of 3, on the
+#: benchmark machine (AMD EPYC, 2 cores); docs/benchmarks.md, section ``work_rates``, holds
+#: the run (a test checks these against its table). Exact envelopes, closed-form steps
+#: (the church's 8 mechanisms without amplification data, 200 frequencies): 2.59e6/s.
+ENVELOPE_STEPS_PER_CORE_S = 2.6e6
+#: The pulse scale factors' spectrum, grid points (``pulse_response_spectrum`` at the
+#: church's ratios): 2.14e6/s.
+PULSE_POINTS_PER_CORE_S = 2.1e6
+#: Time histories, closed-form steps (the church on El Centro at 100 scale factors: runs at
+#: rest, rocking and overturning): 7.39e7/s.
+HISTORY_STEPS_PER_CORE_S = 7.4e7
+#: Elastic response spectra, sub-steps (El Centro at 1000 periods): 1.82e8/s.
+SPECTRUM_STEPS_PER_CORE_S = 1.8e8
+#: The assessment page's figures, drawn on one thread (the church_geometry page on El
+#: Centro, 13 figures): 4.51/s.
+FIGURES_PER_S = 4.5
+#: Sub-steps per natural period of the elastic response spectrum
+#: (``core.spectra.STEPS_PER_PERIOD``; a test checks the copy).
+SPECTRUM_SUBSTEPS = 20
 #: Pulse amplitudes scanned per frequency by an exact envelope (``core.envelope.N_SCAN``;
 #: a test checks the copy).
 N_SCAN = 300
@@ -81,15 +124,12 @@ DEFAULT_LIMITS: dict[str, int] = {
     "max_answer_bytes": 64 * 1024 * 1024,
 }
 #: Work budget of one command-line run [s]: work that cannot finish in it even at
-#: ``MAX_STEPS_PER_S`` is refused (the service's budget is its compute timeout).
+#: ``RATE_MARGIN`` times the measured rates is refused (the service's budget is its compute
+#: timeout).
 CLI_BUDGET_S = 600.0
 #: Grid points per period of the exact pulse response spectrum
 #: (``core.amplification.GRID_PER_PERIOD``; a test checks the copy).
 SPECTRUM_GRID_PER_PERIOD = 64
-#: Upper bound of the rate of the exact pulse response spectrum [grid points per second]:
-#: about ten times the rate measured (64,000 points in 15 ms, 4.3e6 points/s, at
-#: ``f_p/f_n = 1e-3`` on a loaded 2-core machine).
-MAX_POINTS_PER_S = 4.0e7
 #: ``core.exact.P_EQ_PLAUSIBLE`` [rad/s] (a test checks the copy): the solver refuses a run
 #: of a stiffer side itself, naming ``p_eq`` and its valid range, so ``check_run`` leaves
 #: such sides to it rather than blaming the record.
@@ -216,6 +256,67 @@ def time_limit(seconds: Optional[float]) -> Iterator[None]:
             timer(signal.ITIMER_REAL, max(outer - (time.monotonic() - start), 1e-3))
 
 
+def cores() -> int:
+    """Return the cores this process may run on (the compute processes' threads use them)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+#: The kinds of work the estimates count: (rate per core [unit/s], its words); the figures
+#: are drawn on one thread.
+WORK_KINDS: dict[str, tuple[float, str]] = {
+    "envelope_steps": (ENVELOPE_STEPS_PER_CORE_S, "closed-form steps of exact envelopes"),
+    "pulse_points": (PULSE_POINTS_PER_CORE_S, "grid points of pulse spectra"),
+    "history_steps": (HISTORY_STEPS_PER_CORE_S, "closed-form steps of time histories"),
+    "spectrum_steps": (SPECTRUM_STEPS_PER_CORE_S, "sub-steps of response spectra"),
+    "figures": (FIGURES_PER_S, "figures"),
+}
+
+
+def _kinds(work: dict[str, float]) -> list[tuple[str, float]]:
+    unknown = set(work) - set(WORK_KINDS)
+    if unknown:
+        raise TypeError(f"unknown kinds of work: {sorted(unknown)}")
+    return [(kind, float(work.get(kind, 0.0))) for kind in WORK_KINDS]
+
+
+def shortest_time(**work: float) -> float:
+    """Return the least time the work can take [s].
+
+    Parameters
+    ----------
+    **work : float
+        Work by kind (``WORK_KINDS``: ``envelope_steps``, ``pulse_points``,
+        ``history_steps``, ``spectrum_steps``, ``figures``).
+
+    Notes
+    -----
+    Each kind at ``RATE_MARGIN`` times its measured rate per core, on every core (the
+    figures on one).
+    """
+    seconds = 0.0
+    for kind, amount in _kinds(work):
+        rate = WORK_KINDS[kind][0] * RATE_MARGIN
+        seconds += amount / (rate if kind == "figures" else rate * cores())
+    return seconds
+
+
+def work_words(**work: float) -> str:
+    """Return the work in words, e.g. ``3.75e+08 closed-form steps of exact envelopes``."""
+    words = [f"{amount:.3g} {WORK_KINDS[kind][1]}" for kind, amount in _kinds(work) if amount > 0]
+    return " and ".join(words) if words else "no work"
+
+
+def spectrum_steps(n_samples: int, dt: float, period: float) -> float:
+    """Sub-steps of the elastic response spectrum of a record at one ``period`` [s]."""
+    per_sample = SPECTRUM_SUBSTEPS * dt / period
+    if not math.isfinite(per_sample):
+        return math.inf
+    return float(max(n_samples - 1, 0) * max(1.0, math.ceil(per_sample)))
+
+
 def _positive(*values: Any) -> bool:
     return all(
         isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0
@@ -223,15 +324,33 @@ def _positive(*values: Any) -> bool:
     )
 
 
-def mechanism_sides(cf: ConstantsFile, p_max: float = math.inf) -> Iterable[tuple[float, int]]:
-    """(p_eq [rad/s], pulse directions) of every side with a valid ``p_eq`` up to ``p_max``."""
+def directional(mech: Any) -> bool:
+    """Whether a mechanism restitutes differently per impact direction.
+
+    Its envelope is always computed with the exact integrator, the pulse in both directions
+    (``core.envelope.mechanism_envelope``; ``RockingModel.is_directional``).
+    """
+    neg = getattr(mech, "eta_to_negative", None)
+    return neg is not None and neg != getattr(mech, "eta_to_positive", None)
+
+
+def mechanism_sides(
+    cf: ConstantsFile, p_max: float = math.inf, *, only_exact: bool = False
+) -> Iterable[tuple[float, int]]:
+    """(p_eq [rad/s], pulse directions) of every side with a valid ``p_eq`` up to ``p_max``.
+
+    With ``only_exact``, only the sides of mechanisms whose envelope is exact anyway
+    (``directional``).
+    """
     for mech in cf.mechanisms:
+        if only_exact and not directional(mech):
+            continue
         one_sided = mech.rocking == "one_sided"
         sides = (mech.positive,) if one_sided else (mech.positive, mech.negative)
         for side in sides:
             p = None if side is None else side.p_eq
             if p is not None and _positive(p) and p <= p_max:
-                yield float(p), 2 if one_sided else 1
+                yield float(p), 2 if one_sided or directional(mech) else 1
 
 
 def _grid_sum(p: float, f_min: float, f_max: float, n: int) -> float:
@@ -246,13 +365,20 @@ def _grid_sum(p: float, f_min: float, f_max: float, n: int) -> float:
 
 
 def envelope_steps(
-    cf: ConstantsFile, f_min: float, f_max: float, n: int, *, p_max: float = math.inf
+    cf: ConstantsFile,
+    f_min: float,
+    f_max: float,
+    n: int,
+    *,
+    p_max: float = math.inf,
+    exact: bool = True,
 ) -> float:
     """Closed-form steps of exact envelopes of every mechanism at ``n`` frequencies.
 
-    Sides with ``p_eq`` above ``p_max`` [rad/s] are left out.
+    Sides with ``p_eq`` above ``p_max`` [rad/s] are left out. With ``exact`` False (the
+    library's envelopes), only the mechanisms computed exactly anyway (``directional``).
     """
-    sides = mechanism_sides(cf, p_max)
+    sides = mechanism_sides(cf, p_max, only_exact=not exact)
     return float(sum(N_SCAN * d * _grid_sum(p, f_min, f_max, n) for p, d in sides))
 
 
@@ -341,8 +467,9 @@ def check_run(
     limits : dict, optional
         ``DEFAULT_LIMITS`` unless given.
     budget_s : float, optional
-        Work that cannot finish in this time [s] at ``MAX_STEPS_PER_S`` is refused; by
-        default the time limit of the run (``active_time_limit``).
+        Work that cannot finish in this time [s] at ``RATE_MARGIN`` times the measured
+        rates (``shortest_time``) is refused; by default the time limit of the run
+        (``active_time_limit``).
 
     Raises
     ------
@@ -356,12 +483,15 @@ def check_run(
         check_count(len(cf.mechanisms), lim["max_mechanisms"], "mechanisms", "constants")
     check_count(scales, lim["max_scales"], "scale factors", "scales")
     check_count(periods, lim["max_samples"], "periods", "n")
-    steps = 0.0
+    work = {"envelope_steps": 0.0, "pulse_points": 0.0, "history_steps": 0.0}
     if envelope is not None:
         f_min, f_max, n, exact = envelope
         check_count(n, lim["max_samples"], "frequencies", "n")
-        if exact and cf is not None:
-            steps += envelope_steps(cf, f_min, f_max, n, p_max=P_EQ_PLAUSIBLE)
+        if cf is not None:
+            work["envelope_steps"] = envelope_steps(
+                cf, f_min, f_max, n, p_max=P_EQ_PLAUSIBLE, exact=exact
+            )
+            work["pulse_points"] = scale_factor_points(cf, f_min, f_max, n) if exact else 0.0
     if record is not None:
         n_samples, dt = record
         check_count(n_samples, lim["max_samples"], "record samples", "record")
@@ -376,12 +506,15 @@ def check_run(
                     "record",
                 )
             runs = max(scales, 1)
-            steps += history_steps(cf, n_samples, dt, runs, p_max=P_EQ_PLAUSIBLE) * records
-    if steps > MAX_STEPS_PER_S * budget_s:
+            steps = history_steps(cf, n_samples, dt, runs, p_max=P_EQ_PLAUSIBLE) * records
+            work["history_steps"] = steps
+    seconds = shortest_time(**work)
+    if seconds > budget_s:
         field = "record" if record is not None else "exact"
         raise InputError(
-            f"the run would take {steps:.3g} closed-form steps, more than can finish in "
-            f"{budget_s:g} s on any machine we know; ask for less work, give {TIME_LIMIT} "
+            f"the run would take {work_words(**work)}, at least {seconds:.3g} s even at "
+            f"{RATE_MARGIN:g} times the rates measured on all {cores()} cores, more than "
+            f"its time limit of {budget_s:g} s; ask for less work, give {TIME_LIMIT} "
             f"with more seconds, or {NO_LIMITS} to lift the limit",
             field,
         )

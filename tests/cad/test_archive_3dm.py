@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from rhino_plugin.archive_3dm import check_3dm, layout_problem
+from rhino_plugin.archive_3dm import check_3dm, crc_problem, layout_problem
 from rhino_plugin.scene_3dm import Scene
 from shared_schema.errors import InputError
 from solver_service.cli import app
@@ -81,10 +81,28 @@ def test_rhino3dm_written_files_of_every_version_pass(tmp_path: Path) -> None:
     point = rhino3dm.Point(rhino3dm.Point3d(0, 0, 0))
     origin = rhino3dm.Point3d(0, 0, 0)
     model.InstanceDefinitions.Add("b", "", "", "", origin, (point,), (attributes,))
+    # Objects whose data nests other chunks (a Brep's curves and surfaces, user data on the
+    # geometry itself), so the CRC check's search for nested chunks is exercised too.
+    brep = rhino3dm.Brep.CreateFromBox(rhino3dm.Box(rhino3dm.BoundingBox(0, 0, 0, 1, 2, 3)))
+    brep.SetUserString("density_kg_m3", "1800")
+    model.Objects.AddBrep(brep, attributes)
+    mesh = rhino3dm.Mesh()
+    for x, y in ((0, 0), (1, 0), (1, 1), (0, 1)):
+        mesh.Vertices.Add(x, y, 0)
+    mesh.Faces.AddFace(0, 1, 2, 3)
+    mesh.SetUserString("role", "floor")
+    model.Objects.AddMesh(mesh)
+    circle = rhino3dm.Circle(rhino3dm.Point3d(0, 0, 0), 1).ToNurbsCurve()
+    model.Objects.AddExtrusion(rhino3dm.Extrusion.Create(circle, 5, True))
+    cloud = rhino3dm.PointCloud()
+    for i in range(300):
+        cloud.Add(rhino3dm.Point3d(i, 2 * i, 3 * i))
+    model.Objects.AddPointCloud(cloud)
     for version in (5, 6, 7, 8):
         path = tmp_path / f"v{version}.3dm"
         assert model.Write(str(path), version)
-        assert layout_problem(path.read_bytes()) is None, version
+        assert layout_problem(path.read_bytes()) is None, version  # the CRCs included
+        assert crc_problem(path.read_bytes()) is None, version
 
 
 def _corrupt_copies(path: Path) -> Iterator[tuple[str, bytes]]:
@@ -147,3 +165,61 @@ def test_rockmech_constants_refuses_a_corrupt_record_quickly(tmp_path: Path) -> 
     assert "as a .3dm file (truncated, corrupt or not a Rhino model)" in res.stderr
     assert res.stderr.count("\n") == 1
     assert not (tmp_path / "c.json").exists()
+
+
+def _class_data(data: bytes) -> list[tuple[int, int]]:
+    """(content start, end) of every object's class data chunk (``TCODE_OPENNURBS_CLASS_DATA``)."""
+    out = []
+    todo = [(32, len(data))]
+    while todo:
+        pos, end = todo.pop()
+        chunks = []
+        while pos + 12 <= end:
+            code, length = struct.unpack_from("<IQ", data, pos)
+            pos += 12
+            if code & 0x80000000:
+                continue
+            if length > end - pos:
+                break
+            chunks.append((code, pos, pos + length))
+            pos += length
+        if pos != end:
+            continue  # not a sequence of chunks: raw data
+        for code, lo, hi in chunks:
+            if code == 0x0002FFFC:
+                out.append((lo, hi))
+            else:
+                todo.append((lo, hi - 4 if code & 0x8000 else hi))
+    return out
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in SCENES.glob("*.3dm")))
+def test_a_flipped_bit_in_any_object_data_fails_the_crc_check(name: str) -> None:
+    data = (SCENES / name).read_bytes()
+    assert crc_problem(data) is None
+    regions = sorted(_class_data(data), key=lambda r: r[1] - r[0])[-4:]  # the largest
+    assert regions
+    flipped = 0
+    for lo, hi in regions:
+        for offset in range(lo, hi, max(1, (hi - lo) // 6))[1:]:
+            bad = bytearray(data)
+            bad[offset] ^= 0x04
+            problem = layout_problem(bytes(bad))
+            # A flip in a nested chunk's type code is not covered by a CRC (rhino3dm then
+            # refuses the chunk at once); everything else is.
+            code_bytes = _nested_code_bytes(data, lo, hi)
+            if offset in code_bytes:
+                continue
+            assert problem is not None and "fails its CRC check" in problem, (name, offset)
+            flipped += 1
+    assert flipped >= 8
+
+
+def _nested_code_bytes(data: bytes, lo: int, hi: int) -> set[int]:
+    """Offsets of the type codes of the anonymous chunks nested in [lo, hi)."""
+    out: set[int] = set()
+    at = data.find(b"\x00\x80\x00\x40", lo, hi)
+    while at >= 0:
+        out.update(range(at, at + 4))
+        at = data.find(b"\x00\x80\x00\x40", at + 1, hi)
+    return out

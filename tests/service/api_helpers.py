@@ -7,6 +7,7 @@ from __future__ import annotations
 import contextlib
 import json
 import subprocess
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -50,13 +51,17 @@ class Server:
 
 
 @contextlib.contextmanager
-def start_server(tmp: Path, env: dict[str, str] | None = None, **settings: Any) -> Iterator[Server]:
-    """Start ``rockmech serve`` with ``ROCKMECH_*`` settings on a free port; stop it after."""
+def start_server(
+    tmp: Path, env: dict[str, str] | None = None, ready: bool = True, **settings: Any
+) -> Iterator[Server]:
+    """Start ``rockmech serve`` with ``ROCKMECH_*`` settings on a free port; stop it after.
+
+    ``ready``: wait until its compute processes have warmed up (else until it answers).
+    """
     log = tmp / "server.log"
-    with background_server(settings, log, start_timeout_s=START_TIMEOUT_S, env=env) as (
-        url,
-        proc,
-    ):
+    with background_server(
+        settings, log, start_timeout_s=START_TIMEOUT_S, env=env, ready=ready
+    ) as (url, proc):
         yield Server(url, proc, log)
 
 
@@ -84,3 +89,26 @@ def without_runtime(doc: Any) -> Any:
     if isinstance(doc, list):
         return [without_runtime(v) for v in doc]
     return doc
+
+
+def cpu_ticks(pid: int) -> int:
+    """CPU time process ``pid`` has used, user and system [clock ticks] (``/proc``)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return int(fields[11]) + int(fields[12])
+
+
+def peak_rss(pid: int) -> int:
+    """Peak resident memory of process ``pid`` so far (``VmHWM``) [bytes]."""
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmHWM:"):
+            return int(line.split()[1]) * 1024
+    raise AssertionError(f"no VmHWM for {pid}")
+
+
+def wait_busy(pid: int, wait_s: float = 30.0) -> None:
+    """Wait until process ``pid`` has used 0.2 s of CPU (it has taken a job)."""
+    start = cpu_ticks(pid)
+    deadline = time.monotonic() + wait_s
+    while cpu_ticks(pid) - start < 20:  # 0.2 s of CPU at 100 ticks per second
+        assert time.monotonic() < deadline, f"process {pid} never started the job"
+        time.sleep(0.05)

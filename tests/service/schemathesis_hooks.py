@@ -96,10 +96,10 @@ from solver_service.workflows.scaling import factor_groups
 MAX_SAMPLES = int(os.environ["ROCKMECH_MAX_SAMPLES"])
 #: The server's limits and budget, from the same ``ROCKMECH_*`` variables as the server's.
 LIMITS = Settings().limits()
-#: The service refuses up front only work that cannot finish within its budget at
-#: ``MAX_STEPS_PER_S``, ten times the fastest rate measured (``api.estimates``), and stops
-#: the rest at the budget with 503; positive cases are kept within the budget at this many
-#: times less, half the measured rate (the test machine is loaded).
+#: The service refuses up front only work that cannot finish within its budget even at
+#: ``RATE_MARGIN`` times the measured rates on every core (``workflows.limits.shortest_time``),
+#: and stops the rest at the budget with 503; positive cases are kept within the budget at
+#: this many times less (the test machine is loaded and shared).
 LOADED_SLOWDOWN = 20
 #: The server's limits with the budget at the loaded machine's rate.
 LOADED_LIMITS = {**LIMITS, "budget_s": LIMITS["budget_s"] / LOADED_SLOWDOWN}

@@ -199,7 +199,7 @@ def test_no_temporary_file_survives_a_worker_killed_mid_upload(faulty: Server) -
 
 def test_work_that_cannot_finish_in_the_budget_is_refused_at_once(faulty: Server) -> None:
     # The stiffest side and the longest pulses the schema allows: 300 * 2 * (1e6 + 9.1e5)
-    # steps, past MAX_STEPS_PER_S x the 20 s budget.
+    # steps, past what RATE_MARGIN x the measured rate can do in the 20 s budget.
     stiff = {"id": "S", "p_eq": 1e3, "lam": 0.2, "rocking": "one_sided", "eta": -0.5}
     start = time.monotonic()
     body = {
@@ -228,7 +228,7 @@ def test_the_envelope_estimate_uses_the_solvers_scan() -> None:
     body = {"constants": {"mechanisms": [stiff]}, "exact": True, "n": 2}
     job = EnvelopeJob.model_validate({**body, "f_min": 0.001, "f_max": 0.002})
     with pytest.raises(InputError, match=r"9e\+08 closed-form steps"):
-        check_job(job, {"max_samples": 10**6, "max_mechanisms": 10, "budget_s": 10.0})
+        check_job(job, {"max_samples": 10**6, "max_mechanisms": 10, "budget_s": 1e-3})
 
 
 def test_many_json_values_are_refused_before_decoding(faulty: Server) -> None:
@@ -319,7 +319,8 @@ def test_two_former_500s_are_answered(faulty: Server) -> None:
     ]
     res = httpx.post(f"{faulty.url}/hops/pulse", json={"values": values})
     assert res.status_code == 422, res.text
-    assert res.json()["errors"] == ["a number is out of the range of double precision"]
+    (error,) = res.json()["errors"]
+    assert error.startswith("p_eq: the number 1000") and "out of the range of double" in error
 
 
 def test_sigterm_waits_for_work_in_flight_no_longer_than_the_setting(tmp_path: Path) -> None:

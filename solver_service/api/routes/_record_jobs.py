@@ -7,12 +7,16 @@ from typing import Any, Union
 from fastapi import Request, Response
 from pydantic import BaseModel
 
+from shared_schema.errors import InputError
+
 from ..bodies import validate_json
 from ..compute import compute
 from ..deps import JSON, media_type
 from ..forms import FORMS, parse_form, read_form, read_upload
 from ..jobspec import HistoryJob, RecordUpload, ReportJob, SpectrumJob
 from ..pool import ComputePool
+from ..problems import Problem
+from ..uploads import check_record_lines
 
 __all__ = ["RecordJob", "run_record_job"]
 
@@ -39,6 +43,10 @@ async def run_record_job(
             blobs.append(data)
         record = await read_upload(form, "record", spec.record_required)
         if record is not None:
+            try:  # before a compute process parses it (and holds it in memory)
+                check_record_lines(record[0], pool.limits["max_samples"])
+            except InputError as exc:
+                raise Problem(422, "InputError", str(exc), exc.field) from None
             fields["upload"] = RecordUpload(filename=record[1], **options)
             blobs.append(record[0])
     finally:

@@ -24,14 +24,30 @@ def rockmech_version() -> str:
         return "unknown"
 
 
-@router.get("/health", response_model=HealthResponse, summary="Service status")
-async def health(pool: PoolDep, settings: SettingsDep) -> HealthResponse:
-    """Return the version, the compute processes alive and the compute time budget."""
-    return HealthResponse(
-        status="ok",
+@router.get(
+    "/health",
+    response_model=HealthResponse,
+    summary="Service status",
+    responses={
+        503: {"model": HealthResponse, "description": "The compute processes are starting."}
+    },
+)
+async def health(pool: PoolDep, settings: SettingsDep) -> Response:
+    """Return the version, the compute processes alive and the compute time budget.
+
+    503 with ``status: starting`` until every compute process has warmed up.
+    """
+    doc = HealthResponse(
+        status="ok" if pool.ready else "starting",
         version=rockmech_version(),
         compute_workers=pool.alive,
         compute_timeout_s=settings.compute_timeout_s,
+    )
+    return Response(
+        doc.model_dump_json(),
+        status_code=200 if pool.ready else 503,
+        media_type="application/json",
+        headers=None if pool.ready else {"Retry-After": "1"},
     )
 
 
