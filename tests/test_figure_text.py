@@ -29,7 +29,7 @@ from solver_service.report.assess import assess_report
 from solver_service.report.html import build_report
 from solver_service.workflows.assess import read_site
 from solver_service.workflows.documents import frequency_grid, record_analysis, record_pulse_doc
-from solver_service.workflows.inputs import read_constants, read_record
+from solver_service.workflows.inputs import read_record
 from solver_service.workflows.outputs import write_envelope, write_history, write_ida, write_record
 
 REPO = Path(__file__).resolve().parents[1]
@@ -78,9 +78,7 @@ class Figures:
             for axis, scale in ((ax.xaxis, ax.get_xscale()), (ax.yaxis, ax.get_yscale())):
                 if scale == "log":
                     labels = [t for t in axis.get_ticklabels() if t.get_text()]
-                    self.log_axes.append(
-                        [(t.get_text(), bool(t.get_parse_math())) for t in labels]
-                    )
+                    self.log_axes.append([(t.get_text(), bool(t.get_parse_math())) for t in labels])
 
 
 @pytest.fixture

@@ -148,7 +148,8 @@ def _plot_envelope(env: dict[str, Any], path: Path) -> Path:
     a = np.array([np.nan if v is None else v for v in env["a_p_min_g"]], dtype=float)
     ax.loglog(f, a, color="k", lw=1.3, label="overturning envelope a_p,min")
     for p in env.get("pulses", []):
-        ax.loglog([p["f_p"]], [p["a_p_g"]], "o", label=f"{plain(p['record'])} pulse at design scale")
+        text = f"{plain(p['record'])} pulse at design scale"
+        ax.loglog([p["f_p"]], [p["a_p_g"]], "o", label=text)
     ax.set_xlabel("pulse frequency f_p [Hz]")
     ax.set_ylabel("amplitude [g]")
     ax.grid(alpha=0.3, which="both")
