@@ -42,9 +42,10 @@ from .workflows.documents import (
     frequency_grid,
     history_doc,
     log_grid,
-    pulse_doc,
+    pick_mechanism,
     record_analysis,
     record_pulse_doc,
+    solve_pulse,
 )
 from .workflows.inputs import (
     constants_from_files,
@@ -326,8 +327,12 @@ _CRITERIA = _choices(CRITERIA)
 @app.command()
 @_user_errors
 def pulse(
-    p_eq: float = typer.Option(..., "--p-eq", help="Frequency parameter p_eq [rad/s]."),
-    lam: float = typer.Option(..., "--lam", help="Static load multiplier lambda [-]."),
+    p_eq: Optional[float] = typer.Option(
+        None, "--p-eq", help="Frequency parameter p_eq [rad/s] (or --constants)."
+    ),
+    lam: Optional[float] = typer.Option(
+        None, "--lam", help="Static load multiplier lambda [-] (or --constants)."
+    ),
     a_p_g: float = typer.Option(
         ...,
         "--a-p-g",
@@ -342,6 +347,15 @@ def pulse(
     phi_ov: Optional[float] = typer.Option(
         None, "--phi-ov", help="Overturning rotation [rad]; defaults to lambda."
     ),
+    constants: Optional[Path] = typer.Option(
+        None,
+        "--constants",
+        help="Kinematic-constants JSON: run one of its mechanisms (both sides, each impact "
+        "direction's eta) instead of --p-eq, --lam, --eta, --phi-ov, --one-sided.",
+    ),
+    mechanism: Optional[str] = typer.Option(
+        None, "--mechanism", help="Mechanism id in --constants (default: the first)."
+    ),
     shape: str = typer.Option("sine", "--shape", metavar=_SHAPES, help="Pulse shape."),
     criterion: Optional[str] = typer.Option(
         None,
@@ -352,23 +366,23 @@ def pulse(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Response of one mechanism to a one-cycle sine or cosine acceleration pulse."""
-    doc = pulse_doc(
-        p_eq,
-        lam,
-        a_p_g,
-        f_p,
-        eta=eta,
-        one_sided=one_sided,
-        phi_ov=phi_ov,
-        shape=shape,
-        criterion=criterion,
-    )
+    request: dict[str, Any] = {"a_p_g": a_p_g, "f_p": f_p, "shape": shape}
+    short = {"p_eq": p_eq, "lam": lam, "eta": eta, "phi_ov": phi_ov}
+    request.update({k: v for k, v in short.items() if v is not None})
+    request.update({"one_sided": True} if one_sided else {})
+    request.update({"criterion": criterion} if criterion is not None else {})
+    if constants is not None:
+        request["mechanism"] = pick_mechanism(read_constants(constants), mechanism)
+    elif mechanism is not None:
+        _fail("mechanism: needs --constants (the file that holds it)")
+    doc = solve_pulse(request)
     if as_json:
         _print_json(doc)
         return
     verdict = "OVERTURNS" if doc["overturned"] else "survives"
+    name = f"{doc['input']['mechanism']}: " if "mechanism" in doc["input"] else ""
     typer.echo(
-        f"Pulse {shape} a_p = {a_p_g:g} g, f_p = {f_p:g} Hz "
+        f"{name}Pulse {shape} a_p = {a_p_g:g} g, f_p = {f_p:g} Hz "
         f"(Omega = {doc['input']['omega_ratio']:.4g}, A = {doc['input']['amplitude_ratio']:.4g}):"
         f" {verdict} [{doc['criterion']} criterion]"
     )

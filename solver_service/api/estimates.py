@@ -244,9 +244,11 @@ def check_job(job: Job, limits: dict[str, Any]) -> None:
             "max_mechanisms",
         )
         _check_derived(cf)
-    if isinstance(job, PulseJob) and _positive(job.p_eq, job.f_p):
-        # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
-        check_work(job.p_eq / job.f_p, limits, "the pulse", "f_p")
+    if isinstance(job, PulseJob):
+        p_eq = job.p_eq_max
+        if p_eq is not None and _positive(p_eq, job.f_p):
+            # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
+            check_work(p_eq / job.f_p, limits, "the pulse", "f_p")
     elif isinstance(job, EnvelopeJob):
         _envelope(job.constants, job.f_min, job.f_max, job.n, job.exact, limits)
     elif isinstance(job, HistoryJob):

@@ -57,8 +57,8 @@ from ..workflows.documents import (
     history_doc,
     log_grid,
     record_analysis,
+    solve_pulse,
 )
-from ..workflows.documents import pulse_doc as doc
 from ..workflows.inputs import read_record
 from ..workflows.outputs import finite_json
 from ..workflows.scaling import Building
@@ -268,25 +268,15 @@ def pulse_doc(job: PulseRequest, limits: Optional[dict[str, Any]] = None) -> dic
     Parameters
     ----------
     job : PulseRequest
-        ``p_eq`` [rad/s], ``lam`` [-], ``a_p_g`` [g], ``f_p`` [Hz], ``eta``, ``one_sided``,
-        ``phi_ov`` [rad], ``shape``, ``criterion``.
+        The request; ``workflows.documents.solve_pulse`` runs it, as on every other path.
     limits : dict, optional
         The service's size limits (bound the work); none from the command line.
     """
-    if limits is not None and _positive(job.p_eq, job.f_p):
+    p_eq = job.p_eq_max
+    if limits is not None and p_eq is not None and _positive(p_eq, job.f_p):
         # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
-        check_work(job.p_eq / job.f_p, limits, "the pulse", "f_p")
-    return doc(
-        job.p_eq,
-        job.lam,
-        job.a_p_g,
-        job.f_p,
-        eta=job.eta,
-        one_sided=job.one_sided,
-        phi_ov=job.phi_ov,
-        shape=job.shape,
-        criterion=job.criterion,
-    )
+        check_work(p_eq / job.f_p, limits, "the pulse", "f_p")
+    return solve_pulse(job)
 
 
 def _pulse(job: PulseJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:

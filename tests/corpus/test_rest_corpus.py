@@ -635,7 +635,9 @@ OVERRIDES: dict[str, dict[str, Any]] = {
         for ep in BODIES
     },
     **{f"{ep}-deeply-nested": {"problem": "nested deeper than 200 levels"} for ep in BODIES},
-    "pulse-empty-body": {"problem": "send a JSON object with p_eq, lam, a_p_g and f_p$"},
+    "pulse-empty-body": {
+        "problem": "send a JSON object with a_p_g and f_p; and p_eq, lam and eta, or mechanism$"
+    },
     "pulse-eta-2": {"problem": r"\[-1, 1\]"},
     "pulse-number-400-digits": {"problem": "valid number|range|finite"},
     **{

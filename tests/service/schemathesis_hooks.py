@@ -55,6 +55,7 @@ from shared_schema.api import (
     CheckRequest,
     EnvelopeRequest,
     HistoryRequest,
+    PulseRequest,
     ReportRequest,
     SpectrumRequest,
 )
@@ -74,6 +75,7 @@ from solver_service.api.jobspec import (
     CheckJob,
     EnvelopeJob,
     HistoryJob,
+    PulseJob,
     ReportJob,
     SpectrumJob,
 )
@@ -150,6 +152,7 @@ CROSS_FIELD_RULES = frozenset(
 
 #: The request model and the job of each JSON operation.
 JSON_OPERATIONS: dict[str, tuple[type[BaseModel], Callable[..., Any]]] = {
+    "pulse": (PulseRequest, PulseJob),
     "envelope": (EnvelopeRequest, EnvelopeJob),
     "history": (HistoryRequest, HistoryJob),
     "spectrum": (SpectrumRequest, SpectrumJob),
@@ -304,7 +307,7 @@ def scale_factor_rules(context: HookContext, case: Case) -> bool:
 
 
 @schemathesis.hook("filter_case").apply_to(
-    path_regex="/(envelope|history|spectrum|report|check|assess)$", method="POST"
+    path_regex="/(pulse|envelope|history|spectrum|report|check|assess)$", method="POST"
 )
 def json_body_rules(context: HookContext, case: Case) -> bool:
     """Drop positive JSON cases that break a rule JSON Schema cannot state."""
