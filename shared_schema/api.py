@@ -38,6 +38,7 @@ from shared_schema.rules import (
     BUILDING_HEIGHT_MAX_M,
     CRITERIA,
     DT_RANGE_S,
+    ENVELOPE_METHODS,
     F_N_RANGE,
     F_P_RANGE,
     LAM_RANGE,
@@ -395,6 +396,10 @@ def _in_f_p_range(cls: Any, value: float, info: Any) -> float:
     return value
 
 
+def _envelope_method(cls: Any, value: str) -> str:
+    return check_choice(value, ENVELOPE_METHODS, "method")
+
+
 # --- requests ---------------------------------------------------------------------------------
 
 
@@ -570,12 +575,17 @@ class EnvelopeRequest(BaseModel):
     n: JsonInt = Field(
         200, description="Number of log-spaced frequencies, >= 2.", json_schema_extra={"minimum": 2}
     )
-    exact: bool = Field(
-        False, description="Compute the boundaries directly instead of from the library."
+    method: str = Field(
+        "exact",
+        description="How the envelopes are computed: exact (the exact integrator at every "
+        "frequency) or library (the fast mode: interpolated, exact where the library cannot "
+        "interpolate safely; never above the exact value, at most 5 % below).",
+        json_schema_extra={"enum": list(ENVELOPE_METHODS)},
     )
 
     _plausible = field_validator("constants")(classmethod(_time_domain_constants))
     _frequencies = field_validator("f_min", "f_max")(classmethod(_in_f_p_range))
+    _method = field_validator("method")(classmethod(_envelope_method))
 
 
 class BuildingOptions(BaseModel):
@@ -636,10 +646,15 @@ class ReportOptions(HistoryOptions):
         description="Number of log-spaced envelope frequencies, >= 2.",
         json_schema_extra={"minimum": 2},
     )
-    exact: bool = Field(False, description="Exact envelopes instead of the library.")
+    method: str = Field(
+        "exact",
+        description="How the envelopes are computed: exact, or library (the fast mode).",
+        json_schema_extra={"enum": list(ENVELOPE_METHODS)},
+    )
     title: Optional[str] = Field(None, max_length=200, description="Title of the report.")
 
     _frequencies = field_validator("f_min", "f_max")(classmethod(_in_f_p_range))
+    _method = field_validator("method")(classmethod(_envelope_method))
 
 
 class HistoryRequest(HistoryOptions):

@@ -845,6 +845,25 @@ def constants_table(
     typer.echo(f"wrote {output}: {len(cf.mechanisms)} mechanism(s) from {table.name}")
 
 
+_FAST_OPT = typer.Option(
+    False,
+    "--fast",
+    help="Fast mode: envelopes interpolated from the library (exact where it cannot "
+    "interpolate safely): never above the exact values, at most 5 % below; band edges "
+    "within a factor 1.05 in frequency (docs/envelopes.md).",
+)
+_EXACT_OPT = typer.Option(
+    False, "--exact", help="Exact envelopes at every frequency (the default; kept for scripts)."
+)
+
+
+def _envelope_method(fast: bool, exact: bool) -> str:
+    """Return the envelope method of ``--fast`` / ``--exact`` (exact unless --fast)."""
+    if fast and exact:
+        _fail("fast: give --fast or --exact, not both")
+    return "library" if fast else "exact"
+
+
 @app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
 @_user_errors
 def envelope(
@@ -856,9 +875,8 @@ def envelope(
     f_min: float = typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
     f_max: float = typer.Option(10.0, "--f-max", help="Highest pulse frequency [Hz]."),
     n: int = typer.Option(200, "--n", help="Number of log-spaced frequencies."),
-    exact: bool = typer.Option(
-        False, "--exact", help="Compute boundaries directly instead of from the library."
-    ),
+    fast: bool = _FAST_OPT,
+    exact: bool = _EXACT_OPT,
     record: Optional[Path] = typer.Option(
         None,
         "--record",
@@ -877,18 +895,19 @@ def envelope(
     as_json: bool = typer.Option(False, "--json", help="Also print the JSON document."),
 ) -> None:
     """Minimum overturning sine-pulse amplitude of every mechanism, and the critical bands."""
+    method = _envelope_method(fast, exact)
     _limit(no_limits, envelope=(f_min, f_max, n, False))
     f_p = frequency_grid(f_min, f_max, n)
     check_folder_target(out)
     cf = read_constants(constants)
-    _limit(no_limits, cf, envelope=(f_min, f_max, n, exact))
+    _limit(no_limits, cf, envelope=(f_min, f_max, n, method == "exact"))
     pulse = None
     if record is not None:
         motion = _read_record(record, record_format, units, dt, channel, component)
-        pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), exact=exact)
+        pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), method=method)
     elif ctx.args:
         _fail(f"unexpected argument {ctx.args[0]!r}")
-    kind = "exact envelopes" if exact else "envelopes"
+    kind = "exact envelopes" if method == "exact" else "envelopes (fast mode, library)"
     with (
         _status(f"{kind}: {len(cf.mechanisms)} mechanisms x {n} frequencies"),
         run_folder(out, on_note=_out_note) as tmp,
@@ -897,7 +916,7 @@ def envelope(
             cf,
             f_p,
             tmp,
-            exact=exact,
+            method=method,
             title=f"Overturning envelopes: {constants.name}",
             record_pulse=pulse,
         )
@@ -1051,13 +1070,15 @@ def report(
     f_min: float = typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
     f_max: float = typer.Option(10.0, "--f-max", help="Highest pulse frequency [Hz]."),
     n: int = typer.Option(200, "--n", help="Number of log-spaced frequencies."),
-    exact: bool = typer.Option(False, "--exact", help="Exact envelopes, not the library."),
+    fast: bool = _FAST_OPT,
+    exact: bool = _EXACT_OPT,
     title: Optional[str] = typer.Option(None, "--title", help="Title of the report."),
     no_limits: bool = _NO_LIMITS_OPT,
     time_limit: float = _TIME_LIMIT_OPT,
 ) -> None:
     """One self-contained HTML report: constants, envelopes, and with --record its histories."""
     scales = _scales(scale, ctx.args)
+    method = _envelope_method(fast, exact)
     check_file_target(out)
     _limit(no_limits, scales=len(scales), envelope=(f_min, f_max, n, False))
     f_p = frequency_grid(f_min, f_max, n)
@@ -1068,11 +1089,12 @@ def report(
         motion = _read_record(record, record_format, units, dt, channel, component)
         sources.append(input_source("record", record.name, record.read_bytes()))
     size = None if motion is None else _record_size([motion])
-    _limit(no_limits, cf, scales=len(scales), record=size, envelope=(f_min, f_max, n, exact))
+    envelope = (f_min, f_max, n, method == "exact")
+    _limit(no_limits, cf, scales=len(scales), record=size, envelope=envelope)
     options = {"scales": scales, "sf": sf, "building_height": building_height}
     options.update(soil_factor=soil_factor, element_period=element_period, at_height=at_height)
     options.update(criterion=criterion)
-    options.update(f_min=f_min, f_max=f_max, n=n, exact=exact)
+    options.update(f_min=f_min, f_max=f_max, n=n, method=method)
     with _status("report: envelopes and histories"):
         text = build_report(
             cf,
@@ -1085,7 +1107,7 @@ def report(
                 "criterion": criterion,
                 "at_height": at_height,
             },
-            exact=exact,
+            method=method,
             title=title or f"rockmech report: {constants.name}",
             sources=sources,
             request=options,

@@ -68,7 +68,7 @@ def test_the_time_limit_sets_the_up_front_work_budget(tmp_path: Path) -> None:
     argv = ["envelope", str(stiff), "--exact", "--n", "400", "--out", str(out)]
     res = runner.invoke(app, [*argv, "--time-limit", "1"])  # about 1.3e8 steps: over 5e7
     assert res.exit_code == 2
-    assert res.stderr.startswith("error: exact: the run would take 1.")
+    assert res.stderr.startswith("error: method: the run would take 1.")
     assert "more than can finish in 1 s on any machine we know" in res.stderr
     assert "give --time-limit with more seconds, or --no-limits" in res.stderr
     assert not out.exists()

@@ -169,7 +169,7 @@ def _envelope(
         # The pulse scale factors' grid points, as steps of the same time.
         points = scale_factor_points(cf, f_min, f_max, n)
         steps += points * MAX_STEPS_PER_S / MAX_POINTS_PER_S
-        check_total_steps(steps, limits, "the exact envelopes", "exact")
+        check_total_steps(steps, limits, "the exact envelopes (method library is faster)", "method")
 
 
 def _history(job: Any, cf: Optional[ConstantsFile], limits: dict[str, Any]) -> None:
@@ -250,13 +250,13 @@ def check_job(job: Job, limits: dict[str, Any]) -> None:
             # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
             check_work(p_eq / job.f_p, limits, "the pulse", "f_p")
     elif isinstance(job, EnvelopeJob):
-        _envelope(job.constants, job.f_min, job.f_max, job.n, job.exact, limits)
+        _envelope(job.constants, job.f_min, job.f_max, job.n, job.method == "exact", limits)
     elif isinstance(job, HistoryJob):
         _history(job, cf, limits)
     elif isinstance(job, ReportJob):
         _history(job, cf, limits)
         if cf is not None:
-            _envelope(cf, job.f_min, job.f_max, job.n, job.exact, limits)
+            _envelope(cf, job.f_min, job.f_max, job.n, job.method == "exact", limits)
     elif isinstance(job, SpectrumJob):
         check_limit(job.n, limits["max_samples"], "periods", "n", "max_samples")
         if job.record is not None:

@@ -291,7 +291,8 @@ def _grid(f_min: float, f_max: float, n: int, limits: dict[str, Any]) -> Any:
 def _envelope(job: EnvelopeJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     f_p = _grid(job.f_min, job.f_max, job.n, limits)
     cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
-    doc, _ = envelope_doc(cf, f_p, exact=job.exact, library=None if job.exact else shared_library())
+    library = shared_library() if job.method == "library" else None
+    doc, _ = envelope_doc(cf, f_p, method=job.method, library=library)
     return dumps(doc)
 
 
@@ -413,7 +414,7 @@ REPORT_KEYS = (
     "f_min",
     "f_max",
     "n",
-    "exact",
+    "method",
 )
 
 
@@ -451,11 +452,11 @@ def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes
         motion=motion,
         scales=scales,
         history=history_options(job),
-        exact=job.exact,
+        method=job.method,
         title=job.title or "",
         sources=sources,
         request={k: getattr(job, k) for k in REPORT_KEYS},
-        library=None if job.exact else shared_library(),
+        library=shared_library() if job.method == "library" else None,
     )
     return html.encode("utf-8")
 

@@ -266,6 +266,8 @@ def plot_envelopes(
     labels: Union[dict[str, str], None] = None,
     title: str = "",
     pulse_points: Union[Sequence[dict[str, Any]], None] = None,
+    edges: Union[Sequence[dict[str, Any]], None] = None,
+    fast: bool = False,
 ) -> Path:
     """Log-log overturning envelopes at ground level, with the critical bands shaded.
 
@@ -284,6 +286,11 @@ def plot_envelopes(
     pulse_points : sequence of dict, optional
         A record's largest pulse at several scale factors, ``{"scale", "f_p_hz",
         "a_p_g"}`` (``|a_p|`` [g]); drawn as points joined by a line and labelled by scale.
+    edges : sequence of dict, optional
+        Where each band edge lies, ``{"f_low", "f_high"}`` [Hz] (``documents.band_edges``);
+        drawn hatched, so that the reader sees the frequency tolerance of each edge.
+    fast : bool
+        The envelopes are the fast mode's (the library): said in the edges' legend entry.
     """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(9, 8))
@@ -324,6 +331,17 @@ def plot_envelopes(
         mid = float(np.sqrt(band["f_min"] * band["f_max"]))
         name = plain(band["mechanism"])
         ax.text(mid, ymax, name, ha="center", va="top", fontsize=8, color=colour)
+    for k, edge in enumerate(edges or []):
+        where = "within ×1.05 (fast mode)" if fast else "between two grid frequencies"
+        ax.axvspan(
+            edge["f_low"],
+            edge["f_high"],
+            facecolor="none",
+            edgecolor="0.35",
+            hatch="////",
+            lw=0,
+            label=f"band edge: the exact edge lies {where}" if k == 0 else None,
+        )
     ax.set_xlabel("pulse frequency f_p [Hz]")
     ax.set_ylabel("minimum overturning pulse amplitude a_p [g] (ground level)")
     ax.grid(which="both", alpha=0.25)

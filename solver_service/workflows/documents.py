@@ -16,10 +16,15 @@ from pydantic import ValidationError
 from shared_schema.api import PulseRequest
 from shared_schema.constants import ConstantsFile, input_error_from_validation
 from shared_schema.errors import InputError
+from shared_schema.rules import ENVELOPE_METHODS, check_choice
 
 from ..core.amplification import pulse_scale_factor
 from ..core.envelope import (
     A_MAX,
+    LIBRARY_ABOVE,
+    LIBRARY_BELOW,
+    LIBRARY_EDGE_RATIO,
+    LIBRARY_MARGIN,
     Envelope,
     OverturningLibrary,
     boundary_curve,
@@ -39,6 +44,7 @@ from .scaling import Building, option_notes, run_scaled
 
 __all__ = [
     "PULSE_METHOD",
+    "band_edges",
     "boundary_doc",
     "envelope_doc",
     "frequency_grid",
@@ -278,7 +284,7 @@ def envelope_doc(
     cf: ConstantsFile,
     f_p: np.ndarray[Any, Any],
     *,
-    exact: bool = False,
+    method: Optional[str] = None,
     library: Optional[OverturningLibrary] = None,
 ) -> tuple[dict[str, Any], list[Envelope]]:
     """Ground-level envelopes of every mechanism and the critical bands.
@@ -286,17 +292,38 @@ def envelope_doc(
     Mechanisms with ``amplification`` are corrected by ``SF(f_p)`` (theory §7); the others
     skip that work entirely.
 
+    Parameters
+    ----------
+    cf : ConstantsFile
+        The mechanisms.
+    f_p : (n,) float
+        Pulse frequencies [Hz], increasing.
+    method : {"exact", "library"}, optional
+        ``exact`` (the default unless ``library`` is given): the exact integrator at every
+        frequency. ``library``: the fast
+        mode, interpolated from the library (loaded unless given), exact where it cannot
+        interpolate safely; never above the exact value, at most ``LIBRARY_BELOW`` below,
+        band edges within ``LIBRARY_EDGE_RATIO`` (docs/envelopes.md).
+    library : OverturningLibrary, optional
+        The library of the fast mode (the shipped one by default).
+
     Returns
     -------
     doc : dict
-        JSON-ready result (see ``rockmech envelope``).
+        JSON-ready result (see ``rockmech envelope``): ``critical`` bands and
+        ``critical_edges``, the frequency interval [Hz] that holds each edge between two
+        bands as the exact envelopes place it.
     envelopes : list of Envelope
         The envelopes, for plotting.
     """
+    if method is None:
+        method = "exact" if library is None else "library"
+    method = check_choice(method, ENVELOPE_METHODS, "method")
     if not cf.mechanisms:
         raise InputError("needs at least one mechanism", "mechanisms")
-    if not exact and library is None:
+    if method == "library" and library is None:
         library = OverturningLibrary.load()
+    fast = library if method == "library" else None
     envelopes: list[Envelope] = []
     entries: list[dict[str, Any]] = []
     for mech in cf.mechanisms:
@@ -304,11 +331,11 @@ def envelope_doc(
         sf = None
         if mech.amplification is not None:
             amp = mech.amplification
-            if library is not None:
-                sf = library.scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
+            if fast is not None:
+                sf = fast.scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
             else:
                 sf = pulse_scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
-        env = mechanism_envelope(model, f_p, library=library, exact=exact, scale_factor=sf)
+        env = mechanism_envelope(model, f_p, library=fast, exact=fast is None, scale_factor=sf)
         envelopes.append(env)
         entry: dict[str, Any] = {
             "id": mech.id,
@@ -331,27 +358,84 @@ def envelope_doc(
             entry["notes"] = list(env.notes)
         entries.append(entry)
     index, bands = critical_bands(envelopes)
+    edge_ratio = 1.0 if fast is None else LIBRARY_EDGE_RATIO
     doc: dict[str, Any] = {
         "units": {"f_p": "Hz", "a_p": "g"},
         "f_p": [float(v) for v in f_p],
         "mechanisms": entries,
         "critical": bands,
+        "critical_edges": band_edges(np.asarray(f_p, dtype=float), index, cf, edge_ratio),
         "governing": [cf.mechanisms[i].id if i >= 0 else None for i in index],
-        "method": (
-            {"source": "exact", "a_max": A_MAX}
-            if exact or library is None
-            else {
-                "source": "library",
-                "interpolation": "log A_min linear in log Omega and in eta",
-                **{
-                    k: library.metadata[k]
-                    for k in ("library_version", "generated", "scan_ratio", "a_max")
-                    if k in library.metadata
-                },
-            }
-        ),
+        "method": _envelope_method(fast, envelopes),
     }
     return doc, envelopes
+
+
+def _envelope_method(
+    library: Optional[OverturningLibrary], envelopes: list[Envelope]
+) -> dict[str, Any]:
+    """Return the ``method`` block of an envelope document: how the values were computed."""
+    if library is None:
+        return {
+            "source": "exact",
+            "a_max": A_MAX,
+            "note": "exact integrator at every frequency; band edges lie between the last "
+            "frequency of one band and the first of the next",
+        }
+    return {
+        "source": "library",
+        "label": "fast mode (interpolated library)",
+        "interpolation": "log A_min linear in log Omega and in eta, times "
+        f"{LIBRARY_MARGIN:g}; exact where the interpolation crosses a jump or leaves the grid",
+        "exact_points": int(sum(e.n_exact for e in envelopes)),
+        "bound": {"above_exact": LIBRARY_ABOVE, "below_exact": LIBRARY_BELOW},
+        "edge_ratio": LIBRARY_EDGE_RATIO,
+        **{
+            k: library.metadata[k]
+            for k in ("library_version", "generated", "scan_ratio", "a_max")
+            if k in library.metadata
+        },
+    }
+
+
+def band_edges(
+    f_p: np.ndarray[Any, Any], index: np.ndarray[Any, Any], cf: ConstantsFile, ratio: float = 1.0
+) -> list[dict[str, Any]]:
+    """Where the governing mechanism changes: the frequency interval that holds each edge.
+
+    Parameters
+    ----------
+    f_p : (n,) float
+        Pulse frequencies [Hz], increasing.
+    index : (n,) int
+        Governing mechanism per frequency (-1: none overturns), as ``critical_bands``.
+    cf : ConstantsFile
+        The mechanisms (for their ids).
+    ratio : float
+        Frequency tolerance of the method (1 when exact): the interval is widened by this
+        factor on each side [-].
+
+    Returns
+    -------
+    list of dict
+        ``{"below", "above", "f_low", "f_high"}``: the mechanism governing below and above
+        the edge (None: none overturns), and the interval [Hz] in which the exact
+        envelopes change over: ``[f_k / ratio, f_(k+1) * ratio]`` between the last
+        frequency ``f_k`` of one band and the first of the next.
+    """
+    ids = [m.id for m in cf.mechanisms]
+    edges = []
+    for k in range(len(f_p) - 1):
+        if index[k] != index[k + 1]:
+            edges.append(
+                {
+                    "below": ids[index[k]] if index[k] >= 0 else None,
+                    "above": ids[index[k + 1]] if index[k + 1] >= 0 else None,
+                    "f_low": float(f_p[k] / ratio),
+                    "f_high": float(f_p[k + 1] * ratio),
+                }
+            )
+    return edges
 
 
 def boundary_doc(
@@ -399,7 +483,7 @@ def record_pulse_doc(
     *,
     f_min: Optional[float] = None,
     f_max: Optional[float] = None,
-    exact: bool = False,
+    method: str = "exact",
 ) -> dict[str, Any]:
     """Compare a record's largest sine pulse, at several scale factors, with every envelope.
 
@@ -418,13 +502,13 @@ def record_pulse_doc(
         Scale factors on the record [-], each > 0.
     f_min, f_max : float, optional
         Frequency range to search for the pulse [Hz].
-    exact : bool
-        Evaluate the envelopes at ``f_p`` by the exact boundary search, not the library.
+    method : {"exact", "library"}
+        How the envelopes are evaluated at ``f_p`` (``envelope_doc``).
     """
     for j, value in enumerate(scales):
         check_positive(value, f"scales[{j}]")
     pulse = largest_pulse(motion.accel, f_min=f_min, f_max=f_max)
-    at_fp, _ = envelope_doc(cf, np.array([pulse.f_p]), exact=exact)
+    at_fp, _ = envelope_doc(cf, np.array([pulse.f_p]), method=method)
     a_min = {m["id"]: m["a_p_min_g"][0] for m in at_fp["mechanisms"]}
     points = []
     for scale in scales:

@@ -347,7 +347,7 @@ def check_run(
     Raises
     ------
     InputError
-        Naming the option (``n``, ``scales``, ``record``, ``constants``, ``exact``), the limit
+        Naming the option (``n``, ``scales``, ``record``, ``constants``, ``method``), the limit
         and ``--no-limits``.
     """
     lim = DEFAULT_LIMITS if limits is None else limits
@@ -378,10 +378,11 @@ def check_run(
             runs = max(scales, 1)
             steps += history_steps(cf, n_samples, dt, runs, p_max=P_EQ_PLAUSIBLE) * records
     if steps > MAX_STEPS_PER_S * budget_s:
-        field = "record" if record is not None else "exact"
+        field = "record" if record is not None else "method"
+        fast = "" if record is not None else " (--fast for the library's envelopes)"
         raise InputError(
             f"the run would take {steps:.3g} closed-form steps, more than can finish in "
-            f"{budget_s:g} s on any machine we know; ask for less work, give {TIME_LIMIT} "
-            f"with more seconds, or {NO_LIMITS} to lift the limit",
+            f"{budget_s:g} s on any machine we know; ask for less work{fast}, give "
+            f"{TIME_LIMIT} with more seconds, or {NO_LIMITS} to lift the limit",
             field,
         )

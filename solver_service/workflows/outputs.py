@@ -64,14 +64,15 @@ def write_envelope(
     *,
     stem: str = "envelope",
     title: str = "",
-    exact: bool = False,
+    method: str = "exact",
     record_pulse: Optional[dict[str, Any]] = None,
 ) -> dict[str, Any]:
     """Write ``<stem>.json``, ``<stem>.csv`` and ``<stem>.png`` (atomically); return the doc.
 
-    ``record_pulse`` (from ``record_pulse_doc``) is added to the JSON and drawn on the plot.
+    ``method`` as ``envelope_doc``; ``record_pulse`` (from ``record_pulse_doc``) is added to
+    the JSON and drawn on the plot. The plot draws where each band edge lies.
     """
-    doc, envs = envelope_doc(cf, f_p, exact=exact)
+    doc, envs = envelope_doc(cf, f_p, method=method)
     if record_pulse is not None:
         doc["record_pulse"] = record_pulse
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -84,6 +85,8 @@ def write_envelope(
         labels={m.id: f"{m.id}: {m.name}" for m in cf.mechanisms},
         title=title,
         pulse_points=None if record_pulse is None else record_pulse["points"],
+        edges=doc["critical_edges"],
+        fast=method == "library",
     )
     return doc
 

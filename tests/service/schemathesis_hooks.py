@@ -218,7 +218,7 @@ def _scale_factors_ok(job: Any) -> bool:
         if amp is None:
             continue
         try:
-            if job.exact:
+            if job.method == "exact":
                 sf = pulse_scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
             else:
                 sf = shared_library().scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)

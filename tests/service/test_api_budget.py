@@ -17,7 +17,7 @@ BUDGET_S = 1.0
 CHURCH = json.loads((EXAMPLES / "constants" / "church.json").read_text())
 #: Exact envelopes of the church's eight mechanisms at 800 frequencies: seconds, past the
 #: budget, but not refused up front (the estimate assumes the fastest machine we know).
-HEAVY = {"constants": CHURCH, "exact": True, "n": 800}
+HEAVY = {"constants": CHURCH, "method": "exact", "n": 800}
 PULSE = {"p_eq": 2.0, "lam": 0.2, "eta": 0.9, "a_p_g": -0.61, "f_p": 1.59}
 
 

@@ -110,7 +110,7 @@ def test_exact_envelope_of_a_stiff_structure_matches_the_cli(
     path.write_text(json.dumps(constants))
     options = ["--n", "5", "--f-min", "0.1", "--f-max", "10", "--exact"]
     cli = cli_json("envelope", str(path), "--out", str(tmp_path), *options)
-    body = {"constants": constants, "n": 5, "f_min": 0.1, "f_max": 10.0, "exact": True}
+    body = {"constants": constants, "n": 5, "f_min": 0.1, "f_max": 10.0, "method": "exact"}
     res = client.post("/api/v1/envelope", json=body)
     assert res.status_code == 200, res.text
     assert res.json() == cli
