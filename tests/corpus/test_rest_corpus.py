@@ -264,7 +264,9 @@ def _cases() -> list[Rest]:
         Rest(
             "envelope-fmin-zero", "envelope", {"f_min": 0.0}, field="f_min", problem="> 0|greater"
         ),
-        Rest("envelope-method-bool", "envelope", {"method": True}, field="method", problem="string"),
+        Rest(
+            "envelope-method-bool", "envelope", {"method": True}, field="method", problem="string"
+        ),
         Rest(
             "envelope-constants-missing",
             "envelope",
