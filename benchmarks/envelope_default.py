@@ -190,13 +190,13 @@ def markdown(rows: list[dict[str, Any]], info: dict[str, str], loads: tuple[str,
             f"{F_RANGE_HZ[1]:g} Hz (the command line's default). In process: "
             f"`envelope_doc`, best of {REPEATS} after a warm-up. CLI: `rockmech envelope FILE "
             "--out DIR [--fast]` once, in a fresh process (imports, numba cache load, the "
-            f"PNG). Limit: {LIMIT_S:g} s for the exact envelopes (\"a few seconds\").",
+            f'PNG). Limit: {LIMIT_S:g} s for the exact envelopes ("a few seconds").',
             "",
             md_table(headers, table),
             "",
             f"Exact envelopes within {LIMIT_S:g} s on every bundled file: **{verdict}** "
             f"(slowest {fmt_time(worst)}). Exact is therefore the default; the library is "
-            "the fast mode (`--fast`, `method: \"library\"`).",
+            'the fast mode (`--fast`, `method: "library"`).',
             "",
             "### The fast mode against the exact envelopes",
             "",

@@ -947,6 +947,8 @@ class HealthResponse(BaseModel):
 
     status: Literal["ok"]
     version: str = Field(description="rockmech version.")
+    rockmech_version: str = Field(description="rockmech version (as every document names it).")
+    units: Dict[str, str] = Field(description="Units of the quantities.")
     compute_workers: int = Field(description="Compute processes ready or busy.")
     compute_timeout_s: float = Field(description="Compute time budget per request [s].")
 

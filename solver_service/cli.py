@@ -26,7 +26,7 @@ from rhino_plugin.mechanisms.build import MechanismFailure
 from shared_schema.atomic import remove_stale_temps
 from shared_schema.errors import RockmechError
 from shared_schema.extras import MissingExtra, extra_for, require
-from shared_schema.io import save_constants
+from shared_schema.io import save_constants, stamped
 from shared_schema.rules import CRITERIA, PULSE_SHAPES, RECORD_FORMATS, RECORD_UNITS, SF_METHODS
 from shared_schema.version import __version__
 
@@ -65,6 +65,7 @@ from .workflows.outputs import finite_json, write_envelope, write_history, write
 from .workflows.rundir import check_file_target, check_folder_target, os_reason, run_folder
 from .workflows.scaling import Building
 from .workflows.tables import constants_from_table
+from .workflows.units import stamp
 
 # typer re-exports click's exceptions, and newer typer vendors click (``typer._click``): the
 # classes are taken from the module typer's own BadParameter comes from.
@@ -751,7 +752,7 @@ def ida(
             write_ida(doc, tmp, title=f"Fragility: {constants.name}")
     _skipped_notes(doc)
     if as_json:
-        _print_json(doc)
+        _print_json(stamp(doc, "ida"))
         return
     backend = doc["backend"]
     where = "locally" if backend["kind"] == "local" else f"on Dask at {backend['scheduler']}"
@@ -813,7 +814,7 @@ def constants(
         for failure in failures:
             typer.echo(f"  {failure.message}", err=True)
     if as_json:
-        _print_json(json.loads(cf.model_dump_json(exclude_none=True)))
+        _print_json(json.loads(stamped(cf).model_dump_json(exclude_none=True)))
         if failures:
             raise typer.Exit(code=1)
         return
@@ -1158,7 +1159,7 @@ def check(
     """Code checks (NTC 2018 / Circolare §C8.7.1, linear and nonlinear) of every mechanism."""
     doc = check_doc(read_constants(constants), read_site(site))
     if as_json:
-        _print_json(doc)
+        _print_json(stamp(doc, "check"))
         return
     s = doc["site"]
     typer.echo(f"{s['code']}: a_g S = {s['pga_g']:.4f} g, FC = {s['FC']:g}, q = {s['q']:g}")
@@ -1235,7 +1236,7 @@ def assess(
     if pdf:
         typer.echo(f"wrote {print_pdf(out, out.with_suffix('.pdf'))}", err=as_json)
     if as_json:
-        _print_json(doc)
+        _print_json(stamp(doc, "assess"))
 
 
 def main() -> None:  # pragma: no cover - console entry point

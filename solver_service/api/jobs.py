@@ -38,6 +38,7 @@ from shared_schema.api import (
 from shared_schema.constants import ConstantsFile, parse_constants
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import MissingExtra
+from shared_schema.io import stamped
 from shared_schema.rules import CRITERIA, F_N_RANGE, SF_METHODS, check_choice
 from shared_schema.spec import parse_spec
 
@@ -62,6 +63,7 @@ from ..workflows.documents import (
 from ..workflows.inputs import read_record
 from ..workflows.outputs import finite_json
 from ..workflows.scaling import Building
+from ..workflows.units import stamp
 from .errors import error_body
 from .estimates import (
     check_limit,
@@ -374,7 +376,7 @@ def scale_factor_doc(
 
 
 def _scale_factor(job: ScaleFactorJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
-    return dumps(scale_factor_doc(job.request, limits))
+    return dumps(stamp(scale_factor_doc(job.request, limits), "scale_factor"))
 
 
 def _scene_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
@@ -399,7 +401,7 @@ def _scene_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) 
             f"'rockmech[geometry]'), which this deployment lacks ({exc.name} is missing)"
         ) from None
     cf = constants_from_spec(spec_file, scene, scene_name=scene_name, spec_name=spec_name)
-    return cf.model_dump_json(exclude_none=True).encode("utf-8")
+    return stamped(cf).model_dump_json(exclude_none=True).encode("utf-8")
 
 
 #: Request fields a report lists under "Inputs and provenance", in this order.
@@ -463,7 +465,7 @@ def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes
 
 def _check(job: CheckJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
-    return dumps(check_doc(cf, job.site))
+    return dumps(stamp(check_doc(cf, job.site), "check"))
 
 
 def _assess_inputs(job: AssessJob | AssessHtmlJob, limits: dict[str, Any]) -> tuple[Any, list[Any]]:
@@ -511,7 +513,8 @@ def check_spectra_work(
 
 def _assess(job: AssessJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     cf, motions = _assess_inputs(job, limits)
-    return dumps(assessment_doc(cf, job.site, motions, multiples=list(job.multiples)))
+    doc = assessment_doc(cf, job.site, motions, multiples=list(job.multiples))
+    return dumps(stamp(doc, "assess"))
 
 
 def _assess_html(job: AssessHtmlJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:

@@ -41,6 +41,7 @@ from ..core.records import GroundMotion
 from ..core.spectra import Spectrum, response_spectrum
 from .adapter import to_rocking_model
 from .scaling import Building, option_notes, run_scaled
+from .units import stamp
 
 __all__ = [
     "PULSE_METHOD",
@@ -165,7 +166,7 @@ def solve_pulse(request: Union[PulseRequest, Mapping[str, Any]]) -> dict[str, An
         if model.is_directional:
             problem["eta_to_negative"] = model.eta_into(-1)
             problem["eta_to_positive"] = model.eta_into(1)
-    return {
+    doc = {
         "input": {
             **problem,
             "a_p_g": request.a_p_g,
@@ -177,6 +178,7 @@ def solve_pulse(request: Union[PulseRequest, Mapping[str, Any]]) -> dict[str, An
         },
         **res.summary(),
     }
+    return stamp(doc, "pulse")
 
 
 def _finite_or_none(values: np.ndarray[Any, Any]) -> list[Optional[float]]:
@@ -218,7 +220,7 @@ def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> dict[str, Any]:
     pulses : list of ExtractedPulse
         Its largest sine pulses (``core.pulses.extract_pulses``).
     """
-    return {
+    doc = {
         "record": {
             "name": motion.name,
             "n_samples": len(motion.accel.acc),
@@ -238,6 +240,7 @@ def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> dict[str, Any]:
             "runtime_s": spectrum.runtime_s,
         },
     }
+    return stamp(doc, "record")
 
 
 def record_analysis(
@@ -368,7 +371,7 @@ def envelope_doc(
         "governing": [cf.mechanisms[i].id if i >= 0 else None for i in index],
         "method": _envelope_method(fast, envelopes),
     }
-    return doc, envelopes
+    return stamp(doc, "envelope"), envelopes
 
 
 def _envelope_method(
@@ -473,7 +476,7 @@ def boundary_doc(
             "a_min": float(curve.a_min[0]) if math.isfinite(curve.a_min[0]) else None,
         }
     doc["search"] = {"a_max": curve.a_max, "scan_ratio": curve.scan_ratio, "rtol": curve.rtol}
-    return doc
+    return stamp(doc, "boundary")
 
 
 def record_pulse_doc(
@@ -607,7 +610,7 @@ def history_doc(
     notes = linearisation_notes(cf, models)
     if notes:
         doc["warnings"] = notes
-    return doc
+    return stamp(doc, "history")
 
 
 def time_domain_mechanisms(cf: ConstantsFile) -> tuple[ConstantsFile, list[dict[str, str]]]:

@@ -18,6 +18,7 @@ from shared_schema.constants import ConstantsFile
 from ..ida import ida_csv
 from ..report.plots import plot_envelopes, plot_fragility, plot_ratio_histories, plot_record
 from .documents import envelope_doc, history_doc
+from .units import stamp
 
 __all__ = [
     "envelope_csv",
@@ -146,6 +147,6 @@ def write_record(
 def write_ida(doc: dict[str, Any], out_dir: Path, *, title: str = "") -> None:
     """Write ``ida.json``, ``ida.csv`` and ``ida.png`` (fragility curves) of an IDA document."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / "ida.json", json.dumps(doc, indent=2) + "\n")
+    write_atomic(out_dir / "ida.json", json.dumps(stamp(doc, "ida"), indent=2) + "\n")
     write_atomic(out_dir / "ida.csv", ida_csv(doc))
     plot_fragility(doc, out_dir / "ida.png", title=title)
