@@ -34,12 +34,16 @@ from rhino_plugin.flows.analyse import (
     ServiceClient,
     analyse_flow,
     load_constants_files,
+    run_envelopes,
+    run_history,
     run_pulse,
 )
 from shared_schema.errors import RockmechError
 from shared_schema.io import load_constants
 from solver_service.cli import app
+from solver_service.core.records import GroundMotion
 from solver_service.workflows.adapter import to_rocking_model
+from solver_service.workflows.documents import envelope_doc, frequency_grid, history_doc
 
 CONSTANTS = sorted((EXAMPLES / "constants").glob("*.json"))
 RECORD = EXAMPLES / "records" / "elcentro_NS.dat"
@@ -190,3 +194,97 @@ def test_the_rhino_flow_asks_and_answers_as_the_api(server: Server, tmp_path: Pa
         result = analyse_flow(prompter, str(tmp_path), service_url=server.url)
         assert result is not None, prompter.messages
         assert without_runtime(result.doc) == want, where
+
+
+# --- envelopes and time histories --------------------------------------------------------------
+
+N_ENVELOPE = 30
+
+
+def _cli_doc(*argv: str) -> dict[str, Any]:
+    res = runner.invoke(app, [*argv, "--json"])
+    assert res.exit_code == 0, res.output
+    return dict(json.loads(res.stdout))
+
+
+def test_every_envelope_path_gives_the_same_answer(
+    server: Server, client: httpx.Client, tmp_path: Path
+) -> None:
+    for path in CONSTANTS:
+        text = path.read_text()
+        cf = load_constants(path)
+        out = tmp_path / path.stem
+        want = without_runtime(envelope_doc(cf, frequency_grid(0.1, 10.0, N_ENVELOPE))[0])
+        got = {
+            "cli": _cli_doc("envelope", str(path), "--n", str(N_ENVELOPE), "--out", str(out)),
+            "file": json.loads((out / "envelope.json").read_text()),
+            "rest": client.post(
+                "/api/v1/envelope", json={"constants": json.loads(text), "n": N_ENVELOPE}
+            ).json(),
+        }
+        body = hops_payload(constants=text, f_min=0.1, f_max=10.0, n=N_ENVELOPE)
+        got["hops"] = json.loads(outputs(client.post("/hops/envelope", json=body))["json"][0])
+        flows = load_constants_files([str(path)])
+        for where, url in (("flow", None), ("flow-service", server.url)):
+            result = run_envelopes(
+                flows,
+                n=N_ENVELOPE,
+                out_dir=str(tmp_path / f"{path.stem}-{where}"),
+                client=ServiceClient(url) if url else None,
+            )
+            got[where] = result.doc
+        for where, doc in got.items():
+            assert without_runtime(doc) == want, (path.name, where)
+
+
+def _record_g() -> tuple[list[float], float]:
+    """The record's samples in g as written in the file, and its step [s] as read."""
+    rows = [line.split() for line in RECORD.read_text().splitlines() if line.strip()]
+    return [float(r[1]) for r in rows], GroundMotion.from_file(RECORD, units="g").dt
+
+
+def _answer_rows(doc: dict[str, Any]) -> Any:
+    """The verdicts and numbers of a history document (the record's description aside)."""
+    return without_runtime({k: doc[k] for k in ("results", "criterion", "method") if k in doc})
+
+
+def test_every_history_path_gives_the_same_answer(
+    server: Server, client: httpx.Client, tmp_path: Path
+) -> None:
+    accel_g, dt = _record_g()
+    motion = GroundMotion.from_file(RECORD, units="g")
+    scales = [0.5, 1.0, 2.0]
+    for path in (
+        EXAMPLES / "constants" / "rect_walls.json",
+        EXAMPLES / "constants" / "church.json",
+    ):
+        text = path.read_text()
+        cf = load_constants(path)
+        want = _answer_rows(history_doc(cf, motion, scales))
+        assert sum(r["overturned"] for r in want["results"]) >= 1  # something to disagree on
+        got = {
+            "cli": _cli_doc("history", str(path), str(RECORD), "--scale", *map(str, scales)),
+            "rest": client.post(
+                "/api/v1/history",
+                json={
+                    "constants": json.loads(text),
+                    "record": {"accel": accel_g, "dt": dt, "units": "g", "name": "r"},
+                    "scales": scales,
+                },
+            ).json(),
+        }
+        body = hops_payload(constants=text, accel_g=accel_g, dt=dt, scales=scales)
+        got["hops"] = json.loads(outputs(client.post("/hops/history", json=body))["json"][0])
+        flows = load_constants_files([str(path)])
+        for where, url in (("flow", None), ("flow-service", server.url)):
+            result = run_history(
+                flows,
+                str(RECORD),
+                units="g",
+                scales=scales,
+                out_dir=str(tmp_path / f"{path.stem}-{where}"),
+                client=ServiceClient(url) if url else None,
+            )
+            got[where] = result.doc
+        for where, doc in got.items():
+            assert _answer_rows(doc) == want, (path.name, where)
