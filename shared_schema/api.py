@@ -311,6 +311,20 @@ def _constants_need_eta(schema: Dict[str, Any]) -> None:
     schema["properties"]["constants"] = {"allOf": [prop, _TWO_SIDED_ETA, _PLAUSIBLE_SIDES]}
 
 
+#: Time histories run the mechanisms that give ``eta`` (the others get a note): one at least.
+_SOME_ETA: Dict[str, Any] = {
+    "properties": {
+        "mechanisms": {"contains": {"properties": {"eta": _NUMBER}, "required": ["eta"]}}
+    }
+}
+
+
+def _history_schema(schema: Dict[str, Any]) -> None:
+    """State what the constants of time histories need: ``_constants_need_eta``, one ``eta``."""
+    _constants_need_eta(schema)
+    schema["properties"]["constants"]["allOf"].append(_SOME_ETA)
+
+
 def _plausible_constants(schema: Dict[str, Any]) -> None:
     """State in the schema the plausible values of an assessment's constants (eta optional)."""
     prop = schema["properties"]["constants"]
@@ -661,7 +675,7 @@ class HistoryRequest(HistoryOptions):
     """Time histories of every mechanism at every scale factor (``rockmech history``)."""
 
     model_config = ConfigDict(
-        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_history_schema
     )
 
     constants: ConstantsFile = Field(description=_TIME_DOMAIN_CONSTANTS)
@@ -792,6 +806,9 @@ REPORT_RECORD_RULE: Dict[str, Any] = {
 def _report_schema(schema: Dict[str, Any]) -> None:
     _constants_need_eta(schema)
     schema.update(REPORT_RECORD_RULE)
+    # With a record, time histories run: one mechanism at least gives eta.
+    schema["if"] = {"required": ["record"], "properties": {"record": {"type": "object"}}}
+    schema["then"] = {"properties": {"constants": _SOME_ETA}}
 
 
 class ReportRequest(ReportOptions):

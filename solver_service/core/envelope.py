@@ -92,6 +92,12 @@ RTOL = 1e-6
 V_REST_BOUNDARY = 1e-4
 #: Most outcome changes stored per Omega.
 MAX_EDGES = 64
+#: Up to this many Omega are searched on the calling thread, not in the parallel kernel: the
+#: thread pool costs more than it saves there, and a process forked from one that ran the
+#: parallel kernel (GNU OpenMP) may not start its threads.
+SERIAL_OMEGA = 16
+#: No scan point known in advance (``_kernels._search``'s ``known``).
+_NO_KNOWN = np.zeros(0, dtype=np.bool_)
 #: Library grid: Omega points (log-spaced in [0.05, 50]) and eta step.
 LIBRARY_OMEGA = (0.05, 50.0, 400)
 LIBRARY_ETA_STEP = 0.02
@@ -271,18 +277,20 @@ def boundary_curve(
         raise InputError(f"must be >= 0, got {n_scan_near!r}", "n_scan_near")
     scan = _scan(a_max, int(n_scan), int(n_scan_near))
     kern = kernels(backend)
-    edges, n_edges, first = kern.boundary_grid(
-        om,
-        eta,
-        one_sided,
-        float(direction),
-        PULSE_SHAPES[shape],
-        scan,
-        rtol,
-        MAX_EDGES,
-        V_REST_BOUNDARY,
-        math.nan if eta_neg is None else eta_neg,
-    )
+    args = (eta, one_sided, float(direction), PULSE_SHAPES[shape], scan, rtol)
+    eta_n = math.nan if eta_neg is None else eta_neg
+    if om.size <= SERIAL_OMEGA:
+        # The same search as boundary_grid's, one Omega after the other on this thread.
+        edges = np.full((om.size, MAX_EDGES), np.nan)
+        n_edges = np.zeros(om.size, dtype=np.int64)
+        first = np.zeros(om.size, dtype=np.bool_)
+        for i in range(om.size):
+            n_edges[i], first[i] = kern._search(
+                *args[:3], om[i], *args[3:], V_REST_BOUNDARY, edges[i], _NO_KNOWN,
+                kern.KNOWN_IGNORE, eta_n,
+            )  # fmt: skip
+    else:
+        edges, n_edges, first = kern.boundary_grid(om, *args, MAX_EDGES, V_REST_BOUNDARY, eta_n)
     return _curve(
         om,
         (eta, one_sided, direction),

@@ -133,3 +133,18 @@ def test_the_issue_cases_are_now_within_the_bounds(library: OverturningLibrary) 
     assert 4.5 < edge["f_low"] < edge["f_high"] < 4.9
     fast_edge = next(e for e in fast["critical_edges"] if (e["below"], e["above"]) == ("G1", "F1"))
     assert fast_edge["f_low"] <= edge["f_low"] and edge["f_high"] <= fast_edge["f_high"]
+
+
+def test_a_few_omega_are_searched_serially_with_the_same_edges() -> None:
+    """Up to SERIAL_OMEGA Omega skip the thread pool (the fast mode's refinements): same edges."""
+    from solver_service.core import envelope
+
+    omega = np.geomspace(0.3, 30.0, envelope.SERIAL_OMEGA)
+    for eta, one_sided in ((0.9, False), (0.0, False), (-0.5, True)):
+        serial = envelope.boundary_curve(omega, eta, one_sided=one_sided, direction=1)
+        parallel = envelope.boundary_curve(
+            np.concatenate([omega, omega]), eta, one_sided=one_sided, direction=1
+        )
+        assert np.array_equal(serial.a_min, parallel.a_min[: omega.size])
+        for i in range(omega.size):
+            assert serial.intervals(i) == parallel.intervals(i)
