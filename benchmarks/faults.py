@@ -48,7 +48,7 @@ if str(REPO) not in sys.path:
 from solver_service.api.server import background_server  # noqa: E402
 
 CHURCH = json.loads((REPO / "examples" / "constants" / "church.json").read_text())
-HEAVY = {"constants": CHURCH, "exact": True, "n": 800}
+HEAVY = {"constants": CHURCH, "method": "exact", "n": 800}
 PULSE = {"p_eq": 2.0, "lam": 0.2, "eta": 0.9, "a_p_g": -0.61, "f_p": 1.59}
 
 

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 from rockmech._version import __version__
 
 if TYPE_CHECKING:  # the real types for type checkers and editors
+    from shared_schema.api import PulseRequest as PulseRequest
     from shared_schema.constants import ConstantsFile as ConstantsFile
     from shared_schema.errors import (
         GeometryError as GeometryError,
@@ -66,6 +67,7 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from solver_service.report.html import (
         write_report as write_report,
     )
+    from solver_service.workflows.documents import solve_pulse as solve_pulse
     from solver_service.workflows.inputs import constants_from_files as constants_from_files
 
 #: Each public name and the module it comes from (imported on first access).
@@ -89,6 +91,9 @@ _SOURCES = {
     "GroundMotion": "solver_service.core.records",
     "simulate": "solver_service.core.exact",
     "simulate_batch": "solver_service.core.exact",
+    # One pulse request, one function: the same verdict as the CLI, REST, Hops and Rhino.
+    "PulseRequest": "shared_schema.api",
+    "solve_pulse": "solver_service.workflows.documents",
     # Envelopes, pulses in records, spectra.
     "mechanism_envelope": "solver_service.core.envelope",
     "critical_bands": "solver_service.core.envelope",

@@ -29,7 +29,7 @@ from typing import Annotated, Any, Dict, List, Literal, Optional, Tuple, Union
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
-from shared_schema.constants import Amplification, ConstantsFile, JsonInt
+from shared_schema.constants import Amplification, ConstantsFile, JsonInt, Mechanism
 from shared_schema.errors import InputError
 from shared_schema.rules import (
     A_P_G_MAX,
@@ -38,6 +38,7 @@ from shared_schema.rules import (
     BUILDING_HEIGHT_MAX_M,
     CRITERIA,
     DT_RANGE_S,
+    ENVELOPE_METHODS,
     F_N_RANGE,
     F_P_RANGE,
     LAM_RANGE,
@@ -59,6 +60,7 @@ __all__ = [
     "MAX_ASSESS_RECORDS",
     "MULTIPLE_MAX",
     "PULSE_ETA_RULE",
+    "PULSE_SHORT_FORM",
     "RECORD_SAMPLE_RULE",
     "RECORD_UNITS",
     "REPORT_RECORD_RULE",
@@ -100,6 +102,7 @@ __all__ = [
     "SpectrumOptions",
     "SpectrumRequest",
     "SpectrumResponse",
+    "mechanism_problem",
     "time_domain_problem",
 ]
 
@@ -138,26 +141,6 @@ def _height(description: str, *, positive: bool = True, below: str = "") -> Any:
 # states them too (``oneOf``), so that clients learn them from the contract.
 
 _NUMBER = {"type": "number"}
-
-#: A pulse needs ``eta``: in [0, 1] for two-sided rocking, in [-1, 0] for one-sided.
-PULSE_ETA_RULE: Dict[str, Any] = {
-    "oneOf": [
-        {
-            "properties": {
-                "one_sided": {"const": False},
-                "eta": {**_NUMBER, "minimum": 0, "maximum": 1},
-            },
-            "required": ["eta"],
-        },
-        {
-            "properties": {
-                "one_sided": {"const": True},
-                "eta": {**_NUMBER, "minimum": -1, "maximum": 0},
-            },
-            "required": ["eta", "one_sided"],
-        },
-    ]
-}
 
 #: Eq. 28 from S_a and PGA, or from a record and f_n, never both.
 EQ28_RULE: Dict[str, Any] = {
@@ -258,6 +241,55 @@ _PLAUSIBLE_SIDES: Dict[str, Any] = {
 }
 
 
+#: The keys of a pulse's short form: a symmetric mechanism given by its constants.
+PULSE_SHORT_FORM = ("p_eq", "lam", "eta", "phi_ov", "one_sided")
+
+#: A pulse's mechanism: the short form (``p_eq``, ``lam`` and ``eta``: in [0, 1] for
+#: two-sided rocking, in [-1, 0] for one-sided), or ``mechanism`` (one mechanism of a
+#: constants file, with ``eta`` and each side's ``p_eq`` and ``lam`` in the ranges of a
+#: pulse), never both.
+PULSE_ETA_RULE: Dict[str, Any] = {
+    "oneOf": [
+        {
+            "properties": {
+                "p_eq": _NUMBER,
+                "lam": _NUMBER,
+                "one_sided": {"const": False},
+                "eta": {**_NUMBER, "minimum": 0, "maximum": 1},
+                "mechanism": {"type": "null"},
+            },
+            "required": ["p_eq", "lam", "eta"],
+        },
+        {
+            "properties": {
+                "p_eq": _NUMBER,
+                "lam": _NUMBER,
+                "one_sided": {"const": True},
+                "eta": {**_NUMBER, "minimum": -1, "maximum": 0},
+                "mechanism": {"type": "null"},
+            },
+            "required": ["p_eq", "lam", "eta", "one_sided"],
+        },
+        {
+            "properties": {
+                **{key: {"type": "null"} for key in PULSE_SHORT_FORM if key != "one_sided"},
+                "one_sided": {"const": False},
+                "mechanism": {
+                    "type": "object",
+                    "properties": {
+                        "eta": _NUMBER,
+                        **_SIDE_RANGES["properties"],
+                        "positive": _SIDE_RANGES,
+                        "negative": _SIDE_RANGES,
+                    },
+                    "required": ["eta"],
+                },
+            },
+            "required": ["mechanism"],
+        },
+    ]
+}
+
 #: What the constants of a time-domain request need, in words.
 _TIME_DOMAIN_CONSTANTS = (
     "The kinematic-constants file; each side's p_eq [rad/s] and lam [-] (given or derived) "
@@ -277,6 +309,20 @@ def _constants_need_eta(schema: Dict[str, Any]) -> None:
     """State in the schema what time-domain constants need: ``eta``, plausible values."""
     prop = schema["properties"]["constants"]
     schema["properties"]["constants"] = {"allOf": [prop, _TWO_SIDED_ETA, _PLAUSIBLE_SIDES]}
+
+
+#: Time histories run the mechanisms that give ``eta`` (the others get a note): one at least.
+_SOME_ETA: Dict[str, Any] = {
+    "properties": {
+        "mechanisms": {"contains": {"properties": {"eta": _NUMBER}, "required": ["eta"]}}
+    }
+}
+
+
+def _history_schema(schema: Dict[str, Any]) -> None:
+    """State what the constants of time histories need: ``_constants_need_eta``, one ``eta``."""
+    _constants_need_eta(schema)
+    schema["properties"]["constants"]["allOf"].append(_SOME_ETA)
 
 
 def _plausible_constants(schema: Dict[str, Any]) -> None:
@@ -303,21 +349,34 @@ def time_domain_problem(cf: ConstantsFile) -> Optional[Tuple[str, str]]:
     'mechanisms[0].positive.p_eq'
     """
     for i, mech in enumerate(cf.mechanisms):
-        parts = (
-            ("amplification", AMPLIFICATION_RANGES, "a scale factor"),
-            ("positive", TIME_DOMAIN_RANGES, "a pulse"),
-            ("negative", TIME_DOMAIN_RANGES, "a pulse"),
-        )
-        for part, ranges, like in parts:
-            data = getattr(mech, part)
-            for key, (lo, hi) in [] if data is None else ranges.items():
-                value = getattr(data, key)
-                if not lo <= value <= hi:
-                    return (
-                        f"mechanisms[{i}].{part}.{key}",
-                        f"must be in [{lo:g}, {hi:g}] for a time-domain analysis (a plausible "
-                        f"range, as for {like}), got {value!r} (mechanism {mech.id!r})",
-                    )
+        problem = mechanism_problem(mech)
+        if problem is not None:
+            return f"mechanisms[{i}].{problem[0]}", problem[1]
+    return None
+
+
+def mechanism_problem(mech: Mechanism, amplification: bool = True) -> Optional[Tuple[str, str]]:
+    """Return ``(field, message)`` of a mechanism's first value out of its time-domain range.
+
+    The ranges: ``AMPLIFICATION_RANGES`` of its amplification data (unless not
+    ``amplification``), then ``TIME_DOMAIN_RANGES`` of each side; ``field`` is relative to
+    the mechanism (``positive.p_eq``).
+    """
+    parts = (
+        ("amplification", AMPLIFICATION_RANGES if amplification else {}, "a scale factor"),
+        ("positive", TIME_DOMAIN_RANGES, "a pulse"),
+        ("negative", TIME_DOMAIN_RANGES, "a pulse"),
+    )
+    for part, ranges, like in parts:
+        data = getattr(mech, part)
+        for key, (lo, hi) in [] if data is None else ranges.items():
+            value = getattr(data, key)
+            if not lo <= value <= hi:
+                return (
+                    f"{part}.{key}",
+                    f"must be in [{lo:g}, {hi:g}] for a time-domain analysis (a plausible "
+                    f"range, as for {like}), got {value!r} (mechanism {mech.id!r})",
+                )
     return None
 
 
@@ -351,23 +410,39 @@ def _in_f_p_range(cls: Any, value: float, info: Any) -> float:
     return value
 
 
+def _envelope_method(cls: Any, value: str) -> str:
+    return check_choice(value, ENVELOPE_METHODS, "method")
+
+
 # --- requests ---------------------------------------------------------------------------------
 
 
 class PulseRequest(BaseModel):
-    """One mechanism under a one-cycle sine or cosine pulse (``rockmech pulse``)."""
+    """One mechanism under a one-cycle sine or cosine pulse (``rockmech pulse``).
+
+    The one pulse request of every front end: the command line, REST ``/pulse``, Hops, the
+    Rhino and Grasshopper flows and the Python API build it, and
+    ``solver_service.workflows.documents.solve_pulse`` runs it. The mechanism is given
+    either in the short form, ``p_eq``, ``lam`` (and ``phi_ov``, ``eta``, ``one_sided``): a
+    symmetric mechanism; or as ``mechanism``, one mechanism of a kinematic-constants file
+    whose two sides and impact directions may differ (``PULSE_ETA_RULE``). The pulse acts at
+    the mechanism's base: amplification data of the mechanism are not applied.
+    """
 
     model_config = ConfigDict(
         strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=PULSE_ETA_RULE
     )
 
-    p_eq: float = Field(
+    p_eq: Optional[float] = Field(
+        None,
         description=f"Frequency parameter p_eq [rad/s], in [{P_EQ_RANGE[0]:g}, "
-        f"{P_EQ_RANGE[1]:g}] (blocks of half-diagonal 74 km down to 7 µm).",
+        f"{P_EQ_RANGE[1]:g}] (blocks of half-diagonal 74 km down to 7 µm); short form.",
         json_schema_extra={"minimum": P_EQ_RANGE[0], "maximum": P_EQ_RANGE[1]},
     )
-    lam: float = Field(
-        description=f"Static load multiplier lambda [-], in [{LAM_RANGE[0]:g}, {LAM_RANGE[1]:g}].",
+    lam: Optional[float] = Field(
+        None,
+        description=f"Static load multiplier lambda [-], in [{LAM_RANGE[0]:g}, "
+        f"{LAM_RANGE[1]:g}]; short form.",
         json_schema_extra={"minimum": LAM_RANGE[0], "maximum": LAM_RANGE[1]},
     )
     a_p_g: float = Field(
@@ -384,14 +459,20 @@ class PulseRequest(BaseModel):
     eta: Optional[float] = Field(
         None,
         description="Coefficient of restitution [-], in [0, 1] two-sided, [-1, 0] one-sided; "
-        "required for a time-domain analysis.",
+        "short form (required there).",
         json_schema_extra={"minimum": -1, "maximum": 1},
     )
-    one_sided: bool = Field(False, description="One-sided rocking.")
+    one_sided: bool = Field(False, description="One-sided rocking; short form.")
     phi_ov: Optional[float] = Field(
         None,
-        description="Overturning rotation [rad], > 0; defaults to lambda.",
+        description="Overturning rotation [rad], > 0; defaults to lambda; short form.",
         json_schema_extra={"exclusiveMinimum": 0},
+    )
+    mechanism: Optional[Mechanism] = Field(
+        None,
+        description="One mechanism of a kinematic-constants file instead of the short form: "
+        "its sides (each side's p_eq and lam, given or derived, in the ranges above), eta "
+        "(required) and the restitution of each impact direction.",
     )
     shape: str = Field(
         "sine", description="Pulse shape.", json_schema_extra={"enum": list(PULSE_SHAPES)}
@@ -404,16 +485,54 @@ class PulseRequest(BaseModel):
 
     @field_validator("p_eq", "lam", "f_p", "a_p_g")
     @classmethod
-    def _plausible(cls, value: float, info: Any) -> float:
+    def _plausible(cls, value: Optional[float], info: Any) -> Optional[float]:
         # Zero and negative values get the command line's message (the solver's check);
         # the others the plausible range of shared_schema.rules.
         name = info.field_name
+        if value is None:
+            return value
         lo, hi = _PULSE_RANGES[name]
         if name != "a_p_g" and not value > 0:
             raise ValueError(f"must be finite and > 0, got {value!r}")
         if not lo <= value <= hi:
             raise ValueError(f"must be in [{lo:g}, {hi:g}] (a plausible range), got {value!r}")
         return value
+
+    @model_validator(mode="after")
+    def _one_form(self) -> "PulseRequest":
+        if self.mechanism is None:
+            for key in ("p_eq", "lam"):
+                if getattr(self, key) is None:
+                    raise InputError(
+                        "required, unless the mechanism is given (mechanism; on the command "
+                        "line --constants)",
+                        key,
+                    )
+            return self
+        for key in PULSE_SHORT_FORM:
+            if getattr(self, key) not in (None, False):
+                raise InputError(
+                    "give the mechanism's constants either in the short form (p_eq, lam, "
+                    "eta, phi_ov, one_sided) or as mechanism, not both",
+                    key,
+                )
+        problem = mechanism_problem(self.mechanism, amplification=False)
+        if problem is not None:
+            raise PydanticCustomError(
+                "implausible_constant",
+                "{message}",
+                {"field": f"mechanism.{problem[0]}", "message": problem[1]},
+            )
+        return self
+
+    @property
+    def p_eq_max(self) -> Optional[float]:
+        """The larger ``p_eq`` of the mechanism's sides [rad/s] (it sets the work), or None."""
+        if self.mechanism is None:
+            return self.p_eq
+        sides = (self.mechanism.positive, self.mechanism.negative)
+        values = [side.p_eq for side in sides if side is not None and side.p_eq is not None]
+        return max(values) if values else None
 
 
 #: (lowest, highest) of each number of a pulse request (shared_schema.rules).
@@ -470,12 +589,17 @@ class EnvelopeRequest(BaseModel):
     n: JsonInt = Field(
         200, description="Number of log-spaced frequencies, >= 2.", json_schema_extra={"minimum": 2}
     )
-    exact: bool = Field(
-        False, description="Compute the boundaries directly instead of from the library."
+    method: str = Field(
+        "exact",
+        description="How the envelopes are computed: exact (the exact integrator at every "
+        "frequency) or library (the fast mode: interpolated, exact where the library cannot "
+        "interpolate safely; never above the exact value, at most 5 % below).",
+        json_schema_extra={"enum": list(ENVELOPE_METHODS)},
     )
 
     _plausible = field_validator("constants")(classmethod(_time_domain_constants))
     _frequencies = field_validator("f_min", "f_max")(classmethod(_in_f_p_range))
+    _method = field_validator("method")(classmethod(_envelope_method))
 
 
 class BuildingOptions(BaseModel):
@@ -536,17 +660,22 @@ class ReportOptions(HistoryOptions):
         description="Number of log-spaced envelope frequencies, >= 2.",
         json_schema_extra={"minimum": 2},
     )
-    exact: bool = Field(False, description="Exact envelopes instead of the library.")
+    method: str = Field(
+        "exact",
+        description="How the envelopes are computed: exact, or library (the fast mode).",
+        json_schema_extra={"enum": list(ENVELOPE_METHODS)},
+    )
     title: Optional[str] = Field(None, max_length=200, description="Title of the report.")
 
     _frequencies = field_validator("f_min", "f_max")(classmethod(_in_f_p_range))
+    _method = field_validator("method")(classmethod(_envelope_method))
 
 
 class HistoryRequest(HistoryOptions):
     """Time histories of every mechanism at every scale factor (``rockmech history``)."""
 
     model_config = ConfigDict(
-        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_constants_need_eta
+        strict=True, extra="forbid", allow_inf_nan=False, json_schema_extra=_history_schema
     )
 
     constants: ConstantsFile = Field(description=_TIME_DOMAIN_CONSTANTS)
@@ -677,6 +806,9 @@ REPORT_RECORD_RULE: Dict[str, Any] = {
 def _report_schema(schema: Dict[str, Any]) -> None:
     _constants_need_eta(schema)
     schema.update(REPORT_RECORD_RULE)
+    # With a record, time histories run: one mechanism at least gives eta.
+    schema["if"] = {"required": ["record"], "properties": {"record": {"type": "object"}}}
+    schema["then"] = {"properties": {"constants": _SOME_ETA}}
 
 
 class ReportRequest(ReportOptions):
@@ -834,6 +966,8 @@ class HealthResponse(BaseModel):
         description="ok: every compute process has warmed up; starting: not yet (HTTP 503)."
     )
     version: str = Field(description="rockmech version.")
+    rockmech_version: str = Field(description="rockmech version (as every document names it).")
+    units: Dict[str, str] = Field(description="Units of the quantities.")
     compute_workers: int = Field(description="Compute processes ready or busy.")
     compute_timeout_s: float = Field(description="Compute time budget per request [s].")
 

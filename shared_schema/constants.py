@@ -905,6 +905,8 @@ class ConstantsFile(BaseModel):
         Format version, ``"1.<minor>"``; defaults to ``SCHEMA_VERSION``.
     units : Units
         SI units of the quantities (fixed; filled in by default).
+    rockmech_version : str, optional
+        The rockmech version that wrote the file (``shared_schema.io.stamped``).
     mechanisms : list of Mechanism
         At least one mechanism; ids are unique.
 
@@ -932,6 +934,12 @@ class ConstantsFile(BaseModel):
     )
     units: Units = Field(
         default_factory=Units, description="SI units of the quantities (fixed, informative)."
+    )
+    rockmech_version: Optional[str] = Field(
+        None,
+        max_length=100,
+        description="Version of rockmech that wrote the file (informative; rockmech fills "
+        "it in whenever it writes one).",
     )
     mechanisms: List[Mechanism] = Field(
         min_length=1, description="The mechanisms; at least one, with unique ids."

@@ -13,12 +13,14 @@ from shared_schema.atomic import PathLike, write_atomic
 from shared_schema.constants import ConstantsFile, parse_constants
 from shared_schema.errors import InputError
 from shared_schema.text import decode_text
+from shared_schema.version import __version__
 
 __all__ = [
     "CONSTANTS_EXPECTED",
     "load_constants",
     "parse_constants",
     "save_constants",
+    "stamped",
     "write_atomic",
 ]
 
@@ -65,6 +67,14 @@ def load_constants(path: PathLike) -> ConstantsFile:
         raise InputError(str(exc), str(file)) from exc
 
 
+def stamped(model: ConstantsFile) -> ConstantsFile:
+    """Return the constants with ``rockmech_version`` set to this version (the writer's).
+
+    Every constants file rockmech writes or answers carries it, beside its ``units``.
+    """
+    return model.model_copy(update={"rockmech_version": __version__})
+
+
 def save_constants(path: PathLike, model: ConstantsFile) -> None:
     """Write a kinematic-constants file atomically.
 
@@ -86,7 +96,7 @@ def save_constants(path: PathLike, model: ConstantsFile) -> None:
     The JSON is built completely before anything is written, so a serialisation error
     leaves the previous file untouched. Output: indent 2, UTF-8, trailing newline.
     """
-    text = model.model_dump_json(indent=2, exclude_none=True) + "\n"
+    text = stamped(model).model_dump_json(indent=2, exclude_none=True) + "\n"
     try:
         write_atomic(path, text)
     except OSError as exc:

@@ -37,6 +37,7 @@ __all__ = [
     "CRITERIA",
     "DAMPING_PERCENT_RANGE",
     "DT_RANGE_S",
+    "ENVELOPE_METHODS",
     "F_N_RANGE",
     "F_P_RANGE",
     "LAM_RANGE",
@@ -123,6 +124,11 @@ CRITERIA: Tuple[str, ...] = ("ratio", "exact")
 
 #: One-cycle acceleration pulse shapes.
 PULSE_SHAPES: Tuple[str, ...] = ("sine", "cosine")
+
+#: How overturning envelopes are computed: ``exact`` (the exact integrator at every
+#: frequency, the default) or ``library`` (the fast mode: the interpolated library, exact
+#: where it cannot interpolate safely; docs/envelopes.md).
+ENVELOPE_METHODS: Tuple[str, ...] = ("exact", "library")
 
 # Plausible ranges of the numbers a pulse request gives directly (the REST service's
 # ``/pulse``; its OpenAPI schema states them). Each bound lies far past any masonry body and

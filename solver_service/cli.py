@@ -26,7 +26,7 @@ from rhino_plugin.mechanisms.build import MechanismFailure
 from shared_schema.atomic import remove_stale_temps
 from shared_schema.errors import RockmechError
 from shared_schema.extras import MissingExtra, extra_for, require
-from shared_schema.io import save_constants
+from shared_schema.io import save_constants, stamped
 from shared_schema.rules import (
     CRITERIA,
     PULSE_SHAPES,
@@ -49,9 +49,10 @@ from .workflows.documents import (
     frequency_grid,
     history_doc,
     log_grid,
-    pulse_doc,
+    pick_mechanism,
     record_analysis,
     record_pulse_doc,
+    solve_pulse,
     time_domain_mechanisms,
 )
 from .workflows.inputs import (
@@ -72,6 +73,7 @@ from .workflows.outputs import finite_json, write_envelope, write_history, write
 from .workflows.rundir import check_file_target, check_folder_target, os_reason, run_folder
 from .workflows.scaling import Building
 from .workflows.tables import checked_table
+from .workflows.units import stamp
 
 # typer re-exports click's exceptions, and newer typer vendors click (``typer._click``): the
 # classes are taken from the module typer's own BadParameter comes from.
@@ -341,8 +343,12 @@ _CRITERIA = _choices(CRITERIA)
 @app.command()
 @_user_errors
 def pulse(
-    p_eq: float = typer.Option(..., "--p-eq", help="Frequency parameter p_eq [rad/s]."),
-    lam: float = typer.Option(..., "--lam", help="Static load multiplier lambda [-]."),
+    p_eq: Optional[float] = typer.Option(
+        None, "--p-eq", help="Frequency parameter p_eq [rad/s] (or --constants)."
+    ),
+    lam: Optional[float] = typer.Option(
+        None, "--lam", help="Static load multiplier lambda [-] (or --constants)."
+    ),
     a_p_g: float = typer.Option(
         ...,
         "--a-p-g",
@@ -357,6 +363,15 @@ def pulse(
     phi_ov: Optional[float] = typer.Option(
         None, "--phi-ov", help="Overturning rotation [rad]; defaults to lambda."
     ),
+    constants: Optional[Path] = typer.Option(
+        None,
+        "--constants",
+        help="Kinematic-constants JSON: run one of its mechanisms (both sides, each impact "
+        "direction's eta) instead of --p-eq, --lam, --eta, --phi-ov, --one-sided.",
+    ),
+    mechanism: Optional[str] = typer.Option(
+        None, "--mechanism", help="Mechanism id in --constants (default: the first)."
+    ),
     shape: str = typer.Option("sine", "--shape", metavar=_SHAPES, help="Pulse shape."),
     criterion: Optional[str] = typer.Option(
         None,
@@ -367,23 +382,23 @@ def pulse(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
 ) -> None:
     """Response of one mechanism to a one-cycle sine or cosine acceleration pulse."""
-    doc = pulse_doc(
-        p_eq,
-        lam,
-        a_p_g,
-        f_p,
-        eta=eta,
-        one_sided=one_sided,
-        phi_ov=phi_ov,
-        shape=shape,
-        criterion=criterion,
-    )
+    request: dict[str, Any] = {"a_p_g": a_p_g, "f_p": f_p, "shape": shape}
+    short = {"p_eq": p_eq, "lam": lam, "eta": eta, "phi_ov": phi_ov}
+    request.update({k: v for k, v in short.items() if v is not None})
+    request.update({"one_sided": True} if one_sided else {})
+    request.update({"criterion": criterion} if criterion is not None else {})
+    if constants is not None:
+        request["mechanism"] = pick_mechanism(read_constants(constants), mechanism)
+    elif mechanism is not None:
+        _fail("mechanism: needs --constants (the file that holds it)")
+    doc = solve_pulse(request)
     if as_json:
         _print_json(doc)
         return
     verdict = "OVERTURNS" if doc["overturned"] else "survives"
+    name = f"{doc['input']['mechanism']}: " if "mechanism" in doc["input"] else ""
     typer.echo(
-        f"Pulse {shape} a_p = {a_p_g:g} g, f_p = {f_p:g} Hz "
+        f"{name}Pulse {shape} a_p = {a_p_g:g} g, f_p = {f_p:g} Hz "
         f"(Omega = {doc['input']['omega_ratio']:.4g}, A = {doc['input']['amplitude_ratio']:.4g}):"
         f" {verdict} [{doc['criterion']} criterion]"
     )
@@ -780,7 +795,7 @@ def ida(
         raise typer.Exit(code=130) from None
     _skipped_notes(doc)
     if as_json:
-        _print_json(doc)
+        _print_json(stamp(doc, "ida"))
         return
     backend = doc["backend"]
     where = (
@@ -854,7 +869,7 @@ def constants(
         for note in notes if isinstance(notes, list) else []:
             _mechanism_warning(m.id, str(note))
     if as_json:
-        _print_json(json.loads(cf.model_dump_json(exclude_none=True)))
+        _print_json(json.loads(stamped(cf).model_dump_json(exclude_none=True)))
         if failures:
             raise typer.Exit(code=1)
         return
@@ -886,6 +901,25 @@ def constants_table(
     typer.echo(f"wrote {output}: {len(cf.mechanisms)} mechanism(s) from {table.name}")
 
 
+_FAST_OPT = typer.Option(
+    False,
+    "--fast",
+    help="Fast mode: envelopes interpolated from the library (exact where it cannot "
+    "interpolate safely): never above the exact values, at most 5 % below; band edges "
+    "within a factor 1.05 in frequency (docs/envelopes.md).",
+)
+_EXACT_OPT = typer.Option(
+    False, "--exact", help="Exact envelopes at every frequency (the default; kept for scripts)."
+)
+
+
+def _envelope_method(fast: bool, exact: bool) -> str:
+    """Return the envelope method of ``--fast`` / ``--exact`` (exact unless --fast)."""
+    if fast and exact:
+        _fail("fast: give --fast or --exact, not both")
+    return "library" if fast else "exact"
+
+
 @app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
 @_user_errors
 def envelope(
@@ -897,9 +931,8 @@ def envelope(
     f_min: float = typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
     f_max: float = typer.Option(10.0, "--f-max", help="Highest pulse frequency [Hz]."),
     n: int = typer.Option(200, "--n", help="Number of log-spaced frequencies."),
-    exact: bool = typer.Option(
-        False, "--exact", help="Compute boundaries directly instead of from the library."
-    ),
+    fast: bool = _FAST_OPT,
+    exact: bool = _EXACT_OPT,
     record: Optional[Path] = typer.Option(
         None,
         "--record",
@@ -918,18 +951,19 @@ def envelope(
     as_json: bool = typer.Option(False, "--json", help="Also print the JSON document."),
 ) -> None:
     """Minimum overturning sine-pulse amplitude of every mechanism, and the critical bands."""
+    method = _envelope_method(fast, exact)
     _limit(no_limits, envelope=(f_min, f_max, n, False))
     f_p = frequency_grid(f_min, f_max, n)
     check_folder_target(out)
     cf = read_constants(constants, time_domain=True)
-    _limit(no_limits, cf, envelope=(f_min, f_max, n, exact))
+    _limit(no_limits, cf, envelope=(f_min, f_max, n, method == "exact"))
     pulse = None
     if record is not None:
         motion = _read_record(record, record_format, units, dt, channel, component)
-        pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), exact=exact)
+        pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), method=method)
     elif ctx.args:
         _fail(f"unexpected argument {ctx.args[0]!r}")
-    kind = "exact envelopes" if exact else "envelopes"
+    kind = "exact envelopes" if method == "exact" else "envelopes (fast mode, library)"
     with (
         _status(f"{kind}: {len(cf.mechanisms)} mechanisms x {n} frequencies"),
         run_folder(out, on_note=_out_note) as tmp,
@@ -938,7 +972,7 @@ def envelope(
             cf,
             f_p,
             tmp,
-            exact=exact,
+            method=method,
             title=f"Overturning envelopes: {constants.name}",
             record_pulse=pulse,
         )
@@ -1092,13 +1126,15 @@ def report(
     f_min: float = typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
     f_max: float = typer.Option(10.0, "--f-max", help="Highest pulse frequency [Hz]."),
     n: int = typer.Option(200, "--n", help="Number of log-spaced frequencies."),
-    exact: bool = typer.Option(False, "--exact", help="Exact envelopes, not the library."),
+    fast: bool = _FAST_OPT,
+    exact: bool = _EXACT_OPT,
     title: Optional[str] = typer.Option(None, "--title", help="Title of the report."),
     no_limits: bool = _NO_LIMITS_OPT,
     time_limit: float = _TIME_LIMIT_OPT,
 ) -> None:
     """One self-contained HTML report: constants, envelopes, and with --record its histories."""
     scales = _scales(scale, ctx.args)
+    method = _envelope_method(fast, exact)
     check_file_target(out)
     _limit(no_limits, scales=len(scales), envelope=(f_min, f_max, n, False))
     f_p = frequency_grid(f_min, f_max, n)
@@ -1109,11 +1145,12 @@ def report(
         motion = _read_record(record, record_format, units, dt, channel, component)
         sources.append(input_source("record", record.name, record.read_bytes()))
     size = None if motion is None else _record_size([motion])
-    _limit(no_limits, cf, scales=len(scales), record=size, envelope=(f_min, f_max, n, exact))
+    envelope = (f_min, f_max, n, method == "exact")
+    _limit(no_limits, cf, scales=len(scales), record=size, envelope=envelope)
     options = {"scales": scales, "sf": sf, "building_height": building_height}
     options.update(soil_factor=soil_factor, element_period=element_period, at_height=at_height)
     options.update(criterion=criterion)
-    options.update(f_min=f_min, f_max=f_max, n=n, exact=exact)
+    options.update(f_min=f_min, f_max=f_max, n=n, method=method)
     with _status("report: envelopes and histories"):
         text = build_report(
             cf,
@@ -1126,7 +1163,7 @@ def report(
                 "criterion": criterion,
                 "at_height": at_height,
             },
-            exact=exact,
+            method=method,
             title=title or f"rockmech report: {constants.name}",
             sources=sources,
             request=options,
@@ -1180,7 +1217,7 @@ def check(
     """Code checks of every mechanism (Circolare 2019 §C8.7.1: linear SLV, nonlinear SLV/SLC)."""
     doc = check_doc(read_constants(constants), read_site(site))
     if as_json:
-        _print_json(doc)
+        _print_json(stamp(doc, "check"))
         return
     s = doc["site"]
     typer.echo(f"method: {doc['method']['name']}: {doc['method']['standard']}")
@@ -1275,7 +1312,7 @@ def assess(
     if pdf:
         typer.echo(f"wrote {print_pdf(out, out.with_suffix('.pdf'))}", err=as_json)
     if as_json:
-        _print_json(doc)
+        _print_json(stamp(doc, "assess"))
 
 
 def main() -> None:  # pragma: no cover - console entry point

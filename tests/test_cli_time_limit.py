@@ -75,7 +75,7 @@ def test_the_time_limit_sets_the_up_front_work_budget(tmp_path: Path) -> None:
     # About 1.3e8 steps: 12 s at twice the measured rate on two cores.
     res = runner.invoke(app, [*argv, "--time-limit", "1"])
     assert res.exit_code == 2
-    assert res.stderr.startswith("error: exact: the run would take 1.")
+    assert res.stderr.startswith("error: method: the run would take 1.")
     assert "closed-form steps of exact envelopes" in res.stderr
     assert "more than its time limit of 1 s" in res.stderr
     assert "give --time-limit with more seconds, or --no-limits" in res.stderr

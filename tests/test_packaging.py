@@ -54,6 +54,8 @@ PUBLIC = [
     "GroundMotion",
     "simulate",
     "simulate_batch",
+    "PulseRequest",
+    "solve_pulse",
     "mechanism_envelope",
     "critical_bands",
     "extract_pulses",

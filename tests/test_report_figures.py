@@ -46,7 +46,7 @@ def test_a_failing_history_figure_becomes_a_note(
         motion=motion,
         scales=[0.5, 1.0],
         history={"sf": "none", "building": Building()},
-        exact=True,
+        method="exact",
     )
     assert f"at scale 1: not drawn ({REASON})" in page
     assert "<h2>Time histories</h2>" in page  # the table is still there

@@ -23,8 +23,7 @@ from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.io import load_constants
-from solver_service.workflows.adapter import to_rocking_model
-from solver_service.workflows.documents import frequency_grid, model_pulse_doc
+from solver_service.workflows.documents import frequency_grid, pick_mechanism, solve_pulse
 from solver_service.workflows.inputs import read_record
 from solver_service.workflows.outputs import write_envelope, write_history
 
@@ -244,25 +243,17 @@ def run_history(
 def run_pulse(
     cf: Any, mechanism: str, *, a_p_g: float, f_p: float, client: Optional[ServiceClient] = None
 ) -> AnalysisResult:
-    """Response of one mechanism to a one-cycle sine pulse (``rockmech pulse``)."""
-    mech = next((m for m in cf.mechanisms if m.id == mechanism), None)
-    if mech is None:
-        ids = [m.id for m in cf.mechanisms]
-        raise InputError(f"no mechanism {mechanism!r}; the file has {ids}", "mechanism")
+    """Response of one mechanism to a one-cycle sine pulse (``rockmech pulse --constants``).
+
+    Both paths send the same ``PulseRequest`` (the whole mechanism: both sides, each impact
+    direction's restitution) to the same function, ``solve_pulse``: here, or on the service
+    behind ``POST /api/v1/pulse``.
+    """
+    payload = {"mechanism": pick_mechanism(cf, mechanism), "a_p_g": a_p_g, "f_p": f_p}
     if client is not None:
-        side = mech.positive
-        payload = {
-            "p_eq": side.p_eq,
-            "lam": side.lam,
-            "phi_ov": side.phi_ov,
-            "eta": mech.eta,
-            "one_sided": mech.rocking == "one_sided",
-            "a_p_g": a_p_g,
-            "f_p": f_p,
-        }
         doc = client.post("pulse", payload)
     else:
-        doc = model_pulse_doc(to_rocking_model(mech), a_p_g, f_p)
+        doc = solve_pulse(payload)
     verdict = "OVERTURNS" if doc.get("overturned") else "survives"
     line = f"  {mechanism}: sine pulse a_p = {a_p_g:g} g, f_p = {f_p:g} Hz: {verdict}"
     if "peak_ratio" in doc:

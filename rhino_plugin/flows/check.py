@@ -16,6 +16,7 @@ from rhino_plugin.flows.analyse import AnalysisResult, ServiceClient
 from shared_schema.errors import InputError
 from shared_schema.site import parse_site
 from solver_service.workflows.assess import check_doc
+from solver_service.workflows.units import stamp
 
 __all__ = ["check_lines", "parse_site_text", "run_check"]
 
@@ -61,5 +62,5 @@ def run_check(cf: Any, site: Any, *, client: Optional[ServiceClient] = None) -> 
         }
         doc = client.post("check", payload)
     else:
-        doc = check_doc(cf, site)
+        doc = stamp(check_doc(cf, site), "check")
     return AnalysisResult("Check", doc, check_lines(doc))

@@ -27,16 +27,29 @@ M = TypeVar("M")
 
 
 def _fields_to_send(adapter: TypeAdapter[Any]) -> str:
-    """Name the required fields of a body in words: ``p_eq, lam, a_p_g and f_p``."""
+    """Name the required fields of a body in words.
+
+    For example ``a_p_g and f_p; and p_eq, lam and eta, or mechanism`` (``oneOf`` forms).
+    """
     schema = adapter.json_schema()
     chooser = schema.get("discriminator")
     if chooser:
         choices = ", ".join(chooser.get("mapping", {}))
         return f"{chooser['propertyName']} (one of {choices}) and that method's fields"
-    names = list(schema.get("required", []))
+    text = _and(list(schema.get("required", []))) or "its fields"
+    # Fields required by one of several forms (a pulse: p_eq, lam and eta, or mechanism).
+    needs = [list(b.get("required", [])) for b in schema.get("oneOf", [])]
+    forms = [need for need in needs if need and not any(set(other) < set(need) for other in needs)]
+    if forms:
+        text += "; and " + ", or ".join(_and(form) for form in forms)
+    return text
+
+
+def _and(names: list[str]) -> str:
+    """Join names as ``a, b and c``."""
     if len(names) > 1:
         return ", ".join(names[:-1]) + f" and {names[-1]}"
-    return names[0] if names else "its fields"
+    return names[0] if names else ""
 
 
 def _too_deep(exc: ValidationError) -> bool:

@@ -180,7 +180,7 @@ def _envelope(
     _check_answer(n * columns, limits, "the envelopes", "n")
     # Mechanisms with a restitution per impact direction are computed exactly anyway.
     what = (
-        "the exact envelopes"
+        "the exact envelopes (method library is faster)"
         if exact
         else (
             "the envelopes of the mechanisms with a restitution per impact direction (always "
@@ -190,7 +190,7 @@ def _envelope(
     check_time(
         limits,
         what,
-        "exact" if exact else "constants",
+        "method" if exact else "constants",
         envelope_steps=envelope_steps(cf, f_min, f_max, n, exact=exact),
         pulse_points=scale_factor_points(cf, f_min, f_max, n) if exact else 0.0,
     )
@@ -270,17 +270,19 @@ def check_job(job: Job, limits: dict[str, Any]) -> None:
             "max_mechanisms",
         )
         _check_derived(cf)
-    if isinstance(job, PulseJob) and _positive(job.p_eq, job.f_p):
-        # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
-        check_work(job.p_eq / job.f_p, limits, "the pulse", "f_p")
+    if isinstance(job, PulseJob):
+        p_eq = job.p_eq_max
+        if p_eq is not None and _positive(p_eq, job.f_p):
+            # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
+            check_work(p_eq / job.f_p, limits, "the pulse", "f_p")
     elif isinstance(job, EnvelopeJob):
-        _envelope(job.constants, job.f_min, job.f_max, job.n, job.exact, limits)
+        _envelope(job.constants, job.f_min, job.f_max, job.n, job.method == "exact", limits)
     elif isinstance(job, HistoryJob):
         _history(job, cf, limits)
     elif isinstance(job, ReportJob):
         _history(job, cf, limits)
         if cf is not None:
-            _envelope(cf, job.f_min, job.f_max, job.n, job.exact, limits)
+            _envelope(cf, job.f_min, job.f_max, job.n, job.method == "exact", limits)
     elif isinstance(job, SpectrumJob):
         check_limit(job.n, limits["max_samples"], "periods", "n", "max_samples")
         if job.record is not None:

@@ -38,7 +38,7 @@ from shared_schema.api import (
 from shared_schema.constants import ConstantsFile, parse_constants
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import MissingExtra
-from shared_schema.io import CONSTANTS_EXPECTED
+from shared_schema.io import CONSTANTS_EXPECTED, stamped
 from shared_schema.rules import CRITERIA, F_N_RANGE, SF_METHODS, check_choice
 from shared_schema.spec import parse_spec
 from shared_schema.text import decode_text
@@ -60,11 +60,12 @@ from ..workflows.documents import (
     history_doc,
     log_grid,
     record_analysis,
+    solve_pulse,
 )
-from ..workflows.documents import pulse_doc as doc
 from ..workflows.inputs import SPEC_EXPECTED, read_record
 from ..workflows.outputs import finite_json
 from ..workflows.scaling import Building
+from ..workflows.units import stamp
 from .errors import error_body
 from .estimates import (
     check_limit,
@@ -269,25 +270,15 @@ def pulse_doc(job: PulseRequest, limits: Optional[dict[str, Any]] = None) -> dic
     Parameters
     ----------
     job : PulseRequest
-        ``p_eq`` [rad/s], ``lam`` [-], ``a_p_g`` [g], ``f_p`` [Hz], ``eta``, ``one_sided``,
-        ``phi_ov`` [rad], ``shape``, ``criterion``.
+        The request; ``workflows.documents.solve_pulse`` runs it, as on every other path.
     limits : dict, optional
         The service's size limits (bound the work); none from the command line.
     """
-    if limits is not None and _positive(job.p_eq, job.f_p):
+    p_eq = job.p_eq_max
+    if limits is not None and p_eq is not None and _positive(p_eq, job.f_p):
         # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
-        check_work(job.p_eq / job.f_p, limits, "the pulse", "f_p")
-    return doc(
-        job.p_eq,
-        job.lam,
-        job.a_p_g,
-        job.f_p,
-        eta=job.eta,
-        one_sided=job.one_sided,
-        phi_ov=job.phi_ov,
-        shape=job.shape,
-        criterion=job.criterion,
-    )
+        check_work(p_eq / job.f_p, limits, "the pulse", "f_p")
+    return solve_pulse(job)
 
 
 def _pulse(job: PulseJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
@@ -302,7 +293,8 @@ def _grid(f_min: float, f_max: float, n: int, limits: dict[str, Any]) -> Any:
 def _envelope(job: EnvelopeJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     f_p = _grid(job.f_min, job.f_max, job.n, limits)
     cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
-    doc, _ = envelope_doc(cf, f_p, exact=job.exact, library=None if job.exact else shared_library())
+    library = shared_library() if job.method == "library" else None
+    doc, _ = envelope_doc(cf, f_p, method=job.method, library=library)
     return dumps(doc)
 
 
@@ -384,7 +376,7 @@ def scale_factor_doc(
 
 
 def _scale_factor(job: ScaleFactorJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
-    return dumps(scale_factor_doc(job.request, limits))
+    return dumps(stamp(scale_factor_doc(job.request, limits), "scale_factor"))
 
 
 def _scene_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
@@ -409,7 +401,7 @@ def _scene_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) 
             f"'rockmech[geometry]'), which this deployment lacks ({exc.name} is missing)"
         ) from None
     cf = constants_from_spec(spec_file, scene, scene_name=scene_name, spec_name=spec_name)
-    return cf.model_dump_json(exclude_none=True).encode("utf-8")
+    return stamped(cf).model_dump_json(exclude_none=True).encode("utf-8")
 
 
 #: Request fields a report lists under "Inputs and provenance", in this order.
@@ -424,7 +416,7 @@ REPORT_KEYS = (
     "f_min",
     "f_max",
     "n",
-    "exact",
+    "method",
 )
 
 
@@ -462,18 +454,18 @@ def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes
         motion=motion,
         scales=scales,
         history=history_options(job),
-        exact=job.exact,
+        method=job.method,
         title=job.title or "",
         sources=sources,
         request={k: getattr(job, k) for k in REPORT_KEYS},
-        library=None if job.exact else shared_library(),
+        library=shared_library() if job.method == "library" else None,
     )
     return html.encode("utf-8")
 
 
 def _check(job: CheckJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
-    return dumps(check_doc(cf, job.site))
+    return dumps(stamp(check_doc(cf, job.site), "check"))
 
 
 def _assess_inputs(job: AssessJob | AssessHtmlJob, limits: dict[str, Any]) -> tuple[Any, list[Any]]:
@@ -536,7 +528,8 @@ def check_spectra_work(
 
 def _assess(job: AssessJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     cf, motions = _assess_inputs(job, limits)
-    return dumps(assessment_doc(cf, job.site, motions, multiples=list(job.multiples)))
+    doc = assessment_doc(cf, job.site, motions, multiples=list(job.multiples))
+    return dumps(stamp(doc, "assess"))
 
 
 def _assess_html(job: AssessHtmlJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:

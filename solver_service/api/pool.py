@@ -348,7 +348,7 @@ class ComputePool:
                     f"the computation took longer than the service's budget of "
                     f"{self.timeout_s:g} s per request (ROCKMECH_COMPUTE_TIMEOUT_S) and was "
                     "stopped; ask for less work (fewer mechanisms, scale factors, frequencies "
-                    "or samples, or the library instead of exact envelopes), or run it with "
+                    "or samples, or method library instead of exact envelopes), or run it with "
                     "the rockmech command line"
                 ) from None
             except _SendFailed:

@@ -780,7 +780,9 @@ def _scan_pieces(st, fl, nz, z1, z2, xb, big_h, acc_a, trace):
                 return tau_l
             t0 = _taylor_start(x_l, v_l, a_l, tau_l, tau_l, tau_r)
             return _root(0, 0.0, fl, tau_l, tau_r, s, x_l, xr, t0)
-        if sx_r >= 1.0 and sx_l < 1.0 and math.isnan(st[ST_T_CROSS]):
+        if sx_r >= 1.0 and sx_l < 1.0:
+            # Every outward crossing: a body pulled back inside |x| = 1 that collapses on a
+            # later excursion collapses at its last crossing, not its first.
             t0 = _taylor_start(x_l - s, v_l, a_l, tau_l, tau_l, tau_r)
             tc = _root(0, s, fl, tau_l, tau_r, -s, x_l - s, xr - s, t0)
             st[ST_T_CROSS] = ta + tc
@@ -1249,7 +1251,11 @@ def _free_tail(st, sides, rules):
     if col:
         st[OUT_COLLAPSED] = 1.0
         t_cross = st[ST_T_CROSS]
-        st[OUT_T_COLLAPSE] = t + dt_cross if math.isnan(t_cross) else t_cross
+        # Already past |x| = 1 on this excursion: it collapses at that crossing; otherwise
+        # at the crossing the free motion reaches (a later swing, after the excitation).
+        st[OUT_T_COLLAPSE] = (
+            t_cross if dt_cross == 0.0 and not math.isnan(t_cross) else t + dt_cross
+        )
         if math.isnan(st[OUT_T_EXCEED]):
             st[OUT_T_EXCEED] = st[OUT_T_COLLAPSE]
         st[OUT_STATUS] = 1

@@ -62,6 +62,10 @@ from .model import RockingModel, RockingSide, check_eta
 
 __all__ = [
     "A_MAX",
+    "LIBRARY_ABOVE",
+    "LIBRARY_BELOW",
+    "LIBRARY_EDGE_RATIO",
+    "LIBRARY_MARGIN",
     "LIBRARY_PATH",
     "N_SCAN",
     "RTOL",
@@ -71,6 +75,7 @@ __all__ = [
     "boundary_curve",
     "build_library",
     "critical_bands",
+    "library_curve",
     "mechanism_envelope",
 ]
 
@@ -87,6 +92,12 @@ RTOL = 1e-6
 V_REST_BOUNDARY = 1e-4
 #: Most outcome changes stored per Omega.
 MAX_EDGES = 64
+#: Up to this many Omega are searched on the calling thread, not in the parallel kernel: the
+#: thread pool costs more than it saves there, and a process forked from one that ran the
+#: parallel kernel (GNU OpenMP) may not start its threads.
+SERIAL_OMEGA = 16
+#: No scan point known in advance (``_kernels._search``'s ``known``).
+_NO_KNOWN = np.zeros(0, dtype=np.bool_)
 #: Library grid: Omega points (log-spaced in [0.05, 50]) and eta step.
 LIBRARY_OMEGA = (0.05, 50.0, 400)
 LIBRARY_ETA_STEP = 0.02
@@ -98,6 +109,19 @@ LIBRARY_VERSION = "1"
 #: curve; across a larger one (a change of overturning mode) interpolation takes the lower
 #: neighbour, so its error falls on the safe side.
 JUMP = 0.04
+#: Factor on the library's interpolated ``A_min`` in the fast mode: next to the uplift
+#: threshold the interpolation sits up to ~1.7 % above the exact boundary (the scan step,
+#: benchmarks/library_bound.py); lowered by 2 % it errs on the safe side.
+LIBRARY_MARGIN = 0.98
+#: Documented bound of the fast mode: at most this fraction above the exact ground-level
+#: ``a_p,min`` (the tabulated pulse spectrum's interpolation; the curves never above).
+LIBRARY_ABOVE = 1e-4
+#: Documented bound of the fast mode: at most this fraction below the exact ``A_min``
+#: (measured 3.9 %; tests/solver_core/test_library_bound.py).
+LIBRARY_BELOW = 0.05
+#: Documented frequency tolerance of the fast mode's critical-band edges: each lies within
+#: this factor of where the exact envelopes put it [-].
+LIBRARY_EDGE_RATIO = 1.05
 #: Tabulated pulse response spectrum (5 % damping, sine pulse, pseudo-acceleration):
 #: ratios f_p/f_n log-spaced over [1e-3, 1e3]; linear interpolation in log ratio.
 SPECTRUM_GRID = (1e-3, 1e3, 4001)
@@ -253,18 +277,20 @@ def boundary_curve(
         raise InputError(f"must be >= 0, got {n_scan_near!r}", "n_scan_near")
     scan = _scan(a_max, int(n_scan), int(n_scan_near))
     kern = kernels(backend)
-    edges, n_edges, first = kern.boundary_grid(
-        om,
-        eta,
-        one_sided,
-        float(direction),
-        PULSE_SHAPES[shape],
-        scan,
-        rtol,
-        MAX_EDGES,
-        V_REST_BOUNDARY,
-        math.nan if eta_neg is None else eta_neg,
-    )
+    args = (eta, one_sided, float(direction), PULSE_SHAPES[shape], scan, rtol)
+    eta_n = math.nan if eta_neg is None else eta_neg
+    if om.size <= SERIAL_OMEGA:
+        # The same search as boundary_grid's, one Omega after the other on this thread.
+        edges = np.full((om.size, MAX_EDGES), np.nan)
+        n_edges = np.zeros(om.size, dtype=np.int64)
+        first = np.zeros(om.size, dtype=np.bool_)
+        for i in range(om.size):
+            n_edges[i], first[i] = kern._search(
+                *args[:3], om[i], *args[3:], V_REST_BOUNDARY, edges[i], _NO_KNOWN,
+                kern.KNOWN_IGNORE, eta_n,
+            )  # fmt: skip
+    else:
+        edges, n_edges, first = kern.boundary_grid(om, *args, MAX_EDGES, V_REST_BOUNDARY, eta_n)
     return _curve(
         om,
         (eta, one_sided, direction),
@@ -347,18 +373,37 @@ class OverturningLibrary:
 
         Outside the Omega grid the end values are used (``A -> 1`` as ``Omega -> 0``).
         """
+        return self.a_min_flagged(omega, eta, one_sided=one_sided)[0]
+
+    def a_min_flagged(
+        self, omega: ArrayLike, eta: Optional[float] = None, *, one_sided: bool = False
+    ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """Interpolated ``A_min`` [-] at ``omega``, and where the interpolation is uncertain.
+
+        Returns
+        -------
+        a_min : (n,) float
+            As ``a_min``.
+        uncertain : (n,) bool
+            True where the interpolation crossed a jump of the curve (in Omega or in eta;
+            the lower neighbour was taken, which can be far below the exact value) or
+            ``omega`` lies outside the grid (end values were taken).
+        """
         om = np.log(np.atleast_1d(np.asarray(omega, dtype=float)))
         x = np.log(self.omega)
         if one_sided:
-            return _interp_log(om, x, self.a_min_one_sided)
+            return _interp_log_flagged(om, x, self.a_min_one_sided)
         if eta is None:
             raise InputError("two-sided envelopes need a coefficient of restitution", "eta")
         eta = check_eta(eta, False)
         j = int(np.clip(np.searchsorted(self.eta, eta) - 1, 0, self.eta.size - 2))
         w = (eta - self.eta[j]) / (self.eta[j + 1] - self.eta[j])
-        lo = _interp_log(om, x, self.a_min_two_sided[j])
-        hi = _interp_log(om, x, self.a_min_two_sided[j + 1])
-        return _blend(lo, hi, np.full(lo.shape, w))
+        lo, jump_lo = _interp_log_flagged(om, x, self.a_min_two_sided[j])
+        hi, jump_hi = _interp_log_flagged(om, x, self.a_min_two_sided[j + 1])
+        value, jump = _blend_flagged(lo, hi, np.full(lo.shape, w))
+        # A neighbour row that jumps matters only where it carries weight.
+        jump |= (jump_lo & (w < 1.0)) | (jump_hi & (w > 0.0))
+        return value, jump
 
     def save(self, path: Union[str, Path]) -> Path:
         """Write the library atomically as a compressed ``.npz`` (no pickled objects)."""
@@ -405,27 +450,35 @@ class OverturningLibrary:
             )
 
 
-def _blend(
+def _blend_flagged(
     lo: NDArray[np.float64], hi: NDArray[np.float64], w: NDArray[np.float64]
-) -> NDArray[np.float64]:
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """Log-linear blend of two bracketing values; the lower one across a jump (``JUMP``).
 
     ``inf`` (no overturning up to ``a_max``) counts as a jump, so the finite neighbour wins.
+    Returns the values and where a jump was crossed (a weight of 0 or 1 crosses none).
     """
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         smooth = np.exp((1.0 - w) * np.log(lo) + w * np.log(hi))
         jump = ~(np.abs(np.log(hi / lo)) <= JUMP)
-    return np.asarray(np.where(jump, np.minimum(lo, hi), smooth), dtype=np.float64)
+    value = np.where(jump, np.minimum(lo, hi), smooth)
+    at_lo, at_hi = w <= 0.0, w >= 1.0
+    value = np.where(at_lo, lo, np.where(at_hi, hi, value))
+    return np.asarray(value, dtype=np.float64), jump & ~(at_lo | at_hi)
 
 
-def _interp_log(
+def _interp_log_flagged(
     x_new: NDArray[np.float64], x: NDArray[np.float64], a: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """Interpolate ``a`` in ``x`` with ``_blend``; end values outside the grid."""
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Interpolate ``a`` in ``x`` with ``_blend_flagged``; end values outside the grid.
+
+    Returns the values and where they are uncertain: a jump crossed, or outside the grid.
+    """
     xc = np.clip(x_new, x[0], x[-1])
     idx = np.clip(np.searchsorted(x, xc), 1, x.size - 1)
     w = (xc - x[idx - 1]) / (x[idx] - x[idx - 1])
-    return _blend(a[idx - 1], a[idx], w)
+    value, jump = _blend_flagged(a[idx - 1], a[idx], w)
+    return value, jump | (x_new < x[0]) | (x_new > x[-1])
 
 
 def _ragged(curves: Sequence[BoundaryCurve]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
@@ -652,6 +705,9 @@ class Envelope:
     notes : list of str
         How the envelope was computed, where a user should know it (e.g. the exact
         integrator used for a mechanism with two restitution coefficients).
+    n_exact : int
+        Side curves' frequencies computed with the exact integrator (all of them unless in
+        the fast mode, where only those the library cannot interpolate safely).
     """
 
     name: str
@@ -660,6 +716,7 @@ class Envelope:
     scale_factor: NDArray[np.float64]
     governing_side: NDArray[np.int64]
     notes: list[str] = field(default_factory=list)
+    n_exact: int = 0
 
     @property
     def a_p_min_g(self) -> NDArray[np.float64]:
@@ -683,25 +740,61 @@ def _directional_curve(omega: NDArray[np.float64], model: RockingModel) -> NDArr
     return np.minimum(curves[0], curves[1])
 
 
+def _exact_curve(omega: NDArray[np.float64], model: RockingModel) -> NDArray[np.float64]:
+    """``A_min`` at ``omega`` with the exact integrator (both pulses when one-sided).
+
+    An ``omega`` that overflowed (``2 pi f_p / p_eq`` of a degenerate mechanism) is a pulse
+    infinitely short for the body: it never overturns it (``inf``).
+    """
+    a_min = np.full(omega.shape, np.inf)
+    finite = np.isfinite(omega)
+    if np.any(finite):
+        if model.one_sided:
+            a_min[finite] = governing_one_sided(omega[finite], 0.0)[2]
+        else:
+            a_min[finite] = boundary_curve(omega[finite], model.require_eta()).a_min
+    return a_min
+
+
+def library_curve(
+    omega: NDArray[np.float64], model: RockingModel, library: OverturningLibrary
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """``A_min`` at ``omega`` in the fast mode: the library, exact where it is uncertain.
+
+    Where the interpolation crossed a jump of the curve or left the grid
+    (``OverturningLibrary.a_min_flagged``) the exact integrator gives the value; elsewhere
+    the interpolated value times ``LIBRARY_MARGIN`` (the interpolation overshoots the exact
+    boundary by up to ~1.7 % near the uplift threshold, benchmarks/library_bound.py).
+
+    Returns
+    -------
+    a_min : (n,) float
+        ``A_min`` [-].
+    computed : (n,) bool
+        Where the exact integrator gave the value.
+    """
+    eta = None if model.one_sided else model.require_eta()
+    a_min, uncertain = library.a_min_flagged(omega, eta, one_sided=model.one_sided)
+    a_min = a_min * LIBRARY_MARGIN
+    if np.any(uncertain):
+        a_min[uncertain] = _exact_curve(omega[uncertain], model)
+    return a_min, uncertain
+
+
 def _side_curve(
     side: RockingSide,
     f_p: NDArray[np.float64],
     model: RockingModel,
     library: Optional[OverturningLibrary],
-    exact: bool,
-) -> NDArray[np.float64]:
+) -> tuple[NDArray[np.float64], int]:
+    """``a_p,min`` [g] of one side, and the frequencies the exact integrator computed."""
     omega = 2.0 * np.pi * f_p / side.p_eq
     if model.is_directional:
-        a_min = _directional_curve(omega, model)
-    elif exact or library is None:
-        if model.one_sided:
-            a_min = governing_one_sided(omega, 0.0)[2]
-        else:
-            a_min = boundary_curve(omega, model.require_eta()).a_min
-    else:
-        eta = None if model.one_sided else model.require_eta()
-        a_min = library.a_min(omega, eta, one_sided=model.one_sided)
-    return side.lam * a_min
+        return side.lam * _directional_curve(omega, model), omega.size
+    if library is None:
+        return side.lam * _exact_curve(omega, model), omega.size
+    a_min, computed = library_curve(omega, model, library)
+    return side.lam * a_min, int(np.count_nonzero(computed))
 
 
 def mechanism_envelope(
@@ -709,7 +802,7 @@ def mechanism_envelope(
     f_p: ArrayLike,
     *,
     library: Optional[OverturningLibrary] = None,
-    exact: bool = False,
+    exact: Optional[bool] = None,
     scale_factor: Optional[ArrayLike] = None,
 ) -> Envelope:
     """Envelope ``a_p,min(f_p) = g lam A_min(2 pi f_p / p_eq)`` of one mechanism.
@@ -721,9 +814,11 @@ def mechanism_envelope(
     f_p : array_like
         Pulse frequencies [Hz], > 0.
     library : OverturningLibrary, optional
-        Curves to interpolate; default the shipped library unless ``exact``.
-    exact : bool
-        Compute the boundary directly with the exact integrator instead.
+        The fast mode: interpolate these curves (exact where the interpolation is uncertain,
+        ``library_curve``).
+    exact : bool, optional
+        True: the exact integrator at every frequency (the default unless ``library`` is
+        given); False: the fast mode with ``library`` (default: the shipped library).
     scale_factor : array_like, optional
         Amplification ``SF(f_p)`` from the ground to the mechanism (1 if omitted).
 
@@ -743,21 +838,27 @@ def mechanism_envelope(
             "a two-sided envelope needs a coefficient of restitution", f"{model.name}.eta"
         )
     notes = []
+    if exact is None:
+        exact = library is None
+    if exact:
+        library = None
+    elif library is None:
+        library = OverturningLibrary.load()
     if model.is_directional:
         notes.append(DIRECTIONAL_NOTE.format(neg=model.eta_into(-1), pos=model.eta_into(1)))
-    elif library is None and not exact:
-        library = OverturningLibrary.load()
-    pos = _side_curve(model.positive, f, model, library, exact)
+    pos, n_pos = _side_curve(model.positive, f, model, library)
+    n_exact = n_pos
     if model.one_sided or model.is_symmetric:
         local, side = pos, np.ones(f.size, dtype=np.int64)
     else:
-        neg = _side_curve(model.neg, f, model, library, exact)
+        neg, n_neg = _side_curve(model.neg, f, model, library)
         local = np.minimum(pos, neg)
         side = np.where(pos <= neg, 1, -1).astype(np.int64)
+        n_exact += n_neg
     sf = np.ones(f.size) if scale_factor is None else np.asarray(scale_factor, dtype=float)
     if sf.shape != f.shape or not np.all(np.isfinite(sf) & (sf >= 1.0)):
         raise InputError("must be finite and >= 1 at every frequency", f"{model.name}.scale_factor")
-    return Envelope(model.name, f, local, sf, side, notes)
+    return Envelope(model.name, f, local, sf, side, notes, n_exact)
 
 
 def critical_bands(envelopes: Sequence[Envelope]) -> tuple[NDArray[np.int64], list[dict[str, Any]]]:

@@ -39,7 +39,7 @@ from ..core.model import G
 from ..workflows.adapter import to_rocking_model
 from ..workflows.assess import assessment_doc, site_spectrum
 from ..workflows.scaling import mechanism_scale_factor
-from .plots import _pyplot, _save_atomic
+from .plots import _pyplot, _save_atomic, plain
 
 __all__ = [
     "TEMPLATE_NAME",
@@ -342,7 +342,8 @@ def _plot_envelope(env: dict[str, Any], path: Path) -> Path:
     a = np.array([np.nan if v is None else v for v in env["a_p_min_g"]], dtype=float)
     ax.loglog(f, a, color="k", lw=1.3, label="overturning envelope a_p,min")
     for p in env.get("pulses", []):
-        ax.loglog([p["f_p"]], [p["a_p_g"]], "o", label=f"{p['record']} pulse at design scale")
+        text = f"{plain(p['record'])} pulse at design scale"
+        ax.loglog([p["f_p"]], [p["a_p_g"]], "o", label=text)
     ax.set_xlabel("pulse frequency f_p [Hz]")
     ax.set_ylabel("amplitude [g]")
     ax.grid(alpha=0.3, which="both")
@@ -378,7 +379,8 @@ def _plot_history(
         2, 1, figsize=(9, 4.2), sharex=True, gridspec_kw={"height_ratios": [2, 1]}
     )
     verdict = "overturns" if res.overturned else "survives"
-    ax.plot(t, ratio, color="k", lw=1.0, label=f"{label}: peak {res.peak_ratio:.4g} ({verdict})")
+    text = f"{plain(label)}: peak {res.peak_ratio:.4g} ({verdict})"
+    ax.plot(t, ratio, color="k", lw=1.0, label=text)
     for level in (1.0, -1.0):
         ax.axhline(level, color="crimson", ls="--", lw=0.8)
     ax.set_ylabel("φ / φ_ov [-]")

@@ -170,18 +170,21 @@ def _envelope_section(doc: dict[str, Any], figure: str) -> str:
     method = doc["method"]
     if method.get("source") == "exact":
         how = (
-            "Exact boundaries: each amplitude simulated with the exact integrator and the "
-            "exact overturning criterion; changes of outcome bisected to a relative 1e-6 "
-            f"(search limit A_max = {method.get('a_max')})."
+            "Exact boundaries at every frequency: each amplitude simulated with the exact "
+            "integrator and the exact overturning criterion; changes of outcome bisected to a "
+            f"relative 1e-6 (search limit A_max = {method.get('a_max')}). Each band edge lies "
+            "between the last frequency of one band and the first of the next (hatched)."
         )
     else:
+        bound = method.get("bound", {})
         how = (
-            f"Library {_e(method.get('library_version', ''))} "
+            f"Fast mode: library {_e(method.get('library_version', ''))} "
             f"(generated {_e(method.get('generated', ''))}), "
-            f"{_e(method.get('interpolation', ''))}. "
-            "Interpolation error measured at grid mid-points: median 1e-5, never more than 1 % "
-            "above the exact value; next to a jump of the curve up to 35 % below it "
-            "(conservative)."
+            f"{_e(method.get('interpolation', ''))}; {_e(method.get('exact_points', 0))} "
+            "points computed exactly. Never above the exact value (to "
+            f"{_num(bound.get('above_exact'))}), at most "
+            f"{_num(100 * bound.get('below_exact', 0))} % below it; band edges within a "
+            f"factor {_num(method.get('edge_ratio'))} in frequency (hatched)."
         )
     return (
         "<h2>Overturning envelopes and critical mechanism</h2>"
@@ -402,7 +405,7 @@ def build_report(
     motion: Optional[Any] = None,
     scales: Sequence[float] = (1.0,),
     history: Optional[dict[str, Any]] = None,
-    exact: bool = False,
+    method: str = "exact",
     title: str = "",
     sources: Sequence[dict[str, Any]] = (),
     request: Optional[dict[str, Any]] = None,
@@ -423,8 +426,8 @@ def build_report(
     history : dict, optional
         Options of the time histories, passed to ``history_doc`` (``sf``, ``building``,
         ``criterion``, ``at_height``).
-    exact : bool
-        Exact envelopes instead of the library.
+    method : {"exact", "library"}
+        How the envelopes are computed (``envelope_doc``; exact by default).
     title : str
         Report title.
     sources : sequence of dict
@@ -432,7 +435,7 @@ def build_report(
     request : dict, optional
         Analysis options, shown as given.
     library : OverturningLibrary, optional
-        A loaded library (else loaded here unless ``exact``).
+        A loaded library for ``method="library"`` (else loaded here).
 
     Returns
     -------
@@ -446,7 +449,7 @@ def build_report(
         (``check_history_options``).
     """
     check_history_options(scales, history, motion)
-    env, envelopes = envelope_doc(cf, np.asarray(f_p, dtype=float), exact=exact, library=library)
+    env, envelopes = envelope_doc(cf, np.asarray(f_p, dtype=float), method=method, library=library)
     hist = None
     if motion is not None:
         hist = history_doc(cf, motion, list(scales), **(history or {}))

@@ -22,6 +22,7 @@ from ..core.result import RockingResult
 from ..core.spectra import response_spectrum
 
 __all__ = [
+    "plain",
     "plot_envelopes",
     "plot_fragility",
     "plot_ratio_histories",
@@ -34,12 +35,25 @@ def _pyplot() -> Any:
     import matplotlib
 
     matplotlib.use("Agg")
-    # Labels are user text (mechanism ids, record names), never TeX: a "$" in an id must not
-    # start mathtext, whose parser recurses without bound on nested braces.
-    matplotlib.rcParams["text.parse_math"] = False
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def plain(text: str) -> str:
+    r"""Return user text (an id, a record name, a title) escaped so that it is drawn as written.
+
+    matplotlib reads text between two ``$`` as mathtext. The tick labels of log axes need it
+    (their formatter writes ``$\mathdefault{10^{0}}$``), so it stays on; every ``$`` of user
+    text is escaped instead (``\$`` draws a dollar sign), so that an id never starts
+    mathtext, whose parser recurses without bound on nested braces.
+
+    Examples
+    --------
+    >>> plain("W$1{}$")
+    'W\\$1{}\\$'
+    """
+    return str(text).replace("$", r"\$")
 
 
 def _save_atomic(fig: Any, path: Union[str, Path]) -> Path:
@@ -93,7 +107,8 @@ def plot_time_histories(
         if res.t is None or res.ratio is None:
             raise ValueError(f"result {label!r} has no time series; run with dense=True")
         verdict = " (overturned)" if res.overturned else ""
-        ax.plot(res.t, res.ratio, lw=1.0, label=f"{label}: peak {res.peak_ratio:.3f}{verdict}")
+        text = f"{plain(label)}: peak {res.peak_ratio:.3f}{verdict}"
+        ax.plot(res.t, res.ratio, lw=1.0, label=text)
     for level in (1.0, -1.0):
         ax.axhline(level, color="crimson", ls="--", lw=0.8)
     ax.set_ylabel("φ / φ_ov  [-]")
@@ -101,7 +116,7 @@ def plot_time_histories(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper right")
     if title:
-        ax.set_title(title)
+        ax.set_title(plain(title))
     if record_t is not None and record_a_g is not None:
         axr = axes[1, 0]
         axr.plot(record_t, record_a_g, color="0.3", lw=0.6)
@@ -154,7 +169,7 @@ def plot_ratio_histories(
                 raise ValueError(f"result {label!r} has no time series; run with dense=True")
             colour = colours.setdefault(label, cmap(len(colours) % 10))
             mark = " ×" if res.overturned else ""
-            ax.plot(res.t, res.ratio, lw=0.9, color=colour, label=f"{label}{mark}")
+            ax.plot(res.t, res.ratio, lw=0.9, color=colour, label=f"{plain(label)}{mark}")
             if res.overturned and res.t_overturn is not None:
                 ax.axvline(res.t_overturn, color=colour, ls=":", lw=0.8)
         for level in (1.0, -1.0):
@@ -165,7 +180,7 @@ def plot_ratio_histories(
         ax.legend(fontsize=7, loc="upper right", ncol=min(len(runs), 5))
     axes[-1, 0].set_xlabel("time [s]")
     if title:
-        axes[0, 0].set_title(f"{title}  (× overturned; dotted: time of overturning)")
+        axes[0, 0].set_title(f"{plain(title)}  (× overturned; dotted: time of overturning)")
     fig.tight_layout()
     try:
         return _save_atomic(fig, path)
@@ -228,7 +243,7 @@ def plot_record(
         ax_a.legend(fontsize=8, loc="upper right")
     ax_a.set_xlabel("time [s]")
     ax_a.set_ylabel("ground acceleration [g]")
-    ax_a.set_title(f"{motion.name}: PGA {motion.pga_g:.3f} g, dt {motion.dt:g} s")
+    ax_a.set_title(f"{plain(motion.name)}: PGA {motion.pga_g:.3f} g, dt {motion.dt:g} s")
     ax_a.grid(alpha=0.3)
     ax_s.plot(spectrum.periods, spectrum.psa_g, color="navy", lw=1.2)
     ax_s.set_xscale("log")
@@ -251,6 +266,8 @@ def plot_envelopes(
     labels: Union[dict[str, str], None] = None,
     title: str = "",
     pulse_points: Union[Sequence[dict[str, Any]], None] = None,
+    edges: Union[Sequence[dict[str, Any]], None] = None,
+    fast: bool = False,
 ) -> Path:
     """Log-log overturning envelopes at ground level, with the critical bands shaded.
 
@@ -269,6 +286,11 @@ def plot_envelopes(
     pulse_points : sequence of dict, optional
         A record's largest pulse at several scale factors, ``{"scale", "f_p_hz",
         "a_p_g"}`` (``|a_p|`` [g]); drawn as points joined by a line and labelled by scale.
+    edges : sequence of dict, optional
+        Where each band edge lies, ``{"f_low", "f_high"}`` [Hz] (``documents.band_edges``);
+        drawn hatched, so that the reader sees the frequency tolerance of each edge.
+    fast : bool
+        The envelopes are the fast mode's (the library): said in the edges' legend entry.
     """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(9, 8))
@@ -279,7 +301,7 @@ def plot_envelopes(
         colours[env.name] = colour
         y = _log_plottable(env.a_p_min_g)
         text = (labels or {}).get(env.name, env.name)
-        ax.plot(env.f_p, y, color=colour, lw=1.4, label=text)
+        ax.plot(env.f_p, y, color=colour, lw=1.4, label=plain(text))
     if envelopes:
         curves = np.stack([_log_plottable(e.a_p_min_g) for e in envelopes])
         lower = np.full(curves.shape[1], np.nan)
@@ -307,13 +329,25 @@ def plot_envelopes(
         colour = colours.get(band["mechanism"], "0.5")
         ax.axvspan(band["f_min"], band["f_max"], color=colour, alpha=0.10, lw=0)
         mid = float(np.sqrt(band["f_min"] * band["f_max"]))
-        ax.text(mid, ymax, band["mechanism"], ha="center", va="top", fontsize=8, color=colour)
+        name = plain(band["mechanism"])
+        ax.text(mid, ymax, name, ha="center", va="top", fontsize=8, color=colour)
+    for k, edge in enumerate(edges or []):
+        where = "within ×1.05 (fast mode)" if fast else "between two grid frequencies"
+        ax.axvspan(
+            edge["f_low"],
+            edge["f_high"],
+            facecolor="none",
+            edgecolor="0.35",
+            hatch="////",
+            lw=0,
+            label=f"band edge: the exact edge lies {where}" if k == 0 else None,
+        )
     ax.set_xlabel("pulse frequency f_p [Hz]")
     ax.set_ylabel("minimum overturning pulse amplitude a_p [g] (ground level)")
     ax.grid(which="both", alpha=0.25)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.0, -0.12), ncol=1, frameon=False)
     if title:
-        ax.set_title(title)
+        ax.set_title(plain(title))
     fig.tight_layout()
     try:
         return _save_atomic(fig, path)
@@ -346,7 +380,7 @@ def plot_fragility(doc: dict[str, Any], path: Union[str, Path], *, title: str = 
     for k, mech in enumerate(doc["mechanisms"]):
         colour = cmap(k % 10)
         fit = mech["fragility"]
-        label = mech["id"]
+        label = plain(mech["id"])
         if "median" in fit:
             ax.plot(x, lognormal_cdf(x, fit["median"], fit["beta"]), color=colour, lw=1.3)
             label += f": median {fit['median']:.3g}, β {fit['beta']:.2f}"
@@ -359,7 +393,7 @@ def plot_fragility(doc: dict[str, Any], path: Union[str, Path], *, title: str = 
     ax.set_ylabel(f"fraction of {len(doc['records'])} records that overturn")
     ax.grid(which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="upper left")
-    ax.set_title(title or "Fragility from incremental dynamic analysis (lognormal MLE)")
+    ax.set_title(plain(title) or "Fragility from incremental dynamic analysis (lognormal MLE)")
     fig.tight_layout()
     try:
         return _save_atomic(fig, path)

@@ -5,17 +5,26 @@ Units: frequencies in Hz, pulse amplitudes and PGA in g (names end in ``_g``), S
 
 from __future__ import annotations
 
+import json
 import math
-from typing import Any, Optional
+from collections.abc import Mapping
+from typing import Any, Optional, Union
 
 import numpy as np
+from pydantic import ValidationError
 
-from shared_schema.constants import ConstantsFile
+from shared_schema.api import PulseRequest
+from shared_schema.constants import ConstantsFile, input_error_from_validation
 from shared_schema.errors import InputError
+from shared_schema.rules import ENVELOPE_METHODS, check_choice
 
 from ..core.amplification import pulse_scale_factor
 from ..core.envelope import (
     A_MAX,
+    LIBRARY_ABOVE,
+    LIBRARY_BELOW,
+    LIBRARY_EDGE_RATIO,
+    LIBRARY_MARGIN,
     Envelope,
     OverturningLibrary,
     boundary_curve,
@@ -32,108 +41,144 @@ from ..core.records import GroundMotion
 from ..core.spectra import Spectrum, response_spectrum
 from .adapter import to_rocking_model
 from .scaling import Building, option_notes, run_scaled
+from .units import stamp
 
 __all__ = [
     "PULSE_METHOD",
+    "band_edges",
     "boundary_doc",
     "envelope_doc",
     "frequency_grid",
     "history_doc",
     "linearisation_notes",
     "log_grid",
-    "model_pulse_doc",
-    "pulse_doc",
+    "pick_mechanism",
+    "pulse_model",
     "record_analysis",
     "record_doc",
     "record_pulse_doc",
+    "solve_pulse",
     "time_domain_mechanisms",
 ]
 
 
-def pulse_doc(
-    p_eq: float,
-    lam: float,
-    a_p_g: float,
-    f_p: float,
-    *,
-    eta: Optional[float] = None,
-    one_sided: bool = False,
-    phi_ov: Optional[float] = None,
-    shape: str = "sine",
-    criterion: Optional[str] = None,
-) -> dict[str, Any]:
-    """Response of one mechanism to a one-cycle pulse, as ``rockmech pulse --json`` prints it.
+def pulse_model(request: PulseRequest) -> RockingModel:
+    """Return the mechanism of a pulse request as the solver's model.
+
+    The short form is a symmetric mechanism named ``pulse``; ``mechanism`` is converted as
+    every analysis converts a constants file's mechanism (``adapter.to_rocking_model``).
+    """
+    if request.mechanism is not None:
+        return to_rocking_model(request.mechanism)
+    if request.p_eq is None or request.lam is None:  # the request model refuses this
+        raise InputError("required, unless the mechanism is given", "p_eq")
+    return RockingModel.symmetric(
+        request.p_eq,
+        request.lam,
+        request.eta,
+        phi_ov=request.phi_ov,
+        one_sided=request.one_sided,
+        name="pulse",
+    )
+
+
+def pick_mechanism(cf: ConstantsFile, mechanism: Optional[str] = None) -> dict[str, Any]:
+    """One mechanism of a constants file as the ``mechanism`` of a pulse request (JSON data).
 
     Parameters
     ----------
-    p_eq : float
-        Frequency parameter [rad/s].
-    lam : float
-        Static load multiplier [-].
-    a_p_g : float
-        Signed pulse amplitude [g] (> 0 first pushes towards negative rotation).
-    f_p : float
-        Pulse frequency [Hz].
-    eta : float, optional
-        Coefficient of restitution [-].
-    one_sided : bool
-        One-sided rocking.
-    phi_ov : float, optional
-        Overturning rotation [rad]; defaults to ``lam``.
-    shape : {"sine", "cosine"}
-        Pulse shape.
-    criterion : {"exact", "ratio"}, optional
-        Overturning verdict (default ``exact`` for pulses).
+    cf : ConstantsFile
+        The file.
+    mechanism : str, optional
+        Its id (default: the first mechanism).
+
+    Raises
+    ------
+    InputError
+        No mechanism of that id (field ``mechanism``; the message lists the ids).
     """
-    model = RockingModel.symmetric(p_eq, lam, eta, phi_ov=phi_ov, one_sided=one_sided, name="pulse")
-    return model_pulse_doc(model, a_p_g, f_p, shape=shape, criterion=criterion)
+    found = cf.mechanisms[0] if mechanism is None else None
+    for mech in cf.mechanisms if mechanism is not None else ():
+        if mech.id == mechanism:
+            found = mech
+    if found is None:
+        ids = [m.id for m in cf.mechanisms]
+        raise InputError(f"no mechanism {mechanism!r}; the file has {ids}", "mechanism")
+    data: dict[str, Any] = json.loads(found.model_dump_json(exclude_none=True))
+    return data
 
 
-def model_pulse_doc(
-    model: RockingModel,
-    a_p_g: float,
-    f_p: float,
-    *,
-    shape: str = "sine",
-    criterion: Optional[str] = None,
-) -> dict[str, Any]:
-    """Response of a rocking model (either side may differ) to a one-cycle pulse.
+def _pulse_request(request: Union[PulseRequest, Mapping[str, Any]]) -> PulseRequest:
+    """Validate a mapping as a ``PulseRequest``; an error names the field (as REST's 422)."""
+    if isinstance(request, PulseRequest):
+        return request
+    try:
+        return PulseRequest.model_validate(dict(request))
+    except ValidationError as err:
+        raise input_error_from_validation(err) from None
 
-    The document of ``pulse_doc``; the Rhino flow uses it for mechanisms of a constants file.
+
+def solve_pulse(request: Union[PulseRequest, Mapping[str, Any]]) -> dict[str, Any]:
+    """Response of one mechanism to a one-cycle pulse: the one function of every front end.
+
+    ``rockmech pulse``, REST ``/pulse``, the Hops pulse component, RM_Analyse and RM_RunPulse
+    (run here or on the service) and the Python API all build a ``PulseRequest`` and call
+    this, so that the same request gets the same verdict and numbers on every path.
 
     Parameters
     ----------
-    model : RockingModel
-        The mechanism; two-sided models need ``eta``.
-    a_p_g : float
-        Signed pulse amplitude [g] (> 0 first pushes towards negative rotation).
-    f_p : float
-        Pulse frequency [Hz].
-    shape : {"sine", "cosine"}
-        Pulse shape.
-    criterion : {"exact", "ratio"}, optional
-        Overturning verdict (default ``exact`` for pulses).
+    request : PulseRequest or mapping
+        The request (a mapping is validated as ``PulseRequest``; an error names the field).
+        ``a_p_g`` [g] is signed (> 0 first pushes towards negative rotation), ``f_p`` [Hz].
+
+    Returns
+    -------
+    dict
+        The document ``rockmech pulse --json`` prints: ``input`` (the problem as solved,
+        both sides when they differ), the verdict under ``criterion`` (``exact`` by
+        default), ``t_overturn`` [s] (the time of the collapse the verdict refers to),
+        ``peak_ratio`` with its ``error_estimate``, work counters, ``units`` and ``version``.
+
+    Examples
+    --------
+    >>> doc = solve_pulse({"p_eq": 2.0, "lam": 0.2, "eta": 0.95, "a_p_g": 0.282, "f_p": 0.32})
+    >>> doc["overturned"], round(doc["t_overturn"], 3)
+    (True, 3.649)
     """
+    request = _pulse_request(request)
+    model = pulse_model(request)
     model.require_eta()
-    exc = Pulse.from_g(a_p_g, f_p, shape)
-    res = simulate(model, exc, criterion=criterion)
+    pulse = Pulse.from_g(request.a_p_g, request.f_p, request.shape)
+    res = simulate(model, pulse, criterion=request.criterion)
     pos = model.positive
-    return {
+    problem: dict[str, Any] = {
+        "p_eq": pos.p_eq,
+        "lam": pos.lam,
+        "phi_ov": pos.phi_ov,
+        "eta": model.eta,
+        "rocking": "one_sided" if model.one_sided else "two_sided",
+    }
+    if request.mechanism is not None:
+        problem = {"mechanism": request.mechanism.id, **problem}
+        if not model.is_symmetric:
+            neg = model.neg
+            problem["negative"] = {"p_eq": neg.p_eq, "lam": neg.lam, "phi_ov": neg.phi_ov}
+        if model.is_directional:
+            problem["eta_to_negative"] = model.eta_into(-1)
+            problem["eta_to_positive"] = model.eta_into(1)
+    doc = {
         "input": {
-            "p_eq": pos.p_eq,
-            "lam": pos.lam,
-            "phi_ov": pos.phi_ov,
-            "eta": model.eta,
-            "rocking": "one_sided" if model.one_sided else "two_sided",
-            "a_p_g": a_p_g,
-            "f_p": f_p,
-            "shape": shape,
-            "omega_ratio": exc.omega_p / pos.p_eq,
-            "amplitude_ratio": abs(a_p_g) / pos.lam,
+            **problem,
+            "a_p_g": request.a_p_g,
+            "f_p": request.f_p,
+            "shape": request.shape,
+            "omega_ratio": pulse.omega_p / pos.p_eq,
+            "amplitude_ratio": abs(request.a_p_g) / pos.lam,
             "pulse_convention": "A (Zhang & Makris 2001: pulse starts at t = 0)",
         },
         **res.summary(),
     }
+    return stamp(doc, "pulse")
 
 
 def _finite_or_none(values: np.ndarray[Any, Any]) -> list[Optional[float]]:
@@ -175,7 +220,7 @@ def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> dict[str, Any]:
     pulses : list of ExtractedPulse
         Its largest sine pulses (``core.pulses.extract_pulses``).
     """
-    return {
+    doc = {
         "record": {
             "name": motion.name,
             "n_samples": len(motion.accel.acc),
@@ -195,6 +240,7 @@ def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> dict[str, Any]:
             "runtime_s": spectrum.runtime_s,
         },
     }
+    return stamp(doc, "record")
 
 
 def record_analysis(
@@ -241,7 +287,7 @@ def envelope_doc(
     cf: ConstantsFile,
     f_p: np.ndarray[Any, Any],
     *,
-    exact: bool = False,
+    method: Optional[str] = None,
     library: Optional[OverturningLibrary] = None,
 ) -> tuple[dict[str, Any], list[Envelope]]:
     """Ground-level envelopes of every mechanism and the critical bands.
@@ -249,17 +295,38 @@ def envelope_doc(
     Mechanisms with ``amplification`` are corrected by ``SF(f_p)`` (theory §7); the others
     skip that work entirely.
 
+    Parameters
+    ----------
+    cf : ConstantsFile
+        The mechanisms.
+    f_p : (n,) float
+        Pulse frequencies [Hz], increasing.
+    method : {"exact", "library"}, optional
+        ``exact`` (the default unless ``library`` is given): the exact integrator at every
+        frequency. ``library``: the fast
+        mode, interpolated from the library (loaded unless given), exact where it cannot
+        interpolate safely; never above the exact value, at most ``LIBRARY_BELOW`` below,
+        band edges within ``LIBRARY_EDGE_RATIO`` (docs/envelopes.md).
+    library : OverturningLibrary, optional
+        The library of the fast mode (the shipped one by default).
+
     Returns
     -------
     doc : dict
-        JSON-ready result (see ``rockmech envelope``).
+        JSON-ready result (see ``rockmech envelope``): ``critical`` bands and
+        ``critical_edges``, the frequency interval [Hz] that holds each edge between two
+        bands as the exact envelopes place it.
     envelopes : list of Envelope
         The envelopes, for plotting.
     """
+    if method is None:
+        method = "exact" if library is None else "library"
+    method = check_choice(method, ENVELOPE_METHODS, "method")
     if not cf.mechanisms:
         raise InputError("needs at least one mechanism", "mechanisms")
-    if not exact and library is None:
+    if method == "library" and library is None:
         library = OverturningLibrary.load()
+    fast = library if method == "library" else None
     envelopes: list[Envelope] = []
     entries: list[dict[str, Any]] = []
     for mech in cf.mechanisms:
@@ -267,11 +334,11 @@ def envelope_doc(
         sf = None
         if mech.amplification is not None:
             amp = mech.amplification
-            if library is not None:
-                sf = library.scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
+            if fast is not None:
+                sf = fast.scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
             else:
                 sf = pulse_scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
-        env = mechanism_envelope(model, f_p, library=library, exact=exact, scale_factor=sf)
+        env = mechanism_envelope(model, f_p, library=fast, exact=fast is None, scale_factor=sf)
         envelopes.append(env)
         entry: dict[str, Any] = {
             "id": mech.id,
@@ -294,27 +361,84 @@ def envelope_doc(
             entry["notes"] = list(env.notes)
         entries.append(entry)
     index, bands = critical_bands(envelopes)
+    edge_ratio = 1.0 if fast is None else LIBRARY_EDGE_RATIO
     doc: dict[str, Any] = {
         "units": {"f_p": "Hz", "a_p": "g"},
         "f_p": [float(v) for v in f_p],
         "mechanisms": entries,
         "critical": bands,
+        "critical_edges": band_edges(np.asarray(f_p, dtype=float), index, cf, edge_ratio),
         "governing": [cf.mechanisms[i].id if i >= 0 else None for i in index],
-        "method": (
-            {"source": "exact", "a_max": A_MAX}
-            if exact or library is None
-            else {
-                "source": "library",
-                "interpolation": "log A_min linear in log Omega and in eta",
-                **{
-                    k: library.metadata[k]
-                    for k in ("library_version", "generated", "scan_ratio", "a_max")
-                    if k in library.metadata
-                },
-            }
-        ),
+        "method": _envelope_method(fast, envelopes),
     }
-    return doc, envelopes
+    return stamp(doc, "envelope"), envelopes
+
+
+def _envelope_method(
+    library: Optional[OverturningLibrary], envelopes: list[Envelope]
+) -> dict[str, Any]:
+    """Return the ``method`` block of an envelope document: how the values were computed."""
+    if library is None:
+        return {
+            "source": "exact",
+            "a_max": A_MAX,
+            "note": "exact integrator at every frequency; band edges lie between the last "
+            "frequency of one band and the first of the next",
+        }
+    return {
+        "source": "library",
+        "label": "fast mode (interpolated library)",
+        "interpolation": "log A_min linear in log Omega and in eta, times "
+        f"{LIBRARY_MARGIN:g}; exact where the interpolation crosses a jump or leaves the grid",
+        "exact_points": int(sum(e.n_exact for e in envelopes)),
+        "bound": {"above_exact": LIBRARY_ABOVE, "below_exact": LIBRARY_BELOW},
+        "edge_ratio": LIBRARY_EDGE_RATIO,
+        **{
+            k: library.metadata[k]
+            for k in ("library_version", "generated", "scan_ratio", "a_max")
+            if k in library.metadata
+        },
+    }
+
+
+def band_edges(
+    f_p: np.ndarray[Any, Any], index: np.ndarray[Any, Any], cf: ConstantsFile, ratio: float = 1.0
+) -> list[dict[str, Any]]:
+    """Where the governing mechanism changes: the frequency interval that holds each edge.
+
+    Parameters
+    ----------
+    f_p : (n,) float
+        Pulse frequencies [Hz], increasing.
+    index : (n,) int
+        Governing mechanism per frequency (-1: none overturns), as ``critical_bands``.
+    cf : ConstantsFile
+        The mechanisms (for their ids).
+    ratio : float
+        Frequency tolerance of the method (1 when exact): the interval is widened by this
+        factor on each side [-].
+
+    Returns
+    -------
+    list of dict
+        ``{"below", "above", "f_low", "f_high"}``: the mechanism governing below and above
+        the edge (None: none overturns), and the interval [Hz] in which the exact
+        envelopes change over: ``[f_k / ratio, f_(k+1) * ratio]`` between the last
+        frequency ``f_k`` of one band and the first of the next.
+    """
+    ids = [m.id for m in cf.mechanisms]
+    edges = []
+    for k in range(len(f_p) - 1):
+        if index[k] != index[k + 1]:
+            edges.append(
+                {
+                    "below": ids[index[k]] if index[k] >= 0 else None,
+                    "above": ids[index[k + 1]] if index[k + 1] >= 0 else None,
+                    "f_low": float(f_p[k] / ratio),
+                    "f_high": float(f_p[k + 1] * ratio),
+                }
+            )
+    return edges
 
 
 def boundary_doc(
@@ -352,7 +476,7 @@ def boundary_doc(
             "a_min": float(curve.a_min[0]) if math.isfinite(curve.a_min[0]) else None,
         }
     doc["search"] = {"a_max": curve.a_max, "scan_ratio": curve.scan_ratio, "rtol": curve.rtol}
-    return doc
+    return stamp(doc, "boundary")
 
 
 def record_pulse_doc(
@@ -362,7 +486,7 @@ def record_pulse_doc(
     *,
     f_min: Optional[float] = None,
     f_max: Optional[float] = None,
-    exact: bool = False,
+    method: str = "exact",
 ) -> dict[str, Any]:
     """Compare a record's largest sine pulse, at several scale factors, with every envelope.
 
@@ -381,13 +505,13 @@ def record_pulse_doc(
         Scale factors on the record [-], each > 0.
     f_min, f_max : float, optional
         Frequency range to search for the pulse [Hz].
-    exact : bool
-        Evaluate the envelopes at ``f_p`` by the exact boundary search, not the library.
+    method : {"exact", "library"}
+        How the envelopes are evaluated at ``f_p`` (``envelope_doc``).
     """
     for j, value in enumerate(scales):
         check_positive(value, f"scales[{j}]")
     pulse = largest_pulse(motion.accel, f_min=f_min, f_max=f_max)
-    at_fp, _ = envelope_doc(cf, np.array([pulse.f_p]), exact=exact)
+    at_fp, _ = envelope_doc(cf, np.array([pulse.f_p]), method=method)
     a_min = {m["id"]: m["a_p_min_g"][0] for m in at_fp["mechanisms"]}
     points = []
     for scale in scales:
@@ -486,7 +610,7 @@ def history_doc(
     notes = linearisation_notes(cf, models)
     if notes:
         doc["warnings"] = notes
-    return doc
+    return stamp(doc, "history")
 
 
 def time_domain_mechanisms(cf: ConstantsFile) -> tuple[ConstantsFile, list[dict[str, str]]]:

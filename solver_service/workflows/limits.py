@@ -474,7 +474,7 @@ def check_run(
     Raises
     ------
     InputError
-        Naming the option (``n``, ``scales``, ``record``, ``constants``, ``exact``), the limit
+        Naming the option (``n``, ``scales``, ``record``, ``constants``, ``method``), the limit
         and ``--no-limits``.
     """
     lim = DEFAULT_LIMITS if limits is None else limits
@@ -510,11 +510,12 @@ def check_run(
             work["history_steps"] = steps
     seconds = shortest_time(**work)
     if seconds > budget_s:
-        field = "record" if record is not None else "exact"
+        field = "record" if record is not None else "method"
+        fast = "" if record is not None else " (--fast for the library's envelopes)"
         raise InputError(
             f"the run would take {work_words(**work)}, at least {seconds:.3g} s even at "
             f"{RATE_MARGIN:g} times the rates measured on all {cores()} cores, more than "
-            f"its time limit of {budget_s:g} s; ask for less work, give {TIME_LIMIT} "
+            f"its time limit of {budget_s:g} s; ask for less work{fast}, give {TIME_LIMIT} "
             f"with more seconds, or {NO_LIMITS} to lift the limit",
             field,
         )

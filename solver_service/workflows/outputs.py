@@ -18,6 +18,7 @@ from shared_schema.constants import ConstantsFile
 from ..ida import ida_csv
 from ..report.plots import plot_envelopes, plot_fragility, plot_ratio_histories, plot_record
 from .documents import envelope_doc, history_doc
+from .units import stamp
 
 __all__ = [
     "envelope_csv",
@@ -64,14 +65,15 @@ def write_envelope(
     *,
     stem: str = "envelope",
     title: str = "",
-    exact: bool = False,
+    method: str = "exact",
     record_pulse: Optional[dict[str, Any]] = None,
 ) -> dict[str, Any]:
     """Write ``<stem>.json``, ``<stem>.csv`` and ``<stem>.png`` (atomically); return the doc.
 
-    ``record_pulse`` (from ``record_pulse_doc``) is added to the JSON and drawn on the plot.
+    ``method`` as ``envelope_doc``; ``record_pulse`` (from ``record_pulse_doc``) is added to
+    the JSON and drawn on the plot. The plot draws where each band edge lies.
     """
-    doc, envs = envelope_doc(cf, f_p, exact=exact)
+    doc, envs = envelope_doc(cf, f_p, method=method)
     if record_pulse is not None:
         doc["record_pulse"] = record_pulse
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -84,6 +86,8 @@ def write_envelope(
         labels={m.id: f"{m.id}: {m.name}" for m in cf.mechanisms},
         title=title,
         pulse_points=None if record_pulse is None else record_pulse["points"],
+        edges=doc["critical_edges"],
+        fast=method == "library",
     )
     return doc
 
@@ -143,6 +147,6 @@ def write_record(
 def write_ida(doc: dict[str, Any], out_dir: Path, *, title: str = "") -> None:
     """Write ``ida.json``, ``ida.csv`` and ``ida.png`` (fragility curves) of an IDA document."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / "ida.json", json.dumps(doc, indent=2) + "\n")
+    write_atomic(out_dir / "ida.json", json.dumps(stamp(doc, "ida"), indent=2) + "\n")
     write_atomic(out_dir / "ida.csv", ida_csv(doc))
     plot_fragility(doc, out_dir / "ida.png", title=title)

@@ -537,7 +537,7 @@ def _cases() -> list[Case]:
             [*pulse[:7], "--f-p", "1e-9", "--a-p-g", "-0.5"],
             "error",
             "f_p",
-            "at most|shorter",
+            r"must be in \[0.001, 1000\] \(a plausible range\)",
             isolate=True,
         ),
         # click's usage errors: one line ``error: <option>: <problem>``, exit 2

@@ -268,7 +268,9 @@ def _cases() -> list[Rest]:
         Rest(
             "envelope-fmin-zero", "envelope", {"f_min": 0.0}, field="f_min", problem="> 0|greater"
         ),
-        Rest("envelope-exact-string", "envelope", {"exact": "true"}, field="exact", problem="bool"),
+        Rest(
+            "envelope-method-bool", "envelope", {"method": True}, field="method", problem="string"
+        ),
         Rest(
             "envelope-constants-missing",
             "envelope",
@@ -699,7 +701,9 @@ OVERRIDES: dict[str, dict[str, Any]] = {
         for ep in BODIES
     },
     **{f"{ep}-deeply-nested": {"problem": "nested deeper than 200 levels"} for ep in BODIES},
-    "pulse-empty-body": {"problem": "send a JSON object with p_eq, lam, a_p_g and f_p$"},
+    "pulse-empty-body": {
+        "problem": "send a JSON object with a_p_g and f_p; and p_eq, lam and eta, or mechanism$"
+    },
     "pulse-eta-2": {"problem": r"\[-1, 1\]"},
     "pulse-number-400-digits": {"problem": "valid number|range|finite"},
     **{

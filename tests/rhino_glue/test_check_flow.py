@@ -8,6 +8,7 @@ from rhino_plugin.flows.check import parse_site_text, run_check
 from rhino_plugin.flows.params import parse_constants_text
 from shared_schema.errors import InputError
 from solver_service.workflows.assess import check_doc
+from solver_service.workflows.units import stamp
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
@@ -16,7 +17,7 @@ def test_code_check_flow_matches_the_workflow_and_summarises_each_mechanism() ->
     cf = parse_constants_text((EXAMPLES / "constants" / "church_geometry.json").read_text())
     site = parse_site_text((EXAMPLES / "sites" / "ntc_site.json").read_text())
     result = run_check(cf, site)
-    assert result.doc == check_doc(cf, site)
+    assert result.doc == stamp(check_doc(cf, site), "check")  # units and version added
     lines = result.summary
     assert [ln.split(":")[0] for ln in lines[:4]] == ["F1", "F2", "A1", "T1"]
     # The tied façade fails both: its ties are not verified up to collapse (d0 without them).

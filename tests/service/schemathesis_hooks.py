@@ -58,6 +58,7 @@ from shared_schema.api import (
     CheckRequest,
     EnvelopeRequest,
     HistoryRequest,
+    PulseRequest,
     ReportRequest,
     SpectrumRequest,
 )
@@ -77,6 +78,7 @@ from solver_service.api.jobspec import (
     CheckJob,
     EnvelopeJob,
     HistoryJob,
+    PulseJob,
     ReportJob,
     SpectrumJob,
 )
@@ -156,6 +158,7 @@ CROSS_FIELD_RULES = frozenset(
 
 #: The request model and the job of each JSON operation.
 JSON_OPERATIONS: dict[str, tuple[type[BaseModel], Callable[..., Any]]] = {
+    "pulse": (PulseRequest, PulseJob),
     "envelope": (EnvelopeRequest, EnvelopeJob),
     "history": (HistoryRequest, HistoryJob),
     "spectrum": (SpectrumRequest, SpectrumJob),
@@ -221,7 +224,7 @@ def _scale_factors_ok(job: Any) -> bool:
         if amp is None:
             continue
         try:
-            if job.exact:
+            if job.method == "exact":
                 sf = pulse_scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
             else:
                 sf = shared_library().scale_factor(f_p, f_n=amp.f_n, h=amp.h, h_e=amp.h_e)
@@ -317,7 +320,7 @@ def scale_factor_rules(context: HookContext, case: Case) -> bool:
 
 
 @schemathesis.hook("filter_case").apply_to(
-    path_regex="/(envelope|history|spectrum|report|check|assess)$", method="POST"
+    path_regex="/(pulse|envelope|history|spectrum|report|check|assess)$", method="POST"
 )
 def json_body_rules(context: HookContext, case: Case) -> bool:
     """Drop positive JSON cases that break a rule JSON Schema cannot state."""

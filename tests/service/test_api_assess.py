@@ -24,6 +24,7 @@ from solver_service.api.estimates import check_job
 from solver_service.api.jobspec import AssessHtmlJob, AssessJob
 from solver_service.core.records import GroundMotion
 from solver_service.workflows.assess import NO_VIRTUAL_WORK, check_doc
+from solver_service.workflows.units import stamp
 
 RECORD = EXAMPLES / "records" / "elcentro_NS.dat"
 GEOMETRY = EXAMPLES / "constants" / "church_geometry.json"
@@ -218,7 +219,7 @@ def test_code_check_flow_through_the_service_equals_the_python_api(server: Any) 
     cf = parse_constants(GEOMETRY.read_bytes())
     site = parse_site(NTC.read_bytes())
     result = run_check(cf, site, client=ServiceClient(server.url))
-    assert result.doc == check_doc(cf, site)
+    assert result.doc == stamp(check_doc(cf, site), "check")  # units and version added
     assert result.summary == run_check(cf, site).summary
 
 

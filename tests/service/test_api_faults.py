@@ -31,7 +31,7 @@ from solver_service.core import envelope
 CHURCH = json.loads((EXAMPLES / "constants" / "church.json").read_text())
 WALLS = json.loads((EXAMPLES / "constants" / "rect_walls.json").read_text())
 #: Exact envelopes of the church at 800 frequencies: several seconds of one worker.
-HEAVY = {"constants": CHURCH, "exact": True, "n": 800}
+HEAVY = {"constants": CHURCH, "method": "exact", "n": 800}
 PULSE = {"p_eq": 2.0, "lam": 0.2, "eta": 0.9, "a_p_g": -0.61, "f_p": 1.59}
 BUDGET_S = 20.0
 
@@ -204,7 +204,7 @@ def test_work_that_cannot_finish_in_the_budget_is_refused_at_once(faulty: Server
     start = time.monotonic()
     body = {
         "constants": {"mechanisms": [stiff]},
-        "exact": True,
+        "method": "exact",
         "n": 2,
         "f_min": 0.001,
         "f_max": 0.0011,
@@ -225,7 +225,7 @@ def test_the_envelope_estimate_uses_the_solvers_scan() -> None:
     assert N_SCAN == envelope.N_SCAN
     # p_eq = 1e3 at 0.001 and 0.002 Hz, both pulse directions: 300 * 2 * (1e6 + 5e5) steps.
     stiff = {"id": "S", "p_eq": 1e3, "lam": 0.2, "rocking": "one_sided", "eta": -0.5}
-    body = {"constants": {"mechanisms": [stiff]}, "exact": True, "n": 2}
+    body = {"constants": {"mechanisms": [stiff]}, "method": "exact", "n": 2}
     job = EnvelopeJob.model_validate({**body, "f_min": 0.001, "f_max": 0.002})
     with pytest.raises(InputError, match=r"9e\+08 closed-form steps"):
         check_job(job, {"max_samples": 10**6, "max_mechanisms": 10, "budget_s": 1e-3})
@@ -362,7 +362,8 @@ def test_constants_whose_derived_values_overflow_get_422_not_a_worker_fault(
 def test_the_schema_states_the_rules_across_fields(faulty: Server) -> None:
     api = httpx.get(f"{faulty.url}/api/v1/openapi.json").json()["components"]["schemas"]
     pulse = api["PulseRequest"]["oneOf"]
-    assert [b["properties"]["eta"].get("minimum") for b in pulse] == [0, -1]
+    assert [b["properties"]["eta"].get("minimum") for b in pulse] == [0, -1, None]
+    assert pulse[2]["required"] == ["mechanism"]  # or one mechanism of a constants file
     eq28 = api["Eq28Request"]["oneOf"]
     assert [sorted(b["required"]) for b in eq28] == [["pga_g", "sa_g"], ["f_n", "record"]]
     for name in ("EnvelopeRequest", "HistoryRequest"):

@@ -38,7 +38,7 @@ PULSE = {"p_eq": 2.0, "lam": 0.2, "eta": 0.9, "a_p_g": -0.61, "f_p": 1.59}
 SPEC = EXAMPLES / "specs" / "facade.spec.json"
 #: Exact envelopes of the church at 800 frequencies: seconds of one compute process, within
 #: what the estimate lets through at the default 30 s budget.
-HEAVY = {"constants": CHURCH, "exact": True, "n": 800}
+HEAVY = {"constants": CHURCH, "method": "exact", "n": 800}
 #: Modules of the numerics, which only the compute processes may load.
 NUMERICS = ("numpy", "scipy", "numba", "llvmlite", "matplotlib", "rhino3dm", "trimesh")
 
@@ -100,11 +100,11 @@ def test_exact_envelopes_of_the_church_at_20000_frequencies_are_refused_up_front
     os.sched_setaffinity(svc.proc.pid, cpus)
     pid = _worker(svc)
     before = cpu_ticks(pid)
-    body = {"constants": CHURCH, "exact": True, "n": 20_000}
+    body = {"constants": CHURCH, "method": "exact", "n": 20_000}
     res = httpx.post(f"{svc.url}/api/v1/envelope", json=body, timeout=120)
     assert res.status_code == 422, res.text
     doc = res.json()
-    assert doc["field"] == "exact"
+    assert doc["field"] == "method"
     detail = doc["detail"]
     # The work, the rates' margin and the limit it cannot meet, named.
     assert "3.75e+08 closed-form steps of exact envelopes" in detail, detail

@@ -12,7 +12,8 @@ import shared_schema.atomic as atomic
 import shared_schema.io as sio
 from shared_schema.constants import ConstantsFile, Mechanism, parse_constants
 from shared_schema.errors import InputError
-from shared_schema.io import load_constants, save_constants, write_atomic
+from shared_schema.io import load_constants, save_constants, stamped, write_atomic
+from shared_schema.version import __version__
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "constants"
 
@@ -56,7 +57,8 @@ def test_published_table_form_round_trips_and_omits_absent_sections(tmp_path):
     assert mech["positive"] == {"p_eq": 2.15, "lam": 0.25, "phi_ov": 0.25}
     assert saved["schema_version"] == "1.0"
     assert saved["units"]["p_eq"] == "rad/s"
-    assert load_constants(path) == original
+    assert saved["rockmech_version"] == __version__  # the writer's version
+    assert load_constants(path) == stamped(original)
 
 
 def test_physical_form_round_trips_exactly(tmp_path):
@@ -76,7 +78,7 @@ def test_physical_form_round_trips_exactly(tmp_path):
     path = tmp_path / "loaded.json"
     save_constants(path, original)
     loaded = load_constants(path)
-    assert loaded == original
+    assert loaded == stamped(original)
     # Derived values are written next to the physical ones; nulls inside free-form data stay.
     mech = json.loads(path.read_text())["mechanisms"][0]
     assert mech["negative"]["lam"] == original.mechanisms[0].negative.lam

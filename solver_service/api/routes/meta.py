@@ -8,6 +8,7 @@ from fastapi import APIRouter, Response
 
 from shared_schema.api import HealthResponse
 from shared_schema.export import render_schema
+from shared_schema.version import __version__
 
 from ..deps import PoolDep, SettingsDep
 
@@ -40,6 +41,8 @@ async def health(pool: PoolDep, settings: SettingsDep) -> Response:
     doc = HealthResponse(
         status="ok" if pool.ready else "starting",
         version=rockmech_version(),
+        rockmech_version=__version__,
+        units={"compute_timeout_s": "s"},
         compute_workers=pool.alive,
         compute_timeout_s=settings.compute_timeout_s,
     )
