@@ -31,6 +31,8 @@ from shared_schema.rules import CRITERIA, PULSE_SHAPES, RECORD_FORMATS, RECORD_U
 from shared_schema.version import __version__
 
 from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
+from .core.jit import PATHS, kernel_status
+from .core.jit import build as build_kernels
 from .core.model import check_positive
 from .core.records import GroundMotion
 from .demo import run_demo
@@ -293,6 +295,7 @@ def _g4(value: Optional[float]) -> str:
 def _print_version(value: bool) -> None:
     if value:
         typer.echo(f"rockmech {__version__}")
+        typer.echo(kernel_status().describe())
         raise typer.Exit()
 
 
@@ -303,7 +306,7 @@ def _main(
         "--version",
         callback=_print_version,
         is_eager=True,
-        help="Print the version and exit.",
+        help="Print the version, whether the compiled kernels are active, and exit.",
     ),
 ) -> None:
     """Rocking collapse mechanisms of masonry: exact rocking solver and tools (SI units)."""
@@ -1100,10 +1103,34 @@ def serve(
     settings = settings_with(
         host=host, port=port, compute_workers=workers, compute_timeout_s=timeout
     )
+    _kernels_ahead()
     host_part = f"[{settings.host}]" if ":" in settings.host else settings.host
     typer.echo(f"rockmech {__version__} serving on http://{host_part}:{settings.port}")
     typer.echo(f"  docs: http://{host_part}:{settings.port}/api/v1/docs (Ctrl+C to stop)")
     run(settings)
+
+
+def _kernels_ahead() -> None:
+    """Compile the kernels once, in a child process, before the workers start (#28).
+
+    Each worker then loads them from numba's cache in under a second. The child prints a
+    progress line only when it compiles; the service process itself never loads numba.
+    """
+    import subprocess
+    import sys
+
+    code = "import sys; from solver_service.core.jit import main; sys.exit(main())"
+    subprocess.run([sys.executable, "-c", code], check=False)
+
+
+@app.command()
+@_user_errors
+def kernels() -> None:
+    """Compile the solver's kernels now (numba), so that no later run waits for it."""
+    status = kernel_status()
+    if status.active and len(status.built) < len(PATHS):
+        status = build_kernels()
+    typer.echo(status.describe())
 
 
 def _verdict(check: dict[str, Any]) -> str:

@@ -58,6 +58,7 @@ from . import _boundary_kernels as _bk
 from .amplification import pulse_response_spectrum
 from .exact import kernels
 from .excitation import PULSE_SHAPES
+from .jit import first_use
 from .model import RockingModel, RockingSide, check_eta
 
 __all__ = [
@@ -253,6 +254,7 @@ def boundary_curve(
         raise InputError(f"must be >= 0, got {n_scan_near!r}", "n_scan_near")
     scan = _scan(a_max, int(n_scan), int(n_scan_near))
     kern = kernels(backend)
+    compiled = first_use("boundary", backend)
     edges, n_edges, first = kern.boundary_grid(
         om,
         eta,
@@ -265,6 +267,8 @@ def boundary_curve(
         V_REST_BOUNDARY,
         math.nan if eta_neg is None else eta_neg,
     )
+    if compiled is not None:
+        compiled()
     return _curve(
         om,
         (eta, one_sided, direction),
@@ -499,6 +503,7 @@ def _library_curves(
     phase = PULSE_SHAPES[shape]
     probe_dir = -1
     t0 = time.perf_counter()
+    compiled = first_use("library")
     *probe, known = _bk.probe_grid(
         om, float(probe_dir), phase, scan, RTOL, MAX_EDGES, V_REST_BOUNDARY
     )
@@ -540,6 +545,8 @@ def _library_curves(
             out[k] = _curve(om, specs[k], parts, shape, scan_ratio=scan_ratio, runtime_s=each_s)
         if progress is not None:
             progress(len(out), len(specs))
+    if compiled is not None:
+        compiled()
     return [out[k] for k in range(len(specs))]
 
 
