@@ -35,7 +35,7 @@ from .core.jit import PATHS, kernel_status
 from .core.jit import build as build_kernels
 from .core.model import check_positive
 from .core.records import GroundMotion
-from .demo import run_demo
+from .demo import copy_examples, run_demo
 from .ida import IM_MEASURES, parse_levels, run_ida
 from .report.html import build_report, input_source, write_report
 from .workflows.assess import check_doc, check_multiples, read_site
@@ -1007,6 +1007,22 @@ def demo(
     ]
     for line in _table(["mechanism", "scale", "peak |phi|/phi_ov", "verdict"], rows):
         typer.echo(line)
+
+
+@app.command()
+@_user_errors
+def examples(
+    out: Path = typer.Argument(
+        Path("examples"), help="Folder to copy the examples into (default: ./examples)."
+    ),
+) -> None:
+    """Copy the bundled examples (scenes, specs, constants, records, sites) into a folder.
+
+    The README's commands use examples/... paths: run them from the folder holding OUT.
+    Only files an earlier copy wrote are replaced; your own files there are never touched.
+    """
+    written = copy_examples(out, on_note=_out_note)
+    typer.echo(f"wrote {len(written)} example files to {out}")
 
 
 @app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
