@@ -144,6 +144,7 @@ def test_version_is_written_once_and_the_rhino_copies_agree() -> None:
     assert rhproj["identity"]["version"] == version
     manifest = (ROOT / "rhino_plugin" / "manifest.yml").read_text()
     assert f"\nversion: {version}\n" in manifest
+    assert f"\nversion: {version}\n" in (ROOT / "CITATION.cff").read_text()
     res = runner.invoke(app, ["--version"])
     assert res.exit_code == 0 and res.stdout.splitlines()[0] == f"rockmech {version}"
 
@@ -156,10 +157,53 @@ def test_licence_metadata_is_pep639() -> None:
     assert project["urls"]
 
 
+def test_citation_names_the_methods_paper() -> None:
+    text = (ROOT / "CITATION.cff").read_text()
+    assert text.startswith("cff-version: 1.2.0\n")
+    preferred = text.split("preferred-citation:", 1)[1].split("\nreferences:", 1)[0]
+    for needed in (
+        "family-names: Mehrotra",
+        "family-names: DeJong",
+        "year: 2018",
+        "journal: Engineering Structures",
+        "type: article",
+    ):
+        assert needed in preferred, needed
+
+
+def test_all_extra_is_every_user_extra_and_dev_builds_on_it() -> None:
+    extras = PYPROJECT["project"]["optional-dependencies"]
+    (all_line,) = extras["all"]
+    users = set(extras) - {"all", "dev"}
+    assert all_line == f"rockmech[{','.join(sorted(users, key=all_line.index))}]"
+    assert set(all_line[len("rockmech[") : -1].split(",")) == users
+    assert "rockmech[all]" in extras["dev"]
+
+
+def test_python_dash_m_rockmech_is_the_command() -> None:
+    res = subprocess.run(
+        [sys.executable, "-m", "rockmech", "--version"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=120,
+    )
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.splitlines()[0] == f"rockmech {rockmech.__version__}"
+    res = subprocess.run(
+        [sys.executable, "-m", "rockmech", "pulse", "--p-eq", "2"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=120,
+    )
+    assert res.returncode == 2 and res.stderr.startswith("error: --lam: missing option")
+
+
 def test_the_cli_dependencies_are_in_the_base_install() -> None:
     base = {_dist(r) for r in PYPROJECT["project"]["dependencies"]}
-    assert {"numpy", "pydantic", "scipy", "matplotlib", "typer", "rich"} <= base
-    for extra in ("geometry", "service", "dask"):
+    assert {"numpy", "pydantic", "scipy", "matplotlib", "typer", "rich", "numba"} <= base
+    for extra in ("geometry", "service", "dask", "report", "tables"):
         assert not base & {_dist(r) for r in PYPROJECT["project"]["optional-dependencies"][extra]}
 
 
