@@ -30,7 +30,7 @@ from shared_schema.io import save_constants
 from shared_schema.rules import CRITERIA, PULSE_SHAPES, RECORD_FORMATS, RECORD_UNITS, SF_METHODS
 from shared_schema.version import __version__
 
-from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
+from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library, user_library_path
 from .core.jit import PATHS, kernel_status
 from .core.jit import build as build_kernels
 from .core.model import check_positive
@@ -890,6 +890,9 @@ def envelope(
             title=f"Overturning envelopes: {constants.name}",
             record_pulse=pulse,
         )
+    library_file = doc["method"].get("library_file", "shipped with rockmech")
+    if library_file != "shipped with rockmech":
+        _note(f"note: envelopes interpolated in the library {library_file}")
     if as_json:
         _print_json(doc)
         return
@@ -946,7 +949,12 @@ app.add_typer(library_app, name="library")
 @_user_errors
 def library_build(
     out: Optional[Path] = typer.Option(
-        None, "--out", help="Output .npz (default: the package's shipped library)."
+        None,
+        "--out",
+        help=(
+            "Output .npz (default: the user's cache folder, which envelopes read before the "
+            "shipped library; the installed package is never written)."
+        ),
     ),
     n_omega: int = typer.Option(400, "--n-omega", help="Omega points, log-spaced in [0.05, 50]."),
     eta_step: float = typer.Option(0.02, "--eta-step", help="Step of eta in [0, 1]."),
@@ -956,8 +964,10 @@ def library_build(
     from rich.console import Console
     from rich.progress import Progress
 
-    if out is not None:
-        check_file_target(out)
+    target = out if out is not None else user_library_path()
+    if target is None:
+        _fail("out: no user cache folder here (platformdirs is missing); give --out FILE")
+    check_file_target(target)
     if n_omega < 2:
         _fail(f"n_omega: must be >= 2, got {n_omega}")
     if not 0.0 < eta_step <= 1.0:
@@ -974,11 +984,16 @@ def library_build(
             bar.update(task, completed=done, total=total)
 
         lib = build_library(omega=omega, eta=eta, progress=tick)
-    path = lib.save(out or LIBRARY_PATH)
+    path = lib.save(target)
     typer.echo(
         f"wrote {path}: {lib.eta.size} two-sided curves + one-sided, {lib.omega.size} Omega, "
         f"{lib.metadata['build_seconds']} s"
     )
+    if out is None:
+        typer.echo(
+            "  envelopes now read it instead of the shipped library (their method names it); "
+            f"delete it to go back to {LIBRARY_PATH.name}"
+        )
 
 
 @app.command()

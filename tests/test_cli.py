@@ -269,6 +269,43 @@ def test_library_build_writes_a_loadable_library(tmp_path: Path) -> None:
     np.testing.assert_allclose(lib.a_min_two_sided[1], boundary_curve(lib.omega, 0.5).a_min)
 
 
+def test_library_build_without_out_writes_the_user_cache_which_envelopes_read_first(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import hashlib
+
+    from solver_service.core.envelope import LIBRARY_PATH, OverturningLibrary, user_library_path
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    shipped = hashlib.sha256(LIBRARY_PATH.read_bytes()).hexdigest()
+    user = user_library_path()
+    assert user is not None and user.parent == tmp_path / "cache" / "rockmech"
+    assert OverturningLibrary.load().path == LIBRARY_PATH
+    church = EXAMPLES / "constants" / "church.json"
+    before = runner.invoke(app, ["envelope", str(church), "--out", str(tmp_path / "a"), "--n", "9"])
+    assert before.exit_code == 0 and before.stderr == "", before.output
+    res = runner.invoke(app, ["library", "build", "--n-omega", "5", "--eta-step", "0.5"])
+    assert res.exit_code == 0, res.output
+    assert res.stdout.startswith(f"wrote {user}: 3 two-sided curves")
+    # The installed package is never written.
+    assert hashlib.sha256(LIBRARY_PATH.read_bytes()).hexdigest() == shipped
+    lib = OverturningLibrary.load()
+    assert lib.path == user and lib.omega.size == 5 and list(lib.eta) == [0.0, 0.5, 1.0]
+    after = runner.invoke(app, ["envelope", str(church), "--out", str(tmp_path / "b"), "--n", "9"])
+    assert after.exit_code == 0, after.output
+    assert (
+        after.stderr
+        == f"note: envelopes interpolated in the library {user} (not the shipped library)\n"
+    )
+    doc = json.loads((tmp_path / "b" / "envelope.json").read_text())
+    assert doc["method"]["library_file"] == f"{user} (not the shipped library)"
+    assert doc["method"]["generated"] == lib.metadata["generated"]
+    user.unlink()
+    doc = json.loads((tmp_path / "a" / "envelope.json").read_text())
+    assert doc["method"]["library_file"] == "shipped with rockmech"
+    assert OverturningLibrary.load().path == LIBRARY_PATH
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [

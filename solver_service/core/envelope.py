@@ -53,6 +53,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError
+from shared_schema.version import __version__
 
 from . import _boundary_kernels as _bk
 from .amplification import pulse_response_spectrum
@@ -72,7 +73,9 @@ __all__ = [
     "boundary_curve",
     "build_library",
     "critical_bands",
+    "default_library_path",
     "mechanism_envelope",
+    "user_library_path",
 ]
 
 #: Largest pulse amplitude searched, as ``a_p / (g lam)``.
@@ -91,8 +94,11 @@ MAX_EDGES = 64
 #: Library grid: Omega points (log-spaced in [0.05, 50]) and eta step.
 LIBRARY_OMEGA = (0.05, 50.0, 400)
 LIBRARY_ETA_STEP = 0.02
-#: The library shipped with the package.
+#: The library shipped with the package (never rewritten by rockmech: ``user_library_path``).
 LIBRARY_PATH = Path(__file__).resolve().parents[1] / "data" / "overturning_library.npz"
+#: File name of a library built by ``rockmech library build`` in the user's cache folder,
+#: per rockmech version (a library built by another version is not read).
+USER_LIBRARY_NAME = "overturning_library-{version}.npz"
 #: Format version of the library file.
 LIBRARY_VERSION = "1"
 #: Largest change of ``log A_min`` between neighbouring library points that counts as a smooth
@@ -331,6 +337,8 @@ class OverturningLibrary:
     spectrum_ratio: NDArray[np.float64]
     spectrum: NDArray[np.float64]
     metadata: dict[str, Any] = field(default_factory=dict)
+    #: The file it was read from (None: built in this process).
+    path: Optional[Path] = None
 
     def scale_factor(
         self, f_p: ArrayLike, *, f_n: float, h: float, h_e: float
@@ -387,8 +395,13 @@ class OverturningLibrary:
 
     @classmethod
     def load(cls, path: Union[str, Path, None] = None) -> OverturningLibrary:
-        """Read a library file (default: the one shipped with the package)."""
-        p = Path(path) if path is not None else LIBRARY_PATH
+        """Read a library file.
+
+        The default is the user's own build (``rockmech library build``, at
+        ``user_library_path()``) when there is one for this version, else the library
+        shipped with the package. ``path`` records which file was read.
+        """
+        p = Path(path) if path is not None else default_library_path()
         if not p.is_file():
             raise InputError(
                 f"overturning library not found at {p}; build it with `rockmech library build`",
@@ -406,7 +419,30 @@ class OverturningLibrary:
                 spectrum_ratio=data["spectrum_ratio"],
                 spectrum=data["spectrum"],
                 metadata=json.loads(str(data["metadata"])),
+                path=p,
             )
+
+
+def user_library_path() -> Optional[Path]:
+    """Return where ``rockmech library build`` writes a library by default, and reads it first.
+
+    The user's cache folder (platformdirs: ``~/.cache/rockmech`` on Linux,
+    ``~/Library/Caches/rockmech`` on macOS, ``%LOCALAPPDATA%/rockmech/Cache`` on Windows),
+    never the installed package. None where platformdirs is missing (Rhino's Python): there
+    only the shipped library is read.
+    """
+    try:
+        import platformdirs
+    except ImportError:
+        return None
+    folder = Path(platformdirs.user_cache_dir("rockmech", appauthor=False))
+    return folder / USER_LIBRARY_NAME.format(version=__version__)
+
+
+def default_library_path() -> Path:
+    """Return the library ``OverturningLibrary.load()`` reads: the user's build, or the shipped."""
+    user = user_library_path()
+    return user if user is not None and user.is_file() else LIBRARY_PATH
 
 
 def _blend(
@@ -608,6 +644,7 @@ def build_library(
     flat, offsets = _ragged([*curves, pos, neg])
     meta = {
         "library_version": LIBRARY_VERSION,
+        "rockmech": __version__,
         "generated": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         "shape": shape,
         "a_max": A_MAX,

@@ -16,6 +16,7 @@ from shared_schema.errors import InputError
 from ..core.amplification import pulse_scale_factor
 from ..core.envelope import (
     A_MAX,
+    LIBRARY_PATH,
     Envelope,
     OverturningLibrary,
     boundary_curve,
@@ -237,6 +238,15 @@ def record_analysis(
     return record_doc(motion, spectrum, found), spectrum, found
 
 
+def library_label(library: OverturningLibrary) -> str:
+    """Say which library file a result used: the shipped one, or the user's own build."""
+    if library.path is None:
+        return "built in this process"
+    if library.path.resolve() == LIBRARY_PATH.resolve():
+        return "shipped with rockmech"
+    return f"{library.path} (not the shipped library)"
+
+
 def envelope_doc(
     cf: ConstantsFile,
     f_p: np.ndarray[Any, Any],
@@ -305,6 +315,7 @@ def envelope_doc(
             if exact or library is None
             else {
                 "source": "library",
+                "library_file": library_label(library),
                 "interpolation": "log A_min linear in log Omega and in eta",
                 **{
                     k: library.metadata[k]
