@@ -292,10 +292,28 @@ def _g4(value: Optional[float]) -> str:
     return "-" if value is None else f"{value:.4g}"
 
 
+def _foreign_packages() -> list[str]:
+    """Name rockmech's top-level packages loaded from outside its install (a name clash)."""
+    import importlib
+
+    homes = {
+        name: Path(str(importlib.import_module(name).__file__)).resolve().parent.parent
+        for name in ("rockmech", "shared_schema", "solver_service", "rhino_plugin")
+    }
+    return [
+        f"warning: {name} is loaded from {home}, not from rockmech's install "
+        f"({homes['rockmech']}): another package or file has that name (docs/install.md)"
+        for name, home in homes.items()
+        if home != homes["rockmech"]
+    ]
+
+
 def _print_version(value: bool) -> None:
     if value:
         typer.echo(f"rockmech {__version__}")
         typer.echo(kernel_status().describe())
+        for line in _foreign_packages():
+            _note(line)
         raise typer.Exit()
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import email
 import json
 import math
+import os
 import shutil
 import subprocess
 import sys
@@ -461,3 +462,37 @@ def test_rockmech_docstring_example_runs() -> None:
 
     result = doctest.testmod(rockmech, verbose=False)
     assert result.attempted >= 3 and result.failed == 0
+
+
+def test_version_warns_when_a_top_level_package_comes_from_elsewhere(tmp_path: Path) -> None:
+    # Another distribution (or a folder on the path) named rhino_plugin, first on sys.path:
+    # --version names it and where it comes from (docs/install.md, "Package names").
+    other = tmp_path / "rhino_plugin"
+    other.mkdir()
+    (other / "__init__.py").write_text(
+        "from pkgutil import extend_path\n__path__ = extend_path(__path__, __name__)\n"
+    )
+    res = subprocess.run(
+        [sys.executable, "-m", "rockmech", "--version"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(tmp_path)},
+        timeout=120,
+    )
+    assert res.returncode == 0, res.stderr
+    assert res.stderr == (
+        f"warning: rhino_plugin is loaded from {tmp_path.resolve()}, not from rockmech's "
+        f"install ({ROOT}): another package or file has that name (docs/install.md)\n"
+    )
+    # From another folder, without it on the path: no warning.
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    clean = subprocess.run(
+        [sys.executable, "-m", "rockmech", "--version"],
+        capture_output=True,
+        text=True,
+        cwd=elsewhere,
+        timeout=120,
+    )
+    assert clean.returncode == 0 and clean.stderr == ""
