@@ -71,6 +71,7 @@ from solver_service.api.jobs import (
 from solver_service.api.jobspec import (
     AssessHtmlJob,
     AssessJob,
+    AssessPdfJob,
     CheckJob,
     EnvelopeJob,
     HistoryJob,
@@ -157,7 +158,7 @@ JSON_OPERATIONS: dict[str, tuple[type[BaseModel], Callable[..., Any]]] = {
     "check": (CheckRequest, CheckJob),
     "assess": (
         AssessRequest,
-        lambda **f: (AssessHtmlJob if f["format"] == "html" else AssessJob)(**f),
+        lambda **f: {"html": AssessHtmlJob, "pdf": AssessPdfJob}.get(f["format"], AssessJob)(**f),
     ),
 }
 
@@ -180,7 +181,7 @@ def _work_ok(job: Any) -> bool:
         return False
     if isinstance(job, (EnvelopeJob, ReportJob)) and not _scale_factors_ok(job):
         return False
-    if isinstance(job, (AssessJob, AssessHtmlJob)):
+    if isinstance(job, (AssessJob, AssessHtmlJob, AssessPdfJob)):
         return _assess_spectra_ok(job)
     record = getattr(job, "record", None)
     if record is None:
