@@ -108,7 +108,9 @@ class KernelStatus:
         elif self.built:
             state = f"built: {', '.join(self.built)}; the others compile on first use"
         else:
-            state = "not built yet: each path compiles on first use (`rockmech kernels` now)"
+            state = (
+                "not built yet: each path compiles on first use, or all at once by rockmech kernels"
+            )
         return (
             f"compiled kernels: active (numba {self.numba_version}; {state}; "
             f"cache {self.cache_dir})"
