@@ -968,3 +968,46 @@ def test_progress_goes_to_stderr_on_a_terminal_and_nowhere_otherwise(
     assert shown.exit_code == 0, shown.output
     assert json.loads(shown.stdout) == json.loads(plain.stdout)  # stdout: the JSON only
     assert "envelopes: 3 mechanisms x 5 frequencies" in shown.stderr
+
+
+def test_examples_copies_the_bundled_examples_and_never_touches_the_users_files(
+    tmp_path: Path,
+) -> None:
+    folder = tmp_path / "work"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine")
+    dest = folder / "examples"
+    res = runner.invoke(app, ["examples", str(dest)])
+    assert res.exit_code == 0, res.output
+    shipped = sorted(
+        p.relative_to(EXAMPLES).as_posix()
+        for p in EXAMPLES.rglob("*")
+        if p.is_file() and p.suffix not in (".py", ".pyc") and "__pycache__" not in p.parts
+    )
+    copied = sorted(
+        p.relative_to(dest).as_posix()
+        for p in dest.rglob("*")
+        if p.is_file() and ".rockmech" not in p.relative_to(dest).parts
+    )
+    assert copied == shipped and len(copied) >= 25
+    assert res.stdout == f"wrote {len(shipped)} example files to {dest}\n"
+    for rel in shipped:
+        assert (dest / rel).read_bytes() == (EXAMPLES / rel).read_bytes(), rel
+    # The README's commands run on the copy.
+    out = runner.invoke(
+        app, ["envelope", str(dest / "constants" / "church.json"), "--out", str(tmp_path / "o")]
+    )
+    assert out.exit_code == 0, out.output
+    # Again: only its own files are replaced; a file of the user's beside them survives.
+    (dest / "my_site.json").write_text("{}")
+    assert runner.invoke(app, ["examples", str(dest)]).exit_code == 0
+    assert (dest / "my_site.json").read_text() == "{}"
+    assert (folder / "notes.txt").read_text() == "mine"
+    # An example the user changed is kept, and the copy stops with one line naming it.
+    church = dest / "constants" / "church.json"
+    church.write_text(church.read_text() + " ")
+    changed = church.read_bytes()
+    res = runner.invoke(app, ["examples", str(dest)])
+    assert res.exit_code == 2
+    assert res.stderr.startswith(f"error: out: {church} was changed after rockmech wrote it")
+    assert church.read_bytes() == changed
