@@ -32,8 +32,8 @@ from shared_schema.version import __version__
 
 from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library, user_library_path
 from .core.jit import PATHS, kernel_status
-from .core.jit import build as build_kernels
 from .core.model import check_positive
+from .core.precompile import build as build_kernels
 from .core.records import GroundMotion
 from .demo import copy_examples, run_demo
 from .ida import IM_MEASURES, parse_levels, run_ida
@@ -1168,7 +1168,7 @@ def _kernels_ahead() -> None:
     import subprocess
     import sys
 
-    code = "import sys; from solver_service.core.jit import main; sys.exit(main())"
+    code = "import sys; from solver_service.core.precompile import main; sys.exit(main())"
     subprocess.run([sys.executable, "-c", code], check=False)
 
 

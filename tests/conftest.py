@@ -36,6 +36,6 @@ def pytest_configure(config: pytest.Config) -> None:
     """
     if hasattr(config, "workerinput"):
         return
-    from solver_service.core.jit import build
+    from solver_service.core.precompile import build
 
     build()

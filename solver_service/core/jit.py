@@ -10,9 +10,10 @@ Each solver path (``PATHS``) compiles the first time it runs, which takes from a
 to about a minute on a laptop. ``first_use`` wraps the compiled call of each path: when the
 path has not been built for these sources yet, it announces the compilation with one line
 (``set_notifier``; stderr by default) before, and writes a stamp beside numba's cache after.
-``build`` compiles every path ahead (``rockmech kernels``, the Docker image's build, the
-service before it starts its workers). Without numba the same source runs as plain Python,
-10 to 100 times slower; the first kernel call of a process says so once, with the reason.
+``precompile.build`` compiles every path ahead (``rockmech kernels``, the Docker image's
+build, the service before it starts its workers). Without numba the same source runs as
+plain Python, 10 to 100 times slower; the first kernel call of a process says so once, with
+the reason.
 
 Python 3.9-clean: Rhino 8 imports the solver through its flows (without numba).
 """
@@ -24,7 +25,7 @@ import sys
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, Set, Tuple
+from typing import Callable, Dict, List, Optional, Set, Tuple
 
 from shared_schema.atomic import write_atomic
 from shared_schema.version import __version__
@@ -34,9 +35,9 @@ from . import _kernels as _k
 __all__ = [
     "PATHS",
     "KernelStatus",
-    "build",
     "first_use",
     "kernel_status",
+    "notify",
     "set_notifier",
 ]
 
@@ -70,6 +71,11 @@ _NOTIFY: List[Callable[[str], None]] = [_stderr_line]
 def set_notifier(fn: Optional[Callable[[str], None]]) -> None:
     """Send the progress and fallback lines to ``fn`` (None: stderr, the default)."""
     _NOTIFY[0] = fn if fn is not None else _stderr_line
+
+
+def notify(line: str) -> None:
+    """Send one progress or fallback line where ``set_notifier`` says (stderr by default)."""
+    _NOTIFY[0](line)
 
 
 @dataclass(frozen=True)
@@ -228,85 +234,3 @@ def _write_stamp(path: str, key: Dict[str, object]) -> None:
     if stamp is not None:
         with contextlib.suppress(OSError):  # a read-only cache: numba recompiles anyway
             write_atomic(stamp, json.dumps(key, sort_keys=True))
-
-
-def build(
-    progress: Optional[Callable[[str], None]] = None, paths: Optional[Tuple[str, ...]] = None
-) -> KernelStatus:
-    """Compile every solver path now (or load it from numba's cache), and stamp each.
-
-    Parameters
-    ----------
-    paths : tuple of str, optional
-        The paths to build (default: all of ``PATHS``).
-    progress : callable, optional
-        Called with each path's name before it is built (paths already built are skipped).
-
-    Returns
-    -------
-    KernelStatus
-        The status afterwards (``built`` lists every path where numba is active; without
-        numba nothing runs).
-    """
-    if not _k.JIT:  # nothing to compile: the pure-Python kernels need no build
-        return kernel_status()
-    import numpy as np
-
-    # Imported here: they import this module (envelope, exact and spectra use first_use).
-    from .envelope import boundary_curve, build_library
-    from .exact import simulate, simulate_batch, single_threaded
-    from .excitation import Pulse, SampledAccel
-    from .model import RockingModel
-    from .spectra import response_spectrum
-
-    acc = 3.0 * np.sin(np.linspace(0.0, 6.0, 61))
-    wall = RockingModel.symmetric(2.0, 0.2, 0.9)
-    one_sided = RockingModel.symmetric(2.0, 0.2, -0.5, one_sided=True)
-    batch = ([wall, one_sided], SampledAccel(acc, 0.01), [1.0, 2.0])
-    done = set(kernel_status().built)
-    steps: Dict[str, Callable[[], object]] = {
-        "simulate": lambda: (
-            simulate(wall, Pulse(a_p=-3.0, f_p=1.0)),
-            simulate(one_sided, SampledAccel(acc, 0.01), dense=True, impact_log=True),
-        ),
-        "batch": lambda: (simulate_batch(*batch), _serial(single_threaded, simulate_batch, batch)),
-        "boundary": lambda: boundary_curve(np.array([1.0, 5.0]), 0.9, n_scan=8),
-        "library": lambda: build_library(omega=np.array([1.0, 5.0]), eta=np.array([0.0, 1.0])),
-        "spectrum": lambda: response_spectrum(acc, 0.01, [0.5]),
-    }
-    for name, step in steps.items():
-        if name in done or (paths is not None and name not in paths):
-            continue
-        if progress is not None:
-            progress(name)
-        step()
-    return kernel_status()
-
-
-def _serial(
-    context: Callable[[], "contextlib.AbstractContextManager[None]"],
-    fn: Callable[..., object],
-    args: Tuple[Any, ...],
-) -> object:
-    """Run ``fn(*args)`` inside ``context()`` (the batch's single-threaded grid, used by IDA)."""
-    with context():
-        return fn(*args)
-
-
-#: The paths the REST service runs (it loads the shipped library, never builds one).
-SERVICE_PATHS = ("simulate", "batch", "boundary", "spectrum")
-
-
-def main(paths: Tuple[str, ...] = SERVICE_PATHS) -> int:
-    """Build ``paths``, quietly when they are built (``rockmech serve`` runs it first).
-
-    Returns
-    -------
-    int
-        0 when the compiled kernels are active and built, 1 when they are not active.
-    """
-    status = build()
-    if not status.active:
-        _NOTIFY[0](f"note: {status.describe()}")
-        return 1
-    return 0

@@ -112,3 +112,14 @@ def test_without_numba_the_pure_python_kernels_run_and_say_so_once() -> None:
     assert first.count("note:") == 1 and second == "''"
     assert version.startswith("compiled kernels: not active (numba is not installed)")
     assert method == "exact:python"
+
+
+def test_the_build_rockmech_serve_runs_first_is_quiet_when_built_and_says_why_without_numba() -> (
+    None
+):
+    code = "import sys; from solver_service.core.precompile import main; sys.exit(main())"
+    built = _run(code)
+    assert built.returncode == 0 and built.stderr == "", built.stderr
+    blocked = _run("import sys; sys.modules['numba'] = None\n" + code)
+    assert blocked.returncode == 1
+    assert blocked.stderr.startswith("note: compiled kernels: not active (numba is not installed)")
