@@ -15,6 +15,8 @@ import difflib
 import functools
 import importlib
 import json
+import subprocess
+import sys
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any, Iterator, NoReturn, Optional, TypeVar
@@ -294,8 +296,6 @@ def _g4(value: Optional[float]) -> str:
 
 def _foreign_packages() -> list[str]:
     """Name rockmech's top-level packages loaded from outside its install (a name clash)."""
-    import importlib
-
     homes = {
         name: Path(str(importlib.import_module(name).__file__)).resolve().parent.parent
         for name in ("rockmech", "shared_schema", "solver_service", "rhino_plugin")
@@ -1162,12 +1162,10 @@ def serve(
 def _kernels_ahead() -> None:
     """Compile the kernels once, in a child process, before the workers start (#28).
 
-    Each worker then loads them from numba's cache in under a second. The child prints a
-    progress line only when it compiles; the service process itself never loads numba.
+    Each worker then loads them from numba's cache in under a second, instead of every
+    worker compiling them at once at start-up. The child prints a progress line only when it
+    compiles.
     """
-    import subprocess
-    import sys
-
     code = "import sys; from solver_service.core.precompile import main; sys.exit(main())"
     subprocess.run([sys.executable, "-c", code], check=False)
 
