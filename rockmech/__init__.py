@@ -40,16 +40,20 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from shared_schema.extras import MissingExtra as MissingExtra
     from shared_schema.io import load_constants as load_constants
     from shared_schema.io import save_constants as save_constants
+    from shared_schema.site import SiteFile as SiteFile
     from solver_service.core.envelope import (
         critical_bands as critical_bands,
     )
     from solver_service.core.envelope import (
         mechanism_envelope as mechanism_envelope,
     )
+    from solver_service.core.exact import BatchResult as BatchResult
     from solver_service.core.exact import simulate as simulate
     from solver_service.core.exact import simulate_batch as simulate_batch
     from solver_service.core.excitation import Pulse as Pulse
     from solver_service.core.excitation import SampledAccel as SampledAccel
+    from solver_service.core.jit import KernelStatus as KernelStatus
+    from solver_service.core.jit import kernel_status as kernel_status
     from solver_service.core.model import G as G
     from solver_service.core.model import RockingModel as RockingModel
     from solver_service.core.pulses import (
@@ -59,7 +63,9 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
         largest_pulse as largest_pulse,
     )
     from solver_service.core.records import GroundMotion as GroundMotion
+    from solver_service.core.result import RockingResult as RockingResult
     from solver_service.core.spectra import response_spectrum as response_spectrum
+    from solver_service.demo import copy_examples as copy_examples
     from solver_service.demo import examples_dir as examples_dir
     from solver_service.report.html import (
         build_report as build_report,
@@ -69,6 +75,52 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     )
     from solver_service.workflows.documents import solve_pulse as solve_pulse
     from solver_service.workflows.inputs import constants_from_files as constants_from_files
+
+    from .analysis import (
+        assess as assess,
+    )
+    from .analysis import (
+        check as check,
+    )
+    from .analysis import (
+        constants_from_scene as constants_from_scene,
+    )
+    from .analysis import (
+        constants_from_table as constants_from_table,
+    )
+    from .analysis import (
+        envelope as envelope,
+    )
+    from .analysis import (
+        history as history,
+    )
+    from .analysis import (
+        ida as ida,
+    )
+    from .analysis import (
+        load_models as load_models,
+    )
+    from .analysis import (
+        pulse as pulse,
+    )
+    from .analysis import (
+        read_constants as read_constants,
+    )
+    from .analysis import (
+        read_record as read_record,
+    )
+    from .analysis import (
+        read_site as read_site,
+    )
+    from .results import AssessmentResult as AssessmentResult
+    from .results import CheckResult as CheckResult
+    from .results import CriticalBand as CriticalBand
+    from .results import EnvelopeResult as EnvelopeResult
+    from .results import Fragility as Fragility
+    from .results import HistoryResult as HistoryResult
+    from .results import HistoryRun as HistoryRun
+    from .results import IDAResult as IDAResult
+    from .results import MechanismCheck as MechanismCheck
 
 #: Each public name and the module it comes from (imported on first access).
 _SOURCES = {
@@ -83,6 +135,32 @@ _SOURCES = {
     "load_constants": "shared_schema.io",
     "save_constants": "shared_schema.io",
     "constants_from_files": "solver_service.workflows.inputs",
+    # Reading inputs: constants (file, table, scene), models, records, sites.
+    "read_constants": "rockmech.analysis",
+    "constants_from_table": "rockmech.analysis",
+    "constants_from_scene": "rockmech.analysis",
+    "load_models": "rockmech.analysis",
+    "read_record": "rockmech.analysis",
+    "read_site": "rockmech.analysis",
+    "SiteFile": "shared_schema.site",
+    # The analyses, as the command line runs them, and their typed results.
+    "pulse": "rockmech.analysis",
+    "history": "rockmech.analysis",
+    "envelope": "rockmech.analysis",
+    "ida": "rockmech.analysis",
+    "check": "rockmech.analysis",
+    "assess": "rockmech.analysis",
+    "RockingResult": "solver_service.core.result",
+    "BatchResult": "solver_service.core.exact",
+    "HistoryResult": "rockmech.results",
+    "HistoryRun": "rockmech.results",
+    "EnvelopeResult": "rockmech.results",
+    "CriticalBand": "rockmech.results",
+    "IDAResult": "rockmech.results",
+    "Fragility": "rockmech.results",
+    "CheckResult": "rockmech.results",
+    "MechanismCheck": "rockmech.results",
+    "AssessmentResult": "rockmech.results",
     # Models, excitations and the exact solver.
     "G": "solver_service.core.model",
     "RockingModel": "solver_service.core.model",
@@ -104,6 +182,10 @@ _SOURCES = {
     "build_report": "solver_service.report.html",
     "write_report": "solver_service.report.html",
     "examples_dir": "solver_service.demo",
+    "copy_examples": "solver_service.demo",
+    # Whether the solver's compiled kernels are active (numba) and built.
+    "kernel_status": "solver_service.core.jit",
+    "KernelStatus": "solver_service.core.jit",
 }
 
 __all__ = ["__version__", *_SOURCES]

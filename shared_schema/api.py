@@ -836,8 +836,9 @@ MAX_ASSESS_RECORDS = 5
 MAX_ASSESS_MULTIPLES = 8
 #: Largest multiple of the design scale factor [-]: a hundred times the design earthquake.
 MULTIPLE_MAX = 100.0
-#: What ``/assess`` answers: the assessment document or its HTML page.
-ASSESS_FORMATS = ("json", "html")
+#: What ``/assess`` answers: the assessment document, its HTML page, or that page as PDF
+#: (printed by a headless Chromium where the deployment has one; else 501 naming it).
+ASSESS_FORMATS = ("json", "html", "pdf")
 
 
 class CheckRequest(BaseModel):
@@ -877,8 +878,10 @@ class AssessRequest(BaseModel):
             "items": {"type": "number", "exclusiveMinimum": 0, "maximum": MULTIPLE_MAX}
         },
     )
-    format: Literal["json", "html"] = Field(
-        "json", description="Answer with the assessment document (json) or its HTML page (html)."
+    format: Literal["json", "html", "pdf"] = Field(
+        "json",
+        description="Answer with the assessment document (json), its HTML page (html), or the "
+        "page printed to PDF (pdf; needs a headless Chromium in the deployment, else 501).",
     )
 
     _plausible = field_validator("constants")(classmethod(_time_domain_constants))

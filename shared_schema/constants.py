@@ -47,6 +47,7 @@ import json
 import math
 import re
 from typing import (
+    TYPE_CHECKING,
     Annotated,
     Any,
     Dict,
@@ -74,7 +75,7 @@ from pydantic import (
 )
 from pydantic_core import PydanticCustomError
 
-from shared_schema.errors import InputError
+from shared_schema.errors import InputError, per_side_error
 from shared_schema.rules import (
     PRINTABLE_PATTERN,
     ROTATION_MAX,
@@ -894,6 +895,21 @@ class Mechanism(BaseModel):
     def one_sided(self) -> bool:
         """True for one-sided rocking."""
         return self.rocking == "one_sided"
+
+    if not TYPE_CHECKING:  # for type checkers the fields are the attributes, as they are
+
+        def __getattr__(self, name: str) -> Any:
+            """Point a side's constant read on the mechanism (``mech.p_eq``) to its side."""
+            if name in SideConstants.model_fields:
+                negative = None if self.negative is None else getattr(self.negative, name)
+                raise per_side_error(
+                    f"Mechanism {self.id!r}",
+                    name,
+                    getattr(self.positive, name),
+                    negative,
+                    self.one_sided,
+                )
+            return super().__getattr__(name)
 
 
 class ConstantsFile(BaseModel):

@@ -10,7 +10,7 @@ without importing pydantic.
 
 from typing import Optional
 
-__all__ = ["GeometryError", "InputError", "RockmechError", "SolverError"]
+__all__ = ["GeometryError", "InputError", "RockmechError", "SolverError", "per_side_error"]
 
 
 class RockmechError(Exception):
@@ -41,3 +41,31 @@ class GeometryError(RockmechError):
 
 class SolverError(RockmechError):
     """A numerical procedure failed in a way the inputs do not explain."""
+
+
+def per_side_error(
+    owner: str, name: str, positive: object, negative: object, one_sided: bool
+) -> AttributeError:
+    """Build the error for a side's constant read on a whole mechanism (``mech.p_eq``).
+
+    A mechanism's constants live per side (``.positive.p_eq``, ``.negative.p_eq``); the
+    message says so and gives both values, so a script's first guess leads to the fix.
+
+    Parameters
+    ----------
+    owner : str
+        The mechanism, as the message names it (its class and id).
+    name : str
+        The constant asked for (``p_eq``, ``lam``, ``phi_ov``, ...).
+    positive, negative : object
+        Its value on each side (``negative`` None: the same as the positive side).
+    one_sided : bool
+        One-sided rocking (only the positive side rocks).
+    """
+    if one_sided:
+        where = f"use .positive.{name} (= {positive!r}; one-sided rocking has only that side)"
+    elif negative is None:
+        where = f"use .positive.{name} (= {positive!r}; symmetric: the negative side is the same)"
+    else:
+        where = f"use .positive.{name} (= {positive!r}) or .negative.{name} (= {negative!r})"
+    return AttributeError(f"{owner} has no {name} of its own: the constants live per side; {where}")

@@ -15,6 +15,8 @@ import difflib
 import functools
 import importlib
 import json
+import subprocess
+import sys
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any, Iterator, NoReturn, Optional, TypeVar
@@ -37,10 +39,12 @@ from shared_schema.rules import (
 )
 from shared_schema.version import __version__
 
-from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library
+from .core.envelope import LIBRARY_OMEGA, LIBRARY_PATH, build_library, user_library_path
+from .core.jit import PATHS, kernel_status
 from .core.model import check_positive
+from .core.precompile import build as build_kernels
 from .core.records import GroundMotion
-from .demo import run_demo
+from .demo import copy_examples, run_demo
 from .ida import IM_MEASURES, PEAKS_FILE, parse_levels, run_ida
 from .report.html import build_report, input_source, write_report
 from .workflows.assess import check_doc, check_multiples, read_site
@@ -307,9 +311,26 @@ def _g4(value: Optional[float]) -> str:
     return "-" if value is None else f"{value:.4g}"
 
 
+def _foreign_packages() -> list[str]:
+    """Name rockmech's top-level packages loaded from outside its install (a name clash)."""
+    homes = {
+        name: Path(str(importlib.import_module(name).__file__)).resolve().parent.parent
+        for name in ("rockmech", "shared_schema", "solver_service", "rhino_plugin")
+    }
+    return [
+        f"warning: {name} is loaded from {home}, not from rockmech's install "
+        f"({homes['rockmech']}): another package or file has that name (docs/install.md)"
+        for name, home in homes.items()
+        if home != homes["rockmech"]
+    ]
+
+
 def _print_version(value: bool) -> None:
     if value:
         typer.echo(f"rockmech {__version__}")
+        typer.echo(kernel_status().describe())
+        for line in _foreign_packages():
+            _note(line)
         raise typer.Exit()
 
 
@@ -320,7 +341,7 @@ def _main(
         "--version",
         callback=_print_version,
         is_eager=True,
-        help="Print the version and exit.",
+        help="Print the version, whether the compiled kernels are active, and exit.",
     ),
 ) -> None:
     """Rocking collapse mechanisms of masonry: exact rocking solver and tools (SI units)."""
@@ -976,6 +997,9 @@ def envelope(
             title=f"Overturning envelopes: {constants.name}",
             record_pulse=pulse,
         )
+    library_file = doc["method"].get("library_file", "shipped with rockmech")
+    if library_file != "shipped with rockmech":
+        _note(f"note: envelopes interpolated in the library {library_file}")
     if as_json:
         _print_json(doc)
         return
@@ -1032,7 +1056,12 @@ app.add_typer(library_app, name="library")
 @_user_errors
 def library_build(
     out: Optional[Path] = typer.Option(
-        None, "--out", help="Output .npz (default: the package's shipped library)."
+        None,
+        "--out",
+        help=(
+            "Output .npz (default: the user's cache folder, which envelopes read before the "
+            "shipped library; the installed package is never written)."
+        ),
     ),
     n_omega: int = typer.Option(400, "--n-omega", help="Omega points, log-spaced in [0.05, 50]."),
     eta_step: float = typer.Option(0.02, "--eta-step", help="Step of eta in [0, 1]."),
@@ -1042,8 +1071,10 @@ def library_build(
     from rich.console import Console
     from rich.progress import Progress
 
-    if out is not None:
-        check_file_target(out)
+    target = out if out is not None else user_library_path()
+    if target is None:
+        _fail("out: no user cache folder here (platformdirs is missing); give --out FILE")
+    check_file_target(target)
     if n_omega < 2:
         _fail(f"n_omega: must be >= 2, got {n_omega}")
     if not 0.0 < eta_step <= 1.0:
@@ -1060,11 +1091,16 @@ def library_build(
             bar.update(task, completed=done, total=total)
 
         lib = build_library(omega=omega, eta=eta, progress=tick)
-    path = lib.save(out or LIBRARY_PATH)
+    path = lib.save(target)
     typer.echo(
         f"wrote {path}: {lib.eta.size} two-sided curves + one-sided, {lib.omega.size} Omega, "
         f"{lib.metadata['build_seconds']} s"
     )
+    if out is None:
+        typer.echo(
+            "  envelopes now read it instead of the shipped library (their method names it); "
+            f"delete it to go back to {LIBRARY_PATH.name}"
+        )
 
 
 @app.command()
@@ -1093,6 +1129,22 @@ def demo(
     ]
     for line in _table(["mechanism", "scale", "peak |phi|/phi_ov", "verdict"], rows):
         typer.echo(line)
+
+
+@app.command()
+@_user_errors
+def examples(
+    out: Path = typer.Argument(
+        Path("examples"), help="Folder to copy the examples into (default: ./examples)."
+    ),
+) -> None:
+    """Copy the bundled examples (scenes, specs, constants, records, sites) into a folder.
+
+    The README's commands use examples/... paths: run them from the folder holding OUT.
+    Only files an earlier copy wrote are replaced; your own files there are never touched.
+    """
+    written = copy_examples(out, on_note=_out_note)
+    typer.echo(f"wrote {len(written)} example files to {out}")
 
 
 @app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
@@ -1195,10 +1247,32 @@ def serve(
     settings = settings_with(
         host=host, port=port, compute_workers=workers, compute_timeout_s=timeout
     )
+    _kernels_ahead()
     host_part = f"[{settings.host}]" if ":" in settings.host else settings.host
     typer.echo(f"rockmech {__version__} serving on http://{host_part}:{settings.port}")
     typer.echo(f"  docs: http://{host_part}:{settings.port}/api/v1/docs (Ctrl+C to stop)")
     run(settings)
+
+
+def _kernels_ahead() -> None:
+    """Compile the kernels once, in a child process, before the workers start (#28).
+
+    Each worker then loads them from numba's cache in under a second, instead of every
+    worker compiling them at once at start-up. The child prints a progress line only when it
+    compiles.
+    """
+    code = "import sys; from solver_service.core.precompile import main; sys.exit(main())"
+    subprocess.run([sys.executable, "-c", code], check=False)
+
+
+@app.command()
+@_user_errors
+def kernels() -> None:
+    """Compile the solver's kernels now (numba), so that no later run waits for it."""
+    status = kernel_status()
+    if status.active and len(status.built) < len(PATHS):
+        status = build_kernels()
+    typer.echo(status.describe())
 
 
 def _verdict(check: dict[str, Any]) -> str:

@@ -36,8 +36,16 @@ from .core.records import GroundMotion
 from .workflows.documents import frequency_grid
 from .workflows.inputs import constants_from_files
 from .workflows.outputs import write_envelope, write_history
+from .workflows.rundir import run_folder
 
-__all__ = ["DEMO_WALLS", "EXAMPLES_DIR", "examples_dir", "rectangular_block", "run_demo"]
+__all__ = [
+    "DEMO_WALLS",
+    "EXAMPLES_DIR",
+    "copy_examples",
+    "examples_dir",
+    "rectangular_block",
+    "run_demo",
+]
 
 
 def examples_dir() -> Path:
@@ -63,6 +71,49 @@ def examples_dir() -> Path:
         "reinstall rockmech",
         "examples",
     )
+
+
+#: Files of the examples folder that are not examples (a clone's scene-building script).
+_NOT_EXAMPLES = ("*.py", "*.pyc")
+
+
+def copy_examples(
+    dest: Path = Path("examples"), on_note: Optional[Callable[[str], None]] = None
+) -> list[Path]:
+    """Copy the bundled examples into ``dest``, so that the README's commands run from a wheel.
+
+    ``dest`` gets the layout of the repository's ``examples/`` (``constants/``, ``records/``,
+    ``scenes/``, ``sites/``, ``specs/``). The copy is a rockmech run like any other
+    (``workflows.rundir.run_folder``): it replaces only the files an earlier copy wrote and
+    that are unchanged since; a file of the user's in the way stops it with one line naming
+    the file, and nothing else in ``dest`` is touched.
+
+    Parameters
+    ----------
+    dest : Path
+        The folder to copy into (created if missing).
+    on_note : callable, optional
+        Called with each note of the output folder (``run_folder``).
+
+    Returns
+    -------
+    list of Path
+        The files written, under ``dest``.
+    """
+    source = examples_dir()
+    files = sorted(
+        p
+        for p in source.rglob("*")
+        if p.is_file()
+        and "__pycache__" not in p.parts
+        and not any(p.match(pattern) for pattern in _NOT_EXAMPLES)
+    )
+    with run_folder(dest, on_note=on_note) as stage:
+        for path in files:
+            target = stage / path.relative_to(source)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(path.read_bytes())
+    return [Path(dest) / path.relative_to(source) for path in files]
 
 
 #: The bundled examples folder (see ``examples_dir``).

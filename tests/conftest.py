@@ -24,3 +24,18 @@ def shared_records() -> Path:
     if not SHARED_RECORDS.is_dir():
         pytest.skip(f"shared records folder not found at {SHARED_RECORDS} (not part of a clone)")
     return SHARED_RECORDS
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Compile the solver's kernels once, before the test processes start (#28).
+
+    Each path of the solver compiles on its first use and says so on stderr; built here
+    first, every test process loads them from numba's cache and no test's output depends on
+    which test ran first. Only the controlling process builds (xdist workers have
+    ``workerinput``).
+    """
+    if hasattr(config, "workerinput"):
+        return
+    from solver_service.core.precompile import build
+
+    build()

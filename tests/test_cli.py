@@ -269,6 +269,43 @@ def test_library_build_writes_a_loadable_library(tmp_path: Path) -> None:
     np.testing.assert_allclose(lib.a_min_two_sided[1], boundary_curve(lib.omega, 0.5).a_min)
 
 
+def test_library_build_without_out_writes_the_user_cache_which_envelopes_read_first(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import hashlib
+
+    from solver_service.core.envelope import LIBRARY_PATH, OverturningLibrary, user_library_path
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    shipped = hashlib.sha256(LIBRARY_PATH.read_bytes()).hexdigest()
+    user = user_library_path()
+    assert user is not None and user.parent == tmp_path / "cache" / "rockmech"
+    assert OverturningLibrary.load().path == LIBRARY_PATH
+    church = EXAMPLES / "constants" / "church.json"
+    before = runner.invoke(app, ["envelope", str(church), "--out", str(tmp_path / "a"), "--n", "9"])
+    assert before.exit_code == 0 and before.stderr == "", before.output
+    res = runner.invoke(app, ["library", "build", "--n-omega", "5", "--eta-step", "0.5"])
+    assert res.exit_code == 0, res.output
+    assert res.stdout.startswith(f"wrote {user}: 3 two-sided curves")
+    # The installed package is never written.
+    assert hashlib.sha256(LIBRARY_PATH.read_bytes()).hexdigest() == shipped
+    lib = OverturningLibrary.load()
+    assert lib.path == user and lib.omega.size == 5 and list(lib.eta) == [0.0, 0.5, 1.0]
+    after = runner.invoke(app, ["envelope", str(church), "--out", str(tmp_path / "b"), "--n", "9"])
+    assert after.exit_code == 0, after.output
+    assert (
+        after.stderr
+        == f"note: envelopes interpolated in the library {user} (not the shipped library)\n"
+    )
+    doc = json.loads((tmp_path / "b" / "envelope.json").read_text())
+    assert doc["method"]["library_file"] == f"{user} (not the shipped library)"
+    assert doc["method"]["generated"] == lib.metadata["generated"]
+    user.unlink()
+    doc = json.loads((tmp_path / "a" / "envelope.json").read_text())
+    assert doc["method"]["library_file"] == "shipped with rockmech"
+    assert OverturningLibrary.load().path == LIBRARY_PATH
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
@@ -682,7 +719,9 @@ def test_version_option() -> None:
     from rockmech import __version__
 
     res = runner.invoke(app, ["--version"])
-    assert res.exit_code == 0 and res.stdout == f"rockmech {__version__}\n"
+    first, second = res.stdout.splitlines()
+    assert res.exit_code == 0 and first == f"rockmech {__version__}"
+    assert second.startswith("compiled kernels: active (numba ")
 
 
 def test_history_table_is_aligned_within_100_columns_at_4_significant_figures(
@@ -929,3 +968,46 @@ def test_progress_goes_to_stderr_on_a_terminal_and_nowhere_otherwise(
     assert shown.exit_code == 0, shown.output
     assert json.loads(shown.stdout) == json.loads(plain.stdout)  # stdout: the JSON only
     assert "envelopes: 3 mechanisms x 5 frequencies" in shown.stderr
+
+
+def test_examples_copies_the_bundled_examples_and_never_touches_the_users_files(
+    tmp_path: Path,
+) -> None:
+    folder = tmp_path / "work"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine")
+    dest = folder / "examples"
+    res = runner.invoke(app, ["examples", str(dest)])
+    assert res.exit_code == 0, res.output
+    shipped = sorted(
+        p.relative_to(EXAMPLES).as_posix()
+        for p in EXAMPLES.rglob("*")
+        if p.is_file() and p.suffix not in (".py", ".pyc") and "__pycache__" not in p.parts
+    )
+    copied = sorted(
+        p.relative_to(dest).as_posix()
+        for p in dest.rglob("*")
+        if p.is_file() and ".rockmech" not in p.relative_to(dest).parts
+    )
+    assert copied == shipped and len(copied) >= 25
+    assert res.stdout == f"wrote {len(shipped)} example files to {dest}\n"
+    for rel in shipped:
+        assert (dest / rel).read_bytes() == (EXAMPLES / rel).read_bytes(), rel
+    # The README's commands run on the copy.
+    out = runner.invoke(
+        app, ["envelope", str(dest / "constants" / "church.json"), "--out", str(tmp_path / "o")]
+    )
+    assert out.exit_code == 0, out.output
+    # Again: only its own files are replaced; a file of the user's beside them survives.
+    (dest / "my_site.json").write_text("{}")
+    assert runner.invoke(app, ["examples", str(dest)]).exit_code == 0
+    assert (dest / "my_site.json").read_text() == "{}"
+    assert (folder / "notes.txt").read_text() == "mine"
+    # An example the user changed is kept, and the copy stops with one line naming it.
+    church = dest / "constants" / "church.json"
+    church.write_text(church.read_text() + " ")
+    changed = church.read_bytes()
+    res = runner.invoke(app, ["examples", str(dest)])
+    assert res.exit_code == 2
+    assert res.stderr.startswith(f"error: out: {church} was changed after rockmech wrote it")
+    assert church.read_bytes() == changed

@@ -9,6 +9,7 @@ from __future__ import annotations
 import email
 import json
 import math
+import os
 import shutil
 import subprocess
 import sys
@@ -47,6 +48,30 @@ PUBLIC = [
     "load_constants",
     "save_constants",
     "constants_from_files",
+    "read_constants",
+    "constants_from_table",
+    "constants_from_scene",
+    "load_models",
+    "read_record",
+    "read_site",
+    "SiteFile",
+    "pulse",
+    "history",
+    "envelope",
+    "ida",
+    "check",
+    "assess",
+    "RockingResult",
+    "BatchResult",
+    "HistoryResult",
+    "HistoryRun",
+    "EnvelopeResult",
+    "CriticalBand",
+    "IDAResult",
+    "Fragility",
+    "CheckResult",
+    "MechanismCheck",
+    "AssessmentResult",
     "G",
     "RockingModel",
     "Pulse",
@@ -64,6 +89,9 @@ PUBLIC = [
     "build_report",
     "write_report",
     "examples_dir",
+    "copy_examples",
+    "kernel_status",
+    "KernelStatus",
 ]
 
 
@@ -119,8 +147,9 @@ def test_version_is_written_once_and_the_rhino_copies_agree() -> None:
     assert rhproj["identity"]["version"] == version
     manifest = (ROOT / "rhino_plugin" / "manifest.yml").read_text()
     assert f"\nversion: {version}\n" in manifest
+    assert f"\nversion: {version}\n" in (ROOT / "CITATION.cff").read_text()
     res = runner.invoke(app, ["--version"])
-    assert res.exit_code == 0 and res.stdout == f"rockmech {version}\n"
+    assert res.exit_code == 0 and res.stdout.splitlines()[0] == f"rockmech {version}"
 
 
 def test_licence_metadata_is_pep639() -> None:
@@ -131,10 +160,53 @@ def test_licence_metadata_is_pep639() -> None:
     assert project["urls"]
 
 
+def test_citation_names_the_methods_paper() -> None:
+    text = (ROOT / "CITATION.cff").read_text()
+    assert text.startswith("cff-version: 1.2.0\n")
+    preferred = text.split("preferred-citation:", 1)[1].split("\nreferences:", 1)[0]
+    for needed in (
+        "family-names: Mehrotra",
+        "family-names: DeJong",
+        "year: 2018",
+        "journal: Engineering Structures",
+        "type: article",
+    ):
+        assert needed in preferred, needed
+
+
+def test_all_extra_is_every_user_extra_and_dev_builds_on_it() -> None:
+    extras = PYPROJECT["project"]["optional-dependencies"]
+    (all_line,) = extras["all"]
+    users = set(extras) - {"all", "dev"}
+    assert all_line == f"rockmech[{','.join(sorted(users, key=all_line.index))}]"
+    assert set(all_line[len("rockmech[") : -1].split(",")) == users
+    assert "rockmech[all]" in extras["dev"]
+
+
+def test_python_dash_m_rockmech_is_the_command() -> None:
+    res = subprocess.run(
+        [sys.executable, "-m", "rockmech", "--version"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=120,
+    )
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.splitlines()[0] == f"rockmech {rockmech.__version__}"
+    res = subprocess.run(
+        [sys.executable, "-m", "rockmech", "pulse", "--p-eq", "2"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=120,
+    )
+    assert res.returncode == 2 and res.stderr.startswith("error: --lam: missing option")
+
+
 def test_the_cli_dependencies_are_in_the_base_install() -> None:
     base = {_dist(r) for r in PYPROJECT["project"]["dependencies"]}
-    assert {"numpy", "pydantic", "scipy", "matplotlib", "typer", "rich"} <= base
-    for extra in ("geometry", "service", "dask"):
+    assert {"numpy", "pydantic", "scipy", "matplotlib", "typer", "rich", "numba"} <= base
+    for extra in ("geometry", "service", "dask", "report", "tables"):
         assert not base & {_dist(r) for r in PYPROJECT["project"]["optional-dependencies"][extra]}
 
 
@@ -392,3 +464,37 @@ def test_rockmech_docstring_example_runs() -> None:
 
     result = doctest.testmod(rockmech, verbose=False)
     assert result.attempted >= 3 and result.failed == 0
+
+
+def test_version_warns_when_a_top_level_package_comes_from_elsewhere(tmp_path: Path) -> None:
+    # Another distribution (or a folder on the path) named rhino_plugin, first on sys.path:
+    # --version names it and where it comes from (docs/install.md, "Package names").
+    other = tmp_path / "rhino_plugin"
+    other.mkdir()
+    (other / "__init__.py").write_text(
+        "from pkgutil import extend_path\n__path__ = extend_path(__path__, __name__)\n"
+    )
+    res = subprocess.run(
+        [sys.executable, "-m", "rockmech", "--version"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(tmp_path)},
+        timeout=120,
+    )
+    assert res.returncode == 0, res.stderr
+    assert res.stderr == (
+        f"warning: rhino_plugin is loaded from {tmp_path.resolve()}, not from rockmech's "
+        f"install ({ROOT}): another package or file has that name (docs/install.md)\n"
+    )
+    # From another folder, without it on the path: no warning.
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    clean = subprocess.run(
+        [sys.executable, "-m", "rockmech", "--version"],
+        capture_output=True,
+        text=True,
+        cwd=elsewhere,
+        timeout=120,
+    )
+    assert clean.returncode == 0 and clean.stderr == ""

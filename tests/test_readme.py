@@ -39,8 +39,12 @@ NOT_RUN_OPTIONS = {
 #: Commands that are not run, with the reason.
 NOT_RUN_COMMANDS = {
     "serve": "serves until stopped (the service tests start it on a free port)",
-    "library build": "rewrites the library shipped in the package and takes about 4 s "
-    "(tests/solver_core/test_envelope.py rebuilds a sample of it)",
+    "examples": "copies into ./examples, which this test links to the repository's own "
+    "(tests/test_cli.py runs it into a fresh folder; .ci/install_check from a wheel)",
+    "kernels": "compiles every solver path, which the test session does before it starts "
+    "(tests/conftest.py; tests/solver_core/test_jit.py runs the command)",
+    "library build": "writes a library into the user's cache folder and takes about 4 s "
+    "(tests/test_cli.py builds a small one there, in a temporary cache folder)",
 }
 #: Options whose value is a file the command writes (not an input that must exist).
 OUTPUT_OPTIONS = {"-o", "--out"}

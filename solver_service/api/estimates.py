@@ -57,6 +57,7 @@ from ..workflows.limits import (  # the numbers and estimates shared with the co
 from .jobspec import (
     AssessHtmlJob,
     AssessJob,
+    AssessPdfJob,
     EnvelopeJob,
     HistoryJob,
     Job,
@@ -288,8 +289,8 @@ def check_job(job: Job, limits: dict[str, Any]) -> None:
         if job.record is not None:
             n = len(job.record.accel)
             check_limit(n, limits["max_samples"], "samples", "record", "max_samples")
-    elif isinstance(job, (AssessJob, AssessHtmlJob)):
-        _assess(job, job.constants, limits, isinstance(job, AssessHtmlJob))
+    elif isinstance(job, (AssessJob, AssessHtmlJob, AssessPdfJob)):
+        _assess(job, job.constants, limits, isinstance(job, (AssessHtmlJob, AssessPdfJob)))
     elif isinstance(job, ScaleFactorJob):
         record = getattr(job.request, "record", None)
         if record is not None:

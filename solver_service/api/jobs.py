@@ -51,7 +51,7 @@ from ..core.excitation import Pulse, SampledAccel
 from ..core.model import G, RockingModel, check_positive
 from ..core.records import GroundMotion
 from ..core.spectra import STEPS_PER_PERIOD, response_spectrum
-from ..report.assess import assess_report
+from ..report.assess import assess_report, chromium, print_pdf
 from ..report.html import SPECTRUM_PERIODS, build_report, input_source
 from ..workflows.assess import BAND_POINTS, assessment_doc, check_doc, matching_band
 from ..workflows.documents import (
@@ -76,6 +76,7 @@ from .estimates import (
 from .jobspec import (
     AssessHtmlJob,
     AssessJob,
+    AssessPdfJob,
     CheckJob,
     EnvelopeJob,
     HistoryJob,
@@ -468,7 +469,9 @@ def _check(job: CheckJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     return dumps(stamp(check_doc(cf, job.site), "check"))
 
 
-def _assess_inputs(job: AssessJob | AssessHtmlJob, limits: dict[str, Any]) -> tuple[Any, list[Any]]:
+def _assess_inputs(
+    job: AssessJob | AssessHtmlJob | AssessPdfJob, limits: dict[str, Any]
+) -> tuple[Any, list[Any]]:
     """Validate the constants and records and bound the spectrum work (as ``rockmech assess``).
 
     The matching band of each mechanism comes from its nonlinear check (``Ts``), so the
@@ -532,7 +535,28 @@ def _assess(job: AssessJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes
     return dumps(stamp(doc, "assess"))
 
 
-def _assess_html(job: AssessHtmlJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def _assess_pdf(job: AssessPdfJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Print the assessment page to PDF with a headless Chromium, if the deployment has one."""
+    if chromium() is None:
+        raise ServiceUnavailable(
+            "printing the assessment to PDF needs a headless Chromium, which this deployment "
+            "lacks (Debian: apt-get install chromium; the Docker image: build it with "
+            "--build-arg PDF=chromium); format html gives the page to print locally"
+        )
+    page = _assess_html(job, blobs, limits)
+    with tempfile.TemporaryDirectory(prefix="rockmech-pdf-") as tmp:
+        html = Path(tmp) / "assessment.html"
+        html.write_bytes(page)
+        try:
+            pdf = print_pdf(html, Path(tmp) / "assessment.pdf")
+        except InputError as exc:  # Chromium present but failing: the deployment's fault
+            raise ServiceUnavailable(str(exc)) from None
+        return pdf.read_bytes()
+
+
+def _assess_html(
+    job: AssessHtmlJob | AssessPdfJob, blobs: list[bytes], limits: dict[str, Any]
+) -> bytes:
     if importlib.util.find_spec("jinja2") is None:
         raise ServiceUnavailable(
             "the assessment page needs the report extra (pip install 'rockmech[report]'), "
@@ -576,6 +600,7 @@ JOBS: dict[str, tuple[str, Callable[[Any, list[bytes], dict[str, Any]], bytes]]]
     "check": (_JSON, _check),
     "assess": (_JSON, _assess),
     "assess_html": ("text/html; charset=utf-8", _assess_html),
+    "assess_pdf": ("application/pdf", _assess_pdf),
     "warmup": (_JSON, _warmup),
 }
 

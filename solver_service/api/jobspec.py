@@ -32,6 +32,7 @@ __all__ = [
     "JOB",
     "AssessHtmlJob",
     "AssessJob",
+    "AssessPdfJob",
     "CheckJob",
     "EnvelopeJob",
     "HistoryJob",
@@ -60,6 +61,7 @@ JobKind = Literal[
     "check",
     "assess",
     "assess_html",
+    "assess_pdf",
     "warmup",
 ]
 
@@ -163,6 +165,12 @@ class AssessHtmlJob(AssessRequest):
     kind: Literal["assess_html"] = "assess_html"
 
 
+class AssessPdfJob(AssessRequest):
+    """``rockmech assess --pdf``: the assessment's page printed to PDF."""
+
+    kind: Literal["assess_pdf"] = "assess_pdf"
+
+
 class WarmupJob(BaseModel):
     """Load every kernel once, before a compute process takes work."""
 
@@ -184,6 +192,7 @@ Job = Annotated[
         CheckJob,
         AssessJob,
         AssessHtmlJob,
+        AssessPdfJob,
         WarmupJob,
     ],
     Field(discriminator="kind"),

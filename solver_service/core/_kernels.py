@@ -60,6 +60,8 @@ import numpy as np
 from shared_schema.rules import G
 
 _NO_JIT = globals().get("_NO_JIT", False)
+#: Why the kernels run as plain Python (None when numba compiles them).
+JIT_REASON = None
 #: numba options of the helpers that allocate nothing (not in numba's type stubs).
 _LEAF_OPTIONS: dict[str, Any] = {"_nrt": False, "error_model": "numpy"}
 
@@ -86,7 +88,17 @@ try:  # numba is optional: without it the same code runs as plain Python.
 
     _prange: Any = _numba.prange
     JIT = True
-except ImportError:  # pragma: no cover - exercised through the python backend
+except ImportError as _exc:  # pragma: no cover - exercised through the python backend
+    # numba absent (no wheel for this platform), or present but unusable (its message).
+    JIT_REASON = (
+        "compilation switched off"
+        if _NO_JIT
+        else (
+            "numba is not installed"
+            if getattr(_exc, "name", None) == "numba"
+            else f"numba cannot be used: {_exc}"
+        )
+    )
 
     def _jit(fn):
         return fn

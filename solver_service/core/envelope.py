@@ -53,11 +53,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError
+from shared_schema.version import __version__
 
 from . import _boundary_kernels as _bk
 from .amplification import pulse_response_spectrum
 from .exact import kernels
 from .excitation import PULSE_SHAPES
+from .jit import first_use
 from .model import RockingModel, RockingSide, check_eta
 
 __all__ = [
@@ -75,8 +77,10 @@ __all__ = [
     "boundary_curve",
     "build_library",
     "critical_bands",
+    "default_library_path",
     "library_curve",
     "mechanism_envelope",
+    "user_library_path",
 ]
 
 #: Largest pulse amplitude searched, as ``a_p / (g lam)``.
@@ -101,8 +105,11 @@ _NO_KNOWN = np.zeros(0, dtype=np.bool_)
 #: Library grid: Omega points (log-spaced in [0.05, 50]) and eta step.
 LIBRARY_OMEGA = (0.05, 50.0, 400)
 LIBRARY_ETA_STEP = 0.02
-#: The library shipped with the package.
+#: The library shipped with the package (never rewritten by rockmech: ``user_library_path``).
 LIBRARY_PATH = Path(__file__).resolve().parents[1] / "data" / "overturning_library.npz"
+#: File name of a library built by ``rockmech library build`` in the user's cache folder,
+#: per rockmech version (a library built by another version is not read).
+USER_LIBRARY_NAME = "overturning_library-{version}.npz"
 #: Format version of the library file.
 LIBRARY_VERSION = "1"
 #: Largest change of ``log A_min`` between neighbouring library points that counts as a smooth
@@ -277,6 +284,7 @@ def boundary_curve(
         raise InputError(f"must be >= 0, got {n_scan_near!r}", "n_scan_near")
     scan = _scan(a_max, int(n_scan), int(n_scan_near))
     kern = kernels(backend)
+    compiled = first_use("boundary", backend)
     args = (eta, one_sided, float(direction), PULSE_SHAPES[shape], scan, rtol)
     eta_n = math.nan if eta_neg is None else eta_neg
     if om.size <= SERIAL_OMEGA:
@@ -291,6 +299,8 @@ def boundary_curve(
             )  # fmt: skip
     else:
         edges, n_edges, first = kern.boundary_grid(om, *args, MAX_EDGES, V_REST_BOUNDARY, eta_n)
+    if compiled is not None:
+        compiled()
     return _curve(
         om,
         (eta, one_sided, direction),
@@ -353,6 +363,8 @@ class OverturningLibrary:
     spectrum_ratio: NDArray[np.float64]
     spectrum: NDArray[np.float64]
     metadata: dict[str, Any] = field(default_factory=dict)
+    #: The file it was read from (None: built in this process).
+    path: Optional[Path] = None
 
     def scale_factor(
         self, f_p: ArrayLike, *, f_n: float, h: float, h_e: float
@@ -428,8 +440,13 @@ class OverturningLibrary:
 
     @classmethod
     def load(cls, path: Union[str, Path, None] = None) -> OverturningLibrary:
-        """Read a library file (default: the one shipped with the package)."""
-        p = Path(path) if path is not None else LIBRARY_PATH
+        """Read a library file.
+
+        The default is the user's own build (``rockmech library build``, at
+        ``user_library_path()``) when there is one for this version, else the library
+        shipped with the package. ``path`` records which file was read.
+        """
+        p = Path(path) if path is not None else default_library_path()
         if not p.is_file():
             raise InputError(
                 f"overturning library not found at {p}; build it with `rockmech library build`",
@@ -447,7 +464,30 @@ class OverturningLibrary:
                 spectrum_ratio=data["spectrum_ratio"],
                 spectrum=data["spectrum"],
                 metadata=json.loads(str(data["metadata"])),
+                path=p,
             )
+
+
+def user_library_path() -> Optional[Path]:
+    """Return where ``rockmech library build`` writes a library by default, and reads it first.
+
+    The user's cache folder (platformdirs: ``~/.cache/rockmech`` on Linux,
+    ``~/Library/Caches/rockmech`` on macOS, ``%LOCALAPPDATA%/rockmech/Cache`` on Windows),
+    never the installed package. None where platformdirs is missing (Rhino's Python): there
+    only the shipped library is read.
+    """
+    try:
+        import platformdirs
+    except ImportError:
+        return None
+    folder = Path(platformdirs.user_cache_dir("rockmech", appauthor=False))
+    return folder / USER_LIBRARY_NAME.format(version=__version__)
+
+
+def default_library_path() -> Path:
+    """Return the library ``OverturningLibrary.load()`` reads: the user's build, or the shipped."""
+    user = user_library_path()
+    return user if user is not None and user.is_file() else LIBRARY_PATH
 
 
 def _blend_flagged(
@@ -552,6 +592,7 @@ def _library_curves(
     phase = PULSE_SHAPES[shape]
     probe_dir = -1
     t0 = time.perf_counter()
+    compiled = first_use("library")
     *probe, known = _bk.probe_grid(
         om, float(probe_dir), phase, scan, RTOL, MAX_EDGES, V_REST_BOUNDARY
     )
@@ -593,6 +634,8 @@ def _library_curves(
             out[k] = _curve(om, specs[k], parts, shape, scan_ratio=scan_ratio, runtime_s=each_s)
         if progress is not None:
             progress(len(out), len(specs))
+    if compiled is not None:
+        compiled()
     return [out[k] for k in range(len(specs))]
 
 
@@ -654,6 +697,7 @@ def build_library(
     flat, offsets = _ragged([*curves, pos, neg])
     meta = {
         "library_version": LIBRARY_VERSION,
+        "rockmech": __version__,
         "generated": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         "shape": shape,
         "a_max": A_MAX,

@@ -53,6 +53,7 @@ from shared_schema.rules import G
 
 from . import _kernels as _k
 from .excitation import Pulse, SampledAccel
+from .jit import first_use
 from .linearisation import linearisation_warnings
 from .model import RockingModel, check_positive
 from .result import CRITERIA, STATUS_MESSAGES, RockingResult
@@ -435,9 +436,12 @@ def simulate(
     n_log = min(int(max_impacts), IMPACT_LOG_CAP) + 2 if impact_log else 0
     log = np.empty((4, n_log)) if n_log else _NO_LOG
     # One conversion of the output vector to Python floats (cheaper than one per field).
+    compiled = first_use("simulate", backend)
     out = kern.simulate_cells_logged(
         cells.data, params, scale, float(x0), V_REST_REL, int(max_impacts), trace, log
     ).tolist()
+    if compiled is not None:
+        compiled()
     runtime = time.perf_counter() - t_start
     n_tr = int(out[_k.OUT_N_TRACE])
     notes = []
@@ -661,7 +665,10 @@ def simulate_batch(
     )
     kern = kernels(backend)
     grid = kern.simulate_grid_serial if getattr(_THREAD, "serial", False) else kern.simulate_grid
+    compiled = first_use("batch", backend)
     out = grid(cells.data, params, sc, V_REST_REL, int(max_impacts))
+    if compiled is not None:
+        compiled()
     t_exc = out[..., _k.OUT_T_EXCEED]
     return BatchResult(
         names=[m.name for m in models],

@@ -24,9 +24,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import TYPE_CHECKING, Any, Optional
 
-from shared_schema.errors import InputError
+from shared_schema.errors import InputError, per_side_error
 from shared_schema.rules import (
     G,
     check_eta,
@@ -145,6 +145,21 @@ class RockingModel:
         """
         side = RockingSide(p_eq, lam, float("nan") if phi_ov is None else phi_ov)
         return cls(positive=side, negative=side, eta=eta, one_sided=one_sided, name=name)
+
+    if not TYPE_CHECKING:  # for type checkers the fields are the attributes, as they are
+
+        def __getattr__(self, name: str) -> Any:
+            """Point a side's constant read on the model (``model.p_eq``) to its side."""
+            if name in RockingSide.__dataclass_fields__:
+                negative = None if self.negative is self.positive else getattr(self.neg, name)
+                raise per_side_error(
+                    f"RockingModel {self.name!r}",
+                    name,
+                    getattr(self.positive, name),
+                    negative,
+                    self.one_sided,
+                )
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     @property
     def neg(self) -> RockingSide:

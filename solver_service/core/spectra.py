@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from shared_schema.errors import InputError
 
 from .excitation import check_finite_samples
+from .jit import first_use
 from .model import G
 
 __all__ = ["BACKENDS", "Spectrum", "response_spectrum"]
@@ -328,7 +329,10 @@ def _psa(
     n_sub = np.maximum(1, np.ceil(dt * omega * STEPS_PER_PERIOD / (2.0 * np.pi))).astype(np.int64)
     eta = omega * dt / n_sub
     out = np.empty_like(omega)
+    compiled = first_use("spectrum", "numba")
     kernel(acc, _recurrence(eta, zeta), n_sub, eta, zeta, out)
+    if compiled is not None:
+        compiled()
     return out
 
 

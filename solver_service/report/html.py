@@ -27,7 +27,7 @@ import platform
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Optional, Union
 
 import numpy as np
 
@@ -499,8 +499,9 @@ def build_report(
     )
 
 
-def write_report(path: Path, text: str) -> Path:
+def write_report(path: Union[str, Path], text: str) -> Path:
     """Write the report atomically and return its path."""
+    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     write_atomic(path, text)
     return path

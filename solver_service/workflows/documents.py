@@ -25,6 +25,7 @@ from ..core.envelope import (
     LIBRARY_BELOW,
     LIBRARY_EDGE_RATIO,
     LIBRARY_MARGIN,
+    LIBRARY_PATH,
     Envelope,
     OverturningLibrary,
     boundary_curve,
@@ -283,6 +284,15 @@ def record_analysis(
     return record_doc(motion, spectrum, found), spectrum, found
 
 
+def library_label(library: OverturningLibrary) -> str:
+    """Say which library file a result used: the shipped one, or the user's own build."""
+    if library.path is None:
+        return "built in this process"
+    if library.path.resolve() == LIBRARY_PATH.resolve():
+        return "shipped with rockmech"
+    return f"{library.path} (not the shipped library)"
+
+
 def envelope_doc(
     cf: ConstantsFile,
     f_p: np.ndarray[Any, Any],
@@ -388,6 +398,7 @@ def _envelope_method(
     return {
         "source": "library",
         "label": "fast mode (interpolated library)",
+        "library_file": library_label(library),
         "interpolation": "log A_min linear in log Omega and in eta, times "
         f"{LIBRARY_MARGIN:g}; exact where the interpolation crosses a jump or leaves the grid",
         "exact_points": int(sum(e.n_exact for e in envelopes)),

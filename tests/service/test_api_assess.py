@@ -21,8 +21,10 @@ from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
 from shared_schema.site import parse_site
 from solver_service.api.estimates import check_job
-from solver_service.api.jobspec import AssessHtmlJob, AssessJob
+from solver_service.api.jobs import run_job
+from solver_service.api.jobspec import AssessHtmlJob, AssessJob, AssessPdfJob
 from solver_service.core.records import GroundMotion
+from solver_service.report.assess import chromium
 from solver_service.workflows.assess import NO_VIRTUAL_WORK, check_doc
 from solver_service.workflows.units import stamp
 
@@ -93,6 +95,31 @@ def test_assess_html_has_the_verdict_table_and_provenance(client: httpx.Client) 
     assert "http://" not in page and "https://" not in page  # self-contained
 
 
+def test_assess_pdf_is_the_page_printed_by_headless_chromium(client: httpx.Client) -> None:
+    if chromium() is None:
+        pytest.skip("no Chromium on this machine (apt-get install chromium)")
+    res = client.post("/api/v1/assess", json=_assess_body(format="pdf", multiples=[1.0]))
+    assert res.status_code == 200, res.text
+    assert res.headers["content-type"] == "application/pdf"
+    assert res.content.startswith(b"%PDF-") and res.content.rstrip().endswith(b"%%EOF")
+    assert len(res.content) > 10_000
+
+
+def test_assess_pdf_without_chromium_is_501_naming_it(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    # A deployment without a browser (PATH holds none): the page is computed nowhere and the
+    # answer says what is missing and what to do.
+    monkeypatch.setenv("PATH", str(tmp_path))
+    job = AssessPdfJob(**_assess_body(format="pdf", multiples=[1.0]))
+    limits = {"max_samples": 500_000, "max_mechanisms": 100, "max_scales": 100}
+    out = run_job(job, [], limits)
+    assert out.status == 501
+    detail = json.loads(out.body)["detail"]
+    assert "needs a headless Chromium, which this deployment lacks" in detail
+    assert "apt-get install chromium" in detail and "format html" in detail
+
+
 def test_bad_site_is_422_naming_the_field_as_rockmech_does(
     client: httpx.Client, tmp_path: Path
 ) -> None:
@@ -159,7 +186,7 @@ def test_constants_without_virtual_work_answer_rows_that_say_why(client: httpx.C
         ({"records": [TINY] * 6}, "records", "at most 5"),
         ({"multiples": [1.0] * 9}, "multiples", "at most 8"),
         ({"multiples": [1.0, 0.0]}, "multiples[1]", "greater than 0"),
-        ({"format": "pdf"}, "format", "'json' or 'html'"),
+        ({"format": "docx"}, "format", "'json', 'html' or 'pdf'"),
     ],
 )
 def test_assess_request_out_of_bounds_is_422(

@@ -2,7 +2,8 @@
 
 ``/check`` answers the document ``rockmech check --json`` prints; ``/assess`` the document
 ``rockmech assess --json`` prints or, with ``format: "html"``, the page ``rockmech assess``
-writes (no PDF: print the page locally).
+writes, or with ``format: "pdf"`` that page printed by a headless Chromium (501 naming it
+where the deployment has none).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from shared_schema.api import AssessRequest, AssessResponse, CheckRequest, Check
 from ..bodies import json_body
 from ..compute import compute
 from ..deps import JSON, PoolDep, accepts
-from ..jobspec import AssessHtmlJob, AssessJob, CheckJob
+from ..jobspec import AssessHtmlJob, AssessJob, AssessPdfJob, CheckJob
 from ..openapi import body_doc, responses
 
 __all__ = ["router"]
@@ -30,7 +31,10 @@ def _json_or_html(model: Any) -> dict[Any, Any]:
     out[200] = {
         "model": model,
         "description": "The assessment document (format json) or its HTML page (format html).",
-        "content": {"text/html": {"schema": {"type": "string"}}},
+        "content": {
+            "text/html": {"schema": {"type": "string"}},
+            "application/pdf": {"schema": {"type": "string", "format": "binary"}},
+        },
     }
     return out
 
@@ -60,7 +64,8 @@ async def assess(
     request: Annotated[AssessRequest, json_body(AssessRequest)], pool: PoolDep
 ) -> Response:
     """Return the document ``rockmech assess --json`` prints, or the page it writes."""
-    job: Union[AssessJob, AssessHtmlJob] = (
-        AssessHtmlJob(**dict(request)) if request.format == "html" else AssessJob(**dict(request))
+    kinds = {"html": AssessHtmlJob, "pdf": AssessPdfJob}
+    job: Union[AssessJob, AssessHtmlJob, AssessPdfJob] = kinds.get(request.format, AssessJob)(
+        **dict(request)
     )
     return await compute(pool, job)

@@ -1,0 +1,361 @@
+"""Typed results of the analyses in ``rockmech.analysis`` (history, envelope, IDA, check, assess).
+
+Each result keeps the numbers a script reads as typed fields (units in brackets) and the
+whole JSON-ready document the command line writes (``doc``), so nothing the command line
+reports is out of reach. SI units, except where a name says otherwise (``a_p_min_g`` in g).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Optional
+
+import numpy as np
+from numpy.typing import NDArray
+
+from shared_schema.errors import InputError
+
+__all__ = [
+    "AssessmentResult",
+    "CheckResult",
+    "CriticalBand",
+    "EnvelopeResult",
+    "Fragility",
+    "HistoryResult",
+    "HistoryRun",
+    "IDAResult",
+    "MechanismCheck",
+]
+
+
+def _opt_float(value: Any) -> Optional[float]:
+    return None if value is None else float(value)
+
+
+def _unknown(kind: str, name: str, known: list[str]) -> InputError:
+    return InputError(f"no {kind} {name!r}; the result has {known}", kind)
+
+
+@dataclass(frozen=True)
+class HistoryRun:
+    """One mechanism at one scale factor of a record (exact integration).
+
+    Attributes
+    ----------
+    mechanism : str
+        The mechanism's id.
+    scale : float
+        The user's scale factor on the record [-].
+    effective_scale : float
+        The scale applied to the mechanism [-]: ``scale`` times its factor up the structure
+        (``sf``), or ``scale`` at ground level.
+    peak_ratio : float
+        Peak ``|phi| / phi_ov`` over the motion, the free-rocking tail included [-].
+    overturned : bool
+        The verdict of the criterion (``ratio``: ``peak_ratio >= 1``; ``exact``: collapse).
+    t_overturn : float or None
+        Time of overturning [s] (None when it survives).
+    n_impacts : int
+        Impacts counted.
+    error_estimate : float
+        The solver's estimate of the error of ``peak_ratio`` [-].
+    """
+
+    mechanism: str
+    scale: float
+    effective_scale: float
+    peak_ratio: float
+    overturned: bool
+    t_overturn: Optional[float]
+    n_impacts: int
+    error_estimate: float
+
+
+@dataclass(frozen=True)
+class HistoryResult:
+    """Time histories of every mechanism at every scale factor (``rockmech.history``).
+
+    Attributes
+    ----------
+    runs : tuple of HistoryRun
+        One per mechanism and scale factor, mechanism by mechanism.
+    criterion : str
+        ``"ratio"`` or ``"exact"``.
+    skipped : tuple of dict
+        Mechanisms left out, each ``{"mechanism", "reason"}`` (e.g. no ``eta``).
+    doc : dict
+        The whole document, as ``rockmech history --json`` prints it.
+    """
+
+    runs: tuple[HistoryRun, ...]
+    criterion: str
+    skipped: tuple[dict[str, Any], ...]
+    doc: dict[str, Any]
+
+    @classmethod
+    def from_doc(cls, doc: dict[str, Any]) -> HistoryResult:
+        """Read the typed fields of a history document."""
+        runs = tuple(
+            HistoryRun(
+                mechanism=str(r["mechanism"]),
+                scale=float(r["scale"]),
+                effective_scale=float(r.get("effective_scale", r["scale"])),
+                peak_ratio=float(r["peak_ratio"]),
+                overturned=bool(r["overturned"]),
+                t_overturn=_opt_float(r.get("t_overturn")),
+                n_impacts=int(r["n_impacts"]),
+                error_estimate=float(r["error_estimate"]),
+            )
+            for r in doc["results"]
+        )
+        return cls(runs, str(doc["criterion"]), tuple(doc.get("skipped", [])), doc)
+
+    def run(self, mechanism: str, scale: float) -> HistoryRun:
+        """Return the run of ``mechanism`` at the user scale factor ``scale`` [-]."""
+        for r in self.runs:
+            if r.mechanism == mechanism and r.scale == scale:
+                return r
+        known = sorted({f"{r.mechanism} x{r.scale:g}" for r in self.runs})
+        raise _unknown("run", f"{mechanism} x{scale:g}", known)
+
+
+@dataclass(frozen=True)
+class CriticalBand:
+    """A band of pulse frequencies over which one mechanism overturns first.
+
+    Attributes
+    ----------
+    mechanism : str
+        The mechanism's id.
+    f_min, f_max : float
+        The band's ends [Hz].
+    """
+
+    mechanism: str
+    f_min: float
+    f_max: float
+
+
+@dataclass(frozen=True)
+class EnvelopeResult:
+    """Overturning envelopes of every mechanism and the critical bands (``rockmech.envelope``).
+
+    Attributes
+    ----------
+    f_p : (n,) float array
+        Pulse frequencies [Hz].
+    a_p_min_g : dict of str to (n,) float array
+        Per mechanism id, the smallest sine-pulse amplitude at the ground that overturns
+        it [g] (amplified mechanisms corrected by Eq. 28; NaN where none does).
+    critical : tuple of CriticalBand
+        The mechanism that overturns first, band by band.
+    doc : dict
+        The whole document, as ``rockmech envelope --json`` prints it.
+    """
+
+    f_p: NDArray[np.float64]
+    a_p_min_g: dict[str, NDArray[np.float64]]
+    critical: tuple[CriticalBand, ...]
+    doc: dict[str, Any]
+
+    @classmethod
+    def from_doc(cls, doc: dict[str, Any]) -> EnvelopeResult:
+        """Read the typed fields of an envelope document."""
+
+        def arr(values: list[Optional[float]]) -> NDArray[np.float64]:
+            return np.array([np.nan if v is None else v for v in values], dtype=float)
+
+        return cls(
+            f_p=arr(doc["f_p"]),
+            a_p_min_g={str(m["id"]): arr(m["a_p_min_g"]) for m in doc["mechanisms"]},
+            critical=tuple(
+                CriticalBand(str(b["mechanism"]), float(b["f_min"]), float(b["f_max"]))
+                for b in doc["critical"]
+            ),
+            doc=doc,
+        )
+
+    def critical_at(self, f_p: float) -> str:
+        """Return the id of the mechanism that overturns first at the frequency ``f_p`` [Hz].
+
+        The nearest tabulated frequency decides.
+        """
+        i = int(np.argmin(np.abs(np.log(self.f_p) - np.log(f_p))))
+        f = float(self.f_p[i])
+        for band in self.critical:
+            if band.f_min <= f <= band.f_max:
+                return band.mechanism
+        raise _unknown(
+            "frequency", f"{f_p:g} Hz", [f"{b.f_min:g}-{b.f_max:g}" for b in self.critical]
+        )
+
+
+@dataclass(frozen=True)
+class Fragility:
+    """A lognormal fragility fit of one mechanism (binomial maximum likelihood).
+
+    Attributes
+    ----------
+    median : float or None
+        Median intensity of overturning, in the IDA's measure (scale [-] or PGA [g]); None
+        where the levels cannot place it (every record overturned, or none did).
+    beta : float or None
+        Lognormal dispersion [-].
+    note : str
+        Why the fit is missing or weak ("" when it is sound).
+    """
+
+    median: Optional[float]
+    beta: Optional[float]
+    note: str
+
+
+@dataclass(frozen=True)
+class IDAResult:
+    """Incremental dynamic analysis over records (``rockmech.ida``).
+
+    Attributes
+    ----------
+    measure : str
+        Intensity measure, ``"scale"`` [-] or ``"pga"`` [g].
+    levels : (k,) float array
+        Intensity levels, in ``measure``'s units.
+    fraction : dict of str to (k,) float array
+        Per mechanism id, the fraction of records that overturned it at each level [-].
+    fragility : dict of str to Fragility
+        Per mechanism id, its lognormal fit.
+    doc : dict
+        The whole document, as ``rockmech ida`` writes it (``ida.json``).
+    """
+
+    measure: str
+    levels: NDArray[np.float64]
+    fraction: dict[str, NDArray[np.float64]]
+    fragility: dict[str, Fragility]
+    doc: dict[str, Any]
+
+    @classmethod
+    def from_doc(cls, doc: dict[str, Any]) -> IDAResult:
+        """Read the typed fields of an IDA document."""
+        mechs = doc["mechanisms"]
+        return cls(
+            measure=str(doc["intensity"]["measure"]),
+            levels=np.asarray(doc["intensity"]["levels"], dtype=float),
+            fraction={str(m["id"]): np.asarray(m["fraction"], dtype=float) for m in mechs},
+            fragility={
+                str(m["id"]): Fragility(
+                    _opt_float(m["fragility"].get("median")),
+                    _opt_float(m["fragility"].get("beta")),
+                    str(m["fragility"].get("note", "")),
+                )
+                for m in mechs
+            },
+            doc=doc,
+        )
+
+
+@dataclass(frozen=True)
+class MechanismCheck:
+    """The code check of one mechanism (NTC 2018 / Circolare 2019 §C8.7.1), worst side.
+
+    Attributes
+    ----------
+    mechanism : str
+        The mechanism's id.
+    passes : bool or None
+        Both checks pass (None where a check could not run: see ``doc``).
+    linear_ratio, nonlinear_ratio : float or None
+        Capacity over demand of the linear and the nonlinear kinematic check [-] (>= 1
+        passes; None where the check did not run).
+    z : float
+        Height of the mechanism's base above the ground [m].
+    """
+
+    mechanism: str
+    passes: Optional[bool]
+    linear_ratio: Optional[float]
+    nonlinear_ratio: Optional[float]
+    z: float
+
+
+def _ratio(check: dict[str, Any]) -> Optional[float]:
+    return _opt_float(check.get("capacity_ratio")) if check.get("status") == "ok" else None
+
+
+def _checks(doc: dict[str, Any]) -> tuple[MechanismCheck, ...]:
+    return tuple(
+        MechanismCheck(
+            mechanism=str(m["id"]),
+            passes=m["passes"],
+            linear_ratio=_ratio(m["linear"]),
+            nonlinear_ratio=_ratio(m["nonlinear"]),
+            z=float(m["Z"]),
+        )
+        for m in doc["mechanisms"]
+    )
+
+
+@dataclass(frozen=True)
+class CheckResult:
+    """Code checks of every mechanism on a site (``rockmech.check``).
+
+    Attributes
+    ----------
+    mechanisms : tuple of MechanismCheck
+        One per mechanism, in the constants file's order.
+    governing : str or None
+        The id with the lowest capacity ratio (None when no check ran).
+    doc : dict
+        The whole document, as ``rockmech check --json`` prints it.
+    """
+
+    mechanisms: tuple[MechanismCheck, ...]
+    governing: Optional[str]
+    doc: dict[str, Any]
+
+    @classmethod
+    def from_doc(cls, doc: dict[str, Any]) -> CheckResult:
+        """Read the typed fields of a check document."""
+        return cls(_checks(doc), doc.get("governing"), doc)
+
+    def mechanism(self, mechanism: str) -> MechanismCheck:
+        """Return the check of ``mechanism`` (its id)."""
+        for m in self.mechanisms:
+            if m.mechanism == mechanism:
+                return m
+        raise _unknown("mechanism", mechanism, [m.mechanism for m in self.mechanisms])
+
+
+@dataclass(frozen=True)
+class AssessmentResult(CheckResult):
+    """Code checks beside rocking dynamics on records scaled to the site (``rockmech.assess``).
+
+    Attributes
+    ----------
+    survives_design : dict of str to bool or None
+        Per mechanism id, whether it survives every record at the design level (multiple 1;
+        None without records or where it was not run).
+    first_overturning_multiple : dict of str to float or None
+        Per mechanism id, the smallest multiple of the design scale at which some record
+        overturns it [-] (None where none does).
+    """
+
+    survives_design: dict[str, Optional[bool]]
+    first_overturning_multiple: dict[str, Optional[float]]
+
+    @classmethod
+    def from_doc(cls, doc: dict[str, Any]) -> AssessmentResult:
+        """Read the typed fields of an assessment document."""
+        survives: dict[str, Optional[bool]] = {}
+        first: dict[str, Optional[float]] = {}
+        for m in doc["mechanisms"]:
+            runs = m.get("dynamics") or []
+            verdicts = [r.get("survives_design") for r in runs]
+            survives[m["id"]] = None if not runs or None in verdicts else all(verdicts)
+            multiples = [
+                r["first_overturning_multiple"]
+                for r in runs
+                if r.get("first_overturning_multiple") is not None
+            ]
+            first[m["id"]] = float(min(multiples)) if multiples else None
+        return cls(_checks(doc), doc.get("governing"), doc, survives, first)

@@ -1,0 +1,236 @@
+"""The compiled kernels: whether they are active, where numba keeps them, building them ahead.
+
+The exact solver's kernels (``_kernels``, ``_boundary_kernels``) and the spectrum's loop
+(``spectra``) are compiled by numba where it is installed (a dependency of the base install
+on the platforms numba has wheels for). numba keeps the machine code in a cache on disk
+(``cache=True``; beside the sources when that folder is writable, else in the user's cache
+folder, or in ``NUMBA_CACHE_DIR``), so compilation is paid once per install, not per run.
+
+Each solver path (``PATHS``) compiles the first time it runs, which takes from a few seconds
+to about a minute on a laptop. ``first_use`` wraps the compiled call of each path: when the
+path has not been built for these sources yet, it announces the compilation with one line
+(``set_notifier``; stderr by default) before, and writes a stamp beside numba's cache after.
+``precompile.build`` compiles every path ahead (``rockmech kernels``, the Docker image's
+build, the service before it starts its workers). Without numba the same source runs as
+plain Python, 10 to 100 times slower; the first kernel call of a process says so once, with
+the reason.
+
+Python 3.9-clean: Rhino 8 imports the solver through its flows (without numba).
+"""
+
+import contextlib
+import json
+import os
+import sys
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Dict, List, Optional, Set, Tuple
+
+from shared_schema.atomic import write_atomic
+from shared_schema.version import __version__
+
+from . import _kernels as _k
+
+__all__ = [
+    "PATHS",
+    "KernelStatus",
+    "first_use",
+    "kernel_status",
+    "notify",
+    "set_notifier",
+]
+
+#: The solver paths compiled apart, each with what runs it.
+PATHS: Dict[str, str] = {
+    "simulate": "one run (simulate: pulses, records, time series)",
+    "batch": "batches of runs (simulate_batch: histories, IDA)",
+    "boundary": "overturning boundaries (boundary_curve: envelope --exact)",
+    "library": "the overturning library (build_library: library build)",
+    "spectrum": "response spectra (response_spectrum)",
+}
+#: Sources whose compiled code numba caches (their size and time stamp key its cache).
+SOURCES = ("_kernels.py", "_boundary_kernels.py", "spectra.py")
+#: Name of a path's stamp, written beside numba's cache once the path is compiled.
+STAMP = "rockmech-kernels-{path}.json"
+
+_LOCK = threading.Lock()
+#: Paths checked in this process (a stamp is read once per process and path).
+_CHECKED: Set[str] = set()
+_STATE = {"said_python": False}
+
+
+def _stderr_line(text: str) -> None:
+    sys.stderr.write(text + "\n")
+    sys.stderr.flush()
+
+
+_NOTIFY: List[Callable[[str], None]] = [_stderr_line]
+
+
+def set_notifier(fn: Optional[Callable[[str], None]]) -> None:
+    """Send the progress and fallback lines to ``fn`` (None: stderr, the default)."""
+    _NOTIFY[0] = fn if fn is not None else _stderr_line
+
+
+def notify(line: str) -> None:
+    """Send one progress or fallback line where ``set_notifier`` says (stderr by default)."""
+    _NOTIFY[0](line)
+
+
+@dataclass(frozen=True)
+class KernelStatus:
+    """Whether the compiled kernels are active, and which paths are built.
+
+    Attributes
+    ----------
+    active : bool
+        True when numba compiles the kernels; False when they run as plain Python.
+    numba_version : str or None
+        The installed numba's version (None without numba).
+    reason : str or None
+        Why the kernels are not compiled (None when they are).
+    cache_dir : Path or None
+        The folder numba keeps the compiled kernels in (None without numba).
+    built : tuple of str
+        The paths (``PATHS``) compiled for these sources and this numba, in that cache.
+    """
+
+    active: bool
+    numba_version: Optional[str]
+    reason: Optional[str]
+    cache_dir: Optional[Path]
+    built: Tuple[str, ...] = field(default=())
+
+    def describe(self) -> str:
+        """One line for ``rockmech --version``: active or not, and what is built where."""
+        if not self.active:
+            return (
+                f"compiled kernels: not active ({self.reason}); the solver runs its "
+                "pure-Python kernels, 10 to 100 times slower"
+            )
+        if len(self.built) == len(PATHS):
+            state = "all built"
+        elif self.built:
+            state = f"built: {', '.join(self.built)}; the others compile on first use"
+        else:
+            state = (
+                "not built yet: each path compiles on first use, or all at once by rockmech kernels"
+            )
+        return (
+            f"compiled kernels: active (numba {self.numba_version}; {state}; "
+            f"cache {self.cache_dir})"
+        )
+
+
+def _cache_dir() -> Optional[Path]:
+    """Return the folder numba caches ``_kernels`` in (the one it chose for this install)."""
+    if not _k.JIT:
+        return None
+    cache = getattr(_k.simulate_cells_logged, "_cache", None)
+    path = getattr(cache, "_cache_path", None)
+    return Path(path) if path else None
+
+
+def _key() -> Dict[str, object]:
+    """Return what numba's cache depends on: numba, Python, the CPU, the sources' stamps."""
+    import numba
+    from numba.core import config
+
+    cpu = getattr(config, "CPU_NAME", None)
+    if not cpu:
+        import llvmlite.binding as llvm
+
+        cpu = llvm.get_host_cpu_name()
+    here = Path(__file__).resolve().parent
+    sources = {}
+    for name in SOURCES:
+        st = os.stat(here / name)
+        sources[name] = [st.st_mtime, st.st_size]
+    return {
+        "rockmech": __version__,
+        "numba": numba.__version__,
+        "python": list(sys.version_info[:2]),
+        "cpu": cpu,
+        "sources": sources,
+    }
+
+
+def _stamp(path: str) -> Optional[Path]:
+    folder = _cache_dir()
+    return None if folder is None else folder / STAMP.format(path=path)
+
+
+def _is_built(path: str, key: Dict[str, object]) -> bool:
+    stamp = _stamp(path)
+    if stamp is None:
+        return False
+    try:
+        return bool(json.loads(stamp.read_text(encoding="utf-8")) == key)
+    except (OSError, ValueError):
+        return False
+
+
+def kernel_status() -> KernelStatus:
+    """Return whether the compiled kernels are active and which paths are built."""
+    if not _k.JIT:
+        return KernelStatus(False, None, _k.JIT_REASON, None)
+    import numba
+
+    key = _key()
+    built = tuple(p for p in PATHS if _is_built(p, key))
+    return KernelStatus(True, numba.__version__, None, _cache_dir(), built)
+
+
+def first_use(path: str, backend: str = "auto") -> Optional[Callable[[], None]]:
+    """Announce the compilation of ``path`` before its first compiled call.
+
+    Cheap after the first call of a path in a process (one set lookup), so it can sit in
+    front of every kernel call.
+
+    Parameters
+    ----------
+    path : str
+        One of ``PATHS``.
+    backend : str
+        The back end the caller asked for: only ``"auto"`` and ``"numba"`` compile; with
+        ``"auto"`` and no numba, the pure-Python fallback is announced once per process.
+
+    Returns
+    -------
+    callable or None
+        Call it after the compiled call succeeded: it stamps ``path`` as built. None when
+        there is nothing to stamp.
+    """
+    if path in _CHECKED or backend not in ("auto", "numba"):
+        return None
+    with _LOCK:
+        todo = path not in _CHECKED
+        _CHECKED.add(path)
+        say_python = not _k.JIT and not _STATE["said_python"]
+        if say_python:
+            _STATE["said_python"] = True
+    if not _k.JIT:
+        if say_python:
+            _NOTIFY[0](
+                f"note: {_k.JIT_REASON}, so the solver runs its pure-Python kernels, 10 to 100 "
+                "times slower; pip install numba (on a platform it has wheels for) to compile them"
+            )
+        return None
+    if not todo:
+        return None
+    key = _key()
+    if _is_built(path, key):
+        return None
+    _NOTIFY[0](
+        f"note: compiling the solver's kernels for {PATHS[path]}, once for this install "
+        f"(seconds to a minute; kept in {_cache_dir()})"
+    )
+    return lambda: _write_stamp(path, key)
+
+
+def _write_stamp(path: str, key: Dict[str, object]) -> None:
+    stamp = _stamp(path)
+    if stamp is not None:
+        with contextlib.suppress(OSError):  # a read-only cache: numba recompiles anyway
+            write_atomic(stamp, json.dumps(key, sort_keys=True))

@@ -1,0 +1,125 @@
+"""The compiled kernels (#28): active in the base install, built ahead, announced once.
+
+Compiling a solver path takes seconds to a minute: it happens once per install, with a
+progress line, and ``rockmech --version`` says whether the kernels are compiled. Without
+numba the pure-Python kernels run, and the first kernel call of a process says so once.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numba
+from typer.testing import CliRunner
+
+from solver_service.cli import app
+from solver_service.core import jit
+
+ROOT = Path(__file__).resolve().parents[2]
+runner = CliRunner()
+
+
+def _run(code: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env={**os.environ, **(env or {})},
+        timeout=600,
+    )
+
+
+def test_the_dev_install_runs_compiled_kernels_built_ahead_by_the_test_session() -> None:
+    status = jit.kernel_status()
+    assert status.active and status.reason is None
+    assert status.numba_version == numba.__version__
+    # tests/conftest.py builds every path before the tests start.
+    assert status.built == tuple(jit.PATHS)
+    assert status.cache_dir is not None
+    for path in jit.PATHS:
+        stamp = json.loads((status.cache_dir / jit.STAMP.format(path=path)).read_text())
+        assert stamp["numba"] == numba.__version__ and set(stamp["sources"]) == set(jit.SOURCES)
+    line = status.describe()
+    assert line.startswith(f"compiled kernels: active (numba {numba.__version__}; all built;")
+    res = runner.invoke(app, ["--version"])
+    assert res.exit_code == 0 and res.stdout.splitlines()[1] == line
+    res = runner.invoke(app, ["kernels"])
+    assert res.exit_code == 0 and res.stdout == line + "\n"
+
+
+def test_a_stamp_for_other_sources_or_another_numba_is_not_built(tmp_path: Path) -> None:
+    status = jit.kernel_status()
+    assert status.cache_dir is not None
+    stamp = status.cache_dir / jit.STAMP.format(path="simulate")
+    key = json.loads(stamp.read_text())
+    assert jit._is_built("simulate", key)
+    for field, value in (("numba", "0.0.1"), ("sources", {"_kernels.py": [0.0, 1]})):
+        assert not jit._is_built("simulate", {**key, field: value})
+
+
+def test_first_use_of_a_path_in_a_fresh_cache_says_so_once_then_loads_it_silently(
+    tmp_path: Path,
+) -> None:
+    # The spectrum path is the cheapest to compile (a second or two).
+    code = (
+        "import numpy as np\n"
+        "from solver_service.core.spectra import response_spectrum\n"
+        "acc = np.sin(np.linspace(0, 6, 61))\n"
+        "a = response_spectrum(acc, 0.01, [0.5, 1.0]).psa\n"
+        "b = response_spectrum(acc, 0.01, [0.5, 1.0], backend='numpy').psa\n"
+        "assert np.allclose(a, b, rtol=1e-9), (a, b)\n"
+        "response_spectrum(acc, 0.01, [0.7])\n"
+        "from solver_service.core.jit import kernel_status\n"
+        "print(kernel_status().built)\n"
+    )
+    env = {"NUMBA_CACHE_DIR": str(tmp_path)}
+    first = _run(code, env)
+    assert first.returncode == 0, first.stderr
+    lines = first.stderr.strip().splitlines()
+    assert len(lines) == 1, first.stderr
+    assert lines[0].startswith("note: compiling the solver's kernels for response spectra")
+    assert str(tmp_path) in lines[0]
+    assert first.stdout.strip() == "('spectrum',)"
+    assert list(tmp_path.rglob(jit.STAMP.format(path="spectrum")))
+    again = _run(code, env)
+    assert again.returncode == 0 and again.stderr == "", again.stderr
+
+
+def test_without_numba_the_pure_python_kernels_run_and_say_so_once() -> None:
+    # numba blocked, as on a platform without its wheel: the CLI still answers, with the
+    # solver's numbers, and says once why it is slower.
+    code = (
+        "import sys; sys.modules['numba'] = None\n"
+        "from typer.testing import CliRunner\n"
+        "from solver_service.cli import app\n"
+        "r = CliRunner()\n"
+        "args = ['pulse', '--p-eq', '2', '--lam', '0.2', '--eta', '0.9', '--a-p-g', '-0.61',"
+        " '--f-p', '1.59', '--json']\n"
+        "one, two = r.invoke(app, args), r.invoke(app, args)\n"
+        "print(repr(one.stderr), repr(two.stderr), sep='\\n')\n"
+        "print(r.invoke(app, ['--version']).stdout.splitlines()[1])\n"
+        "import json; print(json.loads(one.stdout)['method'])\n"
+    )
+    res = _run(code)
+    assert res.returncode == 0, res.stderr
+    first, second, version, method = res.stdout.strip().splitlines()
+    assert "note: numba is not installed, so the solver runs its pure-Python kernels" in first
+    assert first.count("note:") == 1 and second == "''"
+    assert version.startswith("compiled kernels: not active (numba is not installed)")
+    assert method == "exact:python"
+
+
+def test_the_build_rockmech_serve_runs_first_is_quiet_when_built_and_says_why_without_numba() -> (
+    None
+):
+    code = "import sys; from solver_service.core.precompile import main; sys.exit(main())"
+    built = _run(code)
+    assert built.returncode == 0 and built.stderr == "", built.stderr
+    blocked = _run("import sys; sys.modules['numba'] = None\n" + code)
+    assert blocked.returncode == 1
+    assert blocked.stderr.startswith("note: compiled kernels: not active (numba is not installed)")
