@@ -29,6 +29,7 @@ from solver_service.workflows import tables as _tables
 from solver_service.workflows.adapter import models_from_file
 from solver_service.workflows.documents import envelope_doc, frequency_grid, history_doc
 from solver_service.workflows.scaling import Building
+from solver_service.workflows.units import stamp
 
 from .results import AssessmentResult, CheckResult, EnvelopeResult, HistoryResult, IDAResult
 
@@ -267,7 +268,7 @@ def history(
         criterion=criterion,
         at_height=at_height,
     )
-    return HistoryResult.from_doc(doc)
+    return HistoryResult.from_doc(stamp(doc, "history"))
 
 
 def envelope(
@@ -276,7 +277,7 @@ def envelope(
     f_min: float = 0.1,
     f_max: float = 10.0,
     n: int = 200,
-    exact: bool = False,
+    fast: bool = False,
 ) -> EnvelopeResult:
     """Overturning envelopes of every mechanism and the critical bands.
 
@@ -291,17 +292,20 @@ def envelope(
         Frequency range [Hz], ``0 < f_min < f_max``.
     n : int
         Number of frequencies.
-    exact : bool
-        Compute every boundary directly (exact integrator) instead of interpolating the
-        shipped library (tens of seconds instead of milliseconds).
+    fast : bool
+        The fast mode: interpolate the overturning library (exact where it cannot interpolate
+        safely; never above the exact value, at most 5 % below) instead of the exact
+        integrator at every frequency (the default, as on every other path).
 
     Returns
     -------
     EnvelopeResult
         ``f_p`` [Hz], ``a_p_min_g`` per mechanism [g], ``critical`` bands.
     """
-    doc, _ = envelope_doc(_constants(constants), frequency_grid(f_min, f_max, n), exact=exact)
-    return EnvelopeResult.from_doc(doc)
+    doc, _ = envelope_doc(
+        _constants(constants), frequency_grid(f_min, f_max, n), method="library" if fast else "exact"
+    )
+    return EnvelopeResult.from_doc(stamp(doc, "envelope"))
 
 
 def ida(
@@ -355,7 +359,7 @@ def ida(
         scheduler=scheduler,
         jobs=jobs,
     )
-    return IDAResult.from_doc(doc)
+    return IDAResult.from_doc(stamp(doc, "ida"))
 
 
 def check(constants: Constants, site: Union[SiteFile, PathLike]) -> CheckResult:
@@ -376,7 +380,8 @@ def check(constants: Constants, site: Union[SiteFile, PathLike]) -> CheckResult:
         Per mechanism ``passes`` and the linear and nonlinear capacity ratios [-];
         ``governing``.
     """
-    return CheckResult.from_doc(_assess.check_doc(_constants(constants), _site(site)))
+    doc = _assess.check_doc(_constants(constants), _site(site))
+    return CheckResult.from_doc(stamp(doc, "check"))
 
 
 def assess(
@@ -414,4 +419,4 @@ def assess(
         motions,
         multiples=_assess.check_multiples(list(multiples)),
     )
-    return AssessmentResult.from_doc(doc)
+    return AssessmentResult.from_doc(stamp(doc, "assess"))

@@ -200,7 +200,7 @@ def test_python_dash_m_rockmech_is_the_command() -> None:
         cwd=ROOT,
         timeout=120,
     )
-    assert res.returncode == 2 and res.stderr.startswith("error: --lam: missing option")
+    assert res.returncode == 2 and res.stderr.startswith("error: --a-p-g: missing option")
 
 
 def test_the_cli_dependencies_are_in_the_base_install() -> None:
