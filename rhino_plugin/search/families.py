@@ -468,7 +468,7 @@ def _rigid_candidates(
     return out
 
 
-def _overburden(bld: Building, wall: Wall, d: np.ndarray) -> Tuple[float, float, List[str]]:
+def overburden_load(bld: Building, wall: Wall, d: np.ndarray) -> Tuple[float, float, List[str]]:
     """N [N] on the wall's top and its position x [m] along ``d`` from the outer face."""
     ob = wall.overburden
     b = wall.frame.thickness
@@ -543,7 +543,7 @@ def _flexure_candidates(bld: Building, wall: Wall, grid: int, notes: List[str]) 
         )
         return []
     d = -wall.frame.e_n
-    n, x_n, ob_notes = _overburden(bld, wall, d)
+    n, x_n, ob_notes = overburden_load(bld, wall, d)
     h = wall.z_hi - wall.z_lo
     bounds = (H1_RANGE[0] * h, H1_RANGE[1] * h)
     res = minimise(lambda x: two_block_lam(wall, x[0], d, n, x_n), [bounds], grid)

@@ -36,6 +36,7 @@ __all__ = [
     "ring_moments",
     "rings_area",
     "segment_intervals",
+    "winding",
 ]
 
 Ring = np.ndarray
@@ -250,7 +251,7 @@ def segment_intervals(
         if hi - lo <= 1e-12:
             continue
         mid = np.asarray(p0, dtype=float) + 0.5 * (lo + hi) * d
-        if _winding(rings, mid) != 0:
+        if winding(rings, mid) != 0:
             if spans and abs(spans[-1][1] - lo) <= 1e-12:
                 spans[-1] = (spans[-1][0], hi)
             else:
@@ -258,8 +259,8 @@ def segment_intervals(
     return spans
 
 
-def _winding(rings: Sequence[np.ndarray], p: np.ndarray) -> int:
-    """Winding number of a region (sum over rings) at a point (crossing-number rule)."""
+def winding(rings: Sequence[np.ndarray], p: np.ndarray) -> int:
+    """Return the winding number of a region (sum over rings) at a point (crossing-number rule)."""
     total = 0
     px, pz = float(p[0]), float(p[1])
     for ring in rings:
