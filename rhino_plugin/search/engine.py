@@ -109,10 +109,8 @@ def sliding_check(cand: Candidate, friction: float) -> Optional[Dict[str, Any]]:
     """
     weight = cand.weight()
     sway = weight
-    for c, share in cand.contacts:
-        if c.level.tied:
-            continue
-        m = G * c.mass * share
+    for c in cand.contacts:
+        m = G * c.mass
         sway += m
         if c.bearing:
             weight += m
@@ -183,16 +181,25 @@ def run_search(scene: Any, spec: Any, *, lp: Optional[bool] = None) -> SearchRes
     checks: List[LPCheck] = []
     do_lp = spec.lp if lp is None else lp
     if do_lp:
+        # the check loads the façade along its normal: corner mechanisms, loaded along the
+        # corner's diagonal, are not compared with it
+        along = [c for c in cands if c.family != "corner"]
+        if len(along) < len(cands):
+            notes.append(
+                "the global check loads each façade along its normal; the corner mechanisms "
+                "(loaded along the corner's diagonal) are not compared with it"
+            )
         pairs = []
-        for c in cands:
+        for c in along:
             if (c.facade, c.direction) not in pairs:
                 pairs.append((c.facade, c.direction))
         for facade, direction in pairs:
-            heights, angles = _lines(cands, facade, direction)
-            model = facade_lp_model(bld, facade, direction, heights, angles)
+            heights, angles = _lines(along, facade, direction)
+            first = next(c for c in along if c.facade == facade and c.direction == direction)
+            model = facade_lp_model(bld, facade, direction, heights, angles, loads=first.contacts)
             res = solve_lp(model)
             fric = solve_lp(model, friction=spec.friction)
-            best = min(c.lam0 for c in cands if c.facade == facade and c.direction == direction)
+            best = min(c.lam0 for c in along if c.facade == facade and c.direction == direction)
             gap = (best - res.lam) / best if math.isfinite(res.lam) and best > 0 else 0.0
             lam_f = fric.lam if math.isfinite(fric.lam) else None
             sliding = lam_f is not None and lam_f < res.lam * (1.0 - SLIDING_GAP)

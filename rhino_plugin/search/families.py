@@ -32,11 +32,11 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from rhino_plugin.geometry.massprops import mass_properties
-from rhino_plugin.mechanisms.loaded import largest_contact
+from rhino_plugin.mechanisms.loaded import BEARING_ANGLE, largest_contact
 from rhino_plugin.mechanisms.single import find_objects
 from rhino_plugin.search.model import Building, LevelContact, ReturnWall, TiePoint, Wall
 from rhino_plugin.search.multiplier import rotation_multiplier, two_block_multiplier
-from rhino_plugin.search.prism import Lump, point_lump, ring_moments
+from rhino_plugin.search.prism import Lump, clip_rings, point_lump, ring_moments
 from rhino_plugin.search.refine import minimise
 from shared_schema.rules import G
 
@@ -80,6 +80,39 @@ class Piece:
 
 
 @dataclass
+class LevelLoad:
+    """A level as one mechanism carries it (where the builder finds it).
+
+    Attributes
+    ----------
+    contact : LevelContact
+        The level and one wall it touches (``contact.level`` is the spec's level).
+    point : (3,) float
+        Centroid of its largest contact with the moving parts [m].
+    area : float
+        That contact's area [m²].
+    mass : float
+        The wall's share of its mass (``tributary``) [kg].
+    bearing : bool
+        Its weight acts (a horizontal contact, or a roof).
+    thrust : float
+        Outward roof thrust [N] (0 for floors and tied trusses).
+    """
+
+    contact: LevelContact
+    point: np.ndarray
+    area: float
+    mass: float
+    bearing: bool
+    thrust: float
+
+    @property
+    def level(self) -> Any:
+        """The spec's level."""
+        return self.contact.level
+
+
+@dataclass
 class Candidate:
     """One mechanism of the catalogue, refined.
 
@@ -102,8 +135,8 @@ class Candidate:
         The horizontal collapse direction.
     lam0 : float
         Exact static load multiplier [-].
-    contacts : list of (LevelContact, share)
-        The levels it carries, each with the share of its tributary mass (1: whole).
+    contacts : list of LevelLoad
+        The levels it carries, where the builder finds them.
     ties : list of TiePoint
         The tie-bars on it.
     overburden : dict, optional
@@ -129,7 +162,7 @@ class Candidate:
     axis: np.ndarray
     direction_vector: np.ndarray
     lam0: float
-    contacts: List[Tuple[LevelContact, float]] = field(default_factory=list)
+    contacts: List[LevelLoad] = field(default_factory=list)
     ties: List[TiePoint] = field(default_factory=list)
     overburden: Optional[Dict[str, Any]] = None
     lam0_negative: Optional[float] = None
@@ -227,15 +260,73 @@ def _region_mass(wall: Wall, planes: Sequence[Plane]) -> float:
     return float(ring_moments(wall.region(planes))[0]) * wall.frame.thickness * wall.density
 
 
+def level_loads(
+    bld: Building, pieces: Sequence[Piece], d: np.ndarray
+) -> Tuple[List[LevelLoad], Optional[str]]:
+    """Return the levels a mechanism's moving parts carry, as the constants builder finds them.
+
+    A level acts at the centroid of its largest contact with the moving parts (each of its
+    contacts with a wall clipped to that wall's moving part), bears if that contact is
+    horizontal (a roof always bears), and a roof that is not a tied truss thrusts along the
+    collapse direction ``d`` (span and rise from its bounding box in the mechanism's frame),
+    as ``mechanisms.loaded.loaded_side`` computes them.
+
+    Returns
+    -------
+    loads : list of LevelLoad
+        In the order of the spec's levels.
+    held : str or None
+        The id of a tied level the moving parts touch (the mechanism is then held).
+    """
+    tol = max(bld.contact_tol, 0.0)
+    best: Dict[int, Tuple[float, np.ndarray, LevelContact, Any]] = {}
+    for piece in pieces:
+        for c in bld.contacts.get(piece.wall.id, []):
+            for region in c.regions:
+                rings = list(region.rings)
+                for point, normal in piece.planes:
+                    m = np.asarray(normal, dtype=float)
+                    rings = clip_rings(
+                        rings,
+                        float(m @ region.u),
+                        float(m @ region.v),
+                        float(m @ (region.origin - np.asarray(point, dtype=float))),
+                    )
+                area, su, sv = (float(x) for x in ring_moments(rings)[:3])
+                if not area > 0.0:
+                    continue
+                pts = np.vstack(rings)
+                extent = float(np.max(np.ptp(pts, axis=0)))
+                if area <= tol * extent:
+                    continue  # a touch along a line (the builder's MIN_WIDTH_FACTOR)
+                centroid = region.origin + (su / area) * region.u + (sv / area) * region.v
+                k = c.index
+                if k not in best or area > best[k][0]:
+                    best[k] = (area, centroid, c, region)
+    loads: List[LevelLoad] = []
+    held = None
+    for k in sorted(best):
+        area, point, c, region = best[k]
+        if c.level.tied:
+            held = held or c.level.id
+            continue
+        bearing = c.level.kind == "roof" or abs(float(region.normal[2])) >= math.cos(BEARING_ANGLE)
+        thrust = 0.0
+        if c.level.kind == "roof" and c.level.pushes:
+            thrust = bld.roof_thrust(c, d)
+        loads.append(LevelLoad(c, point, area, c.mass, bearing, thrust))
+    return loads, held
+
+
 def _loads(
-    contacts: Sequence[Tuple[LevelContact, float]], ties: Sequence[TiePoint], d: np.ndarray
+    contacts: Sequence[LevelLoad], ties: Sequence[TiePoint], d: np.ndarray
 ) -> Tuple[Lump, Lump, List[Tuple[np.ndarray, np.ndarray]]]:
     """Bearing and abutting masses and static forces of a rigid mechanism."""
     weighing = Lump.zero()
     abutting = Lump.zero()
     forces = []
-    for c, share in contacts:
-        lump = point_lump(c.mass * share, c.point)
+    for c in contacts:
+        lump = point_lump(c.mass, c.point)
         if c.bearing:
             weighing = weighing + lump
         else:
@@ -253,7 +344,7 @@ class Template:
 
     Attributes
     ----------
-    family, typology, rocking : str
+    family, rocking : str
         What the refined candidate will be.
     names : list of str
         Parameter names.
@@ -267,14 +358,17 @@ class Template:
         A point of the axis [m].
     d : (3,) float
         The collapse direction.
-    contacts, ties
-        The levels and tie-bars the mechanism carries.
+    bld : Building
+        The building (its levels load the moving parts where they touch them).
+    ties : list of TiePoint
+        The tie-bars on the moving parts.
     axis : (2, 3) float
         Two points of the axis [m].
+    hinge_z : float
+        Height of the hinge line [m].
     """
 
     family: str
-    typology: str
     rocking: str
     names: List[str]
     bounds: List[Tuple[float, float]]
@@ -282,7 +376,7 @@ class Template:
     variable: Callable[[Sequence[float]], List[Piece]]
     point: np.ndarray
     d: np.ndarray
-    contacts: List[Tuple[LevelContact, float]]
+    bld: Building
     ties: List[TiePoint]
     axis: np.ndarray
     hinge_z: float
@@ -293,21 +387,25 @@ class Template:
         for p in self.fixed:
             lump = lump + p.lump()
         self._fixed_lump = lump
-        self._weighing, self._abutting, self._forces = _loads(self.contacts, self.ties, self.d)
 
     def pieces(self, x: Sequence[float]) -> List[Piece]:
-        """Every moving part at parameters ``x``."""
+        """Return every moving part at parameters ``x``."""
         return self.fixed + self.variable(x)
 
     def lam(self, x: Sequence[float]) -> float:
-        """λ0 at parameters ``x`` (``inf`` where nothing moves along the load)."""
+        """Return λ0 at parameters ``x`` (``inf`` where nothing moves, or a tied level holds)."""
+        variable = self.variable(x)
         body = self._fixed_lump
-        for p in self.variable(x):
+        for p in variable:
             body = body + p.lump()
         if not body.mass > 0.0:
             return math.inf
-        w = body + self._weighing
-        return rotation_multiplier(w, w + self._abutting, self.point, self.d, self._forces)
+        loads, held = level_loads(self.bld, self.fixed + variable, self.d)
+        if held is not None:
+            return math.inf
+        weighing, abutting, forces = _loads(loads, self.ties, self.d)
+        w = body + weighing
+        return rotation_multiplier(w, w + abutting, self.point, self.d, forces)
 
     def refine(self, facade: str, direction: str, grid: int) -> Optional[Candidate]:
         """Minimise λ0 over the parameters; None where no admissible point exists."""
@@ -316,19 +414,22 @@ class Template:
             return None
         params = {"hinge_height_m": self.hinge_z} if self.family != "corner" else {}
         params.update(zip(self.names, res.x))
+        pieces = self.pieces(res.x)
+        loads, _ = level_loads(self.bld, pieces, self.d)
+        typology = "single_block_loaded" if (loads or self.ties) else "single_block"
         return Candidate(
             self.family,
             facade,
             direction,
-            self.typology,
+            typology,
             self.rocking,
             params,
             dict(zip(self.names, self.bounds)),
-            self.pieces(res.x),
+            pieces,
             self.axis,
             self.d,
             res.value,
-            self.contacts,
+            loads,
             self.ties,
             n_evaluations=res.n_evaluations,
             on_bound=[n for n, b in zip(self.names, res.on_bound) if b],
@@ -390,8 +491,8 @@ def overturning_template(
     d, n_face = _direction(wall, direction)
     f = wall.frame
     returns = bld.returns.get(wall.id, []) if direction == "outward" else []
-    contacts = [(c, 1.0) for c in bld.contacts.get(wall.id, []) if c.point[2] > z_h + tol]
-    tied = [c for c, _ in contacts if c.level.tied]
+    contacts = [c for c in bld.contacts.get(wall.id, []) if c.point[2] > z_h + tol]
+    tied = [c for c in contacts if c.level.tied]
     if tied:
         return None, (
             f"the tied level {tied[0].level.id} holds the wall at z = {tied[0].point[2]:.3f} m"
@@ -423,11 +524,9 @@ def overturning_template(
 
     point = f.to_world(0.0, n_face, z_h)
     axis = np.array([point, f.to_world(wall.length, n_face, z_h)])
-    typology = "single_block_loaded" if (contacts or ties) else "single_block"
     rocking = "two_sided" if free else "one_sided"
     tmpl = Template(
         family,
-        typology,
         rocking,
         [p[0] for p in params],
         [(p[2], p[3]) for p in params],
@@ -435,7 +534,7 @@ def overturning_template(
         variable,
         point,
         d,
-        contacts,
+        bld,
         ties,
         axis,
         z_h,
@@ -586,10 +685,10 @@ def _corner_candidates(bld: Building, wall: Wall, grid: int, notes: List[str]) -
     for r in bld.returns.get(wall.id, []):
         if not r.corner or r.connection != "good":
             continue
-        if bld.contacts.get(wall.id) or bld.contacts.get(r.wall.id) or bld.ties.get(wall.id):
+        if bld.ties.get(wall.id) or bld.ties.get(r.wall.id):
             notes.append(
-                f"{wall.id}/{r.wall.id} corner: not searched, levels or tie-bars load the "
-                "corner's walls and the builder takes a level's share whole"
+                f"{wall.id}/{r.wall.id} corner: not searched, tie-bars cross the corner's walls "
+                "and the builder takes a tie-bar on the plane through the diagonal axis"
             )
             continue
         o = -f.e_s if r.end == "start" else f.e_s
@@ -612,7 +711,6 @@ def _corner_candidates(bld: Building, wall: Wall, grid: int, notes: List[str]) -
         u = np.cross(np.array([0.0, 0.0, 1.0]), d)
         tmpl = Template(
             "corner",
-            "single_block",
             "one_sided",
             ["beta_facade_rad", "beta_return_rad"],
             bounds,
@@ -620,7 +718,7 @@ def _corner_candidates(bld: Building, wall: Wall, grid: int, notes: List[str]) -
             pieces,
             point,
             d,
-            [],
+            bld,
             [],
             np.array([point, point + u]),
             wall.z_lo,

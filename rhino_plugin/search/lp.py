@@ -399,6 +399,7 @@ def facade_lp_model(
     heights: Sequence[float] = (),
     angles: Optional[Mapping[str, Sequence[float]]] = None,
     overburden: Optional[Tuple[float, float]] = None,
+    loads: Sequence[Any] = (),
 ) -> LPModel:
     """Cut a façade and its return walls along every candidate line into macro-blocks.
 
@@ -417,6 +418,10 @@ def facade_lp_model(
     overburden : (N [N], n [m]), optional
         A vertical load on the façade's top at ``n`` from its outer face (default: the
         wall's spec overburden, on the centre line for a force, at its contact otherwise).
+    loads : sequence of LevelLoad
+        Where the best catalogue mechanism carries its levels (``families.level_loads``):
+        those levels load the blocks there, so that the programme holds that mechanism
+        exactly; the other levels load the façade at their contact with it.
 
     Returns
     -------
@@ -543,9 +548,18 @@ def facade_lp_model(
     abutting_m: List[Tuple[int, float, np.ndarray]] = []
     forces: List[Tuple[int, np.ndarray, np.ndarray]] = []
     restraints: List[Tuple[int, np.ndarray, np.ndarray]] = []
+    placed = set()
+    for ld in loads:
+        at = _cell_at(bld, blocks, wall_blocks, ld.point)
+        if at is None or ld.level.tied:
+            continue
+        placed.add(ld.contact.index)
+        (bearing if ld.bearing else abutting_m).append((at, ld.mass, ld.point))
+        if ld.thrust > 0.0:
+            forces.append((at, ld.thrust * d, ld.point))
     for c in bld.contacts.get(facade, []):
         b = _strip_of(blocks, ids, float(c.point[2]), below=c.bearing)
-        if b is None:
+        if b is None or c.index in placed:
             continue
         if c.level.tied:
             # A tied level holds the wall; its weight enters, as in the two-block wall,
@@ -556,8 +570,9 @@ def facade_lp_model(
                     restraints.append((b, f.to_world(s, n, z), d))
             continue
         (bearing if c.bearing else abutting_m).append((b, c.mass, c.point))
-        if c.thrust > 0.0:
-            forces.append((b, c.thrust * d, c.point))
+        thrust = bld.roof_thrust(c, d) if c.level.kind == "roof" and c.level.pushes else 0.0
+        if thrust > 0.0:
+            forces.append((b, thrust * d, c.point))
     for t in bld.ties.get(facade, []):
         b = _strip_of(blocks, ids, t.z, below=False)
         if b is not None:
@@ -573,6 +588,23 @@ def facade_lp_model(
     return LPModel(
         blocks, interfaces, restraints, bearing, abutting_m, forces, d, facade, direction, lines
     )
+
+
+def _cell_at(
+    bld: Building, blocks: List[LPBlock], wall_blocks: Dict[str, List[int]], point: np.ndarray
+) -> Optional[int]:
+    """Return the block holding a point of a wall's face (just below it on a top face), or None."""
+    eps = 1e-7 * max(bld.size, 1.0)
+    for w_id, ids in wall_blocks.items():
+        w = bld.walls[w_id]
+        s, n, z = (float(v) for v in w.frame.to_frame(point))
+        if not -eps <= n <= w.inner_face + eps:
+            continue
+        for probe in (z - eps, z + eps):
+            for b in ids:
+                if _contains(blocks[b], s, probe):
+                    return b
+    return None
 
 
 def _contains(blk: LPBlock, s: float, z: float) -> bool:

@@ -29,11 +29,12 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from rhino_plugin.geometry.contact import contact_region
 from rhino_plugin.geometry.frames import bounding_box_in_frame
 from rhino_plugin.geometry.massprops import mass_properties
 from rhino_plugin.geometry.mesh import TriMesh
 from rhino_plugin.geometry.validate import check_solid
-from rhino_plugin.mechanisms.loaded import BEARING_ANGLE, contact_tolerance, largest_contact
+from rhino_plugin.mechanisms.loaded import BEARING_ANGLE, contact_tolerance
 from rhino_plugin.mechanisms.single import find_objects
 from rhino_plugin.mechanisms.thrust import roof_thrust
 from rhino_plugin.scene_base import SceneObject
@@ -217,6 +218,13 @@ class LevelContact:
         Outward roof thrust at the contact [N] (0 for floors and tied trusses).
     z_range : (float, float)
         Lowest and highest point of the level's solids [m].
+    regions : list of ContactPlane
+        Every contact of the level's solids with the wall (``contact.contact_region``),
+        which a mechanism clips to its moving parts as the builder finds them.
+    meshes : list of TriMesh
+        The level's solids.
+    weight : float
+        The level's whole weight [N].
     """
 
     level: Any
@@ -228,6 +236,9 @@ class LevelContact:
     mass: float
     thrust: float
     z_range: Tuple[float, float] = (0.0, 0.0)
+    regions: List[Any] = field(default_factory=list)
+    meshes: List[TriMesh] = field(default_factory=list)
+    weight: float = 0.0
 
 
 @dataclass
@@ -286,6 +297,26 @@ class Building:
     notes: List[str]
     spec: Any
     level_objects: Dict[str, List[SceneObject]] = field(default_factory=dict)
+    contact_tol: float = 0.0
+    _thrusts: Dict[Tuple[int, Tuple[float, ...]], float] = field(default_factory=dict)
+
+    def roof_thrust(self, contact: "LevelContact", d: np.ndarray) -> float:
+        """Outward thrust of a roof on a mechanism collapsing along ``d`` [N].
+
+        Span along ``d`` and rise from the roof's bounding box in the mechanism's frame, as
+        the builder computes them (``thrust.roof_thrust``, theory §5).
+        """
+        key = (contact.index, tuple(round(float(v), 15) for v in d))
+        if key not in self._thrusts:
+            axis = np.cross(np.array([0.0, 0.0, 1.0]), d)
+            boxes = [bounding_box_in_frame(m, np.zeros(3), d, axis) for m in contact.meshes]
+            lo = np.min([b[0] for b in boxes], axis=0)
+            hi = np.max([b[1] for b in boxes], axis=0)
+            ext = hi - lo
+            self._thrusts[key] = roof_thrust(
+                contact.weight, float(ext[0]), float(abs(ext[2])), not contact.level.pushes
+            )
+        return self._thrusts[key]
 
     @property
     def size(self) -> float:
@@ -612,10 +643,14 @@ def _level_contacts(
         )
         touched = []
         for wall in walls.values():
-            try:
-                area, point, normal = largest_contact(meshes, [wall.mesh], where, tol)
-            except GeometryError:
+            regions = []
+            for m in meshes:
+                hit = contact_region(m, wall.mesh, tol=tol)
+                if hit is not None:
+                    regions.append(hit)
+            if not regions:
                 continue  # this level does not touch this wall
+            area, point, normal, _ = max(regions, key=lambda r: r[0])
             # A roof's share always bears where it touches (as the builder takes it).
             bearing = level.kind == "roof" or abs(float(normal[2])) >= math.cos(BEARING_ANGLE)
             thrust = 0.0
@@ -639,6 +674,9 @@ def _level_contacts(
                     level.tributary * total,
                     thrust,
                     z_range,
+                    [r[3] for r in regions],
+                    meshes,
+                    G * total,
                 )
             )
             touched.append(wall.id)
@@ -770,4 +808,4 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
     returns = _returns(walls, spec, tol, notes)
     contacts, level_objects = _level_contacts(scene, spec, walls, tol, notes, memory)
     ties = _tie_points(scene, spec, walls, memory)
-    return Building(memory, walls, returns, contacts, ties, notes, spec, level_objects)
+    return Building(memory, walls, returns, contacts, ties, notes, spec, level_objects, tol)
