@@ -285,7 +285,7 @@ def _wall_interfaces(
     for b in blocks:
         by_strip.setdefault(all_blocks[b].strip, []).append(b)
     strips = sorted(by_strip)
-    zs = {}
+    zs: Dict[int, float] = {}
     for b in blocks:
         blk = all_blocks[b]
         z_min = min(float(r[:, 1].min()) for r in blk.rings)

@@ -25,7 +25,7 @@ Python 3.9-clean: imported by Rhino 8.
 import math
 import uuid
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, cast
 
 import numpy as np
 
@@ -119,7 +119,7 @@ class Wall:
     @property
     def mesh(self) -> TriMesh:
         """The wall's solid [m]."""
-        return self.obj.geometry  # type: ignore[no-any-return]
+        return cast(TriMesh, self.obj.geometry)
 
     def region(self, planes: Sequence[Tuple[np.ndarray, np.ndarray]]) -> List[np.ndarray]:
         """Return the elevation kept by half-spaces ``normal·(x - point) >= 0``.
@@ -152,7 +152,7 @@ class Wall:
         if cached is None:
             cached = float(self.frame.to_frame(self.mesh.vertices)[:, 1].max())
             self.__dict__["_inner"] = cached
-        return cached  # type: ignore[no-any-return]
+        return float(cached)
 
     @property
     def mass(self) -> float:
@@ -780,7 +780,9 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
     verts = np.vstack([m.vertices for _, _, m, _ in raw])
     size = float(np.linalg.norm(verts.max(axis=0) - verts.min(axis=0)))
     vols = [mass_properties(m, 1.0) for _, _, m, _ in raw]
-    centre = sum(p.volume * np.asarray(p.com) for p in vols) / sum(p.volume for p in vols)
+    centre = np.sum([p.volume * np.asarray(p.com) for p in vols], axis=0) / sum(
+        p.volume for p in vols
+    )
     walls: Dict[str, Wall] = {}
     for w, obj, mesh, selector in raw:
         frame, rings, volume, exact, wall_notes = _orient(mesh, centre, size, w.id)

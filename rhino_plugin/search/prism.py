@@ -22,7 +22,7 @@ Python 3.9-clean: imported by Rhino 8.
 
 import math
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple, cast
 
 import numpy as np
 
@@ -337,7 +337,7 @@ class WallFrame:
                 self.origin.tolist(),
             )
             object.__setattr__(self, "_axes_cache", cached)
-        return cached  # type: ignore[no-any-return]
+        return cast(Tuple[List[float], List[float], List[float], List[float]], cached)
 
     def prism_lump(self, rings: Sequence[np.ndarray], density: float) -> Lump:
         """Lump of the prism of an elevation region through the whole thickness.
@@ -382,7 +382,7 @@ class WallFrame:
         if cached is None:
             cached = np.column_stack([self.e_s, self.e_n, self.e_z])
             object.__setattr__(self, "_rotation_cache", cached)
-        return cached  # type: ignore[no-any-return]
+        return cast(np.ndarray, cached)
 
 
 def frame_from_mesh(
