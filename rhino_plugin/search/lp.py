@@ -429,135 +429,161 @@ def facade_lp_model(
     """
     wall = bld.walls[facade]
     f = wall.frame
-    size = bld.size
     d = -f.e_n if direction == "outward" else f.e_n.copy()
     zs = sorted(set(hinge_lines(bld, wall, bld.spec.candidates.spacing)) | set(heights))
     returns = bld.returns.get(facade, []) if direction == "outward" else []
-    blocks: List[LPBlock] = []
-    wall_blocks: Dict[str, List[int]] = {}
+    blocks: List[LPBlock] = list(_cells(wall, zs, []))
+    wall_blocks: Dict[str, List[int]] = {facade: list(range(len(blocks)))}
     lines: Dict[str, Any] = {"heights": [float(z) for z in zs], "diagonals": {}}
-
-    def add(w: Wall, diagonals: Sequence[Tuple[float, HalfPlane]]) -> None:
-        start = len(blocks)
-        blocks.extend(_cells(w, zs, diagonals))
-        wall_blocks[w.id] = list(range(start, len(blocks)))
-
-    add(wall, [])
     crack_axes: Dict[HalfPlane, Tuple[np.ndarray, np.ndarray]] = {}
     n_face = 0.0 if direction == "outward" else wall.inner_face
     for r in returns:
-        diag: List[Tuple[float, HalfPlane]] = []
         betas = set(angles.get(r.wall.id, ()) if angles else ())
         if r.connection == "good":
             betas.add(r.beta_bond)
-        for z_s in zs:
-            for beta in sorted(betas):
-                point = f.to_world(0.0, wall.inner_face, z_s)
-                normal = -math.cos(beta) * f.e_n + math.sin(beta) * f.e_z
-                h = r.wall.frame.line_of_plane(point, normal)
-                if h is not None:
-                    diag.append((z_s, h))
-                    crack_axes[h] = (f.to_world(0.0, n_face, z_s), f.e_s.copy())
+        diag = _diagonals(wall, r, zs, sorted(betas), n_face, crack_axes)
         lines["diagonals"][r.wall.id] = sorted(float(b) for b in betas)
-        add(r.wall, diag)
+        start = len(blocks)
+        blocks.extend(_cells(r.wall, zs, diag))
+        wall_blocks[r.wall.id] = list(range(start, len(blocks)))
     interfaces: List[LPInterface] = []
-    kinds = {"diagonal": "crack"}
     for w_id, ids in wall_blocks.items():
-        w = bld.walls[w_id]
-        interfaces.extend(_wall_interfaces(w, ids, blocks, size, kinds, crack_axes))
-    eps = PROBE_RTOL * size
+        interfaces.extend(
+            _wall_interfaces(
+                bld.walls[w_id], ids, blocks, bld.size, {"diagonal": "crack"}, crack_axes
+            )
+        )
     for r in returns:
-        kind = {"good": "glued", "tied": "glued", "poor": "free"}[r.connection]
-        rf = r.wall.frame
-        s_mid = 0.5 * (r.span[0] + r.span[1])
-        t_a = wall.inner_face
-        # r's elevation coordinate at the façade's inner face (sigma = 0) and at its far end
-        s_j = float(rf.to_frame(f.to_world(s_mid, t_a, 0.0))[0])
-        s_far = float(rf.to_frame(f.to_world(s_mid, t_a + r.reach, 0.0))[0])
-        inward = 1.0 if s_far > s_j else -1.0
-        abutting = r.span[0] >= -1e-9 and r.span[1] <= wall.length + 1e-9
-        for a_b in wall_blocks[facade]:
-            za = [float(x) for x in np.concatenate([q[:, 1] for q in blocks[a_b].rings])]
-            a_lo, a_hi = min(za), max(za)
-            for r_b in wall_blocks[r.wall.id]:
-                blk = blocks[r_b]
-                if abutting:
-                    # r's end face on the façade's inner face
-                    p0, p1 = np.array([s_j, a_lo]), np.array([s_j, a_hi])
-                    probe = np.array([inward * eps, 0.0])
-                    for lo, hi in _intervals_one_side(blk.rings, p0, p1, probe):
-                        q0, q1 = p0 + lo * (p1 - p0), p0 + hi * (p1 - p0)
-                        seg = _clip_segment(q0 + probe, q1 + probe, blk.constraints)
-                        if seg is None:
-                            continue
-                        z0 = q0[1] + seg[0] * (q1[1] - q0[1])
-                        z1 = q0[1] + seg[1] * (q1[1] - q0[1])
-                        if z1 - z0 <= CONTACT_RTOL * size:
-                            continue
-                        pts = np.array(
-                            [
-                                f.to_world(r.span[0], t_a, z0),
-                                f.to_world(r.span[1], t_a, z0),
-                                f.to_world(r.span[1], t_a, z1),
-                                f.to_world(r.span[0], t_a, z1),
-                            ]
-                        )
-                        interfaces.append(LPInterface(a_b, r_b, pts, f.e_n.copy(), kind))
-                else:
-                    # the façade's end face on r's side face: r's blocks beside the end
-                    s_end = 0.0 if r.end == "start" else wall.length
-                    out_dir = -f.e_s if r.end == "start" else f.e_s
-                    sigma = -0.5 * t_a
-                    s_r = float(rf.to_frame(f.to_world(s_mid, t_a + sigma, 0.0))[0])
-                    z_mid = 0.5 * (a_lo + a_hi)
-                    inside = _contains(blk, s_r, z_mid)
-                    if not inside:
-                        continue
+        interfaces.extend(_junction_interfaces(bld, wall, r, blocks, wall_blocks))
+    model = LPModel(blocks, interfaces, [], [], [], [], d, facade, direction, lines)
+    _load(bld, wall, model, wall_blocks, loads, overburden)
+    return model
+
+
+def _diagonals(
+    wall: Wall,
+    r: Any,
+    zs: Sequence[float],
+    betas: Sequence[float],
+    n_face: float,
+    crack_axes: Dict[HalfPlane, Tuple[np.ndarray, np.ndarray]],
+) -> List[Tuple[float, HalfPlane]]:
+    """Cracks through a return wall from the junction at every line height, every angle."""
+    f = wall.frame
+    diag: List[Tuple[float, HalfPlane]] = []
+    for z_s in zs:
+        for beta in betas:
+            point = f.to_world(0.0, wall.inner_face, z_s)
+            normal = -math.cos(beta) * f.e_n + math.sin(beta) * f.e_z
+            h = r.wall.frame.line_of_plane(point, normal)
+            if h is not None:
+                diag.append((z_s, h))
+                crack_axes[h] = (f.to_world(0.0, n_face, z_s), f.e_s.copy())
+    return diag
+
+
+def _edge_spans(
+    blk: LPBlock, s: float, z_lo: float, z_hi: float, probe: np.ndarray, size: float
+) -> List[Tuple[float, float]]:
+    """Height intervals along the vertical line ``s`` where a block has material beside it."""
+    p0, p1 = np.array([s, z_lo]), np.array([s, z_hi])
+    out = []
+    for lo, hi in _intervals_one_side(blk.rings, p0, p1, probe):
+        q0, q1 = p0 + lo * (p1 - p0), p0 + hi * (p1 - p0)
+        seg = _clip_segment(q0 + probe, q1 + probe, blk.constraints)
+        if seg is None:
+            continue
+        z0 = q0[1] + seg[0] * (q1[1] - q0[1])
+        z1 = q0[1] + seg[1] * (q1[1] - q0[1])
+        if z1 - z0 > CONTACT_RTOL * size:
+            out.append((float(z0), float(z1)))
+    return out
+
+
+def _junction_interfaces(
+    bld: Building,
+    wall: Wall,
+    r: Any,
+    blocks: List[LPBlock],
+    wall_blocks: Dict[str, List[int]],
+) -> List[LPInterface]:
+    """Contacts of a return wall with the façade, and with the wall its far end meets."""
+    f, rf = wall.frame, r.wall.frame
+    size = bld.size
+    eps = PROBE_RTOL * size
+    kind = {"good": "glued", "tied": "glued", "poor": "free"}[r.connection]
+    s_mid = 0.5 * (r.span[0] + r.span[1])
+    t_a = wall.inner_face
+    # r's elevation coordinate at the façade's inner face (sigma = 0) and at its far end
+    s_j = float(rf.to_frame(f.to_world(s_mid, t_a, 0.0))[0])
+    s_far = float(rf.to_frame(f.to_world(s_mid, t_a + r.reach, 0.0))[0])
+    inward = 1.0 if s_far > s_j else -1.0
+    abutting = r.span[0] >= -1e-9 and r.span[1] <= wall.length + 1e-9
+    out: List[LPInterface] = []
+    for a_b in wall_blocks[wall.id]:
+        za = np.concatenate([q[:, 1] for q in blocks[a_b].rings])
+        a_lo, a_hi = float(za.min()), float(za.max())
+        for r_b in wall_blocks[r.wall.id]:
+            blk = blocks[r_b]
+            if abutting:  # r's end face on the façade's inner face
+                probe = np.array([inward * eps, 0.0])
+                for z0, z1 in _edge_spans(blk, s_j, a_lo, a_hi, probe, size):
                     pts = np.array(
                         [
-                            f.to_world(s_end, 0.0, a_lo),
-                            f.to_world(s_end, t_a, a_lo),
-                            f.to_world(s_end, t_a, a_hi),
-                            f.to_world(s_end, 0.0, a_hi),
+                            f.to_world(r.span[k], t_a, z)
+                            for k, z in ((0, z0), (1, z0), (1, z1), (0, z1))
                         ]
                     )
-                    interfaces.append(LPInterface(a_b, r_b, pts, out_dir, kind))
-        if r.far_end_wall is not None:
-            # The catalogue's wedge may reach the return wall's far end: there the wall it
-            # meets holds it from outside but lets it part, as the catalogue assumes.
-            far_kind = "free"
-            for r_b in wall_blocks[r.wall.id]:
-                blk = blocks[r_b]
-                zr = np.concatenate([q[:, 1] for q in blk.rings])
-                p0, p1 = np.array([s_far, float(zr.min())]), np.array([s_far, float(zr.max())])
-                probe = np.array([-inward * eps, 0.0])
-                for lo, hi in _intervals_one_side(blk.rings, p0, p1, probe):
-                    q0, q1 = p0 + lo * (p1 - p0), p0 + hi * (p1 - p0)
-                    seg = _clip_segment(q0 + probe, q1 + probe, blk.constraints)
-                    if seg is None:
-                        continue
-                    z0 = q0[1] + seg[0] * (q1[1] - q0[1])
-                    z1 = q0[1] + seg[1] * (q1[1] - q0[1])
-                    if z1 - z0 <= CONTACT_RTOL * size:
-                        continue
-                    pts = _quad(r.wall, s_far, z0, s_far, z1)
-                    interfaces.append(LPInterface(r_b, -1, pts, inward * rf.e_s, far_kind))
-    # loads and restraints on the façade's blocks
-    ids = wall_blocks[facade]
-    bearing: List[Tuple[int, float, np.ndarray]] = []
-    abutting_m: List[Tuple[int, float, np.ndarray]] = []
-    forces: List[Tuple[int, np.ndarray, np.ndarray]] = []
-    restraints: List[Tuple[int, np.ndarray, np.ndarray]] = []
+                    out.append(LPInterface(a_b, r_b, pts, f.e_n.copy(), kind))
+                continue
+            # the façade's end face on r's side face: r's blocks beside the end
+            s_end = 0.0 if r.end == "start" else wall.length
+            s_r = float(rf.to_frame(f.to_world(s_mid, 0.5 * t_a, 0.0))[0])
+            if not _contains(blk, s_r, 0.5 * (a_lo + a_hi)):
+                continue
+            pts = np.array(
+                [
+                    f.to_world(s_end, n, z)
+                    for n, z in ((0.0, a_lo), (t_a, a_lo), (t_a, a_hi), (0.0, a_hi))
+                ]
+            )
+            out.append(
+                LPInterface(a_b, r_b, pts, -f.e_s if r.end == "start" else f.e_s.copy(), kind)
+            )
+    if r.far_end_wall is not None:
+        # The catalogue's wedge may reach the return wall's far end: there the wall it meets
+        # holds it from outside but lets it part, as the catalogue assumes.
+        probe = np.array([-inward * eps, 0.0])
+        for r_b in wall_blocks[r.wall.id]:
+            blk = blocks[r_b]
+            zr = np.concatenate([q[:, 1] for q in blk.rings])
+            for z0, z1 in _edge_spans(blk, s_far, float(zr.min()), float(zr.max()), probe, size):
+                pts = _quad(r.wall, s_far, z0, s_far, z1)
+                out.append(LPInterface(r_b, -1, pts, inward * rf.e_s, "free"))
+    return out
+
+
+def _load(
+    bld: Building,
+    wall: Wall,
+    model: LPModel,
+    wall_blocks: Dict[str, List[int]],
+    loads: Sequence[Any],
+    overburden: Optional[Tuple[float, float]],
+) -> None:
+    """Put the levels, tie-bars, overburden and restraints on the model's blocks."""
+    f, d, blocks = wall.frame, model.d, model.blocks
+    ids = wall_blocks[wall.id]
     placed = set()
     for ld in loads:
         at = _cell_at(bld, blocks, wall_blocks, ld.point)
         if at is None or ld.level.tied:
             continue
         placed.add(ld.contact.index)
-        (bearing if ld.bearing else abutting_m).append((at, ld.mass, ld.point))
+        (model.bearing if ld.bearing else model.abutting).append((at, ld.mass, ld.point))
         if ld.thrust > 0.0:
-            forces.append((at, ld.thrust * d, ld.point))
-    for c in bld.contacts.get(facade, []):
+            model.forces.append((at, ld.thrust * d, ld.point))
+    for c in bld.contacts.get(wall.id, []):
         b = _strip_of(blocks, ids, float(c.point[2]), below=c.bearing)
         if b is None or c.index in placed:
             continue
@@ -567,27 +593,24 @@ def facade_lp_model(
             z = float(c.point[2])
             for s in (0.0, wall.length):
                 for n in (0.0, wall.inner_face):
-                    restraints.append((b, f.to_world(s, n, z), d))
+                    model.restraints.append((b, f.to_world(s, n, z), d))
             continue
-        (bearing if c.bearing else abutting_m).append((b, c.mass, c.point))
+        (model.bearing if c.bearing else model.abutting).append((b, c.mass, c.point))
         thrust = bld.roof_thrust(c, d) if c.level.kind == "roof" and c.level.pushes else 0.0
         if thrust > 0.0:
-            forces.append((b, thrust * d, c.point))
-    for t in bld.ties.get(facade, []):
+            model.forces.append((b, thrust * d, c.point))
+    for t in bld.ties.get(wall.id, []):
         b = _strip_of(blocks, ids, t.z, below=False)
         if b is not None:
-            forces.append((b, -t.tie.force * d, t.point))
+            model.forces.append((b, -t.tie.force * d, t.point))
     n_ob, x_ob, _ = overburden_load(bld, wall, -f.e_n)
     if overburden is not None:
         n_ob, x_ob = overburden[0], -overburden[1]
-    if n_ob > 0.0 and any(c.level.tied for c in bld.contacts.get(facade, [])):
+    if n_ob > 0.0 and any(c.level.tied for c in bld.contacts.get(wall.id, [])):
         b = _strip_of(blocks, ids, wall.z_hi, below=True)
         if b is not None:
             point = f.to_world(0.5 * wall.length, -x_ob, wall.z_hi)
-            bearing.append((b, n_ob / G, point))
-    return LPModel(
-        blocks, interfaces, restraints, bearing, abutting_m, forces, d, facade, direction, lines
-    )
+            model.bearing.append((b, n_ob / G, point))
 
 
 def _cell_at(

@@ -23,7 +23,9 @@ search's scene with a crack layer) and ``search.png`` (the top mechanisms on the
 
 from __future__ import annotations
 
+import json
 import math
+import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,8 +38,10 @@ from rhino_plugin.search.engine import MISSED_GAP, SearchResult, run_search, sli
 from rhino_plugin.search.families import Candidate
 from rhino_plugin.search.prism import segment_intervals
 from rhino_plugin.search.specs import AGREEMENT_RTOL, build_candidates
+from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.errors import InputError, RockmechError
+from shared_schema.extras import require
 from shared_schema.rules import check_file
 from shared_schema.search import SearchSpec, parse_search_spec
 from shared_schema.spec import SpecFile
@@ -45,9 +49,12 @@ from shared_schema.version import __version__
 
 from ..core.envelope import OverturningLibrary
 from ..core.exact import simulate, simulate_batch
+from ..report.search_figure import plot_search
 from .adapter import to_rocking_model
-from .assess import check_doc
+from .assess import check_doc, read_site
 from .documents import envelope_doc, log_grid
+from .inputs import read_record
+from .outputs import finite_json
 
 __all__ = [
     "SCALE_GRID",
@@ -353,6 +360,194 @@ def _resolve(path: str, spec_dir: Optional[Path], what: str) -> Path:
     return p
 
 
+@dataclass
+class _Ranked:
+    """The built candidates and their ranking (``search_run``'s middle steps)."""
+
+    constants: Optional[ConstantsFile] = None
+    failures: list[MechanismFailure] = field(default_factory=list)
+    spec_file: Optional[SpecFile] = None
+    envelopes: Optional[dict[str, Any]] = None
+    dynamic: list[str] = field(default_factory=list)
+
+
+def _build_and_rank(
+    result: SearchResult,
+    spec: SearchSpec,
+    docs: dict[str, dict[str, Any]],
+    ids: list[str],
+    f_p: np.ndarray[Any, Any],
+    scene_name: str,
+    exact: bool,
+    library: Optional[OverturningLibrary],
+) -> _Ranked:
+    """Build the kept candidates and rank them by their overturning acceleration."""
+    out = _Ranked()
+    n_built = min(spec.candidates.keep, len(result.candidates))
+    if not n_built:
+        return out
+    cf, out.failures, agreement, out.spec_file = build_candidates(
+        result.building, result.candidates[:n_built], ids[:n_built], scene_name=scene_name
+    )
+    for f in out.failures:
+        docs[f.id]["builder"] = {"error": f.message}
+    if cf is None:
+        return out
+    out.constants = cf
+    out.envelopes, _ = envelope_doc(cf, f_p, exact=exact, library=library)
+    for entry, mech in zip(out.envelopes["mechanisms"], cf.mechanisms):
+        d = docs[mech.id]
+        values = entry["a_p_min_g"]
+        finite = [v for v in values if v is not None]
+        d["overturning"] = {
+            "a_p_min_g": values,
+            "band_score_g": _band_score(values),
+            "min_g": min(finite) if finite else None,
+            "f_at_min_hz": float(f_p[values.index(min(finite))]) if finite else None,
+        }
+        a = agreement.get(mech.id, {})
+        d["builder"] = {
+            "lam0": a.get("lam0"),
+            "lam0_rel": a.get("lam0_rel"),
+            "mass_rel": a.get("mass_rel"),
+            "agrees": a.get("agrees"),
+            "tolerance": AGREEMENT_RTOL,
+        }
+        d["lam_linearised"] = mech.positive.lam
+        d["constants"] = {
+            "positive": mech.positive.model_dump(exclude_none=True),
+            "negative": None
+            if mech.negative is None
+            else mech.negative.model_dump(exclude_none=True),
+            "eta": mech.eta,
+            "eta_source": mech.eta_source,
+        }
+        if a and not a.get("agrees"):
+            d["notes"].append(
+                f"the builder's exact λ0 ({a.get('lam0')}) and mass differ from the search's by "
+                f"{a.get('lam0_rel'):.3g} and {a.get('mass_rel'):.3g} (relative): an idealised "
+                "wall or a level the builder places elsewhere; the ranking uses the builder's "
+                "constants"
+            )
+
+    def score(mid: str) -> tuple[float, float]:
+        s = docs[mid]["overturning"]["band_score_g"]
+        return (math.inf if s is None else s, docs[mid]["lam0"])
+
+    out.dynamic = sorted([m.id for m in cf.mechanisms], key=score)
+    for r, mid in enumerate(out.dynamic):
+        docs[mid]["rank_dynamic"] = r + 1
+    return out
+
+
+def _run_records(
+    cf: ConstantsFile, top: list[str], motions: Sequence[Any], docs: dict[str, dict[str, Any]]
+) -> list[dict[str, Any]]:
+    """Each record's smallest scale factor that overturns each top mechanism."""
+    out: list[dict[str, Any]] = []
+    sub = ConstantsFile(mechanisms=[m for m in cf.mechanisms if m.id in top])
+    order = [m.id for m in sub.mechanisms]
+    for motion in motions:
+        try:
+            runs = scales_to_overturn(sub, motion)
+        except RockmechError as exc:
+            out.append({"record": motion.name, "note": f"not run: {exc}"})
+            continue
+        out.append({"record": motion.name, "pga_g": float(motion.pga_g), "dt": float(motion.dt)})
+        for mid, run in zip(order, runs):
+            docs[mid].setdefault("records", []).append({"record": motion.name, **run})
+    return out
+
+
+def _run_check(
+    cf: ConstantsFile, top: list[str], site: Any, docs: dict[str, dict[str, Any]]
+) -> dict[str, Any]:
+    """Run the code check of the top mechanisms (α0 and the verdict beside the dynamics)."""
+    check = check_doc(ConstantsFile(mechanisms=[m for m in cf.mechanisms if m.id in top]), site)
+    for row in check["mechanisms"]:
+        lin = row["linear"]
+        docs[row["id"]]["code_check"] = {
+            "alpha0": lin.get("alpha0"),
+            "passes": row["passes"],
+            "linear": lin,
+            "nonlinear": row["nonlinear"],
+            "Z": row["Z"],
+            "Z_source": row["Z_source"],
+        }
+    return {"site": check["site"], "governing": check["governing"]}
+
+
+def _compare(
+    docs: list[dict[str, Any]], dynamic: list[str], band: Sequence[float]
+) -> dict[str, Any]:
+    """Where the static (λ0) and the dynamic rankings of the built mechanisms differ."""
+    built = set(dynamic)
+    static = [d["id"] for d in docs if d["id"] in built]
+    by_id = {d["id"]: d for d in docs}
+    differences = []
+    for mid in dynamic:
+        rs, rd = static.index(mid) + 1, dynamic.index(mid) + 1
+        if rs != rd:
+            differences.append({"id": mid, "static": rs, "dynamic": rd})
+    summary = []
+    if dynamic and dynamic[0] != static[0]:
+        summary.append(
+            f"the static and the dynamic rankings differ: {static[0]} has the least λ0 "
+            f"({by_id[static[0]]['lam0']:.4g}), {dynamic[0]} the least overturning "
+            f"acceleration over {band[0]:g}-{band[1]:g} Hz "
+            f"({by_id[dynamic[0]]['overturning']['band_score_g']:.4g} g)"
+        )
+    return {"differences": differences, "summary": summary}
+
+
+def _input_doc(
+    scene: Any, spec: SearchSpec, bld: Any, scene_name: str, spec_name: str
+) -> dict[str, Any]:
+    return {
+        "scene": scene_name,
+        "spec": spec_name,
+        "scene_units": getattr(scene, "units", None),
+        "walls": {
+            w.id: {
+                "object": w.selector,
+                "thickness_m": w.frame.thickness,
+                "length_m": w.length,
+                "height_m": w.z_hi - w.z_lo,
+                "exact_prism": w.exact,
+                "openings": len(w.holes),
+                "facade": w.is_facade,
+            }
+            for w in bld.walls.values()
+        },
+        "junctions": [
+            {
+                "facade": a,
+                "wall": r.wall.id,
+                "end": r.end,
+                "connection": r.connection,
+                "beta_bond_rad": r.beta_bond,
+                "corner": r.corner,
+            }
+            for a, rets in bld.returns.items()
+            for r in rets
+        ],
+        "families": list(spec.families),
+        "directions": list(spec.directions),
+        "friction": spec.friction,
+    }
+
+
+#: What every search assumes, stated in its document.
+ASSUMPTIONS = (
+    "single-degree-of-freedom mechanisms only; rocking with infinite friction at the hinge "
+    "joints (the sliding flags say where friction would not hold)",
+    "a crack through a return wall separates its wedge without friction (the macro-block "
+    "model); good connections make it run at least at the bond angle",
+    "mechanisms are ranked on the ground motion: none carries amplification, so the code "
+    "check takes Z = 0 for every one",
+)
+
+
 def search_run(
     scene: Any,
     spec: SearchSpec,
@@ -390,12 +585,7 @@ def search_run(
     -------
     SearchRun
     """
-    from .assess import read_site
-    from .inputs import read_record
-
     t0 = time.perf_counter()
-    result = run_search(scene, spec)
-    t1 = time.perf_counter()
     rk = spec.ranking
     if site is None and rk.site is not None:
         site = read_site(_resolve(rk.site, spec_dir, "ranking.site"))
@@ -404,156 +594,32 @@ def search_run(
             read_record(_resolve(r, spec_dir, f"ranking.records[{k}]"))
             for k, r in enumerate(rk.records)
         ]
+    result = run_search(scene, spec)
+    t1 = time.perf_counter()
     cands = result.candidates
-    all_ids = _ids(len(cands))
-    ids = {k: all_ids[k] for k in range(len(cands))}
-    n_built = min(spec.candidates.keep, len(cands))
-    cf: Optional[ConstantsFile] = None
-    failures: list[MechanismFailure] = []
-    agreement: dict[str, dict[str, Any]] = {}
-    sf: Optional[SpecFile] = None
-    if n_built:
-        cf, failures, agreement, sf = build_candidates(
-            result.building, cands[:n_built], all_ids[:n_built], scene_name=scene_name
-        )
-    t2 = time.perf_counter()
+    ids = _ids(len(cands))
     f_p = log_grid(
         rk.band_hz[0], rk.band_hz[1], rk.n_frequencies, names=("band_hz[0]", "band_hz[1]")
     )
     docs = [_candidate_doc(c, ids[k], k + 1, spec.friction) for k, c in enumerate(cands)]
     by_id = {d["id"]: d for d in docs}
-    env_doc: Optional[dict[str, Any]] = None
-    dynamic: list[str] = []
-    if cf is not None:
-        env_doc, _ = envelope_doc(cf, f_p, exact=exact, library=library)
-        for entry, mech in zip(env_doc["mechanisms"], cf.mechanisms):
-            d = by_id[mech.id]
-            values = entry["a_p_min_g"]
-            finite = [v for v in values if v is not None]
-            d["overturning"] = {
-                "a_p_min_g": values,
-                "band_score_g": _band_score(values),
-                "min_g": min(finite) if finite else None,
-                "f_at_min_hz": float(f_p[values.index(min(finite))]) if finite else None,
-            }
-            a = agreement.get(mech.id, {})
-            d["builder"] = {
-                "lam0": a.get("lam0"),
-                "lam0_rel": a.get("lam0_rel"),
-                "mass_rel": a.get("mass_rel"),
-                "agrees": a.get("agrees"),
-                "tolerance": AGREEMENT_RTOL,
-            }
-            d["lam_linearised"] = mech.positive.lam
-            side = mech.positive.model_dump(exclude_none=True)
-            d["constants"] = {
-                "positive": side,
-                "negative": None
-                if mech.negative is None
-                else mech.negative.model_dump(exclude_none=True),
-                "eta": mech.eta,
-                "eta_source": mech.eta_source,
-            }
-            if a and not a.get("agrees"):
-                d["notes"].append(
-                    f"the builder's exact λ0 ({a.get('lam0')}) and mass differ from the search's "
-                    f"by {a.get('lam0_rel'):.3g} and {a.get('mass_rel'):.3g} (relative): an "
-                    "idealised wall or a level the builder places elsewhere; the ranking uses "
-                    "the builder's constants"
-                )
-
-        def score(mid: str) -> tuple[float, float]:
-            s = by_id[mid]["overturning"]["band_score_g"]
-            return (math.inf if s is None else s, by_id[mid]["lam0"])
-
-        dynamic = sorted([m.id for m in cf.mechanisms], key=score)
-        for r, mid in enumerate(dynamic):
-            by_id[mid]["rank_dynamic"] = r + 1
-    for f in failures:
-        by_id[f.id]["builder"] = {"error": f.message}
+    ranked = _build_and_rank(result, spec, by_id, ids, f_p, scene_name, exact, library)
+    t2 = time.perf_counter()
+    top = ranked.dynamic[: rk.keep]
+    cf = ranked.constants
+    records = _run_records(cf, top, motions, by_id) if cf is not None and top and motions else []
     t3 = time.perf_counter()
-    top = dynamic[: rk.keep]
-    records_doc: list[dict[str, Any]] = []
-    if cf is not None and top and motions:
-        sub = ConstantsFile(mechanisms=[m for m in cf.mechanisms if m.id in top])
-        order = [m.id for m in sub.mechanisms]
-        for motion in motions:
-            try:
-                runs = scales_to_overturn(sub, motion)
-            except RockmechError as exc:
-                records_doc.append({"record": motion.name, "note": f"not run: {exc}"})
-                continue
-            records_doc.append(
-                {"record": motion.name, "pga_g": float(motion.pga_g), "dt": float(motion.dt)}
-            )
-            for mid, run in zip(order, runs):
-                by_id[mid].setdefault("records", []).append({"record": motion.name, **run})
+    check = (
+        _run_check(cf, top, site, by_id) if cf is not None and top and site is not None else None
+    )
     t4 = time.perf_counter()
-    check: Optional[dict[str, Any]] = None
-    if cf is not None and top and site is not None:
-        sub = ConstantsFile(mechanisms=[m for m in cf.mechanisms if m.id in top])
-        check = check_doc(sub, site)
-        for row in check["mechanisms"]:
-            lin = row["linear"]
-            by_id[row["id"]]["code_check"] = {
-                "alpha0": lin.get("alpha0"),
-                "passes": row["passes"],
-                "linear": lin,
-                "nonlinear": row["nonlinear"],
-                "Z": row["Z"],
-                "Z_source": row["Z_source"],
-            }
-    t5 = time.perf_counter()
-    static = [d["id"] for d in docs if d["id"] in set(dynamic)]
-    differences = []
-    for mid in dynamic:
-        rs, rd = static.index(mid) + 1, dynamic.index(mid) + 1
-        if rs != rd:
-            differences.append({"id": mid, "static": rs, "dynamic": rd})
-    summary = []
-    if dynamic and static and dynamic[0] != static[0]:
-        summary.append(
-            f"the static and the dynamic rankings differ: {static[0]} has the least λ0 "
-            f"({by_id[static[0]]['lam0']:.4g}), {dynamic[0]} the least overturning "
-            f"acceleration over {rk.band_hz[0]:g}-{rk.band_hz[1]:g} Hz "
-            f"({by_id[dynamic[0]]['overturning']['band_score_g']:.4g} g)"
-        )
-    bld = result.building
+    compare = _compare(docs, ranked.dynamic, rk.band_hz)
+    env = ranked.envelopes
+    n_built = 0 if cf is None else len(cf.mechanisms)
     doc: dict[str, Any] = {
         "rockmech_version": __version__,
         "kind": "search",
-        "input": {
-            "scene": scene_name,
-            "spec": spec_name,
-            "scene_units": getattr(scene, "units", None),
-            "walls": {
-                w.id: {
-                    "object": w.selector,
-                    "thickness_m": w.frame.thickness,
-                    "length_m": w.length,
-                    "height_m": w.z_hi - w.z_lo,
-                    "exact_prism": w.exact,
-                    "openings": len(w.holes),
-                    "facade": w.is_facade,
-                }
-                for w in bld.walls.values()
-            },
-            "junctions": [
-                {
-                    "facade": a,
-                    "wall": r.wall.id,
-                    "end": r.end,
-                    "connection": r.connection,
-                    "beta_bond_rad": r.beta_bond,
-                    "corner": r.corner,
-                }
-                for a, rets in bld.returns.items()
-                for r in rets
-            ],
-            "families": list(spec.families),
-            "directions": list(spec.directions),
-            "friction": spec.friction,
-        },
+        "input": _input_doc(scene, spec, result.building, scene_name, spec_name),
         "units": {
             "length": "m",
             "mass": "kg",
@@ -566,41 +632,30 @@ def search_run(
         "candidates": docs,
         "rankings": {
             "static": [d["id"] for d in docs],
-            "dynamic": dynamic,
-            "differences": differences,
-            "summary": summary,
-            "governing": env_doc["governing"] if env_doc else [],
-            "critical": env_doc["critical"] if env_doc else [],
-            "envelope_method": env_doc["method"] if env_doc else None,
+            "dynamic": ranked.dynamic,
+            **compare,
+            "governing": env["governing"] if env else [],
+            "critical": env["critical"] if env else [],
+            "envelope_method": env["method"] if env else None,
             "band_score": "geometric mean of a_p,min over the band [g]",
         },
         "lp": [_lp_doc(ch) for ch in result.checks],
-        "records": records_doc,
-        "code_check": None
-        if check is None
-        else {"site": check["site"], "governing": check["governing"]},
-        "not_built": [d["id"] for d in docs[n_built:]],
-        "failures": [{"id": f.id, "error": f.message} for f in failures],
-        "counts": {**result.counts, "built": 0 if cf is None else len(cf.mechanisms)},
+        "records": records,
+        "code_check": check,
+        "not_built": [d["id"] for d in docs[min(spec.candidates.keep, len(docs)) :]],
+        "failures": [{"id": f.id, "error": f.message} for f in ranked.failures],
+        "counts": {**result.counts, "built": n_built},
         "timings": {
             **result.timings,
-            "constants_s": t2 - t1,
-            "ranking_s": t3 - t2,
-            "records_s": t4 - t3,
-            "code_check_s": t5 - t4,
-            "total_s": t5 - t0,
+            "constants_and_ranking_s": t2 - t1,
+            "records_s": t3 - t2,
+            "code_check_s": t4 - t3,
+            "total_s": t4 - t0,
         },
-        "assumptions": [
-            "single-degree-of-freedom mechanisms only; rocking with infinite friction at the "
-            "hinge joints (the sliding flags say where friction would not hold)",
-            "a crack through a return wall separates its wedge without friction (the "
-            "macro-block model); good connections make it run at least at the bond angle",
-            "mechanisms are ranked on the ground motion: none carries amplification, so the "
-            "code check takes Z = 0 for every one",
-        ],
-        "notes": list(result.notes) + summary,
+        "assumptions": list(ASSUMPTIONS),
+        "notes": list(result.notes) + compare["summary"],
     }
-    return SearchRun(doc, sf, cf, result, ids)
+    return SearchRun(doc, ranked.spec_file, cf, result, dict(enumerate(ids)))
 
 
 def _layer(model: Any, r3: Any, path: str, cache: dict[str, int]) -> int:
@@ -629,8 +684,6 @@ def search_3dm(run: SearchRun) -> bytes:
     them; each built mechanism has a layer ``rockmech search::<id>`` with its cracks (planar
     patches through the walls) and its hinge axis.
     """
-    from shared_schema.extras import require
-
     r3 = require("rhino3dm", "geometry", "to write the search's .3dm")
     model = r3.File3dm()
     model.Settings.ModelUnitSystem = r3.UnitSystem.Meters
@@ -680,8 +733,6 @@ def search_3dm(run: SearchRun) -> bytes:
 
 def _encode(model: Any) -> bytes:
     """Write a File3dm to bytes (Rhino 8 format) through a temporary file."""
-    import tempfile
-
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "search.3dm"
         if not model.Write(str(path), 8):
@@ -698,13 +749,6 @@ def write_search(run: SearchRun, out_dir: Path, *, figure: bool = True) -> list[
         ``search.json``, ``search.spec.json``, ``constants.json`` (when any was built),
         ``search.3dm`` and ``search.png``.
     """
-    import json
-
-    from shared_schema.atomic import write_atomic
-
-    from ..report.search_figure import plot_search
-    from .outputs import finite_json
-
     out = []
     doc = finite_json(run.doc)
     path = out_dir / "search.json"
