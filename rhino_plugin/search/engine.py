@@ -13,9 +13,10 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
-from rhino_plugin.search.families import Candidate, enumerate_candidates
+from rhino_plugin.search.families import Budget, Candidate, enumerate_candidates
 from rhino_plugin.search.lp import LPModel, LPResult, facade_lp_model, solve_lp
 from rhino_plugin.search.model import Building, building_from_scene
+from shared_schema.errors import InputError
 from shared_schema.rules import G
 
 __all__ = ["MISSED_GAP", "LPCheck", "SearchResult", "run_search", "sliding_check"]
@@ -151,7 +152,14 @@ def _lines(
     return heights, angles
 
 
-def run_search(scene: Any, spec: Any, *, lp: Optional[bool] = None) -> SearchResult:
+def run_search(
+    scene: Any,
+    spec: Any,
+    *,
+    lp: Optional[bool] = None,
+    max_evaluations: Optional[int] = None,
+    max_lp_blocks: Optional[int] = None,
+) -> SearchResult:
     """Search a scene's mechanisms as the spec asks.
 
     Parameters
@@ -162,6 +170,15 @@ def run_search(scene: Any, spec: Any, *, lp: Optional[bool] = None) -> SearchRes
         The search spec.
     lp : bool, optional
         Run the global check (default: the spec's ``lp``).
+    max_evaluations : int, optional
+        Work limit: most λ0 evaluations of the refinements (none by default).
+    max_lp_blocks : int, optional
+        Work limit: most macro-blocks of one check (none by default).
+
+    Raises
+    ------
+    InputError
+        On field ``work_limit``: the search would exceed a limit (before doing that work).
 
     Returns
     -------
@@ -170,7 +187,7 @@ def run_search(scene: Any, spec: Any, *, lp: Optional[bool] = None) -> SearchRes
     t0 = time.perf_counter()
     bld = building_from_scene(scene, spec)
     t1 = time.perf_counter()
-    cands, notes = enumerate_candidates(bld)
+    cands, notes = enumerate_candidates(bld, Budget(max_evaluations))
     for c in cands:
         flag = sliding_check(c, spec.friction)
         if flag is not None:
@@ -197,6 +214,13 @@ def run_search(scene: Any, spec: Any, *, lp: Optional[bool] = None) -> SearchRes
             heights, angles = _lines(along, facade, direction)
             first = next(c for c in along if c.facade == facade and c.direction == direction)
             model = facade_lp_model(bld, facade, direction, heights, angles, loads=first.contacts)
+            if max_lp_blocks is not None and len(model.blocks) > max_lp_blocks:
+                raise InputError(
+                    f"the global check of {facade} {direction} has {len(model.blocks)} "
+                    f"macro-blocks, more than the work limit's {max_lp_blocks}: set lp false "
+                    "or no candidates.spacing, or raise the work limit",
+                    "work_limit",
+                )
             res = solve_lp(model)
             fric = solve_lp(model, friction=spec.friction)
             best = min(c.lam0 for c in along if c.facade == facade and c.direction == direction)

@@ -38,9 +38,10 @@ from rhino_plugin.search.model import Building, LevelContact, ReturnWall, TiePoi
 from rhino_plugin.search.multiplier import rotation_multiplier, two_block_multiplier
 from rhino_plugin.search.prism import Lump, clip_rings, point_lump, ring_moments
 from rhino_plugin.search.refine import minimise
+from shared_schema.errors import InputError
 from shared_schema.rules import G
 
-__all__ = ["Candidate", "Piece", "enumerate_candidates", "hinge_lines"]
+__all__ = ["Budget", "Candidate", "Piece", "enumerate_candidates", "hinge_lines"]
 
 Plane = Tuple[np.ndarray, np.ndarray]  # (point [m], normal): keeps normal·(x - point) >= 0
 
@@ -52,6 +53,32 @@ BETA_MAX = math.radians(80.0)
 H1_RANGE = (0.02, 0.98)
 #: A block lighter than this fraction of its wall is no block (a sliver at an edge).
 MIN_MASS_FRACTION = 1e-9
+
+
+class Budget:
+    """A cap on the λ0 evaluations of one search (the work limit).
+
+    It is checked before each refinement starts, so that a search too large for the limit
+    stops before doing that work.
+    """
+
+    def __init__(self, limit: Optional[int] = None) -> None:
+        self.limit = limit
+        self.used = 0
+
+    def reserve(self, n: int, what: str) -> None:
+        """Count the seed grid of the next refinement (raise past the limit)."""
+        if self.limit is not None and self.used + n > self.limit:
+            raise InputError(
+                f"the search needs more than {self.limit} evaluations of λ0 (at {what}); "
+                "ask for fewer families or directions, a coarser candidates.grid or no "
+                "candidates.spacing, or raise the work limit",
+                "work_limit",
+            )
+
+    def spend(self, n: int) -> None:
+        """Count the evaluations a refinement made."""
+        self.used += n
 
 
 @dataclass
@@ -407,9 +434,15 @@ class Template:
         w = body + weighing
         return rotation_multiplier(w, w + abutting, self.point, self.d, forces)
 
-    def refine(self, facade: str, direction: str, grid: int) -> Optional[Candidate]:
+    def refine(
+        self, facade: str, direction: str, grid: int, budget: Optional[Budget] = None
+    ) -> Optional[Candidate]:
         """Minimise λ0 over the parameters; None where no admissible point exists."""
+        if budget is not None:
+            budget.reserve(grid ** len(self.bounds), f"{facade} {direction} {self.family}")
         res = minimise(self.lam, self.bounds, grid)
+        if budget is not None:
+            budget.spend(res.n_evaluations)
         if not math.isfinite(res.value):
             return None
         params = {"hinge_height_m": self.hinge_z} if self.family != "corner" else {}
@@ -549,6 +582,7 @@ def _rigid_candidates(
     families: Sequence[str],
     grid: int,
     notes: List[str],
+    budget: Budget,
 ) -> List[Candidate]:
     out: List[Candidate] = []
     said = set()
@@ -561,7 +595,7 @@ def _rigid_candidates(
             continue
         if tmpl.family not in families:
             continue
-        cand = tmpl.refine(wall.id, direction, grid)
+        cand = tmpl.refine(wall.id, direction, grid, budget)
         if cand is not None:
             out.append(cand)
     return out
@@ -626,7 +660,9 @@ def two_block_lam(
     return two_block_multiplier(planar(lo), planar(up), (0.0, 0.0), (-b, h1), (0.0, h), n, (x_p, h))
 
 
-def _flexure_candidates(bld: Building, wall: Wall, grid: int, notes: List[str]) -> List[Candidate]:
+def _flexure_candidates(
+    bld: Building, wall: Wall, grid: int, notes: List[str], budget: Budget
+) -> List[Candidate]:
     tol = _tol(bld) * 1e3
     contacts = bld.contacts.get(wall.id, [])
     top = [c for c in contacts if c.level.tied and c.z_range[1] >= wall.z_hi - tol]
@@ -645,7 +681,9 @@ def _flexure_candidates(bld: Building, wall: Wall, grid: int, notes: List[str]) 
     n, x_n, ob_notes = overburden_load(bld, wall, d)
     h = wall.z_hi - wall.z_lo
     bounds = (H1_RANGE[0] * h, H1_RANGE[1] * h)
+    budget.reserve(grid, f"{wall.id} vertical_flexure")
     res = minimise(lambda x: two_block_lam(wall, x[0], d, n, x_n), [bounds], grid)
+    budget.spend(res.n_evaluations)
     if not math.isfinite(res.value):
         return []
     h1 = res.x[0]
@@ -679,7 +717,9 @@ def _flexure_candidates(bld: Building, wall: Wall, grid: int, notes: List[str]) 
     return [cand]
 
 
-def _corner_candidates(bld: Building, wall: Wall, grid: int, notes: List[str]) -> List[Candidate]:
+def _corner_candidates(
+    bld: Building, wall: Wall, grid: int, notes: List[str], budget: Budget
+) -> List[Candidate]:
     out: List[Candidate] = []
     f = wall.frame
     for r in bld.returns.get(wall.id, []):
@@ -724,14 +764,18 @@ def _corner_candidates(bld: Building, wall: Wall, grid: int, notes: List[str]) -
             wall.z_lo,
             [f"corner of {wall.id} and {r.wall.id} at {wall.id}'s {r.end}"],
         )
-        cand = tmpl.refine(wall.id, "outward", grid)
+        cand = tmpl.refine(wall.id, "outward", grid, budget)
         if cand is not None:
             out.append(cand)
     return out
 
 
-def enumerate_candidates(bld: Building) -> Tuple[List[Candidate], List[str]]:
+def enumerate_candidates(
+    bld: Building, budget: Optional[Budget] = None
+) -> Tuple[List[Candidate], List[str]]:
     """Every refined candidate of the families and directions the spec asks for.
+
+    ``budget`` caps the λ0 evaluations (``InputError`` on field ``work_limit`` past it).
 
     Returns
     -------
@@ -742,6 +786,7 @@ def enumerate_candidates(bld: Building) -> Tuple[List[Candidate], List[str]]:
     """
     spec = bld.spec
     grid = spec.candidates.grid
+    budget = budget if budget is not None else Budget()
     notes: List[str] = []
     out: List[Candidate] = []
     for wall in bld.walls.values():
@@ -757,11 +802,11 @@ def enumerate_candidates(bld: Building) -> Tuple[List[Candidate], List[str]]:
                     )
                     continue
                 free_done = True
-            out.extend(_rigid_candidates(bld, wall, direction, spec.families, grid, notes))
+            out.extend(_rigid_candidates(bld, wall, direction, spec.families, grid, notes, budget))
         if "vertical_flexure" in spec.families:
-            out.extend(_flexure_candidates(bld, wall, grid, notes))
+            out.extend(_flexure_candidates(bld, wall, grid, notes, budget))
         if "corner" in spec.families and "outward" in spec.directions:
-            out.extend(_corner_candidates(bld, wall, grid, notes))
+            out.extend(_corner_candidates(bld, wall, grid, notes, budget))
     seen = set()
     unique = []
     for c in out:

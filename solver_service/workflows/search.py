@@ -34,6 +34,7 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 from rhino_plugin.mechanisms.build import MechanismFailure
+from rhino_plugin.scenes import read_scene
 from rhino_plugin.search.engine import MISSED_GAP, SearchResult, run_search, sliding_check
 from rhino_plugin.search.families import Candidate
 from rhino_plugin.search.prism import segment_intervals
@@ -63,10 +64,16 @@ __all__ = [
     "read_search_spec",
     "scales_to_overturn",
     "search_3dm",
+    "search_from_files",
     "search_run",
     "write_search",
 ]
 
+#: Work limit of one search [evaluations of λ0]: the command line lifts it with
+#: ``--no-limits``, a REST request may lower it (about 0.2 ms each on one core).
+MAX_EVALUATIONS = 200_000
+#: Work limit of one global check [macro-blocks] (about 1 s for 300 on one core).
+MAX_LP_BLOCKS = 2_000
 #: Scale factors of a record tried for overturning: log-spaced (lowest, highest, count).
 SCALE_GRID = (0.05, 50.0, 60)
 #: Relative width to which the first overturning scale factor is bisected.
@@ -322,7 +329,8 @@ def _lp_doc(check: Any) -> dict[str, Any]:
         f"the catalogue missed a mechanism: the check's multiplier {check.lam:.6g} is "
         f"{100 * check.gap:.3g} % below the best catalogue mechanism's {check.best:.6g}"
         if check.missed
-        else f"the best catalogue mechanism holds the check's optimum (gap {100 * check.gap:.3g} %)"
+        else "the best catalogue mechanism holds the check's optimum (the check's multiplier "
+        f"{check.lam:.6g} is {100 * max(check.gap, 0.0):.2g} % below it)"
     )
     doc: dict[str, Any] = {
         "facade": check.facade,
@@ -559,6 +567,8 @@ def search_run(
     motions: Optional[Sequence[Any]] = None,
     exact: bool = False,
     library: Optional[OverturningLibrary] = None,
+    max_evaluations: Optional[int] = MAX_EVALUATIONS,
+    max_lp_blocks: Optional[int] = MAX_LP_BLOCKS,
 ) -> SearchRun:
     """Search, build and rank a scene's mechanisms (the module docstring's steps).
 
@@ -580,6 +590,9 @@ def search_run(
         Envelopes by the exact solver instead of the library.
     library : OverturningLibrary, optional
         The library to interpolate (default: the shipped one).
+    max_evaluations, max_lp_blocks : int or None
+        Work limits (``MAX_EVALUATIONS``, ``MAX_LP_BLOCKS``; None: none): a search that
+        would exceed one stops before doing that work (``InputError`` on ``work_limit``).
 
     Returns
     -------
@@ -594,7 +607,7 @@ def search_run(
             read_record(_resolve(r, spec_dir, f"ranking.records[{k}]"))
             for k, r in enumerate(rk.records)
         ]
-    result = run_search(scene, spec)
+    result = run_search(scene, spec, max_evaluations=max_evaluations, max_lp_blocks=max_lp_blocks)
     t1 = time.perf_counter()
     cands = result.candidates
     ids = _ids(len(cands))
@@ -771,3 +784,50 @@ def write_search(run: SearchRun, out_dir: Path, *, figure: bool = True) -> list[
         if png is not None:
             out.append(png)
     return out
+
+
+def search_from_files(
+    scene: Path,
+    spec: Path,
+    *,
+    units: Optional[str] = None,
+    site: Optional[Path] = None,
+    records: Sequence[Path] = (),
+    exact: bool = False,
+    limits: bool = True,
+) -> SearchRun:
+    """Search a scene file with a search-spec file (the command line's and the API's way in).
+
+    Parameters
+    ----------
+    scene : Path
+        A ``.3dm`` file, or a scan mesh (``.ply``, ``.obj``, ``.stl``, ``.off``) with ``units``.
+    spec : Path
+        The search spec (JSON); its ``ranking.site`` and ``ranking.records`` are relative to
+        its folder.
+    units : str, optional
+        Length unit of a scan mesh.
+    site : Path, optional
+        A site file, instead of the spec's ``ranking.site``.
+    records : sequence of Path
+        Records, instead of the spec's ``ranking.records`` (formats detected).
+    exact : bool
+        Envelopes by the exact solver instead of the library.
+    limits : bool
+        Apply the work limits (``MAX_EVALUATIONS``, ``MAX_LP_BLOCKS``).
+    """
+    check_file(scene, "scene")
+    search_spec = read_search_spec(spec)
+    scene_obj = read_scene(scene, units=units)
+    return search_run(
+        scene_obj,
+        search_spec,
+        scene_name=scene.name,
+        spec_name=spec.name,
+        spec_dir=spec.parent,
+        site=None if site is None else read_site(site),
+        motions=[read_record(r) for r in records] if records else None,
+        exact=exact,
+        max_evaluations=MAX_EVALUATIONS if limits else None,
+        max_lp_blocks=MAX_LP_BLOCKS if limits else None,
+    )
