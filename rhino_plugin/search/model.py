@@ -332,8 +332,18 @@ class Building:
 # --- reading -------------------------------------------------------------------------------
 
 
+def _find(scene: Any, selectors: Sequence[Any], where: str) -> List[SceneObject]:
+    """``find_objects``, with a miss named by the search spec's field."""
+    try:
+        return find_objects(scene, selectors, where)
+    except InputError as exc:
+        if exc.field == "selector":
+            raise InputError(exc.reason, where) from None
+        raise
+
+
 def _one_object(scene: Any, selector: Any, where: str) -> SceneObject:
-    objs = find_objects(scene, [selector], where)
+    objs = _find(scene, [selector], where)
     if len(objs) != 1:
         names = ", ".join(o.label() for o in objs[:6])
         raise InputError(
@@ -628,7 +638,7 @@ def _level_contacts(
     objects: Dict[str, List[SceneObject]] = {}
     for k, level in enumerate(spec.levels):
         where = f"levels[{k}]"
-        objs = find_objects(scene, level.objects, where)
+        objs = _find(scene, level.objects, f"{where}.objects")
         meshes = []
         for obj in objs:
             mesh, warn = check_solid(scene.mesh(obj))
@@ -699,7 +709,7 @@ def _tie_points(
     out: Dict[str, List[TiePoint]] = {w: [] for w in walls}
     for k, tie in enumerate(spec.tie_bars):
         where = f"tie_bars[{k}]"
-        obj = find_objects(scene, [tie.object], where)[0]
+        obj = _find(scene, [tie.object], f"{where}.object")[0]
         start, end = scene.line(obj)
         memory.add(SceneObject(obj.id, obj.name, obj.layer, "line", {}, (start, end)))
         met = False
@@ -752,7 +762,7 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
     memory = MemoryScene([], path=scene.path, tolerance=scene.tolerance, source_units=scene.units)
     openings: List[Tuple[SceneObject, TriMesh]] = []
     for k, sel in enumerate(spec.openings):
-        for obj in find_objects(scene, [sel], f"openings[{k}]"):
+        for obj in _find(scene, [sel], f"openings[{k}]"):
             mesh, warn = check_solid(scene.mesh(obj))
             notes.extend(warn)
             openings.append((obj, mesh))
@@ -771,7 +781,7 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
         if obj.geometry is not mesh:
             obj = SceneObject(obj.id, obj.name, obj.layer, obj.kind, dict(obj.user_text), mesh)
         if w.overburden is not None and w.overburden.objects is not None:
-            for o in find_objects(scene, w.overburden.objects, f"walls[{k}].overburden"):
+            for o in _find(scene, w.overburden.objects, f"walls[{k}].overburden.objects"):
                 m, warn = check_solid(scene.mesh(o))
                 notes.extend(warn)
                 memory.add(SceneObject(o.id, o.name, o.layer, "mesh", dict(o.user_text), m))
