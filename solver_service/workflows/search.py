@@ -381,7 +381,7 @@ class _Ranked:
 
 def _build_and_rank(
     result: SearchResult,
-    spec: SearchSpec,
+    keep: int,
     docs: dict[str, dict[str, Any]],
     ids: list[str],
     f_p: np.ndarray[Any, Any],
@@ -391,7 +391,7 @@ def _build_and_rank(
 ) -> _Ranked:
     """Build the kept candidates and rank them by their overturning acceleration."""
     out = _Ranked()
-    n_built = min(spec.candidates.keep, len(result.candidates))
+    n_built = min(keep, len(result.candidates))
     if not n_built:
         return out
     cf, out.failures, agreement, out.spec_file = build_candidates(
@@ -569,6 +569,7 @@ def search_run(
     library: Optional[OverturningLibrary] = None,
     max_evaluations: Optional[int] = MAX_EVALUATIONS,
     max_lp_blocks: Optional[int] = MAX_LP_BLOCKS,
+    max_built: Optional[int] = None,
 ) -> SearchRun:
     """Search, build and rank a scene's mechanisms (the module docstring's steps).
 
@@ -593,6 +594,9 @@ def search_run(
     max_evaluations, max_lp_blocks : int or None
         Work limits (``MAX_EVALUATIONS``, ``MAX_LP_BLOCKS``; None: none): a search that
         would exceed one stops before doing that work (``InputError`` on ``work_limit``).
+    max_built : int, optional
+        Most mechanisms built and ranked (the service's ``max_mechanisms``), below the spec's
+        ``candidates.keep``; the document says when it cut the list.
 
     Returns
     -------
@@ -616,7 +620,15 @@ def search_run(
     )
     docs = [_candidate_doc(c, ids[k], k + 1, spec.friction) for k, c in enumerate(cands)]
     by_id = {d["id"]: d for d in docs}
-    ranked = _build_and_rank(result, spec, by_id, ids, f_p, scene_name, exact, library)
+    keep = spec.candidates.keep
+    notes = list(result.notes)
+    if max_built is not None and min(keep, len(cands)) > max_built:
+        notes.append(
+            f"only the {max_built} mechanisms of least λ0 are built and ranked (the service's "
+            f"max_mechanisms), not the {min(keep, len(cands))} candidates.keep asks for"
+        )
+        keep = max_built
+    ranked = _build_and_rank(result, keep, by_id, ids, f_p, scene_name, exact, library)
     t2 = time.perf_counter()
     top = ranked.dynamic[: rk.keep]
     cf = ranked.constants
@@ -655,7 +667,7 @@ def search_run(
         "lp": [_lp_doc(ch) for ch in result.checks],
         "records": records,
         "code_check": check,
-        "not_built": [d["id"] for d in docs[min(spec.candidates.keep, len(docs)) :]],
+        "not_built": [d["id"] for d in docs[min(keep, len(docs)) :]],
         "failures": [{"id": f.id, "error": f.message} for f in ranked.failures],
         "counts": {**result.counts, "built": n_built},
         "timings": {
@@ -666,7 +678,7 @@ def search_run(
             "total_s": t4 - t0,
         },
         "assumptions": list(ASSUMPTIONS),
-        "notes": list(result.notes) + compare["summary"],
+        "notes": notes + compare["summary"],
     }
     return SearchRun(doc, ranked.spec_file, cf, result, dict(enumerate(ids)))
 
