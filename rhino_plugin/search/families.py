@@ -287,8 +287,48 @@ def _region_mass(wall: Wall, planes: Sequence[Plane]) -> float:
     return float(ring_moments(wall.region(planes))[0]) * wall.frame.thickness * wall.density
 
 
+Hits = Dict[int, Tuple[float, np.ndarray, LevelContact, Any]]
+
+
+def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = None) -> Hits:
+    """Each level's largest contact with the moving parts: level -> (area, centroid, ...).
+
+    Every contact of a level with a wall is clipped to that wall's moving part (the plane
+    of the contact, cut by the part's half-spaces); ``best`` (the hits of other parts) is
+    extended, not changed.
+    """
+    tol = max(bld.contact_tol, 0.0)
+    out: Hits = dict(best or {})
+    for piece in pieces:
+        for c in bld.contacts.get(piece.wall.id, []):
+            for region in c.regions:
+                rings = list(region.rings)
+                u, v, o = region.u.tolist(), region.v.tolist(), region.origin.tolist()
+                for point, normal in piece.planes:
+                    m0, m1, m2 = (float(x) for x in normal)
+                    p0, p1, p2 = (float(x) for x in point)
+                    rings = clip_rings(
+                        rings,
+                        m0 * u[0] + m1 * u[1] + m2 * u[2],
+                        m0 * v[0] + m1 * v[1] + m2 * v[2],
+                        m0 * (o[0] - p0) + m1 * (o[1] - p1) + m2 * (o[2] - p2),
+                    )
+                area, su, sv = (float(x) for x in ring_moments(rings)[:3])
+                if not area > 0.0:
+                    continue
+                pts = np.vstack(rings) if len(rings) > 1 else rings[0]
+                extent = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
+                if area <= tol * extent:
+                    continue  # a touch along a line (the builder's MIN_WIDTH_FACTOR)
+                k = c.index
+                if k not in out or area > out[k][0]:
+                    centroid = region.origin + (su / area) * region.u + (sv / area) * region.v
+                    out[k] = (area, centroid, c, region)
+    return out
+
+
 def level_loads(
-    bld: Building, pieces: Sequence[Piece], d: np.ndarray
+    bld: Building, pieces: Sequence[Piece], d: np.ndarray, hits: Optional[Hits] = None
 ) -> Tuple[List[LevelLoad], Optional[str]]:
     """Return the levels a mechanism's moving parts carry, as the constants builder finds them.
 
@@ -296,7 +336,8 @@ def level_loads(
     contacts with a wall clipped to that wall's moving part), bears if that contact is
     horizontal (a roof always bears), and a roof that is not a tied truss thrusts along the
     collapse direction ``d`` (span and rise from its bounding box in the mechanism's frame),
-    as ``mechanisms.loaded.loaded_side`` computes them.
+    as ``mechanisms.loaded.loaded_side`` computes them. ``hits`` are the contacts of other
+    moving parts already found (``contact_hits``).
 
     Returns
     -------
@@ -305,31 +346,7 @@ def level_loads(
     held : str or None
         The id of a tied level the moving parts touch (the mechanism is then held).
     """
-    tol = max(bld.contact_tol, 0.0)
-    best: Dict[int, Tuple[float, np.ndarray, LevelContact, Any]] = {}
-    for piece in pieces:
-        for c in bld.contacts.get(piece.wall.id, []):
-            for region in c.regions:
-                rings = list(region.rings)
-                for point, normal in piece.planes:
-                    m = np.asarray(normal, dtype=float)
-                    rings = clip_rings(
-                        rings,
-                        float(m @ region.u),
-                        float(m @ region.v),
-                        float(m @ (region.origin - np.asarray(point, dtype=float))),
-                    )
-                area, su, sv = (float(x) for x in ring_moments(rings)[:3])
-                if not area > 0.0:
-                    continue
-                pts = np.vstack(rings)
-                extent = float(np.max(np.ptp(pts, axis=0)))
-                if area <= tol * extent:
-                    continue  # a touch along a line (the builder's MIN_WIDTH_FACTOR)
-                centroid = region.origin + (su / area) * region.u + (sv / area) * region.v
-                k = c.index
-                if k not in best or area > best[k][0]:
-                    best[k] = (area, centroid, c, region)
+    best = contact_hits(bld, pieces, hits)
     loads: List[LevelLoad] = []
     held = None
     for k in sorted(best):
@@ -414,6 +431,7 @@ class Template:
         for p in self.fixed:
             lump = lump + p.lump()
         self._fixed_lump = lump
+        self._fixed_hits = contact_hits(self.bld, self.fixed)
 
     def pieces(self, x: Sequence[float]) -> List[Piece]:
         """Return every moving part at parameters ``x``."""
@@ -427,7 +445,7 @@ class Template:
             body = body + p.lump()
         if not body.mass > 0.0:
             return math.inf
-        loads, held = level_loads(self.bld, self.fixed + variable, self.d)
+        loads, held = level_loads(self.bld, variable, self.d, self._fixed_hits)
         if held is not None:
             return math.inf
         weighing, abutting, forces = _loads(loads, self.ties, self.d)

@@ -41,6 +41,8 @@ __all__ = [
 
 Ring = np.ndarray
 Rings = List[np.ndarray]
+#: A frame's axes and origin as plain lists (for the per-evaluation arithmetic).
+Axes = Tuple[List[float], List[float], List[float], List[float]]
 
 #: Rings up to this many vertices are integrated and clipped in plain Python (faster than
 #: numpy's per-call overhead on the few vertices of a block); longer ones (scans) in numpy.
@@ -327,7 +329,7 @@ class WallFrame:
         return a, b, c
 
     @property
-    def _axes(self) -> Tuple[List[float], List[float], List[float], List[float]]:
+    def _axes(self) -> Axes:
         cached = self.__dict__.get("_axes_cache")
         if cached is None:
             cached = (
@@ -337,7 +339,7 @@ class WallFrame:
                 self.origin.tolist(),
             )
             object.__setattr__(self, "_axes_cache", cached)
-        return cast(Tuple[List[float], List[float], List[float], List[float]], cached)
+        return cast(Axes, cached)
 
     def prism_lump(self, rings: Sequence[np.ndarray], density: float) -> Lump:
         """Lump of the prism of an elevation region through the whole thickness.
