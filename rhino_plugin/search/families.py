@@ -504,10 +504,13 @@ def _label(bld: Building, wall: Wall, z_h: float, wedges: bool, tol: float) -> s
         return "overturning"
     tops = [c.z_range[1] for c in bld.contacts.get(wall.id, [])]
     if tops and z_h >= max(tops) - tol:
-        ring = wall.rings[0]
-        above = ring[ring[:, 1] > z_h + tol]
-        top = wall.z_hi
-        sloped = bool(np.any(np.abs(above[:, 1] - top) > tol)) if len(above) else False
+        # a gable's outline above the line is no rectangle (sloped edges), a parapet's is
+        above = clip_rings([wall.rings[0]], 0.0, 1.0, -z_h)
+        if not above:
+            return "parapet"
+        pts = np.vstack(above)
+        box = float(np.ptp(pts[:, 0]) * np.ptp(pts[:, 1]))
+        sloped = float(ring_moments(above)[0]) < (1.0 - 1e-9) * box
         return "gable" if sloped else "parapet"
     return "partial_overturning"
 

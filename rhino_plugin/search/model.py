@@ -777,7 +777,9 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
             new_obj, mesh, cut_notes = _cut_openings(obj, mesh, openings, where)
             notes.extend(cut_notes)
             if new_obj is not obj:
-                obj, selector = new_obj, {"id": new_obj.id}
+                # by name: the input scene has no such object, so its wall (without the
+                # voids) cannot be used by mistake, and the message says which one is meant
+                obj, selector = new_obj, new_obj.name
         if obj.geometry is not mesh:
             obj = SceneObject(obj.id, obj.name, obj.layer, obj.kind, dict(obj.user_text), mesh)
         if w.overburden is not None and w.overburden.objects is not None:
