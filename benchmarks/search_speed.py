@@ -23,7 +23,7 @@ between 2 return walls, a back wall, two floors, a roof and a tie-bar) with its 
 5. *the LP check*: the global upper-bound programme (``lp.facade_lp_model`` + ``solve_lp``,
    HiGHS dual simplex) of the example façade at its own candidate lines, of the same façade
    cut by a line every ``LP_SPACING`` metres (about 300 macro-blocks), and of a two-block
-   strip of 300 blocks (MECHSEARCH.md §4.1).
+   strip of 300 blocks (docs/search.md V1).
 
 How: one process, threads pinned to one (``*_NUM_THREADS=1`` before numpy loads, and
 ``core.exact.single_threaded`` around the records); one cold call of each stage, then the
@@ -325,7 +325,7 @@ def _near_300(bld: Any, facade: str, heights: list[float], angles: Any, loads: A
 
 
 def _strip_model() -> Any:
-    """Build the two-block strip of MECHSEARCH.md §4.1 cut into 300 blocks (b 0.3, h 3, N = W)."""
+    """Build the two-block strip of docs/search.md V1 cut into 300 blocks (b 0.3, h 3, N = W)."""
     import tempfile
 
     sys.path.insert(0, str(REPO / "tests" / "search"))

@@ -139,7 +139,7 @@ def two_block_multiplier(
     Block 1 turns at unit rate about O: a point moves by ``(z - z_O, -(x - x_O))``. Block 2
     moves with C and turns at ``ω2 = -δx_C / (z_H - z_C)`` about it so that H stays on its
     restraint. For rectangles with N at H this is
-    ``λ0(h1) = (2b/W) [(W + N)/h1 + N/h2]`` (``../shared/MECHSEARCH.md`` §4.1).
+    ``λ0(h1) = (2b/W) [(W + N)/h1 + N/h2]`` (docs/search.md, V1).
 
     Examples
     --------

@@ -1,10 +1,10 @@
 """V1 and V2 of issue #31: the search's exact λ0 and refinement against closed forms.
 
-V1 (``../shared/MECHSEARCH.md`` §4.1): a two-block wall restrained at the top, overburden N
+V1 (docs/search.md, Validation): a two-block wall restrained at the top, overburden N
 at the top hinge: ``λ0(h1) = (2b/W) [(W + N)/h1 + N/h2]``, minimised at ``h1* = h/(1 + x)``,
 ``λ* = 2b (N + W)(1 + x)² / (W h)``, ``x = sqrt(N/(N + W))``.
 
-V2 (§4.2): a façade with two triangular side-wall wedges cut from the junction's base
+V2 (docs/search.md): a façade with two triangular side-wall wedges cut from the junction's base
 corner at β from the vertical, τ = tan β::
 
     λ0(τ) = [L t²/2 + s H τ t + s H² τ²/3] / [L t H/2 + (2/3) s H² τ]
@@ -118,7 +118,7 @@ def test_v2_wedge_multiplier_matches_the_closed_form(
     beta = math.atan(tau)
     lam = tmpl.lam([beta, beta])
     assert lam == pytest.approx(closed_form_v2(tau), rel=1e-12)
-    assert lam == pytest.approx(expected, abs=5e-6)  # MECHSEARCH.md's five digits
+    assert lam == pytest.approx(expected, abs=5e-6)  # docs/search.md V2, five digits
 
 
 def test_v2_wedge_multiplier_increases_with_the_angle(wedges: object) -> None:

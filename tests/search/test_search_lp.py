@@ -1,7 +1,7 @@
 """The global check (issue #31): an upper-bound LP over every candidate line.
 
 V1 at the LP grid: a two-block wall cut by n bed joints, N at the top hinge, gives exactly
-``min_k λ0(k h/n)`` of the closed form (``../shared/MECHSEARCH.md`` §4.1: 1.165689 for
+``min_k λ0(k h/n)`` of the closed form (docs/search.md, V1: 1.165689 for
 n = 300, N = W). V3: on every test scene the LP multiplier is at most the best catalogue
 mechanism's, and equal (1e-6) where the catalogue holds the optimum.
 """
@@ -57,7 +57,7 @@ def test_v1_lp_gives_the_closed_form_minimum_at_its_grid(two_block: Any, n: int)
 def test_v1_lp_converges_to_mechsearch_worked_check(two_block: Any) -> None:
     heights = [H * k / 300 for k in range(1, 300)]
     res = solve_lp(facade_lp_model(two_block, "W", "outward", heights, overburden=(W, 0.0)))
-    assert res.lam == pytest.approx(1.165689, abs=5e-7)  # MECHSEARCH.md §4.1, n = 300
+    assert res.lam == pytest.approx(1.165689, abs=5e-7)  # docs/search.md V1, n = 300
 
 
 def _scenes(tmp: Path) -> list[tuple[str, Any, Any]]:
