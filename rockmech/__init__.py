@@ -75,6 +75,10 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     )
     from solver_service.workflows.documents import solve_pulse as solve_pulse
     from solver_service.workflows.inputs import constants_from_files as constants_from_files
+    from solver_service.workflows.search import SearchRun as SearchRun
+    from solver_service.workflows.search import search_from_files as search_from_files
+    from solver_service.workflows.search import search_run as search_run
+    from solver_service.workflows.search import write_search as write_search
 
     from .analysis import (
         assess as assess,
@@ -178,6 +182,11 @@ _SOURCES = {
     "extract_pulses": "solver_service.core.pulses",
     "largest_pulse": "solver_service.core.pulses",
     "response_spectrum": "solver_service.core.spectra",
+    # The automatic search of a façade's mechanisms (issue #31).
+    "SearchRun": "solver_service.workflows.search",
+    "search_from_files": "solver_service.workflows.search",
+    "search_run": "solver_service.workflows.search",
+    "write_search": "solver_service.workflows.search",
     # Reports and the bundled examples.
     "build_report": "solver_service.report.html",
     "write_report": "solver_service.report.html",

@@ -302,9 +302,8 @@ def envelope(
     EnvelopeResult
         ``f_p`` [Hz], ``a_p_min_g`` per mechanism [g], ``critical`` bands.
     """
-    doc, _ = envelope_doc(
-        _constants(constants), frequency_grid(f_min, f_max, n), method="library" if fast else "exact"
-    )
+    method = "library" if fast else "exact"
+    doc, _ = envelope_doc(_constants(constants), frequency_grid(f_min, f_max, n), method=method)
     return EnvelopeResult.from_doc(stamp(doc, "envelope"))
 
 

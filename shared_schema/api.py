@@ -64,6 +64,7 @@ __all__ = [
     "RECORD_SAMPLE_RULE",
     "RECORD_UNITS",
     "REPORT_RECORD_RULE",
+    "SEARCH_MAX_EVALUATIONS",
     "TIME_DOMAIN_RANGES",
     "AssessRequest",
     "AssessResponse",
@@ -97,6 +98,8 @@ __all__ = [
     "ReportRequest",
     "ScaleFactorRequest",
     "ScaleFactorResponse",
+    "SearchForm",
+    "SearchResponse",
     "SpectrumCurve",
     "SpectrumForm",
     "SpectrumOptions",
@@ -951,6 +954,58 @@ class ConstantsForm(BaseModel):
         return None if units is None else check_choice(units, LENGTH_UNITS, "units")
 
 
+#: The service's work limit of one search [evaluations of the static multiplier λ0]; a
+#: request may ask for less (``solver_service.workflows.search.MAX_EVALUATIONS``, a test checks
+#: the copy).
+SEARCH_MAX_EVALUATIONS = 200_000
+
+
+class SearchForm(BaseModel):
+    """Multipart form of ``search``: files ``scene``, ``spec``, ``site``, ``record``, and fields.
+
+    ``spec`` is the search spec (JSON); ``site`` (SITE.json) and ``record`` are optional. The
+    spec's ``ranking.site`` and ``ranking.records`` (paths) are refused: upload the files.
+    """
+
+    model_config = _FORM
+
+    units: Optional[str] = Field(
+        None,
+        description=f"Length unit of a scan mesh: {', '.join(LENGTH_UNITS)} (required there; "
+        "a .3dm file states its own).",
+        json_schema_extra={"enum": list(LENGTH_UNITS)},
+    )
+    max_evaluations: Optional[int] = Field(
+        None,
+        ge=1,
+        le=SEARCH_MAX_EVALUATIONS,
+        description="Work limit: most evaluations of the static multiplier λ0 "
+        f"(default and largest {SEARCH_MAX_EVALUATIONS}); a search that needs more is refused "
+        "before it runs them.",
+    )
+    exact: bool = Field(False, description="Envelopes by the exact solver (not the library).")
+    record_format: Optional[str] = Field(
+        None,
+        description=f"Format of the record: {', '.join(RECORD_FORMATS)} (default: detected).",
+        json_schema_extra={"enum": list(RECORD_FORMATS)},
+    )
+    record_units: Optional[str] = Field(
+        None,
+        description=f"Acceleration units of the record: {', '.join(RECORD_UNITS)}.",
+        json_schema_extra={"enum": list(RECORD_UNITS)},
+    )
+    record_dt: Optional[float] = Field(
+        None,
+        description="Time step [s] of a record without a time column.",
+        json_schema_extra={"exclusiveMinimum": 0},
+    )
+
+    @field_validator("units")
+    @classmethod
+    def _known_length_unit(cls, units: Optional[str]) -> Optional[str]:
+        return None if units is None else check_choice(units, LENGTH_UNITS, "units")
+
+
 # --- responses --------------------------------------------------------------------------------
 
 
@@ -1173,3 +1228,26 @@ class AssessResponse(CheckResponse):
 
 #: The constants endpoint answers with a kinematic-constants file.
 ConstantsResponse = ConstantsFile
+
+
+class SearchResponse(BaseModel):
+    """The search document (``search.json``, ``rockmech search --json``)."""
+
+    model_config = _RESPONSE
+
+    kind: Literal["search"]
+    candidates: List[Dict[str, Any]] = Field(
+        description="Every refined mechanism, least λ0 first: family, façade, direction, "
+        "parameters, cracks, hinge axis, λ0, the builder's constants and linearised λ, the "
+        "overturning acceleration over the band, records and the code check (the top ones)."
+    )
+    rankings: Dict[str, Any] = Field(
+        description="Static (λ0) and dynamic (overturning acceleration) rankings and where "
+        "they differ; the governing mechanism per frequency."
+    )
+    lp: List[Dict[str, Any]] = Field(
+        description="The global check per façade and direction: multiplier, gap, whether the "
+        "catalogue missed a mechanism (and that mechanism), the sliding check."
+    )
+    counts: Dict[str, Any] = Field(description="Work counters.")
+    timings: Dict[str, Any] = Field(description="Wall-clock seconds per stage.")

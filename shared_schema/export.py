@@ -1,9 +1,11 @@
-"""Export the JSON Schemas of the kinematic-constants file and of the site file.
+"""Export the JSON Schemas of the kinematic-constants file, the site file and the search spec.
 
-Run ``python -m shared_schema.export`` after changing ``shared_schema.constants`` or
-``shared_schema.site``; it writes ``shared_schema/jsonschema/kinematic_constants.schema.json``
-and ``shared_schema/jsonschema/site.schema.json``. With ``--check`` it writes nothing and
-exits 1 when a file on disk differs from the models (a test does the same).
+Run ``python -m shared_schema.export`` after changing ``shared_schema.constants``,
+``shared_schema.site`` or ``shared_schema.search``; it writes
+``shared_schema/jsonschema/kinematic_constants.schema.json``,
+``shared_schema/jsonschema/site.schema.json`` and ``shared_schema/jsonschema/search.schema.json``.
+With ``--check`` it writes nothing and exits 1 when a file on disk differs from the models (a
+test does the same).
 """
 
 import argparse
@@ -14,15 +16,19 @@ from typing import Any, Dict, List, Optional
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.io import write_atomic
+from shared_schema.search import SearchSpec
 from shared_schema.site import SiteFile
 
 __all__ = [
     "SCHEMA_PATH",
+    "SEARCH_SCHEMA_PATH",
     "SITE_SCHEMA_PATH",
     "build_schema",
+    "build_search_schema",
     "build_site_schema",
     "main",
     "render_schema",
+    "render_search_schema",
     "render_site_schema",
 ]
 
@@ -31,6 +37,9 @@ SCHEMA_PATH = Path(__file__).resolve().parent / "jsonschema" / "kinematic_consta
 
 #: Where the exported site-file schema lives.
 SITE_SCHEMA_PATH = SCHEMA_PATH.parent / "site.schema.json"
+
+#: Where the exported search-spec schema lives.
+SEARCH_SCHEMA_PATH = SCHEMA_PATH.parent / "search.schema.json"
 
 #: JSON Schema dialect pydantic generates.
 DIALECT = "https://json-schema.org/draft/2020-12/schema"
@@ -69,6 +78,19 @@ def render_site_schema() -> str:
     return json.dumps(build_site_schema(), sort_keys=True, indent=2, ensure_ascii=False) + "\n"
 
 
+def build_search_schema() -> Dict[str, Any]:
+    """Return the JSON Schema of ``SearchSpec`` (draft 2020-12) as a dict."""
+    schema = SearchSpec.model_json_schema(mode="validation")
+    schema["$schema"] = DIALECT
+    schema["title"] = "rockmech search spec"
+    return schema
+
+
+def render_search_schema() -> str:
+    """Return the search-spec schema as the text stored on disk."""
+    return json.dumps(build_search_schema(), sort_keys=True, indent=2, ensure_ascii=False) + "\n"
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     """Write the schema files, or with ``--check`` report whether they are up to date.
 
@@ -97,8 +119,18 @@ def main(argv: Optional[List[str]] = None) -> int:
         default=SITE_SCHEMA_PATH,
         help=f"site schema file (default: {SITE_SCHEMA_PATH})",
     )
+    parser.add_argument(
+        "--search-output",
+        type=Path,
+        default=SEARCH_SCHEMA_PATH,
+        help=f"search-spec schema file (default: {SEARCH_SCHEMA_PATH})",
+    )
     args = parser.parse_args(argv)
-    pairs = ((Path(args.output), render_schema()), (Path(args.site_output), render_site_schema()))
+    pairs = (
+        (Path(args.output), render_schema()),
+        (Path(args.site_output), render_site_schema()),
+        (Path(args.search_output), render_search_schema()),
+    )
     status = 0
     for output, text in pairs:
         if args.check:

@@ -33,6 +33,7 @@ __all__ = [
     "BEHAVIOUR_FACTOR_RANGE",
     "BODY_SIZE_PLAUSIBLE",
     "BUILDING_HEIGHT_MAX_M",
+    "CONNECTIONS",
     "COORDINATE_LIMIT",
     "CRITERIA",
     "DAMPING_PERCENT_RANGE",
@@ -51,6 +52,8 @@ __all__ = [
     "ROCKING_KINDS",
     "ROTATION_MAX",
     "SCHEMA_VERSION_PATTERN",
+    "SEARCH_DIRECTIONS",
+    "SEARCH_FAMILIES",
     "SF_METHODS",
     "TYPOLOGIES",
     "G",
@@ -82,6 +85,28 @@ G = 9.80665
 #: Mechanism typologies a spec can ask for; each has a builder in
 #: ``rhino_plugin.mechanisms.build.MECHANISMS`` (constants files also take ``user_defined``).
 TYPOLOGIES: Tuple[str, ...] = ("single_block", "single_block_loaded", "two_block", "multi_block")
+
+#: Mechanism families ``rockmech search`` enumerates (issue #31): overturning of a whole
+#: façade, of its part above a hinge line, with wedges of its return walls, vertical
+#: flexure between restraints (two-block), the corner wedge, and the part above the top
+#: level (a gable, or a parapet).
+SEARCH_FAMILIES: Tuple[str, ...] = (
+    "overturning",
+    "partial_overturning",
+    "wedge_overturning",
+    "vertical_flexure",
+    "corner",
+    "gable",
+    "parapet",
+)
+
+#: Out-of-plane directions of a façade the search tries: away from the building or into it.
+SEARCH_DIRECTIONS: Tuple[str, ...] = ("outward", "inward")
+
+#: Connection quality of a wall junction: good interlocking (a crack through the return
+#: wall runs at least at the bond angle), poor (the walls part along the junction), or tied
+#: (ties or a ring beam hold them together: the façade does not part from that wall).
+CONNECTIONS: Tuple[str, ...] = ("good", "poor", "tied")
 
 #: Rocking kinds: two-sided (rocks about both edges) or one-sided (rebounds off a restraint).
 ROCKING_KINDS: Tuple[str, ...] = ("two_sided", "one_sided")

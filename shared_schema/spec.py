@@ -169,7 +169,9 @@ class Crack(BaseModel):
     ``keep`` is ``"axis_side"`` (default: keep the part that contains the rotation axis),
     ``"positive"`` or ``"negative"`` (the side the plane normal points to, or the other).
     ``keep_point`` names a point on the side to keep instead, which needs no knowledge of
-    the plane's normal (in the spec's ``units``).
+    the plane's normal (in the spec's ``units``). ``objects`` limits the crack to some of the
+    body's objects (a crack through one return wall that must not cut the other); by
+    default it cuts every object of the body.
     """
 
     model_config = _STRICT
@@ -179,6 +181,16 @@ class Crack(BaseModel):
     keep_point: Optional[Point3] = Field(
         default=None, description="A point on the side of the crack to keep [m]."
     )
+    objects: Optional[List[Selector]] = Field(
+        default=None,
+        min_length=1,
+        description="Cut only these objects of the body (default: every object).",
+    )
+
+    @field_validator("objects")
+    @classmethod
+    def _check_objects(cls, value: Optional[List[Selector]]) -> Optional[List[Selector]]:
+        return value if value is None else _once(value)
 
     @model_validator(mode="after")
     def _one_form(self) -> "Crack":
@@ -332,6 +344,8 @@ class MechanismSpec(BaseModel):
         Passed through to the constants file.
     floors, roof, vaults, tie_bars
         Added elements (``single_block_loaded`` only); declare only those that exist.
+    hinge_height : float, optional
+        ``two_block``: the intermediate hinge's height above the base (default Eq. 17).
     """
 
     model_config = _STRICT
@@ -361,6 +375,12 @@ class MechanismSpec(BaseModel):
     overburden: Optional[Overburden] = None
     f_mt: Optional[float] = Field(
         default=None, ge=0, description="Mortar tensile strength [Pa] (two_block; default 0)."
+    )
+    hinge_height: Optional[float] = Field(
+        default=None,
+        gt=0,
+        description="two_block: height of the intermediate hinge above the base, in the spec's "
+        "units (default: Eq. 17 from the overburden and f_mt).",
     )
     eccentricity: Optional[Literal["static_moment", "potential"]] = Field(
         default=None,
@@ -408,11 +428,20 @@ class MechanismSpec(BaseModel):
             problem = eta_problem(self.eta, self.rocking == "one_sided")
             if problem is not None:
                 raise ValueError(f"eta {problem}")
-        two = [k for k in ("overburden", "f_mt", "eccentricity") if getattr(self, k) is not None]
+        two = [
+            k
+            for k in ("overburden", "f_mt", "eccentricity", "hinge_height")
+            if getattr(self, k) is not None
+        ]
         if two and self.typology != "two_block":
             raise ValueError(f"{', '.join(two)} need typology 'two_block'")
         if self.typology == "two_block" and self.cracks:
             raise ValueError("a two-block wall is split at the hinge height; give no cracks")
+        if self.hinge_height is not None and self.f_mt:
+            raise ValueError(
+                "give either 'f_mt' (the hinge height then follows Eq. 17) or 'hinge_height', "
+                "not both"
+            )
         if self.eta_rule is not None and self.rocking != "one_sided":
             raise ValueError("eta_rule applies to one-sided rocking only")
         if self.axis_negative is not None and self.rocking == "one_sided":

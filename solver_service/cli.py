@@ -1389,6 +1389,100 @@ def assess(
         _print_json(stamp(doc, "assess"))
 
 
+@app.command()
+@_user_errors
+def search(
+    scene: Path = typer.Argument(..., help="Rhino .3dm file, or a scan mesh .ply/.obj/.stl/.off."),
+    spec: Path = typer.Argument(..., help="Search spec (JSON): walls, levels, junctions, ranking."),
+    out: Path = typer.Option(
+        ...,
+        "-o",
+        "--out",
+        help="Folder for search.json, search.spec.json, constants.json, search.3dm, search.png.",
+    ),
+    units: Optional[str] = typer.Option(
+        None,
+        "--units",
+        metavar="[mm|cm|m|in|ft]",
+        help="Length unit of a scan mesh (.ply, .obj, .stl, .off; required there).",
+    ),
+    site: Optional[Path] = typer.Option(
+        None, "--site", help="Site file (SITE.json) for the code check (default: the spec's)."
+    ),
+    record: list[Path] = typer.Option(
+        [], "--record", help="Record(s) to rank the top mechanisms on (default: the spec's)."
+    ),
+    exact: bool = typer.Option(
+        False, "--exact", help="Envelopes by the exact solver instead of the library."
+    ),
+    figure: bool = typer.Option(True, "--figure/--no-figure", help="Draw search.png."),
+    no_limits: bool = typer.Option(
+        False,
+        "--no-limits",
+        help="Lift the search's work limits (evaluations of the static multiplier and "
+        "macro-blocks of the global check) and the time limit.",
+    ),
+    time_limit: float = _TIME_LIMIT_OPT,
+    as_json: bool = typer.Option(False, "--json", help="Print search.json."),
+) -> None:
+    """Find a façade's collapse mechanisms and rank them by how they rock (issue #31)."""
+    # the search's workflow is loaded by this command only
+    from .workflows.search import search_from_files, write_search
+
+    check_folder_target(out)
+    with _status(f"search: {scene.name}"):
+        run = search_from_files(
+            scene, spec, units=units, site=site, records=record, exact=exact, limits=not no_limits
+        )
+        with run_folder(out, on_note=_out_note) as tmp:
+            write_search(run, tmp, figure=figure)
+    doc = run.doc
+    for note in doc["notes"]:
+        _note(f"note: {note}")
+    for fail in doc["failures"]:
+        _note(f"warning: {fail['error']}")
+    if as_json:
+        _print_json(doc)
+        return
+    by_id = {d["id"]: d for d in doc["candidates"]}
+    order = doc["rankings"]["dynamic"] or doc["rankings"]["static"]
+    rows = []
+    for mid in order[:15]:
+        d = by_id[mid]
+        score = (d.get("overturning") or {}).get("band_score_g")
+        rows.append(
+            [
+                mid,
+                d["family"],
+                f"{d['facade']} {d['direction']}",
+                _g4(d["lam0"]),
+                _g4(d.get("lam_linearised")),
+                _g4(score),
+                str(d["rank_static"]),
+            ]
+        )
+    band = doc["band"]["band_hz"]
+    headers = [
+        "mechanism",
+        "family",
+        "facade",
+        "lam0 [-]",
+        "lam [-]",
+        f"a_p {band[0]:g}-{band[1]:g} Hz [g]",
+        "static rank",
+    ]
+    for line in _table(headers, rows):
+        typer.echo(line)
+    for check in doc["lp"]:
+        typer.echo(f"{check['facade']} {check['direction']}: {check['message']}")
+    c = doc["counts"]
+    typer.echo(
+        f"{c['candidates']} mechanisms ({c['evaluations']} evaluations of lam0), {c['built']} "
+        f"built; wrote {out / 'search.json'}, search.spec.json, constants.json, search.3dm"
+        + (", search.png" if figure else "")
+    )
+
+
 def main() -> None:  # pragma: no cover - console entry point
     """Entry point of the ``rockmech`` console script."""
     app()

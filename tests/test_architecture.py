@@ -6,9 +6,9 @@ of the file or inside a function, is resolved to the project module it names.
 Floors, each importing only from its own floor or below:
 
 0. formats and domain rules: ``shared_schema``;
-1. maths: ``solver_service.core``, ``rhino_plugin.geometry``, ``rhino_plugin.mechanisms``
-   and the scene readers (``rhino_plugin.scene_base``, ``scene_3dm``, ``scene_mesh``,
-   ``scenes``);
+1. maths: ``solver_service.core``, ``rhino_plugin.geometry``, ``rhino_plugin.mechanisms``,
+   the mechanism search ``rhino_plugin.search`` and the scene readers
+   (``rhino_plugin.scene_base``, ``scene_3dm``, ``scene_mesh``, ``scenes``);
 2. workflows and documents: ``solver_service.workflows``, ``solver_service.report``,
    ``solver_service.ida``, ``solver_service.demo``;
 3. front ends: ``solver_service.cli``, ``solver_service.api``, ``rhino_plugin.flows``,
@@ -33,6 +33,7 @@ FLOORS = {
     "solver_service.core": 1,
     "rhino_plugin.geometry": 1,
     "rhino_plugin.mechanisms": 1,
+    "rhino_plugin.search": 1,
     "rhino_plugin.archive_3dm": 1,
     "rhino_plugin.scene_base": 1,
     "rhino_plugin.scene_3dm": 1,

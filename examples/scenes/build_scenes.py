@@ -251,6 +251,57 @@ def grid_box_solid(
     return displace(p), f.astype(np.int64)
 
 
+def slab_solid(
+    origin: Point,
+    e_s: Point,
+    e_n: Point,
+    thickness: float,
+    outer: Sequence[Tuple[float, float]],
+    holes: Sequence[Sequence[Tuple[float, float]]] = (),
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Return a closed mesh of a wall: an elevation (s, z) with holes, extruded through n.
+
+    The elevation lies in the plane through ``origin`` spanned by ``e_s`` and z; the wall
+    fills ``0 <= n <= thickness`` along ``e_n``. Openings are through-holes.
+    """
+    # rockmech's own triangulation (exact vertices); the examples need the package anyway
+    from rhino_plugin.geometry.polygon import triangulate_polygon
+
+    o, es, en = (np.asarray(v, dtype=np.float64) for v in (origin, e_s, e_n))
+    ez = np.array([0.0, 0.0, 1.0])
+    rings = [np.asarray(outer, dtype=np.float64)] + [np.asarray(h, dtype=np.float64) for h in holes]
+    # outer counter-clockwise, holes clockwise in (s, z): material on the left of each edge
+    fixed = []
+    for k, r in enumerate(rings):
+        a2 = float(np.dot(r[:, 0], np.roll(r[:, 1], -1)) - np.dot(np.roll(r[:, 0], -1), r[:, 1]))
+        fixed.append(r if (a2 > 0.0) == (k == 0) else r[::-1])
+    pts2 = np.vstack(fixed)
+    n = len(pts2)
+    front = o + pts2[:, :1] * es + pts2[:, 1:] * ez
+    verts = np.vstack([front, front + thickness * en])
+    tris = np.array(triangulate_polygon(fixed[0], fixed[1:]), dtype=np.int64)
+    # the triangles are counter-clockwise in (s, z): their normal is es x ez
+    sign = float(np.dot(np.cross(es, ez), en))
+    front_f = tris[:, ::-1] if sign > 0.0 else tris  # front faces look along -en
+    faces = [front_f, (tris if sign > 0.0 else tris[:, ::-1]) + n]
+    start = 0
+    for r in fixed:
+        k = np.arange(len(r)) + start
+        k1 = np.roll(k, -1)
+        start += len(r)
+        quads = np.column_stack([k, k1, k1 + n, k, k1 + n, k + n]).reshape(-1, 3)
+        # outward is to the right of each edge; flip the quads to face it
+        d = pts2[k1 - 0] - pts2[k]
+        right = d[:, 1:] * es - d[:, :1] * ez
+        tri0 = verts[quads[0::2]]
+        nrm = np.cross(tri0[:, 1] - tri0[:, 0], tri0[:, 2] - tri0[:, 0])
+        flip = np.einsum("ij,ij->i", nrm, right) < 0.0
+        quads = quads.reshape(-1, 2, 3)
+        quads[flip] = quads[flip][:, :, ::-1]
+        faces.append(quads.reshape(-1, 3))
+    return verts, np.vstack(faces)
+
+
 # ---------------------------------------------------------------------- scenes
 
 
@@ -537,6 +588,44 @@ def asym_frame(out: Path) -> Path:
     return b.write(out / "asym_frame.3dm")
 
 
+# The search example: a 3-storey façade with 6 windows between two return walls.
+SEARCH_H, SEARCH_L, SEARCH_T = 10.5, 8.0, 0.5  # façade height, length, thickness [m]
+SEARCH_REACH, SEARCH_SIDE_T = 6.0, 0.45  # return walls: length behind the façade, thickness [m]
+#: Windows (s0, s1, z0, z1) [m]: two per storey.
+SEARCH_WINDOWS = [
+    (s0, s0 + 1.2, z0, z0 + h)
+    for z0, h in ((0.9, 2.0), (4.4, 1.8), (7.9, 1.6))
+    for s0 in (1.5, 5.3)
+]
+
+
+def search_facade(out: Path) -> Path:
+    b = Builder("search_facade")
+    t, L, H = SEARCH_T, SEARCH_L, SEARCH_H
+    holes = [[(s0, z0), (s1, z0), (s1, z1), (s0, z1)] for s0, s1, z0, z1 in SEARCH_WINDOWS]
+    # façade: outer face x = 0, inner face x = t, along y in [0, L]
+    v, f = slab_solid(
+        (0.0, 0.0, 0.0),
+        (0.0, 1.0, 0.0),
+        (1.0, 0.0, 0.0),
+        t,
+        [(0.0, 0.0), (L, 0.0), (L, H), (0.0, H)],
+        holes,
+    )
+    b.mesh("facade", "Walls", v, f, "brick")
+    w, r = SEARCH_SIDE_T, SEARCH_REACH
+    b.box("return_left", "Walls", (t, 0.0, 0.0), (t + r, w, H), "brick")
+    b.box("return_right", "Walls", (t, L - w, 0.0), (t + r, L, H), "brick")
+    b.box("back_wall", "Walls", (t + r, 0.0, 0.0), (2 * t + r, L, H), "brick")
+    # floors abut the façade's inner face and rest on the back wall's face (1 cm clear of
+    # the return walls); the roof bears on the wall tops
+    for name, z in (("floor_1", 3.5), ("floor_2", 7.0)):
+        b.box(name, "Floors", (t, w + 0.01, z), (t + r, L - w - 0.01, z + 0.2), "concrete")
+    b.prism_y("roof", "Roof", [(0.0, H), (2 * t + r, H), (t + r / 2, H + 1.6)], 0.0, L, "brick")
+    b.line("tie_1", "Ties", (0.0, 2.0, 9.0), (2 * t + r, 2.0, 9.0))
+    return b.write(out / "search_facade.3dm")
+
+
 SCENES = {
     "rect_wall": rect_wall,
     "statue_column": statue_column,
@@ -546,6 +635,7 @@ SCENES = {
     "side_aisle": side_aisle,
     "portal_frame": portal_frame,
     "asym_frame": asym_frame,
+    "search_facade": search_facade,
 }
 #: Scan-mesh examples (no rhino3dm needed to write them).
 SCANS = {"scan_wall_ply": scan_wall_ply}

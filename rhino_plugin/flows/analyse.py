@@ -15,7 +15,7 @@ Python 3.9-clean: imported by Rhino 8.
 import json
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from rhino_plugin.flows.mechanisms import _number
 from rhino_plugin.flows.prompter import Cancelled, Prompter
@@ -100,14 +100,27 @@ class ServiceClient:
             The service refused the request (its ``detail`` is the message, field
             ``service``), could not be reached, or did not answer JSON.
         """
+        return self.request(endpoint, json.dumps(payload).encode("utf-8"), "application/json")
+
+    def post_files(
+        self,
+        endpoint: str,
+        files: Dict[str, Tuple[str, bytes]],
+        fields: Optional[Dict[str, str]] = None,
+    ) -> Dict[str, Any]:
+        """POST files (name -> (file name, bytes)) and text fields as a multipart form."""
+        return _post_files(self, endpoint, files, fields)
+
+    def request(self, endpoint: str, body: bytes, content_type: str) -> Dict[str, Any]:
+        """POST a body to ``/api/v1/<endpoint>`` and return the JSON answer (see ``post``)."""
         import urllib.error
         import urllib.request
 
         url = f"{self.base_url}/api/v1/{endpoint}"
         request = urllib.request.Request(
             url,
-            data=json.dumps(payload).encode("utf-8"),
-            headers={"Content-Type": "application/json", "Accept": "application/json"},
+            data=body,
+            headers={"Content-Type": content_type, "Accept": "application/json"},
             method="POST",
         )
         try:
@@ -133,6 +146,32 @@ class ServiceClient:
         if not isinstance(doc, dict):
             raise InputError(f"{url} answered {type(doc).__name__}, expected an object", "service")
         return doc
+
+
+def _post_files(
+    client: "ServiceClient",
+    endpoint: str,
+    files: Dict[str, Tuple[str, bytes]],
+    fields: Optional[Dict[str, str]] = None,
+) -> Dict[str, Any]:
+    """POST a multipart form to ``/api/v1/<endpoint>`` (``ServiceClient.post_files``)."""
+    import uuid
+
+    boundary = "rockmech-" + uuid.uuid4().hex
+    parts: List[bytes] = []
+    for name, value in (fields or {}).items():
+        parts.append(
+            f'--{boundary}\r\nContent-Disposition: form-data; name="{name}"\r\n\r\n'
+            f"{value}\r\n".encode()
+        )
+    for name, (filename, data) in files.items():
+        head = (
+            f'--{boundary}\r\nContent-Disposition: form-data; name="{name}"; '
+            f'filename="{filename}"\r\nContent-Type: application/octet-stream\r\n\r\n'
+        )
+        parts.append(head.encode("utf-8") + data + b"\r\n")
+    body = b"".join(parts) + f"--{boundary}--\r\n".encode()
+    return client.request(endpoint, body, f"multipart/form-data; boundary={boundary}")
 
 
 def load_constants_files(paths: Sequence[str]) -> Any:

@@ -11,6 +11,7 @@ n : unit plane normal; (u, v, n) right-handed (``frames.plane_basis``)
 d : signed distance of a vertex from the plane [m]; |d| <= tol counts as on the plane
 """
 
+from dataclasses import dataclass
 from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
@@ -21,7 +22,7 @@ from shared_schema.extras import require
 from .frames import plane_basis
 from .mesh import TriMesh
 
-__all__ = ["contact_area", "find_contact", "section_polygon"]
+__all__ = ["ContactPlane", "contact_area", "contact_region", "find_contact", "section_polygon"]
 
 #: Face normals closer than this (per component) are grouped as one plane [-].
 NORMAL_GAP = 1e-5
@@ -334,10 +335,10 @@ def _single_linkage(columns: List[np.ndarray], gaps: List[float]) -> np.ndarray:
     return label
 
 
-def find_contact(
+def contact_region(
     a: TriMesh, b: TriMesh, *, tol: float = 1e-6
-) -> Optional[Tuple[float, np.ndarray, np.ndarray]]:
-    """Largest planar contact between two solids touching along faces.
+) -> Optional[Tuple[float, np.ndarray, np.ndarray, "ContactPlane"]]:
+    """Largest planar contact between two solids, with its region in the contact plane.
 
     Faces of ``a`` and ``b`` that are coplanar within ``tol``, with opposite normals,
     are grouped by plane; in each plane the union of a's faces is intersected with the
@@ -353,10 +354,11 @@ def find_contact(
 
     Returns
     -------
-    (area, centroid, normal) or None
+    (area, centroid, normal, region) or None
         Area [m²], centroid (3,) [m] and unit normal (3,) pointing from ``a`` into ``b``
-        of the largest contact; None if the solids share no face area (an overlap narrower
-        than ``tol`` does not count).
+        of the largest contact, and its region (``ContactPlane``: rings in the plane's
+        coordinates); None if the solids share no face area (an overlap narrower than
+        ``tol`` does not count).
 
     Notes
     -----
@@ -364,14 +366,6 @@ def find_contact(
     face (horizontal normal), docs/theory.md §2.2. Solids that interpenetrate without sharing a
     face plane are not in contact in this sense; see :func:`contact_area` for a section.
 
-    Examples
-    --------
-    >>> import trimesh
-    >>> lo = trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
-    >>> hi = trimesh.creation.box(bounds=[[0.5, 0, 1], [2, 1, 2]])
-    >>> area, c, n = find_contact(TriMesh(lo.vertices, lo.faces), TriMesh(hi.vertices, hi.faces))
-    >>> round(area, 12), c.round(12).tolist(), n.tolist()
-    (0.5, [0.75, 0.5, 1.0], [0.0, 0.0, 1.0])
     """
     if not tol >= 0.0:
         raise InputError(f"must be >= 0 [m], got {tol!r}", "tol")
@@ -413,7 +407,7 @@ def find_contact(
         [normals[:, 0], normals[:, 1], normals[:, 2], offsets], [NORMAL_GAP] * 3 + [tol]
     )
     la, lb = label[: len(tri_a)], label[len(tri_a) :]
-    best: Optional[Tuple[float, np.ndarray, np.ndarray]] = None
+    best: Optional[Tuple[float, np.ndarray, np.ndarray, ContactPlane]] = None
     for g in np.intersect1d(la, lb):
         in_a = np.nonzero(la == g)[0]
         seed = in_a[np.argmax(ar_a[in_a])]
@@ -441,5 +435,88 @@ def find_contact(
             continue
         if best is None or area > best[0]:
             c = inter.centroid
-            best = (area, ref + p0 + c.x * u + c.y * v, n)
+            best = (
+                area,
+                ref + p0 + c.x * u + c.y * v,
+                n,
+                ContactPlane(ref + p0, u, v, n, _region_rings(inter)),
+            )
     return best
+
+
+def find_contact(
+    a: TriMesh, b: TriMesh, *, tol: float = 1e-6
+) -> Optional[Tuple[float, np.ndarray, np.ndarray]]:
+    """Largest planar contact between two solids touching along faces.
+
+    Faces of ``a`` and ``b`` that are coplanar within ``tol``, with opposite normals,
+    are grouped by plane; in each plane the union of a's faces is intersected with the
+    union of b's faces (``contact_region``).
+
+    Parameters
+    ----------
+    a, b : TriMesh
+        Valid, outward-facing solids (see ``check_solid``) [m].
+    tol : float, optional
+        Distance within which faces count as coplanar (a gap up to ``tol`` is still a
+        contact) [m].
+
+    Returns
+    -------
+    (area, centroid, normal) or None
+        Area [m²], centroid (3,) [m] and unit normal (3,) pointing from ``a`` into ``b``
+        of the largest contact; None if the solids share no face area (an overlap narrower
+        than ``tol`` does not count).
+
+    Notes
+    -----
+    Used to tell a floor bearing on a wall top (vertical normal) from one abutting its
+    face (horizontal normal), docs/theory.md §2.2. Solids that interpenetrate without sharing a
+    face plane are not in contact in this sense; see :func:`contact_area` for a section.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> lo = trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
+    >>> hi = trimesh.creation.box(bounds=[[0.5, 0, 1], [2, 1, 2]])
+    >>> area, c, n = find_contact(TriMesh(lo.vertices, lo.faces), TriMesh(hi.vertices, hi.faces))
+    >>> round(area, 12), c.round(12).tolist(), n.tolist()
+    (0.5, [0.75, 0.5, 1.0], [0.0, 0.0, 1.0])
+    """
+    found = contact_region(a, b, tol=tol)
+    return None if found is None else found[:3]
+
+
+@dataclass(frozen=True)
+class ContactPlane:
+    """A contact's region: rings in the plane through ``origin`` spanned by ``u``, ``v``.
+
+    Attributes
+    ----------
+    origin, u, v, normal : (3,) float
+        The plane: a point [m], two orthonormal in-plane directions and the unit normal.
+    rings : list of (k, 2) float
+        The region's outer boundaries (counter-clockwise) and holes (clockwise), in
+        ``(u, v)`` coordinates [m].
+    """
+
+    origin: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    normal: np.ndarray
+    rings: List[np.ndarray]
+
+
+def _region_rings(region: Any) -> List[np.ndarray]:
+    """Rings of a shapely (multi)polygon: exteriors counter-clockwise, holes clockwise."""
+    shapely = require("shapely", "geometry", "for contact polygons")
+
+    polys = list(region.geoms) if hasattr(region, "geoms") else [region]
+    rings: List[np.ndarray] = []
+    for poly in polys:
+        if poly.is_empty or poly.geom_type != "Polygon":
+            continue
+        poly = shapely.geometry.polygon.orient(poly, sign=1.0)
+        rings.append(np.asarray(poly.exterior.coords, dtype=float)[:-1])
+        rings.extend(np.asarray(h.coords, dtype=float)[:-1] for h in poly.interiors)
+    return rings

@@ -314,6 +314,8 @@ def _points_in_metres(spec: Any, scale: float) -> Any:
             update[key] = hinges.model_copy(
                 update={n: _scaled(getattr(hinges, n), scale) for n in ("A", "B", "C", "D")}
             )
+    if getattr(spec, "hinge_height", None) is not None:
+        update["hinge_height"] = float(spec.hinge_height) * scale
     return spec.model_copy(update=update)
 
 

@@ -138,7 +138,7 @@ def _crack_plane(scene: Any, crack: Any, where: str) -> Tuple[np.ndarray, np.nda
 def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
     """Validate the spec's solids, cut them by its cracks and compute their mass properties."""
     where = f"{spec.id}"
-    solids: List[Tuple[Any, float]] = []
+    solids: List[Tuple[Any, float, str]] = []  # (mesh, density, object id)
     ids: List[str] = []
     warnings: List[str] = []
     seen: Dict[str, str] = {}
@@ -147,7 +147,7 @@ def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
             claim_once(seen, obj, f"{where}.groups[{k}]")
             mesh, notes = check_solid(scene.mesh(obj))
             warnings.extend(notes)
-            solids.append((mesh, group.density))
+            solids.append((mesh, group.density, obj.id))
             ids.append(obj.id)
     for k, crack in enumerate(spec.cracks):
         point, normal = _crack_plane(scene, crack, f"{where}.cracks[{k}]")
@@ -163,14 +163,26 @@ def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
         elif keep == "axis_side":
             keep = "positive" if float(np.dot(axis_mid - point, normal)) >= 0.0 else "negative"
         sign = 1.0 if keep == "positive" else -1.0
-        kept: List[Tuple[Any, float]] = []
+        only = None
+        if getattr(crack, "objects", None) is not None:
+            only = {o.id for o in find_objects(scene, crack.objects, f"{where}.cracks[{k}]")}
+            missing = only - set(ids)
+            if missing:
+                raise InputError(
+                    f"objects {sorted(missing)} are not in the body (list them in its groups)",
+                    f"{where}.cracks[{k}].objects",
+                )
+        kept: List[Tuple[Any, float, str]] = []
         cut_any = False
-        for mesh, density in solids:
+        for mesh, density, oid in solids:
+            if only is not None and oid not in only:
+                kept.append((mesh, density, oid))
+                continue
             dist = (mesh.vertices - point) @ normal * sign
             if dist.min() >= 0.0:
-                kept.append((mesh, density))
+                kept.append((mesh, density, oid))
             elif dist.max() > 0.0:
-                kept.append((cut_by_plane(mesh, point, normal, keep=keep), density))
+                kept.append((cut_by_plane(mesh, point, normal, keep=keep), density, oid))
                 cut_any = True
         if not cut_any:
             raise GeometryError(
@@ -183,10 +195,10 @@ def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
                 f"with normal {[round(float(v), 6) for v in normal]})"
             )
         solids = kept
-    parts = [mass_properties(mesh, density) for mesh, density in solids]
+    parts = [mass_properties(mesh, density) for mesh, density, _ in solids]
     props = combine(parts, name=spec.id)
-    verts = np.vstack([mesh.vertices for mesh, _ in solids])
-    return Body(props, parts, [mesh for mesh, _ in solids], verts, ids, warnings)
+    verts = np.vstack([mesh.vertices for mesh, _, _ in solids])
+    return Body(props, parts, [mesh for mesh, _, _ in solids], verts, ids, warnings)
 
 
 def resolve_axis(scene: Any, axis: Any, where: str) -> Tuple[np.ndarray, np.ndarray]:

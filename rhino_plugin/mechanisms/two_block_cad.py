@@ -8,7 +8,8 @@ The wall (the spec's groups) is restrained at top and bottom. In its rocking pla
   centroid of their contact with the wall, which fixes its eccentricity), or a given force
   (acting on the wall's centre line);
 * the intermediate hinge height follows Eq. 17, ``h_c = h / (1 + sqrt((N + f_mt l b) /
-  (N + W + f_mt l b)))``, and the wall is cut by the horizontal plane at ``h_c``;
+  (N + W + f_mt l b)))``, unless the spec gives ``hinge_height`` (the search's minimum of
+  the exact λ0), and the wall is cut by the horizontal plane at ``h_c``;
 * hinges: O at the base outer edge, C at ``h_c`` on the inner face, H at the top outer edge
   (theory §2.3); the negative side mirrors them about the wall's mid-plane;
 * restitution: the momentum projection of theory §3.4 between the two hinge sets, unless
@@ -110,7 +111,16 @@ def two_block_sides(
         )
         x_p = float((point - o) @ out)
     f_mt = float(spec.f_mt or 0.0)
-    h_c = hinge_height(h, weight, n, f_mt, length * b)
+    given = getattr(spec, "hinge_height", None)
+    if given is not None:
+        h_c = float(given)
+        if not 0.0 < h_c < h:
+            raise GeometryError(
+                f"{where}.hinge_height: {h_c:g} m is not inside the wall (0, {h:g}) m above "
+                "its base"
+            )
+    else:
+        h_c = hinge_height(h, weight, n, f_mt, length * b)
     if h_c >= h * (1.0 - 1e-9):
         raise GeometryError(
             f"{where}: with no overburden and no mortar tensile strength the hinge forms at the "
@@ -169,6 +179,7 @@ def two_block_sides(
         "overburden_x_m": x_p,
         "f_mt_Pa": f_mt,
         "h_c_m": h_c,
+        "h_c_source": "hinge_height (given)" if given is not None else "Eq. 17",
         "eccentricity": ecc,
         "lower_mass_kg": b1.mass,
         "upper_mass_kg": b2.mass,

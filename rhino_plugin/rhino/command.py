@@ -2,7 +2,7 @@
 
 import glob
 import os
-from typing import Optional
+from typing import Optional, Union
 
 import Eto.Drawing
 import Eto.Forms
@@ -10,11 +10,12 @@ import Rhino
 
 from rhino_plugin.flows.analyse import AnalysisResult, analyse_flow
 from rhino_plugin.flows.mechanisms import CommandResult, run_mechanism_command
+from rhino_plugin.flows.search import SEARCH_LAYER, SearchFlowResult, search_flow
 from rhino_plugin.rhino.docscene import DocScene
 from rhino_plugin.rhino.draw import draw_marks
 from rhino_plugin.rhino.prompts import RhinoPrompter
 
-__all__ = ["SERVICE_URL_KEY", "run_analyse", "run_mechanism"]
+__all__ = ["SERVICE_URL_KEY", "run_analyse", "run_mechanism", "run_search"]
 
 #: Document user text holding the REST service URL (set with Rhino's SetDocumentUserText).
 SERVICE_URL_KEY = "rockmech_service_url"
@@ -50,7 +51,7 @@ def run_mechanism(command: str) -> Optional[CommandResult]:
     return result
 
 
-def _show_plot(result: AnalysisResult) -> None:
+def _show_plot(result: Union[AnalysisResult, SearchFlowResult]) -> None:
     if not result.plot or not os.path.isfile(result.plot):
         return
     dialog = Eto.Forms.Dialog()
@@ -85,5 +86,26 @@ def run_analyse() -> Optional[AnalysisResult]:
         service_url=url,
     )
     if result is not None:
+        _show_plot(result)
+    return result
+
+
+def run_search() -> Optional[SearchFlowResult]:
+    """RM_Search on the active document: search, write <model>.search/, draw, show."""
+    doc = _saved_doc("RM_Search")
+    if doc is None:
+        return None
+    path = str(doc.Path)
+    result = search_flow(
+        RhinoPrompter(doc),
+        DocScene.from_doc(doc),
+        os.path.dirname(path),
+        scene_name=os.path.basename(path),
+        scene_path=path,
+        service_url=doc.Strings.GetValue(SERVICE_URL_KEY) or None,
+    )
+    if result is not None:
+        n = draw_marks(doc, result.marks, layer=SEARCH_LAYER)
+        Rhino.RhinoApp.WriteLine(f"RM_Search: {n} objects on layer '{SEARCH_LAYER}'")
         _show_plot(result)
     return result

@@ -14,7 +14,7 @@ from fastapi import Request
 from pydantic import BaseModel, ValidationError
 from starlette.datastructures import FormData, UploadFile
 
-from shared_schema.api import ConstantsForm, HistoryForm, ReportForm, SpectrumForm
+from shared_schema.api import ConstantsForm, HistoryForm, ReportForm, SearchForm, SpectrumForm
 
 from .problems import Problem, validation_message
 
@@ -84,6 +84,15 @@ FORMS = {
     "constants": FormSpec(
         ConstantsForm,
         {"scene": (True, "Rhino .3dm file."), "spec": (True, "Mechanism spec (JSON).")},
+    ),
+    "search": FormSpec(
+        SearchForm,
+        {
+            "scene": (True, "Rhino .3dm file, or a scan mesh (.ply, .obj, .stl, .off) with units."),
+            "spec": (True, "Search spec (JSON): walls, levels, junctions, families, ranking."),
+            "site": (False, "Site file (SITE.json) for the code check of the top mechanisms."),
+            "record": (False, _RECORD),
+        },
     ),
 }
 

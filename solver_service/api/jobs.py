@@ -28,6 +28,7 @@ import numpy as np
 from rhino_plugin.mechanisms.build import constants_from_spec
 from rhino_plugin.scenes import read_scene
 from shared_schema.api import (
+    SEARCH_MAX_EVALUATIONS,
     Ec8Request,
     Eq28Request,
     HistoryOptions,
@@ -40,6 +41,8 @@ from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import MissingExtra
 from shared_schema.io import CONSTANTS_EXPECTED, stamped
 from shared_schema.rules import CRITERIA, F_N_RANGE, SF_METHODS, check_choice
+from shared_schema.search import parse_search_spec
+from shared_schema.site import parse_site
 from shared_schema.spec import parse_spec
 from shared_schema.text import decode_text
 
@@ -65,6 +68,7 @@ from ..workflows.documents import (
 from ..workflows.inputs import SPEC_EXPECTED, read_record
 from ..workflows.outputs import finite_json
 from ..workflows.scaling import Building
+from ..workflows.search import MAX_LP_BLOCKS, search_run
 from ..workflows.units import stamp
 from .errors import error_body
 from .estimates import (
@@ -86,6 +90,7 @@ from .jobspec import (
     ReportJob,
     ScaleFactorJob,
     SceneJob,
+    SearchJob,
     SpectrumJob,
     WarmupJob,
 )
@@ -405,6 +410,43 @@ def _scene_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) 
     return stamped(cf).model_dump_json(exclude_none=True).encode("utf-8")
 
 
+def _search(job: SearchJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    scene_name = safe_filename(job.scene_name, "scene.3dm")
+    spec_name = safe_filename(job.spec_name, "search.json")
+    scene_bytes, spec_bytes, *rest = blobs
+    spec = parse_search_spec(spec_bytes, spec_name)
+    if spec.ranking.site is not None or spec.ranking.records:
+        raise InputError(
+            f"{spec_name}: the service takes no file paths from clients; upload the site file "
+            "and the record as the form's 'site' and 'record' parts",
+            "ranking",
+        )
+    site = parse_site(rest.pop(0)) if job.has_site else None
+    motions = []
+    if job.record is not None:
+        motions.append(motion_from_params(None, job.record, rest[0], limits))
+    try:
+        scene = read_scene(scene_bytes, name=scene_name, units=job.units)
+    except ImportError as exc:
+        raise ServiceUnavailable(
+            "the search needs the geometry extra (pip install 'rockmech[geometry]'), which this "
+            f"deployment lacks ({exc.name} is missing)"
+        ) from None
+    run = search_run(
+        scene,
+        spec,
+        scene_name=scene_name,
+        spec_name=spec_name,
+        site=site,
+        motions=motions,
+        exact=job.exact,
+        max_evaluations=min(job.max_evaluations or SEARCH_MAX_EVALUATIONS, SEARCH_MAX_EVALUATIONS),
+        max_lp_blocks=MAX_LP_BLOCKS,
+        max_built=limits["max_mechanisms"],
+    )
+    return dumps(run.doc)
+
+
 #: Request fields a report lists under "Inputs and provenance", in this order.
 REPORT_KEYS = (
     "scales",
@@ -601,6 +643,7 @@ JOBS: dict[str, tuple[str, Callable[[Any, list[bytes], dict[str, Any]], bytes]]]
     "assess": (_JSON, _assess),
     "assess_html": ("text/html; charset=utf-8", _assess_html),
     "assess_pdf": ("application/pdf", _assess_pdf),
+    "search": (_JSON, _search),
     "warmup": (_JSON, _warmup),
 }
 

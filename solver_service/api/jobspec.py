@@ -11,7 +11,7 @@ not load the compute modules.
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, Optional, Union
+from typing import Annotated, Any, Literal, Optional, Union, cast
 
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
@@ -43,6 +43,7 @@ __all__ = [
     "ReportJob",
     "ScaleFactorJob",
     "SceneJob",
+    "SearchJob",
     "SpectrumJob",
     "WarmupJob",
 ]
@@ -62,6 +63,7 @@ JobKind = Literal[
     "assess",
     "assess_html",
     "assess_pdf",
+    "search",
     "warmup",
 ]
 
@@ -147,6 +149,24 @@ class SceneJob(BaseModel):
     units: Optional[str] = None
 
 
+class SearchJob(BaseModel):
+    """``rockmech search``: blobs are the scene, the search spec, the site and the record.
+
+    The site file and the record come only when given (``has_site``, ``record``).
+    """
+
+    model_config = _JOB
+
+    kind: Literal["search"] = "search"
+    scene_name: str = ""
+    spec_name: str = ""
+    units: Optional[str] = None
+    max_evaluations: Optional[int] = None
+    exact: bool = False
+    has_site: bool = False
+    record: Optional[RecordUpload] = None
+
+
 class CheckJob(CheckRequest):
     """``rockmech check``."""
 
@@ -189,6 +209,7 @@ Job = Annotated[
         ReportJob,
         ScaleFactorJob,
         SceneJob,
+        SearchJob,
         CheckJob,
         AssessJob,
         AssessHtmlJob,
@@ -198,5 +219,6 @@ Job = Annotated[
     Field(discriminator="kind"),
 ]
 
-#: Validates a job from its JSON form (in the compute process).
-JOB: TypeAdapter[Job] = TypeAdapter(Job)
+#: Validates a job from its JSON form (in the compute process). (mypy cannot match a union of
+#: twelve annotated job types against TypeAdapter's overloads: the cast only names the type.)
+JOB: TypeAdapter[Job] = TypeAdapter(cast(Any, Job))

@@ -29,6 +29,7 @@ RHINO_IMPORTED = [
     ROOT / "shared_schema",
     ROOT / "rhino_plugin" / "geometry",
     ROOT / "rhino_plugin" / "mechanisms",
+    ROOT / "rhino_plugin" / "search",
     ROOT / "rhino_plugin" / "flows",
     ROOT / "rhino_plugin" / "scene_3dm.py",
     ROOT / "rhino_plugin" / "scene_base.py",
@@ -36,7 +37,14 @@ RHINO_IMPORTED = [
     ROOT / "rhino_plugin" / "scenes.py",
     ROOT / "rhino_plugin" / "__init__.py",
 ]
-COMMANDS = ["RM_Analyse", "RM_LoadedWall", "RM_MultiBlock", "RM_SingleBlock", "RM_TwoBlock"]
+COMMANDS = [
+    "RM_Analyse",
+    "RM_LoadedWall",
+    "RM_MultiBlock",
+    "RM_Search",
+    "RM_SingleBlock",
+    "RM_TwoBlock",
+]
 
 
 def _headers(path: Path) -> List[str]:

@@ -7,7 +7,7 @@ Checks: all of schemathesis' checks on every operation, including ``not_a_server
 succeed") on every operation that takes a JSON body, and the two GETs
 (``POSITIVE_DATA_OPERATIONS``): ``/pulse``, ``/scale-factor``, ``/envelope``, ``/check``,
 ``/assess`` and the JSON forms of ``/history``, ``/spectrum`` and ``/report``. Uploads are
-excepted: ``/constants`` and the multipart forms of ``/history``, ``/spectrum`` and
+excepted: ``/constants``, ``/search`` and the multipart forms of ``/history``, ``/spectrum`` and
 ``/report`` (a ``.3dm`` must be a Rhino model, a spec must name objects of the scene, a
 record file must be one of the formats); the hooks run the check on JSON bodies only.
 
@@ -145,7 +145,7 @@ def fuzz_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
 #: The operations, in groups of about equal work: each group is one test, so that the test
 #: workers share them (paths under ``/api/v1/``, as regular expressions).
 GROUPS = {
-    "pulse-and-small": r"pulse|scale-factor|health|schema/.*|constants",
+    "pulse-and-small": r"pulse|scale-factor|health|schema/.*|constants|search",
     "envelope-spectrum": r"envelope|spectrum",
     "history": r"history",
     "report": r"report",
@@ -168,7 +168,7 @@ def _operations(url: str, pattern: str) -> int:
 
 def test_the_groups_cover_every_operation(fuzz_server: Server) -> None:
     total = _operations(fuzz_server.url, ".*")
-    assert sum(_operations(fuzz_server.url, p) for p in GROUPS.values()) == total == 11
+    assert sum(_operations(fuzz_server.url, p) for p in GROUPS.values()) == total == 12
 
 
 @pytest.mark.slow

@@ -1,0 +1,837 @@
+"""The mechanism families: candidate crack lines, discrete combinations, continuous refinement.
+
+For each façade and direction the search lists candidate hinge lines (the base, sills,
+lintels, level heights, outline corners and optional extra lines) and, per line, the
+combinations a family allows; each combination has at most two continuous parameters,
+refined by ``refine.minimise`` on the exact λ0 (``multiplier``):
+
+* ``overturning`` / ``partial_overturning``: the façade above a hinge line turns about it
+  (outward about the outer face, inward about the inner face); no parameter;
+* ``gable`` / ``parapet``: the same above the top level (a sloped or a straight top);
+* ``wedge_overturning``: the same with a wedge of each return wall whose connection is
+  good, cut by a crack from the junction at the hinge line at angle β from the vertical,
+  ``β >= atan(l_u / 2 h_u)``; one parameter per such end (a poor connection parts along the
+  junction, a tied one holds the façade);
+* ``vertical_flexure``: the two-block wall between the ground and a tied level at the
+  top (theory §2.3); the hinge height ``h1`` is the parameter;
+* ``corner``: the corner of a façade and a flush return wall with a good connection, cut by
+  a crack in each wall from the base, turning about the horizontal axis through the outer
+  corner across the diagonal; two angles.
+
+A wedge crack separates the wedge without friction (the classical macro-block model: the
+crack opens and slides freely), and a hinge joint does not slide; ``sliding_check`` says
+where the joint's friction would not hold the rocking multiplier.
+
+Python 3.9-clean: imported by Rhino 8.
+"""
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from rhino_plugin.geometry.massprops import mass_properties
+from rhino_plugin.mechanisms.loaded import BEARING_ANGLE, largest_contact
+from rhino_plugin.mechanisms.single import find_objects
+from rhino_plugin.search.model import Building, LevelContact, ReturnWall, TiePoint, Wall
+from rhino_plugin.search.multiplier import rotation_multiplier, two_block_multiplier
+from rhino_plugin.search.prism import Lump, clip_rings, point_lump, ring_moments
+from rhino_plugin.search.refine import minimise
+from shared_schema.errors import InputError
+from shared_schema.rules import G
+
+__all__ = ["Budget", "Candidate", "Piece", "enumerate_candidates", "hinge_lines"]
+
+Plane = Tuple[np.ndarray, np.ndarray]  # (point [m], normal): keeps normal·(x - point) >= 0
+
+#: Relative tolerance on heights (relative to the building's size).
+HEIGHT_RTOL = 1e-9
+#: Largest crack angle from the vertical searched [rad].
+BETA_MAX = math.radians(80.0)
+#: Range of the two-block hinge height searched, as fractions of the wall's height.
+H1_RANGE = (0.02, 0.98)
+#: A block lighter than this fraction of its wall is no block (a sliver at an edge).
+MIN_MASS_FRACTION = 1e-9
+
+
+class Budget:
+    """A cap on the λ0 evaluations of one search (the work limit).
+
+    It is checked before each refinement starts, so that a search too large for the limit
+    stops before doing that work.
+    """
+
+    def __init__(self, limit: Optional[int] = None) -> None:
+        self.limit = limit
+        self.used = 0
+
+    def reserve(self, n: int, what: str) -> None:
+        """Count the seed grid of the next refinement (raise past the limit)."""
+        if self.limit is not None and self.used + n > self.limit:
+            raise InputError(
+                f"the search needs more than {self.limit} evaluations of λ0 (at {what}); "
+                "ask for fewer families or directions, a coarser candidates.grid or no "
+                "candidates.spacing, or raise the work limit",
+                "work_limit",
+            )
+
+    def spend(self, n: int) -> None:
+        """Count the evaluations a refinement made."""
+        self.used += n
+
+
+@dataclass
+class Piece:
+    """The part of one wall that moves with a mechanism.
+
+    Attributes
+    ----------
+    wall : Wall
+        The wall.
+    planes : list of (point, normal)
+        Half-spaces whose intersection with the wall is the part (each plane contains the
+        wall's thickness direction).
+    """
+
+    wall: Wall
+    planes: List[Plane]
+
+    def lump(self) -> Lump:
+        """Return the part's mass moments."""
+        return self.wall.lump(self.planes)
+
+    def rings(self) -> List[np.ndarray]:
+        """Return the part's elevation in the wall's frame."""
+        return self.wall.region(self.planes)
+
+
+@dataclass
+class LevelLoad:
+    """A level as one mechanism carries it (where the builder finds it).
+
+    Attributes
+    ----------
+    contact : LevelContact
+        The level and one wall it touches (``contact.level`` is the spec's level).
+    point : (3,) float
+        Centroid of its largest contact with the moving parts [m].
+    area : float
+        That contact's area [m²].
+    mass : float
+        The wall's share of its mass (``tributary``) [kg].
+    bearing : bool
+        Its weight acts (a horizontal contact, or a roof).
+    thrust : float
+        Outward roof thrust [N] (0 for floors and tied trusses).
+    """
+
+    contact: LevelContact
+    point: np.ndarray
+    area: float
+    mass: float
+    bearing: bool
+    thrust: float
+
+    @property
+    def level(self) -> Any:
+        """The spec's level."""
+        return self.contact.level
+
+
+@dataclass
+class Candidate:
+    """One mechanism of the catalogue, refined.
+
+    Attributes
+    ----------
+    family, facade, direction : str
+        What it is.
+    typology, rocking : str
+        The mechanism spec's typology and rocking kind.
+    params : dict of str to float
+        The refined parameters (``hinge_height_m``, ``beta_start_rad``, ``beta_end_rad``,
+        ``h1_m``, ``beta_facade_rad``, ``beta_return_rad``).
+    bounds : dict of str to (float, float)
+        Their search ranges.
+    pieces : list of Piece
+        The moving parts.
+    axis : (2, 3) float
+        Two points of the rotation axis (two-block: of the base hinge O) [m].
+    direction_vector : (3,) float
+        The horizontal collapse direction.
+    lam0 : float
+        Exact static load multiplier [-].
+    contacts : list of LevelLoad
+        The levels it carries, where the builder finds them.
+    ties : list of TiePoint
+        The tie-bars on it.
+    overburden : dict, optional
+        Two-block: ``N`` [N] and its ``x`` [m] in the rocking plane.
+    lam0_negative : float, optional
+        Two-block: λ0 of the mirrored (inward) side.
+    n_evaluations : int
+        λ0 evaluations of its refinement.
+    on_bound : list of str
+        Parameters whose optimum lies on a bound.
+    notes : list of str
+        What the candidate assumes.
+    """
+
+    family: str
+    facade: str
+    direction: str
+    typology: str
+    rocking: str
+    params: Dict[str, float]
+    bounds: Dict[str, Tuple[float, float]]
+    pieces: List[Piece]
+    axis: np.ndarray
+    direction_vector: np.ndarray
+    lam0: float
+    contacts: List[LevelLoad] = field(default_factory=list)
+    ties: List[TiePoint] = field(default_factory=list)
+    overburden: Optional[Dict[str, Any]] = None
+    lam0_negative: Optional[float] = None
+    n_evaluations: int = 0
+    on_bound: List[str] = field(default_factory=list)
+    notes: List[str] = field(default_factory=list)
+    hinge_z: float = 0.0
+
+    @property
+    def key(self) -> Tuple[Any, ...]:
+        """What makes two candidates the same mechanism (for removing repeats)."""
+        return (
+            self.facade,
+            self.direction,
+            self.typology,
+            tuple(sorted((k, round(v, 12)) for k, v in self.params.items())),
+            tuple(p.wall.id for p in self.pieces),
+        )
+
+    def weight(self) -> float:
+        """Weight of the moving parts [N]."""
+        return G * sum(p.lump().mass for p in self.pieces)
+
+
+def _tol(bld: Building) -> float:
+    return HEIGHT_RTOL * max(bld.size, 1.0)
+
+
+def hinge_lines(bld: Building, wall: Wall, spacing: Optional[float] = None) -> List[float]:
+    """Candidate hinge heights of a façade [m]: base, sills, lintels, levels, outline corners.
+
+    Parameters
+    ----------
+    bld : Building
+        The building.
+    wall : Wall
+        The façade.
+    spacing : float, optional
+        Add a line every ``spacing`` metres above the base (none inside a level's height).
+
+    Returns
+    -------
+    list of float
+        Sorted heights in ``[z_lo, z_hi)``; the base first.
+    """
+    tol = _tol(bld)
+    zs = {wall.z_lo}
+    for _, _, z0, z1 in wall.holes:
+        zs.update((z0, z1))
+    zs.update(float(z) for z in wall.rings[0][:, 1])
+    spans = []
+    for c in bld.contacts.get(wall.id, []):
+        lo, hi = c.z_range
+        zs.update((lo, hi))
+        spans.append((lo, hi))
+        if c.bearing:
+            zs.add(float(c.point[2]))
+    if spacing:
+        z = wall.z_lo + spacing
+        while z < wall.z_hi - tol:
+            if not any(lo + tol < z < hi - tol for lo, hi in spans):
+                zs.add(z)
+            z += spacing
+    out = sorted(z for z in zs if wall.z_lo - tol <= z < wall.z_hi - tol)
+    merged: List[float] = []
+    for z in out:
+        if not merged or z - merged[-1] > tol:
+            merged.append(z)
+    merged[0] = wall.z_lo
+    return merged
+
+
+def _above(point: np.ndarray, z: float) -> Plane:
+    """Keep what lies above the height ``z`` (a horizontal crack through ``point``'s column)."""
+    return np.array([point[0], point[1], z]), np.array([0.0, 0.0, 1.0])
+
+
+def _wedge_plane(facade: Wall, z: float, beta: float) -> Plane:
+    """Keep the return wall's part within ``(z' - z) tan β`` of the façade's inner face."""
+    f = facade.frame
+    point = f.to_world(0.0, facade.inner_face, z)
+    normal = -math.cos(beta) * f.e_n + math.sin(beta) * f.e_z
+    return point, normal
+
+
+def _corner_plane(facade: Wall, end: str, z: float, beta: float) -> Plane:
+    """Keep the façade's part within ``(z' - z) tan β`` of its end ``end``."""
+    f = facade.frame
+    s_end = 0.0 if end == "start" else facade.length
+    e_c = f.e_s if end == "start" else -f.e_s
+    return f.to_world(s_end, 0.0, z), -math.cos(beta) * e_c + math.sin(beta) * f.e_z
+
+
+def _region_mass(wall: Wall, planes: Sequence[Plane]) -> float:
+    return float(ring_moments(wall.region(planes))[0]) * wall.frame.thickness * wall.density
+
+
+Hits = Dict[int, Tuple[float, np.ndarray, LevelContact, Any]]
+
+
+def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = None) -> Hits:
+    """Each level's largest contact with the moving parts: level -> (area, centroid, ...).
+
+    Every contact of a level with a wall is clipped to that wall's moving part (the plane
+    of the contact, cut by the part's half-spaces); ``best`` (the hits of other parts) is
+    extended, not changed.
+    """
+    tol = max(bld.contact_tol, 0.0)
+    out: Hits = dict(best or {})
+    for piece in pieces:
+        for c in bld.contacts.get(piece.wall.id, []):
+            for region in c.regions:
+                rings = list(region.rings)
+                u, v, o = region.u.tolist(), region.v.tolist(), region.origin.tolist()
+                for point, normal in piece.planes:
+                    m0, m1, m2 = (float(x) for x in normal)
+                    p0, p1, p2 = (float(x) for x in point)
+                    rings = clip_rings(
+                        rings,
+                        m0 * u[0] + m1 * u[1] + m2 * u[2],
+                        m0 * v[0] + m1 * v[1] + m2 * v[2],
+                        m0 * (o[0] - p0) + m1 * (o[1] - p1) + m2 * (o[2] - p2),
+                    )
+                area, su, sv = (float(x) for x in ring_moments(rings)[:3])
+                if not area > 0.0:
+                    continue
+                pts = np.vstack(rings) if len(rings) > 1 else rings[0]
+                extent = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
+                if area <= tol * extent:
+                    continue  # a touch along a line (the builder's MIN_WIDTH_FACTOR)
+                k = c.index
+                if k not in out or area > out[k][0]:
+                    centroid = region.origin + (su / area) * region.u + (sv / area) * region.v
+                    out[k] = (area, centroid, c, region)
+    return out
+
+
+def level_loads(
+    bld: Building, pieces: Sequence[Piece], d: np.ndarray, hits: Optional[Hits] = None
+) -> Tuple[List[LevelLoad], Optional[str]]:
+    """Return the levels a mechanism's moving parts carry, as the constants builder finds them.
+
+    A level acts at the centroid of its largest contact with the moving parts (each of its
+    contacts with a wall clipped to that wall's moving part), bears if that contact is
+    horizontal (a roof always bears), and a roof that is not a tied truss thrusts along the
+    collapse direction ``d`` (span and rise from its bounding box in the mechanism's frame),
+    as ``mechanisms.loaded.loaded_side`` computes them. ``hits`` are the contacts of other
+    moving parts already found (``contact_hits``).
+
+    Returns
+    -------
+    loads : list of LevelLoad
+        In the order of the spec's levels.
+    held : str or None
+        The id of a tied level the moving parts touch (the mechanism is then held).
+    """
+    best = contact_hits(bld, pieces, hits)
+    loads: List[LevelLoad] = []
+    held = None
+    for k in sorted(best):
+        area, point, c, region = best[k]
+        if c.level.tied:
+            held = held or c.level.id
+            continue
+        bearing = c.level.kind == "roof" or abs(float(region.normal[2])) >= math.cos(BEARING_ANGLE)
+        thrust = 0.0
+        if c.level.kind == "roof" and c.level.pushes:
+            thrust = bld.roof_thrust(c, d)
+        loads.append(LevelLoad(c, point, area, c.mass, bearing, thrust))
+    return loads, held
+
+
+def _loads(
+    contacts: Sequence[LevelLoad], ties: Sequence[TiePoint], d: np.ndarray
+) -> Tuple[Lump, Lump, List[Tuple[np.ndarray, np.ndarray]]]:
+    """Bearing and abutting masses and static forces of a rigid mechanism."""
+    weighing = Lump.zero()
+    abutting = Lump.zero()
+    forces = []
+    for c in contacts:
+        lump = point_lump(c.mass, c.point)
+        if c.bearing:
+            weighing = weighing + lump
+        else:
+            abutting = abutting + lump
+        if c.thrust > 0.0:
+            forces.append((c.thrust * d, c.point))
+    for tie in ties:
+        forces.append((-tie.tie.force * d, tie.point))
+    return weighing, abutting, forces
+
+
+@dataclass
+class Template:
+    """A rigid mechanism before refinement: fixed pieces, pieces set by the parameters.
+
+    Attributes
+    ----------
+    family, rocking : str
+        What the refined candidate will be.
+    names : list of str
+        Parameter names.
+    bounds : list of (float, float)
+        Their ranges.
+    fixed : list of Piece
+        Parts that do not depend on the parameters.
+    variable : callable
+        ``variable(x) -> list of Piece``: the parts the parameters set.
+    point : (3,) float
+        A point of the axis [m].
+    d : (3,) float
+        The collapse direction.
+    bld : Building
+        The building (its levels load the moving parts where they touch them).
+    ties : list of TiePoint
+        The tie-bars on the moving parts.
+    axis : (2, 3) float
+        Two points of the axis [m].
+    hinge_z : float
+        Height of the hinge line [m].
+    """
+
+    family: str
+    rocking: str
+    names: List[str]
+    bounds: List[Tuple[float, float]]
+    fixed: List[Piece]
+    variable: Callable[[Sequence[float]], List[Piece]]
+    point: np.ndarray
+    d: np.ndarray
+    bld: Building
+    ties: List[TiePoint]
+    axis: np.ndarray
+    hinge_z: float
+    notes: List[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        lump = Lump.zero()
+        for p in self.fixed:
+            lump = lump + p.lump()
+        self._fixed_lump = lump
+        self._fixed_hits = contact_hits(self.bld, self.fixed)
+
+    def pieces(self, x: Sequence[float]) -> List[Piece]:
+        """Return every moving part at parameters ``x``."""
+        return self.fixed + self.variable(x)
+
+    def lam(self, x: Sequence[float]) -> float:
+        """Return λ0 at parameters ``x`` (``inf`` where nothing moves, or a tied level holds)."""
+        variable = self.variable(x)
+        body = self._fixed_lump
+        for p in variable:
+            body = body + p.lump()
+        if not body.mass > 0.0:
+            return math.inf
+        loads, held = level_loads(self.bld, variable, self.d, self._fixed_hits)
+        if held is not None:
+            return math.inf
+        weighing, abutting, forces = _loads(loads, self.ties, self.d)
+        w = body + weighing
+        return rotation_multiplier(w, w + abutting, self.point, self.d, forces)
+
+    def refine(
+        self, facade: str, direction: str, grid: int, budget: Optional[Budget] = None
+    ) -> Optional[Candidate]:
+        """Minimise λ0 over the parameters; None where no admissible point exists."""
+        if budget is not None:
+            budget.reserve(grid ** len(self.bounds), f"{facade} {direction} {self.family}")
+        res = minimise(self.lam, self.bounds, grid)
+        if budget is not None:
+            budget.spend(res.n_evaluations)
+        if not math.isfinite(res.value):
+            return None
+        params = {"hinge_height_m": self.hinge_z} if self.family != "corner" else {}
+        params.update(zip(self.names, res.x))
+        pieces = self.pieces(res.x)
+        loads, _ = level_loads(self.bld, pieces, self.d)
+        typology = "single_block_loaded" if (loads or self.ties) else "single_block"
+        return Candidate(
+            self.family,
+            facade,
+            direction,
+            typology,
+            self.rocking,
+            params,
+            dict(zip(self.names, self.bounds)),
+            pieces,
+            self.axis,
+            self.d,
+            res.value,
+            loads,
+            self.ties,
+            n_evaluations=res.n_evaluations,
+            on_bound=[n for n, b in zip(self.names, res.on_bound) if b],
+            notes=list(self.notes),
+            hinge_z=self.hinge_z,
+        )
+
+
+def _direction(wall: Wall, direction: str) -> Tuple[np.ndarray, float]:
+    """Collapse direction and the face (n) its hinge lies on."""
+    f = wall.frame
+    if direction == "outward":
+        return -f.e_n, 0.0
+    return f.e_n.copy(), wall.inner_face
+
+
+def _label(bld: Building, wall: Wall, z_h: float, wedges: bool, tol: float) -> str:
+    if wedges:
+        return "wedge_overturning"
+    if z_h <= wall.z_lo + tol:
+        return "overturning"
+    tops = [c.z_range[1] for c in bld.contacts.get(wall.id, [])]
+    if tops and z_h >= max(tops) - tol:
+        # a gable's outline above the line is no rectangle (sloped edges), a parapet's is
+        above = clip_rings([wall.rings[0]], 0.0, 1.0, -z_h)
+        if not above:
+            return "parapet"
+        pts = np.vstack(above)
+        box = float(np.ptp(pts[:, 0]) * np.ptp(pts[:, 1]))
+        sloped = float(ring_moments(above)[0]) < (1.0 - 1e-9) * box
+        return "gable" if sloped else "parapet"
+    return "partial_overturning"
+
+
+def overturning_template(
+    bld: Building, wall: Wall, direction: str, z_h: float
+) -> Tuple[Optional[Template], str]:
+    """Build the overturning of a façade's part above ``z_h``, with its admissible wedges.
+
+    Parameters
+    ----------
+    bld : Building
+        The building.
+    wall : Wall
+        The façade.
+    direction : {"outward", "inward"}
+        The collapse direction.
+    z_h : float
+        Height of the hinge line [m] (the base for full-height overturning).
+
+    Returns
+    -------
+    template : Template or None
+        None where the mechanism is not admissible.
+    why : str
+        Why not (empty when admissible).
+    """
+    tol = _tol(bld) * 1e3
+    free = bld.free_standing(wall.id)
+    if direction == "inward" and not free:
+        return None, "the building (return walls, levels or ties) holds the wall's inner face"
+    d, n_face = _direction(wall, direction)
+    f = wall.frame
+    returns = bld.returns.get(wall.id, []) if direction == "outward" else []
+    contacts = [c for c in bld.contacts.get(wall.id, []) if c.point[2] > z_h + tol]
+    tied = [c for c in contacts if c.level.tied]
+    if tied:
+        return None, (
+            f"the tied level {tied[0].level.id} holds the wall at z = {tied[0].point[2]:.3f} m"
+        )
+    held = [r.wall.id for r in returns if r.connection == "tied"]
+    if held:
+        return None, f"the tied junction with {held[0]} holds the façade"
+    ties = [t for t in bld.ties.get(wall.id, []) if t.z > z_h + tol]
+    cut = _above(f.origin, z_h)
+    planes = [cut] if z_h > wall.z_lo + tol else []
+    if _region_mass(wall, planes) <= MIN_MASS_FRACTION * wall.mass:
+        return None, "nothing of the wall lies above the hinge line"
+    params: List[Tuple[str, ReturnWall, float, float]] = []
+    for r in returns:
+        if r.connection != "good":
+            continue
+        if _region_mass(r.wall, [cut]) <= MIN_MASS_FRACTION * r.wall.mass:
+            continue  # the return wall stops below the hinge line
+        dz = max(r.wall.z_hi - z_h, tol)
+        hi = min(max(r.beta_bond, math.atan(r.reach / dz)), BETA_MAX)
+        lo = min(r.beta_bond, hi)
+        params.append((f"beta_{r.end}_rad", r, lo, hi))
+    family = _label(bld, wall, z_h, bool(params), tol)
+
+    def variable(x: Sequence[float]) -> List[Piece]:
+        return [
+            Piece(r.wall, [cut, _wedge_plane(wall, z_h, b)]) for (_, r, _, _), b in zip(params, x)
+        ]
+
+    point = f.to_world(0.0, n_face, z_h)
+    axis = np.array([point, f.to_world(wall.length, n_face, z_h)])
+    rocking = "two_sided" if free else "one_sided"
+    tmpl = Template(
+        family,
+        rocking,
+        [p[0] for p in params],
+        [(p[2], p[3]) for p in params],
+        [Piece(wall, planes)],
+        variable,
+        point,
+        d,
+        bld,
+        ties,
+        axis,
+        z_h,
+    )
+    return tmpl, ""
+
+
+def _rigid_candidates(
+    bld: Building,
+    wall: Wall,
+    direction: str,
+    families: Sequence[str],
+    grid: int,
+    notes: List[str],
+    budget: Budget,
+) -> List[Candidate]:
+    out: List[Candidate] = []
+    said = set()
+    for z_h in hinge_lines(bld, wall, bld.spec.candidates.spacing):
+        tmpl, why = overturning_template(bld, wall, direction, z_h)
+        if tmpl is None:
+            if why and why not in said:
+                said.add(why)
+                notes.append(f"{wall.id} {direction}: no overturning where {why}")
+            continue
+        if tmpl.family not in families:
+            continue
+        cand = tmpl.refine(wall.id, direction, grid, budget)
+        if cand is not None:
+            out.append(cand)
+    return out
+
+
+def overburden_load(bld: Building, wall: Wall, d: np.ndarray) -> Tuple[float, float, List[str]]:
+    """N [N] on the wall's top and its position x [m] along ``d`` from the outer face."""
+    ob = wall.overburden
+    b = wall.frame.thickness
+    if ob is None:
+        return 0.0, -0.5 * b, []
+    if ob.force is not None:
+        return float(ob.force), -0.5 * b, []
+    objs = find_objects(bld.scene, ob.objects, f"{wall.id}.overburden")
+    meshes = [bld.scene.mesh(o) for o in objs]
+    n = ob.tributary * G * sum(mass_properties(m, ob.density).mass for m in meshes)
+    _, point, _ = largest_contact(meshes, [wall.mesh], f"{wall.id}.overburden", 1e-6)
+    x = float((np.asarray(point) - wall.frame.origin) @ d)
+    notes = []
+    if "tributary" not in ob.model_fields_set:
+        notes.append(
+            f"{wall.id}.overburden: tributary not given; the wall carries the default "
+            f"{ob.tributary:g} of the overburden's weight (N = {n:.6g} N)"
+        )
+    return n, x, notes
+
+
+def two_block_lam(
+    wall: Wall, h1: float, d: np.ndarray, n: float, x_n: float, mirrored: bool = False
+) -> float:
+    """λ0 of the façade as a two-block wall with its hinge at ``h1`` above the base.
+
+    Parameters
+    ----------
+    wall : Wall
+        The façade.
+    h1 : float
+        Height of the intermediate hinge above the base [m].
+    d : (3,) float
+        Outward direction (the positive side).
+    n, x_n : float
+        Overburden [N] and its position along ``d`` from the outer face [m].
+    mirrored : bool
+        The inward side: hinges mirrored about the wall's mid-plane.
+    """
+    f = wall.frame
+    b = f.thickness
+    h = wall.z_hi - wall.z_lo
+    z_c = wall.z_lo + h1
+    lo = wall.lump([(f.to_world(0.0, 0.0, z_c), -f.e_z)])
+    up = wall.lump([(f.to_world(0.0, 0.0, z_c), f.e_z)])
+    if not (lo.mass > 0.0 and up.mass > 0.0):
+        return math.inf
+    o = f.to_world(0.0, 0.0, wall.z_lo)
+
+    def planar(lump: Lump) -> Tuple[float, float, float]:
+        g = lump.com - o
+        x = float(g @ d)
+        return lump.mass, (-b - x if mirrored else x), float(g[2])
+
+    x_p = -b - x_n if mirrored else x_n
+    return two_block_multiplier(planar(lo), planar(up), (0.0, 0.0), (-b, h1), (0.0, h), n, (x_p, h))
+
+
+def _flexure_candidates(
+    bld: Building, wall: Wall, grid: int, notes: List[str], budget: Budget
+) -> List[Candidate]:
+    tol = _tol(bld) * 1e3
+    contacts = bld.contacts.get(wall.id, [])
+    top = [c for c in contacts if c.level.tied and c.z_range[1] >= wall.z_hi - tol]
+    if not top:
+        return []
+    others = [c for c in contacts if c not in top]
+    if others or bld.ties.get(wall.id):
+        ties = [f"tie_bars[{t.index}]" for t in bld.ties.get(wall.id, [])]
+        what = ", ".join([c.level.id for c in others] + ties)
+        notes.append(
+            f"{wall.id} vertical_flexure: not searched, {what} load the wall between its "
+            "restraints and the two-block wall carries only its overburden"
+        )
+        return []
+    d = -wall.frame.e_n
+    n, x_n, ob_notes = overburden_load(bld, wall, d)
+    h = wall.z_hi - wall.z_lo
+    bounds = (H1_RANGE[0] * h, H1_RANGE[1] * h)
+    budget.reserve(grid, f"{wall.id} vertical_flexure")
+    res = minimise(lambda x: two_block_lam(wall, x[0], d, n, x_n), [bounds], grid)
+    budget.spend(res.n_evaluations)
+    if not math.isfinite(res.value):
+        return []
+    h1 = res.x[0]
+    lam_neg = two_block_lam(wall, h1, d, n, x_n, mirrored=True)
+    f = wall.frame
+    axis = np.array([f.to_world(0.0, 0.0, wall.z_lo), f.to_world(wall.length, 0.0, wall.z_lo)])
+    cand = Candidate(
+        "vertical_flexure",
+        wall.id,
+        "outward",
+        "two_block",
+        "two_sided",
+        {"h1_m": h1},
+        {"h1_m": bounds},
+        [Piece(wall, [])],
+        axis,
+        d,
+        res.value,
+        overburden={"N": n, "x": x_n},
+        lam0_negative=lam_neg,
+        n_evaluations=res.n_evaluations,
+        on_bound=["h1_m"] if res.on_bound[0] else [],
+        notes=[
+            *ob_notes,
+            f"{wall.id}: held at the top by {top[0].level.id}; the two-block wall spans "
+            "between the ground and that level (its return walls' restraint of the strip's "
+            "edges is not counted)",
+        ],
+        hinge_z=wall.z_lo,
+    )
+    return [cand]
+
+
+def _corner_candidates(
+    bld: Building, wall: Wall, grid: int, notes: List[str], budget: Budget
+) -> List[Candidate]:
+    out: List[Candidate] = []
+    f = wall.frame
+    for r in bld.returns.get(wall.id, []):
+        if not r.corner or r.connection != "good":
+            continue
+        if bld.ties.get(wall.id) or bld.ties.get(r.wall.id):
+            notes.append(
+                f"{wall.id}/{r.wall.id} corner: not searched, tie-bars cross the corner's walls "
+                "and the builder takes a tie-bar on the plane through the diagonal axis"
+            )
+            continue
+        o = -f.e_s if r.end == "start" else f.e_s
+        d = -f.e_n + o
+        d = d / float(np.linalg.norm(d))
+        s_corner = min(0.0, r.span[0]) if r.end == "start" else max(wall.length, r.span[1])
+        point = f.to_world(s_corner, 0.0, wall.z_lo)
+        h = wall.z_hi - wall.z_lo
+        hi_a = min(max(r.beta_bond, math.atan(wall.length / h)), BETA_MAX)
+        dz = max(r.wall.z_hi - wall.z_lo, 1e-9)
+        hi_b = min(max(r.beta_bond, math.atan(r.reach / dz)), BETA_MAX)
+        bounds = [(min(r.beta_bond, hi_a), hi_a), (min(r.beta_bond, hi_b), hi_b)]
+
+        def pieces(x: Sequence[float], r: ReturnWall = r) -> List[Piece]:
+            return [
+                Piece(wall, [_corner_plane(wall, r.end, wall.z_lo, x[0])]),
+                Piece(r.wall, [_wedge_plane(wall, wall.z_lo, x[1])]),
+            ]
+
+        u = np.cross(np.array([0.0, 0.0, 1.0]), d)
+        tmpl = Template(
+            "corner",
+            "one_sided",
+            ["beta_facade_rad", "beta_return_rad"],
+            bounds,
+            [],
+            pieces,
+            point,
+            d,
+            bld,
+            [],
+            np.array([point, point + u]),
+            wall.z_lo,
+            [f"corner of {wall.id} and {r.wall.id} at {wall.id}'s {r.end}"],
+        )
+        cand = tmpl.refine(wall.id, "outward", grid, budget)
+        if cand is not None:
+            out.append(cand)
+    return out
+
+
+def enumerate_candidates(
+    bld: Building, budget: Optional[Budget] = None
+) -> Tuple[List[Candidate], List[str]]:
+    """Every refined candidate of the families and directions the spec asks for.
+
+    ``budget`` caps the λ0 evaluations (``InputError`` on field ``work_limit`` past it).
+
+    Returns
+    -------
+    candidates : list of Candidate
+        In a fixed order (façade, direction, family, hinge line); repeats removed.
+    notes : list of str
+        Families left out where they cannot apply, and why.
+    """
+    spec = bld.spec
+    grid = spec.candidates.grid
+    budget = budget if budget is not None else Budget()
+    notes: List[str] = []
+    out: List[Candidate] = []
+    for wall in bld.walls.values():
+        if not wall.is_facade:
+            continue
+        free_done = False
+        for direction in spec.directions:
+            if bld.free_standing(wall.id):
+                if free_done:
+                    notes.append(
+                        f"{wall.id} {direction}: the free-standing wall rocks two-sided; this "
+                        "direction is the negative side of its mechanisms"
+                    )
+                    continue
+                free_done = True
+            out.extend(_rigid_candidates(bld, wall, direction, spec.families, grid, notes, budget))
+        if "vertical_flexure" in spec.families:
+            out.extend(_flexure_candidates(bld, wall, grid, notes, budget))
+        if "corner" in spec.families and "outward" in spec.directions:
+            out.extend(_corner_candidates(bld, wall, grid, notes, budget))
+    seen = set()
+    unique = []
+    for c in out:
+        if c.key not in seen:
+            seen.add(c.key)
+            unique.append(c)
+    return unique, notes

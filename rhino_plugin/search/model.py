@@ -1,0 +1,825 @@
+"""A building for the search: walls as prisms, their junctions, levels and ties.
+
+``building_from_scene`` reads the objects a search spec names and returns a
+:class:`Building`:
+
+* every wall is one solid, taken as a right prism: its elevation (outer boundary, openings
+  as holes) in its own frame (``s`` along it, ``n`` through it from the outer face, ``z``
+  up; ``e_n`` points into the building) and its thickness. A wall that is not an exact
+  prism (a pocket, a scan's relief) is idealised with the thickness ``V/A`` that keeps its
+  mass, and a note says so; the builder still computes its constants from the real solid,
+  and the search reports the difference;
+* a wall B whose end face abuts the inner face of a façade A at one of A's ends is a
+  return wall of A there, with the connection the spec gives (good: a crack through B runs
+  at least at the bond angle ``atan(l_u / 2 h_u)`` from the vertical; poor: A parts from
+  B; tied: A does not part from B). A return wall flush with A's end makes a corner;
+* a level touches a wall along its largest contact (``mechanisms.loaded.largest_contact``,
+  as the builder finds it): a horizontal contact bears, a vertical one abuts; a roof that
+  is not tied thrusts outward (``thrust.roof_thrust``, span and rise from its bounding box
+  in the wall's frame, as the builder computes them);
+* a tie-bar meets a façade where its line crosses the façade's outer face.
+
+Python 3.9-clean: imported by Rhino 8.
+"""
+
+import math
+import uuid
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Sequence, Tuple, cast
+
+import numpy as np
+
+from rhino_plugin.geometry.contact import contact_region
+from rhino_plugin.geometry.frames import bounding_box_in_frame
+from rhino_plugin.geometry.massprops import mass_properties
+from rhino_plugin.geometry.mesh import TriMesh
+from rhino_plugin.geometry.validate import check_solid
+from rhino_plugin.mechanisms.loaded import BEARING_ANGLE, contact_tolerance
+from rhino_plugin.mechanisms.single import find_objects
+from rhino_plugin.mechanisms.thrust import roof_thrust
+from rhino_plugin.scene_base import SceneObject
+from rhino_plugin.search.prism import Lump, WallFrame, clip_rings, frame_from_mesh, ring_moments
+from rhino_plugin.search.scene import OPENINGS_SUFFIX, MemoryScene
+from shared_schema.errors import GeometryError, InputError
+from shared_schema.extras import require
+from shared_schema.rules import G
+
+__all__ = [
+    "PRISM_RTOL",
+    "Building",
+    "LevelContact",
+    "ReturnWall",
+    "TiePoint",
+    "Wall",
+    "building_from_scene",
+]
+
+#: A wall whose volume equals its elevation area times its thickness to this relative
+#: tolerance is an exact prism (the search's geometry is then the builder's, to rounding).
+PRISM_RTOL = 1e-9
+#: Smallest |cos| between a face normal and the thickness direction for a face of the outer
+#: side (faces within 60 degrees).
+FACE_COS = 0.5
+#: Largest angle between two walls' directions taken as perpendicular [rad].
+SQUARE_TOL = 1e-3
+#: Namespace of the ids of walls with openings cut out of them.
+NAMESPACE = uuid.UUID("2b5d8c1e-6f0a-4f4e-9a3b-7d1c0e9f3a51")
+
+
+@dataclass
+class Wall:
+    """One wall as a prism.
+
+    Attributes
+    ----------
+    id : str
+        The spec's wall id.
+    selector : selector
+        How the mechanism spec selects its solid.
+    obj : SceneObject
+        Its object in the search's scene.
+    density : float
+        [kg/m³].
+    label : str or None
+        Material name.
+    is_facade : bool
+        Whether its own mechanisms are searched.
+    overburden : Overburden or None
+        The spec's overburden for vertical flexure.
+    frame : WallFrame
+        Its frame (``e_n`` into the building) and thickness [m].
+    rings : list of (k, 2) float
+        Elevation (s, z) [m]: the outer boundary counter-clockwise, holes clockwise.
+    length : float
+        Extent along ``e_s`` [m] (``s`` in [0, length]).
+    z_lo, z_hi : float
+        Base and top heights [m].
+    exact : bool
+        Whether the solid is an exact prism.
+    holes : list of (s0, s1, z0, z1)
+        Bounding boxes of the openings in the elevation [m].
+    """
+
+    id: str
+    selector: Any
+    obj: SceneObject
+    density: float
+    label: Optional[str]
+    is_facade: bool
+    overburden: Any
+    frame: WallFrame
+    rings: List[np.ndarray]
+    length: float
+    z_lo: float
+    z_hi: float
+    exact: bool
+    holes: List[Tuple[float, float, float, float]]
+    volume: float
+
+    @property
+    def mesh(self) -> TriMesh:
+        """The wall's solid [m]."""
+        return cast(TriMesh, self.obj.geometry)
+
+    def region(self, planes: Sequence[Tuple[np.ndarray, np.ndarray]]) -> List[np.ndarray]:
+        """Return the elevation kept by half-spaces ``normal·(x - point) >= 0``.
+
+        Each plane must contain the wall's thickness direction ``e_n``.
+
+        Raises
+        ------
+        GeometryError
+            A plane does not contain the wall's thickness direction.
+        """
+        rings = list(self.rings)
+        for point, normal in planes:
+            line = self.frame.line_of_plane(point, normal)
+            if line is None:
+                raise GeometryError(
+                    f"{self.id}: a crack plane cuts the wall obliquely through its thickness"
+                )
+            rings = clip_rings(rings, *line)
+        return rings
+
+    def lump(self, planes: Sequence[Tuple[np.ndarray, np.ndarray]]) -> Lump:
+        """Mass moments of the part of the wall the half-spaces keep."""
+        return self.frame.prism_lump(self.region(planes), self.density)
+
+    @property
+    def inner_face(self) -> float:
+        """``n`` of the inner face of the solid [m] (the thickness, for a prism)."""
+        cached = self.__dict__.get("_inner")
+        if cached is None:
+            cached = float(self.frame.to_frame(self.mesh.vertices)[:, 1].max())
+            self.__dict__["_inner"] = cached
+        return float(cached)
+
+    @property
+    def mass(self) -> float:
+        """Mass of the idealised prism [kg]."""
+        return float(self.density * self.frame.thickness * ring_moments(self.rings)[0])
+
+
+@dataclass
+class ReturnWall:
+    """A wall meeting a façade at one of its ends.
+
+    Attributes
+    ----------
+    wall : Wall
+        The return wall.
+    end : {"start", "end"}
+        The façade's end (``s = 0`` or ``s = length``).
+    connection : {"good", "poor", "tied"}
+        From the spec.
+    beta_bond : float
+        Smallest crack angle from the vertical the bond allows [rad] (0 unless good).
+    corner : bool
+        The return wall is flush with the façade's end (a free corner).
+    span : (float, float)
+        The return wall's extent along the façade's ``s`` [m].
+    reach : float
+        Its length into the building from the façade's inner face [m].
+    far_end_wall : str or None
+        The wall its far end abuts, if any.
+    """
+
+    wall: Wall
+    end: str
+    connection: str
+    beta_bond: float
+    corner: bool
+    span: Tuple[float, float]
+    reach: float
+    far_end_wall: Optional[str] = None
+
+
+@dataclass
+class LevelContact:
+    """A level's largest contact with a wall.
+
+    Attributes
+    ----------
+    level : Level
+        The spec's level.
+    index : int
+        Its index in the spec's ``levels``.
+    wall : str
+        The wall id.
+    bearing : bool
+        A horizontal contact (within ``BEARING_ANGLE``): its weight share acts on the wall.
+    area : float
+        [m²].
+    point : (3,) float
+        Contact centroid [m].
+    mass : float
+        Share carried by the wall, ``tributary`` times the level's mass [kg].
+    thrust : float
+        Outward roof thrust at the contact [N] (0 for floors and tied trusses).
+    z_range : (float, float)
+        Lowest and highest point of the level's solids [m].
+    regions : list of ContactPlane
+        Every contact of the level's solids with the wall (``contact.contact_region``),
+        which a mechanism clips to its moving parts as the builder finds them.
+    meshes : list of TriMesh
+        The level's solids.
+    weight : float
+        The level's whole weight [N].
+    """
+
+    level: Any
+    index: int
+    wall: str
+    bearing: bool
+    area: float
+    point: np.ndarray
+    mass: float
+    thrust: float
+    z_range: Tuple[float, float] = (0.0, 0.0)
+    regions: List[Any] = field(default_factory=list)
+    meshes: List[TriMesh] = field(default_factory=list)
+    weight: float = 0.0
+
+
+@dataclass
+class TiePoint:
+    """Where a tie-bar meets a façade's outer face.
+
+    Attributes
+    ----------
+    index : int
+        Its index in the spec's ``tie_bars``.
+    tie : TieBar
+        The spec's tie-bar.
+    wall : str
+        The façade's id.
+    point : (3,) float
+        The crossing with the outer face [m].
+    s, z : float
+        The point in the façade's elevation [m].
+    """
+
+    index: int
+    tie: Any
+    wall: str
+    point: np.ndarray
+    s: float
+    z: float
+
+
+@dataclass
+class Building:
+    """What the search knows of the building.
+
+    Attributes
+    ----------
+    scene : MemoryScene
+        The objects used, in metres.
+    walls : dict of str to Wall
+        By id, in spec order.
+    returns : dict of str to list of ReturnWall
+        Per façade, its return walls.
+    contacts : dict of str to list of LevelContact
+        Per wall, the levels touching it.
+    ties : dict of str to list of TiePoint
+        Per façade, the tie-bars meeting it.
+    notes : list of str
+        What the reading assumed or idealised.
+    spec : SearchSpec
+        The search spec.
+    """
+
+    scene: MemoryScene
+    walls: Dict[str, Wall]
+    returns: Dict[str, List[ReturnWall]]
+    contacts: Dict[str, List[LevelContact]]
+    ties: Dict[str, List[TiePoint]]
+    notes: List[str]
+    spec: Any
+    level_objects: Dict[str, List[SceneObject]] = field(default_factory=dict)
+    contact_tol: float = 0.0
+    _thrusts: Dict[Tuple[int, Tuple[float, ...]], float] = field(default_factory=dict)
+
+    def roof_thrust(self, contact: "LevelContact", d: np.ndarray) -> float:
+        """Outward thrust of a roof on a mechanism collapsing along ``d`` [N].
+
+        Span along ``d`` and rise from the roof's bounding box in the mechanism's frame, as
+        the builder computes them (``thrust.roof_thrust``, theory §5).
+        """
+        key = (contact.index, tuple(round(float(v), 15) for v in d))
+        if key not in self._thrusts:
+            axis = np.cross(np.array([0.0, 0.0, 1.0]), d)
+            boxes = [bounding_box_in_frame(m, np.zeros(3), d, axis) for m in contact.meshes]
+            lo = np.min([b[0] for b in boxes], axis=0)
+            hi = np.max([b[1] for b in boxes], axis=0)
+            ext = hi - lo
+            self._thrusts[key] = roof_thrust(
+                contact.weight, float(ext[0]), float(abs(ext[2])), not contact.level.pushes
+            )
+        return self._thrusts[key]
+
+    @property
+    def size(self) -> float:
+        """Diagonal of the walls' bounding box [m]."""
+        v = np.vstack([w.mesh.vertices for w in self.walls.values()])
+        return float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+
+    def free_standing(self, wall: str) -> bool:
+        """Tell whether nothing holds either face of a wall (no return walls, levels, ties)."""
+        return not (self.returns.get(wall) or self.contacts.get(wall) or self.ties.get(wall))
+
+
+# --- reading -------------------------------------------------------------------------------
+
+
+def _find(scene: Any, selectors: Sequence[Any], where: str) -> List[SceneObject]:
+    """``find_objects``, with a miss named by the search spec's field."""
+    try:
+        return find_objects(scene, selectors, where)
+    except InputError as exc:
+        if exc.field == "selector":
+            raise InputError(exc.reason, where) from None
+        raise
+
+
+def _one_object(scene: Any, selector: Any, where: str) -> SceneObject:
+    objs = _find(scene, [selector], where)
+    if len(objs) != 1:
+        names = ", ".join(o.label() for o in objs[:6])
+        raise InputError(
+            f"{selector!r} matches {len(objs)} objects ({names}); a wall is one solid: select "
+            "one object (join the pieces of a wall into one solid)",
+            where,
+        )
+    return objs[0]
+
+
+def _boundary_rings(v2: np.ndarray, faces: np.ndarray) -> List[np.ndarray]:
+    """Boundary loops of a set of triangles, as rings of 2-D points."""
+    edges: Dict[Tuple[int, int], int] = {}
+    for a, b, c in faces:
+        for e in ((a, b), (b, c), (c, a)):
+            edges[(int(e[0]), int(e[1]))] = 1
+    nxt: Dict[int, int] = {}
+    for a, b in edges:
+        if (b, a) not in edges:
+            nxt[a] = b
+    rings: List[np.ndarray] = []
+    seen = set()
+    for start in sorted(nxt):
+        if start in seen:
+            continue
+        loop = [start]
+        seen.add(start)
+        cur = nxt[start]
+        while cur != start:
+            if cur in seen or cur not in nxt:
+                raise GeometryError("the wall's face has a non-manifold outline")
+            loop.append(cur)
+            seen.add(cur)
+            cur = nxt[cur]
+        pts = v2[loop]
+        rings.append(_drop_collinear(pts))
+    return [r for r in rings if len(r) >= 3]
+
+
+def _drop_collinear(pts: np.ndarray) -> np.ndarray:
+    keep = []
+    n = len(pts)
+    scale = float(np.max(np.abs(pts))) if n else 1.0
+    for i in range(n):
+        a, b, c = pts[i - 1], pts[i], pts[(i + 1) % n]
+        cross = (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0])
+        if abs(cross) > 1e-14 * max(scale, 1.0) ** 2:
+            keep.append(b)
+    return np.array(keep, dtype=float)
+
+
+def _signed_area(ring: np.ndarray) -> float:
+    return float(ring_moments([ring])[0])
+
+
+def _elevation(mesh: TriMesh, frame: WallFrame, name: str) -> List[np.ndarray]:
+    """Outer boundary (counter-clockwise) and holes (clockwise) of the outer face."""
+    v = mesh.vertices
+    tri = v[mesh.faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    norm = np.linalg.norm(normal, axis=1)
+    ok = norm > 0.0
+    cosn = np.zeros(len(norm))
+    cosn[ok] = -(normal[ok] @ frame.e_n) / norm[ok]
+    outer = mesh.faces[cosn > FACE_COS]
+    if len(outer) == 0:
+        raise GeometryError(f"{name}: no face looks out of the building")
+    local = frame.to_frame(v)
+    rings = _boundary_rings(local[:, [0, 2]], outer)
+    if not rings:
+        raise GeometryError(f"{name}: the outer face has no outline")
+    areas = [abs(_signed_area(r)) for r in rings]
+    k = int(np.argmax(areas))
+    out = rings[k] if _signed_area(rings[k]) > 0.0 else rings[k][::-1]
+    result = [out]
+    for i, r in enumerate(rings):
+        if i == k:
+            continue
+        if not np.all(
+            (r[:, 0] >= out[:, 0].min() - 1e-9)
+            & (r[:, 0] <= out[:, 0].max() + 1e-9)
+            & (r[:, 1] >= out[:, 1].min() - 1e-9)
+            & (r[:, 1] <= out[:, 1].max() + 1e-9)
+        ):
+            raise GeometryError(
+                f"{name}: the outer face is in several pieces; a wall is one slab (split it "
+                "into walls)"
+            )
+        result.append(r if _signed_area(r) < 0.0 else r[::-1])
+    return result
+
+
+def _orient(
+    mesh: TriMesh, centre: np.ndarray, size: float, name: str
+) -> Tuple[WallFrame, List[np.ndarray], float, bool, List[str]]:
+    """Return the wall's frame (e_n into the building), elevation and prism check."""
+    v = mesh.vertices
+    e_n, e_s = frame_from_mesh(v, mesh.faces, name)
+    com = v.mean(axis=0)
+    side = float((centre - com) @ e_n)
+    if abs(side) <= 1e-9 * size:
+        # A lone wall: a fixed rule (e_n towards +x, else +y) names its sides.
+        flip = e_n[0] < -1e-12 or (abs(e_n[0]) <= 1e-12 and e_n[1] < 0.0)
+    else:
+        flip = side < 0.0
+    if flip:
+        e_n, e_s = -e_n, -e_s
+    e_z = np.array([0.0, 0.0, 1.0])
+    n = v @ e_n
+    s = v @ e_s
+    t = float(n.max() - n.min())
+    origin = float(s.min()) * e_s + float(n.min()) * e_n
+    frame = WallFrame(origin, e_s, e_n, e_z, t)
+    rings = _elevation(mesh, frame, name)
+    area = float(ring_moments(rings)[0])
+    volume = float(mass_properties(mesh, 1.0).volume)
+    notes: List[str] = []
+    exact = abs(volume - area * t) <= PRISM_RTOL * volume
+    if not exact:
+        t_eff = volume / area
+        notes.append(
+            f"{name}: not a prism of constant thickness (volume {volume:.6g} m³, outer face "
+            f"{area:.6g} m² x {t:.6g} m): the search idealises it with the thickness "
+            f"{t_eff:.6g} m that keeps its mass; the constants come from the real solid and "
+            "the search reports the difference"
+        )
+        frame = WallFrame(origin, e_s, e_n, e_z, t_eff)
+    return frame, rings, volume, exact, notes
+
+
+def _holes(rings: List[np.ndarray]) -> List[Tuple[float, float, float, float]]:
+    out = []
+    for r in rings[1:]:
+        out.append(
+            (float(r[:, 0].min()), float(r[:, 0].max()), float(r[:, 1].min()), float(r[:, 1].max()))
+        )
+    return out
+
+
+def _cut_openings(
+    wall_obj: SceneObject, mesh: TriMesh, openings: List[Tuple[SceneObject, TriMesh]], name: str
+) -> Tuple[SceneObject, TriMesh, List[str]]:
+    """Subtract the opening solids that cross a wall (manifold3d); the wall becomes new."""
+    lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    hits = [
+        (o, m)
+        for o, m in openings
+        if np.all(m.vertices.max(axis=0) > lo) and np.all(m.vertices.min(axis=0) < hi)
+    ]
+    if not hits:
+        return wall_obj, mesh, []
+    manifold3d = require("manifold3d", "geometry", "to cut openings out of walls")
+    ref = 0.5 * (lo + hi)
+
+    def solid(m: TriMesh) -> Any:
+        return manifold3d.Manifold(
+            manifold3d.Mesh64(
+                vert_properties=np.ascontiguousarray(m.vertices - ref),
+                tri_verts=np.ascontiguousarray(m.faces, dtype=np.uint64),
+            )
+        )
+
+    body = solid(mesh)
+    for _, m in hits:
+        body = body - solid(m)
+    out = body.to_mesh64()
+    verts = np.asarray(out.vert_properties, dtype=np.float64)[:, :3] + ref
+    faces = np.asarray(out.tri_verts, dtype=np.int64)
+    new_id = str(uuid.uuid5(NAMESPACE, f"{wall_obj.id}/" + "/".join(o.id for o, _ in hits)))
+    new_name = (wall_obj.name or name) + OPENINGS_SUFFIX
+    cut = TriMesh(verts, faces, new_name, {"id": new_id, "layer": wall_obj.layer, "kind": "mesh"})
+    cut, notes = check_solid(cut)
+    obj = SceneObject(new_id, new_name, wall_obj.layer, "mesh", dict(wall_obj.user_text), cut)
+    said = ", ".join(o.label() for o, _ in hits)
+    notes.append(
+        f"{name}: the openings {said} are cut out of the wall; the search's scene holds the "
+        f"result as a new object {new_name!r} (id {new_id}), which the search spec selects"
+    )
+    return obj, cut, notes
+
+
+def _unit_angle(unit: Any) -> float:
+    return math.atan(unit.length / (2.0 * unit.height))
+
+
+def _junction(spec: Any, a: str, b: str) -> Tuple[str, Optional[Any], str]:
+    for j in spec.junctions:
+        if sorted(j.walls) == sorted([a, b]):
+            return j.connection, j.unit, "junctions"
+    if spec.default_junction is not None:
+        return spec.default_junction.connection, spec.default_junction.unit, "default_junction"
+    raise InputError(
+        f"the walls {a!r} and {b!r} meet, but the spec gives no connection for them; add "
+        f'{{"walls": ["{a}", "{b}"], "connection": "good"|"poor"|"tied", ...}} to junctions, '
+        "or a default_junction",
+        "junctions",
+    )
+
+
+def _return_at(
+    a: Wall, b: Wall, tol: float
+) -> Optional[Tuple[str, bool, Tuple[float, float], float]]:
+    """Tell whether wall b meets façade a at one of a's ends: (end, corner, span, reach) or None.
+
+    Two arrangements count: b's end face on a's inner face near a's end (b abuts a), or
+    a's end face on b's side face (a butts into b, which runs past a's end). ``corner``:
+    the two walls are flush at the outside.
+    """
+    fa = a.frame
+    if abs(abs(float(b.frame.e_n @ fa.e_s)) - 1.0) > SQUARE_TOL:
+        return None
+    local = fa.to_frame(b.mesh.vertices)
+    s0, s1 = float(local[:, 0].min()), float(local[:, 0].max())
+    n0, n1 = float(local[:, 1].min()), float(local[:, 1].max())
+    z0, z1 = float(local[:, 2].min()), float(local[:, 2].max())
+    t_a = float(fa.to_frame(a.mesh.vertices)[:, 1].max())
+    if z1 <= a.z_lo + tol or z0 >= a.z_hi - tol or n1 <= t_a + tol:
+        return None
+    if abs(n0 - t_a) <= tol and s0 >= -tol and s1 <= a.length + tol:
+        if s0 <= fa.thickness + tol:
+            return "start", abs(s0) <= tol, (s0, s1), n1 - t_a
+        if s1 >= a.length - fa.thickness - tol:
+            return "end", abs(s1 - a.length) <= tol, (s0, s1), n1 - t_a
+        return "middle", False, (s0, s1), n1 - t_a
+    if n0 <= tol:
+        if abs(s1) <= tol:
+            return "start", abs(n0) <= tol, (s0, s1), n1 - t_a
+        if abs(s0 - a.length) <= tol:
+            return "end", abs(n0) <= tol, (s0, s1), n1 - t_a
+    return None
+
+
+def _returns(
+    walls: Dict[str, Wall], spec: Any, tol: float, notes: List[str]
+) -> Dict[str, List[ReturnWall]]:
+    out: Dict[str, List[ReturnWall]] = {w: [] for w in walls}
+    listed = {tuple(sorted(j.walls)) for j in spec.junctions}
+    met = set()
+    for a in walls.values():
+        for b in walls.values():
+            if b.id == a.id:
+                continue
+            found = _return_at(a, b, tol)
+            if found is None:
+                continue
+            end, corner, span, reach = found
+            met.add(tuple(sorted([a.id, b.id])))
+            if not a.is_facade:
+                continue
+            if end == "middle":
+                notes.append(
+                    f"{b.id} meets {a.id} away from its ends (at s = {span[0]:.3f}-{span[1]:.3f} "
+                    f"m): the search takes return walls at a façade's ends only, so "
+                    f"{a.id}'s mechanisms leave {b.id} out"
+                )
+                continue
+            connection, unit, _ = _junction(spec, a.id, b.id)
+            beta = _unit_angle(unit) if connection == "good" and unit is not None else 0.0
+            out[a.id].append(ReturnWall(b, end, connection, beta, corner, span, reach))
+    for pair in sorted(listed - met):
+        raise InputError(
+            f"the junction {list(pair)} is listed, but those walls do not meet (one wall's end "
+            "face on the other's face)",
+            "junctions",
+        )
+    # Far ends: a return wall whose far end meets another wall is held there.
+    for a_id, rets in out.items():
+        fa = walls[a_id].frame
+        t_a = float(fa.to_frame(walls[a_id].mesh.vertices)[:, 1].max())
+        for r in rets:
+            for c in walls.values():
+                if c.id in (a_id, r.wall.id):
+                    continue
+                local = fa.to_frame(c.mesh.vertices)
+                near = float(local[:, 1].min()) - (t_a + r.reach)
+                far = float(local[:, 1].max()) - (t_a + r.reach)
+                lo, hi = float(local[:, 0].min()), float(local[:, 0].max())
+                if near <= tol and far >= -tol and lo <= r.span[1] + tol and hi >= r.span[0] - tol:
+                    r.far_end_wall = c.id
+    return out
+
+
+def _level_contacts(
+    scene: Any,
+    spec: Any,
+    walls: Dict[str, Wall],
+    tol: float,
+    notes: List[str],
+    memory: MemoryScene,
+) -> Tuple[Dict[str, List[LevelContact]], Dict[str, List[SceneObject]]]:
+    out: Dict[str, List[LevelContact]] = {w: [] for w in walls}
+    objects: Dict[str, List[SceneObject]] = {}
+    for k, level in enumerate(spec.levels):
+        where = f"levels[{k}]"
+        objs = _find(scene, level.objects, f"{where}.objects")
+        meshes = []
+        for obj in objs:
+            mesh, warn = check_solid(scene.mesh(obj))
+            notes.extend(f"{where}: {w}" for w in warn)
+            meshes.append(mesh)
+            memory.add(SceneObject(obj.id, obj.name, obj.layer, "mesh", dict(obj.user_text), mesh))
+        objects[level.id] = objs
+        total = sum(mass_properties(m, level.density).mass for m in meshes)
+        z_range = (
+            float(min(m.vertices[:, 2].min() for m in meshes)),
+            float(max(m.vertices[:, 2].max() for m in meshes)),
+        )
+        touched = []
+        for wall in walls.values():
+            regions = []
+            for m in meshes:
+                hit = contact_region(m, wall.mesh, tol=tol)
+                if hit is not None:
+                    regions.append(hit)
+            if not regions:
+                continue  # this level does not touch this wall
+            area, point, normal, _ = max(regions, key=lambda r: r[0])
+            # A roof's share always bears where it touches (as the builder takes it).
+            bearing = level.kind == "roof" or abs(float(normal[2])) >= math.cos(BEARING_ANGLE)
+            thrust = 0.0
+            if level.kind == "roof" and level.pushes:
+                lo_hi = [
+                    bounding_box_in_frame(m, wall.frame.origin, -wall.frame.e_n, wall.frame.e_s)
+                    for m in meshes
+                ]
+                lo = np.min([p[0] for p in lo_hi], axis=0)
+                hi = np.max([p[1] for p in lo_hi], axis=0)
+                ext = hi - lo
+                thrust = roof_thrust(G * total, float(ext[0]), float(abs(ext[2])), not level.pushes)
+            out[wall.id].append(
+                LevelContact(
+                    level,
+                    k,
+                    wall.id,
+                    bearing,
+                    float(area),
+                    np.asarray(point, dtype=float),
+                    level.tributary * total,
+                    thrust,
+                    z_range,
+                    [r[3] for r in regions],
+                    meshes,
+                    G * total,
+                )
+            )
+            touched.append(wall.id)
+        if not touched:
+            raise GeometryError(
+                f"{where} ({level.id}): touches no wall (no shared face with any wall solid "
+                f"within {1000 * tol:.3g} mm)"
+            )
+        if "tributary" not in level.model_fields_set:
+            notes.append(
+                f"{where} ({level.id}): tributary not given; each wall it touches carries the "
+                f"default {level.tributary:g} of its weight and inertia"
+            )
+    return out, objects
+
+
+def _tie_points(
+    scene: Any, spec: Any, walls: Dict[str, Wall], memory: MemoryScene
+) -> Dict[str, List[TiePoint]]:
+    out: Dict[str, List[TiePoint]] = {w: [] for w in walls}
+    for k, tie in enumerate(spec.tie_bars):
+        where = f"tie_bars[{k}]"
+        obj = _find(scene, [tie.object], f"{where}.object")[0]
+        start, end = scene.line(obj)
+        memory.add(SceneObject(obj.id, obj.name, obj.layer, "line", {}, (start, end)))
+        met = False
+        for wall in walls.values():
+            f = wall.frame
+            d = end - start
+            den = float(d @ f.e_n)
+            if abs(den) < 1e-12 * max(float(np.linalg.norm(d)), 1.0):
+                continue
+            u = float((f.origin - start) @ f.e_n) / den
+            v = wall.mesh.vertices
+            size = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+            tol = 1e-3 * size / max(float(np.linalg.norm(d)), 1e-12)
+            if not -tol <= u <= 1.0 + tol:
+                continue
+            p = start + u * d
+            s, _, z = (float(c) for c in f.to_frame(p))
+            if not (-1e-9 <= s <= wall.length + 1e-9 and wall.z_lo - 1e-9 <= z <= wall.z_hi + 1e-9):
+                continue
+            out[wall.id].append(TiePoint(k, tie, wall.id, p, s, z))
+            met = True
+        if not met:
+            raise GeometryError(f"{where}: the tie-bar meets no wall's outer face")
+    return out
+
+
+def building_from_scene(scene: Any, spec: Any) -> Building:
+    """Read the walls, junctions, levels and ties a search spec names.
+
+    Parameters
+    ----------
+    scene : BaseScene
+        The input scene (``read_scene``), in metres.
+    spec : SearchSpec
+        The search spec.
+
+    Returns
+    -------
+    Building
+
+    Raises
+    ------
+    InputError
+        A selector that matches nothing (or several objects for a wall), a junction the
+        spec does not give, a listed junction whose walls do not meet.
+    GeometryError
+        A wall that is not a vertical slab, a level or tie-bar that touches no wall.
+    """
+    notes: List[str] = list(spec.plausibility_notes())
+    memory = MemoryScene([], path=scene.path, tolerance=scene.tolerance, source_units=scene.units)
+    openings: List[Tuple[SceneObject, TriMesh]] = []
+    for k, sel in enumerate(spec.openings):
+        for obj in _find(scene, [sel], f"openings[{k}]"):
+            mesh, warn = check_solid(scene.mesh(obj))
+            notes.extend(warn)
+            openings.append((obj, mesh))
+    raw: List[Tuple[Any, SceneObject, TriMesh, Any]] = []
+    for k, w in enumerate(spec.walls):
+        where = f"walls[{k}] ({w.id})"
+        obj = _one_object(scene, w.object, f"walls[{k}].object")
+        mesh, warn = check_solid(scene.mesh(obj))
+        notes.extend(warn)
+        selector: Any = w.object
+        if openings:
+            new_obj, mesh, cut_notes = _cut_openings(obj, mesh, openings, where)
+            notes.extend(cut_notes)
+            if new_obj is not obj:
+                # by name: the input scene has no such object, so its wall (without the
+                # voids) cannot be used by mistake, and the message says which one is meant
+                obj, selector = new_obj, new_obj.name
+        if obj.geometry is not mesh:
+            obj = SceneObject(obj.id, obj.name, obj.layer, obj.kind, dict(obj.user_text), mesh)
+        if w.overburden is not None and w.overburden.objects is not None:
+            for o in _find(scene, w.overburden.objects, f"walls[{k}].overburden.objects"):
+                m, warn = check_solid(scene.mesh(o))
+                notes.extend(warn)
+                memory.add(SceneObject(o.id, o.name, o.layer, "mesh", dict(o.user_text), m))
+        memory.add(obj)
+        raw.append((w, obj, mesh, selector))
+    verts = np.vstack([m.vertices for _, _, m, _ in raw])
+    size = float(np.linalg.norm(verts.max(axis=0) - verts.min(axis=0)))
+    vols = [mass_properties(m, 1.0) for _, _, m, _ in raw]
+    centre = np.sum([p.volume * np.asarray(p.com) for p in vols], axis=0) / sum(
+        p.volume for p in vols
+    )
+    walls: Dict[str, Wall] = {}
+    for w, obj, mesh, selector in raw:
+        frame, rings, volume, exact, wall_notes = _orient(mesh, centre, size, w.id)
+        notes.extend(wall_notes)
+        z = mesh.vertices[:, 2]
+        length = float(frame.to_frame(mesh.vertices)[:, 0].max())
+        walls[w.id] = Wall(
+            w.id,
+            selector,
+            obj,
+            w.density,
+            w.label,
+            w.facade,
+            w.overburden,
+            frame,
+            rings,
+            length,
+            float(z.min()),
+            float(z.max()),
+            exact,
+            _holes(rings),
+            volume,
+        )
+    tol = max(contact_tolerance(scene), 1e-9 * size)
+    returns = _returns(walls, spec, tol, notes)
+    contacts, level_objects = _level_contacts(scene, spec, walls, tol, notes, memory)
+    ties = _tie_points(scene, spec, walls, memory)
+    return Building(memory, walls, returns, contacts, ties, notes, spec, level_objects, tol)

@@ -1,0 +1,430 @@
+"""Walls as prisms: elevation polygons, half-plane clips and exact mass moments.
+
+The search works on walls that are right prisms: an elevation polygon (outer boundary and
+the openings as holes) in the wall's own frame, extruded through its thickness. A crack
+whose plane contains the wall's thickness direction (a horizontal bed joint, a diagonal
+through a return wall) cuts the prism along a line of the elevation, so every block the
+search weighs is a clipped polygon times a thickness, and its mass moments are exact
+polynomial integrals (Green's theorem), equal to the mesh integrals of the constants
+builder (``rhino_plugin.geometry.massprops``) to rounding.
+
+Notation
+--------
+s, n, z : wall frame coordinates: along the wall, through the thickness (0 on the outer
+    face, ``t`` on the inner face, ``e_n`` pointing inward), and height [m]
+rings : list of (k, 2) float arrays of (s, z) vertices; the outer boundary counter-clockwise,
+    holes clockwise, so that every integral is the sum over the rings
+Lump : mass [kg], first moment ``S = ∫ x dm`` [kg m] and second moment
+    ``C = ∫ x xᵀ dm`` [kg m²] about the model origin; lumps add
+
+Python 3.9-clean: imported by Rhino 8.
+"""
+
+import math
+from dataclasses import dataclass
+from typing import List, Optional, Sequence, Tuple, cast
+
+import numpy as np
+
+from shared_schema.errors import GeometryError
+
+__all__ = [
+    "Lump",
+    "WallFrame",
+    "clip_rings",
+    "point_lump",
+    "ring_moments",
+    "rings_area",
+    "segment_intervals",
+    "winding",
+]
+
+Ring = np.ndarray
+Rings = List[np.ndarray]
+#: A frame's axes and origin as plain lists (for the per-evaluation arithmetic).
+Axes = Tuple[List[float], List[float], List[float], List[float]]
+
+#: Rings up to this many vertices are integrated and clipped in plain Python (faster than
+#: numpy's per-call overhead on the few vertices of a block); longer ones (scans) in numpy.
+LOOP_MAX = 64
+
+
+@dataclass(frozen=True)
+class Lump:
+    """Mass moments of a body about the model origin; lumps of disjoint bodies add.
+
+    Attributes
+    ----------
+    mass : float
+        [kg].
+    S : (3,) float
+        First moment ``∫ x dm`` [kg m].
+    C : (3, 3) float
+        Second moment ``∫ x xᵀ dm`` [kg m²].
+    """
+
+    mass: float
+    S: np.ndarray
+    C: np.ndarray
+
+    @staticmethod
+    def zero() -> "Lump":
+        """Return the empty lump."""
+        return Lump(0.0, np.zeros(3), np.zeros((3, 3)))
+
+    def __add__(self, other: "Lump") -> "Lump":
+        return Lump(self.mass + other.mass, self.S + other.S, self.C + other.C)
+
+    @property
+    def com(self) -> np.ndarray:
+        """Centre of mass [m]."""
+        if not self.mass > 0.0:
+            raise GeometryError("an empty block has no centre of mass")
+        return self.S / self.mass
+
+    def about(self, point: np.ndarray) -> np.ndarray:
+        """Second moment ``∫ (x - p)(x - p)ᵀ dm`` about a point [kg m²]."""
+        p = np.asarray(point, dtype=float)
+        return self.C - np.outer(p, self.S) - np.outer(self.S, p) + self.mass * np.outer(p, p)
+
+    def inertia_about_axis(self, point: np.ndarray, direction: np.ndarray) -> float:
+        """Moment of inertia about a line through ``point`` along ``direction`` [kg m²].
+
+        Notes
+        -----
+        ``I = tr(C_P) - uᵀ C_P u`` with ``C_P`` the second moment about the point.
+        """
+        u = np.asarray(direction, dtype=float)
+        u = u / float(np.linalg.norm(u))
+        c = self.about(point)
+        return float(np.trace(c) - u @ c @ u)
+
+    def inertia_com(self) -> np.ndarray:
+        """Inertia tensor about the centre of mass, world axes [kg m²]."""
+        c = self.about(self.com)
+        return float(np.trace(c)) * np.eye(3) - c
+
+
+def point_lump(mass: float, point: np.ndarray) -> Lump:
+    """Lump of a point mass [kg] at ``point`` [m]."""
+    p = np.asarray(point, dtype=float)
+    return Lump(float(mass), mass * p, mass * np.outer(p, p))
+
+
+def ring_moments(rings: Sequence[np.ndarray]) -> np.ndarray:
+    """Area moments of a polygon with holes, by Green's theorem.
+
+    Parameters
+    ----------
+    rings : sequence of (k, 2) float
+        (s, z) vertices, not repeating the first; the outer boundary counter-clockwise and
+        the holes clockwise (each ring adds its signed integrals).
+
+    Returns
+    -------
+    (6,) float
+        ``A, ∫s, ∫z, ∫s², ∫z², ∫sz`` over the area [m², m³, m³, m⁴, m⁴, m⁴].
+
+    Examples
+    --------
+    A 2 x 1 rectangle:
+
+    >>> ring_moments([np.array([[0.0, 0], [2, 0], [2, 1], [0, 1]])]).round(6).tolist()
+    [2.0, 2.0, 1.0, 2.666667, 0.666667, 1.0]
+    """
+    a = ss = sz = sss = szz = ssz = 0.0
+    for ring in rings:
+        n = len(ring)
+        if n < 3:
+            continue
+        if n > LOOP_MAX:
+            s0, z0 = ring[:, 0], ring[:, 1]
+            s1, z1 = np.roll(s0, -1), np.roll(z0, -1)
+            c = s0 * z1 - s1 * z0
+            a += float(np.sum(c))
+            ss += float(np.sum((s0 + s1) * c))
+            sz += float(np.sum((z0 + z1) * c))
+            sss += float(np.sum((s0 * s0 + s0 * s1 + s1 * s1) * c))
+            szz += float(np.sum((z0 * z0 + z0 * z1 + z1 * z1) * c))
+            ssz += float(np.sum((s0 * z1 + 2.0 * s0 * z0 + 2.0 * s1 * z1 + s1 * z0) * c))
+            continue
+        pts = ring.tolist()
+        p0, q0 = pts[-1]
+        for p1, q1 in pts:
+            c = p0 * q1 - p1 * q0
+            a += c
+            ss += (p0 + p1) * c
+            sz += (q0 + q1) * c
+            sss += (p0 * p0 + p0 * p1 + p1 * p1) * c
+            szz += (q0 * q0 + q0 * q1 + q1 * q1) * c
+            ssz += (p0 * q1 + 2.0 * p0 * q0 + 2.0 * p1 * q1 + p1 * q0) * c
+            p0, q0 = p1, q1
+    return np.array([a / 2.0, ss / 6.0, sz / 6.0, sss / 12.0, szz / 12.0, ssz / 24.0])
+
+
+def rings_area(rings: Sequence[np.ndarray]) -> float:
+    """Area of a polygon with holes [m²] (the first of ``ring_moments``)."""
+    return float(ring_moments(rings)[0])
+
+
+def clip_rings(rings: Sequence[np.ndarray], a: float, b: float, c: float) -> Rings:
+    """Keep the part of a polygon with holes where ``a s + b z + c >= 0``.
+
+    Each ring is clipped on its own (Sutherland-Hodgman against one half-plane). A
+    non-convex ring may come back with edges doubled along the clip line; they cancel in
+    every boundary integral, so ``ring_moments`` of the result are those of the clipped
+    region exactly.
+
+    Parameters
+    ----------
+    rings : sequence of (k, 2) float
+        The polygon's rings.
+    a, b, c : float
+        The half-plane.
+
+    Returns
+    -------
+    list of (k, 2) float
+        The clipped rings (those left empty are dropped).
+    """
+    out: Rings = []
+    for ring in rings:
+        pts = ring.tolist()
+        f = [a * p + b * q + c for p, q in pts]
+        if min(f) >= 0.0:
+            out.append(ring)
+            continue
+        if max(f) <= 0.0:
+            continue
+        kept: List[Tuple[float, float]] = []
+        n = len(pts)
+        for i in range(n):
+            j = i + 1 if i + 1 < n else 0
+            fi, fj = f[i], f[j]
+            if fi >= 0.0:
+                kept.append((pts[i][0], pts[i][1]))
+            if (fi > 0.0 and fj < 0.0) or (fi < 0.0 and fj > 0.0):
+                w = fi / (fi - fj)
+                kept.append(
+                    (
+                        pts[i][0] + w * (pts[j][0] - pts[i][0]),
+                        pts[i][1] + w * (pts[j][1] - pts[i][1]),
+                    )
+                )
+        if len(kept) >= 3:
+            out.append(np.array(kept, dtype=float))
+    return out
+
+
+def segment_intervals(
+    rings: Sequence[np.ndarray], p0: np.ndarray, p1: np.ndarray
+) -> List[Tuple[float, float]]:
+    """Parameter intervals of the segment ``p0 + u (p1 - p0)``, ``u`` in [0, 1], inside a region.
+
+    Parameters
+    ----------
+    rings : sequence of (k, 2) float
+        The region (outer boundary and holes).
+    p0, p1 : (2,) float
+        The segment's ends (s, z) [m].
+
+    Returns
+    -------
+    list of (float, float)
+        Sorted, disjoint intervals of ``u`` where the segment runs through the region's
+        interior or along its boundary with material on at least one side.
+    """
+    d = np.asarray(p1, dtype=float) - np.asarray(p0, dtype=float)
+    cuts = [0.0, 1.0]
+    for ring in rings:
+        a = ring
+        b = np.roll(ring, -1, axis=0)
+        e = b - a
+        den = d[0] * e[:, 1] - d[1] * e[:, 0]
+        w = a - p0
+        ok = np.abs(den) > 1e-300
+        u = np.where(ok, (w[:, 0] * e[:, 1] - w[:, 1] * e[:, 0]) / np.where(ok, den, 1.0), np.nan)
+        v = np.where(ok, (w[:, 0] * d[1] - w[:, 1] * d[0]) / np.where(ok, den, 1.0), np.nan)
+        hit = ok & (v >= -1e-12) & (v <= 1.0 + 1e-12) & (u > 0.0) & (u < 1.0)
+        cuts.extend(float(x) for x in u[hit])
+    cuts = sorted(set(cuts))
+    spans: List[Tuple[float, float]] = []
+    for lo, hi in zip(cuts[:-1], cuts[1:]):
+        if hi - lo <= 1e-12:
+            continue
+        mid = np.asarray(p0, dtype=float) + 0.5 * (lo + hi) * d
+        if winding(rings, mid) != 0:
+            if spans and abs(spans[-1][1] - lo) <= 1e-12:
+                spans[-1] = (spans[-1][0], hi)
+            else:
+                spans.append((lo, hi))
+    return spans
+
+
+def winding(rings: Sequence[np.ndarray], p: np.ndarray) -> int:
+    """Return the winding number of a region (sum over rings) at a point (crossing-number rule)."""
+    total = 0
+    px, pz = float(p[0]), float(p[1])
+    for ring in rings:
+        a = ring
+        b = np.roll(ring, -1, axis=0)
+        up = (a[:, 1] <= pz) & (b[:, 1] > pz)
+        down = (a[:, 1] > pz) & (b[:, 1] <= pz)
+        cross = (b[:, 0] - a[:, 0]) * (pz - a[:, 1]) - (px - a[:, 0]) * (b[:, 1] - a[:, 1])
+        total += int(np.sum(up & (cross > 0.0))) - int(np.sum(down & (cross < 0.0)))
+    return total
+
+
+@dataclass(frozen=True)
+class WallFrame:
+    """A wall's frame: a point on its outer face and three unit axes.
+
+    Attributes
+    ----------
+    origin : (3,) float
+        Point ``s = n = z = 0`` [m] (``z`` is the world height: the origin lies at z = 0).
+    e_s, e_n, e_z : (3,) float
+        Along the wall, through it (outer face to inner face) and up; right-handed or not,
+        as the wall's orientation gives.
+    thickness : float
+        ``t`` [m]: the inner face is at ``n = t``.
+    """
+
+    origin: np.ndarray
+    e_s: np.ndarray
+    e_n: np.ndarray
+    e_z: np.ndarray
+    thickness: float
+
+    def to_world(self, s: float, n: float, z: float) -> np.ndarray:
+        """World point of frame coordinates [m]."""
+        return self.origin + s * self.e_s + n * self.e_n + z * self.e_z
+
+    def to_frame(self, x: np.ndarray) -> np.ndarray:
+        """Frame coordinates (s, n, z) of world points, shape (..., 3) [m]."""
+        d = np.asarray(x, dtype=float) - self.origin
+        return np.stack([d @ self.e_s, d @ self.e_n, d @ self.e_z], axis=-1)
+
+    def line_of_plane(
+        self, point: np.ndarray, normal: np.ndarray
+    ) -> Optional[Tuple[float, float, float]]:
+        """Return the plane ``normal·(x - point) >= 0`` as a half-plane ``a s + b z + c >= 0``.
+
+        Returns None when the plane does not contain the thickness direction (it would cut
+        the prism obliquely, which the elevation cannot represent).
+        """
+        m0, m1, m2 = float(normal[0]), float(normal[1]), float(normal[2])
+        es, en, ez, o = self._axes
+        if abs(m0 * en[0] + m1 * en[1] + m2 * en[2]) > 1e-9 * math.sqrt(
+            m0 * m0 + m1 * m1 + m2 * m2
+        ):
+            return None
+        a = m0 * es[0] + m1 * es[1] + m2 * es[2]
+        b = m0 * ez[0] + m1 * ez[1] + m2 * ez[2]
+        c = (
+            m0 * (o[0] - float(point[0]))
+            + m1 * (o[1] - float(point[1]))
+            + m2 * (o[2] - float(point[2]))
+        )
+        return a, b, c
+
+    @property
+    def _axes(self) -> Axes:
+        cached = self.__dict__.get("_axes_cache")
+        if cached is None:
+            cached = (
+                self.e_s.tolist(),
+                self.e_n.tolist(),
+                self.e_z.tolist(),
+                self.origin.tolist(),
+            )
+            object.__setattr__(self, "_axes_cache", cached)
+        return cast(Axes, cached)
+
+    def prism_lump(self, rings: Sequence[np.ndarray], density: float) -> Lump:
+        """Lump of the prism of an elevation region through the whole thickness.
+
+        Parameters
+        ----------
+        rings : sequence of (k, 2) float
+            The region (s, z) [m].
+        density : float
+            [kg/m³].
+
+        Notes
+        -----
+        In frame coordinates ``(s, n, z)`` with ``n`` in [0, t]: ``M = ρ t A``,
+        ``∫ s dm = ρ t ∫s``, ``∫ n dm = ρ A t²/2``, ``∫ n² dm = ρ A t³/3``,
+        ``∫ s n dm = ρ (t²/2) ∫s`` and so on; then rotated and moved to world axes.
+        """
+        A, Ss, Sz, Sss, Szz, Ssz = ring_moments(rings).tolist()
+        t = self.thickness
+        rho = float(density)
+        m = rho * t * A
+        first = np.array([rho * t * Ss, rho * A * t * t / 2.0, rho * t * Sz])
+        h = rho * t * t / 2.0
+        c = np.array(
+            [
+                [rho * t * Sss, h * Ss, rho * t * Ssz],
+                [h * Ss, rho * A * t**3 / 3.0, h * Sz],
+                [rho * t * Ssz, h * Sz, rho * t * Szz],
+            ]
+        )
+        r = self._rotation
+        o = self.origin
+        s_world = r @ first
+        c_world = r @ c @ r.T
+        so = np.outer(o, s_world)
+        c_world = c_world + so + so.T + m * np.outer(o, o)
+        return Lump(m, m * o + s_world, c_world)
+
+    @property
+    def _rotation(self) -> np.ndarray:
+        cached = self.__dict__.get("_rotation_cache")
+        if cached is None:
+            cached = np.column_stack([self.e_s, self.e_n, self.e_z])
+            object.__setattr__(self, "_rotation_cache", cached)
+        return cast(np.ndarray, cached)
+
+
+def frame_from_mesh(
+    vertices: np.ndarray, faces: np.ndarray, name: str
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Thickness and length directions of a vertical slab from its faces.
+
+    The thickness direction is the horizontal axis of the vertical faces that carry the most
+    area (the two large faces of a wall, whatever its openings), found by averaging each
+    vertical face's horizontal normal on the doubled angle (so that n and -n agree).
+
+    Returns
+    -------
+    e_n, e_s : (3,) float
+        Unit horizontal vectors; ``e_n`` along the thickness (sign not yet fixed).
+
+    Raises
+    ------
+    GeometryError
+        The object has no vertical faces (not a wall).
+    """
+    tri = vertices[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area2 = np.linalg.norm(normal, axis=1)
+    ok = area2 > 0.0
+    unit = np.zeros_like(normal)
+    unit[ok] = normal[ok] / area2[ok, None]
+    vertical = ok & (np.abs(unit[:, 2]) < 1e-6)
+    if not np.any(vertical):
+        raise GeometryError(f"{name}: the object has no vertical faces; a wall is a vertical slab")
+    ang = np.arctan2(unit[vertical, 1], unit[vertical, 0])
+    w = area2[vertical]
+    c2 = float(np.sum(w * np.cos(2.0 * ang)))
+    s2 = float(np.sum(w * np.sin(2.0 * ang)))
+    theta = 0.5 * math.atan2(s2, c2)
+    e_n = np.array([math.cos(theta), math.sin(theta), 0.0])
+    # Snap to the axes when the wall is drawn along them (exact frames for exact walls).
+    for k in range(2):
+        if abs(abs(e_n[k]) - 1.0) < 1e-12:
+            e_n = np.zeros(3)
+            e_n[k] = 1.0
+    e_s = np.array([-e_n[1], e_n[0], 0.0])
+    return e_n, e_s

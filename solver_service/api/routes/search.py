@@ -1,0 +1,77 @@
+"""``POST /search``: a façade's collapse mechanisms found and ranked (``rockmech search``)."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, Request, Response
+
+from rhino_plugin.archive_3dm import check_3dm
+from shared_schema.api import SearchResponse
+from shared_schema.errors import InputError
+
+from ..compute import compute
+from ..deps import MULTIPART, PoolDep, accepts
+from ..forms import FORMS, parse_form, read_form, read_upload
+from ..jobspec import RecordUpload, SearchJob
+from ..openapi import body_doc, responses
+from ..problems import Problem
+from ..uploads import safe_filename
+
+__all__ = ["router"]
+
+router = APIRouter(tags=["geometry"])
+
+
+@router.post(
+    "/search",
+    summary="Find a façade's collapse mechanisms in a scene and rank them by how they rock",
+    response_model=None,
+    responses=responses(SearchResponse, extra=(501,)),
+    openapi_extra=body_doc(None, "search"),
+    dependencies=[accepts(MULTIPART)],
+)
+async def search(request: Request, pool: PoolDep) -> Response:
+    """Return the document ``rockmech search --json`` prints (``search.json``).
+
+    A search whose refinements would need more evaluations of the static multiplier than the
+    work limit (``max_evaluations``, at most the service's) is refused with 422 before it
+    runs them; the compute timeout bounds the rest.
+    """
+    form = await read_form(request)
+    try:
+        fields = parse_form(form, FORMS["search"])
+        scene = await read_upload(form, "scene", True)
+        spec = await read_upload(form, "spec", True)
+        site = await read_upload(form, "site", False)
+        record = await read_upload(form, "record", False)
+    finally:
+        await form.close()
+    assert scene is not None and spec is not None
+    upload = None
+    if record is not None:
+        upload = RecordUpload(
+            filename=record[1] or "record.dat",
+            format=fields.get("record_format"),
+            units=fields.get("record_units"),
+            dt=fields.get("record_dt"),
+        )
+    job = SearchJob(
+        scene_name=scene[1],
+        spec_name=spec[1],
+        units=fields.get("units"),
+        max_evaluations=fields.get("max_evaluations"),
+        exact=bool(fields.get("exact", False)),
+        has_site=site is not None,
+        record=upload,
+    )
+    name = safe_filename(scene[1], "scene.3dm")
+    try:
+        if name.lower().endswith(".3dm"):
+            check_3dm(scene[0], name)
+    except InputError as exc:
+        raise Problem(422, "InputError", str(exc), exc.field) from None
+    blobs = [scene[0], spec[0]]
+    if site is not None:
+        blobs.append(site[0])
+    if record is not None:
+        blobs.append(record[0])
+    return await compute(pool, job, blobs)

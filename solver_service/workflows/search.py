@@ -1,0 +1,846 @@
+"""``rockmech search``: the mechanisms of a façade found, built and ranked by how they rock.
+
+``search_run`` takes a scene and a search spec and returns a :class:`SearchRun`:
+
+1. the maths (``rhino_plugin.search.engine.run_search``): the building read as prisms, the
+   catalogue's candidates refined on the exact static multiplier λ0, the global upper-bound
+   check per façade and direction, the sliding flags;
+2. the ``candidates.keep`` candidates of least λ0 become mechanism specs of the existing
+   typologies and go through the existing constants builder
+   (``rhino_plugin.search.specs.build_candidates``); its exact λ0 and mass agree with the
+   search's to 1e-9 on exact prisms, and its linearised λ is reported beside λ0;
+3. every built mechanism is ranked by its overturning acceleration over the pulse frequency
+   band (``documents.envelope_doc``: the library's envelopes, or the exact solver's): the
+   score is the geometric mean of ``a_p,min`` over the band; the ``ranking.keep`` best run
+   the records (exact solver, ``simulate_batch``: the smallest scale factor of each record
+   that overturns them) and the code check (``assess.check_doc``: α0 and the verdict);
+4. the document (``search.json``) says where the static (λ0) and the dynamic rankings differ.
+
+``write_search`` writes the outputs into a run folder: ``search.json``, ``search.spec.json``
+(the spec the existing commands and Rhino reopen), ``constants.json``, ``search.3dm`` (the
+search's scene with a crack layer) and ``search.png`` (the top mechanisms on the façade).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+from rhino_plugin.mechanisms.build import MechanismFailure
+from rhino_plugin.scenes import read_scene
+from rhino_plugin.search.engine import MISSED_GAP, SearchResult, run_search, sliding_check
+from rhino_plugin.search.families import Candidate
+from rhino_plugin.search.prism import segment_intervals
+from rhino_plugin.search.specs import AGREEMENT_RTOL, build_candidates
+from shared_schema.atomic import write_atomic
+from shared_schema.constants import ConstantsFile, json_document
+from shared_schema.errors import InputError, RockmechError
+from shared_schema.extras import require
+from shared_schema.rules import check_file
+from shared_schema.search import SearchSpec, parse_search_spec
+from shared_schema.spec import SpecFile
+from shared_schema.version import __version__
+
+from ..core.envelope import OverturningLibrary
+from ..core.exact import simulate, simulate_batch
+from ..report.search_figure import plot_search
+from .adapter import to_rocking_model
+from .assess import check_doc, read_site
+from .documents import envelope_doc, log_grid
+from .inputs import read_record
+from .outputs import finite_json
+
+__all__ = [
+    "SCALE_GRID",
+    "SearchRun",
+    "crack_patches",
+    "read_search_spec",
+    "scales_to_overturn",
+    "search_3dm",
+    "search_from_files",
+    "search_run",
+    "write_search",
+]
+
+#: Work limit of one search [evaluations of λ0]: the command line lifts it with
+#: ``--no-limits``, a REST request may lower it (about 0.2 ms each on one core).
+MAX_EVALUATIONS = 200_000
+#: Work limit of one global check [macro-blocks] (about 1 s for 300 on one core).
+MAX_LP_BLOCKS = 2_000
+#: Scale factors of a record tried for overturning: log-spaced (lowest, highest, count).
+SCALE_GRID = (0.05, 50.0, 60)
+#: Relative width to which the first overturning scale factor is bisected.
+SCALE_RTOL = 1e-3
+
+
+@dataclass
+class SearchRun:
+    """A search, built and ranked.
+
+    Attributes
+    ----------
+    doc : dict
+        ``search.json`` (JSON-ready).
+    spec_file : SpecFile or None
+        The mechanism spec of the built candidates (``search.spec.json``).
+    constants : ConstantsFile or None
+        Their constants (``constants.json``).
+    result : SearchResult
+        The maths: the building, every candidate, the checks.
+    ids : dict of int to str
+        Mechanism id of each candidate (by its index in ``result.candidates``).
+    """
+
+    doc: dict[str, Any]
+    spec_file: Optional[SpecFile]
+    constants: Optional[ConstantsFile]
+    result: SearchResult
+    ids: dict[int, str] = field(default_factory=dict)
+
+
+def read_search_spec(path: Path) -> SearchSpec:
+    """Read and validate a search spec file; errors name the spec and the field."""
+    check_file(path, "spec")
+    text = path.read_bytes()
+    json_document(text.decode("utf-8-sig", errors="replace"))  # malformed JSON: one line
+    return parse_search_spec(text, path.name)
+
+
+def _ids(n: int) -> list[str]:
+    width = max(2, len(str(n)))
+    return [f"S{k + 1:0{width}d}" for k in range(n)]
+
+
+def scales_to_overturn(
+    cf: ConstantsFile, motion: Any, grid: tuple[float, float, int] = SCALE_GRID
+) -> list[dict[str, Any]]:
+    """Find the smallest scale factor of a record that overturns each mechanism (exact solver).
+
+    Parameters
+    ----------
+    cf : ConstantsFile
+        The mechanisms (each needs ``eta``).
+    motion : GroundMotion
+        The record.
+    grid : (float, float, int)
+        Scale factors tried: log-spaced from the first to the second, that many.
+
+    Returns
+    -------
+    list of dict
+        Per mechanism: ``scale`` (None when none up to the grid's top overturns), the
+        bracket ``[safe, overturns]`` it was bisected in (relative width ``SCALE_RTOL``),
+        ``pga_g`` (the record's PGA at that scale [g]) and the criterion.
+
+    Notes
+    -----
+    Overturning is not monotonic in the scale (a stronger record may rock a block back):
+    the scale reported is the first on the grid that overturns, refined between it and the
+    grid point below, which did not.
+    """
+    models = [to_rocking_model(m) for m in cf.mechanisms]
+    scales = np.geomspace(grid[0], grid[1], int(grid[2]))
+    batch = simulate_batch(models, motion.accel, scales)
+    out: list[dict[str, Any]] = []
+    for i, model in enumerate(models):
+        hit = np.flatnonzero(batch.overturned[i])
+        if hit.size == 0:
+            out.append(
+                {"scale": None, "bracket": None, "pga_g": None, "criterion": batch.criterion}
+            )
+            continue
+        k = int(hit[0])
+        hi = float(scales[k])
+        lo = float(scales[k - 1]) if k > 0 else 0.0
+        while hi - lo > SCALE_RTOL * hi:
+            mid = 0.5 * (lo + hi) if lo > 0.0 else 0.5 * hi
+            if simulate(model, motion.accel, scale=mid).overturned:
+                hi = mid
+            else:
+                lo = mid
+        out.append(
+            {
+                "scale": hi,
+                "bracket": [lo, hi],
+                "pga_g": hi * float(motion.pga_g),
+                "criterion": batch.criterion,
+            }
+        )
+    return out
+
+
+def crack_patches(cand: Candidate) -> list[dict[str, Any]]:
+    """Return the cracks of a candidate as planar patches through its walls.
+
+    Returns
+    -------
+    list of dict
+        ``wall`` (id), ``segment`` (two (s, z) points in the wall's elevation [m]) and
+        ``corners`` (four world points of the patch through the wall's thickness [m]).
+    """
+    out = []
+    for piece in cand.pieces:
+        wall = piece.wall
+        f = wall.frame
+        ring = wall.rings[0]
+        lo, hi = ring.min(axis=0) - 1.0, ring.max(axis=0) + 1.0
+        for k, plane in enumerate(piece.planes):
+            line = f.line_of_plane(*plane)
+            if line is None:
+                continue
+            a, b, c = line
+            # the line across the elevation's box, parametrised along its direction
+            if abs(b) >= abs(a):
+                p0 = np.array([lo[0], -(a * lo[0] + c) / b])
+                p1 = np.array([hi[0], -(a * hi[0] + c) / b])
+            else:
+                p0 = np.array([-(b * lo[1] + c) / a, lo[1]])
+                p1 = np.array([-(b * hi[1] + c) / a, hi[1]])
+            others = [f.line_of_plane(*q) for j, q in enumerate(piece.planes) if j != k]
+            for u0, u1 in segment_intervals(wall.rings, p0, p1):
+                q0, q1 = p0 + u0 * (p1 - p0), p0 + u1 * (p1 - p0)
+                keep = True
+                for h in others:
+                    if h is None:
+                        continue
+                    f0 = h[0] * q0[0] + h[1] * q0[1] + h[2]
+                    f1 = h[0] * q1[0] + h[1] * q1[1] + h[2]
+                    if f0 < 0.0 and f1 < 0.0:
+                        keep = False
+                        break
+                    if f0 < 0.0:
+                        q0 = q0 + (f0 / (f0 - f1)) * (q1 - q0)
+                    elif f1 < 0.0:
+                        q1 = q0 + (f0 / (f0 - f1)) * (q1 - q0)
+                if not keep or float(np.hypot(*(q1 - q0))) <= 1e-9:
+                    continue
+                t = f.thickness
+                corners = [
+                    f.to_world(q0[0], 0.0, q0[1]),
+                    f.to_world(q1[0], 0.0, q1[1]),
+                    f.to_world(q1[0], t, q1[1]),
+                    f.to_world(q0[0], t, q0[1]),
+                ]
+                out.append(
+                    {
+                        "wall": wall.id,
+                        "segment": [[float(v) for v in q0], [float(v) for v in q1]],
+                        "corners": [[float(v) for v in p] for p in corners],
+                    }
+                )
+    return out
+
+
+def _params_doc(cand: Candidate) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in cand.params.items():
+        out[k] = v
+        if k.endswith("_rad"):
+            out[k[:-4] + "_deg"] = math.degrees(v)
+    return out
+
+
+def _band_score(values: Sequence[Optional[float]]) -> Optional[float]:
+    """Geometric mean of the finite overturning accelerations over the band [g]."""
+    finite = [v for v in values if v is not None and math.isfinite(v) and v > 0.0]
+    if not finite or len(finite) < len(values):
+        return None if not finite else float(np.exp(np.mean(np.log(finite))))
+    return float(np.exp(np.mean(np.log(finite))))
+
+
+def _candidate_doc(cand: Candidate, mid: str, rank: int, friction: float) -> dict[str, Any]:
+    doc: dict[str, Any] = {
+        "id": mid,
+        "rank_static": rank,
+        "family": cand.family,
+        "facade": cand.facade,
+        "direction": cand.direction,
+        "typology": cand.typology,
+        "rocking": cand.rocking,
+        "parameters": _params_doc(cand),
+        "bounds": {k: list(v) for k, v in cand.bounds.items()},
+        "on_bound": list(cand.on_bound),
+        "lam0": cand.lam0,
+        "hinge_axis": [[float(v) for v in p] for p in cand.axis],
+        "direction_vector": [float(v) for v in cand.direction_vector],
+        "crack_planes": [
+            {
+                "wall": piece.wall.id,
+                "point": [float(v) for v in plane[0]],
+                "normal": [float(v) for v in plane[1]],
+            }
+            for piece in cand.pieces
+            for plane in piece.planes
+        ],
+        "cracks": crack_patches(cand),
+        "pieces": [{"wall": p.wall.id, "mass_kg": float(p.lump().mass)} for p in cand.pieces],
+        "mass_kg": float(sum(p.lump().mass for p in cand.pieces)),
+        "levels": [
+            {
+                "level": ld.level.id,
+                "at_m": [float(v) for v in ld.point],
+                "mass_kg": ld.mass,
+                "bearing": ld.bearing,
+                "thrust_N": ld.thrust,
+            }
+            for ld in cand.contacts
+        ],
+        "tie_bars": [
+            {"tie_bar": t.index, "at_m": [float(v) for v in t.point], "force_N": t.tie.force}
+            for t in cand.ties
+        ],
+        "n_evaluations": cand.n_evaluations,
+        "sliding": sliding_check(cand, friction),
+        "notes": list(cand.notes),
+    }
+    if cand.lam0_negative is not None:
+        doc["lam0_negative"] = cand.lam0_negative
+    if cand.overburden is not None:
+        doc["overburden"] = {"N": cand.overburden["N"], "x_m": cand.overburden["x"]}
+    return doc
+
+
+def _lp_doc(check: Any) -> dict[str, Any]:
+    model, res = check.model, check.result
+    bodies = []
+    for body in res.bodies:
+        ref = body[0]
+        bodies.append(
+            {
+                "blocks": [
+                    {
+                        "wall": model.blocks[b].wall,
+                        "rings": [r.tolist() for r in model.blocks[b].rings],
+                    }
+                    for b in body
+                ],
+                "rotation": [float(v) for v in res.velocities[ref, 3:]],
+                "velocity_at_centre": [float(v) for v in res.velocities[ref, :3]],
+            }
+        )
+    message = (
+        f"the catalogue missed a mechanism: the check's multiplier {check.lam:.6g} is "
+        f"{100 * check.gap:.3g} % below the best catalogue mechanism's {check.best:.6g}"
+        if check.missed
+        else "the best catalogue mechanism holds the check's optimum (the check's multiplier "
+        f"{check.lam:.6g} is {100 * max(check.gap, 0.0):.2g} % below it)"
+    )
+    doc: dict[str, Any] = {
+        "facade": check.facade,
+        "direction": check.direction,
+        "lam": check.lam,
+        "best_catalogue_lam0": check.best,
+        "gap": check.gap,
+        "missed": check.missed,
+        "threshold": MISSED_GAP,
+        "message": message,
+        "lam_friction": check.lam_friction,
+        "sliding_governs": check.sliding,
+        "status": res.status,
+        "n_blocks": res.n_blocks,
+        "n_rows": res.n_rows,
+        "n_columns": res.n_columns,
+        "lines": model.lines,
+        "mechanism": bodies if check.missed else None,
+    }
+    if check.sliding:
+        doc["sliding_note"] = (
+            f"with associative friction (μ on the hinge joints) the check's multiplier drops to "
+            f"{check.lam_friction:.6g}: sliding governs this façade, and the rocking-only "
+            "multipliers overestimate its capacity"
+        )
+    return doc
+
+
+def _resolve(path: str, spec_dir: Optional[Path], what: str) -> Path:
+    p = Path(path)
+    if not p.is_absolute() and spec_dir is not None:
+        p = spec_dir / p
+    if not p.is_file():
+        raise InputError(f"file not found: {path} (relative to the search spec)", what)
+    return p
+
+
+@dataclass
+class _Ranked:
+    """The built candidates and their ranking (``search_run``'s middle steps)."""
+
+    constants: Optional[ConstantsFile] = None
+    failures: list[MechanismFailure] = field(default_factory=list)
+    spec_file: Optional[SpecFile] = None
+    envelopes: Optional[dict[str, Any]] = None
+    dynamic: list[str] = field(default_factory=list)
+
+
+def _build_and_rank(
+    result: SearchResult,
+    keep: int,
+    docs: dict[str, dict[str, Any]],
+    ids: list[str],
+    f_p: np.ndarray[Any, Any],
+    scene_name: str,
+    exact: bool,
+    library: Optional[OverturningLibrary],
+) -> _Ranked:
+    """Build the kept candidates and rank them by their overturning acceleration."""
+    out = _Ranked()
+    n_built = min(keep, len(result.candidates))
+    if not n_built:
+        return out
+    cf, out.failures, agreement, out.spec_file = build_candidates(
+        result.building, result.candidates[:n_built], ids[:n_built], scene_name=scene_name
+    )
+    for f in out.failures:
+        docs[f.id]["builder"] = {"error": f.message}
+    if cf is None:
+        return out
+    out.constants = cf
+    method = "exact" if exact else "library"
+    out.envelopes, _ = envelope_doc(cf, f_p, method=method, library=library)
+    for entry, mech in zip(out.envelopes["mechanisms"], cf.mechanisms):
+        d = docs[mech.id]
+        values = entry["a_p_min_g"]
+        finite = [v for v in values if v is not None]
+        d["overturning"] = {
+            "a_p_min_g": values,
+            "band_score_g": _band_score(values),
+            "min_g": min(finite) if finite else None,
+            "f_at_min_hz": float(f_p[values.index(min(finite))]) if finite else None,
+        }
+        a = agreement.get(mech.id, {})
+        d["builder"] = {
+            "lam0": a.get("lam0"),
+            "lam0_rel": a.get("lam0_rel"),
+            "mass_rel": a.get("mass_rel"),
+            "agrees": a.get("agrees"),
+            "tolerance": AGREEMENT_RTOL,
+        }
+        d["lam_linearised"] = mech.positive.lam
+        d["constants"] = {
+            "positive": mech.positive.model_dump(exclude_none=True),
+            "negative": None
+            if mech.negative is None
+            else mech.negative.model_dump(exclude_none=True),
+            "eta": mech.eta,
+            "eta_source": mech.eta_source,
+        }
+        if a and not a.get("agrees"):
+            d["notes"].append(
+                f"the builder's exact λ0 ({a.get('lam0')}) and mass differ from the search's by "
+                f"{a.get('lam0_rel'):.3g} and {a.get('mass_rel'):.3g} (relative): an idealised "
+                "wall or a level the builder places elsewhere; the ranking uses the builder's "
+                "constants"
+            )
+
+    def score(mid: str) -> tuple[float, float]:
+        s = docs[mid]["overturning"]["band_score_g"]
+        return (math.inf if s is None else s, docs[mid]["lam0"])
+
+    out.dynamic = sorted([m.id for m in cf.mechanisms], key=score)
+    for r, mid in enumerate(out.dynamic):
+        docs[mid]["rank_dynamic"] = r + 1
+    return out
+
+
+def _run_records(
+    cf: ConstantsFile, top: list[str], motions: Sequence[Any], docs: dict[str, dict[str, Any]]
+) -> list[dict[str, Any]]:
+    """Each record's smallest scale factor that overturns each top mechanism."""
+    out: list[dict[str, Any]] = []
+    sub = ConstantsFile(mechanisms=[m for m in cf.mechanisms if m.id in top])
+    order = [m.id for m in sub.mechanisms]
+    for motion in motions:
+        try:
+            runs = scales_to_overturn(sub, motion)
+        except RockmechError as exc:
+            out.append({"record": motion.name, "note": f"not run: {exc}"})
+            continue
+        out.append({"record": motion.name, "pga_g": float(motion.pga_g), "dt": float(motion.dt)})
+        for mid, run in zip(order, runs):
+            docs[mid].setdefault("records", []).append({"record": motion.name, **run})
+    return out
+
+
+def _run_check(
+    cf: ConstantsFile, top: list[str], site: Any, docs: dict[str, dict[str, Any]]
+) -> dict[str, Any]:
+    """Run the code check of the top mechanisms (α0 and the verdict beside the dynamics)."""
+    check = check_doc(ConstantsFile(mechanisms=[m for m in cf.mechanisms if m.id in top]), site)
+    for row in check["mechanisms"]:
+        lin = row["linear"]
+        docs[row["id"]]["code_check"] = {
+            "alpha0": lin.get("alpha0"),
+            "passes": row["passes"],
+            "linear": lin,
+            "nonlinear": row["nonlinear"],
+            "Z": row["Z"],
+            "Z_source": row["Z_source"],
+        }
+    return {"site": check["site"], "governing": check["governing"]}
+
+
+def _compare(
+    docs: list[dict[str, Any]], dynamic: list[str], band: Sequence[float]
+) -> dict[str, Any]:
+    """Where the static (λ0) and the dynamic rankings of the built mechanisms differ."""
+    built = set(dynamic)
+    static = [d["id"] for d in docs if d["id"] in built]
+    by_id = {d["id"]: d for d in docs}
+    differences = []
+    for mid in dynamic:
+        rs, rd = static.index(mid) + 1, dynamic.index(mid) + 1
+        if rs != rd:
+            differences.append({"id": mid, "static": rs, "dynamic": rd})
+    summary = []
+    if dynamic and dynamic[0] != static[0]:
+        summary.append(
+            f"the static and the dynamic rankings differ: {static[0]} has the least λ0 "
+            f"({by_id[static[0]]['lam0']:.4g}), {dynamic[0]} the least overturning "
+            f"acceleration over {band[0]:g}-{band[1]:g} Hz "
+            f"({by_id[dynamic[0]]['overturning']['band_score_g']:.4g} g)"
+        )
+    return {"differences": differences, "summary": summary}
+
+
+def _input_doc(
+    scene: Any, spec: SearchSpec, bld: Any, scene_name: str, spec_name: str
+) -> dict[str, Any]:
+    return {
+        "scene": scene_name,
+        "spec": spec_name,
+        "scene_units": getattr(scene, "units", None),
+        "walls": {
+            w.id: {
+                "object": w.selector,
+                "thickness_m": w.frame.thickness,
+                "length_m": w.length,
+                "height_m": w.z_hi - w.z_lo,
+                "exact_prism": w.exact,
+                "openings": len(w.holes),
+                "facade": w.is_facade,
+            }
+            for w in bld.walls.values()
+        },
+        "junctions": [
+            {
+                "facade": a,
+                "wall": r.wall.id,
+                "end": r.end,
+                "connection": r.connection,
+                "beta_bond_rad": r.beta_bond,
+                "corner": r.corner,
+            }
+            for a, rets in bld.returns.items()
+            for r in rets
+        ],
+        "families": list(spec.families),
+        "directions": list(spec.directions),
+        "friction": spec.friction,
+    }
+
+
+#: What every search assumes, stated in its document.
+ASSUMPTIONS = (
+    "single-degree-of-freedom mechanisms only; rocking with infinite friction at the hinge "
+    "joints (the sliding flags say where friction would not hold)",
+    "a crack through a return wall separates its wedge without friction (the macro-block "
+    "model); good connections make it run at least at the bond angle",
+    "mechanisms are ranked on the ground motion: none carries amplification, so the code "
+    "check takes Z = 0 for every one",
+)
+
+
+def search_run(
+    scene: Any,
+    spec: SearchSpec,
+    *,
+    scene_name: str = "scene",
+    spec_name: str = "search spec",
+    spec_dir: Optional[Path] = None,
+    site: Any = None,
+    motions: Optional[Sequence[Any]] = None,
+    exact: bool = False,
+    library: Optional[OverturningLibrary] = None,
+    max_evaluations: Optional[int] = MAX_EVALUATIONS,
+    max_lp_blocks: Optional[int] = MAX_LP_BLOCKS,
+    max_built: Optional[int] = None,
+) -> SearchRun:
+    """Search, build and rank a scene's mechanisms (the module docstring's steps).
+
+    Parameters
+    ----------
+    scene : BaseScene
+        The scene (``rhino_plugin.scenes.read_scene``).
+    spec : SearchSpec
+        The search spec.
+    scene_name, spec_name : str
+        For the document's provenance.
+    spec_dir : Path, optional
+        Folder of the spec: its ``ranking.site`` and ``ranking.records`` are relative to it.
+    site : SiteFile, optional
+        The site for the code check (default: the spec's ``ranking.site``).
+    motions : sequence of GroundMotion, optional
+        Records (default: the spec's ``ranking.records``).
+    exact : bool
+        Envelopes by the exact solver instead of the library.
+    library : OverturningLibrary, optional
+        The library to interpolate (default: the shipped one).
+    max_evaluations, max_lp_blocks : int or None
+        Work limits (``MAX_EVALUATIONS``, ``MAX_LP_BLOCKS``; None: none): a search that
+        would exceed one stops before doing that work (``InputError`` on ``work_limit``).
+    max_built : int, optional
+        Most mechanisms built and ranked (the service's ``max_mechanisms``), below the spec's
+        ``candidates.keep``; the document says when it cut the list.
+
+    Returns
+    -------
+    SearchRun
+    """
+    t0 = time.perf_counter()
+    rk = spec.ranking
+    if site is None and rk.site is not None:
+        site = read_site(_resolve(rk.site, spec_dir, "ranking.site"))
+    if motions is None:
+        motions = [
+            read_record(_resolve(r, spec_dir, f"ranking.records[{k}]"))
+            for k, r in enumerate(rk.records)
+        ]
+    result = run_search(scene, spec, max_evaluations=max_evaluations, max_lp_blocks=max_lp_blocks)
+    t1 = time.perf_counter()
+    cands = result.candidates
+    ids = _ids(len(cands))
+    f_p = log_grid(
+        rk.band_hz[0], rk.band_hz[1], rk.n_frequencies, names=("band_hz[0]", "band_hz[1]")
+    )
+    docs = [_candidate_doc(c, ids[k], k + 1, spec.friction) for k, c in enumerate(cands)]
+    by_id = {d["id"]: d for d in docs}
+    keep = spec.candidates.keep
+    notes = list(result.notes)
+    if max_built is not None and min(keep, len(cands)) > max_built:
+        notes.append(
+            f"only the {max_built} mechanisms of least λ0 are built and ranked (the service's "
+            f"max_mechanisms), not the {min(keep, len(cands))} candidates.keep asks for"
+        )
+        keep = max_built
+    ranked = _build_and_rank(result, keep, by_id, ids, f_p, scene_name, exact, library)
+    t2 = time.perf_counter()
+    top = ranked.dynamic[: rk.keep]
+    cf = ranked.constants
+    records = _run_records(cf, top, motions, by_id) if cf is not None and top and motions else []
+    t3 = time.perf_counter()
+    check = (
+        _run_check(cf, top, site, by_id) if cf is not None and top and site is not None else None
+    )
+    t4 = time.perf_counter()
+    compare = _compare(docs, ranked.dynamic, rk.band_hz)
+    env = ranked.envelopes
+    n_built = 0 if cf is None else len(cf.mechanisms)
+    doc: dict[str, Any] = {
+        "rockmech_version": __version__,
+        "kind": "search",
+        "input": _input_doc(scene, spec, result.building, scene_name, spec_name),
+        "units": {
+            "length": "m",
+            "mass": "kg",
+            "force": "N",
+            "f_p": "Hz",
+            "a_p": "g",
+            "angle": "rad",
+        },
+        "band": {"f_p": [float(v) for v in f_p], "band_hz": list(rk.band_hz)},
+        "candidates": docs,
+        "rankings": {
+            "static": [d["id"] for d in docs],
+            "dynamic": ranked.dynamic,
+            **compare,
+            "governing": env["governing"] if env else [],
+            "critical": env["critical"] if env else [],
+            "envelope_method": env["method"] if env else None,
+            "band_score": "geometric mean of a_p,min over the band [g]",
+        },
+        "lp": [_lp_doc(ch) for ch in result.checks],
+        "records": records,
+        "code_check": check,
+        "not_built": [d["id"] for d in docs[min(keep, len(docs)) :]],
+        "failures": [{"id": f.id, "error": f.message} for f in ranked.failures],
+        "counts": {**result.counts, "built": n_built},
+        "timings": {
+            **result.timings,
+            "constants_and_ranking_s": t2 - t1,
+            "records_s": t3 - t2,
+            "code_check_s": t4 - t3,
+            "total_s": t4 - t0,
+        },
+        "assumptions": list(ASSUMPTIONS),
+        "notes": notes + compare["summary"],
+    }
+    return SearchRun(doc, ranked.spec_file, cf, result, dict(enumerate(ids)))
+
+
+def _layer(model: Any, r3: Any, path: str, cache: dict[str, int]) -> int:
+    """Index of a layer given by its full path ``A::B``, made (with its parents) on first use."""
+    if path in cache:
+        return cache[path]
+    parent = ""
+    parent_id = None
+    for part in path.split("::"):
+        full = f"{parent}::{part}" if parent else part
+        if full not in cache:
+            layer = r3.Layer()
+            layer.Name = part
+            if parent_id is not None:
+                layer.ParentLayerId = parent_id
+            cache[full] = model.Layers.Add(layer)
+        parent_id = model.Layers.FindIndex(cache[full]).Id
+        parent = full
+    return cache[path]
+
+
+def search_3dm(run: SearchRun) -> bytes:
+    """Encode the search's scene (walls, levels, tie-bars [m]) and its crack layer as ``.3dm``.
+
+    Objects keep their ids, names and layers, so the selectors of ``search.spec.json`` find
+    them; each built mechanism has a layer ``rockmech search::<id>`` with its cracks (planar
+    patches through the walls) and its hinge axis.
+    """
+    r3 = require("rhino3dm", "geometry", "to write the search's .3dm")
+    model = r3.File3dm()
+    model.Settings.ModelUnitSystem = r3.UnitSystem.Meters
+    tol = float(run.result.building.scene.tolerance or 0.0)
+    model.Settings.ModelAbsoluteTolerance = tol if tol > 0.0 else 1e-4
+    layers: dict[str, int] = {}
+    for obj in run.result.building.scene.objects:
+        attrs = r3.ObjectAttributes()
+        attrs.Name = obj.name
+        attrs.Id = obj.id
+        attrs.LayerIndex = _layer(model, r3, obj.layer or "rockmech search::scene", layers)
+        geo = obj.geometry
+        if isinstance(geo, tuple):
+            model.Objects.AddLine(r3.Point3d(*geo[0]), r3.Point3d(*geo[1]), attrs)
+            continue
+        mesh = r3.Mesh()
+        for x, y, z in geo.vertices.tolist():
+            mesh.Vertices.AddPoint3d(x, y, z)
+        for a, b, c in geo.faces.tolist():
+            mesh.Faces.AddFace(a, b, c)
+        model.Objects.AddMesh(mesh, attrs)
+    built = set() if run.constants is None else {m.id for m in run.constants.mechanisms}
+    for k, cand in enumerate(run.result.candidates):
+        mid = run.ids[k]
+        if mid not in built:
+            continue
+        index = _layer(model, r3, f"rockmech search::{mid}", layers)
+        doc = next(d for d in run.doc["candidates"] if d["id"] == mid)
+        for j, crack in enumerate(doc["cracks"]):
+            attrs = r3.ObjectAttributes()
+            attrs.Name = f"{mid} crack {j + 1} ({crack['wall']})"
+            attrs.LayerIndex = index
+            mesh = r3.Mesh()
+            for x, y, z in crack["corners"]:
+                mesh.Vertices.AddPoint3d(x, y, z)
+            mesh.Faces.AddFace(0, 1, 2, 3)
+            model.Objects.AddMesh(mesh, attrs)
+        attrs = r3.ObjectAttributes()
+        attrs.Name = f"{mid} hinge axis"
+        attrs.LayerIndex = index
+        a, b = cand.axis
+        if cand.family == "corner":
+            b = a + 2.0 * (b - a)
+        model.Objects.AddLine(r3.Point3d(*a), r3.Point3d(*b), attrs)
+    return _encode(model)
+
+
+def _encode(model: Any) -> bytes:
+    """Write a File3dm to bytes (Rhino 8 format) through a temporary file."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "search.3dm"
+        if not model.Write(str(path), 8):
+            raise InputError("rhino3dm could not write the search's .3dm", "out")
+        return path.read_bytes()
+
+
+def write_search(run: SearchRun, out_dir: Path, *, figure: bool = True) -> list[Path]:
+    """Write a search's files into a folder (``run_folder`` stages it; each written whole).
+
+    Returns
+    -------
+    list of Path
+        ``search.json``, ``search.spec.json``, ``constants.json`` (when any was built),
+        ``search.3dm`` and ``search.png``.
+    """
+    out = []
+    doc = finite_json(run.doc)
+    path = out_dir / "search.json"
+    write_atomic(path, json.dumps(doc, indent=1, allow_nan=False) + "\n")
+    out.append(path)
+    if run.spec_file is not None:
+        path = out_dir / "search.spec.json"
+        text = run.spec_file.model_dump_json(indent=1, exclude_none=True)
+        write_atomic(path, text + "\n")
+        out.append(path)
+    if run.constants is not None:
+        path = out_dir / "constants.json"
+        write_atomic(path, run.constants.model_dump_json(indent=1, exclude_none=True) + "\n")
+        out.append(path)
+    path = out_dir / "search.3dm"
+    write_atomic(path, search_3dm(run))
+    out.append(path)
+    if figure:
+        png = plot_search(run, out_dir / "search.png")
+        if png is not None:
+            out.append(png)
+    return out
+
+
+def search_from_files(
+    scene: Path,
+    spec: Path,
+    *,
+    units: Optional[str] = None,
+    site: Optional[Path] = None,
+    records: Sequence[Path] = (),
+    exact: bool = False,
+    limits: bool = True,
+) -> SearchRun:
+    """Search a scene file with a search-spec file (the command line's and the API's way in).
+
+    Parameters
+    ----------
+    scene : Path
+        A ``.3dm`` file, or a scan mesh (``.ply``, ``.obj``, ``.stl``, ``.off``) with ``units``.
+    spec : Path
+        The search spec (JSON); its ``ranking.site`` and ``ranking.records`` are relative to
+        its folder.
+    units : str, optional
+        Length unit of a scan mesh.
+    site : Path, optional
+        A site file, instead of the spec's ``ranking.site``.
+    records : sequence of Path
+        Records, instead of the spec's ``ranking.records`` (formats detected).
+    exact : bool
+        Envelopes by the exact solver instead of the library.
+    limits : bool
+        Apply the work limits (``MAX_EVALUATIONS``, ``MAX_LP_BLOCKS``).
+    """
+    check_file(scene, "scene")
+    search_spec = read_search_spec(spec)
+    scene_obj = read_scene(scene, units=units)
+    return search_run(
+        scene_obj,
+        search_spec,
+        scene_name=scene.name,
+        spec_name=spec.name,
+        spec_dir=spec.parent,
+        site=None if site is None else read_site(site),
+        motions=[read_record(r) for r in records] if records else None,
+        exact=exact,
+        max_evaluations=MAX_EVALUATIONS if limits else None,
+        max_lp_blocks=MAX_LP_BLOCKS if limits else None,
+    )

@@ -1,0 +1,109 @@
+"""Small ``.3dm`` scenes for the search tests, drawn with the example scenes' builder.
+
+``examples/`` is not a package, so the builder module (``Builder``, ``slab_solid``) is loaded
+from its file, as ``tests/cad/cad_scenes.py`` does.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+from typing import Any, Optional, Sequence
+
+REPO = Path(__file__).resolve().parents[2]
+_spec = importlib.util.spec_from_file_location(
+    "build_scenes_search", REPO / "examples" / "scenes" / "build_scenes.py"
+)
+assert _spec is not None and _spec.loader is not None
+#: The builder module of the example scenes.
+BUILD: Any = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(BUILD)
+
+#: The search example scene and spec.
+EXAMPLE_SCENE = REPO / "examples" / "scenes" / "search_facade.3dm"
+EXAMPLE_SPEC = REPO / "examples" / "specs" / "search_facade.search.json"
+
+
+def two_block_wall(
+    out: Path, b: float = 0.3, h: float = 3.0, length: float = 1.0, name: str = "tb"
+) -> Path:
+    """A wall x in [0, b] (outer face x = 0), y in [0, length], z in [0, h], a slab on top."""
+    bld = BUILD.Builder(name)
+    bld.box("wall", "Walls", (0.0, 0.0, 0.0), (b, length, h), "brick")
+    bld.box("slab", "Floors", (0.0, 0.0, h), (3.0, length, h + 0.2), "concrete")
+    return bld.write(out / f"{name}.3dm")
+
+
+def wedge_facade(
+    out: Path,
+    H: float = 9.0,
+    L: float = 8.0,
+    t: float = 0.5,
+    s: float = 0.5,
+    reach: float = 12.0,
+    windows: Sequence[tuple[float, float, float, float]] = (),
+    mirror: bool = False,
+    scale: float = 1.0,
+    name: str = "wedge",
+) -> Path:
+    """A façade (outer face x = 0) between two return walls running into +x.
+
+    ``mirror`` reflects the scene in the plane y = 0; ``scale`` scales every length.
+    """
+    bld = BUILD.Builder(name)
+    k = scale
+    sy = -1.0 if mirror else 1.0
+
+    def box(nm: str, lo: tuple[float, float, float], hi: tuple[float, float, float]) -> None:
+        y0, y1 = sorted((sy * lo[1], sy * hi[1]))
+        bld.box(
+            nm, "Walls", (k * lo[0], k * y0, k * lo[2]), (k * hi[0], k * y1, k * hi[2]), "brick"
+        )
+
+    holes = [
+        [(k * a, k * c), (k * b, k * c), (k * b, k * d), (k * a, k * d)] for a, b, c, d in windows
+    ]
+    v, f = BUILD.slab_solid(
+        (0.0, 0.0, 0.0),
+        (0.0, sy, 0.0),
+        (1.0, 0.0, 0.0),
+        k * t,
+        [(0.0, 0.0), (k * L, 0.0), (k * L, k * H), (0.0, k * H)],
+        holes,
+    )
+    bld.mesh("facade", "Walls", v, f, "brick")
+    box("left", (t, 0.0, 0.0), (t + reach, s, H))
+    box("right", (t, L - s, 0.0), (t + reach, L, H))
+    return bld.write(out / f"{name}.3dm")
+
+
+def write_spec(path: Path, doc: dict[str, Any]) -> Path:
+    """Write a search spec (JSON)."""
+    path.write_text(json.dumps(doc, indent=1))
+    return path
+
+
+def wedge_spec(
+    connection: str = "good",
+    unit: Optional[tuple[float, float]] = (0.25, 0.12),
+    families: Optional[list[str]] = None,
+    **extra: Any,
+) -> dict[str, Any]:
+    """The search spec of ``wedge_facade``: three walls of 1800 kg/m³, one connection."""
+    junction: dict[str, Any] = {"connection": connection}
+    if unit is not None:
+        junction["unit"] = {"length": unit[0], "height": unit[1]}
+    doc: dict[str, Any] = {
+        "walls": [
+            {"id": "F", "object": "facade", "density": 1800.0},
+            {"id": "L", "object": "left", "density": 1800.0, "facade": False},
+            {"id": "R", "object": "right", "density": 1800.0, "facade": False},
+        ],
+        "default_junction": junction,
+        "directions": ["outward"],
+    }
+    if families is not None:
+        doc["families"] = families
+    doc.update(extra)
+    return doc

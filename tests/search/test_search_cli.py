@@ -1,0 +1,114 @@
+"""``rockmech search`` and the Python API's ``rockmech.search_from_files`` (issue #31)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from search_scenes import EXAMPLE_SCENE, EXAMPLE_SPEC, wedge_facade, wedge_spec, write_spec
+from typer.testing import CliRunner
+
+import rockmech
+from solver_service.cli import app
+from solver_service.workflows.inputs import constants_from_files
+
+runner = CliRunner()
+
+
+def test_cli_writes_the_outputs_and_the_spec_reopens(tmp_path: Path) -> None:
+    scene = wedge_facade(tmp_path, windows=[(1.5, 2.7, 1.0, 3.0)])
+    spec = write_spec(tmp_path / "s.json", wedge_spec("good", (0.25, 0.12)))
+    out = tmp_path / "out"
+    res = runner.invoke(app, ["search", str(scene), str(spec), "-o", str(out), "--no-figure"])
+    assert res.exit_code == 0, res.output
+    assert "wedge_overturning" in res.stdout and "built; wrote" in res.stdout
+    names = sorted(p.name for p in out.iterdir())
+    assert names == [".rockmech", "constants.json", "search.3dm", "search.json", "search.spec.json"]
+    doc = json.loads((out / "search.json").read_text())
+    assert doc["kind"] == "search" and doc["candidates"]
+    # the spec reopens with the existing constants command, on the input and on search.3dm
+    mine = json.loads((out / "constants.json").read_text())["mechanisms"]
+    for scene_file in (scene, out / "search.3dm"):
+        cf = constants_from_files(scene_file, out / "search.spec.json")
+        for m, again in zip(mine, cf.mechanisms):
+            assert again.positive.p_eq == pytest.approx(m["positive"]["p_eq"], rel=1e-12)
+    res = runner.invoke(
+        app,
+        ["constants", str(scene), str(out / "search.spec.json"), "-o", str(tmp_path / "c.json")],
+    )
+    assert res.exit_code == 0, res.output
+
+
+def test_cli_json_prints_one_document(tmp_path: Path) -> None:
+    scene = wedge_facade(tmp_path)
+    spec = write_spec(tmp_path / "s.json", wedge_spec("poor", None, lp=False))
+    res = runner.invoke(
+        app, ["search", str(scene), str(spec), "-o", str(tmp_path / "o"), "--json", "--no-figure"]
+    )
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    assert doc["rankings"]["static"][0] == "S01"
+    assert doc["candidates"][0]["lam0"] == pytest.approx(0.5 / 9.0, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        ({"walls": [{"id": "F", "object": "nothing", "density": 1800}]}, "walls[0].object"),
+        ({"walls": [{"id": "F", "object": "facade", "density": -3}]}, "walls[0].density"),
+        ({"ranking": {"band_hz": [5, 1]}}, "ranking.band_hz"),
+        ({"families": ["three_block"]}, "families[0]"),
+    ],
+)
+def test_cli_bad_spec_exits_2_naming_the_field(
+    tmp_path: Path, edit: dict[str, object], message: str
+) -> None:
+    scene = wedge_facade(tmp_path)
+    spec = write_spec(tmp_path / "s.json", {**wedge_spec("poor", None), **edit})
+    res = runner.invoke(app, ["search", str(scene), str(spec), "-o", str(tmp_path / "o")])
+    assert res.exit_code == 2
+    assert res.stderr.startswith("error: ") and message in res.stderr
+    assert not (tmp_path / "o" / "search.json").exists()
+
+
+def test_cli_missing_junction_names_the_walls(tmp_path: Path) -> None:
+    scene = wedge_facade(tmp_path)
+    doc = wedge_spec("poor", None)
+    del doc["default_junction"]
+    spec = write_spec(tmp_path / "s.json", doc)
+    res = runner.invoke(app, ["search", str(scene), str(spec), "-o", str(tmp_path / "o")])
+    assert res.exit_code == 2
+    assert "junctions" in res.stderr and "'F'" in res.stderr
+
+
+def test_cli_work_limit_refuses_before_searching(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import solver_service.workflows.search as wf
+
+    monkeypatch.setattr(wf, "MAX_EVALUATIONS", 10)
+    scene = wedge_facade(tmp_path)
+    spec = write_spec(tmp_path / "s.json", wedge_spec("good", (0.25, 0.12)))
+    res = runner.invoke(app, ["search", str(scene), str(spec), "-o", str(tmp_path / "o")])
+    assert res.exit_code == 2
+    assert "error: work_limit:" in res.stderr and "more than 10 evaluations" in res.stderr
+    res = runner.invoke(
+        app,
+        ["search", str(scene), str(spec), "-o", str(tmp_path / "o"), "--no-limits", "--no-figure"],
+    )
+    assert res.exit_code == 0, res.output
+
+
+def test_python_api_search_from_files(tmp_path: Path) -> None:
+    run = rockmech.search_from_files(EXAMPLE_SCENE, EXAMPLE_SPEC)
+    assert isinstance(run, rockmech.SearchRun)
+    paths = rockmech.write_search(run, tmp_path, figure=True)
+    assert {p.name for p in paths} == {
+        "search.json",
+        "search.spec.json",
+        "constants.json",
+        "search.3dm",
+        "search.png",
+    }
+    assert (tmp_path / "search.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
