@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 from rockmech._version import __version__
 
 if TYPE_CHECKING:  # the real types for type checkers and editors
+    from rhino_plugin.scenes import read_scene as read_scene
     from shared_schema.api import PulseRequest as PulseRequest
     from shared_schema.constants import ConstantsFile as ConstantsFile
     from shared_schema.errors import (
@@ -76,9 +77,10 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from solver_service.workflows.documents import solve_pulse as solve_pulse
     from solver_service.workflows.inputs import constants_from_files as constants_from_files
     from solver_service.workflows.search import SearchRun as SearchRun
+    from solver_service.workflows.search import read_search_spec as read_search_spec
+    from solver_service.workflows.search import save_search as save_search
     from solver_service.workflows.search import search_from_files as search_from_files
     from solver_service.workflows.search import search_run as search_run
-    from solver_service.workflows.search import write_search as write_search
 
     from .analysis import (
         assess as assess,
@@ -186,7 +188,9 @@ _SOURCES = {
     "SearchRun": "solver_service.workflows.search",
     "search_from_files": "solver_service.workflows.search",
     "search_run": "solver_service.workflows.search",
-    "write_search": "solver_service.workflows.search",
+    "save_search": "solver_service.workflows.search",
+    "read_search_spec": "solver_service.workflows.search",
+    "read_scene": "rhino_plugin.scenes",
     # Reports and the bundled examples.
     "build_report": "solver_service.report.html",
     "write_report": "solver_service.report.html",

@@ -519,6 +519,12 @@ class SpecFile(BaseModel):
     thrust_table: Optional[str] = Field(
         default=None, description="Path of a user thrust table (JSON), relative to the spec."
     )
+    rockmech_version: Optional[str] = Field(
+        default=None,
+        max_length=100,
+        description="Version of rockmech that wrote the file (informative; rockmech fills it "
+        "in whenever it writes one, e.g. the specs of `rockmech search`).",
+    )
     mechanisms: List[MechanismSpec] = Field(min_length=1)
 
     @field_validator("spec_version")

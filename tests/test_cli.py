@@ -282,7 +282,9 @@ def test_library_build_without_out_writes_the_user_cache_which_envelopes_read_fi
     assert user is not None and user.parent == tmp_path / "cache" / "rockmech"
     assert OverturningLibrary.load().path == LIBRARY_PATH
     church = EXAMPLES / "constants" / "church.json"
-    before = runner.invoke(app, ["envelope", str(church), "--out", str(tmp_path / "a"), "--n", "9"])
+    before = runner.invoke(
+        app, ["envelope", str(church), "--out", str(tmp_path / "a"), "--n", "9", "--fast"]
+    )
     assert before.exit_code == 0 and before.stderr == "", before.output
     res = runner.invoke(app, ["library", "build", "--n-omega", "5", "--eta-step", "0.5"])
     assert res.exit_code == 0, res.output
@@ -291,7 +293,9 @@ def test_library_build_without_out_writes_the_user_cache_which_envelopes_read_fi
     assert hashlib.sha256(LIBRARY_PATH.read_bytes()).hexdigest() == shipped
     lib = OverturningLibrary.load()
     assert lib.path == user and lib.omega.size == 5 and list(lib.eta) == [0.0, 0.5, 1.0]
-    after = runner.invoke(app, ["envelope", str(church), "--out", str(tmp_path / "b"), "--n", "9"])
+    after = runner.invoke(
+        app, ["envelope", str(church), "--out", str(tmp_path / "b"), "--n", "9", "--fast"]
+    )
     assert after.exit_code == 0, after.output
     assert (
         after.stderr

@@ -84,6 +84,10 @@ __all__ = [
     "work_words",
 ]
 
+#: The fast mode's library grid of Omega = 2 pi f_p / p_eq: (first, last, points)
+#: (``core.envelope.LIBRARY_OMEGA``; a test checks they agree). Frequencies outside it are
+#: computed with the exact integrator.
+LIBRARY_OMEGA = (0.05, 50.0, 400)
 #: Margin of the up-front estimates over the rates below [-]: work is refused when it
 #: cannot finish within the budget even this many times faster than measured, on every
 #: core. 2: the newest desktop cores are up to about twice as fast per core as the
@@ -335,15 +339,19 @@ def directional(mech: Any) -> bool:
 
 
 def mechanism_sides(
-    cf: ConstantsFile, p_max: float = math.inf, *, only_exact: bool = False
+    cf: ConstantsFile,
+    p_max: float = math.inf,
+    *,
+    only_exact: bool = False,
+    only_other: bool = False,
 ) -> Iterable[tuple[float, int]]:
     """(p_eq [rad/s], pulse directions) of every side with a valid ``p_eq`` up to ``p_max``.
 
     With ``only_exact``, only the sides of mechanisms whose envelope is exact anyway
-    (``directional``).
+    (``directional``); with ``only_other``, only the others.
     """
     for mech in cf.mechanisms:
-        if only_exact and not directional(mech):
+        if (only_exact and not directional(mech)) or (only_other and directional(mech)):
             continue
         one_sided = mech.rocking == "one_sided"
         sides = (mech.positive,) if one_sided else (mech.positive, mech.negative)
@@ -364,6 +372,39 @@ def _grid_sum(p: float, f_min: float, f_max: float, n: int) -> float:
     return series + (n - k)
 
 
+def _index_sum(p: float, f_min: float, ratio: float, i0: int, i1: int) -> float:
+    """Sum of ``max(1, p / f_i)`` over ``i0 <= i < i1``, ``f_i = f_min ratio**i``."""
+    if i1 <= i0:
+        return 0.0
+    k = max(0, math.ceil(math.log(p / f_min) / math.log(ratio))) if p > f_min else 0
+    m = min(i1, max(i0, k))  # f_i < p for i < k: p / f_i; 1 from there on
+    series = (p / f_min) * (ratio ** (-i0) - ratio ** (-m)) / (1.0 - 1.0 / ratio)
+    return series + (i1 - m)
+
+
+def _outside_sum(p: float, f_min: float, f_max: float, n: int) -> float:
+    """``_grid_sum`` over the frequencies whose ``Omega = 2 pi f / p`` leaves the library.
+
+    The fast mode computes those exactly (``core.envelope.library_curve``): the
+    frequencies below ``p Omega_min / (2 pi)`` and above ``p Omega_max / (2 pi)``, the two
+    ends of the log grid.
+
+    Examples
+    --------
+    >>> _outside_sum(1.0, 0.1, 10.0, 3)  # Omega 0.63, 6.3, 63: the last is outside
+    1.0
+    """
+    if n < 2 or not _positive(f_min, f_max, p) or f_max <= f_min:
+        return 0.0
+    ratio = (f_max / f_min) ** (1.0 / (n - 1))
+    step = math.log(ratio)
+    lo = math.log(p * LIBRARY_OMEGA[0] / (2.0 * math.pi) / f_min) / step
+    hi = math.log(p * LIBRARY_OMEGA[1] / (2.0 * math.pi) / f_min) / step
+    k_lo = min(n, max(0, math.ceil(lo)))  # i < k_lo: below the grid
+    k_hi = max(k_lo, min(n, max(0, math.floor(hi) + 1)))  # i >= k_hi: above it
+    return _index_sum(p, f_min, ratio, 0, k_lo) + _index_sum(p, f_min, ratio, k_hi, n)
+
+
 def envelope_steps(
     cf: ConstantsFile,
     f_min: float,
@@ -376,10 +417,20 @@ def envelope_steps(
     """Closed-form steps of exact envelopes of every mechanism at ``n`` frequencies.
 
     Sides with ``p_eq`` above ``p_max`` [rad/s] are left out. With ``exact`` False (the
-    library's envelopes), only the mechanisms computed exactly anyway (``directional``).
+    fast mode, the library's envelopes), the mechanisms computed exactly anyway
+    (``directional``) and the other sides' frequencies outside the library's grid
+    (``LIBRARY_OMEGA``), which the fast mode also computes exactly.
     """
-    sides = mechanism_sides(cf, p_max, only_exact=not exact)
-    return float(sum(N_SCAN * d * _grid_sum(p, f_min, f_max, n) for p, d in sides))
+    steps = sum(
+        N_SCAN * d * _grid_sum(p, f_min, f_max, n)
+        for p, d in mechanism_sides(cf, p_max, only_exact=not exact)
+    )
+    if not exact:
+        steps += sum(
+            N_SCAN * d * _outside_sum(p, f_min, f_max, n)
+            for p, d in mechanism_sides(cf, p_max, only_other=True)
+        )
+    return float(steps)
 
 
 def scale_factor_points(cf: ConstantsFile, f_min: float, f_max: float, n: int) -> float:

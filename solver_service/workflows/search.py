@@ -27,9 +27,10 @@ import json
 import math
 import tempfile
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Optional, Sequence
+from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
@@ -43,6 +44,7 @@ from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import require
+from shared_schema.io import save_constants, stamped
 from shared_schema.rules import check_file
 from shared_schema.search import SearchSpec, parse_search_spec
 from shared_schema.spec import SpecFile
@@ -56,12 +58,15 @@ from .assess import check_doc, read_site
 from .documents import envelope_doc, log_grid
 from .inputs import read_record
 from .outputs import finite_json
+from .rundir import run_folder
+from .units import stamp
 
 __all__ = [
     "SCALE_GRID",
     "SearchRun",
     "crack_patches",
     "read_search_spec",
+    "save_search",
     "scales_to_overturn",
     "search_3dm",
     "search_from_files",
@@ -643,17 +648,8 @@ def search_run(
     env = ranked.envelopes
     n_built = 0 if cf is None else len(cf.mechanisms)
     doc: dict[str, Any] = {
-        "rockmech_version": __version__,
         "kind": "search",
         "input": _input_doc(scene, spec, result.building, scene_name, spec_name),
-        "units": {
-            "length": "m",
-            "mass": "kg",
-            "force": "N",
-            "f_p": "Hz",
-            "a_p": "g",
-            "angle": "rad",
-        },
         "band": {"f_p": [float(v) for v in f_p], "band_hz": list(rk.band_hz)},
         "candidates": docs,
         "rankings": {
@@ -681,7 +677,7 @@ def search_run(
         "assumptions": list(ASSUMPTIONS),
         "notes": notes + compare["summary"],
     }
-    return SearchRun(doc, ranked.spec_file, cf, result, dict(enumerate(ids)))
+    return SearchRun(stamp(doc, "search"), ranked.spec_file, cf, result, dict(enumerate(ids)))
 
 
 def _layer(model: Any, r3: Any, path: str, cache: dict[str, int]) -> int:
@@ -782,12 +778,13 @@ def write_search(run: SearchRun, out_dir: Path, *, figure: bool = True) -> list[
     out.append(path)
     if run.spec_file is not None:
         path = out_dir / "search.spec.json"
-        text = run.spec_file.model_dump_json(indent=1, exclude_none=True)
+        spec = run.spec_file.model_copy(update={"rockmech_version": __version__})
+        text = spec.model_dump_json(indent=1, exclude_none=True)
         write_atomic(path, text + "\n")
         out.append(path)
     if run.constants is not None:
         path = out_dir / "constants.json"
-        write_atomic(path, run.constants.model_dump_json(indent=1, exclude_none=True) + "\n")
+        save_constants(path, stamped(run.constants))
         out.append(path)
     path = out_dir / "search.3dm"
     write_atomic(path, search_3dm(run))
@@ -797,6 +794,25 @@ def write_search(run: SearchRun, out_dir: Path, *, figure: bool = True) -> list[
         if png is not None:
             out.append(png)
     return out
+
+
+def save_search(run: SearchRun, out: Union[str, Path], *, figure: bool = True) -> list[Path]:
+    """Write a search's files into the folder ``out`` as ``rockmech search --out`` does.
+
+    Through ``rundir.run_folder``: only rockmech's own outputs in ``out`` are replaced, as
+    one set; every other file there stays as it was.
+
+    Returns
+    -------
+    list of Path
+        The files written, in ``out`` (as ``write_search``).
+    """
+    notes: list[str] = []
+    with run_folder(out, on_note=notes.append) as tmp:
+        names = [p.name for p in write_search(run, tmp, figure=figure)]
+    for note in notes:
+        warnings.warn(note, UserWarning, stacklevel=2)
+    return [Path(out) / name for name in names]
 
 
 def search_from_files(

@@ -90,6 +90,14 @@ DOCUMENT_UNITS: dict[str, dict[str, str]] = {
         "capacity_ratio": "-",
     },
     "health": {"compute_timeout_s": "s"},
+    "search": {
+        "length": "m",
+        "mass": "kg",
+        "force": "N",
+        "f_p": "Hz",
+        "a_p": "g",
+        "angle": "rad",
+    },
 }
 DOCUMENT_UNITS["assess"] = {
     **DOCUMENT_UNITS["check"],

@@ -10,6 +10,7 @@ from search_scenes import EXAMPLE_SCENE, EXAMPLE_SPEC, wedge_facade, wedge_spec,
 from typer.testing import CliRunner
 
 import rockmech
+from shared_schema.errors import InputError
 from solver_service.cli import app
 from solver_service.workflows.inputs import constants_from_files
 
@@ -103,7 +104,15 @@ def test_cli_work_limit_refuses_before_searching(
 def test_python_api_search_from_files(tmp_path: Path) -> None:
     run = rockmech.search_from_files(EXAMPLE_SCENE, EXAMPLE_SPEC)
     assert isinstance(run, rockmech.SearchRun)
-    paths = rockmech.write_search(run, tmp_path, figure=True)
+    (tmp_path / "constants.json").write_text("the user's own file\n")
+    (tmp_path / "notes.txt").write_text("kept\n")
+    # Written as --out writes: a file rockmech did not write is never replaced.
+    with pytest.raises(InputError, match=r"constants\.json was not written by rockmech"):
+        rockmech.save_search(run, tmp_path, figure=True)
+    (tmp_path / "constants.json").unlink()
+    paths = rockmech.save_search(run, tmp_path, figure=True)
+    assert (tmp_path / "notes.txt").read_text() == "kept\n"
+    assert all(p.parent == tmp_path for p in paths)
     assert {p.name for p in paths} == {
         "search.json",
         "search.spec.json",

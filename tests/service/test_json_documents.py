@@ -29,6 +29,8 @@ RECORD = EXAMPLES / "records" / "elcentro_NS.dat"
 SITE = EXAMPLES / "sites" / "ntc_site.json"
 SCENE = EXAMPLES / "scenes" / "rect_wall.3dm"
 SPEC = EXAMPLES / "specs" / "rect_wall.spec.json"
+SEARCH_SCENE = EXAMPLES / "scenes" / "search_facade.3dm"
+SEARCH_SPEC = EXAMPLES / "specs" / "search_facade.search.json"
 
 
 def _stamped(doc: Any, where: str) -> None:
@@ -69,6 +71,8 @@ def test_every_command_and_file_names_units_and_version(tmp_path: Path) -> None:
         "check": ["check", str(GEOMETRY), str(SITE)],
         "assess": ["assess", str(GEOMETRY), str(SITE), "--record", str(RECORD),
                    "--multiple", "1", "-o", str(out / "assess.html")],
+        "search": ["search", str(SEARCH_SCENE), str(SEARCH_SPEC), "--no-figure",
+                   "-o", str(out / "search")],
     }  # fmt: skip
     assert set(runs) == _json_commands()
     for name, argv in runs.items():
@@ -80,7 +84,14 @@ def test_every_command_and_file_names_units_and_version(tmp_path: Path) -> None:
     files = [p for p in out.rglob("*.json") if ".rockmech" not in p.parts]
     assert len(files) >= 10, files
     for path in files:
-        _stamped(json.loads(path.read_text()), str(path.relative_to(out)))
+        doc = json.loads(path.read_text())
+        if path.name.endswith(".spec.json"):
+            # A mechanism spec (the search's, for `rockmech constants`): an input format whose
+            # `units` names the unit of its points.
+            assert doc.get("rockmech_version") == __version__, path
+            assert doc.get("units") in ("m", "cm", "mm", "file"), path
+            continue
+        _stamped(doc, str(path.relative_to(out)))
 
 
 def _json_operations(client: httpx.Client) -> set[tuple[str, str]]:
@@ -96,7 +107,7 @@ def _json_operations(client: httpx.Client) -> set[tuple[str, str]]:
 
 
 def test_every_endpoint_and_hops_component_names_units_and_version(
-    server: Server, client: httpx.Client
+    server: Server, client: httpx.Client, tmp_path: Path
 ) -> None:
     walls = json.loads(WALLS.read_text())
     geometry = json.loads(GEOMETRY.read_text())
@@ -105,6 +116,10 @@ def test_every_endpoint_and_hops_component_names_units_and_version(
     scene = {
         "scene": (SCENE.name, SCENE.read_bytes(), "application/octet-stream"),
         "spec": (SPEC.name, SPEC.read_bytes(), "application/json"),
+    }
+    search_spec = {
+        **json.loads(SEARCH_SPEC.read_text()),
+        "ranking": {"keep": 3, "n_frequencies": 50},
     }
     calls = {
         ("GET", "/api/v1/health"): {},
@@ -121,6 +136,14 @@ def test_every_endpoint_and_hops_component_names_units_and_version(
         ("POST", "/api/v1/check"): {"json": {"constants": geometry, "site": site}},
         ("POST", "/api/v1/assess"): {
             "json": {"constants": geometry, "site": site, "records": [record], "multiples": [1]}
+        },
+        ("POST", "/api/v1/search"): {
+            "files": {
+                "scene": (SEARCH_SCENE.name, SEARCH_SCENE.read_bytes(), "application/octet-stream"),
+                # The example's ranking names a site and a record by path: the service takes
+                # uploads only, so this spec ranks without them.
+                "spec": ("search.json", json.dumps(search_spec).encode(), "application/json"),
+            }
         },
     }
     assert set(calls) == _json_operations(client)

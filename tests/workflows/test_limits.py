@@ -29,6 +29,7 @@ def test_copied_numbers_match_the_solver() -> None:
     assert limits.N_SCAN == core_envelope.N_SCAN
     assert limits.P_EQ_PLAUSIBLE == exact.P_EQ_PLAUSIBLE
     assert limits.SPECTRUM_GRID_PER_PERIOD == amplification.GRID_PER_PERIOD
+    assert limits.LIBRARY_OMEGA == core_envelope.LIBRARY_OMEGA
 
 
 def test_scale_factor_points_equal_the_direct_sum() -> None:
@@ -54,6 +55,36 @@ def test_envelope_steps_equal_the_direct_sum() -> None:
     assert limits.envelope_steps(cf, 0.1, 10.0, 50) == pytest.approx(direct, rel=1e-9)
     assert limits.envelope_steps(cf, 0.1, 10.0, 50, p_max=5.0) == pytest.approx(
         limits.N_SCAN * np.maximum(1.0, 2.0 / f).sum(), rel=1e-9
+    )
+
+
+@pytest.mark.parametrize(
+    ("p_eqs", "f_min", "f_max", "n"),
+    [((2.0, 7.0), 0.1, 10.0, 50), ((292.9,), 0.001, 307.3, 5079), ((0.05, 50.0), 0.01, 100.0, 999)],
+)
+def test_fast_mode_steps_count_the_frequencies_outside_the_library(
+    p_eqs: tuple[float, ...], f_min: float, f_max: float, n: int
+) -> None:
+    # The fast mode computes exactly where Omega = 2 pi f / p_eq leaves the library's grid
+    # (schemathesis found a stiff one-sided mechanism at 5079 frequencies past the budget).
+    cf = _walls(*p_eqs)
+    f = np.geomspace(f_min, f_max, n)
+    lo, hi, _ = core_envelope.LIBRARY_OMEGA
+    direct = 0.0
+    for p in p_eqs:
+        om = 2.0 * np.pi * f / p
+        outside = (om < lo) | (om > hi)
+        direct += limits.N_SCAN * np.maximum(1.0, p / f)[outside].sum()
+    got = limits.envelope_steps(cf, f_min, f_max, n, exact=False)
+    assert got == pytest.approx(direct, rel=1e-9, abs=1e-9)
+    # The library's exact points: the same count as core.envelope's library_curve makes.
+    lib = core_envelope.OverturningLibrary.load()
+    computed = 0
+    for p in p_eqs:
+        om = 2.0 * np.pi * f / p
+        computed += int(np.count_nonzero(lib.a_min_flagged(om, 0.9)[1] & ((om < lo) | (om > hi))))
+    assert computed == sum(
+        int(np.count_nonzero((2 * np.pi * f / p < lo) | (2 * np.pi * f / p > hi))) for p in p_eqs
     )
 
 
