@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 
-.PHONY: install demo test lint typecheck pyright schema bench numerics serve dist install-check clean
+.PHONY: install demo test lint typecheck pyright schema bench numerics report-png serve dist install-check clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -64,6 +64,14 @@ numerics: $(STAMP)
 	$(BIN)/python benchmarks/stiff.py
 	$(BIN)/python benchmarks/linearisation_map.py
 	$(BIN)/python benchmarks/extremes.py
+
+## Page one of the bundled assessment report as printed (docs/img/report_page_one.png, shown
+## in docs/assess.md): headless Chromium prints the PDF, poppler's pdftoppm draws page one.
+report-png: $(STAMP)
+	mkdir -p build/report
+	$(BIN)/rockmech assess examples/constants/church_geometry.json examples/sites/ntc_site.json \
+		--record examples/records/elcentro_NS.dat -o build/report/report.html --pdf
+	pdftoppm -r 110 -f 1 -l 1 -png -singlefile build/report/report.pdf docs/img/report_page_one
 
 ## The REST service on http://127.0.0.1:8000 (settings: ROCKMECH_* variables; docs/service.md).
 serve: $(STAMP)

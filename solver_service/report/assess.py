@@ -21,6 +21,7 @@ import datetime
 import functools
 import math
 import platform
+import shlex
 import shutil
 import subprocess
 import tempfile
@@ -33,12 +34,14 @@ import numpy as np
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.site import SiteFile
+from shared_schema.version import __version__
 
 from ..core.exact import simulate
 from ..core.model import G
 from ..workflows.adapter import to_rocking_model
 from ..workflows.assess import assessment_doc, site_spectrum
 from ..workflows.scaling import mechanism_scale_factor
+from ..workflows.verdict import ratio_label
 from .plots import _pyplot, _save_atomic, plain
 
 __all__ = [
@@ -495,7 +498,7 @@ def _dynamics_cell(row: dict[str, Any]) -> dict[str, str]:
     return {"text": "; ".join(parts), "cls": cls, "note": "; ".join(n for n in notes if n)}
 
 
-def _margin_cell(row: dict[str, Any]) -> dict[str, str]:
+def _margin_cell(row: dict[str, Any], verdict: dict[str, Any]) -> dict[str, str]:
     env = row.get("envelope") or {}
     if "note" in env:
         return {"text": "not run", "cls": "na", "note": _short(env["note"])}
@@ -503,11 +506,30 @@ def _margin_cell(row: dict[str, Any]) -> dict[str, str]:
     if not pulses:
         return {"text": "–", "cls": "na", "note": "no pulse found in the records"}
     worst = min(pulses, key=lambda p: p["margin"])
-    return {
-        "text": f"{sig(worst['margin'], 3)} ({worst['record']}, {sig(worst['f_p'], 3)} Hz)",
-        "cls": "ok" if worst["margin"] >= 1.0 else "ko",
-        "note": "",
-    }
+    text = f"{sig(worst['margin'], 3)} ({worst['record']}, {sig(worst['f_p'], 3)} Hz)"
+    if "pulse_margin" in verdict:
+        # It disagrees with the time history, which governs: shown, not coloured.
+        return {"text": text, "cls": "na", "note": "screening only: the time history governs"}
+    return {"text": text, "cls": "ok" if worst["margin"] >= 1.0 else "ko", "note": ""}
+
+
+def _final_cell(verdict: dict[str, Any]) -> dict[str, str]:
+    word = {"fails": "FAILS", "passes": "PASSES", "incomplete": "INCOMPLETE"}[verdict["verdict"]]
+    cls = {"fails": "ko", "passes": "ok", "incomplete": "na"}[verdict["verdict"]]
+    code = verdict.get("code_check")
+    if verdict["verdict"] == "incomplete":
+        return {"text": word, "cls": cls, "note": _short(verdict["reason"])}
+    governs = verdict["governs"] or ""
+    if governs.startswith("rocking"):
+        detail = "governed by the rocking time history at design scale"
+    elif code is not None:
+        detail = (
+            f"governed by the {code['check']} check, {code['ratio_name']} = "
+            f"{sig(code['capacity_ratio'], 3)}"
+        )
+    else:
+        detail = governs
+    return {"text": word, "cls": cls, "note": detail}
 
 
 def _constants_rows(mech: Any) -> list[list[str]]:
@@ -552,6 +574,158 @@ def _table_of(mapping: dict[str, Any]) -> list[tuple[str, str]]:
             text = str(value)
         out.append((str(key), text))
     return out
+
+
+#: The hazard table's rows from the site document's ``params``: key -> (quantity, symbol,
+#: unit, source). Values computed by rockmech take their clause from ``site.clauses``.
+_PARAM_ROWS: dict[str, tuple[str, str, str, str]] = {
+    "a_g_g": ("reference peak ground acceleration on rock", "a<sub>g</sub>", "g",
+              "site file: hazard.a_g (NTC) or γ<sub>I</sub> a<sub>gR</sub> (EN 1998-1 §3.2.1)"),
+    "a_gR_g": ("reference peak ground acceleration", "a<sub>gR</sub>", "g",
+               "site file: hazard.a_gR"),
+    "gamma_I": ("importance factor", "γ<sub>I</sub>", "–", "site file: hazard.importance"),
+    "F0": ("maximum spectral amplification", "F<sub>0</sub>", "–", "site file: hazard.F0"),
+    "Tc_star_s": ("upper period of the plateau on rock", "T<sub>C</sub>*", "s",
+                  "site file: hazard.Tc_star"),
+    "soil": ("soil category", "–", "–", "site file: hazard.soil (NTC 2018 Tab. 3.2.II)"),
+    "ground": ("ground type", "–", "–", "site file: hazard.ground (EN 1998-1 Tab. 3.1)"),
+    "spectrum_type": ("spectrum type", "–", "–", "site file: hazard.spectrum_type "
+                      "(EN 1998-1 §3.2.2.2)"),
+    "topography": ("topographic category", "–", "–",
+                   "site file: hazard.topography (NTC 2018 Tab. 3.2.III)"),
+    "S_S": ("stratigraphic amplification", "S<sub>S</sub>", "–", "NTC 2018 Tab. 3.2.IV"),
+    "S_T": ("topographic amplification", "S<sub>T</sub>", "–", "NTC 2018 Tab. 3.2.V"),
+    "C_C": ("soil coefficient of T<sub>C</sub>", "C<sub>C</sub>", "–", "NTC 2018 Tab. 3.2.IV"),
+    "xi_percent": ("viscous damping of the spectrum", "ξ", "%",
+                   "site file: hazard.xi_percent (5 % unless given)"),
+}  # fmt: skip
+_DERIVED_ROWS: tuple[tuple[str, str, str, str], ...] = (
+    ("S", "soil factor", "S", "–"),
+    ("pga_g", "peak ground acceleration at the site", "a<sub>g</sub>S", "g"),
+    ("F", "spectral amplification", "F", "–"),
+    ("eta", "damping correction", "η", "–"),
+    ("T_B", "start of the plateau", "T<sub>B</sub>", "s"),
+    ("T_C", "end of the plateau", "T<sub>C</sub>", "s"),
+    ("T_D", "start of the constant-displacement branch", "T<sub>D</sub>", "s"),
+    ("FC", "confidence factor", "FC", "–"),
+    ("q", "behaviour factor of the linear check", "q", "–"),
+)
+
+
+def hazard_table(site_doc: dict[str, Any]) -> list[dict[str, str]]:
+    """One row per hazard quantity: quantity, symbol, value, unit and source.
+
+    Parameters
+    ----------
+    site_doc : dict
+        The check document's ``site`` block (``check_doc``).
+
+    Returns
+    -------
+    list of dict
+        ``quantity``, ``symbol`` (HTML), ``value``, ``unit`` and ``source`` (the site
+        file's field, or the clause that gives a derived value).
+    """
+    clauses = site_doc.get("clauses", {})
+    rows = [
+        {"quantity": "code of the hazard", "symbol": "–", "value": str(site_doc["code"]),
+         "unit": "–", "source": "site file: hazard.code"},
+        {"quantity": "limit state of the checks", "symbol": "–",
+         "value": str(site_doc.get("limit_state", "SLV")), "unit": "–",
+         "source": "site file: hazard.limit_state"},
+    ]  # fmt: skip
+    for key, value in site_doc.get("params", {}).items():
+        if value is None or key not in _PARAM_ROWS:
+            continue
+        quantity, symbol, unit, source = _PARAM_ROWS[key]
+        rows.append(
+            {"quantity": quantity, "symbol": symbol, "value": sig(value), "unit": unit,
+             "source": source}
+        )  # fmt: skip
+    for key, quantity, symbol, unit in _DERIVED_ROWS:
+        if site_doc.get(key) is None:
+            continue
+        rows.append(
+            {"quantity": quantity, "symbol": symbol, "value": sig(site_doc[key]), "unit": unit,
+             "source": clauses.get(key, "site file")}
+        )  # fmt: skip
+    for name, ls in (site_doc.get("limit_states") or {}).items():
+        if not ls or name == site_doc.get("limit_state"):
+            continue
+        rows.append(
+            {"quantity": f"{name} hazard (for the {name} checks)", "symbol": "a<sub>g</sub>, F, "
+             "T<sub>C</sub>", "value": f"{sig(ls['a_g'])}, {sig(ls['F'])}, {sig(ls['T_C'])}",
+             "unit": "g, –, s", "source": f"site file: {ls.get('source', name)}"}
+        )  # fmt: skip
+    building = site_doc.get("building") or {}
+    for key, quantity, symbol, unit in (
+        ("height", "height of the building", "H", "m"),
+        ("storeys", "storeys", "–", "–"),
+        ("xi_percent", "damping of the building (floor spectra)", "ξ<sub>k</sub>", "%"),
+        ("period_elongation", "period elongation of the floor spectra", "–", "–"),
+    ):
+        if building.get(key) is not None:
+            rows.append(
+                {"quantity": quantity, "symbol": symbol, "value": sig(building[key]),
+                 "unit": unit, "source": f"site file: building.{key}"}
+            )  # fmt: skip
+    if site_doc.get("T1") is not None:
+        rows.append(
+            {"quantity": "fundamental period of the building", "symbol": "T<sub>1</sub>",
+             "value": sig(site_doc["T1"]), "unit": "s",
+             "source": str(site_doc.get("T1_source", ""))}
+        )  # fmt: skip
+    return rows
+
+
+def reproduce_commands(
+    sources: Sequence[dict[str, Any]], options: Optional[dict[str, Any]]
+) -> list[dict[str, str]]:
+    """Return the ``rockmech`` commands that give every number of the page again.
+
+    Run in a folder holding the inputs under the names of the provenance table (their
+    SHA-256 identify them). ``rockmech assess ... --json`` prints the whole document the
+    page shows; ``rockmech check`` the code checks alone (without the records' demand).
+    """
+    names = {"constants": "constants.json", "site": "site.json"}
+    records: list[str] = []
+    for src in sources:
+        if src["role"] in names:
+            names[src["role"]] = _file_name(src["name"], names[src["role"]])
+        elif src["role"] == "record":
+            records.append(_file_name(src["name"], f"record{len(records) + 1}.csv"))
+    opts = options or {}
+    args = [f"--record {shlex.quote(r)}" for r in records]
+    for key, flag in (("units", "--units"), ("format", "--format"), ("dt", "--dt")):
+        if opts.get(key) is not None:
+            args.append(f"{flag} {shlex.quote(str(opts[key]))}")
+    args += [f"--multiple {sig(k)}" for k in opts.get("multiples", [])]
+    c, s = shlex.quote(names["constants"]), shlex.quote(names["site"])
+    out = [
+        {
+            "what": "every number of this page (the assessment document as JSON)",
+            "command": " ".join(["rockmech assess", c, s, *args, "-o report.html --json"]),
+        },
+        {
+            "what": "the code checks alone, without the records' demand (C8.7.1.2.1.8)",
+            "command": f"rockmech check {c} {s} --json",
+        },
+    ]
+    if any("." not in src["name"] for src in sources):
+        out.append(
+            {
+                "what": "inputs sent to the service rather than as files: save the request's "
+                "constants, site and each record (two columns: time [s], acceleration in the "
+                "units sent) under the names above first",
+                "command": "",
+            }
+        )
+    return out
+
+
+def _file_name(name: str, default: str) -> str:
+    """Return a source's name as a file name (an upload's name may be a bare word)."""
+    return name if "." in name else default
 
 
 def _versions() -> dict[str, str]:
@@ -679,6 +853,7 @@ def render_assessment(
         )
         sections = []
         verdicts = []
+        verdicts_by_id = {v["id"]: v for v in doc["conclusion"]["mechanisms"]}
         for row in doc["mechanisms"]:
             mech = by_id[row["id"]]
             non = row["nonlinear"]
@@ -709,16 +884,16 @@ def render_assessment(
                     )
                 )
             figs.extend(_history_figures(mech, row, motions, folder))
-            circ2019 = doc.get("method", {}).get("name") == "circ2019"
+            method = doc.get("method", {}).get("name", "circ2019")
+            verdict = verdicts_by_id[row["id"]]
             cells = {
-                "linear": _verdict_cell(row["linear"], "a_g,SLV/a_g" if circ2019 else "a0*/demand"),
-                "nonlinear": _verdict_cell(
-                    row["nonlinear"], "a_g,SLV/a_g" if circ2019 else "du*/demand"
-                ),
+                "verdict": _final_cell(verdict),
+                "linear": _verdict_cell(row["linear"], ratio_label(method, "linear")),
+                "nonlinear": _verdict_cell(row["nonlinear"], ratio_label(method, "nonlinear")),
                 "dynamics": _dynamics_cell(row),
-                "margin": _margin_cell(row),
+                "margin": _margin_cell(row, verdict),
             }
-            verdicts.append({"row": row, "cells": cells})
+            verdicts.append({"row": row, "cells": cells, "verdict": verdict})
             sections.append(
                 {
                     "row": row,
@@ -737,9 +912,13 @@ def render_assessment(
         "generated": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
         "site": doc["site"],
         "method": doc.get("method", {}),
-        "site_rows": _table_of(doc["site"]["params"]),
-        "hazard_rows": _table_of(site.hazard.model_dump()),
-        "building_rows": _table_of(site.building.model_dump()) if site.building else [],
+        "hazard_table": hazard_table(doc["site"]),
+        "ratio_linear": ratio_label(doc.get("method", {}).get("name", "circ2019"), "linear"),
+        "ratio_nonlinear": ratio_label(doc.get("method", {}).get("name", "circ2019"), "nonlinear"),
+        "conclusion": doc["conclusion"],
+        "disagreements": [v for v in doc["conclusion"]["mechanisms"] if "pulse_margin" in v],
+        "commands": reproduce_commands(sources, options),
+        "version": __version__,
         "spectrum_figure": spectrum_fig,
         "verdicts": verdicts,
         "sections": sections,

@@ -38,6 +38,7 @@ from .codecheck import (
 from .documents import envelope_doc, log_grid
 from .inputs import read_site_file
 from .scaling import mechanism_scale_factor
+from .verdict import conclusion
 
 __all__ = [
     "BAND_DEFAULT",
@@ -311,4 +312,5 @@ def assessment_doc(
         for m in motions
     ]
     doc["multiples"] = list(multiples)
+    doc["conclusion"] = conclusion(doc, site.project.building)
     return doc

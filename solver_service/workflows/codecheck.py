@@ -45,6 +45,7 @@ from ..core.kinematic import (
     participating_mass,
 )
 from ..core.model import G
+from .verdict import conclusion
 
 __all__ = [
     "CIRC2009",
@@ -801,7 +802,7 @@ def check_doc(cf: ConstantsFile, site: SiteFile) -> dict[str, Any]:
             else "the Circolare 617/2009 C8A.4 forms, kept for comparison: not the 2019 text"
         ),
     }
-    return {
+    doc: dict[str, Any] = {
         "method": method,
         "site": {
             "code": hz.code,
@@ -836,6 +837,8 @@ def check_doc(cf: ConstantsFile, site: SiteFile) -> dict[str, Any]:
         "mechanisms": rows,
         "governing": _governing(rows),
     }
+    doc["conclusion"] = conclusion(doc, site.project.building)
+    return doc
 
 
 def recheck_with_records(

@@ -4,8 +4,11 @@ The browser tests use Debian's ``chromium`` and poppler's ``pdftotext`` and skip
 reason, where they are absent.
 """
 
+import contextlib
+import html
 import json
 import re
+import shlex
 import shutil
 import subprocess
 from pathlib import Path
@@ -22,6 +25,7 @@ from solver_service.workflows.assess import assessment_doc
 pytest.importorskip("jinja2")
 
 from solver_service.report.assess import render_assessment, sig
+from solver_service.report.html import input_source
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
@@ -65,7 +69,7 @@ def test_short_form_church_gets_notes_in_every_row_not_an_abort() -> None:
     motion = GroundMotion.from_two_column(RECORD)
     doc = assessment_doc(cf, site, [motion], multiples=(1.0,))
     text = render_assessment(doc, cf, site, [motion])
-    rows = re.findall(r'<tr data-mechanism="([^"]+)">', text)
+    rows = re.findall(r'<tr data-mechanism="([^"]+)"', text)
     assert rows == [m.id for m in cf.mechanisms]
     assert text.count("no virtual_work in the constants") >= len(rows)
     # F1 is one-sided without eta: its dynamics and envelope say why they did not run.
@@ -130,7 +134,7 @@ def test_report_loads_every_plot_in_chromium(tmp_path: Path) -> None:
     loaded = re.search(r'data-plots-loaded="(\d+)/(\d+)"', dom)
     assert loaded is not None
     assert loaded.group(1) == loaded.group(2) and int(loaded.group(2)) >= 1 + 3 * 4
-    assert re.findall(r'<tr data-mechanism="([^"]+)">', dom) == ["F1", "F2", "A1", "T1"]
+    assert re.findall(r'<tr data-mechanism="([^"]+)"', dom) == ["F1", "F2", "A1", "T1"]
 
 
 def test_pdf_first_page_shows_the_verdict_table(tmp_path: Path) -> None:
@@ -146,10 +150,23 @@ def test_pdf_first_page_shows_the_verdict_table(tmp_path: Path) -> None:
         timeout=60,
     ).stdout.decode("utf-8")
     assert "Verdict" in first and "A. Engineer" in first and "2026-11-23" in first
-    for mech_id, verdict in (("F1", "fails"), ("F2", "fails"), ("A1", "fails"), ("T1", "passes")):
+    for mech_id, verdict in (("F1", "FAILS"), ("F2", "FAILS"), ("A1", "FAILS"), ("T1", "PASSES")):
         line = next(ln for ln in first.splitlines() if ln.strip().startswith(mech_id))
         assert verdict in line, line
-    assert "Governing mechanism for the code check" in first
+    # Page one ends in the one sentence a client can quote: the JSON's conclusion.
+    res = runner.invoke(
+        app,
+        ["assess", str(CHURCH_GEOMETRY), str(NTC_SITE), "--record", str(RECORD),
+         "-o", str(tmp_path / "again.html"), "--json"],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout[res.stdout.index("{") :])
+    sentence = doc["conclusion"]["sentence"]
+    assert sentence.startswith("The local collapse mechanisms of Example stone church")
+    assert "do not satisfy" in sentence and "F1" in sentence and "0.396" in sentence
+    # (a word broken at a hyphen across two lines is read back as "tie- bars")
+    words = " ".join(first.split()).replace("- ", "-")
+    assert words.endswith(" ".join(sentence.split())), words[-400:]
 
 
 def test_short_form_church_pdf_first_page_has_every_row(tmp_path: Path) -> None:
@@ -166,3 +183,65 @@ def test_short_form_church_pdf_first_page_has_every_row(tmp_path: Path) -> None:
     starts = [ln.split()[0] for ln in first.splitlines() if ln.split() and ln.split()[0] in ids]
     assert starts == ids
     assert "no virtual_work" in first
+
+
+def _page_and_doc(tmp_path: Path) -> tuple[str, dict]:
+    cf = parse_constants(CHURCH_GEOMETRY.read_bytes())
+    site = parse_site(NTC_SITE.read_bytes())
+    motion = GroundMotion.from_two_column(RECORD)
+    doc = assessment_doc(cf, site, [motion], multiples=[1.0, 2.0])
+    sources = [
+        input_source("constants", CHURCH_GEOMETRY.name, CHURCH_GEOMETRY.read_bytes()),
+        input_source("site", NTC_SITE.name, NTC_SITE.read_bytes()),
+        input_source("record", RECORD.name, RECORD.read_bytes()),
+    ]
+    page = render_assessment(
+        doc, cf, site, [motion], sources=sources, options={"multiples": [1.0, 2.0]}
+    )
+    return page, doc
+
+
+def test_hazard_table_has_one_row_per_quantity_with_its_unit_and_source(tmp_path: Path) -> None:
+    page, _ = _page_and_doc(tmp_path)
+    table = page.split('<table id="hazard-table">', 1)[1].split("</table>", 1)[0]
+    rows = re.findall(r"<tr><td>(.*?)</td><td>(.*?)</td><td class=\"n\">(.*?)</td><td>(.*?)</td>"
+                      r"<td class=\"note\">(.*?)</td></tr>", table)  # fmt: skip
+    quantities = [r[0] for r in rows]
+    assert len(rows) >= 20 and len(set(quantities)) == len(quantities)
+    assert all(r[3] and r[4] for r in rows)  # a unit ("–" where none) and a source each
+    by_name = {r[0]: r for r in rows}
+    assert by_name["reference peak ground acceleration on rock"][2:4] == ("0.2600", "g")
+    assert by_name["peak ground acceleration at the site"][2:4] == ("0.3002", "g")
+    assert by_name["fundamental period of the building"][2:5] == ("0.6000", "s", "site building.T1")
+    assert by_name["end of the plateau"][3] == "s" and "[3.2.5]" in by_name["end of the plateau"][4]
+    # No raw key of the site file or of the document is shown as a quantity.
+    for raw in ("a_g_g", "Tc_star_s", "Tc_star", "xi_percent", "limit_states"):
+        assert f">{raw}<" not in page
+
+
+def test_the_printed_command_gives_every_number_of_the_page_again(tmp_path: Path) -> None:
+    page, doc = _page_and_doc(tmp_path)
+    commands = re.findall(r"<code>(rockmech assess .*?)</code>", page)
+    assert len(commands) == 1
+    argv = shlex.split(html.unescape(commands[0]))
+    assert argv[:2] == ["rockmech", "assess"] and "--json" in argv
+    # In a folder holding the inputs under the provenance table's names.
+    for src in (CHURCH_GEOMETRY, NTC_SITE, RECORD):
+        shutil.copy(src, tmp_path / src.name)
+    with contextlib.chdir(tmp_path):
+        res = runner.invoke(app, argv[1:])
+    assert res.exit_code == 0, res.output
+    again = json.loads(res.stdout)
+
+    def numbers(d: dict) -> dict:
+        return {
+            "conclusion": d["conclusion"],
+            "mechanisms": [
+                (r["id"], r["linear"].get("capacity_ratio"), r["nonlinear"].get("capacity_ratio"),
+                 [[x["peak_ratio"] for x in dd["runs"]] for dd in r["dynamics"]])
+                for r in d["mechanisms"]
+            ],
+            "site": d["site"],
+        }  # fmt: skip
+
+    assert numbers(again) == numbers(doc)
