@@ -211,9 +211,9 @@ def test_maths_packages_import_shared_schema_only(module: str) -> None:
 def test_rhino_plugin_holds_only_what_runs_in_rhino() -> None:
     """Its flows, commands and components; the Rhino-free maths lives in ``cad_maths``."""
     inside = {
-        p.name
-        for p in (ROOT / "rhino_plugin").iterdir()
-        if p.suffix == ".py" or (p.is_dir() and p.name != "__pycache__")
+        path.relative_to(ROOT / "rhino_plugin").parts[0]
+        for path in (ROOT / "rhino_plugin").rglob("*.py")
+        if "__pycache__" not in path.parts
     }
     assert inside == {"__init__.py", "flows", "rhino", "components"}
 
