@@ -224,12 +224,12 @@ def test_constants_under_a_real_python_39(cli_constants: Any) -> None:
     py = _python39()
     if py is None:
         pytest.skip(
-            "no Python 3.9 found (set ROCKMECH_PY39 to a python3.9 with numpy, pydantic, "
+            "no Python 3.9 found (set ROCKMECH_PY39 to a python3.9 with numpy, pydantic, scipy, "
             "trimesh<=4.12, manifold3d, shapely and rhino3dm); ast and ruff 3.9 checks ran"
         )
     cmd = py.split(" ")
     deps = subprocess.run(
-        [*cmd, "-c", "import numpy, pydantic, trimesh, rhino3dm, manifold3d, shapely"],
+        [*cmd, "-c", "import numpy, pydantic, scipy, trimesh, rhino3dm, manifold3d, shapely"],
         capture_output=True, text=True,
     )  # fmt: skip
     if deps.returncode != 0:
