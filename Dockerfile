@@ -44,10 +44,11 @@ COPY shared_schema/version.py ./shared_schema/version.py
 RUN python -c "import pathlib, tomllib; t = tomllib.load(open('pyproject.toml', 'rb'))['tool']['setuptools']; [pathlib.Path(t['package-dir'].get(p, p.replace('.', '/'))).mkdir(parents=True, exist_ok=True) for p in t['packages']]" \
     && pip install -c docker/requirements.lock ".[${EXTRAS}]" \
     && pip uninstall -y rockmech \
-    && rm -rf rockmech shared_schema solver_service rhino_plugin examples build ./*.egg-info
+    && rm -rf rockmech shared_schema cad_maths solver_service rhino_plugin examples build ./*.egg-info
 
 COPY rockmech ./rockmech
 COPY shared_schema ./shared_schema
+COPY cad_maths ./cad_maths
 COPY solver_service ./solver_service
 COPY rhino_plugin ./rhino_plugin
 COPY examples ./examples

@@ -15,7 +15,7 @@ large faces (``examples/scenes/build_scenes.py``), with the spec
 Each wall goes through two paths:
 
 - *in memory*: ``constants_from_spec(parse_spec(text), scene, ...)`` where ``scene`` is a
-  :class:`~rhino_plugin.scene_3dm.Scene` whose ``mesh`` and ``line`` return the in-memory
+  :class:`~cad_maths.scene_3dm.Scene` whose ``mesh`` and ``line`` return the in-memory
   mesh (a fresh ``TriMesh`` per call, so no validity cache carries over between repeats) and
   the axis end points; ``find`` is the real one. This runs the real code path: validation,
   mass properties, two rocking sides, restitution, constants-file validation.
@@ -198,8 +198,8 @@ def import_times() -> list[tuple[str, float]]:
     for label, mod in IMPORTS:
         t0 = time.perf_counter()
         if mod is None:
-            importlib.import_module("rhino_plugin.scene_3dm")
-            importlib.import_module("rhino_plugin.mechanisms.build")
+            importlib.import_module("cad_maths.scene_3dm")
+            importlib.import_module("cad_maths.mechanisms.build")
             importlib.import_module("shared_schema.spec")
         else:
             importlib.import_module(mod)
@@ -241,10 +241,10 @@ class StageTimer:
 
 def install_timers(timer: StageTimer) -> None:
     """Wrap the pipeline's stages (module attributes looked up at call time)."""
-    import rhino_plugin.geometry.massprops as massprops
-    import rhino_plugin.geometry.validate as validate
-    import rhino_plugin.mechanisms.single as single
-    import rhino_plugin.scene_3dm as scene_3dm
+    import cad_maths.geometry.massprops as massprops
+    import cad_maths.geometry.validate as validate
+    import cad_maths.mechanisms.single as single
+    import cad_maths.scene_3dm as scene_3dm
 
     scene_3dm._mesh_arrays = timer.wrap("extract", scene_3dm._mesh_arrays)
     scene_3dm.Scene.mesh = timer.wrap("mesh", scene_3dm.Scene.mesh)  # type: ignore[method-assign]
@@ -257,8 +257,8 @@ def memory_scene(data: Path, size: str) -> Any:
     """Return a Scene whose solid and axes come from memory (``find`` is the real one)."""
     import numpy as np
 
-    from rhino_plugin.geometry.mesh import TriMesh
-    from rhino_plugin.scene_3dm import Scene, SceneObject
+    from cad_maths.geometry.mesh import TriMesh
+    from cad_maths.scene_3dm import Scene, SceneObject
 
     bs = _build_scenes()
     v = np.load(data / f"{size}_v.npy")
@@ -314,8 +314,8 @@ def run_case(kind: str, size: str, data: Path, repeats: int) -> dict[str, Any]:
     """One case in this fresh process: cold call, warm repeats, tracemalloc call."""
     before = set(sys.modules)
     t0 = time.perf_counter()
-    from rhino_plugin.mechanisms.build import constants_from_spec
-    from rhino_plugin.scene_3dm import Scene
+    from cad_maths.mechanisms.build import constants_from_spec
+    from cad_maths.scene_3dm import Scene
     from shared_schema.spec import parse_spec
 
     import_s = time.perf_counter() - t0

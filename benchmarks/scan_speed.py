@@ -5,7 +5,7 @@ What is measured
 1. *Scans*: the 1,007,552-triangle wall of ``benchmarks/geometry_speed.py`` (build_scenes'
    scan wall on a finer grid) written by trimesh as ``.ply`` (binary), ``.obj``, ``.stl``
    (binary) and ``.off``, and by rhino3dm as ``.3dm``; each read with
-   :func:`rhino_plugin.scenes.read_scene` (``units="m"``) and turned into constants with a
+   :func:`cad_maths.scenes.read_scene` (``units="m"``) and turned into constants with a
    spec whose axes are given by points (``axis.start``/``end``, ``axis_negative``), as a
    scan needs. Each format runs in a fresh subprocess: one cold call, then the best of
    ``REPEATS`` warm calls, with stage times (read, weld, orient, check_solid, mass
@@ -14,7 +14,7 @@ What is measured
    runs it (interpreter start, imports, reading, constants, writing the JSON): wall time and
    peak RSS of that process (``os.wait4``).
 3. *Triangulation*: planar faces of 100, 1000 and 2250 vertices (the last with 5 holes),
-   triangulated by ``rhino_plugin.geometry.polygon.triangulate_polygon`` (manifold3d) and by
+   triangulated by ``cad_maths.geometry.polygon.triangulate_polygon`` (manifold3d) and by
    the hand-written ear clipper it replaced (``benchmarks/_earclip.py``), in the same
    process, on the same polygons.
 4. *.3dm mesh copy*: ``scene_3dm._mesh_arrays`` (``np.fromiter`` over C-level ``map``)
@@ -172,13 +172,13 @@ def run_scan(data: Path, fmt: str, repeats: int) -> dict[str, Any]:
     """Constants of the wall read from one format: cold call, best warm call, stages."""
     gs = _geometry_speed()
     timer = gs.StageTimer()
-    import rhino_plugin.geometry.massprops as massprops
-    import rhino_plugin.geometry.validate as validate
-    import rhino_plugin.mechanisms.single as single
-    import rhino_plugin.scene_3dm as scene_3dm
-    import rhino_plugin.scene_base as scene_base
-    import rhino_plugin.scenes as scenes
-    from rhino_plugin.mechanisms.build import constants_from_spec
+    import cad_maths.geometry.massprops as massprops
+    import cad_maths.geometry.validate as validate
+    import cad_maths.mechanisms.single as single
+    import cad_maths.scene_3dm as scene_3dm
+    import cad_maths.scene_base as scene_base
+    import cad_maths.scenes as scenes
+    from cad_maths.mechanisms.build import constants_from_spec
     from shared_schema.spec import parse_spec
 
     scenes.read_scene = timer.wrap("read", scenes.read_scene)  # type: ignore[assignment]
@@ -253,7 +253,7 @@ def run_triangulation(quick: bool) -> list[dict[str, Any]]:
     import numpy as np
     from _earclip import triangulate_polygon_earclip
 
-    from rhino_plugin.geometry.polygon import triangulate_polygon
+    from cad_maths.geometry.polygon import triangulate_polygon
 
     rows = []
     for label, n, holes, per_hole in QUICK_FACES if quick else FACES:
@@ -311,7 +311,7 @@ def run_extract(data: Path) -> list[dict[str, Any]]:
     import numpy as np
     import rhino3dm
 
-    from rhino_plugin.scene_3dm import _mesh_arrays
+    from cad_maths.scene_3dm import _mesh_arrays
 
     rows = []
     for label, path in (("200k example", EXAMPLE_3DM), ("1M wall", data / "scan_wall.3dm")):

@@ -6,7 +6,7 @@ The example scene ``examples/scenes/search_facade.3dm`` (a 3-storey façade with
 between 2 return walls, a back wall, two floors, a roof and a tie-bar) with its search spec
 ``examples/specs/search_facade.search.json`` (all families, both directions):
 
-1. *search*: ``rhino_plugin.search.engine.run_search(scene, spec, lp=False)``: the building
+1. *search*: ``cad_maths.search.engine.run_search(scene, spec, lp=False)``: the building
    read from the scene's objects (walls as prisms, junctions, levels, ties) and every
    candidate enumerated and refined on the exact λ0; the ``.3dm`` file's own reading
    (``read_scene``) is reported beside it;
@@ -57,11 +57,11 @@ if str(HERE) not in sys.path:
 
 from _docs import DOC_MD, fmt_time, machine_info, write_section  # noqa: E402
 
-from rhino_plugin.scenes import read_scene  # noqa: E402
-from rhino_plugin.search.engine import run_search  # noqa: E402
-from rhino_plugin.search.lp import facade_lp_model, solve_lp  # noqa: E402
-from rhino_plugin.search.model import building_from_scene  # noqa: E402
-from rhino_plugin.search.specs import build_candidates  # noqa: E402
+from cad_maths.scenes import read_scene  # noqa: E402
+from cad_maths.search.engine import run_search  # noqa: E402
+from cad_maths.search.lp import facade_lp_model, solve_lp  # noqa: E402
+from cad_maths.search.model import building_from_scene  # noqa: E402
+from cad_maths.search.specs import build_candidates  # noqa: E402
 from shared_schema.constants import ConstantsFile  # noqa: E402
 from shared_schema.search import SearchSpec, parse_search_spec  # noqa: E402
 from solver_service.core.envelope import OverturningLibrary  # noqa: E402

@@ -1,10 +1,11 @@
 """rockmech: rocking collapse mechanisms of masonry, from CAD solids to exact rocking responses.
 
-The stable Python API in one place. The code lives in three packages: ``shared_schema``
-(file formats and errors), ``solver_service`` (the solver, workflows, command line and
-service) and ``rhino_plugin`` (geometry and Rhino); this package re-exports what scripts
-need. Importing it is cheap: each name is imported on first use, so ``import rockmech``
-loads neither numpy, scipy, matplotlib nor rhino3dm.
+The stable Python API in one place. The code lives in four packages: ``shared_schema``
+(file formats and errors), ``cad_maths`` (scene readers, geometry, mechanisms, the search),
+``solver_service`` (the solver, workflows, command line and service) and ``rhino_plugin``
+(what runs inside Rhino); this package re-exports what scripts need. Importing it is cheap:
+each name is imported on first use, so ``import rockmech`` loads neither numpy, scipy,
+matplotlib nor rhino3dm.
 
 Examples
 --------
@@ -23,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 from rockmech._version import __version__
 
 if TYPE_CHECKING:  # the real types for type checkers and editors
-    from rhino_plugin.scenes import read_scene as read_scene
+    from cad_maths.scenes import read_scene as read_scene
     from shared_schema.api import PulseRequest as PulseRequest
     from shared_schema.constants import ConstantsFile as ConstantsFile
     from shared_schema.errors import (
@@ -190,7 +191,7 @@ _SOURCES = {
     "search_run": "solver_service.workflows.search",
     "save_search": "solver_service.workflows.search",
     "read_search_spec": "solver_service.workflows.search",
-    "read_scene": "rhino_plugin.scenes",
+    "read_scene": "cad_maths.scenes",
     # Reports and the bundled examples.
     "build_report": "solver_service.report.html",
     "write_report": "solver_service.report.html",

@@ -1,7 +1,7 @@
 """Domain rules and units of rockmech: one home for each, standard library only.
 
 Every floor may import this module: the file formats beside it (``shared_schema``), the
-maths (``solver_service.core``, ``rhino_plugin``), the workflows and the front ends. It pulls
+maths (``solver_service.core``, ``cad_maths``), the workflows and the front ends. It pulls
 in neither numpy nor pydantic, so Rhino 8's CPython 3.9 and the numerical core can share it.
 
 What lives here
@@ -83,7 +83,7 @@ __all__ = [
 G = 9.80665
 
 #: Mechanism typologies a spec can ask for; each has a builder in
-#: ``rhino_plugin.mechanisms.build.MECHANISMS`` (constants files also take ``user_defined``).
+#: ``cad_maths.mechanisms.build.MECHANISMS`` (constants files also take ``user_defined``).
 TYPOLOGIES: Tuple[str, ...] = ("single_block", "single_block_loaded", "two_block", "multi_block")
 
 #: Mechanism families ``rockmech search`` enumerates (issue #31): overturning of a whole
@@ -137,7 +137,7 @@ RECORD_UNITS: Dict[str, float] = {
     "in/s2": 0.0254,
 }
 
-#: Length units of a scan mesh (``rhino_plugin.scene_mesh.UNITS``; a .3dm states its own).
+#: Length units of a scan mesh (``cad_maths.scene_mesh.UNITS``; a .3dm states its own).
 LENGTH_UNITS: Tuple[str, ...] = ("mm", "cm", "m", "in", "ft")
 
 #: Scale-factor methods of time histories up the structure: none, Eq. 28 from the record's

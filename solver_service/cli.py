@@ -24,7 +24,7 @@ from typing import Any, Iterator, NoReturn, Optional, TypeVar
 import typer
 from typer.core import TyperGroup, TyperOption
 
-from rhino_plugin.mechanisms.build import MechanismFailure
+from cad_maths.mechanisms.build import MechanismFailure
 from shared_schema.atomic import remove_stale_temps
 from shared_schema.errors import RockmechError
 from shared_schema.extras import MissingExtra, extra_for, require
@@ -315,7 +315,7 @@ def _foreign_packages() -> list[str]:
     """Name rockmech's top-level packages loaded from outside its install (a name clash)."""
     homes = {
         name: Path(str(importlib.import_module(name).__file__)).resolve().parent.parent
-        for name in ("rockmech", "shared_schema", "solver_service", "rhino_plugin")
+        for name in ("rockmech", "shared_schema", "cad_maths", "solver_service", "rhino_plugin")
     }
     return [
         f"warning: {name} is loaded from {home}, not from rockmech's install "

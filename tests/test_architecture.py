@@ -3,16 +3,16 @@
 Every module of the project is walked (not a hand list) and every import in it, at the top
 of the file or inside a function, is resolved to the project module it names.
 
-Floors, each importing only from its own floor or below:
+Floors, each importing only from its own floor or below (docs/architecture.md draws them):
 
 0. formats and domain rules: ``shared_schema``;
-1. maths: ``solver_service.core``, ``rhino_plugin.geometry``, ``rhino_plugin.mechanisms``,
-   the mechanism search ``rhino_plugin.search`` and the scene readers
-   (``rhino_plugin.scene_base``, ``scene_3dm``, ``scene_mesh``, ``scenes``);
-2. workflows and documents: ``solver_service.workflows``, ``solver_service.report``,
-   ``solver_service.ida``, ``solver_service.demo``;
-3. front ends: ``solver_service.cli``, ``solver_service.api``, ``rhino_plugin.flows``,
-   ``rhino_plugin.rhino``, the Grasshopper components and the public ``rockmech`` package.
+1. maths, two packages beside each other that import ``shared_schema`` only: ``cad_maths``
+   (scene readers, geometry, mechanisms, the mechanism search) and ``solver_service.core``
+   (the rocking solver);
+2. workflows and documents: the rest of ``solver_service`` (``workflows``, ``report``, ``ida``,
+   ``demo``), the first floor that may import ``cad_maths``;
+3. front ends: ``solver_service.cli``, ``solver_service.api``, ``rhino_plugin`` (what runs
+   inside Rhino: flows, commands, components) and the public ``rockmech`` package.
 """
 
 from __future__ import annotations
@@ -25,33 +25,24 @@ from typing import Optional
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = ("shared_schema", "solver_service", "rhino_plugin", "rockmech")
+PACKAGES = ("shared_schema", "cad_maths", "solver_service", "rhino_plugin", "rockmech")
 
-#: Module-name prefixes and their floors; the longest matching prefix wins.
+#: Module-name prefixes and their floors, whole packages but for ``solver_service``, which
+#: holds three floors; the longest matching prefix wins.
 FLOORS = {
     "shared_schema": 0,
+    "cad_maths": 1,
     "solver_service.core": 1,
-    "rhino_plugin.geometry": 1,
-    "rhino_plugin.mechanisms": 1,
-    "rhino_plugin.search": 1,
-    "rhino_plugin.archive_3dm": 1,
-    "rhino_plugin.scene_base": 1,
-    "rhino_plugin.scene_3dm": 1,
-    "rhino_plugin.scene_mesh": 1,
-    "rhino_plugin.scenes": 1,
-    "solver_service.workflows": 2,
-    "solver_service.report": 2,
-    "solver_service.ida": 2,
-    "solver_service.demo": 2,
+    "solver_service": 2,
     "solver_service.cli": 3,
     "solver_service.api": 3,
-    "rhino_plugin.flows": 3,
-    "rhino_plugin.rhino": 3,
-    "rhino_plugin.components": 3,
+    "rhino_plugin": 3,
     "rockmech": 3,
 }
-#: Package ``__init__`` modules hold no code of a floor; they may be imported from anywhere.
-PACKAGE_INITS = {"solver_service", "rhino_plugin"}
+#: The maths packages of floor 1 import ``shared_schema`` and themselves only, not each other.
+MATHS = ("cad_maths", "solver_service.core")
+#: ``solver_service``'s ``__init__`` holds no code of a floor; it may be imported from anywhere.
+PACKAGE_INITS = {"solver_service"}
 FLOOR_NAMES = ("formats and rules", "maths", "workflows", "front ends")
 
 
@@ -195,8 +186,36 @@ def test_cycle_finder_finds_a_circle() -> None:
 def test_floor_check_catches_a_maths_module_importing_a_workflow() -> None:
     assert floor_of("solver_service.core.exact") == 1
     assert floor_of("solver_service.workflows.documents") == 2
+    assert floor_of("solver_service.demo") == 2
+    assert floor_of("solver_service.api.routes.search") == 3
     assert floor_of("rhino_plugin.flows.analyse") == 3
-    assert floor_of("rhino_plugin.scene_3dm") == 1
+    assert floor_of("cad_maths.scene_3dm") == 1
+    assert floor_of("cad_maths.search.engine") == 1
+
+
+def _maths_package(module: str) -> Optional[str]:
+    return next((p for p in MATHS if module == p or module.startswith(p + ".")), None)
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if _maths_package(m)))
+def test_maths_packages_import_shared_schema_only(module: str) -> None:
+    """``cad_maths`` and ``solver_service.core`` stand beside each other on floor 1."""
+    own = _maths_package(module)
+    for target, line, _ in imports(module):
+        if target in PACKAGE_INITS or target.split(".")[0] == "shared_schema":
+            continue
+        if _maths_package(target) != own:
+            pytest.fail(f"{module} (in {own}) imports {target} at line {line}")
+
+
+def test_rhino_plugin_holds_only_what_runs_in_rhino() -> None:
+    """Its flows, commands and components; the Rhino-free maths lives in ``cad_maths``."""
+    inside = {
+        path.relative_to(ROOT / "rhino_plugin").parts[0]
+        for path in (ROOT / "rhino_plugin").rglob("*.py")
+        if "__pycache__" not in path.parts
+    }
+    assert inside == {"__init__.py", "flows", "rhino", "components"}
 
 
 @pytest.mark.parametrize("module", sorted(MODULES))

@@ -228,7 +228,7 @@ def test_every_package_of_the_tree_is_in_the_wheel_list() -> None:
     # the Grasshopper components, which are package data of rhino_plugin.
     found = {
         ".".join(module.parent.relative_to(ROOT).parts)
-        for top in ("rockmech", "shared_schema", "solver_service", "rhino_plugin")
+        for top in ("rockmech", "shared_schema", "cad_maths", "solver_service", "rhino_plugin")
         for module in (ROOT / top).rglob("*.py")
         if "components" not in module.relative_to(ROOT).parts
     }

@@ -5,7 +5,7 @@ names, layers and ids are fixed (ids are UUID5 of ``scene/name``), so spec files
 them; README.md in this folder lists them. Only the file time stamps change between runs.
 
 Solids use several rhino3dm kinds on purpose (Brep, Extrusion, Mesh), so each reading path of
-``rhino_plugin.scene_3dm`` is exercised by the examples.
+``cad_maths.scene_3dm`` is exercised by the examples.
 
 One example is a scan mesh instead: ``scan_wall.ply`` (binary PLY, in millimetres), a coarser
 mesh of the ``scan_wall.3dm`` wall, for ``rockmech constants ... --units mm``.
@@ -265,7 +265,7 @@ def slab_solid(
     fills ``0 <= n <= thickness`` along ``e_n``. Openings are through-holes.
     """
     # rockmech's own triangulation (exact vertices); the examples need the package anyway
-    from rhino_plugin.geometry.polygon import triangulate_polygon
+    from cad_maths.geometry.polygon import triangulate_polygon
 
     o, es, en = (np.asarray(v, dtype=np.float64) for v in (origin, e_s, e_n))
     ez = np.array([0.0, 0.0, 1.0])

@@ -12,8 +12,8 @@ from typing import Any, List, Tuple
 
 import numpy as np
 
-from rhino_plugin.mechanisms.multi_block_cad import _hinge_point
-from rhino_plugin.mechanisms.single import resolve_axis
+from cad_maths.mechanisms.multi_block_cad import _hinge_point
+from cad_maths.mechanisms.single import resolve_axis
 
 __all__ = ["Mark", "check_marks"]
 
@@ -39,7 +39,7 @@ def check_marks(spec_file: Any, scene: Any, constants: Any) -> List[Mark]:
     Parameters
     ----------
     spec_file : shared_schema.spec.SpecFile
-    scene : rhino_plugin.scene_3dm.Scene
+    scene : cad_maths.scene_3dm.Scene
     constants : shared_schema.constants.ConstantsFile
         Computed from ``spec_file`` and ``scene``.
 

@@ -24,9 +24,9 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Sequence
 
+from cad_maths.mechanisms.build import constants_from_spec
 from rhino_plugin.flows.marks import check_marks
 from rhino_plugin.flows.prompter import Cancelled, Point, Prompter
-from rhino_plugin.mechanisms.build import constants_from_spec
 from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.io import save_constants
@@ -518,7 +518,7 @@ def run_mechanism_command(
         One of :data:`COMMANDS` (``"RM_SingleBlock"``, ...).
     prompter : Prompter
         Answers the questions.
-    scene : rhino_plugin.scene_3dm.Scene
+    scene : cad_maths.scene_3dm.Scene
         The objects the answers refer to (by id).
     out_dir : str
         Folder of ``<scene>.<id>.spec.json`` and ``<scene>.<id>.constants.json``.

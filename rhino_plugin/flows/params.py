@@ -11,9 +11,9 @@ Python 3.9-clean: imported by Rhino 8.
 
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
+from cad_maths.mechanisms.build import constants_from_spec
 from rhino_plugin.flows.mechanisms import ROCKING, _number
 from rhino_plugin.flows.prepared import PreparedScene
-from rhino_plugin.mechanisms.build import constants_from_spec
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
 from shared_schema.spec import parse_spec

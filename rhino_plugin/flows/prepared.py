@@ -1,12 +1,12 @@
 """A scene of geometry already taken out of Rhino: triangle arrays, line ends and planes.
 
 Inside Rhino the objects are RhinoCommon objects. The headless reader
-(:class:`~rhino_plugin.scene_3dm.Scene`) takes rhino3dm objects, and rhino3dm has no
+(:class:`~cad_maths.scene_3dm.Scene`) takes rhino3dm objects, and rhino3dm has no
 CPython 3.9 wheel for macOS, so Rhino 8 cannot rely on it. The Rhino glue
 (``rhino_plugin.rhino.docscene``) and the Grasshopper components therefore turn each object
 into a :class:`Prepared` record (a triangle mesh in model units, a straight line's end
 points, or a plane), and :class:`PreparedScene` serves those records through the
-:class:`~rhino_plugin.scene_3dm.Scene` interface: ``find`` by name, layer or id, and
+:class:`~cad_maths.scene_3dm.Scene` interface: ``find`` by name, layer or id, and
 ``mesh``, ``line``, ``plane`` in metres, with the same welding, winding and closed-solid
 checks as a ``.3dm`` read headless.
 
@@ -18,8 +18,8 @@ from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
-from rhino_plugin.geometry.mesh import TriMesh
-from rhino_plugin.scene_3dm import Scene, SceneObject, solid_mesh
+from cad_maths.geometry.mesh import TriMesh
+from cad_maths.scene_3dm import Scene, SceneObject, solid_mesh
 from shared_schema.errors import GeometryError
 
 __all__ = ["Prepared", "PreparedScene"]
@@ -54,7 +54,7 @@ class Prepared:
 
 
 class PreparedScene(Scene):
-    """A :class:`~rhino_plugin.scene_3dm.Scene` whose objects carry :class:`Prepared` records.
+    """A :class:`~cad_maths.scene_3dm.Scene` whose objects carry :class:`Prepared` records.
 
     Parameters
     ----------

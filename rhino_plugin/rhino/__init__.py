@@ -2,6 +2,6 @@
 
 Everything here imports RhinoCommon (``Rhino``, ``Eto``, ``scriptcontext``) and runs only
 inside Rhino 8 (CPython 3.9). It stays thin: the prompt flows, the spec and the constants
-are computed by ``rhino_plugin.flows`` and ``rhino_plugin.mechanisms``, which are tested
+are computed by ``rhino_plugin.flows`` and ``cad_maths.mechanisms``, which are tested
 headless. Type-checked against RhinoCommon with pyright and ``rhino-stubs-typed``.
 """

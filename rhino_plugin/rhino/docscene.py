@@ -13,8 +13,8 @@ import numpy as np
 import Rhino
 import Rhino.Geometry as rg
 
+from cad_maths.scene_3dm import SceneObject
 from rhino_plugin.flows.prepared import Prepared, PreparedScene
-from rhino_plugin.scene_3dm import SceneObject
 
 __all__ = ["DocScene", "kind_of", "prepare"]
 

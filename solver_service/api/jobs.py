@@ -25,8 +25,8 @@ from typing import Any, Optional, Union
 
 import numpy as np
 
-from rhino_plugin.mechanisms.build import constants_from_spec
-from rhino_plugin.scenes import read_scene
+from cad_maths.mechanisms.build import constants_from_spec
+from cad_maths.scenes import read_scene
 from shared_schema.api import (
     SEARCH_MAX_EVALUATIONS,
     Ec8Request,

@@ -1,7 +1,7 @@
 """Cheap checks of uploaded files, made in the app before a compute process reads them.
 
 Uploads never name a path on the server (``safe_filename``). A ``.3dm`` scene is checked
-against the openNURBS archive layout (:func:`rhino_plugin.archive_3dm.check_3dm`, the one home
+against the openNURBS archive layout (:func:`cad_maths.archive_3dm.check_3dm`, the one home
 of that check, which the scene reader repeats) before a compute process is spent on it. A
 record file is refused when its lines of numbers alone prove it holds more samples than a
 request may carry (``check_record_lines``): every record format has at least one sample on

@@ -9,13 +9,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional, Union
 
-from rhino_plugin.mechanisms.build import (
+from cad_maths.mechanisms.build import (
     MechanismFailure,
     constants_and_failures,
     constants_from_spec,
     failures_error,
 )
-from rhino_plugin.scenes import SCENE_FORMATS, read_scene
+from cad_maths.scenes import SCENE_FORMATS, read_scene
 from shared_schema.api import time_domain_problem
 from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.errors import InputError, RockmechError
@@ -370,7 +370,7 @@ def constants_from_files(scene: Path, spec: Path, units: Optional[str] = None) -
     ----------
     scene : Path
         Rhino ``.3dm`` file (read with rhino3dm) or a scan mesh (``.ply``, ``.obj``, ``.stl``,
-        ``.off``, read with trimesh; ``rhino_plugin.scenes.read_scene``).
+        ``.off``, read with trimesh; ``cad_maths.scenes.read_scene``).
     spec : Path
         Mechanism spec (JSON); relative paths inside it are taken from its folder.
     units : {"mm", "cm", "m", "in", "ft"}, optional

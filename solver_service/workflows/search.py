@@ -2,12 +2,12 @@
 
 ``search_run`` takes a scene and a search spec and returns a :class:`SearchRun`:
 
-1. the maths (``rhino_plugin.search.engine.run_search``): the building read as prisms, the
+1. the maths (``cad_maths.search.engine.run_search``): the building read as prisms, the
    catalogue's candidates refined on the exact static multiplier λ0, the global upper-bound
    check per façade and direction, the sliding flags;
 2. the ``candidates.keep`` candidates of least λ0 become mechanism specs of the existing
    typologies and go through the existing constants builder
-   (``rhino_plugin.search.specs.build_candidates``); its exact λ0 and mass agree with the
+   (``cad_maths.search.specs.build_candidates``); its exact λ0 and mass agree with the
    search's to 1e-9 on exact prisms, and its linearised λ is reported beside λ0;
 3. every built mechanism is ranked by its overturning acceleration over the pulse frequency
    band (``documents.envelope_doc``: the library's envelopes, or the exact solver's): the
@@ -34,12 +34,12 @@ from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
-from rhino_plugin.mechanisms.build import MechanismFailure
-from rhino_plugin.scenes import read_scene
-from rhino_plugin.search.engine import MISSED_GAP, SearchResult, run_search, sliding_check
-from rhino_plugin.search.families import Candidate
-from rhino_plugin.search.prism import segment_intervals
-from rhino_plugin.search.specs import AGREEMENT_RTOL, build_candidates
+from cad_maths.mechanisms.build import MechanismFailure
+from cad_maths.scenes import read_scene
+from cad_maths.search.engine import MISSED_GAP, SearchResult, run_search, sliding_check
+from cad_maths.search.families import Candidate
+from cad_maths.search.prism import segment_intervals
+from cad_maths.search.specs import AGREEMENT_RTOL, build_candidates
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.errors import InputError, RockmechError
@@ -582,7 +582,7 @@ def search_run(
     Parameters
     ----------
     scene : BaseScene
-        The scene (``rhino_plugin.scenes.read_scene``).
+        The scene (``cad_maths.scenes.read_scene``).
     spec : SearchSpec
         The search spec.
     scene_name, spec_name : str

@@ -16,8 +16,8 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from rhino_plugin.archive_3dm import check_3dm, crc_problem, layout_problem
-from rhino_plugin.scene_3dm import Scene
+from cad_maths.archive_3dm import check_3dm, crc_problem, layout_problem
+from cad_maths.scene_3dm import Scene
 from shared_schema.errors import InputError
 from solver_service.cli import app
 

@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 from cad_scenes import BUILD
 
-from rhino_plugin.mechanisms.build import constants_from_spec
-from rhino_plugin.scene_3dm import Scene
+from cad_maths.mechanisms.build import constants_from_spec
+from cad_maths.scene_3dm import Scene
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
 from shared_schema.spec import parse_spec

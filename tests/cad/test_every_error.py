@@ -16,8 +16,8 @@ import pytest
 from cad_scenes import BUILD
 from typer.testing import CliRunner
 
-from rhino_plugin.mechanisms.build import constants_from_spec
-from rhino_plugin.scene_3dm import Scene
+from cad_maths.mechanisms.build import constants_from_spec
+from cad_maths.scene_3dm import Scene
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.spec import parse_spec
 from solver_service.cli import app

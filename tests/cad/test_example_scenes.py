@@ -12,8 +12,8 @@ import pytest
 
 pytest.importorskip("rhino3dm")
 
-from rhino_plugin.geometry.mesh import TriMesh
-from rhino_plugin.scene_3dm import Scene
+from cad_maths.geometry.mesh import TriMesh
+from cad_maths.scene_3dm import Scene
 
 SCENES = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 FILES = [

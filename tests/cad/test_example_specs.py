@@ -10,14 +10,14 @@ import pytest
 
 pytest.importorskip("rhino3dm")
 
-from rhino_plugin.mechanisms.build import constants_from_spec
-from rhino_plugin.mechanisms.multi_block import (
+from cad_maths.mechanisms.build import constants_from_spec
+from cad_maths.mechanisms.multi_block import (
     four_bar_constants,
     four_bar_restitution,
     portal_frame,
 )
-from rhino_plugin.mechanisms.two_block import hinge_height
-from rhino_plugin.scenes import read_scene
+from cad_maths.mechanisms.two_block import hinge_height
+from cad_maths.scenes import read_scene
 from shared_schema.spec import parse_spec
 
 G = 9.80665

@@ -13,8 +13,8 @@ from typing import Any
 import pytest
 from cad_scenes import BUILD
 
-from rhino_plugin.mechanisms.build import constants_from_spec
-from rhino_plugin.scene_3dm import Scene
+from cad_maths.mechanisms.build import constants_from_spec
+from cad_maths.scene_3dm import Scene
 from shared_schema.errors import GeometryError
 from shared_schema.spec import parse_spec
 

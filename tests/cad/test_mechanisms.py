@@ -14,9 +14,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
-from rhino_plugin.mechanisms.build import constants_from_spec
-from rhino_plugin.mechanisms.thrust import DEFAULT_TABLE, ThrustTable, estimate_rows
-from rhino_plugin.scene_3dm import Scene
+from cad_maths.mechanisms.build import constants_from_spec
+from cad_maths.mechanisms.thrust import DEFAULT_TABLE, ThrustTable, estimate_rows
+from cad_maths.scene_3dm import Scene
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.spec import parse_spec
 from solver_service.cli import app
@@ -453,9 +453,9 @@ def test_cli_constants_bad_input_is_one_line(tmp_path: Path) -> None:
 
 def _trapezoid_body(base: float, top: float, shift: float, height: float) -> Any:
     """A prism whose x-z section is a trapezoid, as a mechanisms Body (no scene needed)."""
-    from rhino_plugin.geometry.massprops import mass_properties
-    from rhino_plugin.geometry.mesh import TriMesh
-    from rhino_plugin.mechanisms.single import Body
+    from cad_maths.geometry.massprops import mass_properties
+    from cad_maths.geometry.mesh import TriMesh
+    from cad_maths.mechanisms.single import Body
 
     prof = [(0.0, 0.0), (base, 0.0), (shift + top, height), (shift, height)]
     v = np.array([(x, y, z) for y in (0.0, 1.0) for x, z in prof])
@@ -493,7 +493,7 @@ def _trapezoid_body(base: float, top: float, shift: float, height: float) -> Any
 def test_asymmetric_pivots_sign_behaviour(
     base: float, top: float, shift: float, height: float
 ) -> None:
-    from rhino_plugin.mechanisms import single
+    from cad_maths.mechanisms import single
 
     body = _trapezoid_body(base, top, shift, height)
     g = np.asarray(body.props.com)
@@ -525,7 +525,7 @@ def two_block_scene(b: Any) -> None:
 
 
 def test_two_block_wall_matches_the_rectangular_closed_form(tmp_path: Path) -> None:
-    from rhino_plugin.mechanisms.two_block import hinge_height, rectangular_two_block
+    from cad_maths.mechanisms.two_block import hinge_height, rectangular_two_block
 
     scene = scene_of(tmp_path, two_block_scene)
     mech = block(
@@ -588,7 +588,7 @@ def frame_spec(**extra: Any) -> dict:  # type: ignore[type-arg]
 
 
 def test_portal_frame_matches_makris_vassiliou_through_the_cad_path(tmp_path: Path) -> None:
-    from rhino_plugin.mechanisms.multi_block import (
+    from cad_maths.mechanisms.multi_block import (
         four_bar_constants,
         four_bar_restitution,
         portal_frame,

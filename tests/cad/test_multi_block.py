@@ -18,15 +18,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq
 
-from rhino_plugin.mechanisms import multi_block
-from rhino_plugin.mechanisms.multi_block import (
+from cad_maths.mechanisms import multi_block
+from cad_maths.mechanisms.multi_block import (
     FourBar,
     PlanarBody,
     four_bar_constants,
     four_bar_restitution,
     portal_frame,
 )
-from rhino_plugin.mechanisms.restitution import housner_general
+from cad_maths.mechanisms.restitution import housner_general
 from shared_schema.errors import GeometryError, InputError
 
 G = 9.80665

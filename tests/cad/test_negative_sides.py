@@ -27,8 +27,8 @@ import pytest
 from cad_scenes import BUILD
 from scipy.optimize import brentq, fsolve
 
-from rhino_plugin.mechanisms.build import constants_from_spec
-from rhino_plugin.scene_3dm import Scene
+from cad_maths.mechanisms.build import constants_from_spec
+from cad_maths.scene_3dm import Scene
 from shared_schema.spec import parse_spec
 
 G = 9.80665

@@ -21,9 +21,9 @@ hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
-from rhino_plugin.geometry.mesh import TriMesh  # noqa: E402
-from rhino_plugin.geometry.polygon import triangulate_polygon  # noqa: E402
-from rhino_plugin.scene_3dm import Scene, SceneObject  # noqa: E402
+from cad_maths.geometry.mesh import TriMesh  # noqa: E402
+from cad_maths.geometry.polygon import triangulate_polygon  # noqa: E402
+from cad_maths.scene_3dm import Scene, SceneObject  # noqa: E402
 from shared_schema.errors import GeometryError, InputError  # noqa: E402
 
 P = r3.Point3d

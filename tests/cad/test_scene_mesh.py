@@ -16,10 +16,10 @@ import pytest
 r3 = pytest.importorskip("rhino3dm")
 trimesh = pytest.importorskip("trimesh")
 
-from rhino_plugin.mechanisms.build import constants_from_spec  # noqa: E402
-from rhino_plugin.scene_3dm import Scene  # noqa: E402
-from rhino_plugin.scene_mesh import MeshScene  # noqa: E402
-from rhino_plugin.scenes import read_scene  # noqa: E402
+from cad_maths.mechanisms.build import constants_from_spec  # noqa: E402
+from cad_maths.scene_3dm import Scene  # noqa: E402
+from cad_maths.scene_mesh import MeshScene  # noqa: E402
+from cad_maths.scenes import read_scene  # noqa: E402
 from shared_schema.errors import GeometryError, InputError  # noqa: E402
 from shared_schema.spec import parse_spec  # noqa: E402
 

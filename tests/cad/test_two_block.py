@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, minimize_scalar
 
-from rhino_plugin.mechanisms import two_block as tb
-from rhino_plugin.mechanisms.two_block import (
+from cad_maths.mechanisms import two_block as tb
+from cad_maths.mechanisms.two_block import (
     PlanarBody,
     hinge_height,
     rectangular_bodies,

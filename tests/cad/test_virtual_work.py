@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from rhino_plugin.mechanisms.base import virtual_work_of
-from rhino_plugin.mechanisms.multi_block import four_bar_constants, portal_frame
-from rhino_plugin.mechanisms.two_block import PlanarBody, rectangular_two_block
+from cad_maths.mechanisms.base import virtual_work_of
+from cad_maths.mechanisms.multi_block import four_bar_constants, portal_frame
+from cad_maths.mechanisms.two_block import PlanarBody, rectangular_two_block
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
 
@@ -25,8 +25,8 @@ def e_star(vw: dict) -> float:
 
 def test_rectangular_block_from_cad_gives_b_over_h_and_three_quarters() -> None:
     pytest.importorskip("rhino3dm")
-    from rhino_plugin.mechanisms.build import constants_from_spec
-    from rhino_plugin.scene_3dm import Scene
+    from cad_maths.mechanisms.build import constants_from_spec
+    from cad_maths.scene_3dm import Scene
     from shared_schema.spec import parse_spec
 
     spec_path = EXAMPLES / "specs" / "rect_wall.spec.json"
@@ -61,7 +61,7 @@ def test_symmetric_two_block_strip_is_a_triangle() -> None:
 
 
 def test_two_block_without_second_moments_has_no_virtual_work() -> None:
-    from rhino_plugin.mechanisms.two_block import two_block_constants
+    from cad_maths.mechanisms.two_block import two_block_constants
 
     lower = PlanarBody(1080.0, (-0.15, 1.0), 1080.0 * (0.09 + 4.0) / 12)
     upper = PlanarBody(1080.0, (-0.15, 3.0), 1080.0 * (0.09 + 4.0) / 12)

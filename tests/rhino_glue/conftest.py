@@ -88,7 +88,7 @@ class ScriptedPrompter:
 @pytest.fixture(scope="session")
 def scenes() -> Dict[str, Any]:
     """Example scenes read once with rhino3dm (Scene.from_3dm), by stem."""
-    from rhino_plugin.scene_3dm import Scene
+    from cad_maths.scene_3dm import Scene
 
     cache: Dict[str, Any] = {}
 

@@ -327,7 +327,7 @@ def open_box_scene(tmp_path_factory: pytest.TempPathFactory) -> Any:
     """A .3dm with a closed box, the same box without its top (open) and a base axis."""
     import rhino3dm
 
-    from rhino_plugin.scene_3dm import Scene
+    from cad_maths.scene_3dm import Scene
 
     model = rhino3dm.File3dm()
     model.Settings.ModelUnitSystem = rhino3dm.UnitSystem.Meters

@@ -14,8 +14,8 @@ from typing import Any, ClassVar, Dict, Iterator, List, Tuple
 
 import pytest
 
+from cad_maths.scenes import read_scene
 from rhino_plugin.flows.search import search_flow, search_prepared
-from rhino_plugin.scenes import read_scene
 from shared_schema.errors import InputError
 from shared_schema.search import SearchSpec
 from solver_service.workflows.search import read_search_spec, search_run

@@ -27,14 +27,8 @@ SCRIPTS = sorted((ROOT / "rhino_plugin" / "rhino").glob("RM_*.py"))
 #: Packages Rhino imports (the glue itself, rhino_plugin.rhino, needs RhinoCommon).
 RHINO_IMPORTED = [
     ROOT / "shared_schema",
-    ROOT / "rhino_plugin" / "geometry",
-    ROOT / "rhino_plugin" / "mechanisms",
-    ROOT / "rhino_plugin" / "search",
+    ROOT / "cad_maths",
     ROOT / "rhino_plugin" / "flows",
-    ROOT / "rhino_plugin" / "scene_3dm.py",
-    ROOT / "rhino_plugin" / "scene_base.py",
-    ROOT / "rhino_plugin" / "scene_mesh.py",
-    ROOT / "rhino_plugin" / "scenes.py",
     ROOT / "rhino_plugin" / "__init__.py",
 ]
 COMMANDS = [
@@ -212,8 +206,8 @@ def _python39() -> Optional[str]:
 
 PY39_PROGRAM = r"""
 import json, sys
-from rhino_plugin.scene_3dm import Scene
-from rhino_plugin.mechanisms.build import constants_from_spec
+from cad_maths.scene_3dm import Scene
+from cad_maths.mechanisms.build import constants_from_spec
 import rhino_plugin.flows.mechanisms, rhino_plugin.flows.analyse, rhino_plugin.flows.params
 import rhino_plugin.flows.prepared, rhino_plugin.flows.marks
 import shared_schema.api
@@ -230,12 +224,12 @@ def test_constants_under_a_real_python_39(cli_constants: Any) -> None:
     py = _python39()
     if py is None:
         pytest.skip(
-            "no Python 3.9 found (set ROCKMECH_PY39 to a python3.9 with numpy, pydantic, "
+            "no Python 3.9 found (set ROCKMECH_PY39 to a python3.9 with numpy, pydantic, scipy, "
             "trimesh<=4.12, manifold3d, shapely and rhino3dm); ast and ruff 3.9 checks ran"
         )
     cmd = py.split(" ")
     deps = subprocess.run(
-        [*cmd, "-c", "import numpy, pydantic, trimesh, rhino3dm, manifold3d, shapely"],
+        [*cmd, "-c", "import numpy, pydantic, scipy, trimesh, rhino3dm, manifold3d, shapely"],
         capture_output=True, text=True,
     )  # fmt: skip
     if deps.returncode != 0:
@@ -290,7 +284,7 @@ def test_rhproj_lists_every_command_and_the_libraries() -> None:
     bases = [
         (ROOT / "rhino_plugin" / lib["library"]["base"]).resolve() for lib in proj["libraries"]
     ]
-    assert bases == [ROOT / "rhino_plugin", ROOT / "shared_schema"]
+    assert bases == [ROOT / "rhino_plugin", ROOT / "shared_schema", ROOT / "cad_maths"]
 
 
 def test_yak_manifest_has_the_required_fields() -> None:

@@ -1,6 +1,6 @@
 """Each candidate is a mechanism spec of an existing typology, through the existing builder.
 
-The search's prism geometry and the constants builder (``rhino_plugin.mechanisms.build``,
+The search's prism geometry and the constants builder (``cad_maths.mechanisms.build``,
 meshes cut by manifold3d) agree to 1e-9 on the exact static multiplier and the mass (issue
 #31); the builder's linearised λ sits a few per cent below λ0 on squat blocks.
 """
@@ -14,10 +14,10 @@ from typing import Any
 import pytest
 from search_scenes import EXAMPLE_SCENE, EXAMPLE_SPEC, two_block_wall, wedge_facade, wedge_spec
 
-from rhino_plugin.mechanisms.build import constants_from_spec
-from rhino_plugin.scenes import read_scene
-from rhino_plugin.search.engine import run_search
-from rhino_plugin.search.specs import AGREEMENT_RTOL, build_candidates
+from cad_maths.mechanisms.build import constants_from_spec
+from cad_maths.scenes import read_scene
+from cad_maths.search.engine import run_search
+from cad_maths.search.specs import AGREEMENT_RTOL, build_candidates
 from shared_schema.rules import G
 from shared_schema.search import SearchSpec, parse_search_spec
 from shared_schema.spec import parse_spec

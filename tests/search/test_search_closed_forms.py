@@ -21,10 +21,10 @@ import numpy as np
 import pytest
 from search_scenes import two_block_wall, wedge_facade, wedge_spec
 
-from rhino_plugin.scenes import read_scene
-from rhino_plugin.search.families import enumerate_candidates, overturning_template, two_block_lam
-from rhino_plugin.search.model import building_from_scene
-from rhino_plugin.search.refine import minimise
+from cad_maths.scenes import read_scene
+from cad_maths.search.families import enumerate_candidates, overturning_template, two_block_lam
+from cad_maths.search.model import building_from_scene
+from cad_maths.search.refine import minimise
 from shared_schema.rules import G
 from shared_schema.search import SearchSpec
 

@@ -15,9 +15,9 @@ from typing import Any
 import pytest
 from search_scenes import BUILD, wedge_facade, wedge_spec
 
-from rhino_plugin.scenes import read_scene
-from rhino_plugin.search.engine import run_search
-from rhino_plugin.search.specs import build_candidates
+from cad_maths.scenes import read_scene
+from cad_maths.search.engine import run_search
+from cad_maths.search.specs import build_candidates
 from shared_schema.errors import InputError
 from shared_schema.search import SearchSpec
 from solver_service.workflows.inputs import constants_from_files

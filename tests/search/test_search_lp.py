@@ -14,10 +14,10 @@ from typing import Any
 import pytest
 from search_scenes import EXAMPLE_SCENE, EXAMPLE_SPEC, two_block_wall, wedge_facade, wedge_spec
 
-from rhino_plugin.scenes import read_scene
-from rhino_plugin.search.engine import run_search
-from rhino_plugin.search.lp import facade_lp_model, solve_lp
-from rhino_plugin.search.model import building_from_scene
+from cad_maths.scenes import read_scene
+from cad_maths.search.engine import run_search
+from cad_maths.search.lp import facade_lp_model, solve_lp
+from cad_maths.search.model import building_from_scene
 from shared_schema.rules import G
 from shared_schema.search import SearchSpec, parse_search_spec
 

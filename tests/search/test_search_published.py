@@ -23,8 +23,8 @@ from pathlib import Path
 import pytest
 from search_scenes import BUILD
 
-from rhino_plugin.scenes import read_scene
-from rhino_plugin.search.engine import run_search
+from cad_maths.scenes import read_scene
+from cad_maths.search.engine import run_search
 from shared_schema.search import SearchSpec
 
 

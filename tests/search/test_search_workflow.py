@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 from search_scenes import EXAMPLE_SCENE, EXAMPLE_SPEC, wedge_facade, wedge_spec
 
-from rhino_plugin.scenes import read_scene
-from rhino_plugin.search.engine import run_search
+from cad_maths.scenes import read_scene
+from cad_maths.search.engine import run_search
 from shared_schema.search import SearchSpec, parse_search_spec
 from solver_service.core.exact import simulate
 from solver_service.core.excitation import Pulse

@@ -7,7 +7,7 @@ import typing
 import numpy as np
 import pytest
 
-from rhino_plugin.mechanisms.build import MECHANISMS
+from cad_maths.mechanisms.build import MECHANISMS
 from shared_schema import api, constants, rules, spec
 from shared_schema.errors import InputError
 from solver_service.core import model, records
@@ -44,7 +44,7 @@ def test_api_enums_mirror_the_rules() -> None:
 
 
 def test_scan_length_units_match_the_reader() -> None:
-    from rhino_plugin.scene_mesh import UNITS
+    from cad_maths.scene_mesh import UNITS
 
     assert tuple(UNITS) == rules.LENGTH_UNITS
     assert tuple(_enum(api.ConstantsForm, "units")) == rules.LENGTH_UNITS

@@ -6,9 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from rhino_plugin.geometry.massprops import MassProps
-from rhino_plugin.mechanisms.loaded import _constants
-from rhino_plugin.mechanisms.single import Body, rocking_side
+from cad_maths.geometry.massprops import MassProps
+from cad_maths.mechanisms.loaded import _constants
+from cad_maths.mechanisms.single import Body, rocking_side
 from shared_schema.errors import InputError
 from solver_service.core.hazard import ec8_spectrum, ntc_spectrum
 from solver_service.core.kinematic import (

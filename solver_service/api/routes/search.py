@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Request, Response
 
-from rhino_plugin.archive_3dm import check_3dm
+from cad_maths.archive_3dm import check_3dm
 from shared_schema.api import SearchResponse
 from shared_schema.errors import InputError
 

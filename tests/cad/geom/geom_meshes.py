@@ -4,7 +4,7 @@ from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
-from rhino_plugin.geometry.mesh import TriMesh
+from cad_maths.geometry.mesh import TriMesh
 
 
 def box(lo: Sequence[float], hi: Sequence[float], name: str = "box") -> TriMesh:

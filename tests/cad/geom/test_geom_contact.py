@@ -15,8 +15,8 @@ from geom_meshes import (
     to_manifold,
 )
 
-from rhino_plugin.geometry.contact import contact_area, find_contact
-from rhino_plugin.geometry.mesh import TriMesh
+from cad_maths.geometry.contact import contact_area, find_contact
+from cad_maths.geometry.mesh import TriMesh
 from shared_schema.errors import InputError
 
 LOWER = box([0, 0, 0], [1, 1, 1], "wall")
@@ -159,7 +159,7 @@ def test_bad_plane_is_an_input_error():
 def test_patch_outline_matches_the_union_of_its_triangles_and_falls_back_when_not_manifold():
     import shapely
 
-    from rhino_plugin.geometry.contact import _outline_rings, _patch_region, _triangles_union
+    from cad_maths.geometry.contact import _outline_rings, _patch_region, _triangles_union
 
     outer = np.array([[0, 0], [3, 0], [3, 2], [0, 2]], dtype=float)
     hole = np.array([[1, 0.5], [1, 1.5], [2, 1.5], [2, 0.5]], dtype=float)

@@ -8,9 +8,9 @@ from geom_meshes import box, convex, l_prism, moved, rotation
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rhino_plugin.geometry.cut import cut_by_plane, split_by_plane
-from rhino_plugin.geometry.massprops import mass_properties
-from rhino_plugin.geometry.validate import check_solid
+from cad_maths.geometry.cut import cut_by_plane, split_by_plane
+from cad_maths.geometry.massprops import mass_properties
+from cad_maths.geometry.validate import check_solid
 from shared_schema.errors import GeometryError, InputError
 
 

@@ -10,7 +10,7 @@ MODULES = ["massprops", "validate", "cut", "contact", "frames", "polygon", "topo
 
 @pytest.mark.parametrize("name", MODULES)
 def test_module_examples(name):
-    module = importlib.import_module(f"rhino_plugin.geometry.{name}")
+    module = importlib.import_module(f"cad_maths.geometry.{name}")
     result = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
     assert result.failed == 0
     assert result.attempted > 0

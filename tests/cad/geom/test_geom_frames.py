@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from geom_meshes import box, moved, rotation
 
-from rhino_plugin.geometry.frames import bounding_box_in_frame, plane_basis
-from rhino_plugin.geometry.mesh import TriMesh
+from cad_maths.geometry.frames import bounding_box_in_frame, plane_basis
+from cad_maths.geometry.mesh import TriMesh
 from shared_schema.errors import InputError
 
 

@@ -8,7 +8,7 @@ from geom_meshes import box, convex, moved, prism, regular_polygon, rotation
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rhino_plugin.geometry.massprops import MassProps, _integrals, combine, mass_properties
+from cad_maths.geometry.massprops import MassProps, _integrals, combine, mass_properties
 from shared_schema.errors import GeometryError, InputError
 
 RTOL = 1e-12  # exact polyhedral integrals: rounding only
@@ -110,7 +110,7 @@ def test_two_density_column_and_statue_equal_the_sum_of_their_parts():
 
 
 def test_combining_the_two_halves_of_a_cut_box_gives_the_whole_box():
-    from rhino_plugin.geometry.cut import split_by_plane
+    from cad_maths.geometry.cut import split_by_plane
 
     whole = box([0, 0, 0], [1.2, 0.7, 2.0], "block")
     upper, lower = split_by_plane(whole, [0.3, 0.2, 0.9], [0.3, -0.5, 1.0])

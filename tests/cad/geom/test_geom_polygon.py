@@ -5,7 +5,7 @@ from typing import List, Sequence
 import numpy as np
 import pytest
 
-from rhino_plugin.geometry.polygon import triangulate_polygon
+from cad_maths.geometry.polygon import triangulate_polygon
 
 
 def shoelace(p: np.ndarray) -> float:

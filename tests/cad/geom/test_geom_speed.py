@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from rhino_plugin.geometry.massprops import mass_properties
-from rhino_plugin.geometry.mesh import TriMesh
-from rhino_plugin.geometry.validate import check_solid
+from cad_maths.geometry.massprops import mass_properties
+from cad_maths.geometry.mesh import TriMesh
+from cad_maths.geometry.validate import check_solid
 
 
 @pytest.mark.slow

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from geom_meshes import box, unshared
 
-from rhino_plugin.geometry.topology import orient_outward, weld
+from cad_maths.geometry.topology import orient_outward, weld
 
 
 def signed_volume(v: np.ndarray, f: np.ndarray) -> float:
@@ -59,7 +59,7 @@ def test_orient_outward_reports_open_edges_and_leaves_faces() -> None:
 @pytest.mark.parametrize("high", [2**20, 2**50])
 def test_packed_sort_orders_like_a_stable_argsort(high: int) -> None:
     # 2**50 keys with 3e4 indices need more than 63 bits: the argsort fallback
-    from rhino_plugin.geometry.topology import _argsort_keys
+    from cad_maths.geometry.topology import _argsort_keys
 
     keys = np.random.default_rng(3).integers(0, high, 30_000)
     keys[::7] = keys[0]  # ties are ordered by index

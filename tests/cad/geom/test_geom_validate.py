@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 from geom_meshes import box, from_manifold, l_prism, prism, to_manifold, unshared
 
-from rhino_plugin.geometry import validate
-from rhino_plugin.geometry.massprops import mass_properties
-from rhino_plugin.geometry.mesh import TriMesh
-from rhino_plugin.geometry.validate import check_solid
+from cad_maths.geometry import validate
+from cad_maths.geometry.massprops import mass_properties
+from cad_maths.geometry.mesh import TriMesh
+from cad_maths.geometry.validate import check_solid
 from shared_schema.errors import GeometryError
 
 
@@ -295,7 +295,7 @@ def test_randomly_flipped_faces_on_a_sphere_are_all_fixed(seed):
 def test_numpy_fallback_without_scipy_finds_the_same_shells(monkeypatch):
     import sys
 
-    from rhino_plugin.geometry.validate import shell_labels
+    from cad_maths.geometry.validate import shell_labels
 
     a, b = box([0, 0, 0], [1, 1, 1]), box([2, 0, 0], [3, 2, 1])
     sphere = icosphere(3)

@@ -31,13 +31,13 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from rhino_plugin.geometry.massprops import mass_properties
-from rhino_plugin.mechanisms.loaded import BEARING_ANGLE, largest_contact
-from rhino_plugin.mechanisms.single import find_objects
-from rhino_plugin.search.model import Building, LevelContact, ReturnWall, TiePoint, Wall
-from rhino_plugin.search.multiplier import rotation_multiplier, two_block_multiplier
-from rhino_plugin.search.prism import Lump, clip_rings, point_lump, ring_moments
-from rhino_plugin.search.refine import minimise
+from cad_maths.geometry.massprops import mass_properties
+from cad_maths.mechanisms.loaded import BEARING_ANGLE, largest_contact
+from cad_maths.mechanisms.single import find_objects
+from cad_maths.search.model import Building, LevelContact, ReturnWall, TiePoint, Wall
+from cad_maths.search.multiplier import rotation_multiplier, two_block_multiplier
+from cad_maths.search.prism import Lump, clip_rings, point_lump, ring_moments
+from cad_maths.search.refine import minimise
 from shared_schema.errors import InputError
 from shared_schema.rules import G
 

@@ -6,7 +6,7 @@ whose plane contains the wall's thickness direction (a horizontal bed joint, a d
 through a return wall) cuts the prism along a line of the elevation, so every block the
 search weighs is a clipped polygon times a thickness, and its mass moments are exact
 polynomial integrals (Green's theorem), equal to the mesh integrals of the constants
-builder (``rhino_plugin.geometry.massprops``) to rounding.
+builder (``cad_maths.geometry.massprops``) to rounding.
 
 Notation
 --------

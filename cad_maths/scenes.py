@@ -1,8 +1,8 @@
 """One entry point for every scene file: ``.3dm`` models and scan meshes.
 
 :func:`read_scene` picks the reader from the file's extension: Rhino ``.3dm``
-(:class:`~rhino_plugin.scene_3dm.Scene`, units from the file) or a scan mesh ``.ply``,
-``.obj``, ``.stl``, ``.off`` (:class:`~rhino_plugin.scene_mesh.MeshScene`, units given).
+(:class:`~cad_maths.scene_3dm.Scene`, units from the file) or a scan mesh ``.ply``,
+``.obj``, ``.stl``, ``.off`` (:class:`~cad_maths.scene_mesh.MeshScene`, units given).
 The CLI, the service and the demo call it; each reader stays importable on its own.
 
 Python 3.9-clean.
@@ -11,9 +11,9 @@ Python 3.9-clean.
 import os
 from typing import Optional, Union
 
-from rhino_plugin.scene_3dm import Scene
-from rhino_plugin.scene_base import BaseScene
-from rhino_plugin.scene_mesh import SCAN_FORMATS, MeshScene, unit_ratio
+from cad_maths.scene_3dm import Scene
+from cad_maths.scene_base import BaseScene
+from cad_maths.scene_mesh import SCAN_FORMATS, MeshScene, unit_ratio
 from shared_schema.errors import InputError
 
 __all__ = ["SCENE_FORMATS", "read_scene"]
@@ -48,8 +48,8 @@ def read_scene(
     Returns
     -------
     BaseScene
-        A :class:`~rhino_plugin.scene_3dm.Scene` or a
-        :class:`~rhino_plugin.scene_mesh.MeshScene`, in metres.
+        A :class:`~cad_maths.scene_3dm.Scene` or a
+        :class:`~cad_maths.scene_mesh.MeshScene`, in metres.
 
     Raises
     ------

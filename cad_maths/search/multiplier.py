@@ -20,7 +20,7 @@ from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
-from rhino_plugin.search.prism import Lump
+from cad_maths.search.prism import Lump
 from shared_schema.errors import GeometryError
 from shared_schema.rules import G
 
@@ -79,7 +79,7 @@ def rotation_multiplier(
     --------
     A 0.5 x 3 m block about its outer base edge: λ0 = b/h.
 
-    >>> from rhino_plugin.search.prism import WallFrame
+    >>> from cad_maths.search.prism import WallFrame
     >>> f = WallFrame(np.zeros(3), np.array([0.0, 1, 0]), np.array([1.0, 0, 0]),
     ...               np.array([0.0, 0, 1]), 0.5)
     >>> body = f.prism_lump([np.array([[0.0, 0], [1, 0], [1, 3], [0, 3]])], 1800.0)

@@ -13,9 +13,9 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
-from rhino_plugin.search.families import Budget, Candidate, enumerate_candidates
-from rhino_plugin.search.lp import LPModel, LPResult, facade_lp_model, solve_lp
-from rhino_plugin.search.model import Building, building_from_scene
+from cad_maths.search.families import Budget, Candidate, enumerate_candidates
+from cad_maths.search.lp import LPModel, LPResult, facade_lp_model, solve_lp
+from cad_maths.search.model import Building, building_from_scene
 from shared_schema.errors import InputError
 from shared_schema.rules import G
 
@@ -165,7 +165,7 @@ def run_search(
     Parameters
     ----------
     scene : BaseScene
-        The input scene (``rhino_plugin.scenes.read_scene``).
+        The input scene (``cad_maths.scenes.read_scene``).
     spec : SearchSpec
         The search spec.
     lp : bool, optional

@@ -15,8 +15,8 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
-from rhino_plugin.geometry.mesh import TriMesh
-from rhino_plugin.scene_base import BaseScene, SceneObject
+from cad_maths.geometry.mesh import TriMesh
+from cad_maths.scene_base import BaseScene, SceneObject
 from shared_schema.errors import GeometryError
 
 __all__ = ["OPENINGS_SUFFIX", "MemoryScene"]

@@ -29,13 +29,13 @@ from typing import Any, Dict, List, Tuple
 
 import numpy as np
 
-from rhino_plugin.geometry.contact import find_contact
-from rhino_plugin.geometry.frames import bounding_box_in_frame
-from rhino_plugin.geometry.massprops import mass_properties
-from rhino_plugin.geometry.validate import check_solid
-from rhino_plugin.mechanisms.base import MechanismSides
-from rhino_plugin.mechanisms.single import find_objects, rigid_body, rigid_body_sides
-from rhino_plugin.mechanisms.thrust import roof_thrust
+from cad_maths.geometry.contact import find_contact
+from cad_maths.geometry.frames import bounding_box_in_frame
+from cad_maths.geometry.massprops import mass_properties
+from cad_maths.geometry.validate import check_solid
+from cad_maths.mechanisms.base import MechanismSides
+from cad_maths.mechanisms.single import find_objects, rigid_body, rigid_body_sides
+from cad_maths.mechanisms.thrust import roof_thrust
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.rules import G
 

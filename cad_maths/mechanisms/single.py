@@ -21,11 +21,11 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from rhino_plugin.geometry.cut import cut_by_plane
-from rhino_plugin.geometry.massprops import combine, mass_properties
-from rhino_plugin.geometry.validate import check_solid
-from rhino_plugin.mechanisms.base import MechanismSides
-from rhino_plugin.mechanisms.restitution import ONE_SIDED_RULES, housner_general, one_sided
+from cad_maths.geometry.cut import cut_by_plane
+from cad_maths.geometry.massprops import combine, mass_properties
+from cad_maths.geometry.validate import check_solid
+from cad_maths.mechanisms.base import MechanismSides
+from cad_maths.mechanisms.restitution import ONE_SIDED_RULES, housner_general, one_sided
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.rules import G
 
@@ -52,7 +52,7 @@ TOUCH_RTOL = 1e-3
 class Body:
     """The solids of a mechanism after cracks, with their mass properties."""
 
-    props: Any  # rhino_plugin.geometry.massprops.MassProps (combined)
+    props: Any  # cad_maths.geometry.massprops.MassProps (combined)
     parts: List[Any]  # MassProps per solid
     meshes: List[Any]  # TriMesh per solid, after cracks
     vertices: np.ndarray  # (n, 3) all vertices of the cut solids [m]

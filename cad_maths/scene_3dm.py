@@ -3,7 +3,7 @@
 A :class:`Scene` lists the objects of a ``.3dm`` file (name, full layer path, kind, user text)
 and turns them into what the mechanisms need, in metres whatever the file's model units:
 
-- :meth:`Scene.mesh`: a closed solid as a :class:`~rhino_plugin.geometry.mesh.TriMesh`, from
+- :meth:`Scene.mesh`: a closed solid as a :class:`~cad_maths.geometry.mesh.TriMesh`, from
   a Mesh, from a Brep or Extrusion with planar faces (tessellated here, holes included), or
   from the render meshes stored in the file for curved Breps;
 - :meth:`Scene.line`: the end points of a line (rocking axis, tie-bar);
@@ -11,8 +11,8 @@ and turns them into what the mechanisms need, in metres whatever the file's mode
 
 rhino3dm is imported lazily, inside the functions that need it. rhino3dm has no Brep
 meshing, so planar faces are triangulated in their plane by
-:func:`~rhino_plugin.geometry.polygon.triangulate_polygon`; selection, units and the
-welding and winding of solids are :mod:`rhino_plugin.scene_base`'s, shared with the other
+:func:`~cad_maths.geometry.polygon.triangulate_polygon`; selection, units and the
+welding and winding of solids are :mod:`cad_maths.scene_base`'s, shared with the other
 scene readers. A curved Brep face with no stored render mesh
 cannot be meshed headless and raises :class:`~shared_schema.errors.GeometryError` saying how
 to fix the file.
@@ -28,10 +28,10 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
-from rhino_plugin.archive_3dm import check_3dm, check_3dm_file
-from rhino_plugin.geometry.mesh import TriMesh
-from rhino_plugin.geometry.polygon import newell, triangulate_polygon
-from rhino_plugin.scene_base import BaseScene, SceneObject, solid_mesh
+from cad_maths.archive_3dm import check_3dm, check_3dm_file
+from cad_maths.geometry.mesh import TriMesh
+from cad_maths.geometry.polygon import newell, triangulate_polygon
+from cad_maths.scene_base import BaseScene, SceneObject, solid_mesh
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.extras import require
 

@@ -199,7 +199,7 @@ def mass_properties(mesh: TriMesh, density: float, *, repair: bool = True) -> Ma
     ----------
     mesh : TriMesh
         The solid [m]. It is checked (and, with ``repair``, repaired) by
-        :func:`rhino_plugin.geometry.validate.check_solid` first, so an open mesh never
+        :func:`cad_maths.geometry.validate.check_solid` first, so an open mesh never
         yields a volume.
     density : float
         Density ρ [kg/m³], finite and > 0.
@@ -227,7 +227,7 @@ def mass_properties(mesh: TriMesh, density: float, *, repair: bool = True) -> Ma
 
     Examples
     --------
-    >>> from rhino_plugin.geometry.mesh import TriMesh
+    >>> from cad_maths.geometry.mesh import TriMesh
     >>> tet = TriMesh(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]),
     ...               np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]), "tet")
     >>> p = mass_properties(tet, 600.0)

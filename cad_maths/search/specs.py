@@ -11,7 +11,7 @@ Each refined candidate becomes one mechanism of a spec file (``shared_schema.spe
 * vertical flexure is ``two_block`` with the wall's ``overburden`` and the refined
   ``hinge_height``.
 
-``build_candidates`` runs the existing builder (``rhino_plugin.mechanisms.build``) on the
+``build_candidates`` runs the existing builder (``cad_maths.mechanisms.build``) on the
 search's scene and compares its exact static multiplier and mass with the search's prism
 geometry: on walls that are exact prisms they agree to rounding (issue #31: 1e-9).
 
@@ -23,9 +23,9 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from rhino_plugin.mechanisms.build import MechanismFailure, constants_and_failures
-from rhino_plugin.search.families import Candidate, Plane
-from rhino_plugin.search.model import Building
+from cad_maths.mechanisms.build import MechanismFailure, constants_and_failures
+from cad_maths.search.families import Candidate, Plane
+from cad_maths.search.model import Building
 from shared_schema.constants import ConstantsFile
 from shared_schema.spec import SpecFile
 

@@ -22,12 +22,12 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
-from rhino_plugin.geometry.cut import cut_by_plane
-from rhino_plugin.geometry.massprops import combine, mass_properties
-from rhino_plugin.mechanisms.base import MechanismSides, virtual_work_of
-from rhino_plugin.mechanisms.loaded import contact_tolerance, element_solids, largest_contact
-from rhino_plugin.mechanisms.single import rigid_body
-from rhino_plugin.mechanisms.two_block import (
+from cad_maths.geometry.cut import cut_by_plane
+from cad_maths.geometry.massprops import combine, mass_properties
+from cad_maths.mechanisms.base import MechanismSides, virtual_work_of
+from cad_maths.mechanisms.loaded import contact_tolerance, element_solids, largest_contact
+from cad_maths.mechanisms.single import rigid_body
+from cad_maths.mechanisms.two_block import (
     PlanarBody,
     hinge_height,
     two_block_constants,

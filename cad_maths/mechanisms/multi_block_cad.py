@@ -21,12 +21,12 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
-from rhino_plugin.geometry.massprops import combine, mass_properties
-from rhino_plugin.geometry.validate import check_solid
-from rhino_plugin.mechanisms.base import MechanismSides, virtual_work_of
-from rhino_plugin.mechanisms.multi_block import four_bar_constants, four_bar_restitution
-from rhino_plugin.mechanisms.single import claim_once, find_objects
-from rhino_plugin.mechanisms.two_block import PlanarBody
+from cad_maths.geometry.massprops import combine, mass_properties
+from cad_maths.geometry.validate import check_solid
+from cad_maths.mechanisms.base import MechanismSides, virtual_work_of
+from cad_maths.mechanisms.multi_block import four_bar_constants, four_bar_restitution
+from cad_maths.mechanisms.single import claim_once, find_objects
+from cad_maths.mechanisms.two_block import PlanarBody
 from shared_schema.errors import GeometryError, InputError
 
 __all__ = ["multi_block_sides"]

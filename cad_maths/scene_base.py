@@ -3,8 +3,8 @@
 A scene lists objects (name, layer path, kind, user text, reader-specific geometry) and
 turns them into what the mechanisms need, in metres whatever the file's units:
 :meth:`BaseScene.mesh` (a closed solid), :meth:`BaseScene.line` (rocking axis, tie-bar) and
-:meth:`BaseScene.plane` (crack). The readers are :mod:`rhino_plugin.scene_3dm` (Rhino
-``.3dm`` files), :mod:`rhino_plugin.scene_mesh` (scan meshes: PLY, OBJ, STL, OFF) and the
+:meth:`BaseScene.plane` (crack). The readers are :mod:`cad_maths.scene_3dm` (Rhino
+``.3dm`` files), :mod:`cad_maths.scene_mesh` (scan meshes: PLY, OBJ, STL, OFF) and the
 Rhino glue's :class:`~rhino_plugin.flows.prepared.PreparedScene`.
 
 Python 3.9-clean: imported by Rhino 8.
@@ -17,9 +17,9 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
-from rhino_plugin.geometry.mesh import TriMesh
-from rhino_plugin.geometry.topology import orient_outward, weld
-from rhino_plugin.geometry.validate import REPAIRS_KEY
+from cad_maths.geometry.mesh import TriMesh
+from cad_maths.geometry.topology import orient_outward, weld
+from cad_maths.geometry.validate import REPAIRS_KEY
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.rules import COORDINATE_LIMIT, body_size_note
 

@@ -29,17 +29,17 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, cast
 
 import numpy as np
 
-from rhino_plugin.geometry.contact import contact_region
-from rhino_plugin.geometry.frames import bounding_box_in_frame
-from rhino_plugin.geometry.massprops import mass_properties
-from rhino_plugin.geometry.mesh import TriMesh
-from rhino_plugin.geometry.validate import check_solid
-from rhino_plugin.mechanisms.loaded import BEARING_ANGLE, contact_tolerance
-from rhino_plugin.mechanisms.single import find_objects
-from rhino_plugin.mechanisms.thrust import roof_thrust
-from rhino_plugin.scene_base import SceneObject
-from rhino_plugin.search.prism import Lump, WallFrame, clip_rings, frame_from_mesh, ring_moments
-from rhino_plugin.search.scene import OPENINGS_SUFFIX, MemoryScene
+from cad_maths.geometry.contact import contact_region
+from cad_maths.geometry.frames import bounding_box_in_frame
+from cad_maths.geometry.massprops import mass_properties
+from cad_maths.geometry.mesh import TriMesh
+from cad_maths.geometry.validate import check_solid
+from cad_maths.mechanisms.loaded import BEARING_ANGLE, contact_tolerance
+from cad_maths.mechanisms.single import find_objects
+from cad_maths.mechanisms.thrust import roof_thrust
+from cad_maths.scene_base import SceneObject
+from cad_maths.search.prism import Lump, WallFrame, clip_rings, frame_from_mesh, ring_moments
+from cad_maths.search.scene import OPENINGS_SUFFIX, MemoryScene
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.extras import require
 from shared_schema.rules import G

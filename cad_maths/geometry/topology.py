@@ -1,7 +1,7 @@
 """Edge topology of triangle meshes: welding, shells, consistent and outward winding.
 
 One implementation shared by the scene readers (``solid_mesh``) and the solid check
-(:mod:`rhino_plugin.geometry.validate`). Everything here is vectorised numpy (scipy's
+(:mod:`cad_maths.geometry.validate`). Everything here is vectorised numpy (scipy's
 connected components where available), so a scan of a million triangles costs a few sorts
 of its 3m half-edges.
 

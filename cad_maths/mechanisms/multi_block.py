@@ -48,7 +48,7 @@ import math
 from dataclasses import dataclass
 from typing import List, Optional, Sequence, Tuple
 
-from rhino_plugin.mechanisms.two_block import LinkageResult, PlanarBody, rest_virtual_work
+from cad_maths.mechanisms.two_block import LinkageResult, PlanarBody, rest_virtual_work
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.rules import G
 

@@ -10,7 +10,7 @@ objects, so a :class:`MeshScene` differs from a ``.3dm`` scene in three ways:
   ``crack.points``); asking a scan for a line or a plane names the object and says so.
 
 Every mesh goes through the same welding, winding and closed-solid checks as a ``.3dm``
-mesh (:func:`~rhino_plugin.scene_base.solid_mesh`). trimesh is imported lazily, with
+mesh (:func:`~cad_maths.scene_base.solid_mesh`). trimesh is imported lazily, with
 ``process=False`` so that it neither merges nor reorders anything before those checks.
 
 Python 3.9-clean (the Rhino side may import it; trimesh <= 4.12 works).
@@ -23,8 +23,8 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
-from rhino_plugin.geometry.mesh import TriMesh
-from rhino_plugin.scene_base import BaseScene, SceneObject, solid_mesh
+from cad_maths.geometry.mesh import TriMesh
+from cad_maths.scene_base import BaseScene, SceneObject, solid_mesh
 from shared_schema.errors import GeometryError, InputError
 
 __all__ = ["SCAN_FORMATS", "UNITS", "MeshScene", "unit_ratio"]

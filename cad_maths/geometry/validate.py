@@ -65,7 +65,7 @@ from .topology import (
 __all__ = ["REPAIRS_KEY", "check_solid", "shell_labels"]
 
 #: Key of ``TriMesh.meta`` under which a reader lists the repairs it made before the check
-#: (``rhino_plugin.scene_base.solid_mesh``); ``check_solid`` reports them with its own.
+#: (``cad_maths.scene_base.solid_mesh``); ``check_solid`` reports them with its own.
 REPAIRS_KEY = "repairs"
 #: |volume| below this × (bounding-box diagonal)³ counts as zero [-].
 ZERO_VOLUME_RTOL = 1e-12

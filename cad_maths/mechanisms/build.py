@@ -14,10 +14,10 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 from pydantic import ValidationError
 
-from rhino_plugin.mechanisms import loaded, multi_block_cad, single, two_block_cad
-from rhino_plugin.mechanisms.base import Builder, MechanismSides
-from rhino_plugin.mechanisms.single import AXIS_TILT_TOL, resolve_axis
-from rhino_plugin.mechanisms.thrust import ThrustTable
+from cad_maths.mechanisms import loaded, multi_block_cad, single, two_block_cad
+from cad_maths.mechanisms.base import Builder, MechanismSides
+from cad_maths.mechanisms.single import AXIS_TILT_TOL, resolve_axis
+from cad_maths.mechanisms.thrust import ThrustTable
 from shared_schema.constants import ConstantsFile, input_error_from_validation
 from shared_schema.errors import GeometryError, InputError, RockmechError
 from shared_schema.extras import MissingExtra

@@ -37,9 +37,9 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
-from rhino_plugin.search.families import hinge_lines, overburden_load
-from rhino_plugin.search.model import Building, Wall
-from rhino_plugin.search.prism import Lump, clip_rings, ring_moments, segment_intervals, winding
+from cad_maths.search.families import hinge_lines, overburden_load
+from cad_maths.search.model import Building, Wall
+from cad_maths.search.prism import Lump, clip_rings, ring_moments, segment_intervals, winding
 from shared_schema.errors import GeometryError, SolverError
 from shared_schema.rules import G
 
