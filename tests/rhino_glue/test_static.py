@@ -284,7 +284,13 @@ def test_rhproj_lists_every_command_and_the_libraries() -> None:
     bases = [
         (ROOT / "rhino_plugin" / lib["library"]["base"]).resolve() for lib in proj["libraries"]
     ]
-    assert bases == [ROOT / "rhino_plugin", ROOT / "shared_schema", ROOT / "cad_maths"]
+    # The flows run the solver's workflows in Rhino: solver_service ships too.
+    assert bases == [
+        ROOT / "rhino_plugin",
+        ROOT / "shared_schema",
+        ROOT / "cad_maths",
+        ROOT / "solver_service",
+    ]
 
 
 def test_yak_manifest_has_the_required_fields() -> None:
