@@ -1,9 +1,11 @@
-"""Export the JSON Schemas of the kinematic-constants file, the site file and the search spec.
+"""Export the JSON Schemas of the constants file, the site file, the search and mechanism specs.
 
 Run ``python -m shared_schema.export`` after changing ``shared_schema.constants``,
-``shared_schema.site`` or ``shared_schema.search``; it writes
+``shared_schema.site``, ``shared_schema.search`` or ``shared_schema.spec``; it writes
 ``shared_schema/jsonschema/kinematic_constants.schema.json``,
-``shared_schema/jsonschema/site.schema.json`` and ``shared_schema/jsonschema/search.schema.json``.
+``shared_schema/jsonschema/site.schema.json``, ``shared_schema/jsonschema/search.schema.json``
+and ``shared_schema/jsonschema/spec.schema.json`` (one ``oneOf`` branch per typology, from
+``shared_schema.spec.TYPOLOGY_SPECS``).
 With ``--check`` it writes nothing and exits 1 when a file on disk differs from the models (a
 test does the same).
 """
@@ -12,24 +14,30 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Type
+
+from pydantic import BaseModel
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.io import write_atomic
 from shared_schema.search import SearchSpec
 from shared_schema.site import SiteFile
+from shared_schema.spec import SpecFile
 
 __all__ = [
     "SCHEMA_PATH",
     "SEARCH_SCHEMA_PATH",
     "SITE_SCHEMA_PATH",
+    "SPEC_SCHEMA_PATH",
     "build_schema",
     "build_search_schema",
     "build_site_schema",
+    "build_spec_schema",
     "main",
     "render_schema",
     "render_search_schema",
     "render_site_schema",
+    "render_spec_schema",
 ]
 
 #: Where the exported schema lives (shipped as package data).
@@ -40,6 +48,9 @@ SITE_SCHEMA_PATH = SCHEMA_PATH.parent / "site.schema.json"
 
 #: Where the exported search-spec schema lives.
 SEARCH_SCHEMA_PATH = SCHEMA_PATH.parent / "search.schema.json"
+
+#: Where the exported mechanism-spec schema lives.
+SPEC_SCHEMA_PATH = SCHEMA_PATH.parent / "spec.schema.json"
 
 #: JSON Schema dialect pydantic generates.
 DIALECT = "https://json-schema.org/draft/2020-12/schema"
@@ -91,6 +102,32 @@ def render_search_schema() -> str:
     return json.dumps(build_search_schema(), sort_keys=True, indent=2, ensure_ascii=False) + "\n"
 
 
+def build_spec_schema(model: Type[BaseModel] = SpecFile) -> Dict[str, Any]:
+    """Return the JSON Schema of the mechanism-spec file (draft 2020-12) as a dict.
+
+    Parameters
+    ----------
+    model : type, optional
+        The spec-file model (default ``SpecFile``; a test passes one with an extra typology).
+
+    Returns
+    -------
+    dict
+        Each mechanism is one of the typologies' models (``oneOf``). The reader also takes
+        a key of another typology left empty (null, [] or false) as absent; the schema,
+        stricter, does not list it.
+    """
+    schema = model.model_json_schema(mode="validation")
+    schema["$schema"] = DIALECT
+    schema["title"] = "rockmech mechanism spec"
+    return schema
+
+
+def render_spec_schema() -> str:
+    """Return the mechanism-spec schema as the text stored on disk."""
+    return json.dumps(build_spec_schema(), sort_keys=True, indent=2, ensure_ascii=False) + "\n"
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     """Write the schema files, or with ``--check`` report whether they are up to date.
 
@@ -125,11 +162,18 @@ def main(argv: Optional[List[str]] = None) -> int:
         default=SEARCH_SCHEMA_PATH,
         help=f"search-spec schema file (default: {SEARCH_SCHEMA_PATH})",
     )
+    parser.add_argument(
+        "--spec-output",
+        type=Path,
+        default=SPEC_SCHEMA_PATH,
+        help=f"mechanism-spec schema file (default: {SPEC_SCHEMA_PATH})",
+    )
     args = parser.parse_args(argv)
     pairs = (
         (Path(args.output), render_schema()),
         (Path(args.site_output), render_site_schema()),
         (Path(args.search_output), render_search_schema()),
+        (Path(args.spec_output), render_spec_schema()),
     )
     status = 0
     for output, text in pairs:
