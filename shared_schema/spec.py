@@ -8,6 +8,11 @@ errors. Lengths are in metres once the scene is read (file units are converted);
 written in the spec are in metres unless the file's ``units`` says otherwise (``"file"``:
 the scene's model units). Densities are in kg/m³, forces in N.
 
+Each typology has its own model with only its own keys (``TYPOLOGY_SPECS``); a mechanism is
+read by the model its ``typology`` names (``MechanismSpec``, a union keyed on ``typology``),
+and every list of typologies (``TYPOLOGIES``, the constants file's, the JSON Schemas, the
+builders and the Rhino commands) follows from these models.
+
 Python 3.9-clean: imported by Rhino 8.
 """
 
@@ -651,7 +656,8 @@ class MultiBlockSpec(MechanismBase):
     """
 
     REFUSED: ClassVar[Dict[str, str]] = {
-        key: "a multi_block mechanism takes 'blocks' and 'hinges', not 'groups', 'axis' or 'cracks'"
+        key: "a multi_block mechanism needs 'blocks' (three) and 'hinges', not 'groups', "
+        "'axis' or 'cracks'"
         for key in ("groups", "axis", "cracks")
     }
 
