@@ -56,6 +56,14 @@ SPEC_SCHEMA_PATH = SCHEMA_PATH.parent / "spec.schema.json"
 DIALECT = "https://json-schema.org/draft/2020-12/schema"
 
 
+def _schema_of(model: Type[BaseModel], title: str) -> Dict[str, Any]:
+    """Return a model's validation JSON Schema in the draft pydantic writes, with its title."""
+    schema = model.model_json_schema(mode="validation")
+    schema["$schema"] = DIALECT
+    schema["title"] = title
+    return schema
+
+
 def build_schema() -> Dict[str, Any]:
     """Return the JSON Schema of ``ConstantsFile`` as a dict.
 
@@ -65,10 +73,7 @@ def build_schema() -> Dict[str, Any]:
         A draft 2020-12 schema. It describes the canonical object form; the loader also
         accepts a bare list of mechanisms.
     """
-    schema = ConstantsFile.model_json_schema(mode="validation")
-    schema["$schema"] = DIALECT
-    schema["title"] = "rockmech kinematic-constants file"
-    return schema
+    return _schema_of(ConstantsFile, "rockmech kinematic-constants file")
 
 
 def render_schema() -> str:
@@ -78,10 +83,7 @@ def render_schema() -> str:
 
 def build_site_schema() -> Dict[str, Any]:
     """Return the JSON Schema of ``SiteFile`` (draft 2020-12) as a dict."""
-    schema = SiteFile.model_json_schema(mode="validation")
-    schema["$schema"] = DIALECT
-    schema["title"] = "rockmech site file"
-    return schema
+    return _schema_of(SiteFile, "rockmech site file")
 
 
 def render_site_schema() -> str:
@@ -91,10 +93,7 @@ def render_site_schema() -> str:
 
 def build_search_schema() -> Dict[str, Any]:
     """Return the JSON Schema of ``SearchSpec`` (draft 2020-12) as a dict."""
-    schema = SearchSpec.model_json_schema(mode="validation")
-    schema["$schema"] = DIALECT
-    schema["title"] = "rockmech search spec"
-    return schema
+    return _schema_of(SearchSpec, "rockmech search spec")
 
 
 def render_search_schema() -> str:
@@ -117,10 +116,7 @@ def build_spec_schema(model: Type[BaseModel] = SpecFile) -> Dict[str, Any]:
         a key of another typology left empty (null, [] or false) as absent; the schema,
         stricter, does not list it.
     """
-    schema = model.model_json_schema(mode="validation")
-    schema["$schema"] = DIALECT
-    schema["title"] = "rockmech mechanism spec"
-    return schema
+    return _schema_of(model, "rockmech mechanism spec")
 
 
 def render_spec_schema() -> str:
