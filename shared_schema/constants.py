@@ -45,7 +45,6 @@ The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` 
 
 import json
 import math
-import re
 from typing import (
     TYPE_CHECKING,
     Annotated,
@@ -86,6 +85,8 @@ from shared_schema.rules import (
     rotation_problem,
     schema_version_problem,
 )
+from shared_schema.spec import TYPOLOGIES, Amplification
+from shared_schema.validation import validation_lines
 
 __all__ = [
     "CONSISTENCY_RTOL",
@@ -93,7 +94,6 @@ __all__ = [
     "FLAT_SIDE_KEYS",
     "ROCKING_KINDS",
     "SCHEMA_VERSION",
-    "TYPOLOGIES",
     "Amplification",
     "ConstantsFile",
     "EtaSource",
@@ -123,9 +123,12 @@ MAX_JSON_DEPTH = 1000
 #: derived from the physical constants.
 CONSISTENCY_RTOL = 1e-9
 
-Typology = Literal[
-    "single_block", "single_block_loaded", "two_block", "multi_block", "user_defined"
-]
+if TYPE_CHECKING:
+    Typology = str
+else:
+    #: Typologies of a constants file: those of the spec (``shared_schema.spec.TYPOLOGIES``)
+    #: and ``user_defined`` (constants given by hand or from a table).
+    Typology = Literal[(*TYPOLOGIES, "user_defined")]
 Rocking = Literal["two_sided", "one_sided"]
 EtaSource = Literal[
     "housner_general",
@@ -138,8 +141,6 @@ EtaSource = Literal[
     "published",
 ]
 
-#: Allowed values of ``Mechanism.typology``.
-TYPOLOGIES: Tuple[str, ...] = get_args(Typology)
 #: Allowed values of ``Mechanism.rocking``.
 ROCKING_KINDS: Tuple[str, ...] = get_args(Rocking)
 #: Allowed values of ``Mechanism.eta_source``.
@@ -583,36 +584,6 @@ def _derive_side(side: SideConstants, which: str) -> SideConstants:
     return side.model_copy(update={"M_F": m_f, **derived})
 
 
-class Amplification(BaseModel):
-    """Data for amplifying the ground motion up the structure (theory §7, Eqs. 27-28).
-
-    Attributes
-    ----------
-    f_n : float
-        Natural frequency of the supporting structure [Hz], > 0.
-    h_e : float
-        Effective (modal) height of the supporting structure, ``sum(m h^2)/sum(m h)`` [m], > 0.
-    h : float
-        Height of the mechanism's base above the ground [m], >= 0.
-    """
-
-    model_config = ConfigDict(
-        strict=True,
-        extra="forbid",
-        allow_inf_nan=False,
-        json_schema_extra={
-            "description": "Data for amplifying the ground motion up the structure (theory §7)."
-        },
-    )
-
-    f_n: float = Field(gt=0, description="Natural frequency of the supporting structure [Hz], > 0.")
-    h_e: float = Field(
-        gt=0,
-        description="Effective (modal) height of the supporting structure [m], > 0.",
-    )
-    h: float = Field(ge=0, description="Height of the mechanism's base above the ground [m], >= 0.")
-
-
 def _check_json_safe(value: Any, path: str) -> None:
     # JsonValue lets NaN through in JSON mode, and NaN cannot be written back as JSON.
     if isinstance(value, float) and not math.isfinite(value):
@@ -989,57 +960,6 @@ class ConstantsFile(BaseModel):
                 return mech
         known = ", ".join(repr(m.id) for m in self.mechanisms)
         raise InputError(f"no mechanism with id {mechanism_id!r}; the file has {known}", "id")
-
-
-def _mechanism_label(data: Any, index: int) -> str:
-    mechanisms = data.get("mechanisms") if isinstance(data, Mapping) else None
-    if isinstance(mechanisms, Sequence) and not isinstance(mechanisms, (str, bytes)):
-        if 0 <= index < len(mechanisms):
-            item = mechanisms[index]
-            mech_id = item.get("id") if isinstance(item, Mapping) else None
-            if isinstance(mech_id, str) and mech_id:
-                return f" (id {mech_id!r})"
-    return ""
-
-
-def _format_loc(loc: Sequence[Union[int, str]], data: Any, extra: Optional[str]) -> str:
-    parts: List[Union[int, str]] = list(loc)
-    if extra:
-        index = re.fullmatch(r"\[(\d+)\]", extra)
-        parts.append(int(index.group(1)) if index else extra)
-    out = ""
-    for i, part in enumerate(parts):
-        if isinstance(part, int):
-            out += f"[{part}]"
-            if i == 1 and parts[0] == "mechanisms":
-                out += _mechanism_label(data, part)
-        else:
-            out += f".{part}" if out else str(part)
-    return out
-
-
-def validation_lines(
-    errors: Union[ValidationError, Sequence[Mapping[str, Any]]], data: Any = None
-) -> List[Tuple[str, str]]:
-    """``(path, message)`` of every error of a pydantic ``ValidationError``, in our words.
-
-    The one formatting of validation errors in rockmech: the constants file, spec files, API
-    requests, Hops inputs and settings all read the same. ``errors`` is the exception or its
-    ``errors()`` list (FastAPI's request errors). Paths look like
-    ``mechanisms[1] (id 'W2').positive.p_eq`` (the mechanism named by its id when ``data``,
-    the input as plain Python data, has one); pydantic's "Value error, " prefix is dropped
-    and an unknown key says so.
-    """
-    items = errors.errors(include_url=False) if isinstance(errors, ValidationError) else errors
-    out: List[Tuple[str, str]] = []
-    for err in items:
-        ctx = err.get("ctx") or {}
-        extra = ctx.get("field") if isinstance(ctx.get("field"), str) else None
-        msg = str(err["msg"]).replace("Value error, ", "")
-        if err["type"] == "extra_forbidden":
-            msg = "unknown key; " + msg
-        out.append((_format_loc(err["loc"], data, extra), msg))
-    return out
 
 
 def input_error_from_validation(exc: ValidationError, data: Any = None) -> InputError:

@@ -1,9 +1,11 @@
-"""Export the JSON Schemas of the kinematic-constants file, the site file and the search spec.
+"""Export the JSON Schemas of the constants file, the site file, the search and mechanism specs.
 
 Run ``python -m shared_schema.export`` after changing ``shared_schema.constants``,
-``shared_schema.site`` or ``shared_schema.search``; it writes
+``shared_schema.site``, ``shared_schema.search`` or ``shared_schema.spec``; it writes
 ``shared_schema/jsonschema/kinematic_constants.schema.json``,
-``shared_schema/jsonschema/site.schema.json`` and ``shared_schema/jsonschema/search.schema.json``.
+``shared_schema/jsonschema/site.schema.json``, ``shared_schema/jsonschema/search.schema.json``
+and ``shared_schema/jsonschema/spec.schema.json`` (one ``oneOf`` branch per typology, from
+``shared_schema.spec.TYPOLOGY_SPECS``).
 With ``--check`` it writes nothing and exits 1 when a file on disk differs from the models (a
 test does the same).
 """
@@ -12,24 +14,30 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Type
+
+from pydantic import BaseModel
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.io import write_atomic
 from shared_schema.search import SearchSpec
 from shared_schema.site import SiteFile
+from shared_schema.spec import SpecFile
 
 __all__ = [
     "SCHEMA_PATH",
     "SEARCH_SCHEMA_PATH",
     "SITE_SCHEMA_PATH",
+    "SPEC_SCHEMA_PATH",
     "build_schema",
     "build_search_schema",
     "build_site_schema",
+    "build_spec_schema",
     "main",
     "render_schema",
     "render_search_schema",
     "render_site_schema",
+    "render_spec_schema",
 ]
 
 #: Where the exported schema lives (shipped as package data).
@@ -41,8 +49,19 @@ SITE_SCHEMA_PATH = SCHEMA_PATH.parent / "site.schema.json"
 #: Where the exported search-spec schema lives.
 SEARCH_SCHEMA_PATH = SCHEMA_PATH.parent / "search.schema.json"
 
+#: Where the exported mechanism-spec schema lives.
+SPEC_SCHEMA_PATH = SCHEMA_PATH.parent / "spec.schema.json"
+
 #: JSON Schema dialect pydantic generates.
 DIALECT = "https://json-schema.org/draft/2020-12/schema"
+
+
+def _schema_of(model: Type[BaseModel], title: str) -> Dict[str, Any]:
+    """Return a model's validation JSON Schema in the draft pydantic writes, with its title."""
+    schema = model.model_json_schema(mode="validation")
+    schema["$schema"] = DIALECT
+    schema["title"] = title
+    return schema
 
 
 def build_schema() -> Dict[str, Any]:
@@ -54,10 +73,7 @@ def build_schema() -> Dict[str, Any]:
         A draft 2020-12 schema. It describes the canonical object form; the loader also
         accepts a bare list of mechanisms.
     """
-    schema = ConstantsFile.model_json_schema(mode="validation")
-    schema["$schema"] = DIALECT
-    schema["title"] = "rockmech kinematic-constants file"
-    return schema
+    return _schema_of(ConstantsFile, "rockmech kinematic-constants file")
 
 
 def render_schema() -> str:
@@ -67,10 +83,7 @@ def render_schema() -> str:
 
 def build_site_schema() -> Dict[str, Any]:
     """Return the JSON Schema of ``SiteFile`` (draft 2020-12) as a dict."""
-    schema = SiteFile.model_json_schema(mode="validation")
-    schema["$schema"] = DIALECT
-    schema["title"] = "rockmech site file"
-    return schema
+    return _schema_of(SiteFile, "rockmech site file")
 
 
 def render_site_schema() -> str:
@@ -80,15 +93,35 @@ def render_site_schema() -> str:
 
 def build_search_schema() -> Dict[str, Any]:
     """Return the JSON Schema of ``SearchSpec`` (draft 2020-12) as a dict."""
-    schema = SearchSpec.model_json_schema(mode="validation")
-    schema["$schema"] = DIALECT
-    schema["title"] = "rockmech search spec"
-    return schema
+    return _schema_of(SearchSpec, "rockmech search spec")
 
 
 def render_search_schema() -> str:
     """Return the search-spec schema as the text stored on disk."""
     return json.dumps(build_search_schema(), sort_keys=True, indent=2, ensure_ascii=False) + "\n"
+
+
+def build_spec_schema(model: Type[BaseModel] = SpecFile) -> Dict[str, Any]:
+    """Return the JSON Schema of the mechanism-spec file (draft 2020-12) as a dict.
+
+    Parameters
+    ----------
+    model : type, optional
+        The spec-file model (default ``SpecFile``; a test passes one with an extra typology).
+
+    Returns
+    -------
+    dict
+        Each mechanism is one of the typologies' models (``oneOf``). The reader also takes
+        a key of another typology left empty (null, [] or false) as absent; the schema,
+        stricter, does not list it.
+    """
+    return _schema_of(model, "rockmech mechanism spec")
+
+
+def render_spec_schema() -> str:
+    """Return the mechanism-spec schema as the text stored on disk."""
+    return json.dumps(build_spec_schema(), sort_keys=True, indent=2, ensure_ascii=False) + "\n"
 
 
 def main(argv: Optional[List[str]] = None) -> int:
@@ -125,11 +158,18 @@ def main(argv: Optional[List[str]] = None) -> int:
         default=SEARCH_SCHEMA_PATH,
         help=f"search-spec schema file (default: {SEARCH_SCHEMA_PATH})",
     )
+    parser.add_argument(
+        "--spec-output",
+        type=Path,
+        default=SPEC_SCHEMA_PATH,
+        help=f"mechanism-spec schema file (default: {SPEC_SCHEMA_PATH})",
+    )
     args = parser.parse_args(argv)
     pairs = (
         (Path(args.output), render_schema()),
         (Path(args.site_output), render_site_schema()),
         (Path(args.search_output), render_search_schema()),
+        (Path(args.spec_output), render_spec_schema()),
     )
     status = 0
     for output, text in pairs:

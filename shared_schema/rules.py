@@ -55,7 +55,6 @@ __all__ = [
     "SEARCH_DIRECTIONS",
     "SEARCH_FAMILIES",
     "SF_METHODS",
-    "TYPOLOGIES",
     "G",
     "QuantityRange",
     "accel_max",
@@ -81,10 +80,6 @@ __all__ = [
 
 #: Standard gravity [m/s²].
 G = 9.80665
-
-#: Mechanism typologies a spec can ask for; each has a builder in
-#: ``cad_maths.mechanisms.build.MECHANISMS`` (constants files also take ``user_defined``).
-TYPOLOGIES: Tuple[str, ...] = ("single_block", "single_block_loaded", "two_block", "multi_block")
 
 #: Mechanism families ``rockmech search`` enumerates (issue #31): overturning of a whole
 #: façade, of its part above a hinge line, with wedges of its return walls, vertical

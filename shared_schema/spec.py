@@ -8,23 +8,43 @@ errors. Lengths are in metres once the scene is read (file units are converted);
 written in the spec are in metres unless the file's ``units`` says otherwise (``"file"``:
 the scene's model units). Densities are in kg/m³, forces in N.
 
+Each typology has its own model with only its own keys (``TYPOLOGY_SPECS``); a mechanism is
+read by the model its ``typology`` names (``MechanismSpec``, a union keyed on ``typology``),
+and every list of typologies (``TYPOLOGIES``, the constants file's, the JSON Schemas, the
+builders and the Rhino commands) follows from these models.
+
 Python 3.9-clean: imported by Rhino 8.
 """
 
 import json
-from typing import Any, Dict, List, Literal, Optional, Union
+from typing import (
+    TYPE_CHECKING,
+    Annotated,
+    Any,
+    ClassVar,
+    Dict,
+    List,
+    Literal,
+    Optional,
+    Sequence,
+    Tuple,
+    Type,
+    Union,
+    get_args,
+)
 
 from pydantic import (
     BaseModel,
     ConfigDict,
+    Discriminator,
     Field,
+    Tag,
     ValidationError,
     ValidationInfo,
     field_validator,
     model_validator,
 )
 
-from shared_schema.constants import Amplification, validation_lines
 from shared_schema.errors import InputError
 from shared_schema.rules import (
     control_character,
@@ -33,23 +53,35 @@ from shared_schema.rules import (
     quantity_note,
     quantity_problem,
 )
+from shared_schema.validation import validation_lines
 
 __all__ = [
+    "DEFAULT_TYPOLOGY",
     "SPEC_VERSION",
     "SPEC_VERSIONS",
     "TRIBUTARY_DEFAULT",
+    "TYPOLOGIES",
+    "TYPOLOGY_SPECS",
+    "Amplification",
     "Axis",
     "Crack",
     "DensityGroup",
     "Floor",
     "Hinges",
+    "LoadedWallSpec",
+    "MechanismBase",
     "MechanismSpec",
+    "MultiBlockSpec",
     "Overburden",
     "Roof",
+    "SingleBlockSpec",
     "SpecFile",
     "TieBar",
+    "TwoBlockSpec",
     "Vault",
+    "mechanism_union",
     "parse_spec",
+    "typology_of",
 ]
 
 #: Format version of spec files written today; a file without ``spec_version`` is read as it.
@@ -106,6 +138,39 @@ def _once(selectors: List[Selector]) -> List[Selector]:
             "(its mass, I0 and Q doubled): list each object once"
         )
     return selectors
+
+
+class Amplification(BaseModel):
+    """Data for amplifying the ground motion up the structure (theory §7, Eqs. 27-28).
+
+    Written in a spec and passed through to the kinematic-constants file
+    (``shared_schema.constants``).
+
+    Attributes
+    ----------
+    f_n : float
+        Natural frequency of the supporting structure [Hz], > 0.
+    h_e : float
+        Effective (modal) height of the supporting structure, ``sum(m h^2)/sum(m h)`` [m], > 0.
+    h : float
+        Height of the mechanism's base above the ground [m], >= 0.
+    """
+
+    model_config = ConfigDict(
+        strict=True,
+        extra="forbid",
+        allow_inf_nan=False,
+        json_schema_extra={
+            "description": "Data for amplifying the ground motion up the structure (theory §7)."
+        },
+    )
+
+    f_n: float = Field(gt=0, description="Natural frequency of the supporting structure [Hz], > 0.")
+    h_e: float = Field(
+        gt=0,
+        description="Effective (modal) height of the supporting structure [m], > 0.",
+    )
+    h: float = Field(ge=0, description="Height of the mechanism's base above the ground [m], >= 0.")
 
 
 class _Weighed(BaseModel):
@@ -309,69 +374,231 @@ class Hinges(BaseModel):
         return value
 
 
-class MechanismSpec(BaseModel):
-    """One mechanism: its objects, axis, cracks and added elements.
+def _either(names: Sequence[str]) -> str:
+    """Return the names quoted and joined: ``'a'``, ``'a' or 'b'``, ``'a', 'b' or 'c'``."""
+    quoted = [repr(n) for n in names]
+    return quoted[0] if len(quoted) == 1 else f"{', '.join(quoted[:-1])} or {quoted[-1]}"
+
+
+def _empty(value: Any) -> bool:
+    """Tell whether a spec value says nothing: null, false or an empty list."""
+    return value is None or value is False or (isinstance(value, list) and not value)
+
+
+class MechanismBase(BaseModel):
+    """What every mechanism of a spec has, whatever its typology.
+
+    Each typology is a subclass (its own fields and checks) listed in ``TYPOLOGY_SPECS``;
+    ``MechanismSpec`` tells them apart by ``typology``.
 
     Attributes
     ----------
     id, name : str
         Identifier and description.
-    typology : {"single_block", "single_block_loaded"}
-        Plain block (A1) or wall with added masses and forces (A2).
+    typology : str
+        The typology (each subclass narrows it to its own name).
     rocking : {"two_sided", "one_sided"}
         Rocking kind.
-    groups : list of DensityGroup
-        The body: one group per density.
-    axis : Axis
-        Rotation axis for positive rotation (the collapse direction).
-    axis_negative : Axis, optional
-        Axis of the other rocking side (two-sided ``single_block``); derived from the base
-        footprint if absent. Refused for ``two_block``, whose negative hinges are the mirror
-        of O, C, H about the wall's mid-plane.
-    hinges, hinges_negative : Hinges, optional
-        ``multi_block``: the four hinges of the positive set and of the negative set. The
-        negative set is optional for two-sided rocking: when absent it is derived (each
-        hinge reflected across its column at its height) and a warning gives the points.
-    allow_non_horizontal_axis : bool
-        Accept an inclined axis (off by default).
-    cracks : list of Crack
-        Planes cutting off the collapsing part.
     eta : float, optional
         Coefficient of restitution given by the user (overrides the rules).
     eta_rule : str, optional
         One-sided rule: "one_sided_eq26" (default), "one_sided_alt", "one_sided_energy".
     amplification : Amplification, optional
         Passed through to the constants file.
-    floors, roof, vaults, tie_bars
-        Added elements (``single_block_loaded`` only); declare only those that exist.
-    hinge_height : float, optional
-        ``two_block``: the intermediate hinge's height above the base (default Eq. 17).
     """
 
     model_config = _STRICT
+    #: Keys of other typologies this one refuses with its own reason (key -> reason); any
+    #: other key of another typology is refused naming the typologies that take it.
+    REFUSED: ClassVar[Dict[str, str]] = {}
+
     id: str = Field(min_length=1)
     name: Optional[str] = None
-    typology: Literal["single_block", "single_block_loaded", "two_block", "multi_block"] = (
-        "single_block"
-    )
+    typology: str
     rocking: Literal["two_sided", "one_sided"] = "two_sided"
-    groups: Optional[List[DensityGroup]] = Field(default=None, min_length=1)
-    axis: Optional[Axis] = None
-    blocks: Optional[List[List[DensityGroup]]] = Field(
-        default=None, min_length=3, max_length=3, description="multi_block: three blocks."
-    )
-    hinges: Optional[Hinges] = None
-    hinges_negative: Optional[Hinges] = None
-    axis_negative: Optional[Axis] = None
-    allow_non_horizontal_axis: bool = False
-    cracks: List[Crack] = Field(default_factory=list)
     eta: Optional[float] = Field(default=None, ge=-1, le=1)
     eta_rule: Optional[Literal["one_sided_eq26", "one_sided_alt", "one_sided_energy"]] = None
     amplification: Optional[Amplification] = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _own_keys(cls, data: Any) -> Any:
+        """Refuse a key of another typology, saying which typology takes it.
+
+        A key of another typology left empty (null, [] or false: what a writer of every
+        field puts there) says nothing and is read as absent, as the files have always been.
+        """
+        if not isinstance(data, dict):
+            return data
+        others = [k for k in data if isinstance(k, str) and k not in cls.model_fields]
+        known = {k for m in TYPOLOGY_SPECS for k in m.model_fields}
+        empty = [k for k in others if k in known and _empty(data[k])]
+        if empty:
+            data = {k: v for k, v in data.items() if k not in empty}
+        foreign = [k for k in others if k not in empty]
+        for key in foreign:
+            if key in cls.REFUSED:
+                raise ValueError(cls.REFUSED[key])
+        owners: Dict[str, List[str]] = {}
+        for key in foreign:
+            takers = [typology_of(m) for m in TYPOLOGY_SPECS if key in m.model_fields]
+            if takers:  # a key no typology takes is an unknown key (extra="forbid")
+                owners.setdefault(_either(takers), []).append(key)
+        if owners:
+            raise ValueError(
+                "; ".join(
+                    f"{_either(keys)} {'needs' if len(keys) == 1 else 'need'} typology {who}"
+                    for who, keys in owners.items()
+                )
+            )
+        return data
+
+    @field_validator("id", "name")
+    @classmethod
+    def _check_printable(cls, value: Optional[str]) -> Optional[str]:
+        # issue #25: the id becomes the constants file's (printable text, as it checks)
+        bad = None if value is None else control_character(value)
+        if bad is not None:
+            raise ValueError(f"must be printable text, got the control character {bad}")
+        return value
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "MechanismBase":
+        if self.eta is not None:
+            problem = eta_problem(self.eta, self.rocking == "one_sided")
+            if problem is not None:
+                raise ValueError(f"eta {problem}")
+        if self.eta_rule is not None and self.rocking != "one_sided":
+            raise ValueError("eta_rule applies to one-sided rocking only")
+        first: List[Any] = []  # (selector, group path), in spec order
+        for path, group in self.body_groups():
+            for sel in group.objects:
+                earlier = [p for s, p in first if s == sel]
+                if earlier:
+                    raise ValueError(
+                        f"{sel!r} is listed in two density groups, {earlier[0]} and {path}; it "
+                        "would be counted twice (its mass, I0 and Q doubled): list each object "
+                        "in one group"
+                    )
+                first.append((sel, path))
+        return self
+
+    def body_groups(self) -> List[Tuple[str, DensityGroup]]:
+        """Return the density groups of the moving body, each with its path in the spec."""
+        return []
+
+    def quantities(self) -> List[Tuple[float, str, str]]:
+        """``(value, kind, path)`` of the physical inputs ``rules.QUANTITY_RANGES`` bounds."""
+        return [(g.density, "density", f"{path}.density") for path, g in self.body_groups()]
+
+    def plausibility_notes(self) -> List[str]:
+        """Warnings for admissible but implausible inputs (``rules.QUANTITY_RANGES``).
+
+        Each names the field (``W1.groups[0].density``) and what the value most likely
+        means; the builders add them to the mechanism's warnings.
+        """
+        notes = [quantity_note(v, kind, f"{self.id}.{name}") for v, kind, name in self.quantities()]
+        return [n for n in notes if n is not None]
+
+
+class _Walled(MechanismBase):
+    """A body of density groups turning about an axis (single, loaded and two-block walls).
+
+    Attributes
+    ----------
+    groups : list of DensityGroup
+        The body: one group per density.
+    axis : Axis
+        Rotation axis for positive rotation (the collapse direction).
+    allow_non_horizontal_axis : bool
+        Accept an inclined axis (off by default).
+    """
+
+    groups: List[DensityGroup] = Field(min_length=1)
+    axis: Axis
+    allow_non_horizontal_axis: bool = False
+
+    def body_groups(self) -> List[Tuple[str, DensityGroup]]:
+        return [(f"groups[{k}]", g) for k, g in enumerate(self.groups)]
+
+
+class _Cut(_Walled):
+    """A body cut off by cracks, rocking about its axis or, two-sided, about a second one.
+
+    Attributes
+    ----------
+    axis_negative : Axis, optional
+        Axis of the other rocking side (two-sided); derived from the base footprint if absent.
+    cracks : list of Crack
+        Planes cutting off the collapsing part.
+    """
+
+    axis_negative: Optional[Axis] = None
+    cracks: List[Crack] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _one_axis_one_sided(self) -> "_Cut":
+        if self.axis_negative is not None and self.rocking == "one_sided":
+            raise ValueError("axis_negative applies to two-sided rocking only")
+        return self
+
+
+class SingleBlockSpec(_Cut):
+    """A single rocking block (A1, docs/theory.md §2.1); the typology of a spec that names none."""
+
+    typology: Literal["single_block"] = "single_block"
+
+
+class LoadedWallSpec(_Cut):
+    """A wall with added masses and forces (A2, docs/theory.md §2.2).
+
+    Attributes
+    ----------
+    floors, roof, vaults, tie_bars
+        The added elements; declare only those that exist.
+    """
+
+    typology: Literal["single_block_loaded"]
     floors: Optional[List[Floor]] = None
     roof: Optional[Roof] = None
     vaults: Optional[List[Vault]] = None
     tie_bars: Optional[List[TieBar]] = None
+
+    def quantities(self) -> List[Tuple[float, str, str]]:
+        """Return the body's densities and the added elements' densities and forces."""
+        values = super().quantities()
+        for k, fl in enumerate(self.floors or []):
+            values.append((fl.density, "density", f"floors[{k}].density"))
+        if self.roof is not None:
+            values.append((self.roof.density, "density", "roof.density"))
+        for k, tie in enumerate(self.tie_bars or []):
+            values.append((tie.force, "force", f"tie_bars[{k}].force"))
+        return values
+
+
+class TwoBlockSpec(_Walled):
+    """A wall restrained top and bottom that folds about an intermediate hinge (A3, §2.3).
+
+    Attributes
+    ----------
+    overburden : Overburden, optional
+        What loads the top of the wall.
+    f_mt : float, optional
+        Mortar tensile strength [Pa] (default 0).
+    hinge_height : float, optional
+        Height of the intermediate hinge above the base (default Eq. 17).
+    eccentricity : {"static_moment", "potential"}, optional
+        How an eccentric overburden enters.
+    """
+
+    REFUSED: ClassVar[Dict[str, str]] = {
+        "cracks": "a two-block wall is split at the hinge height; give no cracks",
+        "axis_negative": "axis_negative does not apply to a two_block wall: its negative hinges "
+        "O', C', H' are always the mirror of O, C, H about the wall's mid-plane (base inner "
+        "edge, outer face at h_c, top inner edge)",
+    }
+
+    typology: Literal["two_block"]
     overburden: Optional[Overburden] = None
     f_mt: Optional[float] = Field(
         default=None, ge=0, description="Mortar tensile strength [Pa] (two_block; default 0)."
@@ -393,99 +620,18 @@ class MechanismSpec(BaseModel):
     def _check_f_mt(cls, value: Optional[float]) -> Optional[float]:
         return _in_range(value, "tensile_strength", zero=True)
 
-    @field_validator("id", "name")
-    @classmethod
-    def _check_printable(cls, value: Optional[str]) -> Optional[str]:
-        # issue #25: the id becomes the constants file's (printable text, as it checks)
-        bad = None if value is None else control_character(value)
-        if bad is not None:
-            raise ValueError(f"must be printable text, got the control character {bad}")
-        return value
-
     @model_validator(mode="after")
-    def _consistent(self) -> "MechanismSpec":
-        if self.typology == "multi_block":
-            if self.blocks is None or self.hinges is None:
-                raise ValueError("a multi_block mechanism needs 'blocks' (three) and 'hinges'")
-            if self.groups is not None or self.axis is not None or self.cracks:
-                raise ValueError(
-                    "a multi_block mechanism takes 'blocks' and 'hinges', not "
-                    "'groups', 'axis' or 'cracks'"
-                )
-            if self.rocking == "one_sided" and self.hinges_negative is not None:
-                raise ValueError("hinges_negative applies to two-sided rocking only")
-        else:
-            if self.groups is None or self.axis is None:
-                raise ValueError(f"a {self.typology} mechanism needs 'groups' and 'axis'")
-            if self.blocks is not None or self.hinges is not None:
-                raise ValueError("'blocks' and 'hinges' need typology 'multi_block'")
-        added = [k for k in ("floors", "roof", "vaults", "tie_bars") if getattr(self, k)]
-        if added and self.typology != "single_block_loaded":
-            raise ValueError(
-                f"added elements ({', '.join(added)}) need typology 'single_block_loaded'"
-            )
-        if self.eta is not None:
-            problem = eta_problem(self.eta, self.rocking == "one_sided")
-            if problem is not None:
-                raise ValueError(f"eta {problem}")
-        two = [
-            k
-            for k in ("overburden", "f_mt", "eccentricity", "hinge_height")
-            if getattr(self, k) is not None
-        ]
-        if two and self.typology != "two_block":
-            raise ValueError(f"{', '.join(two)} need typology 'two_block'")
-        if self.typology == "two_block" and self.cracks:
-            raise ValueError("a two-block wall is split at the hinge height; give no cracks")
+    def _one_hinge_rule(self) -> "TwoBlockSpec":
         if self.hinge_height is not None and self.f_mt:
             raise ValueError(
                 "give either 'f_mt' (the hinge height then follows Eq. 17) or 'hinge_height', "
                 "not both"
             )
-        if self.eta_rule is not None and self.rocking != "one_sided":
-            raise ValueError("eta_rule applies to one-sided rocking only")
-        if self.axis_negative is not None and self.rocking == "one_sided":
-            raise ValueError("axis_negative applies to two-sided rocking only")
-        body = [(f"groups[{k}]", g) for k, g in enumerate(self.groups or [])]
-        for b, block in enumerate(self.blocks or []):
-            body += [(f"blocks[{b}][{k}]", g) for k, g in enumerate(block)]
-        first: List[Any] = []  # (selector, group path), in spec order
-        for path, group in body:
-            for sel in group.objects:
-                earlier = [p for s, p in first if s == sel]
-                if earlier:
-                    raise ValueError(
-                        f"{sel!r} is listed in two density groups, {earlier[0]} and {path}; it "
-                        "would be counted twice (its mass, I0 and Q doubled): list each object "
-                        "in one group"
-                    )
-                first.append((sel, path))
-        if self.axis_negative is not None and self.typology == "two_block":
-            raise ValueError(
-                "axis_negative does not apply to a two_block wall: its negative hinges O', C', "
-                "H' are always the mirror of O, C, H about the wall's mid-plane (base inner "
-                "edge, outer face at h_c, top inner edge)"
-            )
         return self
 
-    def plausibility_notes(self) -> List[str]:
-        """Warnings for admissible but implausible inputs (``rules.QUANTITY_RANGES``).
-
-        Each names the field (``W1.groups[0].density``) and what the value most likely
-        means; the builders add them to the mechanism's warnings.
-        """
-        values: List[Any] = []
-        for k, g in enumerate(self.groups or []):
-            values.append((g.density, "density", f"groups[{k}].density"))
-        for b, block in enumerate(self.blocks or []):
-            for k, g in enumerate(block):
-                values.append((g.density, "density", f"blocks[{b}][{k}].density"))
-        for k, fl in enumerate(self.floors or []):
-            values.append((fl.density, "density", f"floors[{k}].density"))
-        if self.roof is not None:
-            values.append((self.roof.density, "density", "roof.density"))
-        for k, tie in enumerate(self.tie_bars or []):
-            values.append((tie.force, "force", f"tie_bars[{k}].force"))
+    def quantities(self) -> List[Tuple[float, str, str]]:
+        """Return the body's densities, the overburden's density or force, and f_mt."""
+        values = super().quantities()
         ob = self.overburden
         if ob is not None and ob.density is not None:
             values.append((ob.density, "density", "overburden.density"))
@@ -493,8 +639,94 @@ class MechanismSpec(BaseModel):
             values.append((ob.force, "force", "overburden.force"))
         if self.f_mt:
             values.append((self.f_mt, "tensile_strength", "f_mt"))
-        notes = [quantity_note(v, kind, f"{self.id}.{name}") for v, kind, name in values]
-        return [n for n in notes if n is not None]
+        return values
+
+
+class MultiBlockSpec(MechanismBase):
+    """Three blocks joined by four hinges (A4, docs/theory.md §2.4).
+
+    Attributes
+    ----------
+    blocks : list of three lists of DensityGroup
+        Block 1 (AB), block 2 (BC), block 3 (DC).
+    hinges, hinges_negative : Hinges
+        The four hinges of the positive set and, optionally, of the negative set. The
+        negative set is optional for two-sided rocking: when absent it is derived (each
+        hinge reflected across its column at its height) and a warning gives the points.
+    """
+
+    REFUSED: ClassVar[Dict[str, str]] = {
+        key: "a multi_block mechanism needs 'blocks' (three) and 'hinges', not 'groups', "
+        "'axis' or 'cracks'"
+        for key in ("groups", "axis", "cracks")
+    }
+
+    typology: Literal["multi_block"]
+    blocks: List[List[DensityGroup]] = Field(
+        min_length=3, max_length=3, description="multi_block: three blocks."
+    )
+    hinges: Hinges
+    hinges_negative: Optional[Hinges] = None
+
+    @model_validator(mode="after")
+    def _negative_two_sided(self) -> "MultiBlockSpec":
+        if self.rocking == "one_sided" and self.hinges_negative is not None:
+            raise ValueError("hinges_negative applies to two-sided rocking only")
+        return self
+
+    def body_groups(self) -> List[Tuple[str, DensityGroup]]:
+        """Return the density groups of the three blocks, each with its path."""
+        return [
+            (f"blocks[{b}][{k}]", g)
+            for b, block in enumerate(self.blocks)
+            for k, g in enumerate(block)
+        ]
+
+
+def typology_of(model: Type[MechanismBase]) -> str:
+    """Return the typology a spec model stands for: its ``typology`` literal."""
+    names = get_args(model.model_fields["typology"].annotation)
+    if len(names) != 1:
+        raise TypeError(f"{model.__name__}.typology must be one Literal name, got {names!r}")
+    return str(names[0])
+
+
+#: One spec model per typology, in the order every list of typologies follows. A new
+#: typology is its model (a ``MechanismBase`` with its own ``typology`` literal) and one
+#: entry here; its builder goes in ``cad_maths.mechanisms.build.MECHANISMS``.
+TYPOLOGY_SPECS: Tuple[Type[MechanismBase], ...] = (
+    SingleBlockSpec,
+    LoadedWallSpec,
+    TwoBlockSpec,
+    MultiBlockSpec,
+)
+#: Mechanism typologies a spec can ask for (constants files also take ``user_defined``).
+TYPOLOGIES: Tuple[str, ...] = tuple(typology_of(m) for m in TYPOLOGY_SPECS)
+#: The typology of a mechanism that names none: the first, whose model alone has a default.
+DEFAULT_TYPOLOGY = TYPOLOGIES[0]
+
+
+def _typology_tag(value: Any) -> Optional[str]:
+    """Return the union's tag of a mechanism: its ``typology`` (default ``single_block``)."""
+    if isinstance(value, dict):
+        tag = value.get("typology", DEFAULT_TYPOLOGY)
+        return tag if isinstance(tag, str) else None
+    if isinstance(value, MechanismBase):
+        return value.typology
+    return DEFAULT_TYPOLOGY  # not an object: the default model says so ("should be an object")
+
+
+def mechanism_union(models: Sequence[Type[MechanismBase]]) -> Any:
+    """Return the pydantic type of a spec's mechanism: one of ``models``, by ``typology``."""
+    choices = tuple(Annotated[m, Tag(typology_of(m))] for m in models)
+    return Annotated[Union[choices], Discriminator(_typology_tag)]
+
+
+if TYPE_CHECKING:
+    #: Any typology's spec model (``TYPOLOGY_SPECS``).
+    MechanismSpec = MechanismBase
+else:
+    MechanismSpec = mechanism_union(TYPOLOGY_SPECS)
 
 
 class SpecFile(BaseModel):
@@ -569,5 +801,22 @@ def parse_spec(text: Union[str, bytes], source: str = "spec") -> SpecFile:
             data = json.loads(text)
         except (ValueError, RecursionError):  # pydantic has named the error; a deep nest too
             pass
-        lines = [f"{path}: {msg}" if path else msg for path, msg in validation_lines(exc, data)]
+        errors = [_plain_error(err) for err in exc.errors(include_url=False)]
+        lines = [f"{path}: {msg}" if path else msg for path, msg in validation_lines(errors, data)]
         raise InputError("\n".join(lines), source) from None
+
+
+def _plain_error(err: Any) -> Any:
+    """Return a pydantic error of a spec as the flat model of the file reads it.
+
+    The union of typologies puts its tag in the path (``mechanisms.0.two_block.f_mt``): the
+    tag is left out, since the mechanism's own ``typology`` says it. A typology no model
+    takes is an error of the field ``typology`` listing the typologies.
+    """
+    loc = tuple(err["loc"])
+    if len(loc) >= 2 and loc[0] == "mechanisms" and isinstance(loc[1], int):
+        if err["type"] in ("union_tag_invalid", "union_tag_not_found") and len(loc) == 2:
+            return dict(err, loc=(*loc, "typology"), msg=f"Input should be {_either(TYPOLOGIES)}")
+        if len(loc) >= 3 and loc[2] in TYPOLOGIES:
+            return dict(err, loc=loc[:2] + loc[3:])
+    return err

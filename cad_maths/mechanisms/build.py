@@ -9,7 +9,7 @@ options, warnings from mesh repair).
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Type
 
 import numpy as np
 from pydantic import ValidationError
@@ -22,10 +22,19 @@ from shared_schema.constants import ConstantsFile, input_error_from_validation
 from shared_schema.errors import GeometryError, InputError, RockmechError
 from shared_schema.extras import MissingExtra
 from shared_schema.rules import eta_range
+from shared_schema.spec import (
+    LoadedWallSpec,
+    MechanismBase,
+    MultiBlockSpec,
+    SingleBlockSpec,
+    TwoBlockSpec,
+    typology_of,
+)
 
 __all__ = [
     "MECHANISMS",
     "MechanismFailure",
+    "TypologyEntry",
     "constants_and_failures",
     "constants_from_spec",
     "failures_error",
@@ -54,18 +63,6 @@ def _mirror_image(positive: Dict[str, float], negative: Dict[str, float]) -> boo
     )
 
 
-#: Mechanism typologies and their builders. Adding a typology: one module with a builder
-#: returning ``MechanismSides``, one line here, its name in ``shared_schema.rules.TYPOLOGIES``
-#: (the spec and constants schemas take it from there), then its flow and command
-#: (CONTRIBUTING.md).
-MECHANISMS: Dict[str, Builder] = {
-    "single_block": single.build_single_block,
-    "single_block_loaded": loaded.build_loaded_wall,
-    "two_block": two_block_cad.build_two_block,
-    "multi_block": multi_block_cad.build_multi_block,
-}
-
-
 #: Relative error on lam (and p_eq²) accepted from the horizontal-axis formulas when an
 #: inclined axis is allowed (``allow_non_horizontal_axis``).
 TILT_RTOL = 1e-3
@@ -74,15 +71,55 @@ TILT_RTOL = 1e-3
 MAX_AXIS_TILT = 0.5 * math.pi * math.sqrt(2.0 * TILT_RTOL)
 
 
-def _axis_tilt(spec: Any, scene: Any) -> float:
+@dataclass(frozen=True)
+class TypologyEntry:
+    """One typology of the registry: its spec model and its builder.
+
+    Attributes
+    ----------
+    spec : type
+        Its spec model (``shared_schema.spec.TYPOLOGY_SPECS``); its ``typology`` literal is
+        the typology's name.
+    build : Builder
+        ``(spec, scene, thrust_table) -> MechanismSides``.
+    largest_tilt : float
+        Largest tilt of its rocking axis from the horizontal the builder bears when the spec
+        allows an inclined axis [rad].
+    """
+
+    spec: Type[MechanismBase]
+    build: Builder
+    largest_tilt: float = MAX_AXIS_TILT
+
+    @property
+    def typology(self) -> str:
+        """The typology's name (the spec model's ``typology`` literal)."""
+        return typology_of(self.spec)
+
+
+#: Mechanism typologies and their builders, one line each, keyed by the spec model's
+#: ``typology``. Adding a typology: its spec model in ``shared_schema.spec``
+#: (``TYPOLOGY_SPECS``), a module with its builder returning ``MechanismSides``, one line
+#: here, then its Rhino flow and command (CONTRIBUTING.md).
+MECHANISMS: Dict[str, TypologyEntry] = {
+    entry.typology: entry
+    for entry in (
+        TypologyEntry(SingleBlockSpec, single.build_single_block),
+        TypologyEntry(LoadedWallSpec, loaded.build_loaded_wall),
+        TypologyEntry(TwoBlockSpec, two_block_cad.build_two_block, largest_tilt=AXIS_TILT_TOL),
+        TypologyEntry(MultiBlockSpec, multi_block_cad.build_multi_block),
+    )
+}
+
+
+def _axis_tilt(spec: Any, scene: Any, largest: float) -> float:
     """Largest tilt from the horizontal of the spec's rocking axes [rad] (0 without axes).
 
     Raises
     ------
     GeometryError
-        An inclined axis is allowed but tilted beyond ``MAX_AXIS_TILT``, or a two-block
-        wall's axis is tilted beyond ``AXIS_TILT_TOL`` (refused up front, before any solid
-        is cut).
+        An inclined axis is allowed but tilted beyond ``largest``, the typology's
+        ``TypologyEntry.largest_tilt`` (refused up front, before any solid is cut).
     """
     tilts = [0.0]
     for key in ("axis", "axis_negative"):
@@ -93,10 +130,9 @@ def _axis_tilt(spec: Any, scene: Any) -> float:
         u = (end - start) / float(np.linalg.norm(end - start))
         tilts.append(math.asin(min(abs(float(u[2])), 1.0)))
     tilt = max(tilts)
-    if tilt <= AXIS_TILT_TOL or not spec.allow_non_horizontal_axis:
+    if tilt <= AXIS_TILT_TOL or not getattr(spec, "allow_non_horizontal_axis", False):
         return tilt  # the builder refuses a tilt beyond AXIS_TILT_TOL without the flag
-    if spec.typology == "two_block" or tilt > MAX_AXIS_TILT:
-        largest = AXIS_TILT_TOL if spec.typology == "two_block" else MAX_AXIS_TILT
+    if tilt > largest:
         raise GeometryError(
             f"{spec.id}.axis: the axis is inclined by {math.degrees(tilt):.3f} deg; the "
             f"largest tilt supported for a {spec.typology} is {math.degrees(largest):.3f} deg. "
@@ -142,14 +178,14 @@ def _check_tilt(spec: Any, tilt: float, geometry: Dict[str, Any]) -> str:
 
 def mechanism_entry(spec: Any, scene: Any, table: Any) -> Dict[str, Any]:
     """One mechanism of the constants file from its spec (through ``MECHANISMS``)."""
-    builder = MECHANISMS.get(spec.typology)
-    if builder is None:
+    typology = MECHANISMS.get(spec.typology)
+    if typology is None:
         raise InputError(
             f"no builder for typology {spec.typology!r}; known: {sorted(MECHANISMS)}",
             f"{spec.id}.typology",
         )
-    tilt = _axis_tilt(spec, scene)
-    sides = builder(spec, scene, table)
+    tilt = _axis_tilt(spec, scene, typology.largest_tilt)
+    sides = typology.build(spec, scene, table)
     if tilt > AXIS_TILT_TOL:
         sides.warnings.append(_check_tilt(spec, tilt, sides.geometry))
     # issue #14: admissible but implausible inputs are said, not silently used
@@ -288,17 +324,21 @@ def _scaled(p: Any, scale: float) -> Any:
 
 
 def _points_in_metres(spec: Any, scale: float) -> Any:
-    """Return the mechanism spec with its written points (axes, cracks, hinges) in metres."""
+    """Return the mechanism spec with its written points (axes, cracks, hinges) in metres.
+
+    Each typology has only some of these fields (``shared_schema.spec.TYPOLOGY_SPECS``).
+    """
     if scale == 1.0:
         return spec
     update: Dict[str, Any] = {}
     for key in ("axis", "axis_negative"):
-        axis = getattr(spec, key)
+        axis = getattr(spec, key, None)
         if axis is not None and axis.start is not None:
             update[key] = axis.model_copy(
                 update={"start": _scaled(axis.start, scale), "end": _scaled(axis.end, scale)}
             )
-    if any(c.points is not None or c.keep_point is not None for c in spec.cracks):
+    cracks = getattr(spec, "cracks", [])
+    if any(c.points is not None or c.keep_point is not None for c in cracks):
         update["cracks"] = [
             c.model_copy(
                 update={
@@ -306,10 +346,10 @@ def _points_in_metres(spec: Any, scale: float) -> Any:
                     "keep_point": None if c.keep_point is None else _scaled(c.keep_point, scale),
                 }
             )
-            for c in spec.cracks
+            for c in cracks
         ]
     for key in ("hinges", "hinges_negative"):
-        hinges = getattr(spec, key)
+        hinges = getattr(spec, key, None)
         if hinges is not None:
             update[key] = hinges.model_copy(
                 update={n: _scaled(getattr(hinges, n), scale) for n in ("A", "B", "C", "D")}
@@ -320,11 +360,15 @@ def _points_in_metres(spec: Any, scale: float) -> Any:
 
 
 def _written_points(spec: Any) -> bool:
-    axes = [a for a in (spec.axis, spec.axis_negative) if a is not None and a.start is not None]
-    hinges = [h for h in (spec.hinges, spec.hinges_negative) if h is not None]
+    axes = [getattr(spec, k, None) for k in ("axis", "axis_negative")]
+    axes = [a for a in axes if a is not None and a.start is not None]
+    hinges = [getattr(spec, k, None) for k in ("hinges", "hinges_negative")]
+    hinges = [h for h in hinges if h is not None]
     return bool(
         axes
-        or any(c.points is not None or c.keep_point is not None for c in spec.cracks)
+        or any(
+            c.points is not None or c.keep_point is not None for c in getattr(spec, "cracks", [])
+        )
         or any(isinstance(getattr(h, n), list) for h in hinges for n in ("A", "B", "C", "D"))
     )
 
@@ -345,9 +389,8 @@ def _body_size_note(spec: Any, scene: Any) -> Optional[str]:
     Where the axis, a crack or a hinge misses a body of kilometres or millimetres, the
     scene's length unit is the likely cause, so the error says it (#25).
     """
-    groups = list(spec.groups or []) + [g for block in spec.blocks or [] for g in block]
     ids = []
-    for group in groups:
+    for _, group in spec.body_groups():
         for sel in group.objects:
             try:
                 ids += [obj.id for obj in scene.find(sel)]
@@ -400,7 +443,7 @@ def constants_and_failures(
                     "scene": scene_name,
                     "spec": spec_name,
                     "scene_units": scene.units,
-                    "thrust_table": table.name if spec.vaults else None,
+                    "thrust_table": table.name if getattr(spec, "vaults", None) else None,
                 }
             )
             if entry["provenance"]["thrust_table"] is None:

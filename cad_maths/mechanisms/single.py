@@ -149,7 +149,7 @@ def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
             warnings.extend(notes)
             solids.append((mesh, group.density, obj.id))
             ids.append(obj.id)
-    for k, crack in enumerate(spec.cracks):
+    for k, crack in enumerate(getattr(spec, "cracks", [])):  # a two-block wall has none
         point, normal = _crack_plane(scene, crack, f"{where}.cracks[{k}]")
         keep = crack.keep
         said = f"keep = {crack.keep!r}"

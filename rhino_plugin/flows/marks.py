@@ -55,8 +55,9 @@ def check_marks(spec_file: Any, scene: Any, constants: Any) -> List[Mark]:
     marks: List[Mark] = []
     for spec, mech in zip(spec_file.mechanisms, constants.mechanisms):
         geo = mech.geometry or {}
-        if spec.axis is not None:
-            start, end = resolve_axis(scene, spec.axis, f"{spec.id}.axis")
+        axis = getattr(spec, "axis", None)  # a multi-block mechanism has hinges instead
+        if axis is not None:
+            start, end = resolve_axis(scene, axis, f"{spec.id}.axis")
             marks.append(Mark(f"{spec.id} axis", (_pt(start, s), _pt(end, s))))
             neg = geo.get("negative")
             if neg is not None:
@@ -69,8 +70,8 @@ def check_marks(spec_file: Any, scene: Any, constants: Any) -> List[Mark]:
         if "com_m" in geo:
             marks.append(Mark(f"{spec.id} G", (_pt(geo["com_m"], s),)))
         two = geo.get("two_block")
-        if two is not None and spec.axis is not None:
-            start, end = resolve_axis(scene, spec.axis, f"{spec.id}.axis")
+        if two is not None and axis is not None:
+            start, end = resolve_axis(scene, axis, f"{spec.id}.axis")
             mid = 0.5 * (start + end) + np.array([0.0, 0.0, float(two["h_c_m"])])
             marks.append(Mark(f"{spec.id} h_c", (_pt(mid, s),)))
         for attr, suffix in (("hinges", ""), ("hinges_negative", "-")):

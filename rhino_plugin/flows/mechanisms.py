@@ -22,7 +22,7 @@ Python 3.9-clean: imported by Rhino 8.
 import json
 import os
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, List, Optional, Sequence
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Type
 
 from cad_maths.mechanisms.build import constants_from_spec
 from rhino_plugin.flows.marks import check_marks
@@ -31,12 +31,23 @@ from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.io import save_constants
 from shared_schema.rules import check_number, quantity_problem
-from shared_schema.spec import TRIBUTARY_DEFAULT, parse_spec
+from shared_schema.spec import (
+    TRIBUTARY_DEFAULT,
+    LoadedWallSpec,
+    MechanismBase,
+    MultiBlockSpec,
+    SingleBlockSpec,
+    TwoBlockSpec,
+    parse_spec,
+    typology_of,
+)
 
 __all__ = [
     "COMMANDS",
     "FLOWS",
+    "MECHANISM_COMMANDS",
     "CommandResult",
+    "MechanismCommand",
     "loaded_wall_flow",
     "multi_block_flow",
     "run_mechanism_command",
@@ -282,7 +293,7 @@ class _Asker:
 def single_block_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, Any]:
     """RM_SingleBlock (A1): density groups, axis, cracks, rocking kind, η, amplification."""
     ask = _Asker(prompter, scene, mech_id)
-    mech: Dict[str, Any] = {"id": mech_id, "typology": "single_block"}
+    mech: Dict[str, Any] = {"id": mech_id, "typology": typology_of(SingleBlockSpec)}
     mech["groups"] = ask.groups("block", "groups")
     mech["axis"] = ask.axis("Pick or draw the rotation axis", "axis")
     cracks = ask.cracks("cracks")
@@ -303,7 +314,7 @@ def loaded_wall_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, 
     ask = _Asker(prompter, scene, mech_id)
     mech: Dict[str, Any] = {
         "id": mech_id,
-        "typology": "single_block_loaded",
+        "typology": typology_of(LoadedWallSpec),
         # the added forces act on one side (docs/geometry.md)
         "rocking": "one_sided",
     }
@@ -378,7 +389,7 @@ def loaded_wall_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, 
 def two_block_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, Any]:
     """RM_TwoBlock (A3): the wall, its base axis, what carries N, densities and f_mt."""
     ask = _Asker(prompter, scene, mech_id)
-    mech: Dict[str, Any] = {"id": mech_id, "typology": "two_block"}
+    mech: Dict[str, Any] = {"id": mech_id, "typology": typology_of(TwoBlockSpec)}
     mech["groups"] = ask.groups("wall", "groups")
     mech["axis"] = ask.axis("Pick or draw the base axis (outer bottom edge)", "axis")
     source = ask.option("Overburden N from", ["Objects", "Force", "None"], 0)
@@ -407,7 +418,7 @@ def two_block_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, An
 def multi_block_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, Any]:
     """RM_MultiBlock (A4): three object groups and two hinge sets A, B, C, D."""
     ask = _Asker(prompter, scene, mech_id)
-    mech: Dict[str, Any] = {"id": mech_id, "typology": "multi_block"}
+    mech: Dict[str, Any] = {"id": mech_id, "typology": typology_of(MultiBlockSpec)}
     mech["rocking"] = ROCKING[ask.option("Rocking", list(ROCKING), 0)]
     mech["blocks"] = [ask.groups(label, f"blocks[{k}]") for k, label in enumerate(BLOCK_LABELS)]
     mech["hinges"] = {
@@ -424,20 +435,52 @@ def multi_block_flow(prompter: Prompter, scene: Any, mech_id: str) -> Dict[str, 
     return ask.finish(mech)
 
 
+#: A prompt flow: ``(prompter, scene, mechanism id) -> one mechanism of a spec``.
+Flow = Callable[[Prompter, Any, str], Dict[str, Any]]
+
+
+@dataclass(frozen=True)
+class MechanismCommand:
+    """A Rhino command that asks for one mechanism of a typology.
+
+    Attributes
+    ----------
+    command : str
+        The command's name; its script is ``rhino_plugin/rhino/<command>.py``, listed in
+        ``rockmech.rhproj``.
+    spec : type
+        The typology's spec model (``shared_schema.spec.TYPOLOGY_SPECS``).
+    prefix : str
+        Prefix of the mechanism ids it proposes (``SB1``, ``SB2``...).
+    flow : Flow
+        The prompts.
+    """
+
+    command: str
+    spec: Type[MechanismBase]
+    prefix: str
+    flow: Flow
+
+    @property
+    def typology(self) -> str:
+        """The typology's name (the spec model's ``typology`` literal)."""
+        return typology_of(self.spec)
+
+
+#: The mechanism commands, one line per typology.
+MECHANISM_COMMANDS = (
+    MechanismCommand("RM_SingleBlock", SingleBlockSpec, "SB", single_block_flow),
+    MechanismCommand("RM_LoadedWall", LoadedWallSpec, "LW", loaded_wall_flow),
+    MechanismCommand("RM_TwoBlock", TwoBlockSpec, "TB", two_block_flow),
+    MechanismCommand("RM_MultiBlock", MultiBlockSpec, "MB", multi_block_flow),
+)
+
 #: Typology -> flow.
-FLOWS: Dict[str, Callable[[Prompter, Any, str], Dict[str, Any]]] = {
-    "single_block": single_block_flow,
-    "single_block_loaded": loaded_wall_flow,
-    "two_block": two_block_flow,
-    "multi_block": multi_block_flow,
-}
+FLOWS: Dict[str, Flow] = {c.typology: c.flow for c in MECHANISM_COMMANDS}
 
 #: Rhino command -> (typology, prefix of its mechanism ids).
-COMMANDS = {
-    "RM_SingleBlock": ("single_block", "SB"),
-    "RM_LoadedWall": ("single_block_loaded", "LW"),
-    "RM_TwoBlock": ("two_block", "TB"),
-    "RM_MultiBlock": ("multi_block", "MB"),
+COMMANDS: Dict[str, Tuple[str, str]] = {
+    c.command: (c.typology, c.prefix) for c in MECHANISM_COMMANDS
 }
 
 
