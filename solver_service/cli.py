@@ -14,12 +14,14 @@ import contextlib
 import difflib
 import functools
 import importlib
+import inspect
 import json
 import subprocess
 import sys
 from collections.abc import Callable, Iterable, Sequence
+from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any, Iterator, NoReturn, Optional, TypeVar
+from typing import Any, Iterator, NoReturn, Optional, TypeVar, get_type_hints
 
 import typer
 from typer.core import TyperGroup, TyperOption
@@ -31,6 +33,7 @@ from shared_schema.extras import MissingExtra, extra_for, require
 from shared_schema.io import save_constants, stamped
 from shared_schema.rules import (
     CRITERIA,
+    LENGTH_UNITS,
     PULSE_SHAPES,
     RECORD_FORMATS,
     RECORD_UNITS,
@@ -266,11 +269,6 @@ def _record_warning(note: str) -> None:
     _note(f"warning: record: {note}")
 
 
-def _read_record(path: Path, *args: Any) -> GroundMotion:
-    """Read a record as every command does, with its warnings on stderr."""
-    return read_record(path, *args, on_warning=_record_warning)
-
-
 def _choices(values: Iterable[str]) -> str:
     """Return the ``--help`` placeholder of a word from a vocabulary: ``[sine|cosine]``.
 
@@ -361,6 +359,288 @@ _SHAPES = _choices(PULSE_SHAPES)
 _CRITERIA = _choices(CRITERIA)
 
 
+# Options that several commands share. An option is defined once here; a set of options that
+# commands take together is an option group: a dataclass of their values and one ``_Group``
+# of their typer options (CONTRIBUTING.md, "A CLI option").
+_JSON_OPT = typer.Option(False, "--json", help="Print one JSON document.")
+_CONSTANTS_ARG = typer.Argument(..., help="Kinematic-constants JSON file.")
+_CONSTANTS_OR_TABLE_ARG = typer.Argument(
+    ..., help="Kinematic-constants JSON file or constants table (.csv, .xlsx)."
+)
+_CONSTANTS_OUTPUT_OPT = typer.Option(
+    ..., "-o", "--output", help="Kinematic-constants JSON to write."
+)
+_SCENE_ARG = typer.Argument(..., help="Rhino .3dm file, or a scan mesh .ply/.obj/.stl/.off.")
+_MESH_UNITS_OPT = typer.Option(
+    None,
+    "--units",
+    metavar=_choices(LENGTH_UNITS),
+    help="Length unit of a scan mesh (.ply, .obj, .stl, .off; required there).",
+)
+_RECORD_ARG = typer.Argument(
+    ...,
+    help="Record file: PEER AT2, ESM/ITACA, K-NET/KiK-net, COSMOS V2, CSMIP/DMG V2, GeoNet "
+    "V2A, two columns (t, a), one column (with --dt) or CSV.",
+)
+
+
+def _criterion_opt(help_text: str) -> Any:
+    """Return the ``--criterion`` option with this command's note on its default."""
+    return typer.Option(None, "--criterion", metavar=_CRITERIA, help=help_text)
+
+
+class _Group:
+    """An option group: options several commands take together, and their dataclass.
+
+    A command takes a group as one parameter whose default is the group
+    (``reading: RecordOptions = _RECORD_OPTIONS``); ``_grouped`` puts the group's options in its
+    place in the signature typer reads (so ``--help`` lists them there, in this order) and
+    hands the command one dataclass instance of their values.
+
+    Parameters
+    ----------
+    cls : type
+        The dataclass; its fields are named as the options' parameters.
+    options : dict
+        ``typer.Option`` of each field, in ``--help`` order.
+    defaults : dict, optional
+        Values of the fields a narrower group (``only``) leaves out; default: each option's.
+    """
+
+    def __init__(
+        self, cls: type, options: dict[str, Any], defaults: Optional[dict[str, Any]] = None
+    ) -> None:
+        self.cls, self.options = cls, options
+        self.defaults = {k: v.default for k, v in options.items()} if defaults is None else defaults
+
+    def only(self, *names: str) -> Any:
+        """Return the group with only the options ``names``; the others keep their defaults."""
+        return _Group(self.cls, {k: self.options[k] for k in names}, self.defaults)
+
+    def but(self, **options: Any) -> Any:
+        """Return the group with some options defined otherwise (another help text)."""
+        return _Group(self.cls, {**self.options, **options}, self.defaults)
+
+    def parameters(self) -> list[inspect.Parameter]:
+        """Return the group's options as parameters of a command's signature."""
+        hints = get_type_hints(self.cls)
+        kind = inspect.Parameter.POSITIONAL_OR_KEYWORD
+        return [
+            inspect.Parameter(name, kind, default=option, annotation=hints[name])
+            for name, option in self.options.items()
+        ]
+
+    def pack(self, kwargs: dict[str, Any]) -> Any:
+        """Take the group's values out of a command's ``kwargs``; return its dataclass."""
+        values = {name: kwargs.pop(name) for name in self.options}
+        return self.cls(**{**self.defaults, **values})
+
+
+def _grouped(fn: F) -> F:
+    """Let a command take option groups (``_Group``): typer sees each group's options."""
+    signature = inspect.signature(fn)
+    groups = {
+        name: p.default for name, p in signature.parameters.items() if isinstance(p.default, _Group)
+    }
+    parameters: list[inspect.Parameter] = []
+    for p in signature.parameters.values():
+        parameters += groups[p.name].parameters() if p.name in groups else [p]
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        for name, group in groups.items():
+            kwargs[name] = group.pack(kwargs)
+        return fn(*args, **kwargs)
+
+    # Signature refuses a name twice: a group's option named as a command's own parameter.
+    wrapper.__signature__ = signature.replace(parameters=parameters)  # type: ignore[attr-defined]
+    return wrapper  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class RecordOptions:
+    """How to read a record file: the options of every command that reads one."""
+
+    units: Optional[str]
+    record_format: Optional[str]
+    dt: Optional[float]
+    channel: Optional[str]
+    component: Optional[str]
+
+    def read(self, path: Path) -> GroundMotion:
+        """Read a record as every command does, with its warnings on stderr."""
+        return read_record(
+            path,
+            self.record_format,
+            self.units,
+            self.dt,
+            self.channel,
+            self.component,
+            on_warning=_record_warning,
+        )
+
+
+_RECORD_OPTIONS: Any = _Group(
+    RecordOptions,
+    {
+        "units": typer.Option(
+            None,
+            "--units",
+            metavar=_choices(RECORD_UNITS),
+            help="Acceleration units; files that state their own (AT2, the strong-motion "
+            "formats, a CSV column 'acc [g]') are read in them, two-column files default to g, "
+            "other files need it.",
+        ),
+        "record_format": typer.Option(
+            None,
+            "--format",
+            metavar=_choices(RECORD_FORMATS),
+            help="Record format (default: detected from the content).",
+        ),
+        "dt": typer.Option(None, "--dt", help="Time step [s] of a record without a time column."),
+        "channel": typer.Option(
+            None, "--channel", help="Channel number in a file with several (DMG V2, GeoNet V2A)."
+        ),
+        "component": typer.Option(
+            None, "--component", help="Component of a file with several, as its header names it."
+        ),
+    },
+)
+
+
+@dataclass(frozen=True)
+class Scaling:
+    """The scale factor up the structure (history, ida, report)."""
+
+    sf: str
+    building_height: Optional[float]
+    soil_factor: float
+    element_period: float
+
+    @property
+    def building(self) -> Building:
+        """The building the scale factor is taken in."""
+        return Building(self.building_height, self.soil_factor, self.element_period)
+
+
+_SCALING: Any = _Group(
+    Scaling,
+    {
+        "sf": typer.Option(
+            "none",
+            "--sf",
+            metavar=_choices(SF_METHODS),
+            help="Scale factor up the structure for mechanisms with amplification data: none; "
+            "eq28 (from the record's 5 % spectrum at T_n = 1/f_n); ec8 (EN 1998-1 §4.3.5.2, "
+            "needs --building-height); nzs (NZS 1170.5 C_Hi, needs --building-height).",
+        ),
+        "building_height": typer.Option(
+            None, "--building-height", help="Height of the building H = h_n [m] (ec8, nzs)."
+        ),
+        "soil_factor": typer.Option(1.0, "--soil-factor", help="EC8 soil factor S [-]."),
+        "element_period": typer.Option(
+            0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
+        ),
+    },
+)
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The size and time limits of a run (the time limit is applied by ``_user_errors``)."""
+
+    no_limits: bool
+    time_limit: float
+
+    def check(self, *args: Any, **kwargs: Any) -> None:
+        """Refuse a run above the size limits (``workflows.limits.check_run``) unless lifted."""
+        if not self.no_limits:
+            check_run(*args, **kwargs)
+
+
+_LIMITS: Any = _Group(
+    Limits,
+    {
+        "no_limits": typer.Option(
+            False,
+            "--no-limits",
+            help=f"Lift the size limits, the REST service's: {DEFAULT_LIMITS['max_samples']} "
+            f"record samples, periods or frequencies, {DEFAULT_LIMITS['max_scales']} scale "
+            f"factors, {DEFAULT_LIMITS['max_mechanisms']} mechanisms, work that cannot finish "
+            f"in {CLI_BUDGET_S:g} s of work, and the time limit.",
+        ),
+        "time_limit": typer.Option(
+            CLI_BUDGET_S,
+            "--time-limit",
+            metavar="S",
+            help="Stop a run that takes longer than S seconds (exit status 2, outputs left as "
+            "they were); work that cannot finish in S seconds is refused up front. The REST "
+            "service's is ROCKMECH_COMPUTE_TIMEOUT_S.",
+        ),
+    },
+)
+
+
+@dataclass(frozen=True)
+class FrequencyGrid:
+    """The pulse frequencies of the envelopes (envelope, report)."""
+
+    f_min: float
+    f_max: float
+    n: int
+
+    def grid(self) -> Any:
+        """Return the log-spaced frequencies [Hz] (checked)."""
+        return frequency_grid(self.f_min, self.f_max, self.n)
+
+    def work(self, exact: bool) -> tuple[float, float, int, bool]:
+        """Return the envelope's size for ``Limits.check`` (``envelope=``)."""
+        return self.f_min, self.f_max, self.n, exact
+
+
+_FREQUENCIES: Any = _Group(
+    FrequencyGrid,
+    {
+        "f_min": typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
+        "f_max": typer.Option(10.0, "--f-max", help="Highest pulse frequency [Hz]."),
+        "n": typer.Option(200, "--n", help="Number of log-spaced frequencies."),
+    },
+)
+
+
+@dataclass(frozen=True)
+class EnvelopeMethod:
+    """``--fast`` / ``--exact``: how the envelopes are computed (envelope, report)."""
+
+    fast: bool
+    exact: bool
+
+    def name(self) -> str:
+        """Return the envelope method: exact unless --fast."""
+        if self.fast and self.exact:
+            _fail("fast: give --fast or --exact, not both")
+        return "library" if self.fast else "exact"
+
+
+_ENVELOPE_METHOD: Any = _Group(
+    EnvelopeMethod,
+    {
+        "fast": typer.Option(
+            False,
+            "--fast",
+            help="Fast mode: envelopes interpolated from the library (exact where it cannot "
+            "interpolate safely): never above the exact values, at most 5 % below; band edges "
+            "within a factor 1.05 in frequency (docs/envelopes.md).",
+        ),
+        "exact": typer.Option(
+            False,
+            "--exact",
+            help="Exact envelopes at every frequency (the default; kept for scripts).",
+        ),
+    },
+)
+
+
 @app.command()
 @_user_errors
 def pulse(
@@ -394,13 +674,10 @@ def pulse(
         None, "--mechanism", help="Mechanism id in --constants (default: the first)."
     ),
     shape: str = typer.Option("sine", "--shape", metavar=_SHAPES, help="Pulse shape."),
-    criterion: Optional[str] = typer.Option(
-        None,
-        "--criterion",
-        metavar=_CRITERIA,
-        help="Overturning verdict: exact (default for pulses) or ratio.",
+    criterion: Optional[str] = _criterion_opt(
+        "Overturning verdict: exact (default for pulses) or ratio."
     ),
-    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+    as_json: bool = _JSON_OPT,
 ) -> None:
     """Response of one mechanism to a one-cycle sine or cosine acceleration pulse."""
     request: dict[str, Any] = {"a_p_g": a_p_g, "f_p": f_p, "shape": shape}
@@ -432,77 +709,25 @@ def pulse(
         _note(f"warning: {note}")
 
 
-# Options shared by every command that reads a ground-motion record.
-_RECORD_ARG = typer.Argument(
-    ...,
-    help="Record file: PEER AT2, ESM/ITACA, K-NET/KiK-net, COSMOS V2, CSMIP/DMG V2, GeoNet "
-    "V2A, two columns (t, a), one column (with --dt) or CSV.",
-)
-_UNITS_OPT = typer.Option(
-    None,
-    "--units",
-    metavar=_choices(RECORD_UNITS),
-    help="Acceleration units; files that state their own (AT2, the strong-motion formats, a "
-    "CSV column 'acc [g]') are read in them, two-column files default to g, other files need "
-    "it.",
-)
-_FORMAT_OPT = typer.Option(
-    None,
-    "--format",
-    metavar=_choices(RECORD_FORMATS),
-    help="Record format (default: detected from the content).",
-)
-_CHANNEL_OPT = typer.Option(
-    None, "--channel", help="Channel number in a file with several (DMG V2, GeoNet V2A)."
-)
-_COMPONENT_OPT = typer.Option(
-    None, "--component", help="Component of a file with several, as its header names it."
-)
-_DT_OPT = typer.Option(None, "--dt", help="Time step [s] of a record without a time column.")
-# Options of the scale factor up the structure (history, ida, report).
-_SF_OPT = typer.Option(
-    "none",
-    "--sf",
-    metavar=_choices(SF_METHODS),
-    help="Scale factor up the structure for mechanisms with amplification data: none; "
-    "eq28 (from the record's 5 % spectrum at T_n = 1/f_n); ec8 (EN 1998-1 §4.3.5.2, "
-    "needs --building-height); nzs (NZS 1170.5 C_Hi, needs --building-height).",
-)
-_BUILDING_HEIGHT_OPT = typer.Option(
-    None, "--building-height", help="Height of the building H = h_n [m] (ec8, nzs)."
-)
-_SOIL_FACTOR_OPT = typer.Option(1.0, "--soil-factor", help="EC8 soil factor S [-].")
-_ELEMENT_PERIOD_OPT = typer.Option(
-    0.0, "--element-period", help="EC8 period of the element T_a [s]; 0 = rigid."
-)
-
-_NO_LIMITS_OPT = typer.Option(
-    False,
-    "--no-limits",
-    help=f"Lift the size limits, the REST service's: {DEFAULT_LIMITS['max_samples']} record "
-    f"samples, periods or frequencies, {DEFAULT_LIMITS['max_scales']} scale factors, "
-    f"{DEFAULT_LIMITS['max_mechanisms']} mechanisms, work that cannot finish in "
-    f"{CLI_BUDGET_S:g} s of work, and the time limit.",
-)
-_TIME_LIMIT_OPT = typer.Option(
-    CLI_BUDGET_S,
-    "--time-limit",
-    metavar="S",
-    help="Stop a run that takes longer than S seconds (exit status 2, outputs left as they "
-    "were); work that cannot finish in S seconds is refused up front. The REST service's "
-    "is ROCKMECH_COMPUTE_TIMEOUT_S.",
-)
-
-
-def _limit(no_limits: bool, *args: Any, **kwargs: Any) -> None:
-    """Refuse a run above the size limits (``workflows.limits.check_run``) unless lifted."""
-    if not no_limits:
-        check_run(*args, **kwargs)
-
-
 def _record_size(motions: Sequence[GroundMotion]) -> tuple[int, float]:
     """Return (samples [-], time step [s]) bounding the work of each record in ``motions``."""
     return max(len(m.accel.acc) for m in motions), max(m.dt for m in motions)
+
+
+def _history_options(
+    scaling: Scaling, criterion: Optional[str], at_height: Optional[float]
+) -> dict[str, Any]:
+    """Return the options of ``write_history`` / ``history_doc`` (history, report)."""
+    return {
+        "sf": scaling.sf,
+        "building": scaling.building,
+        "criterion": criterion,
+        "at_height": at_height,
+    }
+
+
+#: Context of a command that takes several values after one ``--scale`` (``_scales``).
+_MORE_SCALES = {"allow_extra_args": True, "ignore_unknown_options": True}
 
 
 def _scales(first: list[float], extra: list[str]) -> list[float]:
@@ -516,37 +741,26 @@ def _scales(first: list[float], extra: list[str]) -> list[float]:
     return scales
 
 
-@app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+@app.command(context_settings=_MORE_SCALES)
 @_user_errors
+@_grouped
 def history(
     ctx: typer.Context,
-    constants: Path = typer.Argument(
-        ..., help="Kinematic-constants JSON file or constants table (.csv, .xlsx)."
-    ),
+    constants: Path = _CONSTANTS_OR_TABLE_ARG,
     record: Path = _RECORD_ARG,
     scale: list[float] = typer.Option(
         [1.0], "--scale", help="Scale factors on the record, e.g. --scale 0.5 1 2."
     ),
-    units: Optional[str] = _UNITS_OPT,
-    record_format: Optional[str] = _FORMAT_OPT,
-    dt: Optional[float] = _DT_OPT,
-    channel: Optional[str] = _CHANNEL_OPT,
-    component: Optional[str] = _COMPONENT_OPT,
-    sf: str = _SF_OPT,
-    building_height: Optional[float] = _BUILDING_HEIGHT_OPT,
-    soil_factor: float = _SOIL_FACTOR_OPT,
-    element_period: float = _ELEMENT_PERIOD_OPT,
+    reading: RecordOptions = _RECORD_OPTIONS,
+    scaling: Scaling = _SCALING,
     at_height: Optional[float] = typer.Option(
         None,
         "--at-height",
         help="Also report the peak displacement [m] of a point this far [m] above each "
         "mechanism's rotation axis (to compare with shake-table tests).",
     ),
-    criterion: Optional[str] = typer.Option(
-        None,
-        "--criterion",
-        metavar=_CRITERIA,
-        help="Overturning verdict: ratio (default for records) or exact.",
+    criterion: Optional[str] = _criterion_opt(
+        "Overturning verdict: ratio (default for records) or exact."
     ),
     out: Optional[Path] = typer.Option(
         None,
@@ -554,24 +768,18 @@ def history(
         help="Folder for history.json, history.png (phi/phi_ov per scale) and "
         "history_record.png (record, largest pulse and spectrum).",
     ),
-    no_limits: bool = _NO_LIMITS_OPT,
-    time_limit: float = _TIME_LIMIT_OPT,
-    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+    limits: Limits = _LIMITS,
+    as_json: bool = _JSON_OPT,
 ) -> None:
     """Time history of every mechanism in CONSTANTS under RECORD at each scale factor."""
     scales = _scales(scale, ctx.args)
-    _limit(no_limits, scales=len(scales))
+    limits.check(scales=len(scales))
     if out is not None:
         check_folder_target(out)
     cf = read_constants(constants, time_domain=True)
-    motion = _read_record(record, record_format, units, dt, channel, component)
-    _limit(no_limits, cf, scales=len(scales), record=_record_size([motion]))
-    options: dict[str, Any] = {
-        "sf": sf,
-        "building": Building(building_height, soil_factor, element_period),
-        "criterion": criterion,
-        "at_height": at_height,
-    }
+    motion = reading.read(record)
+    limits.check(cf, scales=len(scales), record=_record_size([motion]))
+    options = _history_options(scaling, criterion, at_height)
     runs = len(scales) * len(cf.mechanisms)
     with _status(f"history: {runs} runs of {motion.name}"):
         if out is not None:
@@ -617,13 +825,10 @@ def history(
 
 @app.command("record")
 @_user_errors
+@_grouped
 def record_info(
     record: Path = _RECORD_ARG,
-    units: Optional[str] = _UNITS_OPT,
-    record_format: Optional[str] = _FORMAT_OPT,
-    dt: Optional[float] = _DT_OPT,
-    channel: Optional[str] = _CHANNEL_OPT,
-    component: Optional[str] = _COMPONENT_OPT,
+    reading: RecordOptions = _RECORD_OPTIONS,
     zeta: float = typer.Option(0.05, "--damping", help="Damping ratio of the spectrum [-]."),
     t_min: float = typer.Option(0.02, "--t-min", help="Shortest period of the spectrum [s]."),
     t_max: float = typer.Option(10.0, "--t-max", help="Longest period of the spectrum [s]."),
@@ -634,16 +839,15 @@ def record_info(
     out: Optional[Path] = typer.Option(
         None, "--out", help="Folder for record.json and record.png (record and spectrum)."
     ),
-    no_limits: bool = _NO_LIMITS_OPT,
-    time_limit: float = _TIME_LIMIT_OPT,
-    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+    limits: Limits = _LIMITS,
+    as_json: bool = _JSON_OPT,
 ) -> None:
     """Describe a record: metadata, largest sine pulses and exact response spectrum."""
-    _limit(no_limits, periods=n)
+    limits.check(periods=n)
     if out is not None:
         check_folder_target(out)
-    motion = _read_record(record, record_format, units, dt, channel, component)
-    _limit(no_limits, record=_record_size([motion]))
+    motion = reading.read(record)
+    limits.check(record=_record_size([motion]))
     periods = log_grid(t_min, t_max, n, names=("t_min", "t_max"))
     with _status(f"record: spectrum at {len(periods)} periods and pulses"):
         doc, spectrum, found = record_analysis(
@@ -684,8 +888,9 @@ def record_info(
 
 @app.command()
 @_user_errors
+@_grouped
 def ida(
-    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    constants: Path = _CONSTANTS_ARG,
     records: Optional[list[Path]] = typer.Argument(
         None, help="Record files (any supported format); or --record-spec."
     ),
@@ -706,21 +911,9 @@ def ida(
         metavar=_choices(IM_MEASURES),
         help="Intensity measure: scale (factor on each record) or pga [g].",
     ),
-    units: Optional[str] = _UNITS_OPT,
-    record_format: Optional[str] = _FORMAT_OPT,
-    dt: Optional[float] = _DT_OPT,
-    channel: Optional[str] = _CHANNEL_OPT,
-    component: Optional[str] = _COMPONENT_OPT,
-    sf: str = _SF_OPT,
-    building_height: Optional[float] = _BUILDING_HEIGHT_OPT,
-    soil_factor: float = _SOIL_FACTOR_OPT,
-    element_period: float = _ELEMENT_PERIOD_OPT,
-    criterion: Optional[str] = typer.Option(
-        None,
-        "--criterion",
-        metavar=_CRITERIA,
-        help="Overturning verdict: ratio (default) or exact.",
-    ),
+    reading: RecordOptions = _RECORD_OPTIONS,
+    scaling: Scaling = _SCALING,
+    criterion: Optional[str] = _criterion_opt("Overturning verdict: ratio (default) or exact."),
     scheduler: Optional[str] = typer.Option(
         None,
         "--scheduler",
@@ -743,17 +936,16 @@ def ida(
         "--peaks",
         help=f"Also write every run's peak to {PEAKS_FILE} in --out (needs the parquet extra).",
     ),
-    no_limits: bool = _NO_LIMITS_OPT,
-    time_limit: float = _TIME_LIMIT_OPT,
-    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+    limits: Limits = _LIMITS,
+    as_json: bool = _JSON_OPT,
 ) -> None:
     """Incremental dynamic analysis: overturned fraction per intensity and fragility fits."""
-    # long: 21 options (57 lines of signature), the progress bar and the summary table
+    # long: the progress bar and the summary table
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     levels = parse_levels(scales)
-    _limit(no_limits, scales=len(levels))
+    limits.check(scales=len(levels))
     if out is not None:
         check_folder_target(out)
     if peaks:
@@ -761,12 +953,12 @@ def ida(
             _fail(f"peaks: --peaks writes {PEAKS_FILE} into the --out folder; give --out DIR")
         require("pyarrow.parquet", "parquet", "for ida --peaks")
     cf = read_constants(constants, time_domain=True)
-    motions = [_read_record(p, record_format, units, dt, channel, component) for p in records or []]
+    motions = [reading.read(p) for p in records or []]
     specs = read_record_spec(record_spec) if record_spec else []
     motions += [spec.read(on_warning=_record_warning) for spec in specs]
     if not motions:
         _fail("records: give record files or --record-spec")
-    _limit(no_limits, cf, scales=len(levels), record=_record_size(motions), records=len(motions))
+    limits.check(cf, scales=len(levels), record=_record_size(motions), records=len(motions))
     console = Console(stderr=True)
     show = console.is_terminal if progress is None else progress
     bar = Progress(
@@ -797,8 +989,8 @@ def ida(
                     motions,
                     levels,
                     im=im,
-                    sf=sf,
-                    building=Building(building_height, soil_factor, element_period),
+                    sf=scaling.sf,
+                    building=scaling.building,
                     criterion=criterion,
                     scheduler=scheduler,
                     progress=advance,
@@ -848,9 +1040,9 @@ def ida(
 @app.command()
 @_user_errors
 def constants(
-    scene: Path = typer.Argument(..., help="Rhino .3dm file, or a scan mesh .ply/.obj/.stl/.off."),
+    scene: Path = _SCENE_ARG,
     spec: Path = typer.Argument(..., help="Mechanism spec (JSON)."),
-    output: Path = typer.Option(..., "-o", "--output", help="Kinematic-constants JSON to write."),
+    output: Path = _CONSTANTS_OUTPUT_OPT,
     as_json: bool = typer.Option(False, "--json", help="Also print the constants JSON."),
     keep_going: bool = typer.Option(
         False,
@@ -860,12 +1052,7 @@ def constants(
             "when any failed). Without it, any failure writes nothing and lists every failure."
         ),
     ),
-    units: Optional[str] = typer.Option(
-        None,
-        "--units",
-        metavar="[mm|cm|m|in|ft]",
-        help="Length unit of a scan mesh (.ply, .obj, .stl, .off; required there).",
-    ),
+    units: Optional[str] = _MESH_UNITS_OPT,
 ) -> None:
     """Kinematic constants of every mechanism in SPEC from the solids of SCENE."""
     check_file_target(output, "output")
@@ -910,7 +1097,7 @@ def constants(
 @_user_errors
 def constants_table(
     table: Path = typer.Argument(..., help="Table, one mechanism per row (.csv or .xlsx)."),
-    output: Path = typer.Option(..., "-o", "--output", help="Kinematic-constants JSON to write."),
+    output: Path = _CONSTANTS_OUTPUT_OPT,
 ) -> None:
     """Turn a table of mechanisms (id, p_eq, lam, eta, f_n, h_e, h...) into a constants file."""
     check_file_target(output, "output")
@@ -922,38 +1109,15 @@ def constants_table(
     typer.echo(f"wrote {output}: {len(cf.mechanisms)} mechanism(s) from {table.name}")
 
 
-_FAST_OPT = typer.Option(
-    False,
-    "--fast",
-    help="Fast mode: envelopes interpolated from the library (exact where it cannot "
-    "interpolate safely): never above the exact values, at most 5 % below; band edges "
-    "within a factor 1.05 in frequency (docs/envelopes.md).",
-)
-_EXACT_OPT = typer.Option(
-    False, "--exact", help="Exact envelopes at every frequency (the default; kept for scripts)."
-)
-
-
-def _envelope_method(fast: bool, exact: bool) -> str:
-    """Return the envelope method of ``--fast`` / ``--exact`` (exact unless --fast)."""
-    if fast and exact:
-        _fail("fast: give --fast or --exact, not both")
-    return "library" if fast else "exact"
-
-
-@app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+@app.command(context_settings=_MORE_SCALES)
 @_user_errors
+@_grouped
 def envelope(
     ctx: typer.Context,
-    constants: Path = typer.Argument(
-        ..., help="Kinematic-constants JSON file or constants table (.csv, .xlsx)."
-    ),
+    constants: Path = _CONSTANTS_OR_TABLE_ARG,
     out: Path = typer.Option(..., "--out", help="Folder for envelope.json, .csv and .png."),
-    f_min: float = typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
-    f_max: float = typer.Option(10.0, "--f-max", help="Highest pulse frequency [Hz]."),
-    n: int = typer.Option(200, "--n", help="Number of log-spaced frequencies."),
-    fast: bool = _FAST_OPT,
-    exact: bool = _EXACT_OPT,
+    frequencies: FrequencyGrid = _FREQUENCIES,
+    envelope_method: EnvelopeMethod = _ENVELOPE_METHOD,
     record: Optional[Path] = typer.Option(
         None,
         "--record",
@@ -962,31 +1126,26 @@ def envelope(
     record_scale: list[float] = typer.Option(
         [0.5, 1.0, 2.0], "--record-scale", help="Scale factors of the record's pulse [-]."
     ),
-    units: Optional[str] = _UNITS_OPT,
-    record_format: Optional[str] = _FORMAT_OPT,
-    dt: Optional[float] = _DT_OPT,
-    channel: Optional[str] = _CHANNEL_OPT,
-    component: Optional[str] = _COMPONENT_OPT,
-    no_limits: bool = _NO_LIMITS_OPT,
-    time_limit: float = _TIME_LIMIT_OPT,
+    reading: RecordOptions = _RECORD_OPTIONS,
+    limits: Limits = _LIMITS,
     as_json: bool = typer.Option(False, "--json", help="Also print the JSON document."),
 ) -> None:
     """Minimum overturning sine-pulse amplitude of every mechanism, and the critical bands."""
-    method = _envelope_method(fast, exact)
-    _limit(no_limits, envelope=(f_min, f_max, n, False))
-    f_p = frequency_grid(f_min, f_max, n)
+    method = envelope_method.name()
+    limits.check(envelope=frequencies.work(exact=False))
+    f_p = frequencies.grid()
     check_folder_target(out)
     cf = read_constants(constants, time_domain=True)
-    _limit(no_limits, cf, envelope=(f_min, f_max, n, method == "exact"))
+    limits.check(cf, envelope=frequencies.work(exact=method == "exact"))
     pulse = None
     if record is not None:
-        motion = _read_record(record, record_format, units, dt, channel, component)
+        motion = reading.read(record)
         pulse = record_pulse_doc(cf, motion, _scales(record_scale, ctx.args), method=method)
     elif ctx.args:
         _fail(f"unexpected argument {ctx.args[0]!r}")
     kind = "exact envelopes" if method == "exact" else "envelopes (fast mode, library)"
     with (
-        _status(f"{kind}: {len(cf.mechanisms)} mechanisms x {n} frequencies"),
+        _status(f"{kind}: {len(cf.mechanisms)} mechanisms x {frequencies.n} frequencies"),
         run_folder(out, on_note=_out_note) as tmp,
     ):
         doc = write_envelope(
@@ -1028,7 +1187,7 @@ def boundary(
     ),
     one_sided: bool = typer.Option(False, "--one-sided", help="One-sided rocking."),
     shape: str = typer.Option("sine", "--shape", metavar=_SHAPES, help="Pulse shape."),
-    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+    as_json: bool = _JSON_OPT,
 ) -> None:
     """Every overturning interval in A = a_p/(g lam) at one frequency ratio (exact)."""
     doc = boundary_doc(omega, eta, one_sided=one_sided, shape=shape)
@@ -1147,74 +1306,54 @@ def examples(
     typer.echo(f"wrote {len(written)} example files to {out}")
 
 
-@app.command(context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+@app.command(context_settings=_MORE_SCALES)
 @_user_errors
+@_grouped
 def report(
     ctx: typer.Context,
-    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    constants: Path = _CONSTANTS_ARG,
     out: Path = typer.Option(..., "-o", "--out", help="HTML file to write."),
     record: Optional[Path] = typer.Option(
         None, "--record", help="Record for time histories and its spectrum (any format)."
     ),
     scale: list[float] = typer.Option([1.0], "--scale", help="Scale factors on the record."),
-    units: Optional[str] = _UNITS_OPT,
-    record_format: Optional[str] = _FORMAT_OPT,
-    dt: Optional[float] = _DT_OPT,
-    channel: Optional[str] = _CHANNEL_OPT,
-    component: Optional[str] = _COMPONENT_OPT,
-    sf: str = _SF_OPT,
-    building_height: Optional[float] = _BUILDING_HEIGHT_OPT,
-    soil_factor: float = _SOIL_FACTOR_OPT,
-    element_period: float = _ELEMENT_PERIOD_OPT,
+    reading: RecordOptions = _RECORD_OPTIONS,
+    scaling: Scaling = _SCALING,
     at_height: Optional[float] = typer.Option(
         None, "--at-height", help="Also tabulate the peak displacement [m] this far [m] up."
     ),
-    criterion: Optional[str] = typer.Option(
-        None,
-        "--criterion",
-        metavar=_CRITERIA,
-        help="Verdict of the time histories: ratio (default) or exact.",
+    criterion: Optional[str] = _criterion_opt(
+        "Verdict of the time histories: ratio (default) or exact."
     ),
-    f_min: float = typer.Option(0.1, "--f-min", help="Lowest pulse frequency [Hz]."),
-    f_max: float = typer.Option(10.0, "--f-max", help="Highest pulse frequency [Hz]."),
-    n: int = typer.Option(200, "--n", help="Number of log-spaced frequencies."),
-    fast: bool = _FAST_OPT,
-    exact: bool = _EXACT_OPT,
+    frequencies: FrequencyGrid = _FREQUENCIES,
+    envelope_method: EnvelopeMethod = _ENVELOPE_METHOD,
     title: Optional[str] = typer.Option(None, "--title", help="Title of the report."),
-    no_limits: bool = _NO_LIMITS_OPT,
-    time_limit: float = _TIME_LIMIT_OPT,
+    limits: Limits = _LIMITS,
 ) -> None:
     """One self-contained HTML report: constants, envelopes, and with --record its histories."""
     scales = _scales(scale, ctx.args)
-    method = _envelope_method(fast, exact)
+    method = envelope_method.name()
     check_file_target(out)
-    _limit(no_limits, scales=len(scales), envelope=(f_min, f_max, n, False))
-    f_p = frequency_grid(f_min, f_max, n)
+    limits.check(scales=len(scales), envelope=frequencies.work(exact=False))
+    f_p = frequencies.grid()
     cf = read_constants(constants, time_domain=True)
     sources = [input_source("constants", constants.name, constants.read_bytes())]
     motion = None
     if record is not None:
-        motion = _read_record(record, record_format, units, dt, channel, component)
+        motion = reading.read(record)
         sources.append(input_source("record", record.name, record.read_bytes()))
     size = None if motion is None else _record_size([motion])
-    envelope = (f_min, f_max, n, method == "exact")
-    _limit(no_limits, cf, scales=len(scales), record=size, envelope=envelope)
-    options = {"scales": scales, "sf": sf, "building_height": building_height}
-    options.update(soil_factor=soil_factor, element_period=element_period, at_height=at_height)
-    options.update(criterion=criterion)
-    options.update(f_min=f_min, f_max=f_max, n=n, method=method)
+    envelope = frequencies.work(exact=method == "exact")
+    limits.check(cf, scales=len(scales), record=size, envelope=envelope)
+    options = {"scales": scales, **asdict(scaling), "at_height": at_height, "criterion": criterion}
+    options.update(asdict(frequencies), method=method)
     with _status("report: envelopes and histories"):
         text = build_report(
             cf,
             f_p,
             motion=motion,
             scales=scales,
-            history={
-                "sf": sf,
-                "building": Building(building_height, soil_factor, element_period),
-                "criterion": criterion,
-                "at_height": at_height,
-            },
+            history=_history_options(scaling, criterion, at_height),
             method=method,
             title=title or f"rockmech report: {constants.name}",
             sources=sources,
@@ -1284,9 +1423,9 @@ def _verdict(check: dict[str, Any]) -> str:
 @app.command()
 @_user_errors
 def check(
-    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    constants: Path = _CONSTANTS_ARG,
     site: Path = typer.Argument(..., help="Site file (SITE.json): hazard, FC, q, building."),
-    as_json: bool = typer.Option(False, "--json", help="Print one JSON document."),
+    as_json: bool = _JSON_OPT,
 ) -> None:
     """Code checks of every mechanism (Circolare 2019 §C8.7.1: linear SLV, nonlinear SLV/SLC)."""
     doc = check_doc(read_constants(constants), read_site(site))
@@ -1339,10 +1478,15 @@ def _num(value: Any, width: int, digits: int = 4) -> str:
     return f"{value:>{width}.{digits}g}"
 
 
+# assess reads records without --channel and --component
+_ASSESS_RECORD_OPTIONS = _RECORD_OPTIONS.only("units", "record_format", "dt")
+
+
 @app.command()
 @_user_errors
+@_grouped
 def assess(
-    constants: Path = typer.Argument(..., help="Kinematic-constants JSON file."),
+    constants: Path = _CONSTANTS_ARG,
     site: Path = typer.Argument(..., help="Site file (SITE.json)."),
     record: list[Path] = typer.Option([], "--record", help="Record(s) for the dynamic verdict."),
     out: Path = typer.Option(..., "-o", "--out", help="HTML report to write."),
@@ -1350,9 +1494,7 @@ def assess(
     multiple: list[float] = typer.Option(
         [0.5, 1.0, 1.5, 2.0], "--multiple", help="Multiples of the design scale to run."
     ),
-    units: Optional[str] = _UNITS_OPT,
-    record_format: Optional[str] = _FORMAT_OPT,
-    dt: Optional[float] = _DT_OPT,
+    reading: RecordOptions = _ASSESS_RECORD_OPTIONS,
     template_dir: Optional[Path] = typer.Option(
         None, "--template-dir", help="Folder whose assess.html.j2 overrides the layout."
     ),
@@ -1365,12 +1507,17 @@ def assess(
     multiple = check_multiples(multiple)
     check_file_target(out)
     cf, site_file = read_constants(constants, time_domain=True), read_site(site)
-    motions = [_read_record(r, record_format, units, dt) for r in record]
+    motions = [reading.read(r) for r in record]
     sources = [
         input_source("constants", constants.name, constants.read_bytes()),
         input_source("site", site.name, site.read_bytes()),
     ] + [input_source("record", r.name, r.read_bytes()) for r in record]
-    options = {"multiples": multiple, "units": units, "format": record_format, "dt": dt}
+    options = {
+        "multiples": multiple,
+        "units": reading.units,
+        "format": reading.record_format,
+        "dt": reading.dt,
+    }
     with _status("assess: code checks and rocking dynamics"):
         doc, text = assess_report(
             cf,
@@ -1389,10 +1536,22 @@ def assess(
         _print_json(stamp(doc, "assess"))
 
 
+# the search's --no-limits lifts its own work limits
+_SEARCH_LIMITS = _LIMITS.but(
+    no_limits=typer.Option(
+        False,
+        "--no-limits",
+        help="Lift the search's work limits (evaluations of the static multiplier and "
+        "macro-blocks of the global check) and the time limit.",
+    )
+)
+
+
 @app.command()
 @_user_errors
+@_grouped
 def search(
-    scene: Path = typer.Argument(..., help="Rhino .3dm file, or a scan mesh .ply/.obj/.stl/.off."),
+    scene: Path = _SCENE_ARG,
     spec: Path = typer.Argument(..., help="Search spec (JSON): walls, levels, junctions, ranking."),
     out: Path = typer.Option(
         ...,
@@ -1400,12 +1559,7 @@ def search(
         "--out",
         help="Folder for search.json, search.spec.json, constants.json, search.3dm, search.png.",
     ),
-    units: Optional[str] = typer.Option(
-        None,
-        "--units",
-        metavar="[mm|cm|m|in|ft]",
-        help="Length unit of a scan mesh (.ply, .obj, .stl, .off; required there).",
-    ),
+    units: Optional[str] = _MESH_UNITS_OPT,
     site: Optional[Path] = typer.Option(
         None, "--site", help="Site file (SITE.json) for the code check (default: the spec's)."
     ),
@@ -1416,13 +1570,7 @@ def search(
         False, "--exact", help="Envelopes by the exact solver instead of the library."
     ),
     figure: bool = typer.Option(True, "--figure/--no-figure", help="Draw search.png."),
-    no_limits: bool = typer.Option(
-        False,
-        "--no-limits",
-        help="Lift the search's work limits (evaluations of the static multiplier and "
-        "macro-blocks of the global check) and the time limit.",
-    ),
-    time_limit: float = _TIME_LIMIT_OPT,
+    limits: Limits = _SEARCH_LIMITS,
     as_json: bool = typer.Option(False, "--json", help="Print search.json."),
 ) -> None:
     """Find a façade's collapse mechanisms and rank them by how they rock (issue #31)."""
@@ -1432,7 +1580,13 @@ def search(
     check_folder_target(out)
     with _status(f"search: {scene.name}"):
         run = search_from_files(
-            scene, spec, units=units, site=site, records=record, exact=exact, limits=not no_limits
+            scene,
+            spec,
+            units=units,
+            site=site,
+            records=record,
+            exact=exact,
+            limits=not limits.no_limits,
         )
         with run_folder(out, on_note=_out_note) as tmp:
             write_search(run, tmp, figure=figure)
