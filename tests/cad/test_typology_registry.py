@@ -22,8 +22,8 @@ from pydantic import Field
 pytest.importorskip("rhino3dm")
 
 from cad_maths.mechanisms import build, single
+from cad_maths.scenes import read_scene
 from rhino_plugin.flows import mechanisms as flows
-from rhino_plugin.scenes import read_scene
 from shared_schema import constants, spec
 from shared_schema.errors import InputError
 from shared_schema.export import SCHEMA_PATH, SPEC_SCHEMA_PATH, build_spec_schema
