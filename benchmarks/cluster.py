@@ -45,7 +45,8 @@ GIL, which the Python part of each task (its time outside the kernels) holds: th
 time is also bounded below by the sum of those parts, printed beside.
 
 Run ``.venv/bin/python benchmarks/cluster.py`` to rewrite the ``cluster`` section of
-``docs/benchmarks.md``; ``--quick`` is a smoke run (40 records) that writes nothing;
+``docs/benchmarks.md``; ``--quick`` is a smoke run (40 records) that prints the section
+and writes nothing;
 ``--repeats 1`` runs each case once (a busy machine, a quick look).
 """
 
@@ -176,7 +177,11 @@ def feed_seconds(client: Any, records: list[Any], packs: list[list[int]]) -> flo
 def main(argv: Optional[list[str]] = None) -> int:
     # long: one benchmark run end to end: the cases, the model, the tables and the section
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="smoke run: 40 records, nothing written")
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="smoke run: 40 records, section printed, nothing written",
+    )
     ap.add_argument("--repeats", type=int, default=REPEATS, help="runs per case (best kept)")
     args = ap.parse_args(argv)
     if args.repeats < 1:
@@ -356,12 +361,11 @@ def main(argv: Optional[list[str]] = None) -> int:
         f"{TASK_STEPS_PER_S:.3g})",
     ]
     print("\n".join(model_lines))
-    if args.quick:
-        return 0
+    options = "" if repeats == REPEATS else f" --repeats {repeats}"
     lines = [
         "## IDA on threads and on Dask: parallel efficiency, per-task overhead, the model",
         "",
-        "`.venv/bin/python benchmarks/cluster.py` "
+        f"`.venv/bin/python benchmarks/cluster.py{options}` "
         f"({info['date']}, commit {info['commit']}; {info['cpu']}, {info['nproc']} cores, "
         f"load {info['load']}; numba {info['numba']}, distributed {info['distributed']}).",
         "",
@@ -407,6 +411,9 @@ def main(argv: Optional[list[str]] = None) -> int:
             else ""
         ),
     ]
+    if args.quick:  # the section as it would be written, to check it; nothing written
+        print("\n".join(lines))
+        return 0
     write_section(DOC_MD, "cluster", "\n".join(lines))
     return 0
 
