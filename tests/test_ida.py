@@ -9,7 +9,7 @@ import random
 import socket
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Optional
 
 import numpy as np
 import pytest
@@ -161,11 +161,24 @@ def test_plan_mixes_records_of_each_kind_into_every_pack() -> None:
         assert min(shares) >= 1 and max(shares) - min(shares) <= 2, shares
 
 
-@pytest.mark.parametrize(("jobs", "task_s"), [(1, 1e-9), (3, 1e-9), (3, 0.002), (2, 1e9)])
+def _interleaving_task_s(cf: Any, mixed: list[GroundMotion]) -> float:
+    """A task size that cuts the full-length records into interleaved blocks of 2-3 levels."""
+    costs = ida.record_costs(cf, mixed, len(LEVELS))
+    task_s = max(costs) / 2.5
+    _, tasks = plan_tasks(costs, len(LEVELS), task_s)
+    assert any(t.step > 1 and len(range(t.lo, t.hi, t.step)) > 1 for t in tasks)
+    return task_s
+
+
+@pytest.mark.parametrize(
+    ("jobs", "task_s"), [(1, 1e-9), (3, 1e-9), (3, 0.002), (2, 1e9), (3, None)]
+)
 def test_results_are_identical_on_every_cutting_and_number_of_threads(
-    mixed: list[GroundMotion], jobs: int, task_s: float
+    mixed: list[GroundMotion], jobs: int, task_s: Optional[float]
 ) -> None:
     cf = load_constants(CONSTANTS)
+    if task_s is None:  # interleaved blocks of levels beside a pack of short records
+        task_s = _interleaving_task_s(cf, mixed)
     reference = run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9)  # one task, one thread
     assert reference["backend"]["tasks"] == 1
     doc = run_ida(cf, mixed, LEVELS, jobs=jobs, task_s=task_s)
@@ -213,10 +226,13 @@ def test_peaks_file_holds_every_run_as_a_direct_simulation_gives_it(
         for k, level in enumerate(LEVELS):
             hits = [r for r in rows if r[2] == ids[j] and r[3] == level and r[5]]
             assert len(hits) == mech["n_overturned"][k]
-    # Another cutting, the same rows (in another order).
+    # Other cuttings (one task; interleaved blocks of levels), the same rows (in another order).
     again = tmp_path / "again.parquet"
     run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9, peaks=again)
     assert _peak_rows(again) == rows
+    interleaved = tmp_path / "interleaved.parquet"
+    run_ida(cf, mixed, LEVELS, jobs=2, task_s=_interleaving_task_s(cf, mixed), peaks=interleaved)
+    assert _peak_rows(interleaved) == rows
 
 
 def test_a_stopped_run_leaves_no_peaks_file(motions: list[GroundMotion], tmp_path: Path) -> None:
