@@ -279,8 +279,8 @@ def run_task(
     dict
         ``records`` (indices), ``lo``, ``hi``, ``step``, ``counts`` ((m, k) records that
         overturn, ``k`` levels in the block), ``first`` ((records, m) index of the first
-        level in the block that
-        overturns, ``len(levels)`` where none does), ``max_error``, ``incomplete``,
+        level in the block that overturns, ``len(levels)`` where none does), ``max_error``,
+        ``incomplete``,
         ``factors`` (per record, only in the block that starts at level 0), ``criterion``,
         ``method``, ``peaks`` (``peak_ratio``, ``overturned``, ``error_estimate``,
         ``status`` as (records, m, k) arrays, or None) and the timing: ``kernel_s``
