@@ -13,7 +13,8 @@ through ``run_ida`` on every path:
 3. a dask.distributed ``LocalCluster`` of 1, 2, ... worker processes (up to the cores), one
    thread each, started before the timing and warmed up (kernels loaded) by a small run.
 
-Each case runs ``REPEATS`` times and the best wall time is kept: the machine is shared.
+Each case runs ``REPEATS`` times (``--repeats``) and the best wall time is kept: the machine is
+shared.
 Printed per case: wall time, CPU time (this process, plus the Dask workers' own, read with
 ``resource.getrusage`` on each worker), parallel efficiency ``t(1 thread) / (n t(n))``, the
 number of tasks, the mean task time and the per-task overhead (``run_ida``'s
@@ -25,23 +26,28 @@ The overhead model
 ------------------
 No 16-core machine is at hand here, so Dask on ``MODEL_WORKERS`` workers is predicted from
 inputs measured in this run: the time of every task of the ``MODEL_WORKERS``-worker cutting
-on one thread (the intervals between the progress calls of case 1, taken in the order the
-tasks are submitted), the gap between tasks on a Dask worker thread (``gap_per_task_s`` of
-the 2-worker run) and the fixed cost of a Dask run (its wall time less the span from its
-first task's start to its last task's end: connecting, checking the workers, broadcasting
-the constants, scattering the records, gathering the last result). The tasks are list-
-scheduled, longest first as ``run_ida`` submits them, on ``MODEL_WORKERS`` lanes, each
-taking its measured time plus the gap; the fixed cost is added. Threads on the same machine
-get the same schedule with the local gap and fixed cost. On Dask, lane ``j`` starts only
-once the client has sent it its first task, ``(j + 1)`` times the client's time to scatter
-one task's records (measured), and no task starts before it is sent. As the model gives every lane a
-core of its own, it leaves out what the cores share (memory bandwidth, the clock a chip
-holds with all cores busy) and, for threads, the GIL, which the Python part of each task
-(its time outside the kernels) holds: the threads' time is also bounded below by the sum
-of those parts, printed beside.
+on one thread (the CPU time of this process between the progress calls of case 1, taken in
+the order the tasks are submitted, times the one-thread run's wall time over its CPU time:
+1 on a quiet machine; on a shared one the waits for a core are thus spread evenly over the
+tasks, like the waits in the other inputs, where the wall time between the calls lays them
+on whichever task ran while another session was busy), the gap between tasks on a Dask worker
+thread (``gap_per_task_s`` of the 2-worker run) and the fixed cost of a Dask run (its wall
+time less the span from its first task's start to its last task's end: connecting, checking
+the workers, broadcasting the constants, scattering the records, gathering the last result).
+The tasks are list-scheduled, longest first as ``run_ida`` submits them, on
+``MODEL_WORKERS`` lanes, each taking its measured time plus the gap; the fixed cost is
+added. Threads on the same machine get the same schedule with the local gap and fixed cost.
+On Dask, lane ``j`` starts only once the client has sent it its first task, ``(j + 1)``
+times the client's time to scatter one task's records (measured), and no task starts before
+it is sent. As the model gives every lane a core of its own, it leaves out what the cores
+share (memory bandwidth, the clock a chip holds with all cores busy) and, for threads, the
+GIL, which the Python part of each task (its time outside the kernels) holds: the threads'
+time is also bounded below by the sum of those parts, printed beside.
 
 Run ``.venv/bin/python benchmarks/cluster.py`` to rewrite the ``cluster`` section of
-``docs/benchmarks.md``; ``--quick`` is a smoke run (40 records) that writes nothing.
+``docs/benchmarks.md``; ``--quick`` is a smoke run (40 records) that prints the section
+and writes nothing;
+``--repeats 1`` runs each case once (a busy machine, a quick look).
 """
 
 from __future__ import annotations
@@ -108,17 +114,19 @@ def best_run(
     run: Callable[[Optional[Callable[[int, int], None]]], dict[str, Any]],
     client: Any = None,
     trace: bool = False,
+    repeats: int = REPEATS,
 ) -> dict[str, Any]:
-    """Run ``REPEATS`` times; return the fastest: its document, wall and CPU time, load.
+    """Run ``repeats`` times; return the fastest: its document, wall and CPU time, load.
 
-    With ``trace``, also the (time, runs done) of every progress call of that run.
+    With ``trace``, also the (wall time, CPU time of this process, runs done) of every
+    progress call of that run.
     """
     best: dict[str, Any] = {}
-    for _ in range(REPEATS):
-        calls: list[tuple[float, int]] = []
+    for _ in range(repeats):
+        calls: list[tuple[float, float, int]] = []
 
-        def note(done: int, total: int, calls: list[tuple[float, int]] = calls) -> None:
-            calls.append((time.perf_counter(), done))
+        def note(done: int, total: int, calls: list[tuple[float, float, int]] = calls) -> None:
+            calls.append((time.perf_counter(), time.process_time(), done))
 
         before = load_average()
         c0 = cpu_seconds(client)
@@ -132,9 +140,12 @@ def best_run(
     return best
 
 
-def task_times(calls: list[tuple[float, int]]) -> list[float]:
-    """Return the times of a one-thread run's tasks, from its progress calls, in run order [s]."""
-    return [b[0] - a[0] for a, b in zip(calls, calls[1:])]
+def task_times(calls: list[tuple[float, float, int]], clock: int = 1) -> list[float]:
+    """Return the times of a one-thread run's tasks, from its progress calls, in run order [s].
+
+    ``clock`` 1: CPU time of the process (the one thread's: the main thread waits); 0: wall.
+    """
+    return [b[clock] - a[clock] for a, b in zip(calls, calls[1:])]
 
 
 def list_schedule(durations: list[float], lanes: int, feed_s: float = 0.0) -> float:
@@ -166,8 +177,16 @@ def feed_seconds(client: Any, records: list[Any], packs: list[list[int]]) -> flo
 def main(argv: Optional[list[str]] = None) -> int:
     # long: one benchmark run end to end: the cases, the model, the tables and the section
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="smoke run: 40 records, nothing written")
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="smoke run: 40 records, section printed, nothing written",
+    )
+    ap.add_argument("--repeats", type=int, default=REPEATS, help="runs per case (best kept)")
     args = ap.parse_args(argv)
+    if args.repeats < 1:
+        ap.error(f"--repeats: must be >= 1, got {args.repeats}")
+    repeats = args.repeats
     from distributed import Client, LocalCluster
 
     from solver_service.ida import (
@@ -192,19 +211,20 @@ def main(argv: Optional[list[str]] = None) -> int:
     model_packs, model_tasks = plan_tasks(costs, N_LEVELS, model_task_s)
     print(
         f"{n_rec} records ({min(lengths)}-{max(lengths)} samples) x {N_LEVELS} levels x "
-        f"{len(cf.mechanisms)} mechanisms = {n_runs} runs; {cores} cores; best of {REPEATS}"
+        f"{len(cf.mechanisms)} mechanisms = {n_runs} runs; {cores} cores; best of {repeats}"
     )
 
     run_ida(cf, records[:2], levels[:2], jobs=1)  # kernels loaded or compiled
     one = best_run(
         lambda note: run_ida(cf, records, levels, jobs=1, task_s=model_task_s, progress=note),
         trace=True,
+        repeats=repeats,
     )
     t1 = one["wall"]
     rate = sum(costs) * TASK_STEPS_PER_S / one["cpu"]  # estimated steps per CPU second
     print(f"1 thread: {fmt_time(t1)}; work estimate ran at {rate:.3g} steps/s")
     rows: list[dict[str, Any]] = [{"case": "1 thread (jobs=1)", "n": 1, **one}]
-    threads = best_run(lambda note: run_ida(cf, records, levels, jobs=cores))
+    threads = best_run(lambda note: run_ida(cf, records, levels, jobs=cores), repeats=repeats)
     rows.append({"case": f"in-process threads (jobs={cores})", "n": cores, **threads})
     print(f"threads: {fmt_time(threads['wall'])}")
     for n in range(1, cores + 1):
@@ -217,7 +237,9 @@ def main(argv: Optional[list[str]] = None) -> int:
             address = cluster.scheduler_address
             run_ida(cf, records[:n], levels[:2], scheduler=address)  # warm every worker
             dask = best_run(
-                lambda note, a=address: run_ida(cf, records, levels, scheduler=a), client
+                lambda note, a=address: run_ida(cf, records, levels, scheduler=a),
+                client,
+                repeats=repeats,
             )
             feed_s = feed_seconds(client, records, model_packs)
             c0 = cpu_seconds(client)
@@ -231,9 +253,14 @@ def main(argv: Optional[list[str]] = None) -> int:
     local_backend = threads["doc"]["backend"]
     dask_backend = dask_all["doc"]["backend"]
 
-    # The model: the one-thread run's tasks (cut for MODEL_WORKERS) on MODEL_WORKERS lanes.
-    durations = task_times(one["calls"])
+    # The model: the one-thread run's tasks (cut for MODEL_WORKERS) on MODEL_WORKERS lanes:
+    # their CPU times, each stretched by the run's waits for a core (none on a quiet machine).
+    stretch = t1 / one["cpu"]
+    cpu_times = task_times(one["calls"])
+    durations = [stretch * d for d in cpu_times]
+    walls = task_times(one["calls"], clock=0)
     assert len(durations) == len(model_tasks), (len(durations), len(model_tasks))
+    spread = float(np.std(durations) / np.mean(durations))
     python_s = one["doc"]["runtime_s"] - one["doc"]["compute_s"]
     fixed_dask = dask_all["wall"] - dask_backend["span_s"]
     fixed_local = threads["wall"] - local_backend["span_s"]
@@ -243,6 +270,9 @@ def main(argv: Optional[list[str]] = None) -> int:
     t_model_dask = fixed_dask + span_dask
     t_model_threads = fixed_local + span_local
     eff_model = t1 / (MODEL_WORKERS * t_model_dask)
+    # The same model on the tasks' wall times (the model's input before #30's even cutting).
+    t_wall_dask = fixed_dask + list_schedule([d + gap_dask for d in walls], MODEL_WORKERS, feed_s)
+    eff_wall = t1 / (MODEL_WORKERS * t_wall_dask)
 
     table = []
     for r in rows:
@@ -303,9 +333,12 @@ def main(argv: Optional[list[str]] = None) -> int:
     print(text_table(vheaders, verdicts))
     model_lines = [
         f"one thread, {len(durations)} tasks cut for {MODEL_WORKERS} workers "
-        f"({fmt_time(model_task_s)} each by the estimate): {fmt_time(min(durations))} to "
-        f"{fmt_time(max(durations))}, mean {fmt_time(float(np.mean(durations)))}, sum "
-        f"{fmt_time(sum(durations))} (run {fmt_time(t1)})",
+        f"({fmt_time(model_task_s)} each by the estimate), CPU time x {stretch:.2f} (the "
+        f"one-thread run's wall {fmt_time(t1)} / CPU {fmt_time(one['cpu'])}): "
+        f"{fmt_time(min(durations))} to {fmt_time(max(durations))}, mean "
+        f"{fmt_time(float(np.mean(durations)))}, coefficient of variation {spread:.2f}, sum "
+        f"{fmt_time(sum(durations))} (wall time between the progress calls: "
+        f"{fmt_time(min(walls))} to {fmt_time(max(walls))})",
         f"gap between tasks on a worker thread: Dask {fmt_time(gap_dask)}, threads "
         f"{fmt_time(gap_local)}",
         f"fixed cost of a run: Dask {fmt_time(fixed_dask)}, threads {fmt_time(fixed_local)}",
@@ -321,25 +354,28 @@ def main(argv: Optional[list[str]] = None) -> int:
         f"list schedule on {MODEL_WORKERS} lanes: Dask {fmt_time(span_dask)} + "
         f"{fmt_time(fixed_dask)} = {fmt_time(t_model_dask)}; threads {fmt_time(span_local)} "
         f"+ {fmt_time(fixed_local)} = {fmt_time(t_model_threads)}",
+        f"the same model on the wall times between the progress calls (each task charged "
+        f"the waits for a core that fell in it): {fmt_time(t_wall_dask)}, efficiency "
+        f"{100 * eff_wall:.0f} %",
         f"work estimate's rate on this machine: {rate:.3g} steps/s (TASK_STEPS_PER_S = "
         f"{TASK_STEPS_PER_S:.3g})",
     ]
     print("\n".join(model_lines))
-    if args.quick:
-        return 0
+    options = "" if repeats == REPEATS else f" --repeats {repeats}"
     lines = [
         "## IDA on threads and on Dask: parallel efficiency, per-task overhead, the model",
         "",
-        "`.venv/bin/python benchmarks/cluster.py` "
+        f"`.venv/bin/python benchmarks/cluster.py{options}` "
         f"({info['date']}, commit {info['commit']}; {info['cpu']}, {info['nproc']} cores, "
         f"load {info['load']}; numba {info['numba']}, distributed {info['distributed']}).",
         "",
         f"{n_rec} records ({min(lengths)}-{max(lengths)} samples, the real records stretched "
         f"0.6-1.6, negated and reversed) x {N_LEVELS} scale factors (0.1-5) x "
         f"{len(cf.mechanisms)} example mechanisms = {n_runs:,} runs, ratio criterion. Best "
-        f"of {REPEATS} runs per case. **The machine was shared** with other sessions running "
-        "tests while this ran (the load averages are in the table): wall times and "
-        "efficiencies are lower than a quiet machine gives, CPU times much less so. A quiet "
+        f"of {repeats} run{'s' * (repeats > 1)} per case. **The machine was shared** with "
+        "other sessions running tests while this ran (the load averages are in the table): "
+        "wall times and efficiencies are lower than a quiet machine gives, CPU times much less "
+        "so. A quiet "
         "machine's run is to be recorded before this issue closes.",
         "",
         md_table(headers, table),
@@ -375,6 +411,9 @@ def main(argv: Optional[list[str]] = None) -> int:
             else ""
         ),
     ]
+    if args.quick:  # the section as it would be written, to check it; nothing written
+        print("\n".join(lines))
+        return 0
     write_section(DOC_MD, "cluster", "\n".join(lines))
     return 0
 

@@ -4,9 +4,13 @@ The unit of work is one record at a block of intensity levels: every mechanism a
 level of the block in one compiled batch (``exact.simulate_batch``). ``run_ida`` groups
 these units into **tasks of about** ``TASK_S`` **seconds** by the work estimate the size
 limits already use (``workflows.limits.history_steps``, at ``TASK_STEPS_PER_S``): several
-short records in one task, or one long record cut into blocks of levels. A run too small
-to give every worker ``TASKS_PER_WORKER`` such tasks gets shorter ones (not below
-``MIN_TASK_S``), so that every worker has work to balance. The tasks start longest first:
+short records in one task, or one long record cut into blocks of levels. The estimate
+counts every sample of every run, while a run's true cost depends on how long it rocks, so
+no task is made of runs alike (``plan_tasks``): the short records are dealt into the tasks
+in a snake order by cost, so that each holds a share of every kind of record, and a long
+record's blocks interleave its levels. A run too small to give every worker
+``TASKS_PER_WORKER`` such tasks gets shorter ones (not below ``MIN_TASK_S``), so that every
+worker has work to balance. The tasks start longest first:
 
 * **locally**, on ``jobs`` threads (by default one per core the process may use);
 * **on a dask.distributed cluster**, when a scheduler address is given. The constants and
@@ -250,8 +254,9 @@ def run_task(
     lo: int,
     hi: int,
     stop: Optional[threading.Event] = None,
+    step: int = 1,
 ) -> dict[str, Any]:
-    """One task: every record of ``pack`` at levels ``[lo, hi)``, its runs reduced.
+    """One task: every record of ``pack`` at levels ``range(lo, hi, step)``, its runs reduced.
 
     Runs the single-threaded batch kernel on the calling thread, one record after the other.
 
@@ -266,24 +271,27 @@ def run_task(
         The block of levels, ``0 <= lo < hi <= len(levels)``.
     stop : threading.Event, optional
         Set by a stopped local run: the task ends after the record it is on.
+    step : int
+        Every ``step``-th level of the block, >= 1 (``plan_tasks``'s interleaved blocks).
 
     Returns
     -------
     dict
-        ``records`` (indices), ``lo``, ``hi``, ``counts`` ((m, hi - lo) records that
-        overturn), ``first`` ((records, m) index of the first level in the block that
-        overturns, ``len(levels)`` where none does), ``max_error``, ``incomplete``,
+        ``records`` (indices), ``lo``, ``hi``, ``step``, ``counts`` ((m, k) records that
+        overturn, ``k`` levels in the block), ``first`` ((records, m) index of the first
+        level in the block that overturns, ``len(levels)`` where none does), ``max_error``,
+        ``incomplete``,
         ``factors`` (per record, only in the block that starts at level 0), ``criterion``,
         ``method``, ``peaks`` (``peak_ratio``, ``overturned``, ``error_estimate``,
-        ``status`` as (records, m, hi - lo) arrays, or None) and the timing: ``kernel_s``
+        ``status`` as (records, m, k) arrays, or None) and the timing: ``kernel_s``
         (inside the batches), ``start``, ``end`` (``time.time()`` of this process) and
         ``lane`` (host, process and thread).
     """
     start = time.time()
     setup = _setup(ctx)
-    levels = setup.levels[lo:hi]
+    levels = setup.levels[lo:hi:step]
     n_mech, none = len(setup.models), len(setup.levels)
-    counts = np.zeros((n_mech, hi - lo), dtype=np.int64)
+    counts = np.zeros((n_mech, len(levels)), dtype=np.int64)
     first = np.full((len(pack), n_mech), none, dtype=np.int64)
     max_error, incomplete, kernel_s = 0.0, 0, 0.0
     factors: Optional[list[dict[str, float]]] = [] if lo == 0 else None
@@ -297,7 +305,7 @@ def run_task(
             res = _run_one(setup, acc, dt, name, levels)
             over = res["overturned"]
             counts += over
-            first[j] = np.where(over.any(axis=1), lo + over.argmax(axis=1), none)
+            first[j] = np.where(over.any(axis=1), lo + step * over.argmax(axis=1), none)
             max_error = float(np.maximum(max_error, np.max(res["error_estimate"])))
             incomplete += int(np.count_nonzero(res["status"] < 0))
             kernel_s += res["runtime_s"]
@@ -311,6 +319,7 @@ def run_task(
         "records": [int(index) for index, *_ in pack],
         "lo": lo,
         "hi": hi,
+        "step": step,
         "counts": counts,
         "first": first,
         "max_error": max_error,
@@ -337,14 +346,15 @@ def _levels(levels: Sequence[float]) -> list[float]:
 
 @dataclass(frozen=True)
 class Task:
-    """One task of a run: the records of pack ``pack`` at levels ``[lo, hi)``.
+    """One task of a run: the records of pack ``pack`` at levels ``range(lo, hi, step)``.
 
     Attributes
     ----------
     pack : int
         Index into the packs of ``plan_tasks`` (a group of records).
-    lo, hi : int
-        Block of intensity levels.
+    lo, hi, step : int
+        Its intensity levels, ``range(lo, hi, step)``: all of them (``0, n_levels, 1``) or
+        one of the interleaved blocks of a long record.
     cost_s : float
         Its work by the estimate [s].
     """
@@ -352,6 +362,7 @@ class Task:
     pack: int
     lo: int
     hi: int
+    step: int
     cost_s: float
 
 
@@ -372,12 +383,25 @@ def task_seconds(total_s: float, n_workers: int) -> float:
 def plan_tasks(
     costs: Sequence[float], n_levels: int, task_s: float
 ) -> tuple[list[list[int]], list[Task]]:
-    """Cut a run into tasks of about ``task_s`` seconds; longest first.
+    """Cut a run into tasks of about ``task_s`` seconds, each a mix of cheap and dear runs.
 
-    Records are taken by decreasing cost. One that costs more than ``task_s`` at all levels
-    forms a pack of its own, cut into that many blocks of levels (sizes equal to within one
-    level); the others are gathered, in that order, into packs of at least ``task_s`` each
-    (the last one may be shorter), each run at all levels in one task.
+    The estimate (``record_costs``) counts every sample of every run, while a run's true
+    cost depends on how long it rocks: runs at rest cost little, runs that overturn stop
+    early, a strong record rocks the mechanisms far longer than a weak one of the same
+    length. So no task is made of runs alike:
+
+    * a record that costs more than ``task_s`` at all levels forms a pack of its own, cut
+      into ``n = min(n_levels, ceil(cost / task_s))`` **interleaved** blocks of levels:
+      block ``b`` holds levels ``b, b + n, b + 2n, ...`` (a contiguous block of low levels,
+      all at rest, would be cheap, one of middle levels, all rocking to the end, dear);
+    * the other records are dealt, by decreasing cost, into ``max(1, round(sum / task_s))``
+      packs in a snake order (``0, 1, ..., P - 1, P - 1, ..., 0, 0, 1, ...``), each run at
+      all levels in one task: every pack holds records from across the range of costs and
+      of kinds (a set of variants of one strong record all land in one pack otherwise), and
+      the packs' estimates differ by at most about one record's.
+
+    The tasks are listed by decreasing estimate (longest first). The results do not depend
+    on the cutting.
 
     Parameters
     ----------
@@ -393,52 +417,58 @@ def plan_tasks(
     packs : list of list of int
         Record indices of each pack.
     tasks : list of Task
-        Every (pack, level block) by decreasing ``cost_s`` (ties in pack order).
+        Every (pack, block of levels) by decreasing ``cost_s`` (ties in pack order).
 
     Examples
     --------
-    >>> packs, tasks = plan_tasks([0.3, 2.5, 0.4, 0.2], 10, 1.0)
+    >>> packs, tasks = plan_tasks([0.3, 2.5, 0.4, 0.2, 0.5, 0.6], 10, 1.0)
     >>> packs
-    [[1], [2, 0, 3]]
-    >>> [(t.pack, t.lo, t.hi) for t in tasks]
-    [(0, 6, 10), (1, 0, 10), (0, 0, 3), (0, 3, 6)]
+    [[1], [5, 0, 3], [4, 2]]
+    >>> [(t.pack, t.lo, t.hi, t.step) for t in tasks]
+    [(1, 0, 10, 1), (0, 0, 10, 3), (2, 0, 10, 1), (0, 1, 10, 3), (0, 2, 10, 3)]
     """
     order = sorted(range(len(costs)), key=lambda i: -costs[i])
     packs: list[list[int]] = []
     tasks: list[Task] = []
-    group: list[int] = []
-    group_cost = 0.0
-
-    def close_group() -> None:
-        nonlocal group, group_cost
-        if group:
-            packs.append(group)
-            tasks.append(Task(len(packs) - 1, 0, n_levels, group_cost))
-        group, group_cost = [], 0.0
-
+    short: list[int] = []
     for i in order:
-        if costs[i] > task_s:
-            packs.append([i])
-            n_blocks = min(n_levels, math.ceil(costs[i] / task_s))
-            bounds = [b * n_levels // n_blocks for b in range(n_blocks + 1)]
-            for lo, hi in zip(bounds[:-1], bounds[1:]):
-                tasks.append(Task(len(packs) - 1, lo, hi, costs[i] * (hi - lo) / n_levels))
+        if costs[i] <= task_s:
+            short.append(i)
             continue
-        group.append(i)
-        group_cost += costs[i]
-        if group_cost >= task_s:
-            close_group()
-    close_group()
+        packs.append([i])
+        n_blocks = min(n_levels, math.ceil(costs[i] / task_s))
+        for b in range(n_blocks):
+            share = len(range(b, n_levels, n_blocks)) / n_levels
+            tasks.append(Task(len(packs) - 1, b, n_levels, n_blocks, costs[i] * share))
+    if short:
+        total = sum(costs[i] for i in short)
+        n_packs = min(len(short), max(1, round(total / task_s)))
+        dealt: list[list[int]] = [[] for _ in range(n_packs)]
+        for k, i in enumerate(short):
+            turn, place = divmod(k, n_packs)
+            dealt[place if turn % 2 == 0 else n_packs - 1 - place].append(i)
+        for pack in dealt:
+            packs.append(pack)
+            tasks.append(Task(len(packs) - 1, 0, n_levels, 1, sum(costs[i] for i in pack)))
     tasks.sort(key=lambda t: -t.cost_s)  # stable: ties keep their order
     return packs, tasks
 
 
 def record_costs(cf: ConstantsFile, motions: Sequence[Any], n_levels: int) -> list[float]:
-    """Estimated work of each record at ``n_levels`` levels [s] (``TASK_STEPS_PER_S``)."""
-    return [
-        history_steps(cf, len(m.accel.acc), m.dt, n_levels, p_max=P_EQ_PLAUSIBLE) / TASK_STEPS_PER_S
-        for m in motions
-    ]
+    """Estimated work of each record at ``n_levels`` levels [s] (``TASK_STEPS_PER_S``).
+
+    ``history_steps`` is linear in the record's intervals (samples - 1): it is evaluated once
+    per sampling interval (records mostly share a few) and scaled, not once per record.
+    """
+    per_interval: dict[float, float] = {}
+    costs = []
+    for m in motions:
+        dt = float(m.dt)
+        if dt not in per_interval:
+            one = history_steps(cf, 2, dt, n_levels, p_max=P_EQ_PLAUSIBLE)
+            per_interval[dt] = one / TASK_STEPS_PER_S
+        costs.append(max(len(m.accel.acc) - 1, 0) * per_interval[dt])
+    return costs
 
 
 def available_cores() -> int:
@@ -491,7 +521,7 @@ class _PeakWriter:
         n_rec, n_mech, n_lev = peaks["peak_ratio"].shape
         record = np.repeat(np.asarray(part["records"][:n_rec], dtype=np.int32), n_mech * n_lev)
         mech = np.tile(np.repeat(np.arange(n_mech, dtype=np.int32), n_lev), n_rec)
-        level = np.tile(self.levels[part["lo"] : part["hi"]], n_rec * n_mech)
+        level = np.tile(self.levels[part["lo"] : part["hi"] : part["step"]], n_rec * n_mech)
         columns = [
             pa.array(record),
             pa.DictionaryArray.from_arrays(pa.array(record), self.records),
@@ -547,8 +577,8 @@ class _Totals:
         self.n_runs = n_runs
 
     def add(self, part: dict[str, Any]) -> None:
-        lo, hi, idx = part["lo"], part["hi"], part["records"]
-        self.counts[:, lo:hi] += part["counts"]
+        block, idx = slice(part["lo"], part["hi"], part["step"]), part["records"]
+        self.counts[:, block] += part["counts"]
         self.first[idx] = np.minimum(self.first[idx], part["first"])
         if part["factors"] is not None:
             for i, factors in zip(idx, part["factors"]):
@@ -559,7 +589,7 @@ class _Totals:
         self.criteria.add(part["criterion"])
         self.methods.add(part["method"])
         self.timing.append((part["lane"], part["start"], part["end"], part["kernel_s"]))
-        self.runs_done += len(idx) * self.counts.shape[0] * (hi - lo)
+        self.runs_done += len(idx) * part["counts"].size
 
     def task_stats(self) -> dict[str, Any]:
         """Mean task time and per-task overhead [s] (see ``run_ida``)."""
@@ -677,7 +707,9 @@ def _run_local(
     stop = threading.Event()
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         futures = [
-            pool.submit(run_task, ctx, [records[i] for i in packs[t.pack]], t.lo, t.hi, stop)
+            pool.submit(
+                run_task, ctx, [records[i] for i in packs[t.pack]], t.lo, t.hi, stop, t.step
+            )
             for t in tasks
         ]
         try:
@@ -756,6 +788,7 @@ class _DaskFeed:
                 held,
                 task.lo,
                 task.hi,
+                step=task.step,
                 workers=[worker],
                 allow_other_workers=True,  # a worker that leaves does not strand its tasks
                 pure=False,

@@ -9,7 +9,7 @@ import random
 import socket
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Optional
 
 import numpy as np
 import pytest
@@ -117,30 +117,68 @@ def test_plan_covers_every_run_once_in_tasks_of_the_aimed_size() -> None:
         assert sorted(i for p in packs for i in p) == list(range(n_rec))  # each record once
         cover = np.zeros((n_rec, n_lev), dtype=int)
         for t in tasks:
-            assert 0 <= t.lo < t.hi <= n_lev
+            assert 0 <= t.lo < t.hi <= n_lev and t.step >= 1
             for i in packs[t.pack]:
-                cover[i, t.lo : t.hi] += 1
+                cover[i, t.lo : t.hi : t.step] += 1
         assert (cover == 1).all()  # every run in exactly one task
         assert [t.cost_s for t in tasks] == sorted((t.cost_s for t in tasks), reverse=True)
         assert sum(t.cost_s for t in tasks) == pytest.approx(sum(costs))
+        short = [t for t in tasks if len(packs[t.pack]) > 1 or costs[packs[t.pack][0]] <= task_s]
+        dear = max((c for c in costs if c <= task_s), default=0.0)
         for k, pack in enumerate(packs):
             blocks = [t for t in tasks if t.pack == k]
-            if len(pack) == 1 and costs[pack[0]] > task_s:  # a long record: cut into levels
-                assert len(blocks) == min(n_lev, math.ceil(costs[pack[0]] / task_s))
-                sizes = [t.hi - t.lo for t in blocks]
-                assert max(sizes) - min(sizes) <= 1
-            else:  # short records gathered into one task of at least task_s (the last: less)
-                assert len(blocks) == 1 and (blocks[0].lo, blocks[0].hi) == (0, n_lev)
-                assert blocks[0].cost_s >= task_s or k == len(packs) - 1
+            if len(pack) == 1 and costs[pack[0]] > task_s:  # a long record: interleaved levels
+                n_blocks = min(n_lev, math.ceil(costs[pack[0]] / task_s))
+                assert len(blocks) == n_blocks
+                assert sorted((t.lo, t.step) for t in blocks) == [
+                    (b, n_blocks) for b in range(n_blocks)
+                ]
+            else:  # short records dealt into packs run at all levels, estimates within one
+                assert len(blocks) == 1 and (blocks[0].lo, blocks[0].hi, blocks[0].step) == (
+                    0,
+                    n_lev,
+                    1,
+                )
+                assert max(t.cost_s for t in short) - blocks[0].cost_s <= dear + 1e-12
+        if short:  # as many packs as the short records' work holds tasks of task_s
+            work = sum(t.cost_s for t in short)
+            assert len(short) == min(
+                sum(len(packs[t.pack]) for t in short), max(1, round(work / task_s))
+            )
     assert task_seconds(1e4, 16) == TASK_S and task_seconds(1.0, 16) == MIN_TASK_S
     assert task_seconds(32.0, 16) == pytest.approx(0.25)  # 8 tasks per worker thread
 
 
-@pytest.mark.parametrize(("jobs", "task_s"), [(1, 1e-9), (3, 1e-9), (3, 0.002), (2, 1e9)])
+def test_plan_mixes_records_of_each_kind_into_every_pack() -> None:
+    # 4 kinds of record x 25 variants, each kind's variants alike in cost: every pack gets
+    # a share of each kind (a true cost the estimate misjudges for one kind evens out), where
+    # packs of consecutive records by cost would hold one or two kinds each.
+    costs = [0.04 + 0.01 * kind + 1e-6 * v for kind in range(4) for v in range(25)]
+    packs, tasks = plan_tasks(costs, 10, 0.5)
+    assert len(packs) == len(tasks) == round(sum(costs) / 0.5)
+    for pack in packs:
+        shares = [[i // 25 for i in pack].count(k) for k in range(4)]
+        assert min(shares) >= 1 and max(shares) - min(shares) <= 2, shares
+
+
+def _interleaving_task_s(cf: Any, mixed: list[GroundMotion]) -> float:
+    """A task size that cuts the full-length records into interleaved blocks of 2-3 levels."""
+    costs = ida.record_costs(cf, mixed, len(LEVELS))
+    task_s = max(costs) / 2.5
+    _, tasks = plan_tasks(costs, len(LEVELS), task_s)
+    assert any(t.step > 1 and len(range(t.lo, t.hi, t.step)) > 1 for t in tasks)
+    return task_s
+
+
+@pytest.mark.parametrize(
+    ("jobs", "task_s"), [(1, 1e-9), (3, 1e-9), (3, 0.002), (2, 1e9), (3, None)]
+)
 def test_results_are_identical_on_every_cutting_and_number_of_threads(
-    mixed: list[GroundMotion], jobs: int, task_s: float
+    mixed: list[GroundMotion], jobs: int, task_s: Optional[float]
 ) -> None:
     cf = load_constants(CONSTANTS)
+    if task_s is None:  # interleaved blocks of levels beside a pack of short records
+        task_s = _interleaving_task_s(cf, mixed)
     reference = run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9)  # one task, one thread
     assert reference["backend"]["tasks"] == 1
     doc = run_ida(cf, mixed, LEVELS, jobs=jobs, task_s=task_s)
@@ -188,10 +226,13 @@ def test_peaks_file_holds_every_run_as_a_direct_simulation_gives_it(
         for k, level in enumerate(LEVELS):
             hits = [r for r in rows if r[2] == ids[j] and r[3] == level and r[5]]
             assert len(hits) == mech["n_overturned"][k]
-    # Another cutting, the same rows (in another order).
+    # Other cuttings (one task; interleaved blocks of levels), the same rows (in another order).
     again = tmp_path / "again.parquet"
     run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9, peaks=again)
     assert _peak_rows(again) == rows
+    interleaved = tmp_path / "interleaved.parquet"
+    run_ida(cf, mixed, LEVELS, jobs=2, task_s=_interleaving_task_s(cf, mixed), peaks=interleaved)
+    assert _peak_rows(interleaved) == rows
 
 
 def test_a_stopped_run_leaves_no_peaks_file(motions: list[GroundMotion], tmp_path: Path) -> None:
