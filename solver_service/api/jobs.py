@@ -77,6 +77,7 @@ from .estimates import (
     check_limit,
     check_time,
     check_work,
+    estimate_pulse,
     history_steps,
 )
 from .jobspec import (
@@ -297,10 +298,8 @@ def pulse_doc(job: PulseRequest, limits: Optional[dict[str, Any]] = None) -> dic
     limits : dict, optional
         The service's size limits (bound the work); none from the command line.
     """
-    p_eq = job.p_eq_max
-    if limits is not None and p_eq is not None and _positive(p_eq, job.f_p):
-        # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
-        check_work(p_eq / job.f_p, limits, "the pulse", "f_p")
+    if limits is not None:
+        estimate_pulse(job, limits)  # again: run_job also runs without the app (benchmarks)
     return solve_pulse(job)
 
 
