@@ -1,4 +1,4 @@
-"""Shared fixtures: paths to bundled and shared data."""
+"""Shared fixtures: paths to bundled and shared data, and the real service (``servers.py``)."""
 
 from __future__ import annotations
 
@@ -10,6 +10,10 @@ REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "examples"
 #: The project's shared folder (PEER records), beside the repository; absent on a user's clone.
 SHARED_RECORDS = REPO.parent / "shared" / "data" / "records"
+
+#: The real uvicorn server's fixtures (``server``, ``client``, ``server_with``), one home for
+#: every test folder (this folder is on ``sys.path``: pytest's rootdir-relative imports).
+pytest_plugins = ("servers",)
 
 
 @pytest.fixture(scope="session")

@@ -17,8 +17,7 @@ from fastapi import Request, Response
 
 from shared_schema.errors import InputError
 
-from .estimates import check_job
-from .jobspec import Job
+from .jobspec import Job, check_job
 from .pool import RETRY_AFTER_S, BudgetExceeded, ComputePool, PoolBusy, WorkerLost, WorkerResult
 from .problems import error_response
 

@@ -3,8 +3,10 @@
 A request whose work cannot finish within the compute budget, or whose answer would be
 larger than ``ROCKMECH_MAX_ANSWER_BYTES``, is refused with 422 at once instead of holding a
 compute process for the whole budget (or the server's memory for a huge answer). The app
-estimates every JSON job before sending it to the pool; a compute process repeats the
-history estimate after reading an uploaded record (the app cannot count its samples).
+estimates every JSON job before sending it to the pool (``jobspec.check_job`` runs the
+``estimate_*`` function its kind declares in ``jobspec.JOB_KINDS``); a compute process
+repeats the history estimate after reading an uploaded record (the app cannot count its
+samples).
 
 Light on purpose (standard library and the request models only): the app process uses it.
 
@@ -39,6 +41,7 @@ from __future__ import annotations
 import math
 from typing import Any, Optional
 
+from shared_schema.api import AssessRequest, EnvelopeRequest, PulseRequest
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 
@@ -54,18 +57,6 @@ from ..workflows.limits import (  # the numbers and estimates shared with the co
     shortest_time,
     work_words,
 )
-from .jobspec import (
-    AssessHtmlJob,
-    AssessJob,
-    AssessPdfJob,
-    EnvelopeJob,
-    HistoryJob,
-    Job,
-    PulseJob,
-    ReportJob,
-    ScaleFactorJob,
-    SpectrumJob,
-)
 
 __all__ = [
     "ANSWER_BYTES_PER_FIGURE",
@@ -73,11 +64,19 @@ __all__ = [
     "N_SCAN",
     "WORK_PER_SAMPLE",
     "assess_figures",
-    "check_job",
+    "check_constants",
     "check_limit",
     "check_time",
     "check_work",
     "envelope_steps",
+    "estimate_assess",
+    "estimate_assess_page",
+    "estimate_envelope",
+    "estimate_history",
+    "estimate_pulse",
+    "estimate_report",
+    "estimate_scale_factor",
+    "estimate_spectrum",
     "history_steps",
 ]
 
@@ -253,46 +252,68 @@ def _assess(job: Any, cf: ConstantsFile, limits: dict[str, Any], html: bool) -> 
         )
 
 
-def check_job(job: Job, limits: dict[str, Any]) -> None:
-    """Refuse a job whose work or answer is too large, before it reaches a compute process.
+def check_constants(cf: ConstantsFile, limits: dict[str, Any]) -> None:
+    """Count the mechanisms of any job's constants, and refuse non-finite derived values."""
+    check_limit(
+        len(cf.mechanisms),
+        limits["max_mechanisms"],
+        "mechanisms",
+        "constants",
+        "max_mechanisms",
+    )
+    _check_derived(cf)
 
-    Raises
-    ------
-    InputError
-        The work or the answer exceeds a limit; the message names the setting.
-    """
-    cf = getattr(job, "constants", None)
+
+# --- the estimates of the job kinds (``jobspec.JOB_KINDS``), each ``(job, limits) -> None`` ---
+
+
+def estimate_pulse(job: PulseRequest, limits: dict[str, Any]) -> None:
+    """Bound a pulse: ``p_eq / f_p`` closed-form steps."""
+    p_eq = job.p_eq_max
+    if p_eq is not None and _positive(p_eq, job.f_p):
+        # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
+        check_work(p_eq / job.f_p, limits, "the pulse", "f_p")
+
+
+def estimate_envelope(job: EnvelopeRequest, limits: dict[str, Any]) -> None:
+    """Bound envelopes: the frequencies, the answer's size and the pulse runs."""
+    _envelope(job.constants, job.f_min, job.f_max, job.n, job.method == "exact", limits)
+
+
+def estimate_history(job: Any, limits: dict[str, Any]) -> None:
+    """Bound time histories of a record given as samples (an upload: where it is read)."""
+    _history(job, job.constants, limits)
+
+
+def estimate_report(job: Any, limits: dict[str, Any]) -> None:
+    """Bound a report: its time histories and its envelopes."""
+    cf = job.constants
+    _history(job, cf, limits)
     if cf is not None:
-        check_limit(
-            len(cf.mechanisms),
-            limits["max_mechanisms"],
-            "mechanisms",
-            "constants",
-            "max_mechanisms",
-        )
-        _check_derived(cf)
-    if isinstance(job, PulseJob):
-        p_eq = job.p_eq_max
-        if p_eq is not None and _positive(p_eq, job.f_p):
-            # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
-            check_work(p_eq / job.f_p, limits, "the pulse", "f_p")
-    elif isinstance(job, EnvelopeJob):
-        _envelope(job.constants, job.f_min, job.f_max, job.n, job.method == "exact", limits)
-    elif isinstance(job, HistoryJob):
-        _history(job, cf, limits)
-    elif isinstance(job, ReportJob):
-        _history(job, cf, limits)
-        if cf is not None:
-            _envelope(cf, job.f_min, job.f_max, job.n, job.method == "exact", limits)
-    elif isinstance(job, SpectrumJob):
-        check_limit(job.n, limits["max_samples"], "periods", "n", "max_samples")
-        if job.record is not None:
-            n = len(job.record.accel)
-            check_limit(n, limits["max_samples"], "samples", "record", "max_samples")
-    elif isinstance(job, (AssessJob, AssessHtmlJob, AssessPdfJob)):
-        _assess(job, job.constants, limits, isinstance(job, (AssessHtmlJob, AssessPdfJob)))
-    elif isinstance(job, ScaleFactorJob):
-        record = getattr(job.request, "record", None)
-        if record is not None:
-            n = len(record.accel)
-            check_limit(n, limits["max_samples"], "samples", "record", "max_samples")
+        _envelope(cf, job.f_min, job.f_max, job.n, job.method == "exact", limits)
+
+
+def estimate_spectrum(job: Any, limits: dict[str, Any]) -> None:
+    """Bound a spectrum: the periods, and the samples of a record given as samples."""
+    check_limit(job.n, limits["max_samples"], "periods", "n", "max_samples")
+    if job.record is not None:
+        n = len(job.record.accel)
+        check_limit(n, limits["max_samples"], "samples", "record", "max_samples")
+
+
+def estimate_assess(job: AssessRequest, limits: dict[str, Any]) -> None:
+    """Bound the assessment document: every record's time histories at every multiple."""
+    _assess(job, job.constants, limits, False)
+
+
+def estimate_assess_page(job: AssessRequest, limits: dict[str, Any]) -> None:
+    """Bound the assessment page (HTML or PDF): the time histories and the figures."""
+    _assess(job, job.constants, limits, True)
+
+
+def estimate_scale_factor(job: Any, limits: dict[str, Any]) -> None:
+    """Bound a scale factor: the samples of a record (eq. 28 from a record)."""
+    record = getattr(job.request, "record", None)
+    if record is not None:
+        n = len(record.accel)
+        check_limit(n, limits["max_samples"], "samples", "record", "max_samples")

@@ -3,7 +3,9 @@
 Each job takes JSON-ready parameters (already type-checked by the request models), the raw
 bytes of any uploads and the service's size limits, and returns the response body. The
 documents are the ones ``rockmech ... --json`` prints, so the service and the CLI agree;
-errors are ``RockmechError`` with the CLI's messages.
+errors are ``RockmechError`` with the CLI's messages. Each kind's function (``run_<kind>``)
+is named by its declaration in ``solver_service.api.jobspec.JOB_KINDS``, from which
+``JOBS`` is built.
 
 Uploads never name a path on the server: a record upload is written under a sanitised
 version of its file name into a private temporary folder (the readers take files), and that
@@ -75,9 +77,11 @@ from .estimates import (
     check_limit,
     check_time,
     check_work,
+    estimate_pulse,
     history_steps,
 )
 from .jobspec import (
+    JOB_KINDS,
     AssessHtmlJob,
     AssessJob,
     AssessPdfJob,
@@ -99,6 +103,7 @@ from .uploads import check_record_lines, safe_filename
 __all__ = [
     "JOBS",
     "JobOutput",
+    "Runner",
     "ServiceUnavailable",
     "check_limit",
     "check_record_work",
@@ -108,7 +113,20 @@ __all__ = [
     "history_options",
     "motion_from_params",
     "pulse_doc",
+    "run_assess",
+    "run_assess_html",
+    "run_assess_pdf",
+    "run_check",
+    "run_constants",
+    "run_envelope",
+    "run_history",
     "run_job",
+    "run_pulse",
+    "run_report",
+    "run_scale_factor",
+    "run_search",
+    "run_spectrum",
+    "run_warmup",
     "safe_filename",
 ]
 
@@ -280,14 +298,13 @@ def pulse_doc(job: PulseRequest, limits: Optional[dict[str, Any]] = None) -> dic
     limits : dict, optional
         The service's size limits (bound the work); none from the command line.
     """
-    p_eq = job.p_eq_max
-    if limits is not None and p_eq is not None and _positive(p_eq, job.f_p):
-        # Segments of at most 1/p_eq seconds over the pulse's 1/f_p seconds.
-        check_work(p_eq / job.f_p, limits, "the pulse", "f_p")
+    if limits is not None:
+        estimate_pulse(job, limits)  # again: run_job also runs without the app (benchmarks)
     return solve_pulse(job)
 
 
-def _pulse(job: PulseJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_pulse(job: PulseJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer ``rockmech pulse --json``'s document."""
     return dumps(pulse_doc(job, limits))
 
 
@@ -296,7 +313,8 @@ def _grid(f_min: float, f_max: float, n: int, limits: dict[str, Any]) -> Any:
     return frequency_grid(f_min, f_max, n)
 
 
-def _envelope(job: EnvelopeJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_envelope(job: EnvelopeJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer ``rockmech envelope --json``'s document."""
     f_p = _grid(job.f_min, job.f_max, job.n, limits)
     cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
     library = shared_library() if job.method == "library" else None
@@ -315,7 +333,8 @@ def history_options(job: HistoryOptions) -> dict[str, Any]:
     }
 
 
-def _history(job: HistoryJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_history(job: HistoryJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer ``rockmech history --json``'s document (constants and record as data or uploads)."""
     scales = _scales(job.scales, limits)
     cf = _constants(_constants_source(job.constants, blobs), job.constants_label, limits)
     motion = motion_from_params(job.record, job.upload, _blob(blobs), limits)
@@ -335,7 +354,8 @@ def _blob(blobs: list[bytes]) -> Optional[bytes]:
     return blobs[-1] if blobs else None
 
 
-def _spectrum(job: SpectrumJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_spectrum(job: SpectrumJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer ``rockmech record --json``'s document."""
     check_limit(job.n, limits["max_samples"], "periods", "n", "max_samples")
     motion = motion_from_params(job.record, job.upload, _blob(blobs), limits)
     periods = log_grid(job.t_min, job.t_max, job.n, names=("t_min", "t_max"))
@@ -381,11 +401,13 @@ def scale_factor_doc(
     return info
 
 
-def _scale_factor(job: ScaleFactorJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_scale_factor(job: ScaleFactorJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer a code or paper scale factor, stamped."""
     return dumps(stamp(scale_factor_doc(job.request, limits), "scale_factor"))
 
 
-def _scene_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer the kinematic-constants file ``rockmech constants`` writes (blobs: scene, spec)."""
     scene_name = safe_filename(job.scene_name, "scene.3dm")
     spec_name = safe_filename(job.spec_name, "spec.json")
     scene_bytes, spec_bytes = blobs
@@ -410,7 +432,8 @@ def _scene_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) 
     return stamped(cf).model_dump_json(exclude_none=True).encode("utf-8")
 
 
-def _search(job: SearchJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_search(job: SearchJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer ``rockmech search --json``'s document (blobs: scene, spec, site, record)."""
     scene_name = safe_filename(job.scene_name, "scene.3dm")
     spec_name = safe_filename(job.spec_name, "search.json")
     scene_bytes, spec_bytes, *rest = blobs
@@ -463,7 +486,8 @@ REPORT_KEYS = (
 )
 
 
-def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer the HTML page ``rockmech report`` writes."""
     # Checked with or without a record, as the schema states them.
     check_choice(job.sf, SF_METHODS, "sf")
     if job.criterion is not None:
@@ -506,7 +530,8 @@ def _report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes
     return html.encode("utf-8")
 
 
-def _check(job: CheckJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_check(job: CheckJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer ``rockmech check --json``'s document."""
     cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
     return dumps(stamp(check_doc(cf, job.site), "check"))
 
@@ -571,13 +596,14 @@ def check_spectra_work(
             check_time(limits, "the records' spectra", f"records[{i}]", spectrum_steps=steps)
 
 
-def _assess(job: AssessJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_assess(job: AssessJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer ``rockmech assess --json``'s document."""
     cf, motions = _assess_inputs(job, limits)
     doc = assessment_doc(cf, job.site, motions, multiples=list(job.multiples))
     return dumps(stamp(doc, "assess"))
 
 
-def _assess_pdf(job: AssessPdfJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_assess_pdf(job: AssessPdfJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     """Print the assessment page to PDF with a headless Chromium, if the deployment has one."""
     if chromium() is None:
         raise ServiceUnavailable(
@@ -585,7 +611,7 @@ def _assess_pdf(job: AssessPdfJob, blobs: list[bytes], limits: dict[str, Any]) -
             "lacks (Debian: apt-get install chromium; the Docker image: build it with "
             "--build-arg PDF=chromium); format html gives the page to print locally"
         )
-    page = _assess_html(job, blobs, limits)
+    page = run_assess_html(job, blobs, limits)
     with tempfile.TemporaryDirectory(prefix="rockmech-pdf-") as tmp:
         html = Path(tmp) / "assessment.html"
         html.write_bytes(page)
@@ -596,9 +622,10 @@ def _assess_pdf(job: AssessPdfJob, blobs: list[bytes], limits: dict[str, Any]) -
         return pdf.read_bytes()
 
 
-def _assess_html(
+def run_assess_html(
     job: AssessHtmlJob | AssessPdfJob, blobs: list[bytes], limits: dict[str, Any]
 ) -> bytes:
+    """Answer the assessment's HTML page, as ``rockmech assess`` writes it."""
     if importlib.util.find_spec("jinja2") is None:
         raise ServiceUnavailable(
             "the assessment page needs the report extra (pip install 'rockmech[report]'), "
@@ -617,7 +644,7 @@ def _assess_html(
     return page.encode("utf-8")
 
 
-def _warmup(job: WarmupJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+def run_warmup(job: WarmupJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     """Compile (or load from numba's cache) every kernel a request may need, once."""
     model = RockingModel.symmetric(2.0, 0.2, 0.9)
     simulate(model, Pulse(a_p=-3.0, f_p=1.0))
@@ -630,22 +657,21 @@ def _warmup(job: WarmupJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes
 
 _JSON = "application/json"
 
+#: A job's function: ``(job, blobs, limits) -> body``.
+Runner = Callable[[Any, list[bytes], dict[str, Any]], bytes]
+
+
+def _runners() -> dict[str, tuple[str, Runner]]:
+    """Each kind of ``JOB_KINDS``: the media type of its answer and the function it names."""
+    here = globals()
+    missing = [k.run for k in JOB_KINDS.values() if not callable(here.get(k.run))]
+    if missing:
+        raise ImportError(f"jobspec.JOB_KINDS names functions this module lacks: {missing}")
+    return {kind: (k.media_type, here[k.run]) for kind, k in JOB_KINDS.items()}
+
+
 #: Job kinds: media type of the answer and the function that computes it.
-JOBS: dict[str, tuple[str, Callable[[Any, list[bytes], dict[str, Any]], bytes]]] = {
-    "pulse": (_JSON, _pulse),
-    "envelope": (_JSON, _envelope),
-    "history": (_JSON, _history),
-    "spectrum": (_JSON, _spectrum),
-    "scale_factor": (_JSON, _scale_factor),
-    "constants": (_JSON, _scene_constants),
-    "report": ("text/html; charset=utf-8", _report),
-    "check": (_JSON, _check),
-    "assess": (_JSON, _assess),
-    "assess_html": ("text/html; charset=utf-8", _assess_html),
-    "assess_pdf": ("application/pdf", _assess_pdf),
-    "search": (_JSON, _search),
-    "warmup": (_JSON, _warmup),
-}
+JOBS = _runners()
 
 
 def run_job(job: Job, blobs: list[bytes], limits: dict[str, Any]) -> JobOutput:

@@ -1,17 +1,26 @@
-"""Typed job requests: what the app hands a compute process, one model per kind of job.
+"""The kinds of job the service runs: each declared once, in ``JOB_KINDS``.
+
+A kind of job is its typed model (its ``kind`` field's literal names it), the function in
+``solver_service.api.jobs`` that computes it, its work estimate (``solver_service.api.
+estimates``) and the media type of its answer: one ``JobKind`` line. The union a compute
+process validates (``JOB``), its dispatch table (``jobs.JOBS``) and the app's up-front
+estimate (``check_job``) are derived from that list.
 
 The app builds a job from a validated request (JSON body, multipart form or Hops inputs);
 the pool sends it to a compute process as JSON, where ``JOB.validate_python`` rebuilds the
 same model and ``solver_service.api.jobs`` runs it. Uploaded files travel beside the job as
 raw bytes (``blobs``): the constants file first, when uploaded, then the record.
 
-Light on purpose (pydantic and ``shared_schema`` only): the app process imports it, and must
-not load the compute modules.
+Light on purpose (pydantic, ``shared_schema`` and the estimates only): the app process
+imports it, and must not load the compute modules; so a declaration names its function
+rather than holding it.
 """
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal, Optional, Union, cast
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Annotated, Any, Literal, Optional, Union, cast
 
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
@@ -28,8 +37,21 @@ from shared_schema.api import (
 )
 from shared_schema.constants import ConstantsFile
 
+from .estimates import (
+    check_constants,
+    estimate_assess,
+    estimate_assess_page,
+    estimate_envelope,
+    estimate_history,
+    estimate_pulse,
+    estimate_report,
+    estimate_scale_factor,
+    estimate_spectrum,
+)
+
 __all__ = [
     "JOB",
+    "JOB_KINDS",
     "AssessHtmlJob",
     "AssessJob",
     "AssessPdfJob",
@@ -46,26 +68,19 @@ __all__ = [
     "SearchJob",
     "SpectrumJob",
     "WarmupJob",
+    "check_job",
 ]
 
 _JOB = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
+_JSON = "application/json"
+_HTML = "text/html; charset=utf-8"
 
-#: The kinds of job a compute process runs.
-JobKind = Literal[
-    "pulse",
-    "envelope",
-    "history",
-    "spectrum",
-    "scale_factor",
-    "constants",
-    "report",
-    "check",
-    "assess",
-    "assess_html",
-    "assess_pdf",
-    "search",
-    "warmup",
-]
+
+class Job(BaseModel):
+    """Any job: the base of every job model below (the static type of a job)."""
+
+    if TYPE_CHECKING:  # each model declares its own literal; a field here would reorder them
+        kind: str
 
 
 class RecordUpload(BaseModel):
@@ -79,13 +94,13 @@ class RecordUpload(BaseModel):
     dt: Optional[float] = None
 
 
-class PulseJob(PulseRequest):
+class PulseJob(PulseRequest, Job):
     """``rockmech pulse``."""
 
     kind: Literal["pulse"] = "pulse"
 
 
-class EnvelopeJob(EnvelopeRequest):
+class EnvelopeJob(EnvelopeRequest, Job):
     """``rockmech envelope``."""
 
     kind: Literal["envelope"] = "envelope"
@@ -105,7 +120,7 @@ class _ConstantsInput(BaseModel):
     constants_label: str = Field("constants", description="Names the constants in messages.")
 
 
-class HistoryJob(_RecordInput, _ConstantsInput, HistoryOptions):
+class HistoryJob(_RecordInput, _ConstantsInput, HistoryOptions, Job):
     """``rockmech history``."""
 
     model_config = _JOB
@@ -113,7 +128,7 @@ class HistoryJob(_RecordInput, _ConstantsInput, HistoryOptions):
     kind: Literal["history"] = "history"
 
 
-class SpectrumJob(_RecordInput, SpectrumOptions):
+class SpectrumJob(_RecordInput, SpectrumOptions, Job):
     """``rockmech record``."""
 
     model_config = _JOB
@@ -121,7 +136,7 @@ class SpectrumJob(_RecordInput, SpectrumOptions):
     kind: Literal["spectrum"] = "spectrum"
 
 
-class ReportJob(_RecordInput, _ConstantsInput, ReportOptions):
+class ReportJob(_RecordInput, _ConstantsInput, ReportOptions, Job):
     """``rockmech report``."""
 
     model_config = _JOB
@@ -129,7 +144,7 @@ class ReportJob(_RecordInput, _ConstantsInput, ReportOptions):
     kind: Literal["report"] = "report"
 
 
-class ScaleFactorJob(BaseModel):
+class ScaleFactorJob(Job):
     """A code or paper scale factor."""
 
     model_config = _JOB
@@ -138,7 +153,7 @@ class ScaleFactorJob(BaseModel):
     request: ScaleFactorRequest
 
 
-class SceneJob(BaseModel):
+class SceneJob(Job):
     """``rockmech constants``: blobs are the .3dm scene and the spec."""
 
     model_config = _JOB
@@ -149,7 +164,7 @@ class SceneJob(BaseModel):
     units: Optional[str] = None
 
 
-class SearchJob(BaseModel):
+class SearchJob(Job):
     """``rockmech search``: blobs are the scene, the search spec, the site and the record.
 
     The site file and the record come only when given (``has_site``, ``record``).
@@ -167,31 +182,31 @@ class SearchJob(BaseModel):
     record: Optional[RecordUpload] = None
 
 
-class CheckJob(CheckRequest):
+class CheckJob(CheckRequest, Job):
     """``rockmech check``."""
 
     kind: Literal["check"] = "check"
 
 
-class AssessJob(AssessRequest):
+class AssessJob(AssessRequest, Job):
     """``rockmech assess --json``: the assessment document."""
 
     kind: Literal["assess"] = "assess"
 
 
-class AssessHtmlJob(AssessRequest):
+class AssessHtmlJob(AssessRequest, Job):
     """``rockmech assess``: the assessment's HTML page."""
 
     kind: Literal["assess_html"] = "assess_html"
 
 
-class AssessPdfJob(AssessRequest):
+class AssessPdfJob(AssessRequest, Job):
     """``rockmech assess --pdf``: the assessment's page printed to PDF."""
 
     kind: Literal["assess_pdf"] = "assess_pdf"
 
 
-class WarmupJob(BaseModel):
+class WarmupJob(Job):
     """Load every kernel once, before a compute process takes work."""
 
     model_config = _JOB
@@ -199,26 +214,94 @@ class WarmupJob(BaseModel):
     kind: Literal["warmup"] = "warmup"
 
 
-#: Any job.
-Job = Annotated[
-    Union[
-        PulseJob,
-        EnvelopeJob,
-        HistoryJob,
-        SpectrumJob,
-        ReportJob,
-        ScaleFactorJob,
-        SceneJob,
-        SearchJob,
-        CheckJob,
-        AssessJob,
-        AssessHtmlJob,
-        AssessPdfJob,
-        WarmupJob,
-    ],
-    Field(discriminator="kind"),
-]
+#: A job's up-front estimate: ``(job, limits) -> None``, raising ``InputError`` (naming the
+#: setting) when the work or the answer would be too large.
+Estimate = Callable[[Any, dict[str, Any]], None]
 
-#: Validates a job from its JSON form (in the compute process). (mypy cannot match a union of
-#: twelve annotated job types against TypeAdapter's overloads: the cast only names the type.)
-JOB: TypeAdapter[Job] = TypeAdapter(cast(Any, Job))
+
+@dataclass(frozen=True)
+class JobKind:
+    """One kind of job, declared once.
+
+    Attributes
+    ----------
+    model : type of Job
+        The job's model; the literal of its ``kind`` field names the kind.
+    run : str
+        The function of ``solver_service.api.jobs`` that computes it, ``(job, blobs, limits)
+        -> bytes`` (named: the app process must not import the compute modules).
+    estimate : callable, optional
+        Its work and answer estimate (``solver_service.api.estimates``), run in the app
+        before a compute process is spent; None when nothing can be bounded up front.
+    media_type : str
+        The media type of its answer.
+    """
+
+    model: type[Job]
+    run: str
+    estimate: Optional[Estimate] = None
+    media_type: str = _JSON
+
+    @property
+    def kind(self) -> str:
+        """The kind's name: the default of the model's ``kind`` literal."""
+        name: str = self.model.model_fields["kind"].default
+        return name
+
+
+def _by_kind(*kinds: JobKind) -> dict[str, JobKind]:
+    """Key the declarations by kind; a kind declared twice is a bug (refused at import)."""
+    out = {k.kind: k for k in kinds}
+    if len(out) != len(kinds):
+        raise ValueError("a job kind is declared twice in JOB_KINDS")
+    return out
+
+
+#: Every kind of job, by name: model, function, estimate, media type.
+JOB_KINDS = _by_kind(
+    JobKind(PulseJob, "run_pulse", estimate_pulse),
+    JobKind(EnvelopeJob, "run_envelope", estimate_envelope),
+    JobKind(HistoryJob, "run_history", estimate_history),
+    JobKind(SpectrumJob, "run_spectrum", estimate_spectrum),
+    JobKind(ScaleFactorJob, "run_scale_factor", estimate_scale_factor),
+    JobKind(SceneJob, "run_constants"),
+    JobKind(ReportJob, "run_report", estimate_report, media_type=_HTML),
+    JobKind(CheckJob, "run_check"),
+    JobKind(AssessJob, "run_assess", estimate_assess),
+    JobKind(AssessHtmlJob, "run_assess_html", estimate_assess_page, media_type=_HTML),
+    JobKind(AssessPdfJob, "run_assess_pdf", estimate_assess_page, media_type="application/pdf"),
+    JobKind(SearchJob, "run_search"),
+    JobKind(WarmupJob, "run_warmup"),
+)
+
+#: Validates any job from its JSON form (in the compute process): the union of the models
+#: of ``JOB_KINDS``, chosen by ``kind``. (A union built from a list has no static type: the
+#: casts only name it.)
+JOB: TypeAdapter[Job] = TypeAdapter(
+    cast(
+        Any,
+        Annotated[
+            cast(Any, Union)[tuple(k.model for k in JOB_KINDS.values())],
+            Field(discriminator="kind"),
+        ],
+    )
+)
+
+
+def check_job(job: Job, limits: dict[str, Any]) -> None:
+    """Refuse a job whose work or answer is too large, before it reaches a compute process.
+
+    The constants of any job are counted and their derived values checked first; then the
+    kind's own estimate (``JobKind.estimate``) runs.
+
+    Raises
+    ------
+    InputError
+        The work or the answer exceeds a limit; the message names the setting.
+    """
+    cf = getattr(job, "constants", None)
+    if cf is not None:
+        check_constants(cf, limits)
+    estimate = JOB_KINDS[job.kind].estimate
+    if estimate is not None:
+        estimate(job, limits)

@@ -18,7 +18,7 @@ from typing import Any, Optional
 import httpx
 import numpy as np
 import pytest
-from api_helpers import TEST_SETTINGS
+from servers import TEST_SETTINGS
 
 from shared_schema.api import PulseRequest
 from solver_service.api.bodies import MAX_BODY_DEPTH, validate_json

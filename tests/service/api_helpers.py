@@ -1,68 +1,24 @@
-"""Helpers of the service tests: a real ``rockmech serve`` (uvicorn) on a free loopback port,
-and the ``rockmech`` command line run in-process, the independent path results are compared with.
+"""Helpers of the service tests: the ``rockmech`` command line run in-process, the independent
+path results are compared with, and readings of a server's processes. The real server and its
+fixtures are in ``tests/servers.py``.
 """
 
 from __future__ import annotations
 
 import contextlib
 import json
-import subprocess
 import time
-from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from typer.testing import CliRunner
 
-from solver_service.api.server import background_server
 from solver_service.cli import app
 
 REPO = Path(__file__).resolve().parents[2]
 EXAMPLES = REPO / "examples"
-#: Seconds a server may take to start (two compute processes warm their kernels up).
-START_TIMEOUT_S = 120.0
-#: Settings of the shared test server (small limits, so limit tests stay cheap).
-TEST_SETTINGS = {
-    "compute_workers": 2,
-    "compute_timeout_s": 120,
-    "max_body_bytes": 4 * 1024 * 1024,
-    "max_samples": 100_000,
-    "max_mechanisms": 20,
-    "max_scales": 20,
-}
-
 runner = CliRunner()
 """In-process runner of the ``rockmech`` command line."""
-
-
-@dataclass
-class Server:
-    """A running service: its base URL, process and log file."""
-
-    url: str
-    proc: subprocess.Popen[bytes]
-    log: Path
-
-    def children(self) -> list[int]:
-        """Process ids of the server's compute processes."""
-        path = Path(f"/proc/{self.proc.pid}/task/{self.proc.pid}/children")
-        return [int(p) for p in path.read_text().split()]
-
-
-@contextlib.contextmanager
-def start_server(
-    tmp: Path, env: dict[str, str] | None = None, ready: bool = True, **settings: Any
-) -> Iterator[Server]:
-    """Start ``rockmech serve`` with ``ROCKMECH_*`` settings on a free port; stop it after.
-
-    ``ready``: wait until its compute processes have warmed up (else until it answers).
-    """
-    log = tmp / "server.log"
-    with background_server(
-        settings, log, start_timeout_s=START_TIMEOUT_S, env=env, ready=ready
-    ) as (url, proc):
-        yield Server(url, proc, log)
 
 
 def cli_json(*args: str) -> Any:

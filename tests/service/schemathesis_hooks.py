@@ -63,7 +63,6 @@ from shared_schema.api import (
     SpectrumRequest,
 )
 from shared_schema.errors import InputError
-from solver_service.api.estimates import check_job
 from solver_service.api.jobs import (
     check_history_work,
     check_record_work,
@@ -82,6 +81,7 @@ from solver_service.api.jobspec import (
     PulseJob,
     ReportJob,
     SpectrumJob,
+    check_job,
 )
 from solver_service.api.settings import Settings
 from solver_service.core.amplification import pulse_scale_factor
@@ -179,7 +179,7 @@ def _ordered(lo: Any, hi: Any) -> bool:
 def _work_ok(job: Any) -> bool:
     """Return False when a job exceeds the server's work or size limits (its own checks).
 
-    The app's estimate (``api.estimates.check_job``), then the compute process's checks of
+    The app's estimate (``api.jobspec.check_job``), then the compute process's checks of
     the work on a record (``api.jobs``: the integrator's steps per sample, a spectrum's
     shortest period). A PDF is left out: printing it is Chromium's work, which no estimate
     covers and which alone can pass the test server's short budget on a busy machine

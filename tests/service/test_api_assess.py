@@ -13,16 +13,16 @@ from typing import Any
 
 import httpx
 import pytest
-from api_helpers import EXAMPLES, TEST_SETTINGS, cli_error, cli_json
+from api_helpers import EXAMPLES, cli_error, cli_json
+from servers import TEST_SETTINGS
 
 from rhino_plugin.flows.analyse import ServiceClient
 from rhino_plugin.flows.check import run_check
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
 from shared_schema.site import parse_site
-from solver_service.api.estimates import check_job
 from solver_service.api.jobs import run_job
-from solver_service.api.jobspec import AssessHtmlJob, AssessJob, AssessPdfJob
+from solver_service.api.jobspec import AssessHtmlJob, AssessJob, AssessPdfJob, check_job
 from solver_service.core.records import GroundMotion
 from solver_service.report.assess import chromium
 from solver_service.workflows.assess import NO_VIRTUAL_WORK, check_doc

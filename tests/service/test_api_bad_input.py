@@ -7,7 +7,8 @@ from pathlib import Path
 
 import httpx
 import pytest
-from api_helpers import EXAMPLES, TEST_SETTINGS, cli_error
+from api_helpers import EXAMPLES, cli_error
+from servers import TEST_SETTINGS
 
 RECORD = EXAMPLES / "records" / "elcentro_NS.dat"
 WALLS = EXAMPLES / "constants" / "rect_walls.json"

@@ -6,12 +6,12 @@ import json
 import os
 import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import httpx
 import pytest
-from api_helpers import EXAMPLES, Server, start_server
+from api_helpers import EXAMPLES
+from servers import Server, ServerWith
 
 BUDGET_S = 1.0
 CHURCH = json.loads((EXAMPLES / "constants" / "church.json").read_text())
@@ -23,12 +23,9 @@ PULSE = {"p_eq": 2.0, "lam": 0.2, "eta": 0.9, "a_p_g": -0.61, "f_p": 1.59}
 
 
 @pytest.fixture(scope="module")
-def tight(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+def tight(server_with: ServerWith) -> Server:
     """A server with one compute process and a one-second budget."""
-    with start_server(
-        tmp_path_factory.mktemp("budget"), compute_workers=1, compute_timeout_s=BUDGET_S
-    ) as srv:
-        yield srv
+    return server_with(compute_workers=1, compute_timeout_s=BUDGET_S)
 
 
 def _gone(pid: int, wait_s: float = 10.0) -> bool:

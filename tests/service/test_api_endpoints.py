@@ -9,7 +9,8 @@ from pathlib import Path
 import httpx
 import numpy as np
 import pytest
-from api_helpers import EXAMPLES, TEST_SETTINGS, cli_json, without_runtime
+from api_helpers import EXAMPLES, cli_json, without_runtime
+from servers import TEST_SETTINGS
 
 from shared_schema.export import build_schema
 from solver_service.core import codes

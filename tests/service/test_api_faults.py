@@ -16,16 +16,16 @@ import struct
 import subprocess
 import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import httpx
 import pytest
-from api_helpers import EXAMPLES, Server, cli_error, start_server
+from api_helpers import EXAMPLES, cli_error
+from servers import ONE_PROCESS, Server, ServerWith, start_server
 
 from shared_schema.errors import InputError
-from solver_service.api.estimates import N_SCAN, check_job
-from solver_service.api.jobspec import EnvelopeJob
+from solver_service.api.estimates import N_SCAN
+from solver_service.api.jobspec import EnvelopeJob, check_job
 from solver_service.core import envelope
 
 CHURCH = json.loads((EXAMPLES / "constants" / "church.json").read_text())
@@ -33,34 +33,17 @@ WALLS = json.loads((EXAMPLES / "constants" / "rect_walls.json").read_text())
 #: Exact envelopes of the church at 800 frequencies: several seconds of one worker.
 HEAVY = {"constants": CHURCH, "method": "exact", "n": 800}
 PULSE = {"p_eq": 2.0, "lam": 0.2, "eta": 0.9, "a_p_g": -0.61, "f_p": 1.59}
-BUDGET_S = 20.0
 
 
 @pytest.fixture(scope="module")
-def faulty(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+def faulty(server_with: ServerWith) -> Server:
     """One compute process (so a test knows which one is busy), a private TMPDIR."""
-    tmp = tmp_path_factory.mktemp("faults")
-    (tmp / "tmp").mkdir()
-    with start_server(
-        tmp,
-        env={"TMPDIR": str(tmp / "tmp")},
-        compute_workers=1,
-        compute_timeout_s=BUDGET_S,
-        shutdown_timeout_s=2,
-    ) as srv:
-        yield srv
+    return server_with(**ONE_PROCESS)
 
 
-def _worker(server: Server, wait_s: float = 60.0) -> int:
+def _worker(server: Server) -> int:
     """Pid of the server's compute process, once one is up and warmed (health says so)."""
-    deadline = time.monotonic() + wait_s
-    while time.monotonic() < deadline:
-        kids = server.children()
-        health = httpx.get(f"{server.url}/api/v1/health").json()
-        if len(kids) == 1 and health["compute_workers"] == 1:
-            return kids[0]
-        time.sleep(0.1)
-    raise AssertionError("no compute process came up")
+    return server.worker()
 
 
 def _gone(pid: int, wait_s: float) -> bool:
@@ -199,7 +182,7 @@ def test_no_temporary_file_survives_a_worker_killed_mid_upload(faulty: Server) -
 
 def test_work_that_cannot_finish_in_the_budget_is_refused_at_once(faulty: Server) -> None:
     # The stiffest side and the longest pulses the schema allows: 300 * 2 * (1e6 + 9.1e5)
-    # steps, past what RATE_MARGIN x the measured rate can do in the 20 s budget.
+    # steps, past what RATE_MARGIN x the measured rate can do in the 30 s budget.
     stiff = {"id": "S", "p_eq": 1e3, "lam": 0.2, "rocking": "one_sided", "eta": -0.5}
     start = time.monotonic()
     body = {

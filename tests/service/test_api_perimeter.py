@@ -22,16 +22,8 @@ from typing import Any
 
 import httpx
 import pytest
-from api_helpers import (
-    EXAMPLES,
-    REPO,
-    Server,
-    cli_error,
-    cpu_ticks,
-    peak_rss,
-    start_server,
-    wait_busy,
-)
+from api_helpers import EXAMPLES, REPO, cli_error, cpu_ticks, peak_rss, wait_busy
+from servers import ONE_PROCESS, Server, ServerWith, start_server
 
 CHURCH = json.loads((EXAMPLES / "constants" / "church.json").read_text())
 PULSE = {"p_eq": 2.0, "lam": 0.2, "eta": 0.9, "a_p_g": -0.61, "f_p": 1.59}
@@ -44,15 +36,13 @@ NUMERICS = ("numpy", "scipy", "numba", "llvmlite", "matplotlib", "rhino3dm", "tr
 
 
 @pytest.fixture(scope="module")
-def svc(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+def svc(server_with: ServerWith) -> Server:
     """One compute process, the default limits and budget (30 s)."""
-    with start_server(tmp_path_factory.mktemp("perimeter"), compute_workers=1) as srv:
-        yield srv
+    return server_with(**ONE_PROCESS)
 
 
 def _worker(server: Server) -> int:
-    (pid,) = server.children()
-    return pid
+    return server.worker()
 
 
 def _no_traceback(log: Path) -> None:

@@ -49,7 +49,7 @@ to the service, which must still refuse them:
   overflow or underflow, unique ids, ``eta`` between ``eta_to_negative`` and
   ``eta_to_positive``, and ``p_eq``/``lam`` derived from a physical form in range;
 - the options: ``f_min < f_max``, ``t_min < t_max``, a spectrum's ``f_min <= f_max``;
-- the server's settings and work bounds (``api.estimates.check_job``; the compute process's
+- the server's settings and work bounds (``api.jobspec.check_job``; the compute process's
   steps per sample of a time history and a spectrum's shortest period, an assessment's
   spectra over each mechanism's matching band), a scaled record within the solver's range
   (scale x peak / (g lam) <= ``MAX_AMPLITUDE_RATIO``), a pulse scale factor up the
@@ -89,12 +89,11 @@ import os
 import re
 import subprocess
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 
 import httpx
 import pytest
-from api_helpers import Server, start_server
+from servers import Server, ServerWith
 
 #: Test cases per operation and phase.
 MAX_EXAMPLES = 30
@@ -133,13 +132,8 @@ checks.positive_data_acceptance.enabled = true
 
 
 @pytest.fixture(scope="module")
-def fuzz_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
-    with start_server(
-        tmp_path_factory.mktemp("fuzz"),
-        compute_timeout_s=COMPUTE_TIMEOUT_S,
-        max_samples=MAX_SAMPLES,
-    ) as srv:
-        yield srv
+def fuzz_server(server_with: ServerWith) -> Server:
+    return server_with(compute_timeout_s=COMPUTE_TIMEOUT_S, max_samples=MAX_SAMPLES)
 
 
 #: The operations, in groups of about equal work: each group is one test, so that the test

@@ -20,7 +20,8 @@ from pathlib import Path
 
 import pytest
 import tomllib
-from api_helpers import REPO, Server
+from api_helpers import REPO
+from servers import Server
 
 DOCKERFILE = REPO / "Dockerfile"
 LOCK = REPO / "docker" / "requirements.lock"

@@ -17,7 +17,8 @@ from typing import Any
 
 import httpx
 import typer
-from api_helpers import EXAMPLES, Server, runner
+from api_helpers import EXAMPLES, runner
+from servers import Server
 from test_hops import hops_payload, outputs
 
 from shared_schema.version import __version__

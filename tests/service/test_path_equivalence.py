@@ -26,7 +26,8 @@ from pathlib import Path
 from typing import Any, Optional, Sequence
 
 import httpx
-from api_helpers import EXAMPLES, Server, runner, without_runtime
+from api_helpers import EXAMPLES, runner, without_runtime
+from servers import Server
 from test_hops import hops_payload, outputs
 
 import rockmech
