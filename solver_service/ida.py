@@ -43,6 +43,7 @@ them).
 from __future__ import annotations
 
 import contextlib
+import logging
 import math
 import os
 import re
@@ -50,6 +51,7 @@ import secrets
 import socket
 import threading
 import time
+import traceback
 import uuid
 from collections.abc import Callable, Sequence
 from concurrent.futures import CancelledError, ThreadPoolExecutor, as_completed
@@ -896,6 +898,21 @@ def _run_dask(
         raise
 
 
+def _drop_interrupt_noise(record: logging.LogRecord) -> bool:
+    """Drop the traceback distributed logs when Ctrl+C lands inside one of its calls.
+
+    ``distributed.utils.sync`` schedules a cancel callback that reads a variable set only
+    once its call started; an interrupt before that logs a ``NameError`` traceback through
+    tornado after rockmech's own one-line message. The interrupt itself is handled (the
+    run's tasks are cancelled), so that log says nothing to the user.
+    """
+    exc = record.exc_info[1] if record.exc_info else None
+    if not isinstance(exc, NameError):
+        return True
+    frames = traceback.extract_tb(exc.__traceback__)
+    return not (frames and "distributed" in frames[-1].filename)
+
+
 def _collect(
     ctx: dict[str, Any],
     motions: Sequence[Any],
@@ -917,6 +934,8 @@ def _collect(
     # Checked before anything else touches dask: a missing extra names its install line.
     distributed = require("dask.distributed", "dask", "for ida --scheduler")
     client = _dask_client(distributed, scheduler, timeout)
+    # Kept for the process: the callback may run after the run has ended.
+    logging.getLogger("tornado.application").addFilter(_drop_interrupt_noise)
     try:
         n_workers, n_threads = _cluster_threads(client, scheduler, timeout)
         packs, tasks = plan_tasks(costs, n_levels, task_s or task_seconds(sum(costs), n_threads))

@@ -88,7 +88,7 @@ def test_assess_html_has_the_verdict_table_and_provenance(client: httpx.Client) 
     assert res.headers["content-type"].startswith("text/html")
     page = res.text
     assert '<table id="verdict-table">' in page
-    rows = re.findall(r'<tr data-mechanism="([^"]+)">', page)
+    rows = re.findall(r'<tr data-mechanism="([^"]+)"', page)
     assert rows == ["F1", "F2", "A1", "T1"]
     assert "A. Engineer" in page  # the site's project fields fill page one
     assert page.count("<h2>Provenance</h2>") == 1
