@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 
-.PHONY: install demo test lint typecheck pyright schema bench numerics report-png serve dist install-check clean
+.PHONY: install demo test test-all lint typecheck pyright schema bench numerics report-png serve dist install-check clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -19,7 +19,13 @@ demo: $(STAMP)
 	$(BIN)/rockmech demo --out out
 
 ## The whole test suite: lint, format check, types, schema drift, then pytest.
+## The quick loop: everything but the tests marked slow (fuzzing, the load test, the
+## kill-at-every-step test, the wheel and Docker builds...): under 6 minutes on 2 cores.
 test: lint typecheck schema
+	$(BIN)/python -m pytest -n auto -m "not slow"
+
+## The whole suite, slow tests included: what CI runs (.ci/run) and the README's test command.
+test-all: lint typecheck schema
 	$(BIN)/python -m pytest -n auto
 
 lint: $(STAMP)
@@ -37,12 +43,12 @@ dist: $(STAMP)
 
 ## The wheel installed as a user would, in a fresh virtual environment: with no extras
 ## (--version, --help, demo, import rockmech), then with geometry,service (constants and
-## one request to rockmech serve). .ci/run runs it after `make test`.
+## one request to rockmech serve). .ci/run runs it after `make test-all`.
 install-check: dist
 	.ci/install_check dist
 
 ## The Rhino glue against RhinoCommon (pyright + rhino-stubs-typed; needs node on PATH).
-## `make test` runs the same check in tests/rhino_glue/test_static.py.
+## `make test-all` runs the same check in tests/rhino_glue/test_static.py.
 pyright: $(STAMP)
 	$(BIN)/pyright --pythonpath $(BIN)/python
 

@@ -95,6 +95,7 @@ def test_assess_html_has_the_verdict_table_and_provenance(client: httpx.Client) 
     assert "http://" not in page and "https://" not in page  # self-contained
 
 
+@pytest.mark.slow
 def test_assess_pdf_is_the_page_printed_by_headless_chromium(client: httpx.Client) -> None:
     if chromium() is None:
         pytest.skip("no Chromium on this machine (apt-get install chromium)")

@@ -11,9 +11,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from api_helpers import REPO
 
 
+@pytest.mark.slow
 def test_mixed_and_malformed_traffic_gives_no_5xx(tmp_path: Path) -> None:
     out = tmp_path / "load.json"
     cmd = [sys.executable, str(REPO / "benchmarks" / "load.py")]
