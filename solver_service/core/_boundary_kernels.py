@@ -3,7 +3,7 @@
 ``boundary_grids`` runs the scan-and-bisect of ``_kernels.boundary_grid`` for several curves
 (each its own restitution, one-sided flag and pulse direction) in one parallel loop over
 every (curve, Omega) pair, so that all threads share the work of all curves (no thread idle
-at the end of each curve). Each pair is searched by the same ``_kernels._search`` as
+at the end of each curve). Each pair is searched by the same ``_kernels.search`` as
 ``boundary_grid``, so the edges are those of ``boundary_grid`` bit for bit.
 
 Restitution-free outcomes. The restitution enters a run only at an impact (and in the
@@ -22,14 +22,14 @@ import math
 
 import numpy as np
 
+from ._compile import jit_parallel as _jit_parallel
+from ._compile import prange as _prange
 from ._kernels import (
     GOLDEN,
     KNOWN_FILL,
     KNOWN_IGNORE,
     KNOWN_USE,
-    _jit_parallel,
-    _prange,
-    _search,
+    search,
 )
 
 
@@ -49,7 +49,7 @@ def probe_grid(omegas, sign, phase, a_scan, rtol, max_edges, v_rest_rel):
     order = np.argsort((np.arange(n_om) * GOLDEN) % 1.0)
     for c in _prange(n_om):
         i = order[c]
-        ne, f = _search(
+        ne, f = search(
             0.0,
             False,
             sign,
@@ -110,7 +110,7 @@ def boundary_grids(
         k = order[t]
         c = k // n_om
         i = k % n_om
-        ne, f = _search(
+        ne, f = search(
             etas[c],
             one_sided[c],
             signs[c],

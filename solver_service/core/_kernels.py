@@ -38,7 +38,7 @@ phi_ov of each side, ``SIDE_*``), ``rules`` (restitution, one-sided, rest rule, 
 ``_free_tail`` after the excitation. At an impact into side ``s`` the restitution of that
 direction applies (``RULE_ETA`` into +1, ``RULE_ETA_NEG`` into -1; theory §1.8).
 Helpers that allocate nothing are compiled without reference counting (``_leaf``):
-passing arrays to them costs nothing.
+passing arrays to them costs nothing. The decorators are those of ``_compile``.
 
 Batch path (``simulate_grid``). Scales are run in blocks as a structure of arrays
 (``_simulate_block``), one stretch of ``DOZE`` cells at a time, each run through the whole
@@ -49,66 +49,23 @@ and width (``_propagator``: the record's few distinct widths, not per sample or 
 above, that no event lies inside; only a cell where one may lie takes the event path, with
 the same arithmetic, so a batch gives the numbers of single runs bit for bit.
 
-The same source runs uncompiled (``exact.kernels("python")``) as the pure-numpy path.
+The same functions run uncompiled (``exact.kernels("python")``, ``_compile.python_twins``)
+as the pure-numpy path.
 """
 
 import math
-from typing import Any
 
 import numpy as np
 
 from shared_schema.rules import G
 
-_NO_JIT = globals().get("_NO_JIT", False)
-#: Why the kernels run as plain Python (None when numba compiles them).
-JIT_REASON = None
-#: numba options of the helpers that allocate nothing (not in numba's type stubs).
-_LEAF_OPTIONS: dict[str, Any] = {"_nrt": False, "error_model": "numpy"}
-
-try:  # numba is optional: without it the same code runs as plain Python.
-    if _NO_JIT:
-        raise ImportError
-    import numba as _numba
-
-    def _jit(fn):
-        return _numba.njit(cache=True, nogil=True, error_model="numpy")(fn)
-
-    def _jit_parallel(fn):
-        return _numba.njit(cache=True, nogil=True, parallel=True)(fn)
-
-    def _leaf(fn):
-        # Helpers that allocate nothing run without the reference counting of their array
-        # arguments, which would otherwise cost more than the arithmetic of a step.
-        return _numba.njit(cache=True, nogil=True, **_LEAF_OPTIONS)(fn)
-
-    def _inline(fn):
-        # The small helpers of the per-sample and per-impact paths, inlined where they are
-        # called (numba IR): a call with array arguments costs more than their arithmetic.
-        return _numba.njit(cache=True, nogil=True, inline="always", **_LEAF_OPTIONS)(fn)
-
-    _prange: Any = _numba.prange
-    JIT = True
-except ImportError as _exc:  # pragma: no cover - exercised through the python backend
-    # numba absent (no wheel for this platform), or present but unusable (its message).
-    JIT_REASON = (
-        "compilation switched off"
-        if _NO_JIT
-        else (
-            "numba is not installed"
-            if getattr(_exc, "name", None) == "numba"
-            else f"numba cannot be used: {_exc}"
-        )
-    )
-
-    def _jit(fn):
-        return fn
-
-    _jit_parallel = _jit
-    _leaf = _jit
-    _inline = _jit
-    _prange = range
-    JIT = False
-
+# JIT and JIT_REASON say whether a kernel module is compiled (False in its python twin).
+from ._compile import JIT, JIT_REASON  # noqa: F401
+from ._compile import inline as _inline
+from ._compile import jit as _jit
+from ._compile import jit_parallel as _jit_parallel
+from ._compile import leaf as _leaf
+from ._compile import prange as _prange
 
 #: Unit roundoff of float64.
 EPS = 2.220446049250313e-16
@@ -540,7 +497,7 @@ def _free_time_to_zero(y, w, p):
 
 
 @_leaf
-def _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest):
+def free_rocking_kernel(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest):
     """Free-rocking outcome; documented in ``freemotion.free_rocking``, which wraps it."""
     y = s * x - 1.0
     w = s * v
@@ -1259,7 +1216,7 @@ def _free_tail(st, sides, rules):
     # The next impact, the only one that can matter (theory §1.8), leads into side -s.
     eta = rules[RULE_ETA] if one_sided else _eta_into(rules, -s)
     v_rest = rules[RULE_V_REST] * (p_s if one_sided else p_o)
-    col, dt_cross, pk, dt_pk = _free_rocking(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest)
+    col, dt_cross, pk, dt_pk = free_rocking_kernel(s, x, v, p_s, p_o, r_so, eta, one_sided, v_rest)
     if col:
         st[OUT_COLLAPSED] = 1.0
         t_cross = st[ST_T_CROSS]
@@ -1275,8 +1232,8 @@ def _free_tail(st, sides, rules):
         # Sensitivity of the analytic tail to the propagated state error.
         dx = math.sqrt(st[ST_PXX]) + EPS
         dv = math.sqrt(st[ST_PVV]) + EPS * p_s
-        pk_x = _free_rocking(s, x + s * dx, v, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
-        pk_v = _free_rocking(s, x, v + s * dv, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
+        pk_x = free_rocking_kernel(s, x + s * dx, v, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
+        pk_v = free_rocking_kernel(s, x, v + s * dv, p_s, p_o, r_so, eta, one_sided, 0.0)[2]
         st[ST_VAR_PEAK] = (pk_x - pk) ** 2 + (pk_v - pk) ** 2
         st[OUT_PEAK] = pk
         st[OUT_T_PEAK] = t + dt_pk
@@ -1903,7 +1860,7 @@ def pulse_work(eta, one_sided, v_rest_rel, quarter_cells, eta_neg=math.nan):
     return cells, sides, rules, np.empty(NST), np.empty(NFL), np.empty((2, 0)), np.empty((4, 0))
 
 
-#: What ``_search`` does with its ``known`` row: nothing, take its True entries as overturned
+#: What ``search`` does with its ``known`` row: nothing, take its True entries as overturned
 #: without a run, or fill it with the restitution-free outcomes (the ``eta = 0`` probe).
 KNOWN_IGNORE = 0
 KNOWN_USE = 1
@@ -1927,7 +1884,7 @@ def _scan_point(amp, om, phase, work, known, j, mode):
 
 
 @_jit
-def _search(
+def search(
     eta, one_sided, sign, om, phase, a_scan, rtol, v_rest_rel, edges_row, known, mode, eta_neg
 ):
     """Scan and bisect the outcome in A at one Omega; return (n_edges, collapsed at first).
@@ -1981,7 +1938,7 @@ def boundary_grid(
     no_known = np.zeros(0, dtype=np.bool_)
     for c in _prange(n_om):
         i = order[c]
-        n_edges[i], first[i] = _search(
+        n_edges[i], first[i] = search(
             eta,
             one_sided,
             sign,
