@@ -1,9 +1,16 @@
 """How the solver's kernels are compiled, and their pure-Python twins.
 
-The kernel modules (``_kernels``, ``_boundary_kernels``) are plain Python functions under
-the decorators of this module: with numba installed each decorator compiles its function
-(``cache=True``: numba keeps the machine code on disk, keyed by the function's module
-file), without numba each returns the function unchanged.
+The kernel modules (``KERNEL_SOURCES``: ``_closed_form``, ``_stepping``, ``_batch_kernels``,
+``_boundary_kernels``, gathered by ``_kernels``) are plain Python functions under the
+decorators of this module: with numba installed each decorator compiles its function
+(``cache=True``: numba keeps the machine code on disk), without numba each returns the
+function unchanged.
+
+numba keys the cache of a function by its own source file only, while the machine code of a
+kernel holds the kernels it calls from the other files (numba issue #8396): an edit of
+``_closed_form.py`` would leave the cached ``_stepping`` kernels running the old code. Each
+compiled kernel's cache is therefore keyed by the content of every kernel source
+(``key_by_sources``): an edit of any of them recompiles them all.
 
 ``python_twins`` gives the same functions uncompiled next to the compiled ones
 (``exact.kernels("python")``): for each kernel module a module object holding the same
@@ -14,6 +21,8 @@ twice and no flag is injected; the compiled modules and numba's cache are untouc
 Python 3.9-clean: Rhino 8 imports the solver through its flows (without numba).
 """
 
+import hashlib
+import os
 import threading
 import types
 from typing import Any, Callable, Dict, Optional, Tuple
@@ -25,9 +34,11 @@ __all__ = [
     "inline",
     "jit",
     "jit_parallel",
+    "key_by_sources",
     "leaf",
     "prange",
     "python_twins",
+    "sources_stamp",
 ]
 
 #: numba options of the helpers that allocate nothing (not in numba's type stubs).
@@ -36,6 +47,16 @@ LEAF_OPTIONS: Dict[str, Any] = {"_nrt": False, "error_model": "numpy"}
 TWIN_REASON = "compilation switched off"
 
 Fn = Callable[..., Any]
+
+#: The kernel sources beside this module, compiled together (module docstring).
+KERNEL_SOURCES = (
+    "_compile.py",
+    "_kernels.py",
+    "_closed_form.py",
+    "_stepping.py",
+    "_batch_kernels.py",
+    "_boundary_kernels.py",
+)
 
 #: Why the kernels run as plain Python (None when numba compiles them).
 JIT_REASON: Optional[str] = None
@@ -53,18 +74,49 @@ except ImportError as _exc:  # pragma: no cover - exercised where numba is missi
     )
 
 
+def sources_stamp(folder: str, names: Tuple[str, ...]) -> Optional[str]:
+    """Return a digest of the contents of the files ``names`` in ``folder`` (None if unread)."""
+    digest = hashlib.sha256()
+    try:
+        for name in names:
+            with open(os.path.join(folder, name), "rb") as f:
+                digest.update(name.encode() + b"\0" + f.read() + b"\0")
+    except OSError:  # no sources to read (a frozen install): numba's own stamp stands
+        return None
+    return digest.hexdigest()
+
+
+def key_by_sources(dispatcher: Any, stamp: Optional[str]) -> Any:
+    """Key the on-disk cache of a numba ``dispatcher`` by ``stamp`` as well as its own file.
+
+    Returns
+    -------
+    dispatcher
+        The same object. Its cached code is loaded only while ``stamp`` (``sources_stamp``
+        of every file its code comes from) is unchanged; ``tests/solver_core/test_jit.py``
+        checks that the installed numba honours this.
+    """
+    cache_file: Any = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
+    if stamp is not None and hasattr(cache_file, "_source_stamp"):
+        cache_file._source_stamp = (cache_file._source_stamp, stamp)
+    return dispatcher
+
+
+_STAMP = sources_stamp(os.path.dirname(os.path.abspath(__file__)), KERNEL_SOURCES) if JIT else None
+
+
 def jit(fn: Fn) -> Fn:
     """Compile ``fn`` (numba, cached on disk, no GIL); unchanged without numba."""
     if not JIT:
         return fn
-    return _numba.njit(cache=True, nogil=True, error_model="numpy")(fn)
+    return key_by_sources(_numba.njit(cache=True, nogil=True, error_model="numpy")(fn), _STAMP)  # type: ignore[no-any-return]
 
 
 def jit_parallel(fn: Fn) -> Fn:
     """Compile ``fn`` with numba's parallel loops (``prange``); unchanged without numba."""
     if not JIT:
         return fn
-    return _numba.njit(cache=True, nogil=True, parallel=True)(fn)
+    return key_by_sources(_numba.njit(cache=True, nogil=True, parallel=True)(fn), _STAMP)  # type: ignore[no-any-return]
 
 
 def leaf(fn: Fn) -> Fn:
@@ -75,7 +127,7 @@ def leaf(fn: Fn) -> Fn:
     """
     if not JIT:
         return fn
-    return _numba.njit(cache=True, nogil=True, **LEAF_OPTIONS)(fn)  # type: ignore[no-any-return]
+    return key_by_sources(_numba.njit(cache=True, nogil=True, **LEAF_OPTIONS)(fn), _STAMP)  # type: ignore[no-any-return]
 
 
 def inline(fn: Fn) -> Fn:
@@ -86,7 +138,8 @@ def inline(fn: Fn) -> Fn:
     """
     if not JIT:
         return fn
-    return _numba.njit(cache=True, nogil=True, inline="always", **LEAF_OPTIONS)(fn)  # type: ignore[no-any-return]
+    compiled = _numba.njit(cache=True, nogil=True, inline="always", **LEAF_OPTIONS)(fn)
+    return key_by_sources(compiled, _STAMP)  # type: ignore[no-any-return]
 
 
 #: The parallel loop of ``jit_parallel`` kernels (``range`` when they run as Python).
@@ -109,7 +162,8 @@ def python_twins(*modules: types.ModuleType) -> Dict[str, types.ModuleType]:
     dict of str to module
         For each module's ``__name__``, its twin: the same names, with every function of
         these modules (compiled or not) replaced by an uncompiled function of the same code
-        whose globals are the twin's, ``prange`` by ``range``, ``JIT`` False and
+        whose globals are the twin's, each of these modules by its twin, ``prange`` by
+        ``range``, ``JIT`` False and
         ``JIT_REASON`` ``TWIN_REASON``. Setting a twin's attribute (a test replacing a
         helper) changes what the twin's kernels call, never the compiled modules.
     """
@@ -135,6 +189,8 @@ def _build_twins(modules: Tuple[types.ModuleType, ...]) -> Dict[str, types.Modul
                 if id(fn) not in plain:
                     plain[id(fn)] = _rebind(fn, vars(twins[fn.__module__]))
                 setattr(twin, name, plain[id(fn)])
+            elif isinstance(value, types.ModuleType) and value.__name__ in names:
+                setattr(twin, name, twins[value.__name__])
             elif JIT and value is _numba.prange:
                 setattr(twin, name, range)
         twin.JIT = False  # type: ignore[attr-defined]

@@ -3,7 +3,7 @@
 Between impacts the motion is solved in closed form: exactly for one-sine and one-cosine
 pulses, and exactly for sampled records taken as piecewise-linear acceleration. Impact,
 uplift, turning-point and ``|phi|/phi_ov = 1`` times are found to machine precision
-(theory §1.8, §6.3, §10; the argument that no event is missed is in ``_kernels``).
+(theory §1.8, §6.3, §10; the argument that no event is missed is in ``_closed_form``).
 
 Rules (all documented in theory §1.8 and §10):
 
@@ -122,7 +122,7 @@ def kernels(backend: str = "auto") -> ModuleType:
         if not JIT:
             raise InputError("numba is not installed; use backend='python'", "backend")
         return _k
-    return python_twins(_k)[_k.__name__]
+    return python_twins(_k, *_k.MODULES)[_k.__name__]
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,6 @@
 """The compiled kernels: whether they are active, where numba keeps them, building them ahead.
 
-The exact solver's kernels (``_kernels``, ``_boundary_kernels``) and the spectrum's loop
+The exact solver's kernels (``_kernels`` and the modules it gathers) and the spectrum's loop
 (``spectra``) are compiled by numba where it is installed (a dependency of the base install
 on the platforms numba has wheels for). numba keeps the machine code in a cache on disk
 (``cache=True``; beside the sources when that folder is writable, else in the user's cache
@@ -30,7 +30,7 @@ from typing import Callable, Dict, List, Optional, Set, Tuple
 from shared_schema.atomic import write_atomic
 from shared_schema.version import __version__
 
-from ._compile import JIT, JIT_REASON
+from ._compile import JIT, JIT_REASON, KERNEL_SOURCES
 from ._kernels import simulate_cells_logged
 
 __all__ = [
@@ -51,7 +51,7 @@ PATHS: Dict[str, str] = {
     "spectrum": "response spectra (response_spectrum)",
 }
 #: Sources whose compiled code numba caches (their size and time stamp key its cache).
-SOURCES = ("_compile.py", "_kernels.py", "_boundary_kernels.py", "spectra.py")
+SOURCES = (*KERNEL_SOURCES, "spectra.py")
 #: Name of a path's stamp, written beside numba's cache once the path is compiled.
 STAMP = "rockmech-kernels-{path}.json"
 
