@@ -100,7 +100,7 @@ MAX_EDGES = 64
 #: thread pool costs more than it saves there, and a process forked from one that ran the
 #: parallel kernel (GNU OpenMP) may not start its threads.
 SERIAL_OMEGA = 16
-#: No scan point known in advance (``_kernels._search``'s ``known``).
+#: No scan point known in advance (``_kernels.search``'s ``known``).
 _NO_KNOWN = np.zeros(0, dtype=np.bool_)
 #: Library grid: Omega points (log-spaced in [0.05, 50]) and eta step.
 LIBRARY_OMEGA = (0.05, 50.0, 400)
@@ -293,7 +293,7 @@ def boundary_curve(
         n_edges = np.zeros(om.size, dtype=np.int64)
         first = np.zeros(om.size, dtype=np.bool_)
         for i in range(om.size):
-            n_edges[i], first[i] = kern._search(
+            n_edges[i], first[i] = kern.search(
                 *args[:3], om[i], *args[3:], V_REST_BOUNDARY, edges[i], _NO_KNOWN,
                 kern.KNOWN_IGNORE, eta_n,
             )  # fmt: skip

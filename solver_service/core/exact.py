@@ -3,7 +3,7 @@
 Between impacts the motion is solved in closed form: exactly for one-sine and one-cosine
 pulses, and exactly for sampled records taken as piecewise-linear acceleration. Impact,
 uplift, turning-point and ``|phi|/phi_ov = 1`` times are found to machine precision
-(theory §1.8, §6.3, §10; the argument that no event is missed is in ``_kernels``).
+(theory §1.8, §6.3, §10; the argument that no event is missed is in ``_closed_form``).
 
 Rules (all documented in theory §1.8 and §10):
 
@@ -32,9 +32,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import importlib.util
 import math
-import sys
 import threading
 import time
 import warnings
@@ -43,7 +41,7 @@ from collections import OrderedDict
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any, Optional, Union
+from typing import Any, Optional
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -52,7 +50,9 @@ from shared_schema.errors import InputError
 from shared_schema.rules import G
 
 from . import _kernels as _k
+from ._compile import JIT, python_twins
 from .excitation import Pulse, SampledAccel
+from .integrator import V_REST_REL, Excitation, Integrator
 from .jit import first_use
 from .linearisation import linearisation_warnings
 from .model import RockingModel, check_positive
@@ -70,10 +70,7 @@ __all__ = [
     "single_threaded",
 ]
 
-Excitation = Union[Pulse, SampledAccel]
 
-#: Rest rule: an impact leaving at below ``V_REST_REL * p`` [1/s per rad/s] ends in rest.
-V_REST_REL = 1e-9
 #: Pulses whose cells ``simulate`` keeps for reuse.
 PULSE_CELLS_CACHE = 256
 #: Records whose cells ``simulate`` and ``simulate_batch`` keep (the last used ones).
@@ -101,7 +98,6 @@ MAX_AMPLITUDE_RATIO = 1e6
 #: Most impacts kept in an impact log (``impact_log=True``); later ones are counted only.
 IMPACT_LOG_CAP = 1_000_000
 
-_KERNEL_CACHE: dict[str, ModuleType] = {}
 #: Per-thread switch of ``simulate_batch`` to the single-threaded grid (``single_threaded``).
 _THREAD = threading.local()
 #: Empty time-series and impact-log buffers (the kernels write nothing into them).
@@ -114,29 +110,19 @@ _METHOD = {True: "exact:numba", False: "exact:python"}
 def kernels(backend: str = "auto") -> ModuleType:
     """Return the kernel module for ``backend``.
 
-    ``"numba"`` is the compiled module (an error if numba is missing); ``"python"`` loads
-    a second copy of the same source with compilation switched off, so both paths run the
-    same code; ``"auto"`` prefers numba.
+    ``"numba"`` is the compiled module (an error if numba is missing); ``"python"`` is its
+    pure-Python twin (``_compile.python_twins``: the same functions, uncompiled), so both
+    paths run the same code; ``"auto"`` prefers numba.
     """
     if backend not in BACKENDS:
         raise InputError(f"must be one of {BACKENDS}, got {backend!r}", "backend")
     if backend == "auto":
-        backend = "numba" if _k.JIT else "python"
+        backend = "numba" if JIT else "python"
     if backend == "numba":
-        if not _k.JIT:
+        if not JIT:
             raise InputError("numba is not installed; use backend='python'", "backend")
         return _k
-    if "python" not in _KERNEL_CACHE:
-        spec = importlib.util.spec_from_file_location(
-            "solver_service.core._kernels_python", _k.__file__
-        )
-        assert spec is not None and spec.loader is not None
-        mod = importlib.util.module_from_spec(spec)
-        mod.__dict__["_NO_JIT"] = True
-        spec.loader.exec_module(mod)
-        sys.modules[spec.name] = mod
-        _KERNEL_CACHE["python"] = mod
-    return _KERNEL_CACHE["python"]
+    return python_twins(_k, *_k.MODULES)[_k.__name__]
 
 
 @dataclass(frozen=True)
@@ -687,3 +673,7 @@ def simulate_batch(
         runtime_s=time.perf_counter() - t_start,
         method=_METHOD[kern.JIT],
     )
+
+
+#: The entry satisfies the integrators' contract (mypy checks this assignment).
+_CONTRACT: Integrator[RockingModel] = simulate

@@ -9,7 +9,7 @@ smaller (its speed carries another factor ``eta**2`` two-sided, the product of t
 directions' values when they differ, ``|eta|`` one-sided), so two excursions decide the
 outcome and the peak, and only the restitution of the next impact enters.
 
-The computation lives in the integrator's kernels (``_kernels._free_rocking``), which
+The computation lives in the integrator's kernels (``_kernels.free_rocking_kernel``), which
 the exact integrator calls compiled; this module is its documented Python entry point.
 """
 
@@ -83,7 +83,7 @@ def free_rocking(
     >>> free_rocking(1.0, 1.2, 0.0, 2.0, 2.0, 1.0, 0.8, False, 0.0)[0]
     True
     """
-    col, dt_cross, peak, dt_peak = _kernels._free_rocking(
+    col, dt_cross, peak, dt_peak = _kernels.free_rocking_kernel(
         float(s),
         float(x),
         float(v),

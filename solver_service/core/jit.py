@@ -1,6 +1,6 @@
 """The compiled kernels: whether they are active, where numba keeps them, building them ahead.
 
-The exact solver's kernels (``_kernels``, ``_boundary_kernels``) and the spectrum's loop
+The exact solver's kernels (``_kernels`` and the modules it gathers) and the spectrum's loop
 (``spectra``) are compiled by numba where it is installed (a dependency of the base install
 on the platforms numba has wheels for). numba keeps the machine code in a cache on disk
 (``cache=True``; beside the sources when that folder is writable, else in the user's cache
@@ -30,7 +30,8 @@ from typing import Callable, Dict, List, Optional, Set, Tuple
 from shared_schema.atomic import write_atomic
 from shared_schema.version import __version__
 
-from . import _kernels as _k
+from ._compile import JIT, JIT_REASON, KERNEL_SOURCES
+from ._kernels import simulate_cells_logged
 
 __all__ = [
     "PATHS",
@@ -50,7 +51,7 @@ PATHS: Dict[str, str] = {
     "spectrum": "response spectra (response_spectrum)",
 }
 #: Sources whose compiled code numba caches (their size and time stamp key its cache).
-SOURCES = ("_kernels.py", "_boundary_kernels.py", "spectra.py")
+SOURCES = (*KERNEL_SOURCES, "spectra.py")
 #: Name of a path's stamp, written beside numba's cache once the path is compiled.
 STAMP = "rockmech-kernels-{path}.json"
 
@@ -125,9 +126,9 @@ class KernelStatus:
 
 def _cache_dir() -> Optional[Path]:
     """Return the folder numba caches ``_kernels`` in (the one it chose for this install)."""
-    if not _k.JIT:
+    if not JIT:
         return None
-    cache = getattr(_k.simulate_cells_logged, "_cache", None)
+    cache = getattr(simulate_cells_logged, "_cache", None)
     path = getattr(cache, "_cache_path", None)
     return Path(path) if path else None
 
@@ -173,8 +174,8 @@ def _is_built(path: str, key: Dict[str, object]) -> bool:
 
 def kernel_status() -> KernelStatus:
     """Return whether the compiled kernels are active and which paths are built."""
-    if not _k.JIT:
-        return KernelStatus(False, None, _k.JIT_REASON, None)
+    if not JIT:
+        return KernelStatus(False, None, JIT_REASON, None)
     import numba
 
     key = _key()
@@ -207,13 +208,13 @@ def first_use(path: str, backend: str = "auto") -> Optional[Callable[[], None]]:
     with _LOCK:
         todo = path not in _CHECKED
         _CHECKED.add(path)
-        say_python = not _k.JIT and not _STATE["said_python"]
+        say_python = not JIT and not _STATE["said_python"]
         if say_python:
             _STATE["said_python"] = True
-    if not _k.JIT:
+    if not JIT:
         if say_python:
             _NOTIFY[0](
-                f"note: {_k.JIT_REASON}, so the solver runs its pure-Python kernels, 10 to 100 "
+                f"note: {JIT_REASON}, so the solver runs its pure-Python kernels, 10 to 100 "
                 "times slower; pip install numba (on a platform it has wheels for) to compile them"
             )
         return None

@@ -17,8 +17,10 @@ p_s, lam_s, phi_ov_s : constants of side ``s`` [rad/s], [-], [rad]
 eta : coefficient of restitution [-] (``<= 0`` for one-sided rebound)
 G : standard gravity [m/s²]
 
-The engine below (``_run``) is shared with the nonlinear Housner reference (``nonlinear.py``),
-which supplies its own equation of motion through a ``_Physics`` object.
+The engine below (``integrate_events``, with ``Forcing``, ``solve_segment`` and
+``check_ivp_inputs``) is shared with the nonlinear Housner reference (``nonlinear.py``), which
+supplies its own equation of motion through a ``Physics`` object (the contract of
+``integrator.py``).
 
 Design notes
 ------------
@@ -37,16 +39,15 @@ Design notes
   a window opens, and a turning point found on the wrong side (``s*x < 0``) triggers a
   re-integration up to it, where the impact is bracketed.
 * Events that vanish at a segment start (``x = 0`` after an impact or uplift, ``v = 0`` after
-  uplift or release) are given the sign they take just after it (``_Event``).
+  uplift or release) are given the sign they take just after it (``integrator.Event``).
 """
 
 from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Optional, Union
+from typing import Any, Optional
 
 import numpy as np
 from numpy.typing import NDArray
@@ -54,16 +55,38 @@ from numpy.typing import NDArray
 from shared_schema.errors import InputError, SolverError
 from solver_service.core.excitation import Pulse, SampledAccel
 from solver_service.core.freemotion import free_rocking
+from solver_service.core.integrator import (
+    V_REST_REL,
+    Accel,
+    Array,
+    Event,
+    Excitation,
+    FreeOutcome,
+    Integrator,
+    Physics,
+    Rhs,
+    motion_events,
+)
 from solver_service.core.model import G, RockingModel, check_positive
 from solver_service.core.result import CRITERIA, RockingResult
 
-__all__ = ["IVP_METHODS", "MAX_IMPACTS", "ZENO_VREL", "simulate_ivp"]
+__all__ = [
+    "IVP_METHODS",
+    "MAX_IMPACTS",
+    "ZENO_VREL",
+    "Forcing",
+    "check_ivp_inputs",
+    "integrate_events",
+    "simulate_ivp",
+    "solve_segment",
+]
 
 #: Methods of ``scipy.integrate.solve_ivp`` the references accept.
 IVP_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
 
-#: Rest rule: after an impact the body rests when ``|v| < ZENO_VREL * p`` [-] (theory §10).
-ZENO_VREL = 1e-9
+#: Rest rule: after an impact the body rests when ``|v| < ZENO_VREL * p`` [-] (theory §10);
+#: the rule of every integrator (``integrator.V_REST_REL``).
+ZENO_VREL = V_REST_REL
 
 #: Default hard cap on the number of impacts; the run stops with status -1 beyond it.
 MAX_IMPACTS = 100_000
@@ -82,18 +105,12 @@ _MAX_DIP_RETRIES = 3
 #: Relative time below which a segment is too short to integrate and is skipped [-].
 _TIME_EPS = 8.0 * np.finfo(float).eps
 
-Excitation = Union[Pulse, SampledAccel]
-Array = NDArray[np.float64]
-Rhs = Callable[[float, Array], Array]
-Accel = Callable[[float], float]
-
-
 # --------------------------------------------------------------------------------------------
 # Input checks shared with nonlinear.py
 # --------------------------------------------------------------------------------------------
 
 
-def _check_common(
+def check_ivp_inputs(
     excitation: object,
     scale: object,
     method: object,
@@ -135,7 +152,7 @@ def _check_common(
 # --------------------------------------------------------------------------------------------
 
 
-class _Forcing:
+class Forcing:
     """Scaled ground acceleration with restart points, uplift search and future maxima.
 
     Parameters
@@ -301,7 +318,7 @@ class _Forcing:
         Inside such a window the motion on side ``s`` cannot turn back on the correct side,
         and past ``x = 0`` it can come back (the only way an integration step can hold two
         crossings of ``x = 0``). Ending segments at window starts keeps every step inside a
-        window free of turning points on the correct side (see ``_run``).
+        window free of turning points on the correct side (see ``integrate_events``).
         """
         if not self._sampled:
             k = -s * self._amp
@@ -342,49 +359,7 @@ class _Forcing:
 # --------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class _FreeOutcome:
-    """Outcome of the free motion after the excitation (see ``freemotion.free_rocking``)."""
-
-    collapses: bool
-    dt_cross: float
-    peak: float
-    dt_peak: float
-    nfev: int = 0
-
-
-class _Physics:
-    """What the engine needs to know about an equation of motion (in ``x`` units)."""
-
-    one_sided: bool
-    eta: float
-
-    def p(self, s: int) -> float:
-        """Frequency parameter of side ``s`` [rad/s] (scales the rest rule)."""
-        raise NotImplementedError
-
-    def uplift_accel(self, s: int) -> float:
-        """Magnitude of the ground acceleration that uplifts a body into side ``s`` [m/s²]."""
-        raise NotImplementedError
-
-    def rhs(self, s: int, accel: Accel) -> Rhs:
-        """Right-hand side ``(t, [x, v]) -> [v, x'']`` on side ``s``."""
-        raise NotImplementedError
-
-    def collapse_level(self, s: int, amax: float) -> float:
-        """``s*x`` beyond which outward motion cannot come back while ``|a_g| <= amax``."""
-        raise NotImplementedError
-
-    def impact(self, s: int, v: float) -> tuple[int, float]:
-        """Return the new side and ``v`` [1/s] after an impact at ``x = 0`` arriving with ``v``."""
-        raise NotImplementedError
-
-    def free(self, s: int, x: float, v: float, zeno_vrel: float) -> _FreeOutcome:
-        """Outcome of the free motion from ``(x, v)`` on side ``s`` once the excitation ends."""
-        raise NotImplementedError
-
-
-class _LinearPhysics(_Physics):
+class _LinearPhysics(Physics):
     """Linearised rocking (theory §1.4, §1.8), ``x'' = p_s²(x - s - a_g/(G lam_s))``."""
 
     def __init__(self, model: RockingModel) -> None:
@@ -427,7 +402,7 @@ class _LinearPhysics(_Physics):
         eta = self.model.eta_into(-s)
         return -s, eta * (self._sides[s].phi_ov / self._sides[-s].phi_ov) * v
 
-    def free(self, s: int, x: float, v: float, zeno_vrel: float) -> _FreeOutcome:
+    def free(self, s: int, x: float, v: float, zeno_vrel: float) -> FreeOutcome:
         """Exact free rocking (``freemotion.free_rocking``, theory §1.8)."""
         o = s if self.one_sided else -s
         r_so = self._sides[s].phi_ov / self._sides[o].phi_ov
@@ -442,64 +417,12 @@ class _LinearPhysics(_Physics):
             self.one_sided,
             zeno_vrel * self._sides[o].p_eq,
         )
-        return _FreeOutcome(c, dt_cross, peak, dt_peak)
+        return FreeOutcome(c, dt_cross, peak, dt_peak)
 
 
 # --------------------------------------------------------------------------------------------
 # The engine
 # --------------------------------------------------------------------------------------------
-
-
-class _Event:
-    """An event function with scipy's ``terminal``/``direction`` attributes.
-
-    ``value0`` replaces the value at the segment start ``t0``. An event that is exactly zero
-    at ``t0`` (``x = 0`` after an impact or uplift, ``v = 0`` after uplift or release) is
-    given the sign it takes just after ``t0``; otherwise scipy may count the start as a
-    crossing, and with interpolants that do not reproduce ``y(t0)`` exactly (LSODA) its root
-    bracket fails.
-    """
-
-    def __init__(
-        self,
-        fun: Callable[[float, Array], float],
-        terminal: bool,
-        direction: float,
-        t0: float,
-        value0: float,
-    ) -> None:
-        self.fun = fun
-        self.terminal = terminal
-        self.direction = direction
-        self.t0 = t0
-        self.value0 = value0
-
-    def __call__(self, t: float, y: Array) -> float:
-        return self.value0 if t == self.t0 else self.fun(t, y)
-
-
-def _first_sign(*values: float) -> float:
-    """Sign (+-1) of the first non-zero value: the sign of a Taylor series near its start."""
-    for val in values:
-        if val != 0.0:
-            return math.copysign(1.0, val)
-    return 1.0
-
-
-def _events(s: int, level: float, t0: float, y0: Array, acc0: float) -> list[_Event]:
-    """Impact (terminal), certain collapse (terminal), ``|x| = 1`` and turning points.
-
-    ``acc0`` is ``x''`` at the start ``t0``; when both ``v`` and ``x''`` vanish there (uplift
-    at the exact threshold), the motion still starts outward, towards side ``s``.
-    """
-    sf = float(s)
-    x0, v0 = float(y0[0]), float(y0[1])
-    return [
-        _Event(lambda t, y: float(y[0]), True, -sf, t0, x0 or _first_sign(v0, acc0, sf)),
-        _Event(lambda t, y: sf * float(y[0]) - level, True, 1.0, t0, sf * x0 - level),
-        _Event(lambda t, y: sf * float(y[0]) - 1.0, False, 0.0, t0, sf * x0 - 1.0),
-        _Event(lambda t, y: float(y[1]), False, 0.0, t0, v0 or _first_sign(acc0, sf)),
-    ]
 
 
 @dataclass
@@ -519,16 +442,28 @@ class _Track:
             self.t_peak = t
 
 
-def _solve(
+def solve_segment(
     rhs: Rhs,
     t_span: tuple[float, float],
     y0: Array,
     method: str,
     rtol: float,
     atol: float,
-    events: list[_Event],
+    events: list[Event],
     max_step: float,
 ) -> Any:
+    """Integrate one segment with ``solve_ivp``, stopping at its terminal events.
+
+    Returns
+    -------
+    OdeResult
+        scipy's result (``t``, ``y``, ``t_events``, ``y_events``, ``nfev``, ``status``).
+
+    Raises
+    ------
+    SolverError
+        ``solve_ivp`` failed (its message and the time it reached).
+    """
     from scipy.integrate import solve_ivp
 
     sol = solve_ivp(
@@ -546,9 +481,9 @@ def _solve(
     return sol
 
 
-def _run(
-    physics: _Physics,
-    forcing: _Forcing,
+def integrate_events(
+    physics: Physics,
+    forcing: Forcing,
     *,
     x0: float,
     method: str,
@@ -634,10 +569,10 @@ def _run(
         y0 = np.array([x, v])
         # At an uplift x'' is zero up to round-off and the motion starts outward.
         acc0 = 0.0 if uplift else float(rhs(t, y0)[1])
-        events = _events(s, level, t, y0, acc0)
+        events = motion_events(s, level, t, y0, acc0)
         t_stop = tb
         for _ in range(_MAX_DIP_RETRIES + 1):
-            sol = _solve(rhs, (t, t_stop), y0, method, rtol, atol, events, max_step)
+            sol = solve_segment(rhs, (t, t_stop), y0, method, rtol, atol, events, max_step)
             trk.nfev += int(sol.nfev)
             # A turning point on the wrong side (s*x < 0) means that a step held two
             # crossings of x = 0 and the impact event missed them: integrate again up to
@@ -839,7 +774,7 @@ def simulate_ivp(
     >>> r.collapsed, r.method
     (True, 'solve_ivp:DOP853')
     """
-    scale_f, rtol_f, atol_f, crit, zeno, cap, x0_f = _check_common(
+    scale_f, rtol_f, atol_f, crit, zeno, cap, x0_f = check_ivp_inputs(
         excitation, scale, method, rtol, atol, criterion, zeno_vrel, max_impacts, x0
     )
     if not isinstance(model, RockingModel):
@@ -847,11 +782,11 @@ def simulate_ivp(
     if model.one_sided and x0_f < 0.0:
         raise InputError(f"must be >= 0 for a one-sided mechanism, got {x0_f}", "x0")
     physics = _LinearPhysics(model)
-    forcing = _Forcing(excitation, scale_f, bool(restart_at_samples))
+    forcing = Forcing(excitation, scale_f, bool(restart_at_samples))
     max_step = np.inf
     if isinstance(excitation, SampledAccel) and not restart_at_samples:
         max_step = excitation.dt
-    return _run(
+    return integrate_events(
         physics,
         forcing,
         x0=x0_f,
@@ -865,3 +800,7 @@ def simulate_ivp(
         max_step=max_step,
         label=f"solve_ivp:{method}",
     )
+
+
+#: The entry satisfies the integrators' contract (mypy checks this assignment).
+_CONTRACT: Integrator[RockingModel] = simulate_ivp

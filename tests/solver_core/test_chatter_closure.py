@@ -2,7 +2,7 @@
 
 The kernel closes a chattering sequence at an impact when bounds on the bounces that
 follow prove that it ends in rest within the cell, how many impacts it still counts, and
-that none raises the peak (``_kernels._chatter_count``, theory §10.5). An impact log or a
+that none raises the peak (``_stepping._chatter_count``, theory §10.5). An impact log or a
 time series asks for every bounce, so a run with either follows them one by one: those runs
 are the reference here. Every output but the number of closed-form steps must be the same, bit for
 bit, on many scale factors of El Centro and on mechanisms of every kind (symmetric,

@@ -27,13 +27,13 @@ def elcentro(elcentro_path: Any) -> SampledAccel:
 @pytest.fixture()
 def general_scan_only() -> Iterator[None]:
     """The python kernels with the short route declined (every flight takes the scan)."""
-    kern = kernels("python")
-    short = kern._short_return
-    kern._short_return = lambda *args: -1.0
+    step = kernels("python")._stepping
+    short = step._short_return
+    step._short_return = lambda *args: -1.0
     try:
         yield
     finally:
-        kern._short_return = short
+        step._short_return = short
 
 
 def test_short_route_agrees_with_the_general_scan(
@@ -74,20 +74,24 @@ def test_mirrored_record_gives_the_mirrored_impacts_bit_for_bit(elcentro: Sample
 
 @pytest.fixture()
 def counted() -> Iterator[tuple[Any, dict[str, int]]]:
-    """The python kernels with a counter on the closed-form evaluations (``_state``)."""
+    """The python kernels with a counter on the closed-form evaluations (``state``)."""
     kern = kernels("python")
-    state = kern._state
+    # Both the one-run path and the closed forms it calls evaluate the state.
+    callers = (kern._closed_form, kern._stepping)
+    state = kern._closed_form.state
     count = {"state": 0}
 
     def counting(fl: Any, tau: float) -> Any:
         count["state"] += 1
         return state(fl, tau)
 
-    kern._state = counting
+    for mod in callers:
+        mod.state = counting
     try:
         yield kern, count
     finally:
-        kern._state = state
+        for mod in callers:
+            mod.state = state
 
 
 @pytest.mark.parametrize("speed", [1e-2, 1e-4, 1e-7])
@@ -99,20 +103,21 @@ def test_a_chattering_impact_costs_two_or_three_evaluations(
     # the impact evaluates the state once (it took 11 to 26 before). The impact log asks for
     # every bounce (no closed chattering sequence, test_chatter_closure.py).
     kern, count = counted
+    step, cf = kern._stepping, kern._closed_form
     params = np.array([2.0, 2.0, 0.15, 0.15, 0.15, 0.15, 0.9, 0.0])
-    sides, rules = kern._run_constants(params, 1.0, 1e-9, 1e6)
+    sides, rules = step.run_constants(params, 1.0, 1e-9, 1e6)
     cell = np.array([0.0, 0.3, 5.0, 0.0, 10.0, 10.02, 3.0])
-    st = kern._init_state(10.0, 0.0)
-    st[kern.ST_MODE] = kern.FLIGHT
-    st[kern.ST_S] = 1.0
-    st[kern.ST_V] = 2.0 * speed
-    st[kern.OUT_PEAK] = 0.5
-    done = kern._flight_step(
-        st, np.empty(kern.NFL), cell, sides, rules, 10.02, 10.0, np.empty((2, 0)), np.empty((4, 1))
+    st = step.init_state(10.0, 0.0)
+    st[cf.ST_MODE] = cf.FLIGHT
+    st[cf.ST_S] = 1.0
+    st[cf.ST_V] = 2.0 * speed
+    st[cf.OUT_PEAK] = 0.5
+    done = step._flight_step(
+        st, np.empty(cf.NFL), cell, sides, rules, 10.02, 10.0, np.empty((2, 0)), np.empty((4, 1))
     )
-    assert not done and st[kern.OUT_N_IMPACTS] == 1
+    assert not done and st[cf.OUT_N_IMPACTS] == 1
     assert count["state"] <= 3
     # The return time of x'' = p**2 (x - 1 - q), q = ks (0.3 + 5 t), from x = 0 at speed v:
     # to leading order 2 v / (p**2 (1 + q)).
     q = 0.3 / (9.80665 * 0.15)
-    assert st[kern.ST_T] - 10.0 == pytest.approx(2 * 2.0 * speed / (4.0 * (1 + q)), rel=2e-2)
+    assert st[cf.ST_T] - 10.0 == pytest.approx(2 * 2.0 * speed / (4.0 * (1 + q)), rel=2e-2)

@@ -17,7 +17,7 @@ import numba
 from typer.testing import CliRunner
 
 from solver_service.cli import app
-from solver_service.core import jit
+from solver_service.core import _compile, _kernels, jit
 
 ROOT = Path(__file__).resolve().parents[2]
 runner = CliRunner()
@@ -123,3 +123,57 @@ def test_the_build_rockmech_serve_runs_first_is_quiet_when_built_and_says_why_wi
     blocked = _run("import sys; sys.modules['numba'] = None\n" + code)
     assert blocked.returncode == 1
     assert blocked.stderr.startswith("note: compiled kernels: not active (numba is not installed)")
+
+
+CALLEE = "import numba\n\n\n@numba.njit(cache=True)\ndef f(x):\n    return x + {k}\n"
+CALLER = """import os
+
+import numba
+
+from callee import f
+from solver_service.core._compile import key_by_sources, sources_stamp
+
+
+def g(x):
+    return f(x) * 10
+
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+g = key_by_sources(numba.njit(cache=True)(g), sources_stamp(HERE, ("callee.py", "caller.py")))
+"""
+
+
+def test_an_edit_of_a_kernel_that_a_cached_kernel_calls_recompiles_the_caller(
+    tmp_path: Path,
+) -> None:
+    # numba keys a function's cache by its own file; the caller's machine code holds the
+    # callee's, so without key_by_sources the caller would keep the old callee (#29).
+    (tmp_path / "callee.py").write_text(CALLEE.format(k=1))
+    (tmp_path / "caller.py").write_text(CALLER)
+    code = (
+        f"import sys; sys.path.insert(0, {str(tmp_path)!r})\n"
+        "from caller import g\n"
+        "print(g(1), sum(g.stats.cache_hits.values()))\n"
+    )
+    env = {"NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    runs = []
+    for k in (1, 1, 2):
+        (tmp_path / "callee.py").write_text(CALLEE.format(k=k))
+        res = _run(code, env)
+        assert res.returncode == 0, res.stderr
+        runs.append(res.stdout.split())
+    # compiled, then loaded from the cache, then compiled again with the new callee
+    assert runs == [["20", "0"], ["20", "1"], ["30", "0"]]
+
+
+def test_every_compiled_kernel_is_keyed_by_every_kernel_source() -> None:
+    assert _compile._STAMP is not None
+    kernels = [
+        v
+        for mod in _kernels.MODULES
+        for v in vars(mod).values()
+        if getattr(getattr(v, "py_func", None), "__module__", None) == mod.__name__
+    ]
+    assert len(kernels) > 50
+    for k in kernels:
+        assert k._cache._cache_file._source_stamp[1] == _compile._STAMP, k

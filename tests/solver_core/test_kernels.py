@@ -1,6 +1,6 @@
 """The exact kernel's batch path, its cheap no-event bound and its series (issue #18).
 
-The batch path (``_kernels.simulate_grid``: blocks of scales, a propagator per cell width,
+The batch path (``_batch_kernels.simulate_grid``: blocks of scales, a propagator per cell width,
 the no-event bound before any root finding) must give the event-by-event path's numbers bit
 for bit; the bound must never wave through a cell that holds an event; the series of the
 closed form must be accurate to a few ulps.
@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 
+from solver_service.core import _closed_form as CF
 from solver_service.core import _kernels as K
 from solver_service.core.exact import (
     _params,
@@ -80,8 +81,8 @@ def _dense_extremes(s: float, xa: float, va: float, q0: float, q1: float, p: flo
     """min and max of ``s x`` over a flight of ``h``, sampled densely from the closed form."""
     fl = np.array([0.0, q0, q1, 0.0, 0.0, 1.0, s, p, 0.0, xa, va])  # ks = 1: q = a
     taus = np.linspace(0.0, h, 2001)
-    xs = np.array([K._state(fl, t)[0] for t in taus])
-    return float(np.min(s * xs)), float(np.max(s * xs)), K._state(fl, h)
+    xs = np.array([CF.state(fl, t)[0] for t in taus])
+    return float(np.min(s * xs)), float(np.max(s * xs)), CF.state(fl, h)
 
 
 def test_no_event_bound_never_clears_an_event() -> None:
@@ -102,7 +103,7 @@ def test_no_event_bound_never_clears_an_event() -> None:
         lo, hi, (xb, vb, _a, _j) = _dense_extremes(s, xa, va, q0, q1, p, h)
         if va * vb < 0.0:
             with_turn += 1
-        if K._no_event(s, xa, va, xb, vb, q0, q1, h, p, peak):
+        if CF.no_event(s, xa, va, xb, vb, q0, q1, h, p, peak):
             cleared += 1
             assert lo >= 0.0 and hi < 1.0
             assert hi <= max(peak, s * xb) + 1e-12
@@ -115,7 +116,7 @@ def test_closed_form_coefficients_are_accurate_to_a_few_ulps(u: float) -> None:
     mpmath.mp.dps = 40
     p = 1.7
     tau = u / p
-    chm1, shp, smp, psh = K._flow_coeffs(p, tau)
+    chm1, shp, smp, psh = CF.flow_coeffs(p, tau)
     uu, pp = mpmath.mpf(p) * mpmath.mpf(tau), mpmath.mpf(p)
     exact = (
         mpmath.cosh(uu) - 1,
@@ -127,7 +128,7 @@ def test_closed_form_coefficients_are_accurate_to_a_few_ulps(u: float) -> None:
     # scale of sinh(u)/p (above SERIES_U it is sinh(u) - u in floating point, as before).
     scales = (exact[0], exact[1], exact[1], exact[3])
     for got, ref, scale in zip((chm1, shp, smp, psh), exact, scales):
-        assert abs(got - float(ref)) <= 4 * K.EPS * abs(float(scale)), (u, got, ref)
+        assert abs(got - float(ref)) <= 4 * CF.EPS * abs(float(scale)), (u, got, ref)
 
 
 def test_pulse_cells_match_the_quarter_period_layout() -> None:
