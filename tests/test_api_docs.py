@@ -58,6 +58,7 @@ def test_the_examples_use_the_facade_alone() -> None:
     assert not inner, inner
 
 
+@pytest.mark.slow
 def test_docs_api_runs_as_a_doctest_in_an_empty_folder(tmp_path: Path) -> None:
     code = (
         "import doctest, sys\n"

@@ -187,6 +187,7 @@ def test_ec8_site_says_which_method_it_applies() -> None:
     assert lin["a0_star"] == pytest.approx((0.5 / 3.0) * G / (0.75 * 1.2), rel=1e-12)
 
 
+@pytest.mark.slow
 def test_cli_assess_json_prints_one_document(tmp_path: Path) -> None:
     pytest.importorskip("jinja2")
     out = tmp_path / "r.html"

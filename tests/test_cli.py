@@ -269,6 +269,7 @@ def test_library_build_writes_a_loadable_library(tmp_path: Path) -> None:
     np.testing.assert_allclose(lib.a_min_two_sided[1], boundary_curve(lib.omega, 0.5).a_min)
 
 
+@pytest.mark.slow
 def test_library_build_without_out_writes_the_user_cache_which_envelopes_read_first(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -115,6 +115,7 @@ def _draw_everything(tmp: Path) -> None:
     run_demo(tmp / "demo")
 
 
+@pytest.mark.slow
 def test_every_figure_shows_its_labels_as_meant(tmp_path: Path, figures: Figures) -> None:
     _draw_everything(tmp_path)
     assert figures.count >= 12, figures.count

@@ -122,6 +122,7 @@ def test_the_cluster_gives_the_local_numbers_as_docs_check_them(
     ).read_bytes()
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_the_command_and_cancels_its_tasks_on_the_cluster(
     scheduler: str, tmp_path: Path, elcentro_path: Path
 ) -> None:

@@ -102,6 +102,7 @@ def test_constants_files_are_merged_and_duplicate_ids_refused(tmp_path: Path) ->
 # ---------------------------------------------------------------------- the flow
 
 
+@pytest.mark.slow
 def test_analyse_flow_envelopes_of_the_current_mechanisms(tmp_path: Path) -> None:
     steps = [
         ("get_option", "Current"),

@@ -32,6 +32,7 @@ def _without_timings(doc: Dict[str, Any]) -> Dict[str, Any]:
     return {k: v for k, v in doc.items() if k != "timings"}
 
 
+@pytest.mark.slow
 def test_command_flow_writes_the_search_folder_and_draws_the_best_mechanisms(
     tmp_path: Path,
 ) -> None:

@@ -125,6 +125,7 @@ def test_components_cover_the_pipeline() -> None:
 # ---------------------------------------------------------------------- pyright
 
 
+@pytest.mark.slow
 def test_glue_type_checks_against_rhinocommon() -> None:
     """pyright with rhino-stubs-typed on rhino_plugin/rhino and the components."""
     pyright = shutil.which("pyright", path=str(Path(sys.executable).parent)) or shutil.which(

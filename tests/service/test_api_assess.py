@@ -65,6 +65,7 @@ def test_check_equals_rockmech_check_json(client: httpx.Client) -> None:
     assert doc["governing"] in {"F1", "F2", "A1", "T1"}
 
 
+@pytest.mark.slow
 def test_assess_json_equals_rockmech_assess_on_el_centro(
     client: httpx.Client, tmp_path: Path
 ) -> None:

@@ -105,6 +105,7 @@ def _post_in_thread(
     return thread
 
 
+@pytest.mark.slow
 def test_a_worker_killed_while_busy_gives_503_and_the_next_request_succeeds(
     faulty: Server,
 ) -> None:
@@ -124,6 +125,7 @@ def test_a_worker_killed_while_busy_gives_503_and_the_next_request_succeeds(
     assert _worker(faulty) != pid
 
 
+@pytest.mark.slow
 def test_a_worker_killed_while_idle_is_replaced_and_the_next_request_succeeds(
     faulty: Server,
 ) -> None:
@@ -306,6 +308,7 @@ def test_two_former_500s_are_answered(faulty: Server) -> None:
     assert error.startswith("p_eq: the number 1000") and "out of the range of double" in error
 
 
+@pytest.mark.slow
 def test_sigterm_waits_for_work_in_flight_no_longer_than_the_setting(tmp_path: Path) -> None:
     with start_server(tmp_path, compute_workers=1, shutdown_timeout_s=2) as srv:
         pid = _worker(srv)

@@ -53,6 +53,7 @@ def _no_traceback(log: Path) -> None:
 # --- a request still running when the shutdown grace ends -----------------------------------
 
 
+@pytest.mark.slow
 def test_a_request_cut_by_the_shutdown_gets_503_json_and_the_log_no_traceback(
     tmp_path: Path,
 ) -> None:
@@ -177,6 +178,7 @@ def test_bit_flipped_scenes_are_refused_by_the_archive_check(svc: Server, tmp_pa
 
 
 @pytest.mark.parametrize("where", ["mechanism id", "unknown key", "units"])
+@pytest.mark.slow
 def test_a_422_quotes_at_most_200_characters_of_a_31_mb_value(svc: Server, where: str) -> None:
     big = "W" * 31_000_000
     mech: dict[str, Any] = {"id": "W", "p_eq": 2.0, "lam": 0.2, "eta": 0.9}

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import httpx
+import pytest
 import typer
 from api_helpers import EXAMPLES, runner
 from servers import Server
@@ -57,6 +58,7 @@ def _json_commands() -> set[str]:
     return found
 
 
+@pytest.mark.slow
 def test_every_command_and_file_names_units_and_version(tmp_path: Path) -> None:
     out = tmp_path
     runs = {

@@ -5,6 +5,8 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import pytest
+
 BLOCKED = [
     "fastapi",
     "pydantic",
@@ -33,6 +35,7 @@ print("ok")
 """
 
 
+@pytest.mark.slow
 def test_core_imports_without_framework_or_rhino() -> None:
     proc = subprocess.run(
         [sys.executable, "-c", SCRIPT], capture_output=True, text=True, timeout=300, check=False

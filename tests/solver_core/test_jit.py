@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 import numba
+import pytest
 from typer.testing import CliRunner
 
 from solver_service.cli import app
@@ -62,6 +63,7 @@ def test_a_stamp_for_other_sources_or_another_numba_is_not_built(tmp_path: Path)
         assert not jit._is_built("simulate", {**key, field: value})
 
 
+@pytest.mark.slow
 def test_first_use_of_a_path_in_a_fresh_cache_says_so_once_then_loads_it_silently(
     tmp_path: Path,
 ) -> None:
