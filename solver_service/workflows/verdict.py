@@ -148,7 +148,9 @@ def _mechanism(row: dict[str, Any], method: str) -> dict[str, Any]:
             if at_design
             else ("; no record was run at the design scale" if dyn is not None else "")
         )
-        out["reason"] = f"passes every code check; the lowest: {code_text} >= 1{tail}"
+        out["reason"] = f"passes every code check that ran; the lowest: {code_text} >= 1{tail}"
+        if code.get("not_run"):
+            out["reason"] += f" (not run: {'; '.join(code['not_run'])})"
     else:
         out["verdict"] = "incomplete"
         out["governs"] = None

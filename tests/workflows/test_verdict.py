@@ -102,6 +102,15 @@ def test_everything_passes_and_the_sentence_says_on_what() -> None:
     assert c["sentence"].endswith("all 1 mechanisms pass (lowest capacity/demand 1.1, W1).")
 
 
+def test_a_pass_on_one_check_says_which_check_did_not_run() -> None:
+    row = _row("W1", 1.4, None, [True])
+    row["passes"] = True  # check_doc: the verdicts of the checks that ran
+    (w1,) = conclusion(_doc(row))["mechanisms"]
+    assert w1["verdict"] == "passes"
+    assert w1["reason"].startswith("passes every code check that ran; the lowest: linear")
+    assert w1["reason"].endswith("(not run: nonlinear: no virtual_work in the constants)")
+
+
 def test_a_check_that_could_not_run_makes_the_verdict_incomplete_not_a_pass() -> None:
     c = conclusion(_doc(_row("W1", 1.3, 1.1, [True]), _row("W2", None, None, [True])))
     assert c["verdict"] == "incomplete"
