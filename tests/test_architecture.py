@@ -256,12 +256,7 @@ def test_functions_are_short_or_say_why(module: str) -> None:
 
 #: Private names still imported across modules, with their home, to be made public or moved
 #: (#29). Keyed by name so that a module's move does not hide one; remove an entry once done.
-PRIVATE_IMPORTS_TO_REMOVE = {
-    "_number": "rhino_plugin.flows.mechanisms (imported by the other flows)",
-    "_hinge_point": "rhino_plugin.mechanisms.multi_block_cad (imported by flows.marks)",
-    "_pyplot": "solver_service.report.plots (imported by the other report figures)",
-    "_save_atomic": "solver_service.report.plots (imported by the other report figures)",
-}
+PRIVATE_IMPORTS_TO_REMOVE: dict[str, str] = {}
 
 
 def _is_private(name: str) -> bool:

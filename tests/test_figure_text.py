@@ -138,7 +138,7 @@ def test_every_figure_shows_its_labels_as_meant(tmp_path: Path, figures: Figures
 
 def test_matplotlib_keeps_mathtext_on() -> None:
     """Drawing does not switch mathtext off for everyone (it was a global rcParams change)."""
-    from solver_service.report.plots import _pyplot
+    from solver_service.report.plots import load_pyplot
 
-    _pyplot()
+    load_pyplot()
     assert matplotlib.rcParams["text.parse_math"] is True

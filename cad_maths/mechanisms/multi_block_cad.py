@@ -51,7 +51,7 @@ def _hinge(scene: Any, hinge: Any, where: str) -> Tuple[np.ndarray, Optional[np.
     return 0.5 * (start + end), d / float(np.linalg.norm(d))
 
 
-def _hinge_point(scene: Any, hinge: Any, where: str) -> np.ndarray:
+def hinge_point(scene: Any, hinge: Any, where: str) -> np.ndarray:
     """Return a hinge's point [m] (a line object's mid-point); used by the flows' marks."""
     return _hinge(scene, hinge, where)[0]
 

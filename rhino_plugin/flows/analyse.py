@@ -17,7 +17,7 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
-from rhino_plugin.flows.mechanisms import _number
+from rhino_plugin.flows.mechanisms import checked_number
 from rhino_plugin.flows.prompter import Cancelled, Prompter
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile
@@ -301,7 +301,7 @@ def run_pulse(
 
 
 def _num(prompter: Prompter, prompt: str, what: str, default: Optional[float] = None) -> float:
-    return _number(prompter.get_number(prompt, default), what, what, above=0.0)
+    return checked_number(prompter.get_number(prompt, default), what, what, above=0.0)
 
 
 def analyse_flow(
@@ -353,7 +353,7 @@ def analyse_flow(
                 more = prompter.get_number("Another scale factor (Enter when done)", None, True)
                 if more is None:
                     break
-                scales.append(_number(more, "scale factor", "scale factor", above=0.0))
+                scales.append(checked_number(more, "scale factor", "scale factor", above=0.0))
             fmt_units = None if record.lower().endswith(".at2") else units
             result = run_history(
                 cf, record, units=fmt_units, scales=scales, out_dir=out_dir, client=client
@@ -362,7 +362,7 @@ def analyse_flow(
             ids = [m.id for m in cf.mechanisms]
             mechanism = prompter.get_option("Mechanism", ids, 0)
             a_p = prompter.get_number("Pulse amplitude a_p [g] (signed)", None)
-            a_p_g = _number(a_p, "a_p [g]", "a_p_g")
+            a_p_g = checked_number(a_p, "a_p [g]", "a_p_g")
             f_p = _num(prompter, "Pulse frequency f_p [Hz]", "f_p [Hz]", 1.0)
             result = run_pulse(cf, mechanism, a_p_g=a_p_g, f_p=f_p, client=client)
     except Cancelled:

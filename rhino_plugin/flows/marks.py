@@ -12,7 +12,7 @@ from typing import Any, List, Tuple
 
 import numpy as np
 
-from cad_maths.mechanisms.multi_block_cad import _hinge_point
+from cad_maths.mechanisms.multi_block_cad import hinge_point
 from cad_maths.mechanisms.single import resolve_axis
 
 __all__ = ["Mark", "check_marks"]
@@ -79,6 +79,6 @@ def check_marks(spec_file: Any, scene: Any, constants: Any) -> List[Mark]:
             if hinges is None:
                 continue
             for name in ("A", "B", "C", "D"):
-                p = _hinge_point(scene, getattr(hinges, name), f"{spec.id}.{attr}.{name}")
+                p = hinge_point(scene, getattr(hinges, name), f"{spec.id}.{attr}.{name}")
                 marks.append(Mark(f"{spec.id} {name}{suffix}", (_pt(p, s),)))
     return marks

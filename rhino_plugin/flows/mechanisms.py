@@ -70,7 +70,7 @@ BLOCK_LABELS = ("block 1 (AB, turning about A)", "block 2 (BC)", "block 3 (DC, t
 HINGE_NAMES = ("A", "B", "C", "D")
 
 
-def _number(
+def checked_number(
     answer: Any,
     what: str,
     where: str,
@@ -150,7 +150,7 @@ class _Asker:
         self, prompt: str, what: str, path: str, default: Optional[float] = None, **bounds: Any
     ) -> float:
         answer = self.prompter.get_number(prompt, default)
-        return _number(answer, what, self.where(path), **bounds)
+        return checked_number(answer, what, self.where(path), **bounds)
 
     def tributary(self, what: str, path: str) -> float:
         """Ask the share of ``what``'s weight and inertia the wall carries (0.5 offered)."""

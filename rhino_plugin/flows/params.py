@@ -12,7 +12,7 @@ Python 3.9-clean: imported by Rhino 8.
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from cad_maths.mechanisms.build import constants_from_spec
-from rhino_plugin.flows.mechanisms import ROCKING, _number
+from rhino_plugin.flows.mechanisms import ROCKING, checked_number
 from rhino_plugin.flows.prepared import PreparedScene
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
@@ -65,7 +65,7 @@ def spec_from_parameters(
     if not has_axis:
         raise InputError("connect the rotation axis (a line)", "axis")
     dens = [
-        _number(d, "the density [kg/m³]", f"densities[{k}]", above=0.0, kind="density")
+        checked_number(d, "the density [kg/m³]", f"densities[{k}]", above=0.0, kind="density")
         for k, d in enumerate(densities)
     ]
     if len(dens) == 1:
@@ -93,7 +93,7 @@ def spec_from_parameters(
     if cracks:
         mech["cracks"] = [{"object": c} for c in cracks]
     if eta is not None:
-        mech["eta"] = _number(eta, "eta", "eta", at_least=-1.0, at_most=1.0)
+        mech["eta"] = checked_number(eta, "eta", "eta", at_least=-1.0, at_most=1.0)
     return {"mechanisms": [mech]}, [*solids, "axis", *cracks]
 
 

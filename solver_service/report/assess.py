@@ -42,7 +42,7 @@ from ..workflows.adapter import to_rocking_model
 from ..workflows.assess import assessment_doc, site_spectrum
 from ..workflows.scaling import mechanism_scale_factor
 from ..workflows.verdict import ratio_label
-from .plots import _pyplot, _save_atomic, plain
+from .plots import load_pyplot, plain, save_figure_atomic
 
 __all__ = [
     "TEMPLATE_NAME",
@@ -98,7 +98,7 @@ def _embed(draw: Callable[[], Path], caption: str) -> dict[str, str]:
 
 
 def _plot_spectrum(spectrum: Any, path: Path) -> Path:
-    plt = _pyplot()
+    plt = load_pyplot()
     t = np.linspace(0.0, 4.0, 401)
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(9, 3.2))
     ax1.plot(t, spectrum.Se(t), color="k", lw=1.2)
@@ -115,7 +115,7 @@ def _plot_spectrum(spectrum: Any, path: Path) -> Path:
     ax2.grid(alpha=0.3)
     fig.tight_layout()
     try:
-        return _save_atomic(fig, path)
+        return save_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -129,7 +129,7 @@ def _plot_capacity(lin: dict[str, Any], non: dict[str, Any], spectrum: Any, path
     ``a0*`` against its demand ``demand_activation / q``. The legend gives each verdict.
     The 2009 forms: the curve, ``d_u*`` and the demand over the 5 % site spectrum.
     """
-    plt = _pyplot()
+    plt = load_pyplot()
     fig, ax = plt.subplots(figsize=(6.8, 3.9))
     d_cur = non["curve"].get("d", non["curve"].get("d_star"))
     a_cur = non["curve"].get("a", non["curve"].get("a_star"))
@@ -213,7 +213,7 @@ def _plot_capacity(lin: dict[str, Any], non: dict[str, Any], spectrum: Any, path
     ax.legend(fontsize=6, loc="upper right")
     fig.tight_layout()
     try:
-        return _save_atomic(fig, path)
+        return save_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -339,7 +339,7 @@ def _rows_2009(check: dict[str, Any]) -> list[dict[str, str]]:
 
 
 def _plot_envelope(env: dict[str, Any], path: Path) -> Path:
-    plt = _pyplot()
+    plt = load_pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 3.6))
     f = np.asarray(env["f_p"], dtype=float)
     a = np.array([np.nan if v is None else v for v in env["a_p_min_g"]], dtype=float)
@@ -353,7 +353,7 @@ def _plot_envelope(env: dict[str, Any], path: Path) -> Path:
     ax.legend(fontsize=7)
     fig.tight_layout()
     try:
-        return _save_atomic(fig, path)
+        return save_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -374,7 +374,7 @@ def _crop(t: np.ndarray[Any, Any], ratio: np.ndarray[Any, Any]) -> tuple[float, 
 def _plot_history(
     label: str, res: Any, motion: Any, scale: float, path: Path
 ) -> tuple[Path, tuple[float, float]]:
-    plt = _pyplot()
+    plt = load_pyplot()
     t = np.asarray(res.t, dtype=float)
     ratio = np.asarray(res.ratio, dtype=float)
     lo, hi = _crop(t, ratio)
@@ -397,7 +397,7 @@ def _plot_history(
     axr.set_xlim(lo, hi)
     fig.tight_layout()
     try:
-        return _save_atomic(fig, path), (lo, hi)
+        return save_figure_atomic(fig, path), (lo, hi)
     finally:
         plt.close(fig)
 

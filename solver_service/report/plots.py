@@ -31,7 +31,7 @@ __all__ = [
 ]
 
 
-def _pyplot() -> Any:
+def load_pyplot() -> Any:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -56,7 +56,7 @@ def plain(text: str) -> str:
     return str(text).replace("$", r"\$")
 
 
-def _save_atomic(fig: Any, path: Union[str, Path]) -> Path:
+def save_figure_atomic(fig: Any, path: Union[str, Path]) -> Path:
     """Render a figure in memory and write it atomically (format from the suffix)."""
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -92,7 +92,7 @@ def plot_time_histories(
     Path
         The written file.
     """
-    plt = _pyplot()
+    plt = load_pyplot()
     nrows = 2 if record_t is not None else 1
     fig, axes = plt.subplots(
         nrows,
@@ -125,7 +125,7 @@ def plot_time_histories(
     axes[-1, 0].set_xlabel("time [s]")
     fig.tight_layout()
     try:
-        return _save_atomic(fig, path)
+        return save_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -158,7 +158,7 @@ def plot_ratio_histories(
     Path
         The written file.
     """
-    plt = _pyplot()
+    plt = load_pyplot()
     n = max(len(panels), 1)
     fig, axes = plt.subplots(n, 1, figsize=(9, 1.2 + 2.1 * n), sharex=True, squeeze=False)
     cmap = plt.get_cmap("tab10")
@@ -183,7 +183,7 @@ def plot_ratio_histories(
         axes[0, 0].set_title(f"{plain(title)}  (× overturned; dotted: time of overturning)")
     fig.tight_layout()
     try:
-        return _save_atomic(fig, path)
+        return save_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -219,7 +219,7 @@ def plot_record(
     Path
         The written file.
     """
-    plt = _pyplot()
+    plt = load_pyplot()
     if spectrum is None:
         t_n = np.geomspace(0.02, 10.0, 100) if periods is None else np.asarray(periods, float)
         spectrum = response_spectrum(motion.accel.acc, motion.dt, t_n, zeta)
@@ -253,7 +253,7 @@ def plot_record(
     ax_s.grid(which="both", alpha=0.3)
     fig.tight_layout()
     try:
-        return _save_atomic(fig, path)
+        return save_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -292,7 +292,7 @@ def plot_envelopes(
     fast : bool
         The envelopes are the fast mode's (the library): said in the edges' legend entry.
     """
-    plt = _pyplot()
+    plt = load_pyplot()
     fig, ax = plt.subplots(figsize=(9, 8))
     colours = {}
     cmap = plt.get_cmap("tab10")
@@ -350,7 +350,7 @@ def plot_envelopes(
         ax.set_title(plain(title))
     fig.tight_layout()
     try:
-        return _save_atomic(fig, path)
+        return save_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -372,7 +372,7 @@ def plot_fragility(doc: dict[str, Any], path: Union[str, Path], *, title: str = 
     Path
         The written file.
     """
-    plt = _pyplot()
+    plt = load_pyplot()
     levels = np.asarray(doc["intensity"]["levels"], dtype=float)
     fig, ax = plt.subplots(figsize=(8, 5))
     cmap = plt.get_cmap("tab10")
@@ -396,6 +396,6 @@ def plot_fragility(doc: dict[str, Any], path: Union[str, Path], *, title: str = 
     ax.set_title(plain(title) or "Fragility from incremental dynamic analysis (lognormal MLE)")
     fig.tight_layout()
     try:
-        return _save_atomic(fig, path)
+        return save_figure_atomic(fig, path)
     finally:
         plt.close(fig)

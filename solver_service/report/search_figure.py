@@ -14,7 +14,7 @@ from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
-from .plots import _pyplot, _save_atomic
+from .plots import load_pyplot, save_figure_atomic
 
 __all__ = ["plot_search"]
 
@@ -78,7 +78,7 @@ def plot_search(
     Path or None
         The image, or None when there is no candidate to draw.
     """
-    plt = _pyplot()
+    plt = load_pyplot()
     doc = run.doc
     order = doc["rankings"]["dynamic"] or doc["rankings"]["static"]
     order = order[:top]
@@ -133,6 +133,6 @@ def plot_search(
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    out = _save_atomic(fig, path)
+    out = save_figure_atomic(fig, path)
     plt.close(fig)
     return out
