@@ -1479,9 +1479,6 @@ def _num(value: Any, width: int, digits: int = 4) -> str:
 
 
 # assess reads records without --channel and --component
-_ASSESS_RECORD_OPTIONS = _RECORD_OPTIONS.only("units", "record_format", "dt")
-
-
 @app.command()
 @_user_errors
 @_grouped
@@ -1494,7 +1491,7 @@ def assess(
     multiple: list[float] = typer.Option(
         [0.5, 1.0, 1.5, 2.0], "--multiple", help="Multiples of the design scale to run."
     ),
-    reading: RecordOptions = _ASSESS_RECORD_OPTIONS,
+    reading: RecordOptions = _RECORD_OPTIONS,
     template_dir: Optional[Path] = typer.Option(
         None, "--template-dir", help="Folder whose assess.html.j2 overrides the layout."
     ),
@@ -1517,6 +1514,8 @@ def assess(
         "units": reading.units,
         "format": reading.record_format,
         "dt": reading.dt,
+        "channel": reading.channel,
+        "component": reading.component,
     }
     with _status("assess: code checks and rocking dynamics"):
         doc, text = assess_report(

@@ -204,3 +204,29 @@ def test_cli_assess_json_prints_one_document(tmp_path: Path) -> None:
     doc = json.loads(res.stdout)
     assert [r["id"] for r in doc["mechanisms"]] == ["F1", "F2", "A1", "T1"]
     assert out.is_file() and "wrote" in res.stderr
+
+
+def test_cli_assess_reads_one_channel_of_a_multi_channel_record(
+    tmp_path: Path, shared_records: Path
+) -> None:
+    # A CSMIP/DMG V2 file holds three channels: assess takes --channel / --component as every
+    # other record-reading command does, and its report's command repeats the choice.
+    dmg = shared_records / "formats" / "ce36456p_CE36456.V2"
+    if not dmg.is_file():
+        pytest.skip(f"shared strong-motion record not found at {dmg} (not part of a clone)")
+    constants = EXAMPLES / "constants" / "rect_walls.json"
+    site = EXAMPLES / "sites" / "ntc_site.json"
+    base = ["assess", str(constants), str(site), "--record", str(dmg), "--multiple", "1"]
+    res = runner.invoke(app, [*base, "-o", str(tmp_path / "none.html")])
+    assert res.exit_code == 2
+    assert "holds 3 acceleration channels" in res.stderr
+    out = tmp_path / "report.html"
+    res = runner.invoke(app, [*base, "--channel", "3", "-o", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    by_component = runner.invoke(
+        app, [*base, "--component", "0 DEG", "-o", str(tmp_path / "b.html"), "--json"]
+    )
+    assert by_component.exit_code == 0, by_component.output
+    assert json.loads(by_component.stdout)["records"] == doc["records"]
+    assert "--channel 3" in out.read_text(encoding="utf-8")

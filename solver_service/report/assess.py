@@ -696,7 +696,14 @@ def reproduce_commands(
             records.append(_file_name(src["name"], f"record{len(records) + 1}.csv"))
     opts = options or {}
     args = [f"--record {shlex.quote(r)}" for r in records]
-    for key, flag in (("units", "--units"), ("format", "--format"), ("dt", "--dt")):
+    flags = (
+        ("units", "--units"),
+        ("format", "--format"),
+        ("dt", "--dt"),
+        ("channel", "--channel"),
+        ("component", "--component"),
+    )
+    for key, flag in flags:
         if opts.get(key) is not None:
             args.append(f"{flag} {shlex.quote(str(opts[key]))}")
     args += [f"--multiple {sig(k)}" for k in opts.get("multiples", [])]
