@@ -14,9 +14,12 @@ from fastapi import Request
 from pydantic import BaseModel, ValidationError
 from starlette.datastructures import FormData, UploadFile
 
+from cad_maths.archive_3dm import check_3dm
 from shared_schema.api import ConstantsForm, HistoryForm, ReportForm, SearchForm, SpectrumForm
+from shared_schema.errors import InputError
 
 from .problems import Problem, validation_message
+from .uploads import safe_filename
 
 __all__ = [
     "FORMS",
@@ -183,3 +186,17 @@ def parse_form(form: FormData, spec: FormSpec) -> dict[str, Any]:
         raise Problem(422, "InputError", message, field) from None
     except ValueError as exc:
         raise Problem(422, "InputError", str(exc)) from None
+
+
+def check_scene_upload(data: bytes, filename: Optional[str]) -> None:
+    """Check an uploaded ``.3dm`` scene's layout before a compute process reads it.
+
+    ``cad_maths.archive_3dm.check_3dm`` (a cheap walk of the archive's chunks); a broken file
+    is a 422 naming the field. Scan meshes are read by their own checked readers.
+    """
+    name = safe_filename(filename, "scene.3dm")
+    try:
+        if name.lower().endswith(".3dm"):
+            check_3dm(data, name)
+    except InputError as exc:
+        raise Problem(422, "InputError", str(exc), exc.field) from None

@@ -4,17 +4,13 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Request, Response
 
-from cad_maths.archive_3dm import check_3dm
 from shared_schema.api import ConstantsResponse
-from shared_schema.errors import InputError
 
 from ..compute import compute
 from ..deps import MULTIPART, PoolDep, accepts
-from ..forms import FORMS, parse_form, read_form, read_upload
+from ..forms import FORMS, check_scene_upload, parse_form, read_form, read_upload
 from ..jobspec import SceneJob
 from ..openapi import body_doc, responses
-from ..problems import Problem
-from ..uploads import safe_filename
 
 __all__ = ["router"]
 
@@ -40,10 +36,5 @@ async def constants(request: Request, pool: PoolDep) -> Response:
         await form.close()
     assert scene is not None and spec is not None
     job = SceneJob(scene_name=scene[1], spec_name=spec[1], units=fields.get("units"))
-    name = safe_filename(scene[1], "scene.3dm")
-    try:
-        if name.lower().endswith(".3dm"):
-            check_3dm(scene[0], name)
-    except InputError as exc:
-        raise Problem(422, "InputError", str(exc), exc.field) from None
+    check_scene_upload(scene[0], scene[1])
     return await compute(pool, job, [scene[0], spec[0]])

@@ -4,17 +4,13 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Request, Response
 
-from cad_maths.archive_3dm import check_3dm
 from shared_schema.api import SearchResponse
-from shared_schema.errors import InputError
 
 from ..compute import compute
 from ..deps import MULTIPART, PoolDep, accepts
-from ..forms import FORMS, parse_form, read_form, read_upload
+from ..forms import FORMS, check_scene_upload, parse_form, read_form, read_upload
 from ..jobspec import RecordUpload, SearchJob
 from ..openapi import body_doc, responses
-from ..problems import Problem
-from ..uploads import safe_filename
 
 __all__ = ["router"]
 
@@ -63,12 +59,7 @@ async def search(request: Request, pool: PoolDep) -> Response:
         has_site=site is not None,
         record=upload,
     )
-    name = safe_filename(scene[1], "scene.3dm")
-    try:
-        if name.lower().endswith(".3dm"):
-            check_3dm(scene[0], name)
-    except InputError as exc:
-        raise Problem(422, "InputError", str(exc), exc.field) from None
+    check_scene_upload(scene[0], scene[1])
     blobs = [scene[0], spec[0]]
     if site is not None:
         blobs.append(site[0])
