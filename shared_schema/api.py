@@ -960,21 +960,14 @@ class ConstantsForm(BaseModel):
 SEARCH_MAX_EVALUATIONS = 200_000
 
 
-class SearchForm(BaseModel):
+class SearchForm(ConstantsForm):
     """Multipart form of ``search``: files ``scene``, ``spec``, ``site``, ``record``, and fields.
 
     ``spec`` is the search spec (JSON); ``site`` (SITE.json) and ``record`` are optional. The
     spec's ``ranking.site`` and ``ranking.records`` (paths) are refused: upload the files.
     """
 
-    model_config = _FORM
-
-    units: Optional[str] = Field(
-        None,
-        description=f"Length unit of a scan mesh: {', '.join(LENGTH_UNITS)} (required there; "
-        "a .3dm file states its own).",
-        json_schema_extra={"enum": list(LENGTH_UNITS)},
-    )
+    # ``units`` (a scan mesh's length unit) and its check are ConstantsForm's.
     max_evaluations: Optional[int] = Field(
         None,
         ge=1,
@@ -999,11 +992,6 @@ class SearchForm(BaseModel):
         description="Time step [s] of a record without a time column.",
         json_schema_extra={"exclusiveMinimum": 0},
     )
-
-    @field_validator("units")
-    @classmethod
-    def _known_length_unit(cls, units: Optional[str]) -> Optional[str]:
-        return None if units is None else check_choice(units, LENGTH_UNITS, "units")
 
 
 # --- responses --------------------------------------------------------------------------------
