@@ -41,7 +41,7 @@ from ..core.model import G
 from ..workflows.adapter import to_rocking_model
 from ..workflows.assess import assessment_doc, site_spectrum
 from ..workflows.scaling import mechanism_scale_factor
-from ..workflows.verdict import ratio_label
+from ..workflows.verdict import ratio_label, worst_pulse
 from .plots import load_pyplot, plain, save_figure_atomic
 
 __all__ = [
@@ -502,10 +502,9 @@ def _margin_cell(row: dict[str, Any], verdict: dict[str, Any]) -> dict[str, str]
     env = row.get("envelope") or {}
     if "note" in env:
         return {"text": "not run", "cls": "na", "note": _short(env["note"])}
-    pulses = [p for p in env.get("pulses", []) if p.get("margin") is not None]
-    if not pulses:
+    worst = worst_pulse(row)
+    if worst is None:
         return {"text": "–", "cls": "na", "note": "no pulse found in the records"}
-    worst = min(pulses, key=lambda p: p["margin"])
     text = f"{sig(worst['margin'], 3)} ({worst['record']}, {sig(worst['f_p'], 3)} Hz)"
     if "pulse_margin" in verdict:
         # It disagrees with the time history, which governs: shown, not coloured.

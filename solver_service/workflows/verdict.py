@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-__all__ = ["RULE", "check_label", "conclusion", "ratio_label"]
+__all__ = ["RULE", "check_label", "conclusion", "ratio_label", "worst_pulse"]
 
 #: The rule that turns the analyses into one verdict, printed with it.
 RULE = (
@@ -82,13 +82,18 @@ def _code_part(row: dict[str, Any], method: str) -> dict[str, Any]:
     return out
 
 
-def _margin_note(row: dict[str, Any], overturns: list[str]) -> Optional[str]:
-    """Say where the largest-pulse margin disagrees with the time history, and which governs."""
+def worst_pulse(row: dict[str, Any]) -> Optional[dict[str, Any]]:
+    """Return the record pulse of a mechanism row with the smallest margin, or None."""
     env = row.get("envelope") or {}
     pulses = [p for p in env.get("pulses", []) if p.get("margin") is not None]
-    if not pulses or "dynamics" not in row:
+    return min(pulses, key=lambda p: p["margin"]) if pulses else None
+
+
+def _margin_note(row: dict[str, Any], overturns: list[str]) -> Optional[str]:
+    """Say where the largest-pulse margin disagrees with the time history, and which governs."""
+    worst = worst_pulse(row)
+    if worst is None or "dynamics" not in row:
         return None
-    worst = min(pulses, key=lambda p: p["margin"])
     margin = float(worst["margin"])
     record = worst["record"]
     if margin >= 1.0 and record in overturns:
