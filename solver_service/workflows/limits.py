@@ -365,17 +365,14 @@ def _grid_sum(p: float, f_min: float, f_max: float, n: int) -> float:
     """Sum of ``max(1, p / f)`` over ``n`` log-spaced frequencies in ``[f_min, f_max]``."""
     if n < 2 or not _positive(f_min, f_max) or f_max <= f_min:
         return 0.0  # an invalid grid: the compute refuses it with its own message
-    ratio = (f_max / f_min) ** (1.0 / (n - 1))
-    # Frequencies below p contribute p/f (a geometric series), the others 1 each.
-    k = min(n, max(0, math.ceil(math.log(p / f_min) / math.log(ratio)))) if p > f_min else 0
-    series = (p / f_min) * (1.0 - ratio ** (-k)) / (1.0 - 1.0 / ratio) if k else 0.0
-    return series + (n - k)
+    return _index_sum(p, f_min, (f_max / f_min) ** (1.0 / (n - 1)), 0, n)
 
 
 def _index_sum(p: float, f_min: float, ratio: float, i0: int, i1: int) -> float:
     """Sum of ``max(1, p / f_i)`` over ``i0 <= i < i1``, ``f_i = f_min ratio**i``."""
     if i1 <= i0:
         return 0.0
+    # Frequencies below p contribute p/f (a geometric series), the others 1 each.
     k = max(0, math.ceil(math.log(p / f_min) / math.log(ratio))) if p > f_min else 0
     m = min(i1, max(i0, k))  # f_i < p for i < k: p / f_i; 1 from there on
     series = (p / f_min) * (ratio ** (-i0) - ratio ** (-m)) / (1.0 - 1.0 / ratio)
