@@ -49,6 +49,7 @@ import os
 import re
 import secrets
 import socket
+import sys
 import threading
 import time
 import traceback
@@ -913,6 +914,25 @@ def _drop_interrupt_noise(record: logging.LogRecord) -> bool:
     return not (frames and "distributed" in frames[-1].filename)
 
 
+class _QuietHalfBuilt:
+    """``sys.unraisablehook`` that drops the error of a half-built distributed object's ``__del__``.
+
+    Ctrl+C inside ``distributed.Future.__init__`` leaves an object whose ``__del__`` raises
+    ``AttributeError`` when it is collected, printed as "Exception ignored in ..." after
+    rockmech's one-line message. The interrupt itself is handled; every other unraisable error
+    goes to the hook there was before.
+    """
+
+    def __init__(self, previous: Callable[[Any], Any]) -> None:
+        self.previous = previous
+
+    def __call__(self, unraisable: Any) -> None:
+        module = getattr(unraisable.object, "__module__", "") or ""
+        if isinstance(unraisable.exc_value, AttributeError) and module.startswith("distributed"):
+            return
+        self.previous(unraisable)
+
+
 def _collect(
     ctx: dict[str, Any],
     motions: Sequence[Any],
@@ -936,6 +956,8 @@ def _collect(
     client = _dask_client(distributed, scheduler, timeout)
     # Kept for the process: the callback may run after the run has ended.
     logging.getLogger("tornado.application").addFilter(_drop_interrupt_noise)
+    if not isinstance(sys.unraisablehook, _QuietHalfBuilt):
+        sys.unraisablehook = _QuietHalfBuilt(sys.unraisablehook)
     try:
         n_workers, n_threads = _cluster_threads(client, scheduler, timeout)
         packs, tasks = plan_tasks(costs, n_levels, task_s or task_seconds(sum(costs), n_threads))
