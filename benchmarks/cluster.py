@@ -11,7 +11,13 @@ through ``run_ida`` on every path:
    results do not depend on the cutting; the per-task times feed the model below);
 2. in-process threads, one per core (``jobs=cores``);
 3. a dask.distributed ``LocalCluster`` of 1, 2, ... worker processes (up to the cores), one
-   thread each, started before the timing and warmed up (kernels loaded) by a small run.
+   thread each, with rockmech's Dask settings (``ida.DASK_SETTINGS``, as docs/cluster.md
+   sets them up), started before the timing and warmed up (kernels loaded) by a small run;
+4. the same on all the cores with Dask's default settings, for comparison.
+
+After each Dask case the cluster is left idle ``IDLE_S`` seconds and the CPU time Dask's
+processes take meanwhile (their background work: event-loop ticks, heartbeats, profiler) is
+measured.
 
 Each case runs ``REPEATS`` times (``--repeats``) and the best wall time is kept: the machine is
 shared.
@@ -35,7 +41,9 @@ thread (``gap_per_task_s`` of the 2-worker run) and the fixed cost of a Dask run
 time less the span from its first task's start to its last task's end: connecting, checking
 the workers, broadcasting the constants, scattering the records, gathering the last result).
 The tasks are list-scheduled, longest first as ``run_ida`` submits them, on
-``MODEL_WORKERS`` lanes, each taking its measured time plus the gap; the fixed cost is
+``MODEL_WORKERS`` lanes, each taking its measured time plus the gap, stretched by the
+background CPU per worker of the all-core cluster (its idle CPU over its number of workers:
+the scheduler's share is thus counted once per worker, an upper bound); the fixed cost is
 added. Threads on the same machine get the same schedule with the local gap and fixed cost.
 On Dask, lane ``j`` starts only once the client has sent it its first task, ``(j + 1)``
 times the client's time to scatter one task's records (measured), and no task starts before
@@ -54,6 +62,7 @@ from __future__ import annotations
 
 import argparse
 import heapq
+import os
 import sys
 import time
 from pathlib import Path
@@ -78,7 +87,7 @@ from records_speed import autogroup, derived_records, mechanisms  # noqa: E402
 
 N_RECORDS = 2000
 N_LEVELS = 50
-REPEATS = 2
+REPEATS = 3
 #: Workers the overhead model predicts for.
 MODEL_WORKERS = 16
 #: Targets: Dask on all cores within this factor of the threads; overhead per task.
@@ -86,6 +95,8 @@ TARGET_DASK_VS_THREADS = 1.10
 TARGET_OVERHEAD = 0.05
 #: Targets of the model: efficiency against one thread on ``MODEL_WORKERS`` workers.
 TARGET_MODEL_EFFICIENCY = 0.75
+#: Load average (1 min, per core) at the start above which the machine is called shared.
+SHARED_LOAD = 0.5
 #: Seconds the Dask cluster is left idle to measure its own background CPU.
 IDLE_S = 5.0
 #: What must not differ between two runs of the same IDA.
@@ -187,9 +198,11 @@ def main(argv: Optional[list[str]] = None) -> int:
     if args.repeats < 1:
         ap.error(f"--repeats: must be >= 1, got {args.repeats}")
     repeats = args.repeats
+    import dask
     from distributed import Client, LocalCluster
 
     from solver_service.ida import (
+        DASK_SETTINGS,
         TASK_STEPS_PER_S,
         available_cores,
         plan_tasks,
@@ -200,6 +213,7 @@ def main(argv: Optional[list[str]] = None) -> int:
 
     n_rec = 40 if args.quick else N_RECORDS
     cores = available_cores()
+    shared = os.getloadavg()[0] > SHARED_LOAD * cores  # before this script's own load
     info = machine_info(("numpy", "numba", "distributed"))
     records = derived_records(n_rec)
     cf = mechanisms()
@@ -227,8 +241,11 @@ def main(argv: Optional[list[str]] = None) -> int:
     threads = best_run(lambda note: run_ida(cf, records, levels, jobs=cores), repeats=repeats)
     rows.append({"case": f"in-process threads (jobs={cores})", "n": cores, **threads})
     print(f"threads: {fmt_time(threads['wall'])}")
-    for n in range(1, cores + 1):
+    cases = [(n, DASK_SETTINGS) for n in range(1, cores + 1)] + [(cores, {})]
+    idle: dict[str, float] = {}  # case -> Dask's CPU left idle, in cores
+    for n, settings in cases:
         with (
+            dask.config.set(settings),  # the nannies hand the settings to their workers
             LocalCluster(
                 n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
             ) as cluster,
@@ -236,20 +253,24 @@ def main(argv: Optional[list[str]] = None) -> int:
         ):
             address = cluster.scheduler_address
             run_ida(cf, records[:n], levels[:2], scheduler=address)  # warm every worker
-            dask = best_run(
+            dask_run = best_run(
                 lambda note, a=address: run_ida(cf, records, levels, scheduler=a),
                 client,
                 repeats=repeats,
             )
-            feed_s = feed_seconds(client, records, model_packs)
+            if settings:
+                feed_s = feed_seconds(client, records, model_packs)
             c0 = cpu_seconds(client)
             time.sleep(IDLE_S)
-            idle_cpu = (cpu_seconds(client) - c0) / IDLE_S  # cores Dask keeps busy, idle
-        rows.append({"case": f"Dask, {n} worker{'s' * (n > 1)} x 1 thread", "n": n, **dask})
-        print(f"Dask {n}: {fmt_time(dask['wall'])}")
+            case = f"Dask, {n} worker{'s' * (n > 1)} x 1 thread"
+            if not settings:
+                case += ", Dask's default settings"
+            idle[case] = (cpu_seconds(client) - c0) / IDLE_S
+        rows.append({"case": case, "n": n, "idle": idle[case], **dask_run})
+        print(f"{case}: {fmt_time(dask_run['wall'])}; idle CPU {100 * idle[case]:.1f} % of a core")
 
     same = all(r["doc"][k] == one["doc"][k] for r in rows for k in RESULT_KEYS if k in one["doc"])
-    dask_all = rows[-1]
+    dask_all, dask_default = rows[-2], rows[-1]
     local_backend = threads["doc"]["backend"]
     dask_backend = dask_all["doc"]["backend"]
 
@@ -265,13 +286,24 @@ def main(argv: Optional[list[str]] = None) -> int:
     fixed_dask = dask_all["wall"] - dask_backend["span_s"]
     fixed_local = threads["wall"] - local_backend["span_s"]
     gap_dask, gap_local = dask_backend["gap_per_task_s"], local_backend["gap_per_task_s"]
-    span_dask = list_schedule([d + gap_dask for d in durations], MODEL_WORKERS, feed_s)
+    # Dask's background CPU per worker, stretching every task on its core.
+    bg = dask_all["idle"] / dask_all["n"]
+    bg_default = dask_default["idle"] / dask_default["n"]
+
+    def dask_model(times: list[float], background: float) -> float:
+        lanes = [(1 + background) * d + gap_dask for d in times]
+        return float(fixed_dask + list_schedule(lanes, MODEL_WORKERS, feed_s))
+
+    t_model_dask = dask_model(durations, bg)
+    span_dask = t_model_dask - fixed_dask
     span_local = list_schedule([d + gap_local for d in durations], MODEL_WORKERS)
-    t_model_dask = fixed_dask + span_dask
     t_model_threads = fixed_local + span_local
     eff_model = t1 / (MODEL_WORKERS * t_model_dask)
+    # The same model with Dask's default settings (their background CPU; the same gaps).
+    t_model_default = dask_model(durations, bg_default)
+    eff_default = t1 / (MODEL_WORKERS * t_model_default)
     # The same model on the tasks' wall times (the model's input before #30's even cutting).
-    t_wall_dask = fixed_dask + list_schedule([d + gap_dask for d in walls], MODEL_WORKERS, feed_s)
+    t_wall_dask = dask_model(walls, bg)
     eff_wall = t1 / (MODEL_WORKERS * t_wall_dask)
 
     table = []
@@ -286,6 +318,7 @@ def main(argv: Optional[list[str]] = None) -> int:
                 f"{100 * eff:.0f} %",
                 f"{backend['tasks']} x {fmt_time(backend['task_s'])}",
                 f"{100 * backend['overhead_fraction']:.2f} %",
+                f"{100 * r['idle']:.1f} %" if "idle" in r else "-",
                 r["load"],
             ]
         )
@@ -296,9 +329,11 @@ def main(argv: Optional[list[str]] = None) -> int:
         "parallel efficiency",
         "tasks x mean time",
         "overhead per task",
+        "Dask's CPU, idle",
         "load before / after",
     ]
     ratio = dask_all["wall"] / threads["wall"]
+    ratio_default = dask_default["wall"] / threads["wall"]
     verdicts = [
         [
             f"Dask {cores} workers vs threads (jobs={cores}), wall",
@@ -347,10 +382,16 @@ def main(argv: Optional[list[str]] = None) -> int:
         f"send {1 / feed_s:.0f} tasks/s, the {MODEL_WORKERS} workers need "
         f"{MODEL_WORKERS / float(np.mean(durations)):.0f})",
         f"Python outside the kernels (holds the GIL), all tasks: {fmt_time(python_s)}",
-        f"Dask's own background CPU (heartbeats, the workers' profilers; the {cores}-worker "
-        f"cluster left idle {IDLE_S:g} s): {100 * idle_cpu:.1f} % of a core, "
-        f"{fmt_time(idle_cpu * dask_all['wall'])} over the {cores}-worker run (its extra CPU "
-        f"over one thread: {fmt_time(dask_all['cpu'] - one['cpu'])})",
+        f"Dask's own background CPU (event-loop ticks, heartbeats, the workers' profilers; "
+        f"the {cores}-worker cluster left idle {IDLE_S:g} s): {100 * dask_all['idle']:.1f} % "
+        f"of a core with rockmech's settings, {100 * bg:.2f} % per worker, "
+        f"{fmt_time(dask_all['idle'] * dask_all['wall'])} over the {cores}-worker run (its "
+        f"extra CPU over one thread: {fmt_time(dask_all['cpu'] - one['cpu'])}); "
+        f"{100 * dask_default['idle']:.1f} % with Dask's defaults, "
+        f"{100 * bg_default:.2f} % per worker",
+        f"Dask's default settings: {cores} workers against threads {ratio_default:.3f} (wall "
+        f"{fmt_time(dask_default['wall'])}); the model for {MODEL_WORKERS} workers "
+        f"{fmt_time(t_model_default)}, efficiency {100 * eff_default:.0f} %",
         f"list schedule on {MODEL_WORKERS} lanes: Dask {fmt_time(span_dask)} + "
         f"{fmt_time(fixed_dask)} = {fmt_time(t_model_dask)}; threads {fmt_time(span_local)} "
         f"+ {fmt_time(fixed_local)} = {fmt_time(t_model_threads)}",
@@ -372,11 +413,14 @@ def main(argv: Optional[list[str]] = None) -> int:
         f"{n_rec} records ({min(lengths)}-{max(lengths)} samples, the real records stretched "
         f"0.6-1.6, negated and reversed) x {N_LEVELS} scale factors (0.1-5) x "
         f"{len(cf.mechanisms)} example mechanisms = {n_runs:,} runs, ratio criterion. Best "
-        f"of {repeats} run{'s' * (repeats > 1)} per case. **The machine was shared** with "
-        "other sessions running tests while this ran (the load averages are in the table): "
-        "wall times and efficiencies are lower than a quiet machine gives, CPU times much less "
-        "so. A quiet "
-        "machine's run is to be recorded before this issue closes.",
+        f"of {repeats} run{'s' * (repeats > 1)} per case. "
+        + (
+            "**The machine was shared** with other sessions while this ran (the load "
+            "averages are in the table): wall times and efficiencies are lower than a quiet "
+            "machine gives, CPU times much less so."
+            if shared
+            else "Nothing else ran on the machine (the load averages are in the table)."
+        ),
         "",
         md_table(headers, table),
         "",

@@ -1022,6 +1022,12 @@ def ida(
         f"({backend['tasks']} tasks, overhead {100 * backend['overhead_fraction']:.1f} % of "
         f"task time); largest error estimate {doc['max_error_estimate']:.1e}"
     )
+    if backend.get("settings_differ"):
+        _note(
+            "note: the Dask workers run without rockmech's settings, which keep Dask's own "
+            f"background work off the cores ({'; '.join(backend['settings_differ'])}); "
+            'see docs/cluster.md, "Dask\'s settings"'
+        )
     unit = doc["intensity"]["units"]
     rows, notes = [], []
     for mech in doc["mechanisms"]:

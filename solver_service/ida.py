@@ -122,6 +122,16 @@ RETRIES = 3
 REFRESH_S = 1.0
 #: Prepared constants kept per process (a Dask worker keeps those of its latest runs).
 SETUPS_KEPT = 4
+#: Dask's settings for a rockmech cluster (docs/cluster.md, "Dask's settings"), in Dask's
+#: dotted keys. Dask's defaults wake every process 50 times a second to time its event loop
+#: (``tick``) and sample each worker thread's stack 100 times a second (``profile``): about
+#: 4 % of a core per worker, idle or busy, and 2 % in the scheduler, measured by
+#: ``benchmarks/cluster.py``. The tick only feeds the "event loop was unresponsive" warning
+#: (after 3 s), which a 1 s tick still gives; the profile feeds the dashboard's profile page.
+DASK_SETTINGS: dict[str, Any] = {
+    "distributed.admin.tick.interval": "1s",
+    "distributed.worker.profile.enabled": False,
+}
 
 
 @dataclass(frozen=True)
@@ -654,6 +664,46 @@ def worker_version() -> str:
     return __version__
 
 
+def worker_settings() -> dict[str, Any]:
+    """Return this process's values of the keys of ``DASK_SETTINGS`` (asked of the workers)."""
+    import dask
+
+    return {key: dask.config.get(key, None) for key in DASK_SETTINGS}
+
+
+def _same_setting(value: Any, wanted: Any) -> bool:
+    """Whether a Dask setting has the value wanted (times compared as seconds)."""
+    if isinstance(wanted, str):
+        from dask.utils import parse_timedelta
+
+        try:
+            return bool(parse_timedelta(value) == parse_timedelta(wanted))
+        except (TypeError, ValueError, KeyError):
+            return False
+    return bool(value == wanted)
+
+
+def settings_differ(client: Any) -> list[str]:
+    """Return the ``DASK_SETTINGS`` the cluster's workers run otherwise, one line each.
+
+    Empty where every worker has rockmech's settings (or where they cannot be read: the run
+    goes on, this only tells how fast it could go).
+    """
+    try:
+        found = client.run(worker_settings)
+    except Exception:  # only a hint about speed: what fails here, the run itself reports
+        return []
+    lines = []
+    for key, wanted in DASK_SETTINGS.items():
+        other = sorted({str(v[key]) for v in found.values() if not _same_setting(v[key], wanted)})
+        if other:
+            n = sum(not _same_setting(v[key], wanted) for v in found.values())
+            lines.append(
+                f"{key}: {' / '.join(other)} on {n} of {len(found)} workers (rockmech: {wanted})"
+            )
+    return lines
+
+
 def _wait_for_workers(client: Any, address: str, timeout: float, left: str) -> None:
     """Wait up to ``timeout`` [s] for a worker; else an error naming ``left`` (work left)."""
     try:
@@ -960,12 +1010,16 @@ def _collect(
         sys.unraisablehook = _QuietHalfBuilt(sys.unraisablehook)
     try:
         n_workers, n_threads = _cluster_threads(client, scheduler, timeout)
+        differ = settings_differ(client)
         packs, tasks = plan_tasks(costs, n_levels, task_s or task_seconds(sum(costs), n_threads))
         _run_dask(client, distributed, scheduler, timeout, ctx, records, packs, tasks, on_part)
     finally:
         client.close()
-    backend = {"kind": "dask", "scheduler": scheduler, "n_workers": n_workers}
-    return {**backend, "threads": n_threads, "tasks": len(tasks)}
+    backend: dict[str, Any] = {"kind": "dask", "scheduler": scheduler, "n_workers": n_workers}
+    backend.update(threads=n_threads, tasks=len(tasks))
+    if differ:
+        backend["settings_differ"] = differ
+    return backend
 
 
 def _check_options(im: str, motions: Sequence[Any], jobs: Optional[int], task_s: Any) -> None:
@@ -1047,7 +1101,9 @@ def run_ida(
         task outside the kernels, plus the gap before the next task on the same worker
         thread) and its ``overhead_fraction`` of the task time, the gap alone
         (``gap_per_task_s``) and ``span_s``, from the first task's start to the last one's
-        end (on the workers' clocks). With ``peaks``, ``peaks`` (``file``, ``rows``).
+        end (on the workers' clocks); on Dask, ``settings_differ`` where the workers run other
+        values of ``DASK_SETTINGS`` (one line each). With ``peaks``, ``peaks`` (``file``,
+        ``rows``).
 
     Raises
     ------

@@ -267,8 +267,25 @@ def test_dask_local_cluster_gives_the_local_numbers_on_every_cutting(
         remote = run_ida(cf, mixed, LEVELS, scheduler=address, peaks=tmp_path / "dask.parquet")
         # Single levels: tasks share the scattered records (each fetched once per worker).
         cut = run_ida(cf, mixed, LEVELS, scheduler=address, task_s=1e-9)
+        # The command line says, in one note, that the workers run Dask's defaults.
+        res = runner.invoke(
+            app,
+            [
+                *("ida", str(CONSTANTS), str(EXAMPLES / "records" / "elcentro_NS.dat")),
+                *("--scales", "1,2", "--scheduler", address, "--no-progress"),
+            ],
+        )
     assert remote["backend"]["kind"] == "dask"
     assert remote["backend"]["n_workers"] == 2 and remote["backend"]["threads"] == 2
+    # Dask's own defaults: the document names each setting that differs from rockmech's.
+    assert remote["backend"]["settings_differ"] == [
+        "distributed.admin.tick.interval: 20ms on 2 of 2 workers (rockmech: 1s)",
+        "distributed.worker.profile.enabled: True on 2 of 2 workers (rockmech: False)",
+    ]
+    assert res.exit_code == 0, res.output
+    [note] = [line for line in res.stderr.splitlines() if "rockmech's settings" in line]
+    assert note.startswith("note: the Dask workers run without rockmech's settings")
+    assert "tick.interval: 20ms on 2 of 2 workers" in note and "docs/cluster.md" in note
     assert cut["backend"]["tasks"] == len(mixed) * len(LEVELS)
     assert remote.pop("peaks") == {"file": "dask.parquet", "rows": local.pop("peaks")["rows"]}
     assert _results(remote) == _results(local) == _results(cut)
@@ -415,12 +432,18 @@ def test_a_worker_lost_during_the_run_costs_its_tasks_not_the_run(
     mixed: list[GroundMotion],
 ) -> None:
     distributed = pytest.importorskip("distributed")
+    dask = pytest.importorskip("dask")
     cf = load_constants(CONSTANTS)
     local = run_ida(cf, mixed, LEVELS, jobs=1)
     killed: list[int] = []
-    with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-    ) as cluster:
+    # Started with rockmech's Dask settings (docs/cluster.md): the nannies hand them to the
+    # workers they start, the one started again after the kill included.
+    with (
+        dask.config.set(ida.DASK_SETTINGS),
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+    ):
         nanny = next(iter(cluster.workers.values()))
 
         def kill_one(done: int, total: int) -> None:
@@ -433,6 +456,7 @@ def test_a_worker_lost_during_the_run_costs_its_tasks_not_the_run(
         )
     assert killed
     assert _results(remote) == _results(local)
+    assert "settings_differ" not in remote["backend"]
 
 
 def test_a_half_built_dask_future_says_nothing_when_collected(

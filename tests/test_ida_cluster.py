@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
+import re
 import signal
 import socket
 import subprocess
@@ -24,12 +26,47 @@ import numpy as np
 import pytest
 
 distributed = pytest.importorskip("distributed")
+yaml = pytest.importorskip("yaml")
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
 CONSTANTS = EXAMPLES / "constants" / "rect_walls.json"
 BIN = Path(sys.executable).parent
 #: What docs/cluster.md leaves out of the comparison: timing and where the run ran.
 TIMING = {"runtime_s", "compute_s", "backend"}
+
+
+def _docs_settings() -> tuple[dict[str, Any], dict[str, str]]:
+    """docs/cluster.md's Dask settings: its YAML file, and its ``export`` line as variables."""
+    text = (ROOT / "docs" / "cluster.md").read_text(encoding="utf-8")
+    section = text.split("## Dask's settings", 1)[1].split("\n## ", 1)[0]
+    [block] = re.findall(r"```yaml\n(.*?)```", section, flags=re.S)
+    [line] = re.findall(r"^export (.*)$", section, flags=re.M)
+    return yaml.safe_load(block), dict(word.split("=", 1) for word in line.split())
+
+
+def _dotted(tree: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in tree.items():
+        if isinstance(value, dict):
+            out.update(_dotted(value, f"{prefix}{key}."))
+        else:
+            out[prefix + key] = value
+    return out
+
+
+def test_the_settings_docs_give_are_the_ones_rockmech_checks() -> None:
+    from dask.config import collect_env
+
+    from solver_service.ida import DASK_SETTINGS, _same_setting
+
+    tree, env = _docs_settings()
+    for given in (_dotted(tree), _dotted(collect_env(env))):  # read as Dask reads them
+        assert set(given) == set(DASK_SETTINGS)
+        assert all(_same_setting(given[k], v) for k, v in DASK_SETTINGS.items()), given
+    # And the batch script of docs/cluster.md exports the same line.
+    text = (ROOT / "docs" / "cluster.md").read_text(encoding="utf-8")
+    assert text.count("export " + " ".join(f"{k}={v}" for k, v in env.items())) == 2
 
 
 def _free_port() -> int:
@@ -51,7 +88,10 @@ def _stop(proc: subprocess.Popen[Any]) -> None:
 
 @pytest.fixture(scope="module")
 def scheduler(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
-    """A scheduler and two one-thread workers, started with docs/cluster.md's commands."""
+    """A scheduler and two one-thread workers, started with docs/cluster.md's commands.
+
+    With its Dask settings, given as its ``export`` line gives them.
+    """
     logs = tmp_path_factory.mktemp("dask")
     address = f"tcp://127.0.0.1:{_free_port()}"
     port = address.rsplit(":", 1)[1]
@@ -59,10 +99,13 @@ def scheduler(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
         "scheduler": ["scheduler", "--host", "127.0.0.1", "--port", port, "--no-dashboard"],
         "workers": ["worker", address, "--nworkers", "2", "--nthreads", "1", "--no-dashboard"],
     }
+    env = _docs_settings()[1]
     with contextlib.ExitStack() as stack:
         for name, args in commands.items():
             log = stack.enter_context(open(logs / f"{name}.log", "w"))
-            proc = subprocess.Popen([str(BIN / "dask"), *args], stdout=log, stderr=log)
+            proc = subprocess.Popen(
+                [str(BIN / "dask"), *args], stdout=log, stderr=log, env={**os.environ, **env}
+            )
             stack.callback(_stop, proc)
         client = distributed.Client(address, timeout=60, set_as_default=False)
         try:
@@ -117,6 +160,8 @@ def test_the_cluster_gives_the_local_numbers_as_docs_check_them(
         k: v for k, v in b.items() if k not in TIMING
     }
     assert b["backend"]["kind"] == "dask" and b["backend"]["n_workers"] == 2
+    # Started with the settings of docs/cluster.md: no note about them.
+    assert "settings_differ" not in b["backend"] and "rockmech's settings" not in cluster.stderr
     assert (tmp_path / "local" / "ida.csv").read_bytes() == (
         tmp_path / "cluster" / "ida.csv"
     ).read_bytes()
