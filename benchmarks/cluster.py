@@ -296,6 +296,9 @@ def main(argv: Optional[list[str]] = None) -> int:
 
     t_model_dask = dask_model(durations, bg)
     span_dask = t_model_dask - fixed_dask
+    # What Dask adds over threads in the model: its background CPU, its fixed cost, and the
+    # rest (the gaps between tasks and the client's feeding of the first ones).
+    extra_bg = t_model_dask - dask_model(durations, 0.0)
     span_local = list_schedule([d + gap_local for d in durations], MODEL_WORKERS)
     t_model_threads = fixed_local + span_local
     eff_model = t1 / (MODEL_WORKERS * t_model_dask)
@@ -392,6 +395,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         f"Dask's default settings: {cores} workers against threads {ratio_default:.3f} (wall "
         f"{fmt_time(dask_default['wall'])}); the model for {MODEL_WORKERS} workers "
         f"{fmt_time(t_model_default)}, efficiency {100 * eff_default:.0f} %",
+        f"Dask over threads in the model, {fmt_time(t_model_dask - t_model_threads)}: its "
+        f"background CPU {fmt_time(extra_bg)}, its fixed cost {fmt_time(fixed_dask - fixed_local)}"
+        f", the gaps between tasks and the feeding of the first ones "
+        f"{fmt_time(t_model_dask - t_model_threads - extra_bg - fixed_dask + fixed_local)}",
         f"list schedule on {MODEL_WORKERS} lanes: Dask {fmt_time(span_dask)} + "
         f"{fmt_time(fixed_dask)} = {fmt_time(t_model_dask)}; threads {fmt_time(span_local)} "
         f"+ {fmt_time(fixed_local)} = {fmt_time(t_model_threads)}",

@@ -48,6 +48,7 @@ import math
 import os
 import re
 import secrets
+import signal
 import socket
 import sys
 import threading
@@ -887,6 +888,64 @@ class _DaskFeed:
             self.client.cancel(futures, force=True)
 
 
+class _Interrupts:
+    """Ctrl+C on a Dask run, taken only where it cannot cut one of distributed's calls in half.
+
+    Installed on the main thread where SIGINT raises ``KeyboardInterrupt`` (Python's own
+    handler): while the client scatters, submits, takes a result or cancels, a SIGINT is
+    held, and raised as ``KeyboardInterrupt`` when the client next waits (``taken``); while it
+    waits for a task to finish or for a worker, it is raised at once. An interrupt inside
+    distributed's calls left half-built futures and tracebacks after the one-line message.
+    Elsewhere (another thread, another handler) nothing changes.
+    """
+
+    def __init__(self) -> None:
+        self.open = False
+        self.pending = False
+        self.previous: Any = None
+
+    def __enter__(self) -> _Interrupts:
+        main = threading.current_thread() is threading.main_thread()
+        if main and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+            self.previous = signal.signal(signal.SIGINT, self._handler)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.previous is not None:
+            signal.signal(signal.SIGINT, self.previous)
+        if self.pending and exc[0] is None:  # held to the end: raised now
+            self.pending = False
+            raise KeyboardInterrupt
+
+    def _handler(self, signum: int, frame: Any) -> None:
+        if self.open:
+            raise KeyboardInterrupt
+        self.pending = True
+
+    @contextlib.contextmanager
+    def taken(self) -> Any:
+        """Raise a held Ctrl+C now, and take one at once while the block runs (a wait)."""
+        if self.pending:
+            self.pending = False
+            raise KeyboardInterrupt
+        self.open = True
+        try:
+            yield
+        finally:
+            self.open = False
+
+
+def _completed(done: Any, stops: _Interrupts) -> Any:
+    """Yield the finished futures of ``done``, taking Ctrl+C only while waiting for one."""
+    futures = iter(done)
+    while True:
+        with stops.taken():
+            future = next(futures, None)
+        if future is None:
+            return
+        yield future
+
+
 class _OnPart(Exception):
     """An error of the caller's handling of a result, carried past the connection's errors."""
 
@@ -905,6 +964,7 @@ def _run_dask(
     packs: list[list[int]],
     tasks: list[Task],
     on_part: Callable[[dict[str, Any]], None],
+    stops: _Interrupts,
 ) -> None:
     """Run the tasks on the cluster: constants broadcast, records scattered, each once."""
     feed: Optional[_DaskFeed] = None
@@ -914,7 +974,7 @@ def _run_dask(
             feed.refresh()
             feed.fill()
             while True:
-                for future in feed.done:
+                for future in _completed(feed.done, stops):
                     part = feed.finish(future)
                     if part is not None:
                         try:
@@ -926,7 +986,8 @@ def _run_dask(
                 if not feed.queue:
                     break
                 # Tasks left and none running: the workers left (or lost tasks); wait for one.
-                _wait_for_workers(client, address, timeout, f"{len(feed.queue)} tasks to run")
+                with stops.taken():
+                    _wait_for_workers(client, address, timeout, f"{len(feed.queue)} tasks to run")
                 feed.refreshed = -math.inf
                 feed.refresh()
                 feed.fill()
@@ -1008,13 +1069,19 @@ def _collect(
     logging.getLogger("tornado.application").addFilter(_drop_interrupt_noise)
     if not isinstance(sys.unraisablehook, _QuietHalfBuilt):
         sys.unraisablehook = _QuietHalfBuilt(sys.unraisablehook)
-    try:
-        n_workers, n_threads = _cluster_threads(client, scheduler, timeout)
-        differ = settings_differ(client)
-        packs, tasks = plan_tasks(costs, n_levels, task_s or task_seconds(sum(costs), n_threads))
-        _run_dask(client, distributed, scheduler, timeout, ctx, records, packs, tasks, on_part)
-    finally:
-        client.close()
+    with _Interrupts() as stops:
+        try:
+            with stops.taken():  # waits for the first worker
+                n_workers, n_threads = _cluster_threads(client, scheduler, timeout)
+            differ = settings_differ(client)
+            packs, tasks = plan_tasks(
+                costs, n_levels, task_s or task_seconds(sum(costs), n_threads)
+            )
+            _run_dask(
+                client, distributed, scheduler, timeout, ctx, records, packs, tasks, on_part, stops
+            )
+        finally:
+            client.close()
     backend: dict[str, Any] = {"kind": "dask", "scheduler": scheduler, "n_workers": n_workers}
     backend.update(threads=n_threads, tasks=len(tasks))
     if differ:

@@ -7,6 +7,7 @@ import json
 import math
 import os
 import random
+import signal
 import socket
 import sys
 import time
@@ -480,3 +481,37 @@ def test_a_half_built_dask_future_says_nothing_when_collected(
     other = types.SimpleNamespace(exc_value=AttributeError("x"), object=time.sleep)
     hook(other)
     assert seen == [other]
+
+
+def test_ctrl_c_inside_a_dask_call_is_held_until_the_call_returns(
+    mixed: list[GroundMotion], monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]
+) -> None:
+    # A Ctrl+C that landed inside distributed's scatter or submit left half-built futures and
+    # tracebacks (#30). Now it is held while the client talks to the cluster: the call
+    # finishes, then the run stops with KeyboardInterrupt and cancels its tasks.
+    distributed = pytest.importorskip("distributed")
+    cf = load_constants(CONSTANTS)
+    calls: list[int] = []
+    fill = ida._DaskFeed.fill
+
+    def fill_interrupted(feed: Any) -> None:
+        if not calls:
+            signal.raise_signal(signal.SIGINT)  # the handler runs before the next bytecode
+        fill(feed)
+        calls.append(len(feed.running))  # reached: the interrupt did not cut the call
+
+    monkeypatch.setattr(ida._DaskFeed, "fill", fill_interrupted)
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", dashboard_address=None
+    ) as cluster:
+        with pytest.raises(KeyboardInterrupt):
+            run_ida(cf, mixed, LEVELS, scheduler=cluster.scheduler_address, task_s=1e-9)
+        assert calls and calls[0] > 0  # the first fill ran to its end and submitted tasks
+        scheduler = cluster.scheduler
+        deadline = time.monotonic() + 30
+        while scheduler.tasks and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not scheduler.tasks  # cancelled, with the run's records and constants
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # put back
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and "Exception ignored" not in err
