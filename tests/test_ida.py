@@ -43,6 +43,12 @@ LEVELS = [0.2, 0.5, 1.0, 2.0, 3.5]
 #: What a document holds that depends on the path and the cutting: timing and the backend.
 TIMING = {"runtime_s", "compute_s", "backend"}
 runner = CliRunner()
+#: LocalCluster options: no dashboard, and the scheduler's HTTP server (its metrics, there
+#: even without a dashboard) on a free port, not 8787, which tests running at once share.
+NO_DASHBOARD: dict[str, Any] = {
+    "dashboard_address": None,
+    "scheduler_kwargs": {"dashboard_address": ":0"},
+}
 
 
 @pytest.fixture(scope="module")
@@ -262,7 +268,7 @@ def test_dask_local_cluster_gives_the_local_numbers_on_every_cutting(
     cf = load_constants(CONSTANTS)
     local = run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9, peaks=tmp_path / "local.parquet")
     with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        n_workers=2, threads_per_worker=1, processes=True, **NO_DASHBOARD
     ) as cluster:
         address = cluster.scheduler_address
         remote = run_ida(cf, mixed, LEVELS, scheduler=address, peaks=tmp_path / "dask.parquet")
@@ -298,12 +304,12 @@ def test_a_scheduler_without_workers_or_with_another_rockmech_is_a_clear_error(
 ) -> None:
     distributed = pytest.importorskip("distributed")
     cf = load_constants(CONSTANTS)
-    with distributed.LocalCluster(n_workers=0, dashboard_address=None) as cluster:
+    with distributed.LocalCluster(n_workers=0, **NO_DASHBOARD) as cluster:
         address = cluster.scheduler_address
         with pytest.raises(InputError, match=f"no worker joined the Dask scheduler at {address}"):
             run_ida(cf, motions[:1], [1.0], scheduler=address, timeout=1.0)
     with distributed.LocalCluster(
-        n_workers=1, processes=False, protocol="tcp", dashboard_address=None
+        n_workers=1, processes=False, protocol="tcp", **NO_DASHBOARD
     ) as cluster:
         monkeypatch.setattr(ida, "worker_version", lambda: "0.0.1")
         with pytest.raises(InputError, match=r"runs rockmech 0\.0\.1, this machine"):
@@ -442,7 +448,7 @@ def test_a_worker_lost_during_the_run_costs_its_tasks_not_the_run(
     with (
         dask.config.set(ida.DASK_SETTINGS),
         distributed.LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+            n_workers=2, threads_per_worker=1, processes=True, **NO_DASHBOARD
         ) as cluster,
     ):
         nanny = next(iter(cluster.workers.values()))
@@ -502,7 +508,7 @@ def test_ctrl_c_inside_a_dask_call_is_held_until_the_call_returns(
 
     monkeypatch.setattr(ida._DaskFeed, "fill", fill_interrupted)
     with distributed.LocalCluster(
-        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", dashboard_address=None
+        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", **NO_DASHBOARD
     ) as cluster:
         with pytest.raises(KeyboardInterrupt):
             run_ida(cf, mixed, LEVELS, scheduler=cluster.scheduler_address, task_s=1e-9)
