@@ -507,17 +507,23 @@ def test_ctrl_c_inside_a_dask_call_is_held_until_the_call_returns(
         calls.append(len(feed.running))  # reached: the interrupt did not cut the call
 
     monkeypatch.setattr(ida._DaskFeed, "fill", fill_interrupted)
-    with distributed.LocalCluster(
-        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", **NO_DASHBOARD
-    ) as cluster:
-        with pytest.raises(KeyboardInterrupt):
-            run_ida(cf, mixed, LEVELS, scheduler=cluster.scheduler_address, task_s=1e-9)
-        assert calls and calls[0] > 0  # the first fill ran to its end and submitted tasks
-        scheduler = cluster.scheduler
-        deadline = time.monotonic() + 30
-        while scheduler.tasks and time.monotonic() < deadline:
-            time.sleep(0.05)
-        assert not scheduler.tasks  # cancelled, with the run's records and constants
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # put back
+    # Python's own handler, as a terminal gives it (a test run in the background of a
+    # non-interactive shell starts with SIGINT ignored); put back after the test.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with distributed.LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", **NO_DASHBOARD
+        ) as cluster:
+            with pytest.raises(KeyboardInterrupt):
+                run_ida(cf, mixed, LEVELS, scheduler=cluster.scheduler_address, task_s=1e-9)
+            assert calls and calls[0] > 0  # the first fill ran to its end and submitted tasks
+            scheduler = cluster.scheduler
+            deadline = time.monotonic() + 30
+            while scheduler.tasks and time.monotonic() < deadline:
+                time.sleep(0.05)
+            assert not scheduler.tasks  # cancelled, with the run's records and constants
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # put back
+    finally:
+        signal.signal(signal.SIGINT, previous)
     err = capfd.readouterr().err
     assert "Traceback" not in err and "Exception ignored" not in err

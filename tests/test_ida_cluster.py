@@ -181,7 +181,15 @@ def test_ctrl_c_stops_the_command_and_cancels_its_tasks_on_the_cluster(
     argv += ["--dt", str(ns[1, 0] - ns[0, 0]), "--units", "g", "--scales", "0.05:5:100"]
     argv += ["--scheduler", scheduler, "--out", str(out), "--no-progress"]
     assert _tasks_on(scheduler) == 0
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        argv,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        # SIGINT as a terminal delivers it, even where this test runs with it ignored (the
+        # background of a non-interactive shell), which the command would inherit.
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     try:
         deadline = time.monotonic() + 240
         while _tasks_on(scheduler) == 0 and proc.poll() is None:
