@@ -14,9 +14,9 @@ probit regression, whose log-likelihood is concave in ``(a, b)``: Newton's metho
 one maximum to rounding in about ten steps. Where the data have no maximum inside the bounds
 of ``(theta, beta)`` (a step from none to all overturning, fractions that fall as the level
 rises, a median far outside the levels), a bounded Nelder-Mead search gives the best values
-within the bounds (the fit's ``note`` says where they lie on one). ``theta`` is the median
-(the intensity that overturns half the records) and ``beta`` the logarithmic standard
-deviation [-].
+within the bounds (the fit's ``note`` says where they lie on one); docs/theory.md §10.8.
+``theta`` is the median (the intensity that overturns half the records) and ``beta`` the
+logarithmic standard deviation [-].
 """
 
 from __future__ import annotations
