@@ -19,8 +19,8 @@ After each Dask case the cluster is left idle ``IDLE_S`` seconds and the CPU tim
 processes take meanwhile (their background work: event-loop ticks, heartbeats, profiler) is
 measured.
 
-Each case runs ``REPEATS`` times (``--repeats``) and the best wall time is kept: the machine is
-shared.
+Each case runs ``REPEATS`` times (``--repeats``) and the best wall time is kept: the machine may
+be shared.
 Printed per case: wall time, CPU time (this process, plus the Dask workers' own, read with
 ``resource.getrusage`` on each worker), parallel efficiency ``t(1 thread) / (n t(n))``, the
 number of tasks, the mean task time and the per-task overhead (``run_ida``'s
@@ -437,7 +437,10 @@ def main(argv: Optional[list[str]] = None) -> int:
         "workers (`getrusage` on each), and its ratio to the one-thread run (1: no extra "
         "work). Overhead per task = time in a task outside the kernels (Python: the record, "
         "the scale factors, the reduction) plus the gap before the next task on the same "
-        "worker thread (dispatch, transfer of the result), over the mean task time. The "
+        "worker thread (dispatch, transfer of the result), over the mean task time. Dask's "
+        f"CPU, idle = the CPU time of the cluster's processes over {IDLE_S:g} s left idle "
+        "after the case, in cores (this process's share included: its scheduler, nannies and "
+        "client). The "
         "one-thread run is cut for "
         f"{MODEL_WORKERS} workers (the model's input); the others as `run_ida` cuts for "
         "their threads. Every run gave the one-thread run's numbers.",
