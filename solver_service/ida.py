@@ -125,9 +125,9 @@ REFRESH_S = 1.0
 SETUPS_KEPT = 4
 #: Dask's settings for a rockmech cluster (docs/cluster.md, "Dask's settings"), in Dask's
 #: dotted keys. Dask's defaults wake every process 50 times a second to time its event loop
-#: (``tick``) and sample each worker thread's stack 100 times a second (``profile``): about
-#: 4 % of a core per worker, idle or busy, and 2 % in the scheduler, measured by
-#: ``benchmarks/cluster.py``. The tick only feeds the "event loop was unresponsive" warning
+#: (``tick``) and sample each worker thread's stack 100 times a second (``profile``): an idle
+#: 2-worker cluster took 10-14 % of a core with them, 3.4 % with these settings
+#: (``benchmarks/cluster.py``). The tick only feeds the "event loop was unresponsive" warning
 #: (after 3 s), which a 1 s tick still gives; the profile feeds the dashboard's profile page.
 DASK_SETTINGS: dict[str, Any] = {
     "distributed.admin.tick.interval": "1s",
