@@ -889,45 +889,58 @@ class _DaskFeed:
 
 
 class _Interrupts:
-    """Ctrl+C on a Dask run, taken only where it cannot cut one of distributed's calls in half.
+    """Ctrl+C and the time limit on a Dask run, taken only where they cannot cut a call in half.
 
-    Installed on the main thread where SIGINT raises ``KeyboardInterrupt`` (Python's own
-    handler): while the client scatters, submits, takes a result or cancels, a SIGINT is
-    held, and raised as ``KeyboardInterrupt`` when the client next waits (``taken``); while it
-    waits for a task to finish or for a worker, it is raised at once. An interrupt inside
-    distributed's calls left half-built futures and tracebacks after the one-line message.
-    Elsewhere (another thread, another handler) nothing changes.
+    On the main thread, where SIGINT raises ``KeyboardInterrupt`` (Python's own handler) and
+    where the command line's time limit (``workflows.limits.time_limit``) handles SIGALRM:
+    while the client scatters, submits, takes a result or cancels, either signal is held, and
+    acted on when the client next waits (``taken``), Ctrl+C first; while it waits for a task
+    to finish or for a worker, it is acted on at once. An interrupt inside distributed's calls
+    left half-built futures and tracebacks after the one-line message. Elsewhere (another
+    thread, other handlers) nothing changes.
     """
 
     def __init__(self) -> None:
         self.open = False
-        self.pending = False
-        self.previous: Any = None
+        self.held: dict[int, Any] = {}  # signal -> the handler it was held from
+        self.previous: dict[int, Any] = {}
 
     def __enter__(self) -> _Interrupts:
-        main = threading.current_thread() is threading.main_thread()
-        if main and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-            self.previous = signal.signal(signal.SIGINT, self._handler)
+        if threading.current_thread() is not threading.main_thread():
+            return self
+        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+            self.previous[signal.SIGINT] = signal.signal(signal.SIGINT, self._handler)
+        alarm = getattr(signal, "SIGALRM", None)
+        if alarm is not None and callable(signal.getsignal(alarm)):
+            self.previous[alarm] = signal.signal(alarm, self._handler)
         return self
 
     def __exit__(self, *exc: object) -> None:
-        if self.previous is not None:
-            signal.signal(signal.SIGINT, self.previous)
-        if self.pending and exc[0] is None:  # held to the end: raised now
-            self.pending = False
-            raise KeyboardInterrupt
+        for signum, handler in self.previous.items():
+            signal.signal(signum, handler)
+        if exc[0] is None:  # held to the end: acted on now
+            self._release()
 
     def _handler(self, signum: int, frame: Any) -> None:
         if self.open:
+            self._act(signum, frame)
+        else:
+            self.held[signum] = frame
+
+    def _act(self, signum: int, frame: Any) -> None:
+        if signum == signal.SIGINT:
             raise KeyboardInterrupt
-        self.pending = True
+        self.previous[signum](signum, frame)  # the time limit's: raises TimeLimitExceeded
+
+    def _release(self) -> None:
+        for signum in sorted(self.held, key=lambda s: s != signal.SIGINT):  # Ctrl+C first
+            frame = self.held.pop(signum)
+            self._act(signum, frame)
 
     @contextlib.contextmanager
     def taken(self) -> Any:
-        """Raise a held Ctrl+C now, and take one at once while the block runs (a wait)."""
-        if self.pending:
-            self.pending = False
-            raise KeyboardInterrupt
+        """Act on a held signal now, and on one at once while the block runs (a wait)."""
+        self._release()
         self.open = True
         try:
             yield

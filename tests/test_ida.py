@@ -36,6 +36,7 @@ from solver_service.ida import (
     task_seconds,
 )
 from solver_service.workflows.adapter import models_from_file
+from solver_service.workflows.limits import TimeLimitExceeded, time_limit
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 CONSTANTS = EXAMPLES / "constants" / "rect_walls.json"
@@ -525,5 +526,41 @@ def test_ctrl_c_inside_a_dask_call_is_held_until_the_call_returns(
         assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # put back
     finally:
         signal.signal(signal.SIGINT, previous)
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and "Exception ignored" not in err
+
+
+def test_the_time_limit_inside_a_dask_call_is_held_until_the_call_returns(
+    mixed: list[GroundMotion], monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]
+) -> None:
+    # The command line's time limit (SIGALRM) could cut distributed's calls in half as Ctrl+C
+    # did: it is held the same way, and the run stops with the limit's error once the call
+    # has returned.
+    distributed = pytest.importorskip("distributed")
+    cf = load_constants(CONSTANTS)
+    calls: list[int] = []
+    fill = ida._DaskFeed.fill
+
+    def slow_fill(feed: Any) -> None:
+        if not calls:
+            time.sleep(1.0)  # the 0.3 s limit fires in here
+        fill(feed)
+        calls.append(len(feed.running))
+
+    monkeypatch.setattr(ida._DaskFeed, "fill", slow_fill)
+    before = signal.getsignal(signal.SIGALRM)
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", **NO_DASHBOARD
+    ) as cluster:
+        address = cluster.scheduler_address
+        with pytest.raises(TimeLimitExceeded), time_limit(0.3):
+            run_ida(cf, mixed, LEVELS, scheduler=address, task_s=1e-9)
+        assert calls and calls[0] > 0  # the first fill ran to its end and submitted tasks
+        scheduler = cluster.scheduler
+        deadline = time.monotonic() + 30
+        while scheduler.tasks and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not scheduler.tasks
+    assert signal.getsignal(signal.SIGALRM) is before
     err = capfd.readouterr().err
     assert "Traceback" not in err and "Exception ignored" not in err
