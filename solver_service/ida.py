@@ -902,7 +902,7 @@ class _Interrupts:
 
     def __init__(self) -> None:
         self.open = False
-        self.held: dict[int, Any] = {}  # signal -> the handler it was held from
+        self.held: dict[int, Any] = {}  # signal held -> the frame it came in
         self.previous: dict[int, Any] = {}
 
     def __enter__(self) -> _Interrupts:
