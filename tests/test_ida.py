@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import json
 import math
@@ -12,6 +13,7 @@ import socket
 import sys
 import time
 import types
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Optional
 
@@ -490,44 +492,64 @@ def test_a_half_built_dask_future_says_nothing_when_collected(
     assert seen == [other]
 
 
+def _stopped_in_the_first_fill(
+    mixed: list[GroundMotion],
+    monkeypatch: pytest.MonkeyPatch,
+    capfd: pytest.CaptureFixture[str],
+    inside: Callable[[], None],
+    stop: type[BaseException],
+    limit: Optional[float] = None,
+) -> None:
+    """Run ``inside`` in the Dask feed's first call; the run must stop with ``stop`` after it.
+
+    Checks that the call ran to its end (it submitted tasks), that the run left no task on
+    the scheduler, and that nothing was printed.
+    """
+    distributed = pytest.importorskip("distributed")
+    calls: list[int] = []
+    fill = ida._DaskFeed.fill
+
+    def interrupted_fill(feed: Any) -> None:
+        if not calls:
+            inside()
+        fill(feed)
+        calls.append(len(feed.running))  # reached: the signal did not cut the call
+
+    monkeypatch.setattr(ida._DaskFeed, "fill", interrupted_fill)
+    limited = time_limit(limit) if limit is not None else contextlib.nullcontext()
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", **NO_DASHBOARD
+    ) as cluster:
+        with pytest.raises(stop), limited:
+            cf = load_constants(CONSTANTS)
+            run_ida(cf, mixed, LEVELS, scheduler=cluster.scheduler_address, task_s=1e-9)
+        assert calls and calls[0] > 0  # the first fill ran to its end and submitted tasks
+        scheduler = cluster.scheduler
+        deadline = time.monotonic() + 30
+        while scheduler.tasks and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not scheduler.tasks  # cancelled, with the run's records and constants
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and "Exception ignored" not in err
+
+
 def test_ctrl_c_inside_a_dask_call_is_held_until_the_call_returns(
     mixed: list[GroundMotion], monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]
 ) -> None:
     # A Ctrl+C that landed inside distributed's scatter or submit left half-built futures and
     # tracebacks (#30). Now it is held while the client talks to the cluster: the call
     # finishes, then the run stops with KeyboardInterrupt and cancels its tasks.
-    distributed = pytest.importorskip("distributed")
-    cf = load_constants(CONSTANTS)
-    calls: list[int] = []
-    fill = ida._DaskFeed.fill
-
-    def fill_interrupted(feed: Any) -> None:
-        if not calls:
-            signal.raise_signal(signal.SIGINT)  # the handler runs before the next bytecode
-        fill(feed)
-        calls.append(len(feed.running))  # reached: the interrupt did not cut the call
-
-    monkeypatch.setattr(ida._DaskFeed, "fill", fill_interrupted)
     # Python's own handler, as a terminal gives it (a test run in the background of a
     # non-interactive shell starts with SIGINT ignored); put back after the test.
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
-        with distributed.LocalCluster(
-            n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", **NO_DASHBOARD
-        ) as cluster:
-            with pytest.raises(KeyboardInterrupt):
-                run_ida(cf, mixed, LEVELS, scheduler=cluster.scheduler_address, task_s=1e-9)
-            assert calls and calls[0] > 0  # the first fill ran to its end and submitted tasks
-            scheduler = cluster.scheduler
-            deadline = time.monotonic() + 30
-            while scheduler.tasks and time.monotonic() < deadline:
-                time.sleep(0.05)
-            assert not scheduler.tasks  # cancelled, with the run's records and constants
+        # raise_signal: the handler runs before the next bytecode, inside the call
+        _stopped_in_the_first_fill(
+            mixed, monkeypatch, capfd, lambda: signal.raise_signal(signal.SIGINT), KeyboardInterrupt
+        )
         assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # put back
     finally:
         signal.signal(signal.SIGINT, previous)
-    err = capfd.readouterr().err
-    assert "Traceback" not in err and "Exception ignored" not in err
 
 
 def test_the_time_limit_inside_a_dask_call_is_held_until_the_call_returns(
@@ -536,31 +558,8 @@ def test_the_time_limit_inside_a_dask_call_is_held_until_the_call_returns(
     # The command line's time limit (SIGALRM) could cut distributed's calls in half as Ctrl+C
     # did: it is held the same way, and the run stops with the limit's error once the call
     # has returned.
-    distributed = pytest.importorskip("distributed")
-    cf = load_constants(CONSTANTS)
-    calls: list[int] = []
-    fill = ida._DaskFeed.fill
-
-    def slow_fill(feed: Any) -> None:
-        if not calls:
-            time.sleep(1.0)  # the 0.3 s limit fires in here
-        fill(feed)
-        calls.append(len(feed.running))
-
-    monkeypatch.setattr(ida._DaskFeed, "fill", slow_fill)
     before = signal.getsignal(signal.SIGALRM)
-    with distributed.LocalCluster(
-        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", **NO_DASHBOARD
-    ) as cluster:
-        address = cluster.scheduler_address
-        with pytest.raises(TimeLimitExceeded), time_limit(0.3):
-            run_ida(cf, mixed, LEVELS, scheduler=address, task_s=1e-9)
-        assert calls and calls[0] > 0  # the first fill ran to its end and submitted tasks
-        scheduler = cluster.scheduler
-        deadline = time.monotonic() + 30
-        while scheduler.tasks and time.monotonic() < deadline:
-            time.sleep(0.05)
-        assert not scheduler.tasks
+    _stopped_in_the_first_fill(
+        mixed, monkeypatch, capfd, lambda: time.sleep(1.0), TimeLimitExceeded, limit=0.3
+    )
     assert signal.getsignal(signal.SIGALRM) is before
-    err = capfd.readouterr().err
-    assert "Traceback" not in err and "Exception ignored" not in err
