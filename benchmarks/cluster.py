@@ -242,7 +242,6 @@ def main(argv: Optional[list[str]] = None) -> int:
     rows.append({"case": f"in-process threads (jobs={cores})", "n": cores, **threads})
     print(f"threads: {fmt_time(threads['wall'])}")
     cases = [(n, DASK_SETTINGS) for n in range(1, cores + 1)] + [(cores, {})]
-    idle: dict[str, float] = {}  # case -> Dask's CPU left idle, in cores
     for n, settings in cases:
         with (
             dask.config.set(settings),  # the nannies hand the settings to their workers
@@ -265,9 +264,9 @@ def main(argv: Optional[list[str]] = None) -> int:
             case = f"Dask, {n} worker{'s' * (n > 1)} x 1 thread"
             if not settings:
                 case += ", Dask's default settings"
-            idle[case] = (cpu_seconds(client) - c0) / IDLE_S
-        rows.append({"case": case, "n": n, "idle": idle[case], **dask_run})
-        print(f"{case}: {fmt_time(dask_run['wall'])}; idle CPU {100 * idle[case]:.1f} % of a core")
+            idle = (cpu_seconds(client) - c0) / IDLE_S  # Dask's CPU left idle, in cores
+        rows.append({"case": case, "n": n, "idle": idle, **dask_run})
+        print(f"{case}: {fmt_time(dask_run['wall'])}; idle CPU {100 * idle:.1f} % of a core")
 
     same = all(r["doc"][k] == one["doc"][k] for r in rows for k in RESULT_KEYS if k in one["doc"])
     dask_all, dask_default = rows[-2], rows[-1]

@@ -696,11 +696,11 @@ def settings_differ(client: Any) -> list[str]:
         return []
     lines = []
     for key, wanted in DASK_SETTINGS.items():
-        other = sorted({str(v[key]) for v in found.values() if not _same_setting(v[key], wanted)})
-        if other:
-            n = sum(not _same_setting(v[key], wanted) for v in found.values())
+        off = [str(v[key]) for v in found.values() if not _same_setting(v[key], wanted)]
+        if off:
+            values = " / ".join(sorted(set(off)))
             lines.append(
-                f"{key}: {' / '.join(other)} on {n} of {len(found)} workers (rockmech: {wanted})"
+                f"{key}: {values} on {len(off)} of {len(found)} workers (rockmech: {wanted})"
             )
     return lines
 
