@@ -129,11 +129,7 @@ def fit_lognormal(levels: ArrayLike, n_overturned: ArrayLike, n_records: ArrayLi
     if np.all(z == n):
         return FragilityFit(None, None, None, f"every record overturned it (median < {x.min():g})")
     lx = np.log(x)
-    frac = z / n
-    above = np.flatnonzero(frac >= 0.5)
-    start = lx[above[0]] if above.size else lx.max()
-    span = max(lx.max() - lx.min(), 1.0)
-    bounds = [(lx.min() - 2 * span, lx.max() + 2 * span), BETA_BOUNDS]
+    start, bounds = _start_and_bounds(lx, z, n)
     found = _probit_newton(lx, z, n, start)
     if found is not None and _inside(found, bounds):
         ln_theta, beta, loglik = found
@@ -145,6 +141,20 @@ def fit_lognormal(levels: ArrayLike, n_overturned: ArrayLike, n_records: ArrayLi
     elif ln_theta <= bounds[0][0] + 1e-9 or ln_theta >= bounds[0][1] - 1e-9:
         note = "the median lies far outside the levels run: extrapolated"
     return FragilityFit(math.exp(ln_theta), beta, loglik, note)
+
+
+def _start_and_bounds(
+    lx: np.ndarray[Any, Any], z: np.ndarray[Any, Any], n: np.ndarray[Any, Any]
+) -> tuple[float, list[tuple[float, float]]]:
+    """Where both searches start (``ln theta`` [-]) and the bounds of ``(ln theta, beta)``.
+
+    ``ln theta`` starts at the first level where half the records overturn (else the
+    highest) and is bounded to twice the span of the levels (at least 1) beyond them.
+    """
+    above = np.flatnonzero(z / n >= 0.5)
+    start = float(lx[above[0]] if above.size else lx.max())
+    span = max(float(lx.max() - lx.min()), 1.0)
+    return start, [(float(lx.min()) - 2 * span, float(lx.max()) + 2 * span), BETA_BOUNDS]
 
 
 def _loglik(u: np.ndarray[Any, Any], z: np.ndarray[Any, Any], n: np.ndarray[Any, Any]) -> float:

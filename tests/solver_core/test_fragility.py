@@ -83,11 +83,8 @@ def test_bad_input() -> None:
 def _reference(levels: np.ndarray, z: np.ndarray, n: int) -> tuple[float, float, float]:
     """The bounded Nelder-Mead search alone, from the starts ``fit_lognormal`` uses."""
     lx = np.log(levels)
-    above = np.flatnonzero(z / n >= 0.5)
-    start = lx[above[0]] if above.size else lx.max()
-    span = max(lx.max() - lx.min(), 1.0)
-    bounds = [(lx.min() - 2 * span, lx.max() + 2 * span), BETA_BOUNDS]
     zf, nf = z.astype(float), np.full(z.shape, float(n))
+    start, bounds = fragility._start_and_bounds(lx, zf, nf)
     return fragility._bounded_search(lx, zf, nf, start, bounds)
 
 
