@@ -263,6 +263,9 @@ class VirtualWork(BaseModel):
     J : float
         Second moment ``sum ∫ δx² dm`` at rest [kg m²], > 0; for one block the second moment
         of its mass about the horizontal plane through the axis.
+    J_blocks : float, optional
+        The same sum as Circolare 2019 [C8.7.1.5] takes it, one term ``m_k δx_k²`` per
+        block at the centroid of its forces [kg m²], ``S²/mass <= J_blocks <= J``.
 
     Notes
     -----
@@ -303,6 +306,16 @@ class VirtualWork(BaseModel):
             "(one block: second moment of its mass about the horizontal plane through the axis)."
         ),
     )
+    J_blocks: Optional[float] = Field(
+        None,
+        gt=0,
+        description=(
+            "Second moment as Circ. 2019 [C8.7.1.5] sums it: one term m_k dx_k^2 per block, "
+            "dx_k the virtual displacement of the centroid of the forces on block k [kg m^2], "
+            "> 0, <= J (one block: S^2/mass). Absent: a single-block or user-defined "
+            "mechanism is taken as one block."
+        ),
+    )
 
     @model_validator(mode="after")
     def _check_bound(self) -> "VirtualWork":
@@ -318,6 +331,23 @@ class VirtualWork(BaseModel):
                 "physical range (overflow or underflow)",
                 "non_finite_constant",
             )
+        if self.J_blocks is not None:
+            if self.S * self.S > self.mass * self.J_blocks * (1.0 + VIRTUAL_WORK_RTOL):
+                raise _error(
+                    "J_blocks",
+                    f"S^2 = {self.S * self.S:.6g} exceeds mass*J_blocks = "
+                    f"{self.mass * self.J_blocks:.6g}: the mass fraction of [C8.7.1.5] would "
+                    "exceed 1 (inconsistent virtual-work quantities)",
+                    "inconsistent_constant",
+                )
+            if self.J_blocks > self.J * (1.0 + VIRTUAL_WORK_RTOL):
+                raise _error(
+                    "J_blocks",
+                    f"J_blocks = {self.J_blocks:.6g} exceeds J = {self.J:.6g}: the blocks' "
+                    "centroids cannot move more than their masses do on average "
+                    "(inconsistent virtual-work quantities)",
+                    "inconsistent_constant",
+                )
         if self.S * self.S > self.mass * self.J * (1.0 + VIRTUAL_WORK_RTOL):
             raise _error(
                 "J",

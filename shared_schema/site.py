@@ -436,6 +436,11 @@ class LocalMechanisms(BaseModel):
         Tab. C8.5.I); without it T0 is unknown and the spectrum's peak is used.
     unit_weight : float, optional
         Unit weight of the masonry [N/m³] where the geometry gives no density.
+    e_star : str
+        How the sums of [C8.7.1.4]-[C8.7.1.5] run: ``"blocks"`` (default, the text: one
+        term per block, at the centroid of the forces acting on it, so one block gives
+        ``e* = 1``) or ``"integral"`` (over every mass element of the solids, ``e* = 3/4``
+        for a rectangular block; docs/theory.md §11.1).
     mechanisms : dict
         ``MechanismOptions`` by mechanism id.
     """
@@ -464,6 +469,14 @@ class LocalMechanisms(BaseModel):
     )
     unit_weight: Optional[float] = Field(
         None, gt=0, le=100000, description="Unit weight of the masonry [N/m³]."
+    )
+    e_star: Literal["blocks", "integral"] = Field(
+        "blocks",
+        description=(
+            "How the sums of Circ. 2019 [C8.7.1.4]-[C8.7.1.5] run: blocks (the text: one term "
+            "per block at the centroid of its forces; one block gives e* = 1) or integral "
+            "(over every mass element of the solids; e* = 3/4 for a rectangular block)."
+        ),
     )
     mechanisms: Dict[str, MechanismOptions] = Field(
         default_factory=dict, description="Choices per mechanism id."

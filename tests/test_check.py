@@ -54,8 +54,9 @@ def test_check_doc_block_and_short_form_note() -> None:
     doc = check_doc(parse_constants(block_file()), parse_site(NTC_SITE))
     w1, s1 = doc["mechanisms"]
     lin = w1["linear"]
-    assert lin["e_star"] == pytest.approx(0.75, abs=1e-12)
-    assert lin["a0_star"] == pytest.approx((0.5 / 3.0) * G / (0.75 * 1.35), rel=1e-12)
+    # One block: [C8.7.1.5] has one term (the centroid of its forces), e* = 1.
+    assert lin["e_star"] == pytest.approx(1.0, abs=1e-12)
+    assert lin["a0_star"] == pytest.approx((0.5 / 3.0) * G / (1.0 * 1.35), rel=1e-12)
     # A two-sided user-defined block is free-standing by default (C8.7.1.2.1.3) and, with no
     # E, L, t or unit weight, T0 is unknown: the demand is the spectrum's peak a_g S F0.
     assert w1["free_standing"]["value"] is True
@@ -172,9 +173,10 @@ def test_example_church_from_geometry_checks_every_mechanism() -> None:
     site = parse_site((EXAMPLES / "sites" / "ntc_site.json").read_bytes())
     doc = check_doc(cf, site)
     assert [r["linear"]["status"] for r in doc["mechanisms"]] == ["ok"] * 4
-    # The two-block strip is a triangle of displacements: e* = 3/4 (theory §11.1).
+    # The two-block strip: both blocks' centres move alike, so [C8.7.1.5] by blocks gives
+    # e* = 1 (over the solid, a triangle of displacements: 3/4; theory §11.1).
     t1 = next(r for r in doc["mechanisms"] if r["id"] == "T1")
-    assert t1["linear"]["e_star"] == pytest.approx(0.75, rel=1e-6)
+    assert t1["linear"]["e_star"] == pytest.approx(1.0, rel=1e-6)
 
 
 def test_ec8_site_says_which_method_it_applies() -> None:
@@ -184,7 +186,7 @@ def test_ec8_site_says_which_method_it_applies() -> None:
     lin = doc["mechanisms"][0]["linear"]
     # EC8 ground A, type 1: S = 1; free-standing with T0 unknown: the plateau a_g S 2.5.
     assert lin["demand_activation"] == pytest.approx(0.2 * 2.5 * G, rel=1e-12)
-    assert lin["a0_star"] == pytest.approx((0.5 / 3.0) * G / (0.75 * 1.2), rel=1e-12)
+    assert lin["a0_star"] == pytest.approx((0.5 / 3.0) * G / (1.0 * 1.2), rel=1e-12)
 
 
 @pytest.mark.slow

@@ -63,7 +63,8 @@ def virtual_work_of(details: Dict[str, float], alpha0_key: str) -> Optional[Dict
     Parameters
     ----------
     details : dict
-        A linkage result's details with ``S0``, ``J0``, ``mass0`` and ``alpha0_key``.
+        A linkage result's details with ``S0``, ``J0``, ``Jb0`` (the per-block second
+        moment), ``mass0`` and ``alpha0_key``.
     alpha0_key : str
         The key of the exact static multiplier at rest (``lam_static_exact``,
         ``lam_static``).
@@ -71,10 +72,10 @@ def virtual_work_of(details: Dict[str, float], alpha0_key: str) -> Optional[Dict
     Returns
     -------
     dict or None
-        ``alpha0``, ``mass`` [kg], ``S`` [kg m], ``J`` [kg m²]; None where the blocks had no
-        second moments (docs/theory.md §11.1).
+        ``alpha0``, ``mass`` [kg], ``S`` [kg m], ``J`` and ``J_blocks`` [kg m²]; None where
+        the blocks had no second moments (docs/theory.md §11.1).
     """
-    keys = ("S0", "J0", "mass0", alpha0_key)
+    keys = ("S0", "J0", "Jb0", "mass0", alpha0_key)
     if not all(k in details for k in keys):
         return None
     return {
@@ -82,4 +83,5 @@ def virtual_work_of(details: Dict[str, float], alpha0_key: str) -> Optional[Dict
         "mass": float(details["mass0"]),
         "S": float(details["S0"]),
         "J": float(details["J0"]),
+        "J_blocks": float(details["Jb0"]),
     }

@@ -322,6 +322,9 @@ def _constants(
         "mass": m_cs,
         "S": over,
         "J": j_wall + sum(m * z(p) ** 2 for m, p, _ in bearing + nonbearing),
+        # Circolare 2019 [C8.7.1.5]: the wall and what it carries are one block, one term
+        # at the centroid of its forces.
+        "J_blocks": over * over / m_cs,
     }
     summary: Dict[str, Any] = {
         "M_c_kg": m_c,

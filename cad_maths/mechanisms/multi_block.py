@@ -584,7 +584,9 @@ def four_bar_constants(
         )
         if rest is not None and at_rest.Q > 0.0:
             # Q is sum m u_x along the collapse direction, the S of §11.1.
-            details.update({"S0": at_rest.Q, "J0": rest["J"], "mass0": rest["mass"]})
+            details.update(
+                {"S0": at_rest.Q, "J0": rest["J"], "Jb0": rest["J_blocks"], "mass0": rest["mass"]}
+            )
     return FourBarResult(
         I0=i0,
         K=k,

@@ -289,7 +289,8 @@ def side_virtual_work(body: Body, side: RockingSide) -> Dict[str, float]:
 
     A unit virtual rotation moves a point at height ``z`` above the axis by ``δx = z``
     horizontally, so ``S = M z_G``, ``J`` is the second moment of the mass about the
-    horizontal plane through the axis, and ``alpha0 = x_G / z_G = tan(alpha)``.
+    horizontal plane through the axis, and ``alpha0 = x_G / z_G = tan(alpha)``. The block
+    is one term of Circolare 2019 [C8.7.1.5]: ``J_blocks = M z_G² = S²/M``.
     """
     m = float(body.props.mass)
     n = np.cross(side.outward, side.direction)
@@ -297,12 +298,8 @@ def side_virtual_work(body: Body, side: RockingSide) -> Dict[str, float]:
     if n[2] < 0.0:
         n = -n
     j = float(body.props.second_moment_about_plane(side.point, n))
-    return {
-        "alpha0": math.tan(side.alpha),
-        "mass": m,
-        "S": m * side.R * math.cos(side.alpha),
-        "J": j,
-    }
+    s = m * side.R * math.cos(side.alpha)
+    return {"alpha0": math.tan(side.alpha), "mass": m, "S": s, "J": j, "J_blocks": s * s / m}
 
 
 def side_summary(side: RockingSide) -> Dict[str, Any]:

@@ -401,12 +401,16 @@ def rest_virtual_work(
     -----
     A point of block k at height ``z`` moves by ``δx = u_x,k ± omega_k (z - z_Gk)``, so
     ``sum ∫ δx² dm = sum (m_k u_x,k² + omega_k² j_z,k)`` (the cross term vanishes about G).
+    Circolare 2019 [C8.7.1.5] sums one term per block, at the centroid of its forces:
+    ``J_blocks = sum m_k u_x,k²`` (docs/theory.md §11.1).
     """
     if any(b.j_z is None for b in bodies):
         return None
     s = sum(b.mass * u for b, u in zip(bodies, u_x))
     j = sum(b.mass * u * u + w * w * float(b.j_z or 0.0) for b, u, w in zip(bodies, u_x, omega))
-    return {"alpha0": alpha0, "mass": sum(b.mass for b in bodies), "S": s, "J": j}
+    j_blocks = sum(b.mass * u * u for b, u in zip(bodies, u_x))
+    mass = sum(b.mass for b in bodies)
+    return {"alpha0": alpha0, "mass": mass, "S": s, "J": j, "J_blocks": j_blocks}
 
 
 def _critical(
@@ -583,7 +587,9 @@ def two_block_constants(
         (lower, upper), (v1_rest[0], v2_rest[0]), (1.0, s_rest.beta[1]), details["lam_static_exact"]
     )
     if rest is not None:
-        details.update({"S0": rest["S"], "J0": rest["J"], "mass0": rest["mass"]})
+        details.update(
+            {"S0": rest["S"], "J0": rest["J"], "Jb0": rest["J_blocks"], "mass0": rest["mass"]}
+        )
     return TwoBlockResult(
         I0=s.M,
         K=K,

@@ -53,7 +53,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.errors import InputError
 
-from .floor_spectra import FloorModel, floor_acceleration, floor_displacement, floor_spectrum
+from .floor_spectra import (
+    FLOOR_A,
+    FLOOR_B,
+    FloorModel,
+    floor_acceleration,
+    floor_displacement,
+    floor_spectrum,
+)
 from .hazard import ElasticSpectrum
 from .kinematic import VirtualWork, participating_mass
 from .model import G, check_number, check_positive
@@ -94,11 +101,17 @@ XI_SLV, XI_SLC = 8.0, 10.0
 D_SLV_FRACTION, D_SLC_FRACTION = 0.4, 0.6
 #: ... and a break counts for the SLV when the capacity drops by more than 50 % of its peak.
 BREAK_DROP_FRACTION = 0.5
+#: The start of d_rule where the ties' break gives d_SLV.
+BREAK_RULE = "the ties break"
 #: [C8.7.1.10], [C8.7.1.11]: the factors of π.
 T_SLV_FACTOR, T_SLC_FACTOR = 1.68, 1.56
 #: Shortest period of the records' demand [s] when T0 is 0 (a rigid mechanism): below it a
 #: record's spectral displacement is at most PSA (0.05/2π)² ≈ 0.6 mm per g of PSA.
 T_RECORD_MIN = 0.05
+#: Periods scanned for the code spectrum's largest displacement over [T0, T] at height
+#: (log-spaced from T_SCAN_MIN [s], corners added), and the relative tolerance on the
+#: period of the refined maximum.
+T_SCAN_MIN, DEMAND_SCAN_POINTS, DEMAND_XATOL = 0.01, 200, 1e-10
 #: Periods of the records' demand over [T0, T_SLV] (log-spaced, both ends included).
 RECORD_POINTS = 40
 #: Periods scanned for the spectrum's peak when a free-standing element's T0 is unknown:
@@ -147,7 +160,8 @@ CL_LS = {
     "T_SLV": _C + "C8.7.1.2.1.8 [C8.7.1.10]: T_SLV = 1.68 π sqrt(d_SLV/a(d_SLV))",
     "T_SLC": _C + "C8.7.1.2.1.8 [C8.7.1.11]: T_SLC = 1.56 π sqrt(d_SLC/a(d_SLC))",
     "xi_percent": _C + "C8.7.1.2.1.8 (8 % SLV, 10 % SLC)",
-    "demand_code": _C + "C8.7.1.2.1.8 (see demand_rule)",
+    "demand_code": _C + "C8.7.1.2.1.8: largest S_De over [T0, T] (see demand_rule)",
+    "demand_code_at_T": _C + "C8.7.1.2.1.8: the period of [T0, T] where demand_code is [s]",
     "demand_records": _C + "C8.7.1.2.1.8: largest S_De over [T0, T_SLV] of the records",
     "demand": _C + "C8.7.1.2.1.8 (the larger of demand_code and demand_records)",
     "ratio_displacement": _C + "C8.7.1.2.1.8: d/demand = a_g,X/a_g",
@@ -237,6 +251,62 @@ class _Demand:
         ]
         return np.asarray(fd["SDe_Z_m"], dtype=np.float64), rules
 
+    def corner_periods(self) -> list[float]:
+        """Periods where the ground spectrum changes its expression [s] (none known here)."""
+        return []
+
+    def largest_displacement(
+        self, t_lo: float, t_hi: float, xi_percent: float
+    ) -> tuple[float, float, str]:
+        """Largest spectral displacement over ``[t_lo, t_hi]`` [m], where [s], and its rule.
+
+        Notes
+        -----
+        §C8.7.1.2.1.8: "La domanda di spostamento sul meccanismo locale allo SLV corrisponde
+        al valore massimo dello spostamento spettrale valutato nell'intervallo di periodi
+        [T0, T_SLV]" (and by the text's "espressione analoga" at the SLC). On the ground's
+        code spectrum every piece between two corner periods is monotonic (NTC [3.2.10]
+        rises to T_E, [3.2.11] falls to T_F, then d_g), so the maximum is at an end or a
+        corner and is exact. At height the pieces of [C7.2.6] times T² are smooth but not
+        monotonic: the best of a scan (the corners included) is refined by bounded Brent.
+        """
+        lo, hi = max(float(t_lo), 0.0), float(t_hi)
+        corners = self.corner_periods()
+        if self.floor is not None and self.floor.psi != 0.0:
+            tk = self.floor.T_k
+            corners = [*corners, FLOOR_A * tk, FLOOR_B * tk, tk, self.floor.T1]
+        inside = [c for c in corners if lo < c < hi]
+        smooth = self.floor is not None and self.floor.psi != 0.0
+        scan: list[float] = []
+        if smooth:
+            scan = np.geomspace(max(lo, T_SCAN_MIN), hi, DEMAND_SCAN_POINTS).tolist()
+        t = np.unique(np.asarray([lo, hi, *inside, *scan], dtype=np.float64))
+        t = t[(t >= lo) & (t <= hi)]
+        disp, _ = self.displacement(t, xi_percent)
+        k = int(np.argmax(disp))
+        t_best, d_best = float(t[k]), float(disp[k])
+        if smooth and 0 < k < t.size - 1:
+            # Imported here: only a check at height refines, and scipy.optimize is heavy.
+            from scipy.optimize import minimize_scalar
+
+            res = minimize_scalar(
+                lambda x: -float(self.displacement([x], xi_percent)[0][0]),
+                bounds=(float(t[k - 1]), float(t[k + 1])),
+                method="bounded",
+                options={"xatol": DEMAND_XATOL * float(t[k])},
+            )
+            if -float(res.fun) > d_best:
+                t_best, d_best = float(res.x), -float(res.fun)
+        rule_at = self.displacement([t_best], xi_percent)[1][0]
+        if t_best >= hi * (1.0 - 1e-12):
+            rule = f"{rule_at} (the largest over [T0, T] is at T itself, C8.7.1.2.1.8)"
+        else:
+            rule = (
+                f"largest spectral displacement over [T0 = {lo:.4g} s, T = {hi:.4g} s] "
+                f"(C8.7.1.2.1.8), at {t_best:.4g} s: {rule_at}"
+            )
+        return d_best, t_best, rule
+
 
 @dataclass
 class CodeDemand(_Demand):
@@ -276,6 +346,11 @@ class CodeDemand(_Demand):
     def sde_m(self, T: NDArray[np.float64], xi_percent: float) -> NDArray[np.float64]:
         """Elastic spectral displacement at ``T`` [s] for damping ``xi_percent`` [m]."""
         return self._at(xi_percent).SDe(T)
+
+    def corner_periods(self) -> list[float]:
+        """``T_B, T_C, T_D, T_E, T_F`` of the spectrum [s]."""
+        sp = self.spectrum
+        return [sp.T_B, sp.T_C, sp.T_D, sp.T_E, sp.T_F]
 
     @property
     def pga_g(self) -> float:
@@ -423,19 +498,24 @@ class CapacityCurve:
             for name, v in zip(("alpha0", "phi0", "phi_break"), self.before):
                 check_positive(v, f"ties.{name}")
 
-    def _rigid(self, d: NDArray[np.float64]) -> NDArray[np.float64]:
+    def _rigid(self, d: NDArray[np.float64], held_at_break: bool = False) -> NDArray[np.float64]:
         phi = d / self.d_per_rad
         alpha = self.alpha0 * (1.0 - phi / self.phi0)
         if self.before is not None:
             a0, p0, pb = self.before
-            held = phi < pb
+            held = phi <= pb if held_at_break else phi < pb
             alpha = np.where(held, a0 * (1.0 - phi / p0), alpha)
         return np.maximum(alpha, 0.0) * G / (self.e_star * self.FC)
 
-    def a(self, d: ArrayLike) -> NDArray[np.float64]:
-        """Capacity ``a(d)`` [m/s²] at spectral displacements ``d`` [m] (>= 0)."""
+    def a(self, d: ArrayLike, held_at_break: bool = False) -> NDArray[np.float64]:
+        """Capacity ``a(d)`` [m/s²] at spectral displacements ``d`` [m] (>= 0).
+
+        At the ties' failure displacement the curve has two values: the one after the break
+        (default) and, with ``held_at_break``, the one as the mechanism reaches the break
+        with the ties still holding (the limit from the left).
+        """
         dd = np.atleast_1d(np.asarray(d, dtype=np.float64))
-        rigid = self._rigid(dd)
+        rigid = self._rigid(dd, held_at_break)
         if self.T0 is None:
             return rigid
         return np.minimum(rigid, (2.0 * math.pi / self.T0) ** 2 * dd)
@@ -510,7 +590,10 @@ def _activation_demand(
             f"{', '.join(free.missing)}): the spectrum's peak over 0-{PEAK_SCAN_S:g} s "
             f"(at {t[k]:.3g} s), an upper bound of S_e(T0) for any T0"
         )
-        return float(values[k]) * G, rule, {}
+        floor_terms: dict[str, Any] = {}
+        if demand.floor is not None and demand.floor.psi != 0.0:
+            floor_terms = floor_acceleration(demand.se_g, demand.floor)  # a_Z for the record
+        return float(values[k]) * G, rule, floor_terms
     v, rule, terms = demand.acceleration(t0, XI_SLD)
     return v * G, f"free-standing, [C8.7.1.9]: S_e(T0 = {t0:.4g} s, 5 %): " + rule, terms
 
@@ -674,18 +757,23 @@ def _limit_state(
     t0: float,
     ratio_sld: Optional[float],
     evaluated: bool,
+    at_break: bool = False,
 ) -> dict[str, Any]:
-    """One limit state of the displacement check (§C8.7.1.2.1.8)."""
+    """One limit state of the displacement check (§C8.7.1.2.1.8).
+
+    ``at_break``: ``d_limit`` is where the ties break; ``a(d)`` of [C8.7.1.10] is then
+    taken as the mechanism reaches that displacement ("raggiungimento dello SLV"), with the
+    ties still holding.
+    """
     factor = T_SLV_FACTOR if name == "SLV" else T_SLC_FACTOR
-    a_d = float(curve.a([d_limit])[0])
+    a_d = float(curve.a([d_limit], held_at_break=at_break)[0])
     if not a_d > 0.0:
         raise InputError(
             f"the capacity vanishes at d_{name} = {d_limit:.4g} m: no period for {name}",
             f"d_{name}",
         )
     period = factor * math.pi * math.sqrt(d_limit / a_d)
-    code, rules = demand.displacement([period], xi_percent)
-    code_v = float(code[0])
+    code_v, code_at, code_rule = demand.largest_displacement(t0, period, xi_percent)
     rec_v, rec_rows = _record_demand(records, t0, period, xi_percent)
     governing = code_v if rec_v is None else max(code_v, rec_v)
     ratio_d = d_limit / governing
@@ -696,7 +784,8 @@ def _limit_state(
         f"T_{name}": period,
         "xi_percent": xi_percent,
         "demand_code": code_v,
-        "demand_rule": rules[0],
+        "demand_code_at_T": code_at,
+        "demand_rule": code_rule,
         "demand_records": rec_v,
         "records": rec_rows,
         "demand": governing,
@@ -738,14 +827,14 @@ def _thresholds(
     if curve.before is not None:
         d_b = curve.before[2] * curve.d_per_rad
         drop = float(
-            curve._rigid(np.array([d_b * (1 - 1e-12)]))[0] - curve._rigid(np.array([d_b]))[0]
+            curve._rigid(np.array([d_b]), held_at_break=True)[0] - curve._rigid(np.array([d_b]))[0]
         )
         peak = curve.peak()
         if drop > BREAK_DROP_FRACTION * peak:
             candidates.append(
                 (
                     d_b,
-                    "the ties break (C8.7.1.2.1.6: capacity loss "
+                    f"{BREAK_RULE} (C8.7.1.2.1.6: capacity loss "
                     f"{drop / peak:.0%} of the peak > 50 %)",
                 )
             )
@@ -822,6 +911,7 @@ def nonlinear_check_2019(
     a_g_slv = check_positive(a_g_slv, "a_g")
     d0 = curve.d0
     (d_slv, rule_slv), (d_slc, rule_slc), notes = _thresholds(curve, instability_rotation)
+    at_break = rule_slv.startswith(BREAK_RULE)
     t0 = curve.T0 or 0.0
     # a_g,SLD on the SLV spectrum (for the lower bound of C8.7.1.2.1.8).
     dem_act, act_rule, _ = _activation_demand(demand_slv, free)
@@ -839,6 +929,7 @@ def nonlinear_check_2019(
         t0,
         ratio_sld,
         evaluated_slv,
+        at_break,
     )
     slc_demand = demand_slc if demand_slc is not None else demand_slv
     slc_ag = a_g_slc if (demand_slc is not None and a_g_slc is not None) else a_g_slv

@@ -79,8 +79,36 @@ NO_BUILDING_NOTE = (
     "storeys): the demand at height was not evaluated and the numbers are the ground's"
 )
 
+#: Typologies whose constants hold more than one block ([C8.7.1.5] needs J_blocks).
+MULTI_BLOCK_TYPOLOGIES = ("two_block", "multi_block")
+#: How e* and d of [C8.7.1.4]-[C8.7.1.5] were summed (each check's ``e_star_rule``).
+E_STAR_RULES = {
+    "blocks": "Circ. 2019 [C8.7.1.5]: one term per block at the centroid of its forces "
+    "(C8.7.1.2.1.1's δ_PQx,k; virtual_work.J_blocks)",
+    "one_block": "Circ. 2019 [C8.7.1.5]: one block (the constants give no J_blocks), one term "
+    "at the centroid of its forces: e* = 1, d = φ S/mass",
+    "integral": "integral over every mass element of the solids (site local_mechanisms.e_star "
+    "= integral; not the text's per-block sum): e* = S²/(mass J), d = φ J/S",
+}
+
 #: Where the text leaves a choice or reads two ways, and what rockmech does (theory §11).
 DECISIONS = [
+    "e* and d ([C8.7.1.4]-[C8.7.1.5]) sum one term per block, δ_PQx,k at the centroid of the "
+    "forces on block k (C8.7.1.2.1.1): one block gives e* = 1 (site local_mechanisms.e_star "
+    "= blocks, the default; 'integral' integrates over the solids, e* = 3/4 for a "
+    "rectangular block, and gives a0* 4/3 of the text's).",
+    "A tie that breaks at d_SLV (C8.7.1.2.1.6): a(d_SLV) of [C8.7.1.10] is the capacity as "
+    "the mechanism reaches the break, the tie still holding (the text's 'raggiungimento "
+    "dello SLV'), not the capacity after it.",
+    "The code spectrum's displacement demand is the largest S_De over [T0, T_SLV] (and "
+    "[T0, T_SLC]), as C8.7.1.2.1.8 states for the SLV ('valore massimo dello spostamento "
+    "spettrale ... [T0, T_SLV]'); beyond T_E it is not the falling branch of NTC [3.2.11].",
+    "The linear check (C8.7.1.2.1.7) and a_g,SLD (C8.7.1.2.1.5) count every action, ties "
+    "not verified up to collapse included: the text restricts only d0 (C8.7.1.2.1.6) to the "
+    "actions verified present.",
+    "T1 of the building, where the site does not give it, is Circ. 2019 [C7.3.2] "
+    "(T1 = 0.050 H^(3/4)), not NTC 2018 [7.3.6] (T1 = 2 sqrt(d), which needs the building's "
+    "displacement under its weight applied horizontally).",
     "Circ. 2019 C7.2.3 defines ξ_k 'in percentuale'; rockmech reads it as a fraction in "
     "[C7.2.6]/[C7.2.9] (in percent 1.1 ξ_k^-0.5 = 0.49 at 5 %: the floor spectrum would fall "
     "at resonance below its value at T = 0) and in percent in [C7.2.7] (sqrt(1 + 0.0004 "
@@ -97,8 +125,8 @@ DECISIONS = [
     "The lower bound a_g,SLV >= a_g,SLD is in C8.7.1.2.1.8 (nonlinear check); rockmech "
     "applies it there and reports a_g,SLD beside the linear check.",
     "The capacity curve is linear in the rotation between alpha0 and 0 at phi0 (rockmech's "
-    "linearised kinematics, d = phi J/S); the exact curve of a block is convex and lies up "
-    "to 1 % below it for slenderness b/h <= 0.2.",
+    "linearised kinematics, d = phi J/S with J as e_star sums it); the exact curve of a "
+    "block is convex and lies up to 1 % below it for slenderness b/h <= 0.2.",
     "[C8.7.1.7] has no added masses: a free-standing element's T0 is the text's, without "
     "the masses it carries.",
     "E of the masonry has no single default in the text (Tab. C8.5.I gives 690-5600 MPa): "
@@ -389,17 +417,38 @@ def _tie_terms(mech: Mechanism, side: SideConstants) -> Optional[dict[str, Any]]
     }
 
 
+def _blocks_virtual_work(mech: Mechanism, v: Any, reading: str) -> tuple[VirtualWork, str]:
+    """Return the side's virtual-work quantities as [C8.7.1.4]-[C8.7.1.5] sum them, and how.
+
+    ``reading`` is the site's ``local_mechanisms.e_star``: ``"blocks"`` (the text: one term
+    per block at the centroid of its forces, ``J_blocks``) or ``"integral"`` (``J``).
+    """
+    if reading == "integral":
+        return VirtualWork(v.alpha0, v.mass, v.S, v.J), E_STAR_RULES["integral"]
+    if v.J_blocks is not None:
+        return VirtualWork(v.alpha0, v.mass, v.S, v.J_blocks), E_STAR_RULES["blocks"]
+    if mech.typology in MULTI_BLOCK_TYPOLOGIES:
+        raise InputError(
+            f"mechanism {mech.id}: the constants give no virtual_work.J_blocks, which "
+            f"[C8.7.1.5] needs for a {mech.typology} mechanism (one term per block); "
+            "recompute the constants with `rockmech constants`, or set the site's "
+            "local_mechanisms.e_star to 'integral'",
+            "virtual_work.J_blocks",
+        )
+    return VirtualWork(v.alpha0, v.mass, v.S, v.S * v.S / v.mass), E_STAR_RULES["one_block"]
+
+
 def _curve(
     mech: Mechanism,
     side: SideConstants,
+    vw: VirtualWork,
     e_star: float,
     fc: float,
     free: Optional[FreeStanding],
     opts: MechanismOptions,
 ) -> tuple[Optional[CapacityCurve], dict[str, Any]]:
     """Return the side's capacity curve with the ties' choice made, and that choice."""
-    vw = side.virtual_work
-    assert vw is not None and side.phi_ov is not None
+    assert side.phi_ov is not None
     d_per_rad = vw.J / vw.S
     t0 = free.T0 if free is not None else None
     terms = _tie_terms(mech, side)
@@ -548,11 +597,11 @@ def _side_checks_2019(
     site = ctx.site
     hz = site.hazard
     v = side.virtual_work
-    vw = VirtualWork(v.alpha0, v.mass, v.S, v.J)
-    _, e_star = participating_mass(vw)
     opts = _options(site, mech)
     extra_notes: list[str] = []
     try:
+        vw, e_star_rule = _blocks_virtual_work(mech, v, site.local_mechanisms.e_star)
+        _, e_star = participating_mass(vw)
         free, _ = _free_standing(site, mech)
         floor, floor_note = _floor(site, z, ctx.t1)
     except RockmechError as exc:
@@ -578,6 +627,7 @@ def _side_checks_2019(
         if vw.alpha0 <= 0.0:
             raise InputError("alpha0 <= 0: the static loads alone activate the mechanism", "alpha0")
         lin = linear_check_2019(vw, slv, FC=hz.FC, a_g=ctx.slv.a_g, q=hz.q, free=free)
+        lin["e_star_rule"] = e_star_rule
         lin["notes"] = extra_notes + lin["notes"]
         if not complete:
             lin["passes"] = None
@@ -591,7 +641,7 @@ def _side_checks_2019(
                 "capacity curve",
                 "alpha0",
             )
-        curve, ties = _curve(mech, side, e_star, hz.FC, free, opts)
+        curve, ties = _curve(mech, side, vw, e_star, hz.FC, free, opts)
         if curve is None:
             non = _no_curve(ties["rule"])
         else:
@@ -619,6 +669,7 @@ def _side_checks_2019(
         non["ties"] = ties
         if ties.get("note"):
             extra_notes.append(ties["note"])
+        non["e_star_rule"] = e_star_rule
         non["notes"] = extra_notes + list(non.get("notes", []))
         if not complete:
             non["passes"] = None

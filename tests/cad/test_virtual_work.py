@@ -1,8 +1,9 @@
 """Virtual-work quantities at rest for the code check (docs/theory.md §11.1), per typology.
 
-References are closed forms: a rectangular block (alpha0 = b/h, e* = 3/4), a symmetric
-two-block strip (a triangular displacement shape: e* = 3/4, alpha0 = 2b/h1) and a portal
-frame whose beam translates with the column tops.
+References are closed forms: a rectangular block (alpha0 = b/h, e* = 3/4 over the solid,
+1 by the blocks of Circolare 2019 [C8.7.1.5]), a symmetric two-block strip (a triangular
+displacement shape: e* = 3/4 over the solid, 1 by its two blocks, whose centres move alike;
+alpha0 = 2b/h1) and a portal frame whose beam translates with the column tops.
 """
 
 import json
@@ -42,6 +43,8 @@ def test_rectangular_block_from_cad_gives_b_over_h_and_three_quarters() -> None:
     assert vw.S == pytest.approx(mass * h / 2, rel=1e-12)
     assert vw.J == pytest.approx(mass * h * h / 3, rel=1e-12)
     assert vw.S**2 / (vw.mass * vw.J) == pytest.approx(0.75, abs=1e-12)
+    # [C8.7.1.5] by blocks: one term, the centre of mass at h/2: J_blocks = m (h/2)², e* = 1.
+    assert vw.J_blocks == pytest.approx(mass * (h / 2) ** 2, rel=1e-12)
     # Symmetric block: the negative side equals the positive one and is not stored.
     assert mech.negative is None
 
@@ -57,6 +60,8 @@ def test_symmetric_two_block_strip_is_a_triangle() -> None:
     assert vw["S"] == pytest.approx(mass * h / 4, rel=1e-12)
     assert vw["J"] == pytest.approx(mass * (h / 4) ** 2 * 4 / 3, rel=1e-12)
     assert e_star(vw) == pytest.approx(0.75, abs=1e-12)
+    # [C8.7.1.5] by blocks: two terms (m/2) (h/4)², so e* = (m h/4)²/(m · m (h/4)²) = 1.
+    assert vw["J_blocks"] == pytest.approx(mass * (h / 4) ** 2, rel=1e-12)
     assert vw["alpha0"] == pytest.approx(2 * b / (h / 2), rel=1e-12)
 
 
@@ -79,6 +84,8 @@ def test_portal_frame_beam_translates_with_the_column_tops() -> None:
     # Columns turn about their bases (u_x = h/2, omega = 1); the beam translates by h.
     assert vw["S"] == pytest.approx(2 * m_c * h / 2 + m_b * h, rel=1e-12)
     assert vw["J"] == pytest.approx(2 * m_c * h * h / 3 + m_b * h * h, rel=1e-12)
+    # [C8.7.1.5] by blocks: the columns' centres move by h/2, the beam by h.
+    assert vw["J_blocks"] == pytest.approx(2 * m_c * (h / 2) ** 2 + m_b * h * h, rel=1e-12)
     assert vw["mass"] == pytest.approx(2 * m_c + m_b, rel=1e-12)
     assert vw["alpha0"] == pytest.approx(b / h, rel=1e-12)
 
@@ -100,3 +107,29 @@ def test_inconsistent_virtual_work_is_rejected_naming_the_field() -> None:
         parse_constants(json.dumps(data))
     assert "positive.virtual_work.J" in str(err.value.field)
     assert "exceed" in str(err.value)
+
+
+def test_virtual_work_with_blocks_moving_more_than_their_masses_is_rejected() -> None:
+    # J_blocks > J: the blocks' centres cannot move more than their masses do on average.
+    data = {
+        "mechanisms": [
+            {
+                "id": "W1",
+                "positive": {
+                    "p_eq": 2.0,
+                    "lam": 0.1,
+                    "virtual_work": {
+                        "alpha0": 0.1,
+                        "mass": 1.0,
+                        "S": 1.5,
+                        "J": 3.0,
+                        "J_blocks": 4.0,
+                    },
+                },
+            }
+        ]
+    }
+    with pytest.raises(InputError) as err:
+        parse_constants(json.dumps(data))
+    assert "positive.virtual_work.J_blocks" in str(err.value.field)
+    assert "exceeds J" in str(err.value)

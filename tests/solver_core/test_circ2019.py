@@ -94,7 +94,8 @@ def block_constants(
     }
 
 
-def ntc_site(**extra: Any) -> dict[str, Any]:
+def ntc_site(e_star: str = "integral", **extra: Any) -> dict[str, Any]:
+    """The issue's site; the hand cases below sum e* over the solid unless they say so."""
     site: dict[str, Any] = {
         "hazard": {
             "code": "NTC2018",
@@ -107,6 +108,7 @@ def ntc_site(**extra: Any) -> dict[str, Any]:
         "local_mechanisms": {
             "E": E_MASONRY,
             "unit_weight": RHO * G,
+            "e_star": e_star,
             "mechanisms": {"W": {"L": 6.0, "t": 0.5}},
         },
     }
@@ -379,12 +381,16 @@ def test_ec8_type1_ground_b_rigid_block_by_hand() -> None:
     # EN 1998-1 Tables 3.2: type 1, ground B: S = 1.2, T_B = 0.15, T_C = 0.5, T_D = 2.0 s;
     # a_g = γ_I a_gR = 0.2 g; plateau factor 2.5; η = sqrt(10/(5 + ξ)) (Eq. 3.6).
     a_g, s_b, tc, td = 0.2, 1.2, 0.5, 2.0
-    a0 = (b / h) * G / (0.75 * fc)  # [C8.7.1.8]
+    # [C8.7.1.5] by the text (the site's default e_star = blocks): one block, one term at
+    # its centroid, e* = 1; [C8.7.1.8]: a0* = α0 g/(e* FC).
+    assert lin["e_star"] == pytest.approx(1.0, rel=1e-12)
+    a0 = (b / h) * G / (1.0 * fc)
     # [C8.7.1.8] at the ground: a_g,SLD = a0*/(S g) (the ground's peak); a_g,SLV = 2 a_g,SLD.
     assert lin["demand_activation"] == pytest.approx(a_g * s_b * G, rel=1e-12)
     assert lin["capacity_ratio"] == pytest.approx(2.0 * a0 / (a_g * s_b * G), rel=1e-12)
-    # C8.7.1.2.1.6 and [C8.7.1.10]: d_SLV = 0.4 atan(b/h) 2h/3; T_SLV in [T_C, T_D].
-    d_slv = 0.4 * math.atan(b / h) * 2 * h / 3
+    # C8.7.1.2.1.6 and [C8.7.1.4] with one block: d = φ δ_G/1 = φ h/2, so d_SLV = 0.4
+    # atan(b/h) h/2 (d0 where α = 0: φ0 = atan(b/h)); [C8.7.1.10]: T_SLV in [T_C, T_D].
+    d_slv = 0.4 * math.atan(b / h) * h / 2
     t_slv = 1.68 * math.pi * math.sqrt(d_slv / (0.6 * a0))
     assert tc < t_slv < td
     # EN 1998-1 Eq. 3.4 at 8 % and Eq. 3.7: S_De = a_g S η 2.5 (T_C/T) g T²/(4π²).
@@ -433,7 +439,9 @@ def test_tied_facade_d0_with_and_without_the_ties_by_hand() -> None:
     assert phi_with == pytest.approx(0.1426, abs=1e-4)
     assert phi_without == pytest.approx(0.0320, abs=1e-4)  # the vault's thrust is kept
     assert side.phi_cr == pytest.approx(0.0776, abs=1e-4)  # the issue's 0.078: no forces at all
-    d_per_rad = vw.J / vw.S  # [C8.7.1.4] to first order
+    # [C8.7.1.4] to first order with one block (the façade and what it carries): d = φ S/m.
+    assert vw.J_blocks == pytest.approx(vw.S * vw.S / vw.mass, rel=1e-12)
+    d_per_rad = vw.S / vw.mass
     # Default: the ties are not verified up to collapse (C8.7.1.2.1.6): d0 without them.
     non = check_doc(cf, _site())["mechanisms"][0]["nonlinear"]
     assert non["ties"]["treatment"] == "not_verified"
@@ -452,8 +460,13 @@ def test_tied_facade_d0_with_and_without_the_ties_by_hand() -> None:
     assert (held - broken) / vw.alpha0 > 0.5
     assert non["SLV"]["d"] == pytest.approx(0.01 * d_per_rad, rel=1e-12)
     assert "ties break" in non["SLV"]["d_rule"]
-    e_star = vw.S**2 / (vw.mass * vw.J)
-    assert non["SLV"]["a"] == pytest.approx(broken * G / (e_star * 1.35), rel=1e-9)
+    # [C8.7.1.10] at the break: a(d_SLV) as the mechanism reaches it, the ties still holding
+    # ("raggiungimento dello SLV"), with e* = 1 of one block ([C8.7.1.5]).
+    assert non["e_star"] == pytest.approx(1.0, rel=1e-12)
+    assert non["SLV"]["a"] == pytest.approx(held * G / (1.0 * 1.35), rel=1e-9)
+    d_b = 0.01 * d_per_rad
+    t_slv = 1.68 * math.pi * math.sqrt(d_b / (held * G / 1.35))
+    assert non["T_SLV"] == pytest.approx(t_slv, rel=1e-9)
 
 
 def test_church_row_says_which_mechanisms_are_free_standing() -> None:
@@ -555,3 +568,138 @@ def test_records_demand_is_the_largest_over_t0_to_t_slv() -> None:
     at_t_slv = float(response_spectrum(acc, dt, [slv["T_SLV"]], 0.08).sd[0])
     assert slv["demand_records"] > 3.0 * at_t_slv
     assert slv["demand"] == max(slv["demand_code"], slv["demand_records"])
+
+
+# --- 9. the text's readings (issue #36): e* by blocks, the demand over [T0, T] ---------
+
+
+def test_one_block_by_the_text_gives_e_star_one_and_d_at_its_centroid() -> None:
+    b, h = 0.5, 6.0
+    constants = block_constants(b, h, 4.0, rocking="one_sided")  # restrained: rigid
+    constants["mechanisms"][0]["eta"] = -0.5
+    row = run(constants, ntc_site(e_star="blocks"))
+    lin, non = row["linear"], row["nonlinear"]
+    # C8.7.1.2.1.1: δ_PQx,k is the displacement of the centroid of the forces on block k, so
+    # [C8.7.1.5] has one term for one block: e* = (P δ)²/(P · P δ²) = 1.
+    assert lin["e_star"] == pytest.approx(1.0, rel=1e-12)
+    # (a hand-written file gives no J_blocks: a user-defined mechanism is one block, said so)
+    assert "[C8.7.1.5]" in lin["e_star_rule"] and "one block" in lin["e_star_rule"]
+    # [C8.7.1.8]: a0* = α0 g/(e* FC), α0 = b/h; at the ground a_g,SLD = a0*/(a_g S g) a_g and
+    # a_g,SLV = q a_g,SLD (C8.7.1.2.1.7).
+    a0 = (b / h) * G / FC
+    pga = A_G * S * G
+    assert lin["a0_star"] == pytest.approx(a0, rel=1e-12)
+    assert lin["capacity_ratio"] == pytest.approx(2.0 * a0 / pga, rel=1e-12)
+    # [C8.7.1.4] with one block: d = φ δ_G = φ h/2; d0 at φ0 = atan(b/h), d_SLV = 0.4 d0.
+    d_slv = 0.4 * math.atan(b / h) * h / 2
+    assert non["d_per_rad"] == pytest.approx(h / 2, rel=1e-12)
+    assert non["d_SLV"] == pytest.approx(d_slv, rel=1e-12)
+    # [C8.7.1.3] on the linear curve: a(d_SLV) = 0.6 a0*; [C8.7.1.10].
+    t_slv = 1.68 * math.pi * math.sqrt(d_slv / (0.6 * a0))
+    assert non["T_SLV"] == pytest.approx(t_slv, rel=1e-12)
+    assert T_C < t_slv < 6.0  # soil C: T_E = 6 s (Tab. 3.2.VII), S_De rises up to it
+    assert non["SLV"]["demand"] == pytest.approx(sde(t_slv, 8.0), rel=1e-12)
+    assert non["capacity_ratio"] == pytest.approx(max(d_slv / sde(t_slv, 8.0), a0 / pga), rel=1e-12)
+    # The integral over the solid (e_star = integral) gives e* = 3/4 and a0* 4/3 of the text's.
+    lin_integral = run(constants, ntc_site(e_star="integral"))["linear"]
+    assert lin_integral["e_star"] == pytest.approx(0.75, rel=1e-12)
+    assert lin_integral["capacity_ratio"] == pytest.approx(
+        lin["capacity_ratio"] * 4.0 / 3.0, rel=1e-12
+    )
+    assert "integral" in lin_integral["e_star_rule"]
+
+
+def test_a_two_block_file_without_j_blocks_is_not_checked_by_blocks() -> None:
+    constants = block_constants(0.3, 4.0, 1.0, typology="two_block")
+    row = run(constants, ntc_site(e_star="blocks"))
+    for check in (row["linear"], row["nonlinear"]):
+        assert check["status"] == "not_run"
+        assert "J_blocks" in check["note"] and "rockmech constants" in check["note"]
+    # With the integral reading the same file is checked.
+    assert run(constants, ntc_site(e_star="integral"))["linear"]["status"] == "ok"
+
+
+def test_demand_beyond_t_e_is_the_largest_displacement_over_t0_to_t() -> None:
+    # A 10 m façade, 0.45 m thick, rigid (one-sided), on soil A; the SLC hazard given.
+    b, h = 0.45, 10.0
+    constants = block_constants(b, h, 6.0, rocking="one_sided")
+    constants["mechanisms"][0]["eta"] = -0.5
+    a_g_slc, f0_slc, tc_slc = 0.30, 2.45, 0.32
+    site = ntc_site(e_star="blocks")
+    site["hazard"].update(
+        soil="A", limit_states={"SLC": {"a_g": a_g_slc, "F0": f0_slc, "Tc_star": tc_slc}}
+    )
+    non = run(constants, site)["nonlinear"]
+    # Soil A: S = S_S S_T = 1, C_C = 1 (Tab. 3.2.IV), so T_C = T_C*; T_D = 4 a_g/g + 1.6
+    # ([3.2.7]); T_E = 4.5 s, T_F = 10 s (Tab. 3.2.VII).
+    t_c, t_d, t_e, t_f = tc_slc, 4.0 * a_g_slc + 1.6, 4.5, 10.0
+    # One block ([C8.7.1.5]): d = φ h/2; d_SLC = 0.6 d0 (C8.7.1.2.1.6), a(d_SLC) = 0.4 a0*.
+    a0 = (b / h) * G / FC
+    d_slc = 0.6 * math.atan(b / h) * h / 2
+    t_slc = 1.56 * math.pi * math.sqrt(d_slc / (0.4 * a0))  # [C8.7.1.11]
+    assert non["SLC"]["T_SLC"] == pytest.approx(t_slc, rel=1e-12)
+    assert t_e < t_slc < t_f
+    # NTC [3.2.10] rises to T_E ([3.2.2] × T²/(4π²): a_g S η F0 T_C T_D g/(4π²) beyond T_D)
+    # and [3.2.11] falls after it; the largest over [T0, T_SLC] (C8.7.1.2.1.8) is at T_E.
+    eta10 = eta(10.0)
+    at_t_e = a_g_slc * eta10 * f0_slc * t_c * t_d * G / (4.0 * math.pi**2)
+    d_g = 0.025 * a_g_slc * G * t_c * t_d  # [3.2.12]
+    falling = d_g * (f0_slc * eta10 + (1.0 - f0_slc * eta10) * (t_slc - t_e) / (t_f - t_e))
+    assert non["SLC"]["demand"] == pytest.approx(at_t_e, rel=1e-12)
+    # (S_De is flat from T_D to T_E, where S_e falls as 1/T²: the first of them is reported)
+    assert t_d - 1e-12 <= non["SLC"]["demand_code_at_T"] <= t_e
+    assert falling < 0.95 * at_t_e  # S_De(T_SLC) on [3.2.11] would be unconservative
+    assert non["SLC"]["capacity_ratio"] == pytest.approx(d_slc / at_t_e, rel=1e-12)
+    assert "largest spectral displacement over [T0" in non["SLC"]["demand_rule"]
+
+
+def test_floor_demand_is_the_largest_over_t0_to_t_by_a_dense_scan() -> None:
+    # A rigid wall at Z = 6 m of a 12 m building with T1 = 1.6 s (a flexible building):
+    # T_SLV = 2.77 s lies past the floor spectrum's peak [0.8, 1.1] T1, where S_eZ T²/(4π²)
+    # of [C7.2.6] first falls; the demand is its largest value over [T0, T_SLV]
+    # (C8.7.1.2.1.8), found here by brute force.
+    building = {"height": 12.0, "storeys": 4, "T1": 1.6}
+    constants = block_constants(
+        0.5, 6.0, 4.0, rocking="one_sided", amplification={"f_n": 1 / 1.6, "h_e": 9.0, "h": 6.0}
+    )
+    constants["mechanisms"][0]["eta"] = -0.5
+    non = run(constants, ntc_site(e_star="blocks", building=building))["nonlinear"]
+    t_slv = non["T_SLV"]
+    model = FloorModel(T1=1.6, elongation=1.0, xi_k_percent=5.0, gamma=12.0 / 9.0, psi=0.5)
+    spectrum = ntc_spectrum(A_G, F0, TC_STAR, soil="C")
+
+    def ground(t: np.ndarray, xi: float) -> np.ndarray:
+        return spectrum.with_damping(xi).Se(t)
+
+    t = np.linspace(1e-4, t_slv, 200001)
+    disp = floor_displacement(t, 8.0, ground, model)["SDe_Z_m"]
+    k = int(np.argmax(disp))
+    assert 0 < k < t.size - 1  # an interior maximum: S_DeZ(T_SLV) alone would be less
+    assert float(disp[-1]) < 0.99 * float(disp[k])
+    assert non["SLV"]["demand"] == pytest.approx(float(disp[k]), rel=1e-8)
+    assert non["SLV"]["demand"] >= float(disp[k])
+
+
+def test_a_free_standing_wall_at_height_without_t0_reports_a_z() -> None:
+    building = {"height": 12.0, "storeys": 4, "T1": 0.6}
+    constants = block_constants(0.5, 6.0, 4.0, amplification={"f_n": 1 / 0.6, "h_e": 9.0, "h": 6.0})
+    site = ntc_site(e_star="blocks", building=building)
+    del site["local_mechanisms"]["E"]  # T0 of [C8.7.1.7] unknown
+    lin = run(constants, site)["linear"]
+    assert "T0 unknown" in lin["demand_rule"]
+    # [C7.2.7]: a_Z = S_e(T1, 5 %) |γ ψ| sqrt(1 + 0.0004 ξ_k²), γ = 12/9, ψ = 6/12.
+    a_z = se(0.6) * (12.0 / 9.0) * 0.5 * math.sqrt(1.0 + 0.0004 * 25.0)
+    assert lin["floor"]["a_Z_g"] == pytest.approx(a_z, rel=1e-12)
+
+
+def test_every_reading_of_issue_36_is_among_the_decisions() -> None:
+    doc = check_doc(parse_constants(block_constants(0.5, 6.0, 4.0)), parse_site(ntc_site()))
+    decisions = " ".join(doc["method"]["decisions"])
+    for phrase in (
+        "one term per block",  # e* of [C8.7.1.5]
+        "the tie still holding",  # a(d_SLV) at a break
+        "largest S_De over [T0, T_SLV]",  # the demand beyond T_E
+        "ties not verified up to collapse included",  # the linear check and a_g,SLD
+        "NTC 2018 [7.3.6]",  # T1
+    ):
+        assert phrase in decisions, phrase

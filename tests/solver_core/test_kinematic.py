@@ -107,7 +107,11 @@ def test_hand_worked_loaded_wall() -> None:
     assert vw["J"] == pytest.approx(j_hand, rel=1e-9)
     assert vw["mass"] == pytest.approx(12140.0, rel=1e-9)
     assert vw["alpha0"] == pytest.approx(alpha0_hand, rel=1e-9)
-    out = linear_check(VirtualWork(**vw), ntc_spectrum(0.15, 2.5, 0.3), FC=1.35)
+    # Circ. 2019 [C8.7.1.5] by blocks: the wall and what it carries are one term.
+    assert vw["J_blocks"] == pytest.approx(s_hand**2 / 12140.0, rel=1e-9)
+    # The 2009 forms (core.kinematic) sum over the solid, as before.
+    integral = VirtualWork(vw["alpha0"], vw["mass"], vw["S"], vw["J"])
+    out = linear_check(integral, ntc_spectrum(0.15, 2.5, 0.3), FC=1.35)
     e_hand = s_hand**2 / j_hand / 12140.0
     assert out["e_star"] == pytest.approx(e_hand, rel=1e-9)
     assert out["a0_star"] == pytest.approx(alpha0_hand * G / (e_hand * 1.35), rel=1e-9)
