@@ -16,6 +16,7 @@ import subprocess
 import sys
 import threading
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
@@ -1030,3 +1031,33 @@ def test_a_server_starting_removes_what_servers_no_longer_running_left(tmp_path:
     assert "left by a service that is no longer running" in srv.log.read_text()
     # A server that stops normally removes its own root.
     assert {p.name for p in tmp.iterdir()} == {k.name for k in kept}
+
+
+@pytest.mark.parametrize(
+    ("hosts", "host", "status", "problem"),
+    [
+        (["127.0.0.1"], "127.0.0.1:8000@evil.example", 400, "'@' is not allowed"),
+        (["*"], "127.0.0.1:8000@evil.example", 400, "'@' is not allowed"),  # any name, no '@'
+        (["*"], "evil.example:8000/path", 400, "'/' is not allowed"),
+        (["localhost"], "localhost:0", 400, "port '0' is not a number from 1 to 65535"),
+        (["localhost"], "LocalHost:65535", 503, "starting"),  # passed on to the app
+        (["[::1]"], "[::1]", 503, "starting"),
+        (["*"], "rockmech.lab.example:8443", 503, "starting"),
+    ],
+)
+def test_the_host_check_in_process(hosts: list[str], host: str, status: int, problem: str) -> None:
+    """The same check in the app itself (starlette's TestClient, the pool never started)."""
+    with warnings.catch_warnings():  # starlette's note on its httpx transport
+        warnings.simplefilter("ignore")
+        from fastapi.testclient import TestClient
+
+    from solver_service.api.app import create_app
+    from solver_service.api.settings import Settings
+
+    client = TestClient(create_app(Settings(allowed_hosts=hosts)))
+    res = client.get("/api/v1/health", headers={"host": host})
+    assert res.status_code == status, res.text
+    doc = res.json()
+    assert re.search(problem, doc.get("detail", doc.get("status", ""))), doc
+    if status == 400:
+        assert doc["field"] == "Host" and doc["error"] == "InputError", doc
