@@ -45,6 +45,7 @@ REPO = HERE.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
+from solver_service.api import scratch  # noqa: E402
 from solver_service.api.server import background_server  # noqa: E402
 
 CHURCH = json.loads((REPO / "examples" / "constants" / "church.json").read_text())
@@ -176,7 +177,14 @@ def main(argv: list[str] | None = None) -> int:
                 for item in Path(f"/proc/{pid}/environ").read_bytes().split(b"\0"):
                     if item.startswith(b"TMPDIR="):
                         own.add(Path(item[7:].decode()).name)
-            leftovers = sorted({p.name for p in tmp.iterdir()} - own)
+            # The workers' folders live in the server's one root (solver_service.api.scratch).
+            entries = set(tmp.iterdir())
+            roots = {p for p in entries if p.name.startswith(scratch.ROOT_PREFIX)}
+            inside = {p.name for r in roots for p in r.iterdir()} - {scratch.OWNER_FILE}
+            stray = {p.name for p in entries - roots}
+            if len(roots) != 1:  # one server, one root
+                stray |= {r.name for r in roots}
+            leftovers = sorted(stray | (inside - own))
             alive = proc.poll() is None
         tracebacks = log.read_text(errors="replace").count("Traceback")
     ok = True

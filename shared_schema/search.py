@@ -29,8 +29,10 @@ from shared_schema.rules import (
     quantity_problem,
 )
 from shared_schema.spec import TRIBUTARY_DEFAULT, Overburden, Selector, TieBar
+from shared_schema.text import decode_text
 
 __all__ = [
+    "SEARCH_SPEC_EXPECTED",
     "SEARCH_VERSION",
     "SEARCH_VERSIONS",
     "Candidates",
@@ -358,14 +360,25 @@ class SearchSpec(BaseModel):
         return [n for n in notes if n is not None]
 
 
+#: What a search spec must be, for the messages on empty, binary or non-UTF-8 files.
+SEARCH_SPEC_EXPECTED = 'a search spec (JSON, {"walls": [...], "levels": [...], ...})'
+
+
 def parse_search_spec(text: Union[str, bytes], source: str = "search spec") -> SearchSpec:
-    """Validate a search spec's JSON text; every error is listed, one per line.
+    """Validate a search spec's JSON text, or a file's bytes; every error is listed, one per line.
+
+    Bytes are decoded by ``shared_schema.text.decode_text``: an empty or binary file, or
+    text that is not UTF-8 (nor UTF-16/32 with a byte-order mark), is an ``InputError``
+    naming ``spec`` and the file, never a codec's or the JSON parser's error.
 
     Raises
     ------
     InputError
-        ``search.json: walls[0].density: ...`` (one line per error), field = the source.
+        ``search.json: walls[0].density: ...`` (one line per error), field = the source;
+        ``spec: search.json is not a text file ...`` for bytes that are not text.
     """
+    if isinstance(text, bytes):
+        text = decode_text(text, source, "spec", SEARCH_SPEC_EXPECTED)
     try:
         return SearchSpec.model_validate_json(text)
     except ValidationError as exc:

@@ -40,10 +40,13 @@ from shared_schema.constants import (
     schema_version_field,
     whole_number,
 )
+from shared_schema.errors import InputError
 from shared_schema.rules import BEHAVIOUR_FACTOR_RANGE, DAMPING_PERCENT_RANGE, range_problem
+from shared_schema.text import decode_text
 
 __all__ = [
     "LIMIT_STATES",
+    "SITE_EXPECTED",
     "SITE_SCHEMA_VERSION",
     "Building",
     "EC8Hazard",
@@ -55,6 +58,8 @@ __all__ = [
     "Project",
     "SiteFile",
     "parse_site",
+    "read_site",
+    "site_from_text",
 ]
 
 #: The limit states of NTC 2018 §3.2.1 (Tab. 3.2.I), by which the hazard is given.
@@ -518,25 +523,72 @@ class SiteFile(BaseModel):
     )
 
 
+#: What a site file must be, for the messages on empty, binary or non-JSON files.
+SITE_EXPECTED = 'a site file (JSON, {"hazard": {...}, "building": {...}})'
+
+
 def parse_site(source: Union[str, bytes, Mapping[str, Any]]) -> SiteFile:
-    """Validate a site file given as JSON text or plain data.
+    """Validate a site file given as JSON text, the bytes of a file, or plain data.
+
+    Bytes are decoded by ``shared_schema.text.decode_text`` (UTF-8, or UTF-16/32 with a
+    byte-order mark): an empty or binary file, or one in another encoding, is an
+    ``InputError`` naming ``site``, never a codec's error.
 
     Raises
     ------
     InputError
-        Malformed JSON or an invalid value; the message names the field
-        (``hazard.NTC2018.a_g: Input should be greater than 0``).
+        Bytes that are not text, malformed JSON or an invalid value; the message names the
+        field (``hazard.NTC2018.a_g: Input should be greater than 0``).
     """
     if isinstance(source, SiteFile):
         return source
     if isinstance(source, (str, bytes)):
-        text = source.decode("utf-8-sig") if isinstance(source, bytes) else source
-        data = json_document(text)
+        if isinstance(source, bytes):
+            source = decode_text(source, "the site file", "site", SITE_EXPECTED)
+        data = json_document(source)
         try:
-            return SiteFile.model_validate_json(text)
+            return SiteFile.model_validate_json(source)
         except ValidationError as exc:
             raise input_error_from_validation(exc, data) from exc
     try:
         return SiteFile.model_validate(source)
     except ValidationError as exc:
         raise input_error_from_validation(exc, source) from exc
+
+
+def site_from_text(text: str, name: str) -> SiteFile:
+    """Validate the text of the site file ``name``; every error names a field.
+
+    An error of the whole document (malformed JSON) names ``site`` and the file, and says
+    what a site file is.
+
+    Raises
+    ------
+    InputError
+        As ``parse_site``; field ``site`` where the error has no field of its own.
+    """
+    try:
+        return parse_site(text)
+    except InputError as exc:
+        if exc.field:
+            raise
+        raise InputError(f"{name}: {exc.reason}; expected {SITE_EXPECTED}", "site") from None
+
+
+def read_site(raw: bytes, name: str) -> SiteFile:
+    """Validate a site file's bytes as every entry point reads it (the CLI, the service).
+
+    Parameters
+    ----------
+    raw : bytes
+        The file's content.
+    name : str
+        The file's name, for the messages.
+
+    Raises
+    ------
+    InputError
+        An empty or binary file, text that is not UTF-8 (``decode_text``), malformed JSON or
+        an invalid value (``site_from_text``).
+    """
+    return site_from_text(decode_text(raw, name, "site", SITE_EXPECTED), name)

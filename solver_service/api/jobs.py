@@ -44,7 +44,7 @@ from shared_schema.extras import MissingExtra
 from shared_schema.io import CONSTANTS_EXPECTED, stamped
 from shared_schema.rules import CRITERIA, F_N_RANGE, SF_METHODS, check_choice
 from shared_schema.search import parse_search_spec
-from shared_schema.site import parse_site
+from shared_schema.site import read_site
 from shared_schema.spec import parse_spec
 from shared_schema.text import decode_text
 
@@ -444,7 +444,9 @@ def run_search(job: SearchJob, blobs: list[bytes], limits: dict[str, Any]) -> by
             "and the record as the form's 'site' and 'record' parts",
             "ranking",
         )
-    site = parse_site(rest.pop(0)) if job.has_site else None
+    site = None
+    if job.has_site:
+        site = read_site(rest.pop(0), safe_filename(job.site_name, "site.json"))
     motions = []
     if job.record is not None:
         motions.append(motion_from_params(None, job.record, rest[0], limits))

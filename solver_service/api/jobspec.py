@@ -179,6 +179,7 @@ class SearchJob(Job):
     max_evaluations: Optional[int] = None
     exact: bool = False
     has_site: bool = False
+    site_name: str = ""
     record: Optional[RecordUpload] = None
 
 

@@ -26,7 +26,12 @@ computations, so that is safe. A worker that dies while computing is a fault of 
 service: ``WorkerLost`` (503 with ``Retry-After``). A job whose caller gives up (its task is
 cancelled) ends its worker at once. Every worker gets a private temporary folder
 (``TMPDIR``), removed when the worker ends however it ends, so no temporary file outlives
-its process.
+its process; the folders live under one root per server (``solver_service.api.scratch``).
+
+The server killed. A worker whose server is gone (SIGKILL: the server closed nothing) sees
+its stdin, a pipe only the server holds, reach its end: it removes its folder and exits at
+once, even in the middle of a job (``solver_service.api.worker``). A server starting removes
+the roots of servers no longer running.
 """
 
 from __future__ import annotations
@@ -46,6 +51,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Optional
 
+from . import scratch
 from .jobspec import Job
 
 __all__ = ["BudgetExceeded", "ComputePool", "PoolBusy", "WorkerLost", "WorkerResult"]
@@ -152,6 +158,7 @@ class ComputePool:
         self._cond: Optional[asyncio.Condition] = None
         self._closing = False
         self._started = 0  # workers of the first start that have warmed up
+        self._root: Optional[str] = None  # the workers' temporary folders live in it
 
     @property
     def ready(self) -> bool:
@@ -173,7 +180,14 @@ class ComputePool:
         return self._cond
 
     async def start(self) -> None:
-        """Start every worker in the background (``ready`` says when all have warmed up)."""
+        """Start every worker in the background (``ready`` says when all have warmed up).
+
+        First removes what servers no longer running left in the temporary folder
+        (``scratch.sweep``), then makes this server's root for the workers' folders.
+        """
+        for root in scratch.sweep():
+            log.warning("removed %s, left by a service that is no longer running", root)
+        self._root = scratch.make_root()
         for _ in range(self.size):
             self._background(self._start_one(initial=True))
 
@@ -197,7 +211,9 @@ class ComputePool:
             return
 
     async def _spawn(self, timeout_s: float) -> None:
-        tmpdir = tempfile.mkdtemp(prefix="rockmech-worker-")
+        if self._root is None or not os.path.isdir(self._root):  # removed under us: anew
+            self._root = scratch.make_root()
+        tmpdir = tempfile.mkdtemp(prefix=scratch.WORKER_PREFIX, dir=self._root)
         proc = await asyncio.create_subprocess_exec(
             sys.executable,
             "-m",
@@ -401,6 +417,8 @@ class ComputePool:
             task.cancel()
         await asyncio.gather(*self._tasks, return_exceptions=True)
         await asyncio.gather(*(self._end(w, EXIT_GRACE_S) for w in list(self._all)))
+        if self._root is not None:
+            shutil.rmtree(self._root, ignore_errors=True)
 
     def info(self) -> dict[str, Optional[int]]:
         """Return worker counts for the health endpoint."""

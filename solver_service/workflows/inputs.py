@@ -21,7 +21,7 @@ from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.io import load_constants
 from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, check_file, check_positive
-from shared_schema.site import SiteFile, parse_site
+from shared_schema.site import SITE_EXPECTED, SiteFile, site_from_text
 from shared_schema.spec import parse_spec
 from shared_schema.text import decode_text
 
@@ -309,12 +309,8 @@ def read_constants(path: Path, *, time_domain: bool = False) -> ConstantsFile:
     return cf
 
 
-#: What a site file must be, for the messages on empty, binary or non-JSON files.
-SITE_EXPECTED = 'a site file (JSON, {"hazard": {...}, "building": {...}})'
-
-
 def read_site_file(path: Path) -> SiteFile:
-    """Read and validate a site file (``shared_schema.site.SiteFile``); field ``site``.
+    """Read and validate a site file (``shared_schema.site.read_site``); field ``site``.
 
     A constants file or another of rockmech's inputs given instead is named as such (the
     arguments of ``check`` or ``assess`` were swapped).
@@ -322,8 +318,8 @@ def read_site_file(path: Path) -> SiteFile:
     check_file(path, "site")
     text = decode_text(path.read_bytes(), path.name, "site", SITE_EXPECTED)
     try:
-        return parse_site(text)
-    except InputError as exc:
+        return site_from_text(text, path.name)
+    except InputError:
         wrong = _wrong_file(
             path,
             "site",
@@ -331,9 +327,7 @@ def read_site_file(path: Path) -> SiteFile:
         )
         if wrong is not None:
             raise wrong from None
-        if exc.field:
-            raise
-        raise InputError(f"{path.name}: {exc.reason}; expected {SITE_EXPECTED}", "site") from None
+        raise
 
 
 #: What a mechanism spec must be, for the messages on empty, binary or non-JSON files.

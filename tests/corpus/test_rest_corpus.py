@@ -10,7 +10,13 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
 import re
+import subprocess
+import sys
+import threading
+import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
@@ -18,7 +24,7 @@ from typing import Any, Optional
 import httpx
 import numpy as np
 import pytest
-from servers import TEST_SETTINGS
+from servers import TEST_SETTINGS, start_server
 
 from shared_schema.api import PulseRequest
 from solver_service.api.bodies import MAX_BODY_DEPTH, validate_json
@@ -67,6 +73,8 @@ class Rest:
     content: Optional[bytes] = None  # raw body instead of the JSON one
     headers: dict[str, str] = dataclasses.field(default_factory=dict)
     xfail: str = ""
+    #: Multipart file parts instead of the JSON body: name -> (file name, bytes).
+    files: Optional[dict[str, tuple[str, bytes]]] = None
 
 
 DROP = object()
@@ -741,11 +749,85 @@ def _corrected(cases: list[Rest]) -> list[Rest]:
     return [dataclasses.replace(c, **OVERRIDES.get(c.id, {})) for c in cases]
 
 
-CASES = _corrected(_cases())
+# --- issue #36, the service's perimeter: a Host with user information, binary uploads -------
+
+#: 4 KiB of random bytes (fixed seed): no text in any encoding, no file format's signature.
+GARBAGE = np.random.default_rng(36).integers(0, 256, 4096, dtype=np.uint8).tobytes()
+_SEARCH_SPEC = json.loads((REPO / "examples" / "specs" / "search_facade.search.json").read_text())
+_SEARCH_SPEC["ranking"] = {k: v for k, v in _SEARCH_SPEC["ranking"].items() if k != "records"}
+del _SEARCH_SPEC["ranking"]["site"]  # the service takes the site as an upload, not a path
+_UPLOADS: dict[str, dict[str, tuple[str, bytes]]] = {
+    "search": {
+        "scene": ("search_facade.3dm", (REPO / "examples/scenes/search_facade.3dm").read_bytes()),
+        "spec": ("search.json", json.dumps(_SEARCH_SPEC).encode()),
+        "site": ("site.json", json.dumps(SITE).encode()),
+    },
+    "constants": {
+        "scene": ("facade.3dm", (REPO / "examples/scenes/facade.3dm").read_bytes()),
+        "spec": ("facade.spec.json", (REPO / "examples/specs/facade.spec.json").read_bytes()),
+    },
+    "history": {
+        "constants": ("walls.json", json.dumps(WALLS).encode()),
+        "record": ("r.dat", "\n".join(f"{a:.6f}" for a in RECORD["accel"]).encode()),
+    },
+}
+_UPLOADS["report"] = {"constants": _UPLOADS["history"]["constants"]}
+_UPLOADS["spectrum"] = {"record": _UPLOADS["history"]["record"]}
+
+
+def _issue36_cases() -> list[Rest]:
+    """A Host carrying user information; every text file part of every form as binary garbage.
+
+    The record parts go as one-column text with the form's ``dt``; each garbage part is named
+    in the answer, by its form field or by the file's name (a constants upload, as the CLI
+    names the file).
+    """
+    host = [
+        Rest(
+            f"pulse-host-{name}",
+            "pulse",
+            headers={"host": value},
+            status=400,
+            field=r"^Host\b",
+            problem=problem,
+        )
+        for name, value, problem in (
+            ("userinfo", "127.0.0.1:8000@evil.example", "'@' is not allowed.*user information"),
+            ("port-99999", "127.0.0.1:99999", "port '99999' is not a number from 1 to 65535"),
+            ("two-colons", "127.0.0.1:80:80", "more than one ':'"),
+            ("bad-ipv6", "[::zz]:8000", r"\[::zz\] is not an IPv6 address"),
+        )
+    ]
+    uploads = [
+        Rest(f"{ep}-upload-ok", ep, files=parts, status=200)
+        for ep, parts in _UPLOADS.items()
+        if ep != "search"
+    ]
+    for ep, parts in _UPLOADS.items():
+        for part, (filename, _) in parts.items():
+            if part == "scene":
+                continue
+            named = {"constants": filename}.get(part, part)
+            uploads.append(
+                Rest(
+                    f"{ep}-upload-{part}-binary",
+                    ep,
+                    files={**parts, part: (filename, GARBAGE)},
+                    field=f"^{re.escape(named)}\\b",
+                    problem=f"{re.escape(filename)}.* is not a text file",
+                )
+            )
+    return host + uploads
+
+
+CASES = _corrected(_cases()) + _issue36_cases()
 
 
 def _send(client: httpx.Client, case: Rest) -> httpx.Response:
     url = f"/api/v1/{case.endpoint}"
+    if case.files is not None:  # a multipart form (the record parts say their time step)
+        data = {"dt": "0.01", "units": "g"} if "record" in case.files else {}
+        return client.post(url, files=case.files, data=data, timeout=HANG_SECONDS)
     headers = {"content-type": "application/json", **case.headers}
     if case.content is not None:
         content = case.content
@@ -834,3 +916,148 @@ def test_assess_checks_each_record_as_the_cli_does(
     else:
         assert doc["field"] == "records[0].accel", doc
         assert re.search(expect, doc["detail"]), doc
+
+
+# --- issue #36: a server killed with SIGKILL leaves no compute process and no folder --------
+
+#: Exact envelopes of the church at 20000 frequencies: far more work than the hang guard below
+#: waits for (allowed by a 600 s budget), so a compute process that computed on would be seen.
+LONG_JOB = {
+    "constants": json.loads((REPO / "examples" / "constants" / "church.json").read_text()),
+    "method": "exact",
+    "n": 20_000,
+}
+#: Longest wait for a compute process to stop, or for a job to start [s]: a hang guard.
+GONE_WAIT_S = 30.0
+
+
+def _ticks(pid: int) -> int:
+    """CPU time process ``pid`` has used, user and system [clock ticks] (``/proc``)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return int(fields[11]) + int(fields[12])
+
+
+def _stopped(pid: int) -> bool:
+    """Whether process ``pid`` has exited (a zombie nobody reaped has exited)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except FileNotFoundError:
+        return True
+    return state in ("Z", "X")
+
+
+def _wait(condition: Any, what: str) -> None:
+    deadline = time.monotonic() + GONE_WAIT_S
+    while not condition():
+        assert time.monotonic() < deadline, f"{what} within {GONE_WAIT_S:g} s"
+        time.sleep(0.05)
+
+
+def _tree(folder: Path) -> list[str]:
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
+
+
+@pytest.mark.slow
+def test_a_server_killed_with_sigkill_leaves_no_compute_process_and_no_folder(
+    tmp_path: Path,
+) -> None:
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    settings = {"compute_workers": 2, "compute_timeout_s": 600}
+    with start_server(tmp_path, env={"TMPDIR": str(tmp)}, **settings) as srv:
+        workers = srv.children()
+        assert len(workers) == 2
+        # One root for the server, marked with its pid, and one folder per compute process.
+        (root,) = tmp.iterdir()
+        assert root.name.startswith("rockmech-service-")
+        assert (root / "owner.pid").read_text().strip() == str(srv.proc.pid)
+        assert len([p for p in root.iterdir() if p.name.startswith("rockmech-worker-")]) == 2
+        before = {pid: _ticks(pid) for pid in workers}
+        answers: list[Any] = []
+
+        def post() -> None:
+            try:
+                answers.append(httpx.post(f"{srv.url}/api/v1/envelope", json=LONG_JOB, timeout=600))
+            except httpx.HTTPError as exc:  # the server is killed under the request
+                answers.append(exc)
+
+        thread = threading.Thread(target=post, daemon=True)
+        thread.start()
+        _wait(
+            lambda: any(_ticks(pid) - before[pid] >= 50 for pid in workers),
+            "no compute process took the job",
+        )
+        srv.proc.kill()
+        srv.proc.wait()
+        # The busy process stops in the middle of its job, the idle one at once, and each
+        # removes its folder; the last one out removes the root.
+        for pid in workers:
+            _wait(lambda pid=pid: _stopped(pid), f"compute process {pid} still runs")
+        _wait(lambda: not any(tmp.iterdir()), f"the folders {_tree(tmp)} stay")
+        thread.join(GONE_WAIT_S)
+    assert answers and isinstance(answers[0], httpx.HTTPError), answers
+
+
+def test_a_server_starting_removes_what_servers_no_longer_running_left(tmp_path: Path) -> None:
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    finished = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    dead = finished.stdout.strip()
+
+    def folder(name: str, owner: Optional[str]) -> Path:
+        path = tmp / name / "rockmech-worker-abc"
+        path.mkdir(parents=True)
+        (path / "upload.dat").write_text("0.1\n")
+        if owner is not None:
+            (tmp / name / "owner.pid").write_text(f"{owner}\n")
+        return tmp / name
+
+    stale = folder("rockmech-service-stale", dead)  # what a killed server left: removed
+    kept = [
+        folder("rockmech-service-running", str(os.getpid())),  # its server still runs
+        folder("rockmech-service-unmarked", None),  # not marked: not the service's
+        folder("someone-elses", dead),  # not the service's name
+    ]
+    with start_server(tmp_path, env={"TMPDIR": str(tmp)}, compute_workers=1) as srv:
+        assert not stale.exists()
+        assert all((k / "rockmech-worker-abc" / "upload.dat").exists() for k in kept)
+        own = {p.name for p in tmp.iterdir()} - {k.name for k in kept}
+        assert len(own) == 1 and own.pop().startswith("rockmech-service-")
+    assert "left by a service that is no longer running" in srv.log.read_text()
+    # A server that stops normally removes its own root.
+    assert {p.name for p in tmp.iterdir()} == {k.name for k in kept}
+
+
+@pytest.mark.parametrize(
+    ("hosts", "host", "status", "problem"),
+    [
+        (["127.0.0.1"], "127.0.0.1:8000@evil.example", 400, "'@' is not allowed"),
+        (["*"], "127.0.0.1:8000@evil.example", 400, "'@' is not allowed"),  # any name, no '@'
+        (["*"], "evil.example:8000/path", 400, "'/' is not allowed"),
+        (["localhost"], "localhost:0", 400, "port '0' is not a number from 1 to 65535"),
+        (["localhost"], "LocalHost:65535", 503, "starting"),  # passed on to the app
+        (["[::1]"], "[::1]", 503, "starting"),
+        (["*"], "rockmech.lab.example:8443", 503, "starting"),
+    ],
+)
+def test_the_host_check_in_process(hosts: list[str], host: str, status: int, problem: str) -> None:
+    """The same check in the app itself (starlette's TestClient, the pool never started)."""
+    with warnings.catch_warnings():  # starlette's note on its httpx transport
+        warnings.simplefilter("ignore")
+        from fastapi.testclient import TestClient
+
+    from solver_service.api.app import create_app
+    from solver_service.api.settings import Settings
+
+    client = TestClient(create_app(Settings(allowed_hosts=hosts)))
+    res = client.get("/api/v1/health", headers={"host": host})
+    assert res.status_code == status, res.text
+    doc = res.json()
+    assert re.search(problem, doc.get("detail", doc.get("status", ""))), doc
+    if status == 400:
+        assert doc["field"] == "Host" and doc["error"] == "InputError", doc

@@ -81,7 +81,12 @@ def _rss(pid: int) -> int:
 
 
 def _temp_entries(server: Server) -> set[str]:
-    return {p.name for p in (server.log.parent / "tmp").iterdir()}
+    """Names in the server's ``TMPDIR``, and in its one service root the compute processes'."""
+    entries = list((server.log.parent / "tmp").iterdir())
+    roots = [p for p in entries if p.name.startswith("rockmech-service-")]
+    assert len(roots) == 1, entries
+    inside = {p.name for p in roots[0].iterdir()} - {"owner.pid"}
+    return {p.name for p in entries if p not in roots} | inside
 
 
 def _worker_tmpdirs(server: Server) -> set[str]:

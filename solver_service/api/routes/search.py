@@ -57,6 +57,7 @@ async def search(request: Request, pool: PoolDep) -> Response:
         max_evaluations=fields.get("max_evaluations"),
         exact=bool(fields.get("exact", False)),
         has_site=site is not None,
+        site_name=site[1] if site is not None else "",
         record=upload,
     )
     check_scene_upload(scene[0], scene[1])
