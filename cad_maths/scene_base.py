@@ -271,7 +271,7 @@ FLAT_RTOL = 1e-9
 
 
 def _is_flat(v: np.ndarray) -> bool:
-    """True if every vertex lies in one plane, within ``FLAT_RTOL`` of the mesh's size."""
+    """Tell whether every vertex lies in one plane, within ``FLAT_RTOL`` of the mesh's size."""
     centred = v - v.mean(axis=0)
     size = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
     if size == 0.0:

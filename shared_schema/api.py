@@ -535,9 +535,9 @@ class PulseRequest(BaseModel):
                         key,
                     )
             assert self.lam is not None
-            problem = None if self.phi_ov is not None else default_rotation_problem(self.lam)
-            if problem is not None:
-                raise InputError(problem, "lam")
+            rotation = None if self.phi_ov is not None else default_rotation_problem(self.lam)
+            if rotation is not None:
+                raise InputError(rotation, "lam")
             return self
         for key in PULSE_SHORT_FORM:
             if getattr(self, key) not in (None, False):

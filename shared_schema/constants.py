@@ -81,8 +81,8 @@ from shared_schema.rules import (
     SCHEMA_VERSION_PATTERN,
     G,
     control_character,
-    eta_problem,
     default_rotation_problem,
+    eta_problem,
     rotation_problem,
     schema_version_problem,
 )

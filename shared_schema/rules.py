@@ -68,6 +68,7 @@ __all__ = [
     "check_quantity",
     "control_character",
     "coordinate_problem",
+    "default_rotation_problem",
     "eta_problem",
     "eta_range",
     "printable",
@@ -75,7 +76,6 @@ __all__ = [
     "quantity_problem",
     "range_problem",
     "rotation_problem",
-    "default_rotation_problem",
     "schema_version_problem",
 ]
 

@@ -35,7 +35,7 @@ HEADER_LINES = 64
 
 
 def _header_lines(lines: list[str]) -> list[str]:
-    """The leading ``KEY: value`` lines of a file, up to ``USER5:``."""
+    """Return the keys of the leading ``KEY: value`` lines of a file, up to ``USER5:``."""
     out = []
     for line in lines:
         key, sep, _ = line.partition(":")
