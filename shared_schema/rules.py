@@ -268,7 +268,7 @@ def default_rotation_problem(lam: float) -> Optional[str]:
 
     Examples
     --------
-    >>> default_rotation_problem(5.0)[-30:]
+    >>> default_rotation_problem(5.0)[-31:]
     'give phi_ov [rad] for this side'
     >>> default_rotation_problem(0.2) is None
     True
