@@ -1266,3 +1266,8 @@ class SearchResponse(BaseModel):
     )
     counts: Dict[str, Any] = Field(description="Work counters.")
     timings: Dict[str, Any] = Field(description="Wall-clock seconds per stage.")
+    warnings: List[str] = Field(
+        description="The spec's admissible but implausible values (a density or a tie-bar "
+        "force outside its plausible range, as for a mechanism spec), each with what it most "
+        "likely means."
+    )
