@@ -266,6 +266,21 @@ def _norm_id(value: str) -> str:
         return value.strip().lower()
 
 
+#: A mesh whose vertices lie within this share of its size of one plane is flat (a surface).
+FLAT_RTOL = 1e-9
+
+
+def _is_flat(v: np.ndarray) -> bool:
+    """Tell whether every vertex lies in one plane, within ``FLAT_RTOL`` of the mesh's size."""
+    centred = v - v.mean(axis=0)
+    size = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+    if size == 0.0:
+        return True
+    # the smallest singular direction is the normal of the best-fitting plane
+    normal = np.linalg.svd(centred, full_matrices=False)[2][-1]
+    return float(np.abs(centred @ normal).max()) <= FLAT_RTOL * size
+
+
 def solid_mesh(
     v: np.ndarray, f: np.ndarray, obj: SceneObject, *, require_closed: bool = True
 ) -> TriMesh:
@@ -306,6 +321,13 @@ def solid_mesh(
             "their corners coincide)"
         )
     oriented, closed, n_open = orient_outward(v, f)
+    if require_closed and not closed and _is_flat(v):
+        # issue #36: a surface drawn for the wall was told to be closed with Cap/Join
+        raise GeometryError(
+            f"{obj.label()}: the {obj.kind} is flat: its {v.shape[0]} vertices lie in one "
+            "plane, so it has zero volume (a surface, not a solid body); model the body with "
+            "its thickness, as a closed solid (Rhino: ExtrudeSrf or OffsetSrf with Solid=Yes)"
+        )
     if require_closed and not closed:
         raise GeometryError(
             f"{obj.label()}: the {obj.kind} is not a closed solid ({n_open} open or "

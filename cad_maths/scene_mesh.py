@@ -176,6 +176,10 @@ class MeshScene(BaseScene):
             )
         if ext == "ply":
             _check_ply(data, base)
+        elif ext == "stl":
+            _check_stl(data, base)
+        elif ext == "off":
+            _check_off(data, base)
         try:
             parts, repeated = _load(data, ext, stem)
         except InputError:
@@ -184,6 +188,13 @@ class MeshScene(BaseScene):
             raise InputError(_unreadable(data, ext, base, exc), "scene") from None
         for part_name, v, f in parts:
             _check_indices(v, f, part_name, base, one_based=ext == "obj")
+            if f.size == 0:
+                # issue #36: random bytes read as an empty mesh were "the mesh has no faces"
+                raise InputError(
+                    f"{base}: no faces could be read: it is not a valid .{ext} mesh (or holds "
+                    f"only points); export the mesh again as .{ext}",
+                    "scene",
+                )
         objects = [
             SceneObject(id=f"{nm}#{k}", name=nm, layer="", kind="mesh", geometry=(v, f))
             for k, (nm, v, f) in enumerate(parts)
@@ -354,6 +365,106 @@ def _check_ply(data: bytes, name: str) -> None:
             "export the mesh again",
             "scene",
         )
+
+
+#: Bytes of a binary STL before its triangles (80-byte header, 4-byte count), and per triangle.
+_STL_HEAD, _STL_TRIANGLE = 84, 50
+
+
+def _check_stl(data: bytes, name: str) -> None:
+    """Refuse an STL file that holds no triangles, or fewer than its count says (issue #36).
+
+    An ASCII STL starts with ``solid`` and lists ``facet`` blocks; a binary one is an 80-byte
+    header, a triangle count, then 50 bytes a triangle. trimesh reads random bytes, or a
+    binary file cut short, as a mesh of no faces without a word.
+    """
+    layout = (
+        "an STL file is text ('solid', then 'facet' blocks) or binary (an 80-byte header, "
+        "the triangle count, then 50 bytes a triangle)"
+    )
+    if data.lstrip()[:5].lower() == b"solid" and b"facet" in data[:4096]:
+        if b"endsolid" not in data[-1024:]:
+            raise InputError(
+                f"{name}: the ASCII STL does not end with 'endsolid': the file is truncated; "
+                "export the mesh again",
+                "scene",
+            )
+        return
+    if len(data) < _STL_HEAD:
+        raise InputError(
+            f"{name} is not a valid STL file: {len(data)} bytes, fewer than the {_STL_HEAD} of "
+            f"a binary STL's header ({layout}); export the mesh again as STL",
+            "scene",
+        )
+    count = int.from_bytes(data[80:84], "little")
+    need = _STL_HEAD + _STL_TRIANGLE * count
+    if count == 0 or len(data) < need:
+        said = (
+            "gives 0 triangles"
+            if count == 0
+            else f"gives {count} triangles ({need} bytes), but the file is {len(data)} bytes"
+        )
+        raise InputError(
+            f"{name} is not a valid STL file: read as a binary STL, its header {said} "
+            f"({layout}); the file is truncated or not an STL: export the mesh again as STL",
+            "scene",
+        )
+
+
+def _check_off(data: bytes, name: str) -> None:
+    """Refuse an ASCII OFF file whose lines fall short of what its header promises (issue #36).
+
+    An OFF file is the line ``OFF``, the counts ``vertices faces edges``, one line per
+    vertex (x y z) and one per face (its corner count, then the corners). trimesh reads a
+    file cut short as a mesh with faces missing ("not a closed solid") or with numpy's words.
+    """
+    rows = []
+    for k, line in enumerate(data.decode("latin-1").splitlines(), start=1):
+        text = line.split("#", 1)[0].split()
+        if text:
+            rows.append((k, text))
+    if not rows or not rows[0][1][0].upper().endswith("OFF"):
+        raise InputError(
+            f"{name} is not an OFF file: an OFF file starts with the line 'OFF', then the "
+            "counts 'vertices faces edges'; export the mesh again as OFF",
+            "scene",
+        )
+    if any(t.upper() == "BINARY" for t in rows[0][1]):
+        return  # binary OFF: trimesh checks its length
+    counts, body = rows[0][1][1:], rows[1:]
+    if not counts and body:
+        counts, body = body[0][1], body[1:]
+    try:
+        n_v, n_f = int(counts[0]), int(counts[1])
+    except (IndexError, ValueError):
+        raise InputError(
+            f"{name}: the OFF header must give the counts 'vertices faces edges' after 'OFF', "
+            f"got {' '.join(counts)!r}: the file is truncated or damaged; export it again",
+            "scene",
+        ) from None
+    if len(body) < n_v + n_f:
+        raise InputError(
+            f"{name}: the OFF header promises {n_v} vertices and {n_f} faces ({n_v + n_f} "
+            f"lines), but the file has {len(body)}: it is truncated or its header was edited; "
+            "export the mesh again",
+            "scene",
+        )
+    for k, row in body[:n_v]:
+        if len(row) < 3:
+            raise InputError(
+                f"{name} line {k}: a vertex has {len(row)} coordinates, not 3: the file is "
+                "truncated or damaged; export the mesh again",
+                "scene",
+            )
+    for k, row in body[n_v : n_v + n_f]:
+        corners = int(row[0]) if row[0].isdigit() else -1
+        if corners < 3 or len(row) < 1 + corners:
+            raise InputError(
+                f"{name} line {k}: a face reads {' '.join(row)!r}, but a face is its corner "
+                "count (3 or more), then that many vertex numbers: the file is truncated or "
+                "damaged; export the mesh again",
+                "scene",
+            )
 
 
 def _unreadable(data: bytes, ext: str, name: str, exc: Exception) -> str:

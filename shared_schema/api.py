@@ -47,9 +47,12 @@ from shared_schema.rules import (
     PULSE_SHAPES,
     RECORD_FORMATS,
     RECORD_UNITS,
+    ROTATION_MAX,
     SF_METHODS,
     accel_max,
     check_choice,
+    default_rotation_problem,
+    rotation_problem,
 )
 from shared_schema.site import SiteFile
 
@@ -247,6 +250,13 @@ _PLAUSIBLE_SIDES: Dict[str, Any] = {
 #: The keys of a pulse's short form: a symmetric mechanism given by its constants.
 PULSE_SHORT_FORM = ("p_eq", "lam", "eta", "phi_ov", "one_sided")
 
+#: A short form's overturning rotation, given or defaulted to lam, is at most pi/2 (as in a
+#: constants file's side; issue #36).
+_SHORT_ROTATION: List[Dict[str, Any]] = [
+    {"properties": {"phi_ov": {"type": "number"}}, "required": ["phi_ov"]},
+    {"properties": {"phi_ov": {"type": "null"}, "lam": {"maximum": ROTATION_MAX}}},
+]
+
 #: A pulse's mechanism: the short form (``p_eq``, ``lam`` and ``eta``: in [0, 1] for
 #: two-sided rocking, in [-1, 0] for one-sided), or ``mechanism`` (one mechanism of a
 #: constants file, with ``eta`` and each side's ``p_eq`` and ``lam`` in the ranges of a
@@ -262,6 +272,7 @@ PULSE_ETA_RULE: Dict[str, Any] = {
                 "mechanism": {"type": "null"},
             },
             "required": ["p_eq", "lam", "eta"],
+            "anyOf": _SHORT_ROTATION,
         },
         {
             "properties": {
@@ -272,6 +283,7 @@ PULSE_ETA_RULE: Dict[str, Any] = {
                 "mechanism": {"type": "null"},
             },
             "required": ["p_eq", "lam", "eta", "one_sided"],
+            "anyOf": _SHORT_ROTATION,
         },
         {
             "properties": {
@@ -468,8 +480,10 @@ class PulseRequest(BaseModel):
     one_sided: bool = Field(False, description="One-sided rocking; short form.")
     phi_ov: Optional[float] = Field(
         None,
-        description="Overturning rotation [rad], > 0; defaults to lambda; short form.",
-        json_schema_extra={"exclusiveMinimum": 0},
+        description=f"Overturning rotation [rad], in (0, pi/2 = {ROTATION_MAX:.5g}] (a rocking "
+        "body on its side; degrees are refused); defaults to lambda, which must then be at "
+        "most pi/2; short form.",
+        json_schema_extra={"exclusiveMinimum": 0, "maximum": ROTATION_MAX},
     )
     mechanism: Optional[Mechanism] = Field(
         None,
@@ -501,6 +515,15 @@ class PulseRequest(BaseModel):
             raise ValueError(f"must be in [{lo:g}, {hi:g}] (a plausible range), got {value!r}")
         return value
 
+    @field_validator("phi_ov")
+    @classmethod
+    def _rotation(cls, value: Optional[float]) -> Optional[float]:
+        # issue #36: phi_ov = 10 rad (degrees?) was taken, as a constants file refuses it.
+        problem = None if value is None else rotation_problem(value)
+        if problem is not None:
+            raise PydanticCustomError("rotation_too_large", "{message}", {"message": problem})
+        return value
+
     @model_validator(mode="after")
     def _one_form(self) -> "PulseRequest":
         if self.mechanism is None:
@@ -511,6 +534,10 @@ class PulseRequest(BaseModel):
                         "line --constants)",
                         key,
                     )
+            assert self.lam is not None
+            rotation = None if self.phi_ov is not None else default_rotation_problem(self.lam)
+            if rotation is not None:
+                raise InputError(rotation, "lam")
             return self
         for key in PULSE_SHORT_FORM:
             if getattr(self, key) not in (None, False):
@@ -1239,3 +1266,8 @@ class SearchResponse(BaseModel):
     )
     counts: Dict[str, Any] = Field(description="Work counters.")
     timings: Dict[str, Any] = Field(description="Wall-clock seconds per stage.")
+    warnings: List[str] = Field(
+        description="The spec's admissible but implausible values (a density or a tie-bar "
+        "force outside its plausible range, as for a mechanism spec), each with what it most "
+        "likely means."
+    )

@@ -81,6 +81,7 @@ from shared_schema.rules import (
     SCHEMA_VERSION_PATTERN,
     G,
     control_character,
+    default_rotation_problem,
     eta_problem,
     rotation_problem,
     schema_version_problem,
@@ -531,14 +532,9 @@ class SideConstants(BaseModel):
                 raise _error("phi_ov", problem, "rotation_too_large")
         else:
             assert self.lam is not None
-            if self.lam > ROTATION_MAX:
-                raise _error(
-                    "lam",
-                    f"phi_ov defaults to lam (exact for a single block, whose lam is its angle "
-                    f"alpha < pi/2), and lam = {self.lam!r} is above pi/2 = {ROTATION_MAX:.5g} "
-                    "rad: give phi_ov [rad] for this side",
-                    "rotation_too_large",
-                )
+            problem = default_rotation_problem(self.lam)
+            if problem is not None:
+                raise _error("lam", problem, "rotation_too_large")
         return self
 
     @property
@@ -1069,6 +1065,46 @@ def _json_int(text: str) -> Union[int, float]:
     return int(text) if len(text) <= 4000 else float(text)
 
 
+#: Keys of a whole constants file (not of a mechanism), for a file given inside a list.
+_FILE_KEYS = ("schema_version", "mechanisms", "units", "rockmech_version")
+
+
+def _check_bare_list(items: List[Any]) -> None:
+    """Refuse a top-level list that is not a list of mechanisms, saying what it holds.
+
+    A bare list is read as the list of mechanisms (``parse_constants``); a whole file inside
+    one (``[{"schema_version": ..., "mechanisms": [...]}]``) or an item that is no object
+    got pydantic's "positive: Field required" or "Input should be an object" (issue #36).
+    """
+    example = '{"id": "W1", "p_eq": 2.15, "lam": 0.25, "eta": 0.9}'
+    for i, item in enumerate(items):
+        if isinstance(item, Mapping):
+            keys = [k for k in _FILE_KEYS if k in item]
+            if keys:
+                raise InputError(
+                    f"the file's top level is a list, which is read as the list of "
+                    f"mechanisms, but item {i} is a whole constants file (it has "
+                    f"{', '.join(repr(k) for k in keys)}): remove the [ ] around it, so that "
+                    'the file is {"schema_version": ..., "mechanisms": [...]}',
+                    f"mechanisms[{i}]",
+                )
+            continue
+        if isinstance(item, list):
+            found = "a list"
+        elif isinstance(item, str):
+            found = f"the text {item[:40]!r}"
+        elif item is None or isinstance(item, bool):
+            found = json.dumps(item)
+        else:
+            found = f"the number {item!r}"
+        raise InputError(
+            f"the file's top level is a list, which is read as the list of mechanisms, but "
+            f"item {i} is {found}, not a mechanism: each item is an object like {example}; "
+            'or write the file as {"mechanisms": [...]}',
+            f"mechanisms[{i}]",
+        )
+
+
 def parse_constants(source: Union[str, bytes, Mapping[str, Any], Sequence[Any]]) -> ConstantsFile:
     """Validate a kinematic-constants file given as JSON text or as plain Python data.
 
@@ -1101,12 +1137,15 @@ def parse_constants(source: Union[str, bytes, Mapping[str, Any], Sequence[Any]])
         text = source.decode("utf-8-sig") if isinstance(source, bytes) else source
         data = json_document(text)
         if isinstance(data, list):
+            _check_bare_list(data)
             text = '{"mechanisms": ' + text + "}"
             data = {"mechanisms": data}
         try:
             return ConstantsFile.model_validate_json(text)
         except ValidationError as exc:
             raise input_error_from_validation(_json_invalid_fields(exc, data), data) from exc
+    if not isinstance(source, Mapping):
+        _check_bare_list(list(source))
     data = {"mechanisms": list(source)} if not isinstance(source, Mapping) else source
     try:
         return ConstantsFile.model_validate(data)

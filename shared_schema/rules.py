@@ -68,6 +68,7 @@ __all__ = [
     "check_quantity",
     "control_character",
     "coordinate_problem",
+    "default_rotation_problem",
     "eta_problem",
     "eta_range",
     "printable",
@@ -256,6 +257,28 @@ def rotation_problem(value: float) -> Optional[str]:
         f"must be at most pi/2 = {ROTATION_MAX:.5g} rad (a rocking body on its side), got "
         f"{value:g} rad = {math.degrees(value):.4g} deg; the value is in radians: if it is "
         f"{value:g} deg, write {math.radians(value):.4g}"
+    )
+
+
+def default_rotation_problem(lam: float) -> Optional[str]:
+    """Return why ``lam`` cannot stand for a missing ``phi_ov`` (above ``ROTATION_MAX``), or None.
+
+    ``phi_ov`` defaults to ``lam``, exact for a single block, whose ``lam`` is its angle
+    ``alpha < pi/2``; a larger ``lam`` would be taken as a rotation past the block on its side.
+
+    Examples
+    --------
+    >>> default_rotation_problem(5.0)[-31:]
+    'give phi_ov [rad] for this side'
+    >>> default_rotation_problem(0.2) is None
+    True
+    """
+    if lam <= ROTATION_MAX:
+        return None
+    return (
+        f"phi_ov defaults to lam (exact for a single block, whose lam is its angle alpha < "
+        f"pi/2), and lam = {lam!r} is above pi/2 = {ROTATION_MAX:.5g} rad: give phi_ov [rad] "
+        "for this side"
     )
 
 

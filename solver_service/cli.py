@@ -1596,6 +1596,8 @@ def search(
         with run_folder(out, on_note=_out_note) as tmp:
             write_search(run, tmp, figure=figure)
     doc = run.doc
+    for warning in doc["warnings"]:
+        _note(f"warning: {warning}")
     for note in doc["notes"]:
         _note(f"note: {note}")
     for fail in doc["failures"]:

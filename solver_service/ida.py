@@ -1306,22 +1306,95 @@ def ida_csv(doc: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: Most levels a log range ``start:stop:n`` may ask for: far above any analysis (the
+#: command's work limit is ``max_scales``), below a count whose list would not fit in memory.
+MAX_RANGE_LEVELS = 1_000_000
+
+
+def _range_levels(text: str) -> list[float]:
+    """Levels of a log range ``start:stop:n``; each fault is named (issue #36).
+
+    Examples
+    --------
+    >>> [round(v, 6) for v in _range_levels("0.1:10:3")]
+    [0.1, 1.0, 10.0]
+    """
+    parts = text.split(":")
+    example = "e.g. 0.1:3:20 (20 levels from 0.1 to 3)"
+    if len(parts) != 3:
+        raise InputError(
+            f"a log range is three numbers start:stop:n, {example}; got {text!r} "
+            f"({len(parts)} parts)",
+            "scales",
+        )
+    names = ("start", "stop")
+    bounds = []
+    for name, part in zip(names, parts[:2]):
+        try:
+            value = float(part)
+        except ValueError:
+            raise InputError(
+                f"the range's {name} {part.strip()!r} is not a number, in {text!r}; {example}",
+                "scales",
+            ) from None
+        if not math.isfinite(value):
+            raise InputError(f"the range's {name} must be finite, got {part.strip()!r}", "scales")
+        bounds.append(value)
+    lo, hi = bounds
+    try:
+        count = int(parts[2])
+    except ValueError:
+        raise InputError(
+            f"the range's n (the number of levels, its third number) must be a whole number, "
+            f"got {parts[2].strip()!r} in {text!r}; {example}",
+            "scales",
+        ) from None
+    if count < 2:
+        raise InputError(
+            f"the range {text!r} asks for {count} levels: n (its third number) must be at "
+            f"least 2; for one level give the level itself ({parts[0].strip()})",
+            "scales",
+        )
+    if count > MAX_RANGE_LEVELS:
+        raise InputError(
+            f"the range {text!r} asks for {count} levels, more than {MAX_RANGE_LEVELS:,}; "
+            "n (its third number) is the number of levels",
+            "scales",
+        )
+    if lo <= 0.0:
+        raise InputError(
+            f"the range {text!r} starts at {lo:g}: a log range's start must be > 0 (levels "
+            "are spaced evenly on a log scale, and log 0 is -infinity); start at the smallest "
+            "intensity of interest, e.g. 0.05",
+            "scales",
+        )
+    if lo >= hi:
+        fix = (
+            f"write the smaller first, {parts[1].strip()}:{parts[0].strip()}:{count}"
+            if lo > hi
+            else "give a stop above the start"
+        )
+        raise InputError(
+            f"the range {text!r} starts at {lo:g} and stops at {hi:g}: the start must be "
+            f"below the stop; {fix}",
+            "scales",
+        )
+    return [float(v) for v in np.geomspace(lo, hi, count)]
+
+
 def parse_levels(text: str) -> list[float]:
     """Parse intensity levels: ``"0.1,0.2,0.5"`` or a log range ``"0.1:3:20"`` (start:stop:n).
 
     Raises
     ------
     InputError
-        Text that is neither form, or a list with an empty item (``0.5,,1``: the position is
-        named, never skipped); field ``scales``.
+        Text that is neither form, a list with an empty item (``0.5,,1``: the position is
+        named, never skipped), or a range whose fault is named (``_range_levels``); field
+        ``scales``.
     """
+    if ":" in text:
+        return _range_levels(text)
     try:
-        if ":" in text:
-            lo, hi, n = text.split(":")
-            count = int(n)
-            if count < 2 or not (0 < float(lo) < float(hi)) or not math.isfinite(float(hi)):
-                raise ValueError
-            return [float(v) for v in np.geomspace(float(lo), float(hi), count)]
         items = re.split(r"\s*,\s*|\s+", text.strip()) if text.strip() else []
         empty = [k for k, item in enumerate(items, start=1) if not item]
         if not empty:

@@ -404,7 +404,12 @@ def _body_size_note(spec: Any, scene: Any) -> Optional[str]:
 
 
 #: Words of the geometry errors that an axis, crack or hinge far from the body gives.
-FAR_FROM_BODY = ("does not touch the body", "misses the body", "not at the body's base")
+FAR_FROM_BODY = (
+    "does not touch the body",
+    "misses the body",
+    "not at the body's base",
+    "other side of the centre of mass",
+)
 
 
 def constants_and_failures(

@@ -213,6 +213,30 @@ def resolve_axis(scene: Any, axis: Any, where: str) -> Tuple[np.ndarray, np.ndar
     return np.asarray(start, dtype=float), np.asarray(end, dtype=float)
 
 
+def _base_hint(body: Body, start: np.ndarray, end: np.ndarray, tol: float) -> str:
+    """Say where the body's base is, for an axis that does not touch the body (issue #36).
+
+    A rocking axis is an edge of the base the body stands on; an axis drawn at mid-height,
+    or beside the body, gets the base's height and plan extent and, where it is above the
+    base, its own height.
+    """
+    v = body.vertices
+    z0 = float(v[:, 2].min())
+    base = v[v[:, 2] <= z0 + tol]
+    (x0, y0), (x1, y1) = base[:, :2].min(axis=0), base[:, :2].max(axis=0)
+    hint = (
+        f"; a rocking axis is an edge of the body's base, where it rests on its support: the "
+        f"base is at z = {z0:.4g} m, over x {x0:.4g} to {x1:.4g} m, y {y0:.4g} to {y1:.4g} m"
+    )
+    z_axis = 0.5 * float(start[2] + end[2])
+    if z_axis > z0 + tol:
+        hint += (
+            f", and the axis is at z = {z_axis:.4g} m, {z_axis - z0:.4g} m above it: draw it "
+            "along the bottom edge the body rocks about"
+        )
+    return hint
+
+
 def rocking_side(
     body: Body, start: np.ndarray, end: np.ndarray, *, where: str, allow_tilt: bool = False
 ) -> RockingSide:
@@ -238,6 +262,7 @@ def rocking_side(
     if dist.min() > tol:
         raise GeometryError(
             f"{where}: the axis does not touch the body (closest vertex {dist.min():.4f} m away)"
+            + _base_hint(body, start, end, tol)
         )
     # Height of the axis where each vertex projects on it (an inclined axis rises along u).
     below = float(np.max(start[2] + u[2] * (d @ u) - body.vertices[:, 2]))
@@ -375,9 +400,11 @@ def _negative_side(spec: Any, scene: Any, body: Body, pos: RockingSide) -> Rocki
         allow_tilt=spec.allow_non_horizontal_axis,
     )
     if float(np.dot(neg.outward, pos.outward)) >= 0.0:
-        raise InputError(
-            "the negative-side axis must lie on the other side of the centre of mass",
-            f"{where}.axis_negative",
+        com = ", ".join(f"{c:.4g}" for c in body.props.com)
+        raise GeometryError(
+            f"{where}.axis_negative: the negative-side axis must lie on the other side of the "
+            f"centre of mass from the axis, but both lie on the same side of it (the centre of "
+            f"mass is at ({com}) m); the negative side rocks about the base's opposite edge"
         )
     return neg
 

@@ -26,11 +26,18 @@ import json
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple, Union
 
+from shared_schema.constants import json_document
 from shared_schema.errors import InputError
-from shared_schema.rules import G
+from shared_schema.rules import G, check_file
+from shared_schema.text import decode_text
 
 __all__ = ["DEFAULT_TABLE", "ThrustTable", "estimate_rows", "roof_thrust"]
 
+#: What a thrust table file must be, for the messages on a file that is not one.
+THRUST_TABLE_EXPECTED = (
+    'a thrust table (JSON text, {"source": ..., "rows": [{"class", "rise_span", "v_N_m2", '
+    '"h_N_m2"}, ...]})'
+)
 #: The shipped table.
 DEFAULT_TABLE = Path(__file__).resolve().parent / "data" / "vault_thrust.json"
 #: Construction classes of the estimate: shell thickness [m] and density [kg/m³].
@@ -84,10 +91,25 @@ class ThrustTable:
     def load(cls, path: Optional[Union[str, Path]] = None) -> "ThrustTable":
         """Read a table file (default: the shipped estimate)."""
         p = Path(path) if path is not None else DEFAULT_TABLE
+        check_file(p, "thrust_table")
         try:
-            data = json.loads(p.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
-            raise InputError(f"cannot read thrust table {p}: {exc}", "thrust_table") from None
+            raw = p.read_bytes()
+        except OSError as exc:
+            raise InputError(f"cannot read {p}: {exc.strerror or exc}", "thrust_table") from None
+        # issue #36: a table that is not UTF-8 JSON was answered in the codec's words
+        text = decode_text(raw, p.name, "thrust_table", THRUST_TABLE_EXPECTED)
+        try:
+            data = json_document(text)
+        except InputError as exc:
+            raise InputError(
+                f"{p.name}: {exc.reason}; expected {THRUST_TABLE_EXPECTED}", "thrust_table"
+            ) from None
+        if not isinstance(data, dict):
+            raise InputError(
+                f"{p.name}: the top level is {type(data).__name__}, not an object; expected "
+                f"{THRUST_TABLE_EXPECTED}",
+                "thrust_table",
+            )
         return cls(data, name=str(p.name))
 
     @property

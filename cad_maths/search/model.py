@@ -758,7 +758,8 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
     GeometryError
         A wall that is not a vertical slab, a level or tie-bar that touches no wall.
     """
-    notes: List[str] = list(spec.plausibility_notes())
+    # the spec's implausible values are warnings of the search's document (issue #36), not notes
+    notes: List[str] = []
     memory = MemoryScene([], path=scene.path, tolerance=scene.tolerance, source_units=scene.units)
     openings: List[Tuple[SceneObject, TriMesh]] = []
     for k, sel in enumerate(spec.openings):

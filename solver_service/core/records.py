@@ -56,6 +56,7 @@ from shared_schema.text import decimal_point, decode_text, delimiter_of
 from .excitation import SampledAccel, check_finite_samples
 from .formats import READERS, Channel, channel_list, select_channel
 from .formats import detect as detect_strong_motion
+from .formats import truncated as truncated_strong_motion
 from .formats._text import units_or_none
 
 __all__ = [
@@ -858,6 +859,9 @@ def detect_format(p: Path) -> str:
     strong = detect_strong_motion(text)
     if strong is not None:
         return strong
+    cut = truncated_strong_motion(text, p.name)
+    if cut is not None:
+        raise InputError(cut, "record")
     lines = _data_lines(text)
     if not lines:
         raise InputError(f"{p.name} is empty: no data lines to read", "record")

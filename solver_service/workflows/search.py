@@ -48,6 +48,7 @@ from shared_schema.io import save_constants, stamped
 from shared_schema.rules import check_file
 from shared_schema.search import SearchSpec, parse_search_spec
 from shared_schema.spec import SpecFile
+from shared_schema.text import decode_text
 from shared_schema.version import __version__
 
 from ..core.envelope import OverturningLibrary
@@ -110,11 +111,24 @@ class SearchRun:
     ids: dict[int, str] = field(default_factory=dict)
 
 
+#: What a search spec must be, for the messages on empty, binary or non-JSON files.
+SEARCH_SPEC_EXPECTED = 'a search spec (JSON, {"walls": [...], "levels": [...], ...})'
+
+
 def read_search_spec(path: Path) -> SearchSpec:
-    """Read and validate a search spec file; errors name the spec and the field."""
+    """Read and validate a search spec file; errors name the spec and the field.
+
+    An empty, binary (gzip, a workbook) or non-UTF-8 file is told as such, naming the file
+    (``shared_schema.text.decode_text``; issue #36), as every other input file.
+    """
     check_file(path, "spec")
-    text = path.read_bytes()
-    json_document(text.decode("utf-8-sig", errors="replace"))  # malformed JSON: one line
+    text = decode_text(path.read_bytes(), path.name, "spec", SEARCH_SPEC_EXPECTED)
+    try:
+        json_document(text)  # malformed JSON: one line
+    except InputError as exc:
+        raise InputError(
+            f"{path.name}: {exc.reason}; expected {SEARCH_SPEC_EXPECTED}", "spec"
+        ) from None
     return parse_search_spec(text, path.name)
 
 
@@ -675,6 +689,8 @@ def search_run(
             "total_s": t4 - t0,
         },
         "assumptions": list(ASSUMPTIONS),
+        # issue #36: a density of 1.8 (t/m^3?) was a note among ten; a warning, as in a spec
+        "warnings": spec.plausibility_notes(),
         "notes": notes + compare["summary"],
     }
     return SearchRun(stamp(doc, "search"), ranked.spec_file, cf, result, dict(enumerate(ids)))

@@ -65,9 +65,11 @@ def test_a_spec_of_one_mechanism_keeps_its_own_error(tmp_path: Path) -> None:
     spec = parse_spec(spec_text(FAR), "spec.json")
     with pytest.raises(GeometryError) as err:
         constants_from_spec(spec, scene, scene_name="scene.3dm", spec_name="spec.json")
-    assert (
-        str(err.value)
-        == "FAR.axis: the axis does not touch the body (closest vertex 2.0000 m away)"
+    # issue #36: the message says where the body's base is (the 0.5 x 1 m wall stands on z = 0)
+    assert str(err.value) == (
+        "FAR.axis: the axis does not touch the body (closest vertex 2.0000 m away); a rocking "
+        "axis is an edge of the body's base, where it rests on its support: the base is at "
+        "z = 0 m, over x 0 to 0.5 m, y 0 to 1 m"
     )
 
 

@@ -16,6 +16,7 @@ import csv
 import functools
 import io
 import json
+import math
 import re
 from pathlib import Path
 from typing import Any
@@ -84,6 +85,8 @@ CONSTANTS_FILES: dict[str, Any] = {
     "no_mechs.json": json.dumps({"mechanisms": []}),
     "not_json.json": "{mechanisms: [",
     "list.json": "[1, 2, 3]",
+    # a whole file inside a list (issue #36: was "positive: Field required")
+    "list_wrapped.json": json.dumps([{"schema_version": "1.0", "mechanisms": [_W]}]),
     "nested.json": "[" * 5000 + "]" * 5000,
     "nested_id.json": json.dumps({"mechanisms": [{**_W, "id": {"a": {"b": {"c": 1}}}}]}),
     "eta_sign.json": json.dumps({"mechanisms": [{**_W, "eta": -0.5}]}),
@@ -724,6 +727,15 @@ def _cases() -> list[Case]:
             problem = r"the file is empty \(0 bytes\): expected a kinematic-constants file"
         if name == "binary.json":
             problem = r"is not a text file \(binary data .*expected a kinematic-constants file"
+        if name == "list.json":
+            fld = r"mechanisms\[0\]"
+            problem = r"top level is a list, .* item 0 is the number 1, not a mechanism"
+        if name == "list_wrapped.json":
+            fld = r"mechanisms\[0\]"
+            problem = (
+                r"item 0 is a whole constants file \(it has 'schema_version', 'mechanisms'\): "
+                r"remove the \[ \] around it"
+            )
         if name == "not_json.json":
             problem = r"invalid JSON at line 1, column 2: .*the file is not JSON .*or is cut short"
         cases.append(
@@ -856,7 +868,14 @@ def _cases() -> list[Case]:
         Case("ida-scales-empty", [*ida, "--scales", ""], "error", "scales", "."),
         Case("ida-scales-text", [*ida, "--scales", "a,b"], "error", "scales", "number|a"),
         Case("ida-scales-neg", [*ida, "--scales", "-1,1"], "error", "scales", r"> 0"),
-        Case("ida-scales-range-bad", [*ida, "--scales", "2:1:5"], "error", "scales", "."),
+        Case(
+            "ida-scales-range-bad",
+            [*ida, "--scales", "2:1:5"],
+            "error",
+            "scales",
+            r"starts at 2 and stops at 1: the start must be below the stop; write the smaller "
+            r"first, 1:2:5",
+        ),
         Case(
             "ida-scales-million",
             [*ida, "--scales", "1:2:1000000"],
@@ -1050,7 +1069,98 @@ def _cases() -> list[Case]:
             r"\(0, 1\]",
         ),
     ]
-    return cases + _range_cases()
+    return cases + _range_cases() + _issue36_cases()
+
+
+def _issue36_cases() -> list[Case]:
+    """Issue #36: the perimeter's last answers that did not say what to fix."""
+    pulse = ["pulse", "--p-eq", "2", "--lam", "0.2", "--eta", "0.9", "--f-p", "1", "--a-p-g", "1"]
+    ida = ["ida", "{c:ok.json}", "{r:good.dat}", "--scales"]
+    return [
+        # a rotation over pi/2 rad (degrees?) was simulated and said OVERTURNS; the constants
+        # file's limit and words (shared_schema.rules.rotation_problem)
+        Case(
+            "pulse-phi-ov-10-rad",
+            [*pulse, "--phi-ov", "10"],
+            "error",
+            "phi_ov",
+            r"must be at most pi/2 = 1\.5708 rad \(a rocking body on its side\), got 10 rad = "
+            r"573 deg; the value is in radians: if it is 10 deg, write 0\.1745",
+        ),
+        Case(
+            "pulse-phi-ov-pi-half",
+            [*pulse, "--phi-ov", repr(math.pi / 2), "--json"],
+            "ok",
+            check=lambda d: d["input"]["phi_ov"] == math.pi / 2,
+        ),
+        Case(
+            # phi_ov defaults to lam: lam = 5 would be a rotation of 286 deg
+            "pulse-lam-5-no-phi-ov",
+            [*pulse, "--lam", "5"],
+            "error",
+            "lam",
+            r"phi_ov defaults to lam .* lam = 5\.0 is above pi/2 = 1\.5708 rad: give phi_ov",
+        ),
+        Case(
+            "ida-scales-range-zero-levels",
+            [*ida, "0.1:4:0"],
+            "error",
+            "scales",
+            r"the range '0\.1:4:0' asks for 0 levels: n \(its third number\) must be at least 2",
+        ),
+        Case(
+            "ida-scales-range-start-above-stop",
+            [*ida, "4:0.1:20"],
+            "error",
+            "scales",
+            r"starts at 4 and stops at 0\.1: the start must be below the stop; write the "
+            r"smaller first, 0\.1:4:20",
+        ),
+        Case(
+            "ida-scales-range-negative-start",
+            [*ida, "-1:2:5"],
+            "error",
+            "scales",
+            r"starts at -1: a log range's start must be > 0",
+        ),
+        Case(
+            "ida-scales-range-zero-start",
+            [*ida, "0:4:10"],
+            "error",
+            "scales",
+            r"starts at 0: a log range's start must be > 0 \(levels are spaced evenly on a log "
+            r"scale",
+        ),
+        Case(
+            "ida-scales-range-count-not-whole",
+            [*ida, "0.1:2:3.5"],
+            "error",
+            "scales",
+            r"n \(the number of levels, its third number\) must be a whole number, got '3\.5'",
+        ),
+        Case(
+            "ida-scales-range-two-parts",
+            [*ida, "0.1:2"],
+            "error",
+            "scales",
+            r"a log range is three numbers start:stop:n, .* got '0\.1:2' \(2 parts\)",
+        ),
+        Case(
+            # was numpy's "Unable to allocate 7.28 TiB", a traceback, even with --no-limits
+            "ida-scales-range-trillion-levels",
+            [*ida, "0.1:4:1000000000000", "--no-limits"],
+            "error",
+            "scales",
+            r"asks for 1000000000000 levels, more than 1,000,000",
+        ),
+        Case(
+            # 0.1, 1, 10: the levels of a range are log-spaced (hand: 10**-1, 10**0, 10**1)
+            "ida-scales-range-ok",
+            [*ida, "0.1:10:3", "--json"],
+            "ok",
+            check=lambda d: np.allclose(d["intensity"]["levels"], [0.1, 1.0, 10.0], rtol=1e-12),
+        ),
+    ]
 
 
 def _four_mechanisms(out: Any) -> bool:

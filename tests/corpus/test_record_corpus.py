@@ -498,6 +498,98 @@ SYNTH: list[tuple[Any, ...]] = [
     ),
 ]
 
+# --- issue #36: strong-motion headers cut short or miscounted, built here from scratch --------
+
+#: A record in cm/s² for the strong-motion builders (30 cm/s² peak at 1.5 Hz).
+A_CM = 30.0 * np.sin(2 * np.pi * 1.5 * T)
+PGA_CM = float(np.max(np.abs(A_CM)))
+
+
+def _esm(a: np.ndarray = A_CM) -> str:
+    """An ESM / ITACA ASCII file (DYNA 1.2: 64 ``KEY: value`` lines to ``USER5:``) in cm/s²."""
+    keys = ["EVENT_NAME: CORPUS", "EVENT_ID: TEST-36", "EVENT_DATE_YYYYMMDD: 20000101"]
+    keys += [f"FIELD_{k}: " for k in range(27)]
+    keys += [f"SAMPLING_INTERVAL_S: {DT:.6f}", f"NDATA: {len(a)}", f"DURATION_S: {len(a) * DT:.3f}"]
+    keys += ["STREAM: HNE", "UNITS: cm/s^2", f"PGA_CM/S^2: {np.max(np.abs(a)):.6f}"]
+    keys += ["DATA_TYPE: ACCELERATION"]
+    keys += [f"FILLER_{k}: " for k in range(len(keys), 63)] + ["USER5: "]
+    assert len(keys) == 64
+    return "\n".join(keys + [f"{x:.6f}" for x in a]) + "\n"
+
+
+def _esm_lines(n: int) -> str:
+    """The ESM file's first ``n`` lines (a download cut short in its header)."""
+    return "".join(_esm().splitlines(keepends=True)[:n])
+
+
+def _cosmos(text_lines: int = 13, a: np.ndarray = A_CM) -> str:
+    """A COSMOS V2 file of one channel in cm/s², its first line saying ``text_lines``."""
+    head = [f"Corrected acceleration    (Format v01.20 with {text_lines:2d} text lines)"]
+    head += [f"corpus text line {k}" for k in range(2, 14)]
+    ints = [-999] * 100
+    ints[0], ints[1] = 2, 1  # corrected (V2), acceleration
+    reals = [-999.0] * 100
+    peak = int(np.argmax(np.abs(a)))
+    reals[61:65] = [DT * 1000.0, len(a) * DT, float(a[peak]), peak * DT]
+    out = [*head, " 100 Integer-header values follow on  10 lines, Format= (10I8)"]
+    out += ["".join(f"{v:8d}" for v in ints[k : k + 10]) for k in range(0, 100, 10)]
+    out += [" 100 Real-header values follow on  20 lines, Format= (5F15.6)"]
+    out += ["".join(f"{v:15.6f}" for v in reals[k : k + 5]) for k in range(0, 100, 5)]
+    out += ['   1 Comment line(s) follow, each starting with a "|":', "| corpus"]
+    data = f"  {len(a)} acceleration pts, approx  {round(len(a) * DT)} secs, units=cm/sec2(04)"
+    out += [data + ",Format=(1E15.6)", *[f"{x:15.6e}" for x in a]]
+    return "\n".join([*out, "End-of-data for Chan 1 acceleration"]) + "\n"
+
+
+SYNTH += [
+    # the builders give readable files: the peak is the samples' (cm/s² to g by 980.665)
+    ("esm-good", "r.ASC", _esm(), [], "ok", "", "", "", _pga_is(PGA_CM / 980.665)),
+    ("cosmos-good", "r.V2c", _cosmos(), [], "ok", "", "", "", _pga_is(PGA_CM / 980.665)),
+    (
+        # cut within the keys that identify the format: was "cannot tell the format"
+        "esm-header-cut-at-line-20",
+        "r.ASC",
+        _esm_lines(20),
+        [],
+        "error",
+        "record",
+        r"r\.ASC: the ESM / ITACA header stops after line 20 \(FIELD_16:\), before its last key "
+        r"USER5: .*the file is truncated; .*\(it lacks NDATA, SAMPLING_INTERVAL_S, UNITS\)",
+    ),
+    (
+        # cut after them: was "header says 400 samples, but the file has 0"
+        "esm-header-cut-at-line-40",
+        "r.ASC",
+        _esm_lines(40),
+        [],
+        "error",
+        "record",
+        r"the ESM / ITACA header stops after line 40 \(FILLER_39:\), before its last key USER5: "
+        r"\(a DYNA 1\.2 header has 64 'KEY: value' lines",
+    ),
+    (
+        # was "line 201: expected the integer-header line"
+        "cosmos-text-lines-200",
+        "r.V2c",
+        _cosmos(200),
+        [],
+        "error",
+        "record",
+        r"r\.V2c line 1 says the channel's text header has 200 lines, but its integer-header "
+        r"line is line 14, after 13 text lines .*it should read 'with 13 text lines'",
+    ),
+    (
+        "cosmos-header-cut-in-text",
+        "r.V2c",
+        "".join(_cosmos().splitlines(keepends=True)[:10]),
+        [],
+        "error",
+        "record",
+        r"says the channel's text header has 13 lines, but the file ends after 10 lines .*the "
+        r"file is truncated or its header is too long",
+    ),
+]
+
 #: The shared strong-motion files: name -> (format, options picking one channel).
 REAL = {
     "CHB0031412312349.NS": ("knet", []),

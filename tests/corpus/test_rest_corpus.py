@@ -199,6 +199,23 @@ def _cases() -> list[Rest]:
             field="a_p",
             problem="range|at most|<=|too",
         ),
+        # issue #36: as a constants file, a rotation over pi/2 rad is refused (rules.py's words)
+        Rest(
+            "pulse-phi_ov-10-rad",
+            "pulse",
+            {"phi_ov": 10.0},
+            field="phi_ov",
+            problem=r"must be at most pi/2 = 1\.5708 rad \(a rocking body on its side\), got 10 "
+            r"rad = 573 deg; the value is in radians: if it is 10 deg, write 0\.1745",
+        ),
+        Rest(
+            "pulse-lam-5-phi_ov-defaulted",
+            "pulse",
+            {"lam": 5.0},
+            field="lam",
+            problem=r"phi_ov defaults to lam .* above pi/2 = 1\.5708 rad: give phi_ov",
+        ),
+        Rest("pulse-lam-5-phi_ov-given", "pulse", {"lam": 5.0, "phi_ov": 0.2}, status=200),
         Rest(
             "pulse-eta-missing-two-sided",
             "pulse",

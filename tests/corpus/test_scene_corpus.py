@@ -699,6 +699,136 @@ SCENE_CASES += [
     ),
 ]
 
+#: A flat sheet: the wall's face x = 0 as two triangles (a surface drawn for the wall).
+SHEET: Mesh = (
+    np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 1.0, 3.0], [0.0, 0.0, 3.0]]),
+    np.array([[0, 1, 2], [0, 2, 3]]),
+)
+
+
+def _off_cut(keep_lines: int) -> Writer:
+    """The wall as an OFF file, its first ``keep_lines`` lines kept (a copy cut short)."""
+
+    def write(tmp: Path) -> Path:
+        path = _scan("off")(tmp)
+        lines = path.read_text().splitlines(keepends=True)
+        path.write_text("".join(lines[:keep_lines]))
+        return path
+
+    return write
+
+
+#: A mm scan read as m, its two axes written in m: both lie by the body's corner at x = 0.
+SPEC_SCAN_BOTH_AXES = {
+    "mechanisms": [
+        {
+            **SPEC_SCAN["mechanisms"][0],
+            "axis_negative": {"start": [0.0, 0.0, 0.0], "end": [0.0, 1.0, 0.0]},
+        }
+    ]
+}
+#: The axis drawn on the wall's face at mid-height (z = 1.5 m) instead of its base edge.
+SPEC_SCAN_MID_HEIGHT = {
+    "mechanisms": [
+        {**SPEC_SCAN["mechanisms"][0], "axis": {"start": [0.5, 0.0, 1.5], "end": [0.5, 1.0, 1.5]}}
+    ]
+}
+
+# issue #36: the scene answers that did not say what to fix
+SCENE_CASES += [
+    (
+        "3dm-flat-sheet-mesh",
+        _3dm(lambda: _wall_scene(SHEET)),
+        SPEC_3DM,
+        [],
+        "error",
+        "wall",
+        r"wall \(.*\): the mesh is flat: its 4 vertices lie in one plane, so it has zero volume "
+        r"\(a surface, not a solid body\); model the body with its thickness",
+    ),
+    (
+        "scan-ply-flat-sheet",
+        _scan("ply", SHEET),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "wall",
+        r"the mesh is flat: its 4 vertices lie in one plane, so it has zero volume",
+    ),
+    (
+        "scan-stl-random-bytes",
+        _bytes("wall.stl", lambda t: np.random.default_rng(36).bytes(4096)),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "scene",
+        r"wall\.stl is not a valid STL file: read as a binary STL, its header gives \d+ "
+        r"triangles \(\d+ bytes\), but the file is 4096 bytes",
+    ),
+    (
+        "scan-stl-too-short",
+        _bytes("wall.stl", lambda t: b"\x00" * 40),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "scene",
+        r"wall\.stl is not a valid STL file: 40 bytes, fewer than the 84 of a binary STL",
+    ),
+    (
+        # 8 vertices and 12 faces: 20 data lines after the 2 header lines; 17 of them kept
+        "scan-off-truncated-faces",
+        _off_cut(19),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "scene",
+        r"wall\.off: the OFF header promises 8 vertices and 12 faces \(20 lines\), but the file "
+        r"has 17: it is truncated",
+    ),
+    (
+        "scan-off-truncated-vertices",
+        _off_cut(6),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "scene",
+        r"promises 8 vertices and 12 faces \(20 lines\), but the file has 4",
+    ),
+    (
+        "scan-off-no-header",
+        _bytes("wall.off", lambda t: b"0 0 0\n1 0 0\n"),
+        SPEC_SCAN,
+        ["--units", "m"],
+        "error",
+        "scene",
+        r"wall\.off is not an OFF file: an OFF file starts with the line 'OFF'",
+    ),
+    (
+        # the centre of mass of the 500 x 1000 x 3000 "m" body is at x = 250: both axes by x = 0
+        "scan-ply-mm-read-as-m-negative-axis",
+        _scan("ply", WALL, 1000.0),
+        SPEC_SCAN_BOTH_AXES,
+        ["--units", "m"],
+        "error",
+        r"W\.axis_negative",
+        r"must lie on the other side of the centre of mass from the axis, but both lie on the "
+        r"same side of it \(the centre of mass is at \(250, 500, 1500\) m\).*3202 m across as "
+        r"read in meters.*if the file is in mm, give units mm \(--units mm\)",
+    ),
+    (
+        "scan-ply-axis-at-mid-height",
+        _scan("ply"),
+        SPEC_SCAN_MID_HEIGHT,
+        ["--units", "m"],
+        "error",
+        r"W\.axis",
+        r"does not touch the body \(closest vertex 1\.5000 m away\); a rocking axis is an edge "
+        r"of the body's base, where it rests on its support: the base is at z = 0 m, over x 0 "
+        r"to 0\.5 m, y 0 to 1 m, and the axis is at z = 1\.5 m, 1\.5 m above it: draw it along "
+        r"the bottom edge",
+    ),
+]
+
 
 def _right_wall_said(pattern: str) -> Callable[[Any], bool]:
     """The right wall, with the repair warning in the constants file (provenance) too."""
@@ -761,6 +891,9 @@ REST_CASES = {
     "scan-ply-good": (200, ""),
     "scan-ply-no-units": (400, "units"),
     "scan-stl-open": (400, "wall.*(open|closed|watertight|boundary)"),
+    "scan-stl-random-bytes": (400, r"wall\.stl is not a valid STL file"),
+    "scan-off-truncated-faces": (400, r"the OFF header promises 8 vertices and 12 faces"),
+    "3dm-flat-sheet-mesh": (400, r"the mesh is flat: its 4 vertices lie in one plane"),
     "scene-unknown-extension": (400, "scene|3dm|ply"),
 }
 

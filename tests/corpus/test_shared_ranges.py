@@ -146,3 +146,48 @@ def test_constants_ranges_are_the_rules_on_cli_tables_and_rest(
             assert (code, status) == (2, 422), (value, argv[1])
             assert key in cli_error and key in rest_error, (cli_error, rest_error)
             assert _reason(cli_error) == _reason(rest_error), (cli_error, rest_error)
+
+
+PULSE_ARGS = ["pulse", "--p-eq", "2", "--eta", "0.9", "--f-p", "1", "--a-p-g", "1"]
+
+
+@pytest.mark.parametrize(
+    ("given", "field"),
+    [({"phi_ov": "value", "lam": 0.2}, "phi_ov"), ({"lam": "value"}, "lam")],
+)
+def test_a_pulse_rotation_is_the_constants_files_on_cli_and_rest(
+    given: dict[str, Any], field: str, client: httpx.Client, tmp_path: Path
+) -> None:
+    """Issue #36: ``pulse --phi-ov 10`` and ``POST /pulse`` said OVERTURNS; a file refused it.
+
+    phi_ov, given or defaulted to lam, is at most pi/2 on the command line, the REST service
+    and in a constants file, refused one step past it with the same words.
+    """
+    prop = _schema(client, "PulseRequest")["phi_ov"]
+    assert prop["maximum"] == rules.ROTATION_MAX
+    for value, accepted in _around((0.01, rules.ROTATION_MAX)):
+        if not accepted and value < 1.0:
+            continue  # below: lam's and phi_ov's own lower bounds, not this rule
+        side = {k: value if v == "value" else v for k, v in given.items()}
+        argv = [
+            *PULSE_ARGS,
+            *[a for k, v in side.items() for a in (f"--{k.replace('_', '-')}", repr(v))],
+        ]
+        code, cli_error = _cli(argv)
+        body = {"p_eq": 2.0, "eta": 0.9, "f_p": 1.0, "a_p_g": 1.0, **side}
+        status, rest_error = _rest(client, "pulse", body)
+        path = tmp_path / "c.json"
+        path.write_text(json.dumps({"mechanisms": [{"id": "W", "p_eq": 2.0, "eta": 0.9, **side}]}))
+        file_code, file_error = _cli(
+            ["envelope", str(path), "--out", str(tmp_path / "e"), "--n", "5"]
+        )
+        if accepted:
+            assert (code, status, file_code) == (0, 200, 0), (value, cli_error, rest_error)
+            continue
+        assert (code, status, file_code) == (2, 422, 2), value
+        assert f"error: {field}: " in cli_error and field in rest_error and field in file_error
+        words = rules.rotation_problem(value) if field == "phi_ov" else None
+        words = words or rules.default_rotation_problem(value)
+        assert words is not None
+        for said in (cli_error, rest_error, file_error):
+            assert said.endswith(words), (said, words)

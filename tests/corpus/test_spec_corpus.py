@@ -9,6 +9,7 @@ with their #14 class.
 from __future__ import annotations
 
 import copy
+import gzip
 import json
 from collections.abc import Callable
 from pathlib import Path
@@ -16,6 +17,8 @@ from typing import Any
 
 import pytest
 from corpus_case import Case, params, run_case
+
+from shared_schema.rules import quantity_note
 
 REPO = Path(__file__).resolve().parents[2]
 SCENES = REPO / "examples" / "scenes"
@@ -926,3 +929,144 @@ def test_keep_going_writes_the_good_mechanism(tmp_path: Path) -> None:
 
 def test_spec_corpus_is_large() -> None:
     assert len(CASES) >= 90
+
+
+# --- issue #36: the files a spec names, and the search's spec ---------------------------------
+
+SEARCH_SCENE = SCENES / "search_facade.3dm"
+
+
+def _search_spec(**change: Any) -> Spec:
+    """The bundled search spec, quick to run (one family, 20 frequencies, no records)."""
+    doc: Spec = json.loads((SPECS / "search_facade.search.json").read_text())
+    doc["families"] = ["overturning"]
+    doc["ranking"] = {"band_hz": [0.5, 10.0], "n_frequencies": 20, "records": [], "keep": 1}
+    for key, value in change.items():
+        doc[key] = value
+    return doc
+
+
+def _density(value: float) -> Spec:
+    doc = _search_spec()
+    doc["walls"][0]["density"] = value
+    return doc
+
+
+def _with_table(name: str) -> str:
+    return json.dumps({**_base("rect_wall"), "thrust_table": name})
+
+
+#: (id, files written into the case's folder, argv, expect, field, problem[, check])
+FILE_CASES: list[tuple[Any, ...]] = [
+    (
+        "thrust-table-not-json",
+        {"spec.json": _with_table("table.json"), "table.json": "class,rise_span\na,0.2\n"},
+        "constants",
+        "error",
+        "thrust_table",
+        r"table\.json: invalid JSON at line 1, column 1: .*expected a thrust table \(JSON text",
+    ),
+    (
+        "thrust-table-not-utf8",
+        {"spec.json": _with_table("table.json"), "table.json": b'{"source": "K\xf6ln"}'},
+        "constants",
+        "error",
+        "thrust_table",
+        r"table\.json is not UTF-8 text: byte 13 \(line 1\) is 0xf6, .*expected a thrust table"
+        r".*save it again as UTF-8 text",
+    ),
+    (
+        "thrust-table-a-list",
+        {"spec.json": _with_table("table.json"), "table.json": "[]"},
+        "constants",
+        "error",
+        "thrust_table",
+        r"table\.json: the top level is list, not an object; expected a thrust table",
+    ),
+    (
+        "thrust-table-missing",
+        {"spec.json": _with_table("table.json")},
+        "constants",
+        "error",
+        "thrust_table",
+        r"file not found: .*table\.json",
+    ),
+    (
+        "search-spec-empty",
+        {"s.search.json": "  \n"},
+        "search",
+        "error",
+        "spec",
+        r"s\.search\.json holds only blank space: expected a search spec \(JSON",
+    ),
+    (
+        "search-spec-gzip",
+        {"s.search.json": gzip.compress(json.dumps(_search_spec()).encode())},
+        "search",
+        "error",
+        "spec",
+        r"s\.search\.json is not a text file \(it starts like a gzip archive\): expected a "
+        r"search spec \(JSON",
+    ),
+    (
+        "search-spec-not-json",
+        {"s.search.json": "{walls: ["},
+        "search",
+        "error",
+        "spec",
+        r"s\.search\.json: invalid JSON at line 1, column 2: .*expected a search spec",
+    ),
+    (
+        # t/m^3 for kg/m^3: a warning as in a mechanism spec (rules.quantity_note), not a note
+        "search-density-1.8",
+        {"s.search.json": json.dumps(_density(1.8))},
+        "search",
+        "warn",
+        "",
+        r"warning: walls\[0\]\.density = 1\.8 kg/m\^3 is outside the plausible range \[300, "
+        r"9000\] kg/m\^3: .*t/m\^3",
+        lambda d: (
+            d["warnings"] == [quantity_note(1.8, "density", "walls[0].density")]
+            and not any("density" in n for n in d["notes"])
+        ),
+    ),
+    (
+        "search-density-1800-no-warning",
+        {"s.search.json": json.dumps(_density(1800.0))},
+        "search",
+        "ok",
+        "",
+        "",
+        lambda d: d["warnings"] == [],
+    ),
+]
+
+
+def _file_case(row: tuple[Any, ...]) -> Case:
+    cid, files, command, expect, fld, problem = row[:6]
+    check = row[6] if len(row) > 6 else None
+    if command == "constants":
+        argv = [command, str(SCENES / "rect_wall.3dm"), "{tmp}/spec.json", "-o", "{tmp}/out.json"]
+    else:
+        argv = [command, str(SEARCH_SCENE), "{tmp}/s.search.json", "-o", "{tmp}/out"]
+        argv.append("--no-figure")
+    if check is not None:
+        argv.append("--json")
+    return Case(f"{cid}", argv, expect, fld, problem, check=check, files=files)
+
+
+FILE_CASE_LIST = [_file_case(r) for r in FILE_CASES]
+
+
+@pytest.mark.parametrize("case", params(FILE_CASE_LIST))
+def test_file_case(case: Case, tmp_path: Path) -> None:
+    for name, content in case.files.items():
+        path = tmp_path / name
+        if isinstance(content, bytes):
+            path.write_bytes(content)
+        else:
+            path.write_text(content)
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in case.argv]
+    run_case(case, argv)
+    if case.expect == "error":
+        assert not (tmp_path / "out.json").exists() and not (tmp_path / "out").exists()

@@ -92,8 +92,13 @@ CORNERS = list(
 def test_every_corner_of_the_ranges_computes(
     p_eq: float, f_p: float, lam: float, a_p_g: float
 ) -> None:
-    PulseRequest.model_validate({**PULSE, "p_eq": p_eq, "f_p": f_p, "lam": lam, "a_p_g": a_p_g})
+    # phi_ov defaults to lam only where lam is an angle (at most pi/2, issue #36): beyond, the
+    # largest rotation admitted
+    phi_ov = min(lam, rules.ROTATION_MAX)
+    body = {**PULSE, "p_eq": p_eq, "f_p": f_p, "lam": lam, "a_p_g": a_p_g, "phi_ov": phi_ov}
+    PulseRequest.model_validate(body)
     args = ["pulse", "--p-eq", str(p_eq), "--f-p", str(f_p), "--lam", str(lam)]
+    args += ["--phi-ov", repr(phi_ov)]
     res = runner.invoke(app, [*args, "--a-p-g", str(a_p_g), "--eta", "0.9", "--json"])
     assert res.exit_code == 0, res.output
     doc: dict[str, Any] = json.loads(res.stdout)

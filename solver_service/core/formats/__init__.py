@@ -26,7 +26,7 @@ from shared_schema.errors import InputError
 from . import cosmos, dmg, esm, geonet, knet
 from ._text import Channel
 
-__all__ = ["READERS", "Channel", "channel_list", "detect", "select_channel"]
+__all__ = ["READERS", "Channel", "channel_list", "detect", "select_channel", "truncated"]
 
 #: Format name -> (sniff, read), in the order detection tries them.
 READERS: dict[str, tuple[Callable[[str], bool], Callable[[str, str], list[Channel]]]] = {
@@ -47,6 +47,15 @@ def detect(text: str) -> Optional[str]:
         if sniff(head):
             return fmt
     return None
+
+
+def truncated(text: str, name: str) -> Optional[str]:
+    """Return why a file that starts like a strong-motion header but is cut short is refused.
+
+    For the files ``detect`` does not recognise: an ESM / ITACA header cut before the keys
+    that identify it (``esm.truncated_header``); None for any other file.
+    """
+    return esm.truncated_header(text[:HEAD_CHARS].replace("\r\n", "\n"), name)
 
 
 def channel_list(channels: list[Channel]) -> str:

@@ -119,6 +119,45 @@ def _block(lines: list[str], i: int, name: str, kind: str) -> tuple[list[float],
     return [float(v) for v in values], i + 1 + nlines, int(match.group(6) or 0)
 
 
+def _check_text_count(lines: list[str], i: int, count: int, name: str) -> None:
+    """Refuse a channel whose first line's text-line count does not reach its integer header.
+
+    A COSMOS channel is its text header (as many lines as its first line says, ``with 13
+    text lines``), then the integer-header line. A wrong count was answered "line 201:
+    expected the integer-header line" (issue #36); this says what the count should be.
+    """
+    at = i + count
+    if at < len(lines) and _is_block(lines[at], "integer"):
+        return
+    said = f"{name} line {i + 1} says the channel's text header has {count} lines"
+    found = next((k for k in range(i + 1, len(lines)) if _is_block(lines[k], "integer")), None)
+    layout = (
+        "a COSMOS V2 channel is its text header (the count on its first line), then the line "
+        "'100 Integer-header values follow on 10 lines, ...'"
+    )
+    if found is not None:
+        raise InputError(
+            f"{said}, but its integer-header line is line {found + 1}, after {found - i} text "
+            f"lines ({layout}): the count on line {i + 1} was edited or the file is damaged "
+            f"(it should read 'with {found - i} text lines')",
+            "record",
+        )
+    ends = (
+        f"the file ends after {len(lines) - i} lines"
+        if at >= len(lines)
+        else f"no integer-header line follows in the file's {len(lines)} lines"
+    )
+    raise InputError(
+        f"{said}, but {ends} ({layout}): the file is truncated or its header is too long",
+        "record",
+    )
+
+
+def _is_block(line: str, kind: str) -> bool:
+    match = _BLOCK.match(line)
+    return match is not None and match.group(2).lower() == kind
+
+
 def read(text: str, name: str) -> list[Channel]:
     """Read every acceleration channel of a COSMOS V2 file (usually one).
 
@@ -138,6 +177,7 @@ def read(text: str, name: str) -> list[Channel]:
         first = _FIRST.search(lines[i])
         if first is None:
             raise InputError(f"{name} line {i + 1}: expected a COSMOS channel header", "record")
+        _check_text_count(lines, i, int(first.group(1)), name)
         text_header = lines[i : i + int(first.group(1))]
         i += int(first.group(1))
         ints, i, _ = _block(lines, i, name, "integer")

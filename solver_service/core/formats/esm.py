@@ -8,6 +8,8 @@ the samples. Reference: the ESM/ITACA "DYNA 1.2" format note and ``gmprocess.io.
 
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 
 from shared_schema.errors import InputError
@@ -15,7 +17,7 @@ from shared_schema.rules import RECORD_UNITS
 
 from ._text import Channel, check_count, check_duration, check_peak, number, units_from_text
 
-__all__ = ["read", "sniff"]
+__all__ = ["read", "sniff", "truncated_header"]
 
 #: Keys that identify the format (all present in a DYNA 1.2 header).
 _KEYS = ("EVENT_ID:", "NDATA:", "SAMPLING_INTERVAL_S:", "UNITS:")
@@ -26,6 +28,50 @@ _LAST_KEY = "USER5"
 def sniff(head: str) -> bool:
     """Tell the start of an ESM / ITACA file (DYNA 1.x ``KEY: value`` header)."""
     return head.startswith("EVENT_NAME:") and all(k in head for k in _KEYS)
+
+
+#: Lines of a DYNA 1.2 header (``EVENT_NAME:`` to ``USER5:``), for the messages.
+HEADER_LINES = 64
+
+
+def _header_lines(lines: list[str]) -> list[str]:
+    """Return the keys of the leading ``KEY: value`` lines of a file, up to ``USER5:``."""
+    out = []
+    for line in lines:
+        key, sep, _ = line.partition(":")
+        if not sep:
+            break
+        out.append(key.strip())
+        if key.strip() == _LAST_KEY:
+            break
+    return out
+
+
+def _cut_short(keys: list[str], name: str) -> str:
+    """Say where a DYNA 1.2 header that never reaches ``USER5:`` stops."""
+    last = f" ({keys[-1]}:)" if keys else ""
+    return (
+        f"{name}: the ESM / ITACA header stops after line {len(keys)}{last}, before its last "
+        f"key {_LAST_KEY}: (a DYNA 1.2 header has {HEADER_LINES} 'KEY: value' lines from "
+        "EVENT_NAME: to USER5:, then one sample a line): the file is truncated; download or "
+        "copy it again"
+    )
+
+
+def truncated_header(head: str, name: str) -> Optional[str]:
+    """Return the message for a file that starts like ESM but whose header is cut short, or None.
+
+    ``sniff`` needs ``EVENT_ID``, ``NDATA``, ``SAMPLING_INTERVAL_S`` and ``UNITS``; a file cut
+    within its first 33 lines has ``EVENT_NAME:`` but not all of them (issue #36: it was
+    answered "cannot tell the format").
+    """
+    if not head.startswith("EVENT_NAME:") or sniff(head):
+        return None
+    keys = _header_lines(head.splitlines())
+    if keys and keys[-1] == _LAST_KEY:
+        return None
+    missing = [k.rstrip(":") for k in _KEYS if k.rstrip(":") not in keys]
+    return _cut_short(keys, name) + f" (it lacks {', '.join(missing)})"
 
 
 def read(text: str, name: str) -> list[Channel]:
@@ -50,8 +96,14 @@ def read(text: str, name: str) -> list[Channel]:
         if key.strip() == _LAST_KEY:
             break
 
+    if _LAST_KEY not in header and not any(ln.strip() for ln in lines[start:]):
+        # the file ends inside its header (no sample follows): cut short
+        raise InputError(_cut_short(list(header), name), "record")
+
     def need(key: str) -> str:
         if not header.get(key):
+            if _LAST_KEY not in header:
+                raise InputError(_cut_short(list(header), name) + f" (no {key})", "record")
             raise InputError(f"{name}: ESM header has no {key}", "record")
         return header[key]
 
