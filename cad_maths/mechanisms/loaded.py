@@ -16,7 +16,9 @@ Added elements and how they enter:
   load-bearing mass and ``H`` an outward static force, both at the springing (the contact
   with the wall).
 * **tie-bars**: a restraining (inward) force where the bar meets the façade's outer face
-  (the vertical plane through the axis).
+  (the vertical plane through the axis), on the outward swing only: a bar pulls while the
+  motion stretches it and goes slack towards its anchorage, so the negative side of a
+  two-sided wall with tie-bars alone is the plain wall's (theory §1.8).
 
 Constants (about ``phi_cr = alpha_c``): ``I0 = I_O + sum M_i R_i²`` (added masses as point
 masses), ``K = M_c g R_c``, ``Q = M_c* R_c* cos(alpha_c* - alpha_c)``,
