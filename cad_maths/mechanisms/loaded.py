@@ -396,6 +396,14 @@ def build_loaded_wall(spec: Any, scene: Any, table: Any) -> MechanismSides:
     warnings.extend(notes)
     if spec.rocking == "two_sided":
         summary["negative_side"] = SLACK_TIES
+        if "rocking" not in spec.model_fields_set:
+            # a loaded wall without 'rocking' was refused before tie-bars alone could rock
+            # two-sided: say what the default now makes of it
+            warnings.append(
+                f"{spec.id}.rocking: not given; the wall rocks two-sided (the default), its "
+                "tie-bars pulling on the outward swing only. A façade held on its inner face "
+                "(transverse walls, floors) is one_sided: give 'rocking'"
+            )
     geometry["loaded"] = summary
     inertia = (summary["M_c_kg"], summary["R_c_m"], summary["alpha_c_rad"], positive["I0"])
     virtual_work = {"positive": dict(summary["virtual_work"])}

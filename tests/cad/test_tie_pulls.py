@@ -120,10 +120,19 @@ def test_two_sided_tied_wall_pulls_on_the_outward_swing_only(tmp_path: Path) -> 
         )
     assert tied["eta"] == pytest.approx(plain["eta"], rel=1e-12)
     assert "slack" in tied["geometry"]["loaded"]["negative_side"]
+    assert not any("rocking" in w for w in tied["provenance"]["warnings"])  # it was given
     # The solver rocks each side with its own constants.
     model = to_rocking_model(parse_constants(json.dumps(doc)).mechanisms[0])
     assert model.neg.lam == pytest.approx(ALPHA, rel=1e-9)
     assert model.positive.lam == pytest.approx(pos["lam"], rel=1e-15)
+
+
+def test_a_defaulted_rocking_of_a_tied_wall_is_said(tmp_path: Path) -> None:
+    mech = {k: v for k, v in TIED.items() if k != "rocking"}
+    tied = _constants(tmp_path, mech)["mechanisms"][0]
+    assert tied["rocking"] == "two_sided" and "negative" in tied
+    said = [w for w in tied["provenance"]["warnings"] if w.startswith("T.rocking: not given")]
+    assert len(said) == 1 and "one_sided" in said[0]
 
 
 def test_two_sided_loaded_wall_with_one_sided_elements_is_still_refused(tmp_path: Path) -> None:
