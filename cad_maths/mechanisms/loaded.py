@@ -281,9 +281,10 @@ def _face_point(
     far = max((start, end), key=lambda q: abs(float(np.dot(q - point, side.outward))))
     if float(np.dot(far - point, side.outward)) > 0.0:
         raise GeometryError(
-            f"{where}: the tie-bar runs outward from the façade's outer face; a tie-bar is "
+            f"{where}: the tie-bar runs outward from the façade's outer face (the face "
+            "through the axis), so the positive swing would not stretch it; a tie-bar is "
             "anchored inside the building and pulls the wall towards it: draw it from the "
-            "outer face into the building"
+            "outer face into the building, with the axis on the outer face"
         )
     return point
 

@@ -156,6 +156,15 @@ def test_a_tie_drawn_outward_from_the_face_is_refused(tmp_path: Path) -> None:
     spec = parse_spec(json.dumps({"mechanisms": [TIED]}), "spec.json")
     with pytest.raises(GeometryError, match="runs outward from the façade's outer face"):
         constants_from_spec(spec, scene, scene_name="tied.3dm", spec_name="spec.json")
+    # The axis on the inner face (x = B): the positive swing moves the wall towards the
+    # anchorage, where the bar is slack, so the spec is refused rather than pulled wrongly.
+    inner = BUILD.Builder("inner")
+    inner.box("wall", "Walls", (0, 0, 0), (B, L, H), "brick")
+    inner.line("tie", "Ties", (0, 2, H_T), (6.0, 2, H_T))
+    inner.line("axis", "Axes", (B, 0, 0), (B, L, 0))
+    scene = Scene.from_3dm(inner.write(tmp_path / "inner.3dm"))
+    with pytest.raises(GeometryError, match="the positive swing would not stretch it"):
+        constants_from_spec(spec, scene, scene_name="inner.3dm", spec_name="spec.json")
     with pytest.raises(GeometryError, match="runs outward from W's outer face"):
         building_from_scene(
             read_scene(_scene(tmp_path, tie_to=-3.0)),
