@@ -258,8 +258,8 @@ class TiePoint:
     s, z : float
         The point in the façade's elevation [m].
     pull : (3,) float
-        Horizontal unit vector of its pull on the façade: along the façade's normal, towards
-        the line's end farther from the outer face (its anchorage, inside the building).
+        Horizontal unit vector of its pull on the façade: the façade's inward normal, towards
+        its anchorage inside the building.
     """
 
     index: int
@@ -733,9 +733,10 @@ def _tie_points(
             s, _, z = (float(c) for c in f.to_frame(p))
             if not (-1e-9 <= s <= wall.length + 1e-9 and wall.z_lo - 1e-9 <= z <= wall.z_hi + 1e-9):
                 continue
-            # the bar pulls the façade towards its anchorage, the end farther from the face
-            far = max((start, end), key=lambda q: abs(float((q - p) @ f.e_n)))
-            if float((far - p) @ f.e_n) < 0.0:
+            # the bar pulls the façade towards its anchorage, inside the building (+e_n); a
+            # line with no part on that side is anchored outside. A line through the wall (a
+            # tie across the building meets several walls) keeps the inward pull.
+            if max(float((q - p) @ f.e_n) for q in (start, end)) <= 0.0:
                 raise GeometryError(
                     f"{where}: the tie-bar runs outward from {wall.id}'s outer face; a tie-bar "
                     "is anchored inside the building and pulls the wall towards it: draw it "
