@@ -16,7 +16,9 @@ Added elements and how they enter:
   load-bearing mass and ``H`` an outward static force, both at the springing (the contact
   with the wall).
 * **tie-bars**: a restraining (inward) force where the bar meets the façade's outer face
-  (the vertical plane through the axis).
+  (the vertical plane through the axis), on the outward swing only: a bar pulls while the
+  motion stretches it and goes slack towards its anchorage, so the negative side of a
+  two-sided wall with tie-bars alone is the plain wall's (theory §1.8).
 
 Constants (about ``phi_cr = alpha_c``): ``I0 = I_O + sum M_i R_i²`` (added masses as point
 masses), ``K = M_c g R_c``, ``Q = M_c* R_c* cos(alpha_c* - alpha_c)``,
@@ -39,7 +41,14 @@ from cad_maths.mechanisms.thrust import roof_thrust
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.rules import G
 
-__all__ = ["BEARING_ANGLE", "contact_tolerance", "element_solids", "largest_contact", "loaded_side"]
+__all__ = [
+    "BEARING_ANGLE",
+    "SLACK_TIES",
+    "contact_tolerance",
+    "element_solids",
+    "largest_contact",
+    "loaded_side",
+]
 
 #: A contact whose normal is within this angle of vertical counts as bearing [rad].
 BEARING_ANGLE = math.radians(30.0)
@@ -266,7 +275,18 @@ def _face_point(
     tol = 1e-3 * size / max(float(np.linalg.norm(d)), 1e-12)
     if not -tol <= t <= 1.0 + tol:
         raise GeometryError(f"{where}: the tie-bar does not reach the façade's outer face")
-    return start + t * d
+    point = start + t * d
+    # A tie pulls the wall towards its anchorage, the line's end farther from the face: the
+    # force enters as restraining (inward) only when that end lies inside the building.
+    far = max((start, end), key=lambda q: abs(float(np.dot(q - point, side.outward))))
+    if float(np.dot(far - point, side.outward)) > 0.0:
+        raise GeometryError(
+            f"{where}: the tie-bar runs outward from the façade's outer face (the face "
+            "through the axis), so the positive swing would not stretch it; a tie-bar is "
+            "anchored inside the building and pulls the wall towards it: draw it from the "
+            "outer face into the building, with the axis on the outer face"
+        )
+    return point
 
 
 def _constants(
@@ -350,21 +370,44 @@ def _constants(
     return {"I0": i0, "K": k, "Q": q, "phi_cr": a_c, "M_F": m_f}, summary, notes
 
 
+#: What a two-sided loaded wall's negative side carries (geometry summary, theory §1.8).
+SLACK_TIES = (
+    "the tie-bars go slack when the wall swings towards their anchorage (a bar does not "
+    "push): the negative side is the wall's own, without them"
+)
+
+
 def build_loaded_wall(spec: Any, scene: Any, table: Any) -> MechanismSides:
     """Builder of typology ``single_block_loaded`` (docs/theory.md §2.2).
 
-    Added masses and forces act on one side only, so the wall rocks one-sided.
+    Floors, a roof and vaults act on one side only, so a wall carrying them rocks
+    one-sided. A wall whose only added elements are tie-bars may rock two-sided: a tie
+    pulls only while the motion stretches it (the positive, outward swing), so the negative
+    side is the plain wall's (theory §1.8).
     """
     if spec.rocking == "two_sided":
-        raise InputError(
-            "two-sided rocking of a loaded wall is not supported (added forces act on one "
-            "side); use one_sided",
-            f"{spec.id}.rocking",
-        )
+        one_side = [name for name in ("floors", "roof", "vaults") if getattr(spec, name)]
+        if one_side:
+            raise InputError(
+                "two-sided rocking of a loaded wall is supported with tie-bars only (they go "
+                "slack on the inward swing); its " + ", ".join(one_side) + " act on one side: "
+                "use one_sided",
+                f"{spec.id}.rocking",
+            )
     body, pos, geometry = rigid_body(spec, scene)
     warnings = list(body.warnings)
     positive, summary, notes = loaded_side(spec, scene, body, pos, table)
     warnings.extend(notes)
+    if spec.rocking == "two_sided":
+        summary["negative_side"] = SLACK_TIES
+        if "rocking" not in spec.model_fields_set:
+            # a loaded wall without 'rocking' was refused before tie-bars alone could rock
+            # two-sided: say what the default now makes of it
+            warnings.append(
+                f"{spec.id}.rocking: not given; the wall rocks two-sided (the default), its "
+                "tie-bars pulling on the outward swing only. A façade held on its inner face "
+                "(transverse walls, floors) is one_sided: give 'rocking'"
+            )
     geometry["loaded"] = summary
     inertia = (summary["M_c_kg"], summary["R_c_m"], summary["alpha_c_rad"], positive["I0"])
     virtual_work = {"positive": dict(summary["virtual_work"])}

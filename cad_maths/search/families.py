@@ -35,7 +35,7 @@ from cad_maths.geometry.massprops import mass_properties
 from cad_maths.mechanisms.loaded import BEARING_ANGLE, largest_contact
 from cad_maths.mechanisms.single import find_objects
 from cad_maths.search.model import Building, LevelContact, ReturnWall, TiePoint, Wall
-from cad_maths.search.multiplier import rotation_multiplier, two_block_multiplier
+from cad_maths.search.multiplier import Force, rotation_multiplier, two_block_multiplier
 from cad_maths.search.prism import Lump, clip_rings, point_lump, ring_moments
 from cad_maths.search.refine import minimise
 from shared_schema.errors import InputError
@@ -364,11 +364,15 @@ def level_loads(
 
 def _loads(
     contacts: Sequence[LevelLoad], ties: Sequence[TiePoint], d: np.ndarray
-) -> Tuple[Lump, Lump, List[Tuple[np.ndarray, np.ndarray]]]:
-    """Bearing and abutting masses and static forces of a rigid mechanism."""
+) -> Tuple[Lump, Lump, List[Force], List[Force]]:
+    """Bearing and abutting masses, static forces and tie-bars' pulls of a rigid mechanism.
+
+    A tie pulls its façade towards its anchorage (``TiePoint.pull``); the multiplier counts
+    it only on a motion that stretches it (``rotation_multiplier``'s ``ties``).
+    """
     weighing = Lump.zero()
     abutting = Lump.zero()
-    forces = []
+    forces: List[Force] = []
     for c in contacts:
         lump = point_lump(c.mass, c.point)
         if c.bearing:
@@ -377,9 +381,8 @@ def _loads(
             abutting = abutting + lump
         if c.thrust > 0.0:
             forces.append((c.thrust * d, c.point))
-    for tie in ties:
-        forces.append((-tie.tie.force * d, tie.point))
-    return weighing, abutting, forces
+    pulls: List[Force] = [(tie.tie.force * tie.pull, tie.point) for tie in ties]
+    return weighing, abutting, forces, pulls
 
 
 @dataclass
@@ -448,9 +451,9 @@ class Template:
         loads, held = level_loads(self.bld, variable, self.d, self._fixed_hits)
         if held is not None:
             return math.inf
-        weighing, abutting, forces = _loads(loads, self.ties, self.d)
+        weighing, abutting, forces, pulls = _loads(loads, self.ties, self.d)
         w = body + weighing
-        return rotation_multiplier(w, w + abutting, self.point, self.d, forces)
+        return rotation_multiplier(w, w + abutting, self.point, self.d, forces, pulls)
 
     def refine(
         self, facade: str, direction: str, grid: int, budget: Optional[Budget] = None

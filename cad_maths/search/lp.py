@@ -117,13 +117,16 @@ class LPModel:
     bearing, abutting : list of (block, mass [kg], point)
         Masses whose weight (bearing) or only inertia (abutting) the block carries.
     forces : list of (block, force [N], point)
-        Static forces.
+        Static forces, on any motion (thrusts).
     d : (3,) float
         Load direction.
     facade, direction : str
         What it checks.
     lines : dict
         The candidate lines used (for the output).
+    ties : list of (block, force [N], point)
+        Tie-bars' pulls: tension-only, each doing work only where the motion stretches its
+        bar (moves its point against the pull); slack otherwise.
     """
 
     blocks: List[LPBlock]
@@ -136,6 +139,7 @@ class LPModel:
     facade: str
     direction: str
     lines: Dict[str, Any] = field(default_factory=dict)
+    ties: List[Tuple[int, np.ndarray, np.ndarray]] = field(default_factory=list)
 
 
 @dataclass
@@ -602,7 +606,7 @@ def _load(
     for t in bld.ties.get(wall.id, []):
         b = _strip_of(blocks, ids, t.z, below=False)
         if b is not None:
-            model.forces.append((b, -t.tie.force * d, t.point))
+            model.ties.append((b, t.tie.force * t.pull, t.point))
     n_ob, x_ob, _ = overburden_load(bld, wall, -f.e_n)
     if overburden is not None:
         n_ob, x_ob = overburden[0], -overburden[1]
@@ -848,7 +852,25 @@ def solve_lp(model: LPModel, friction: Optional[float] = None) -> LPResult:
         if size > 0.0 and body[k] >= 0:
             b = body[k]
             cost[6 * b : 6 * b + 6] -= scale * size * _point_map(coms, b, p, f / size) / G
-    a_eq = vstack([eq.matrix(coms, ncol), csr_matrix(norm.reshape(1, -1))]).tocsr()
+    # A tie does work only while stretched: one more unknown t >= 0 per tie with
+    # t >= -pull·v(p), its bar's stretch rate, and T t / g in the cost. At the optimum
+    # t = max(0, stretch), so a slack bar (its point moving towards the anchorage) costs 0.
+    ties = [(body[k], f, p) for k, f, p in model.ties if body[k] >= 0]
+    n_ties = len(ties)
+    eq_rows = eq.matrix(coms, ncol)
+    if n_ties:
+        from scipy.sparse import hstack
+
+        stretch = np.zeros((n_ties, ncol + n_ties))
+        for r, (b, f, p) in enumerate(ties):
+            stretch[r, 6 * b : 6 * b + 6] = -_point_map(coms, b, p, f / float(np.linalg.norm(f)))
+            stretch[r, ncol + r] = -1.0
+        cost = np.concatenate([cost, [scale * float(np.linalg.norm(f)) / G for _, f, _ in ties]])
+        norm = np.concatenate([norm, np.zeros(n_ties)])
+        a_ub = vstack([hstack([a_ub, csr_matrix((a_ub.shape[0], n_ties))]), csr_matrix(stretch)])
+        a_ub = a_ub.tocsr()
+        eq_rows = hstack([eq_rows, csr_matrix((eq_rows.shape[0], n_ties))])
+    a_eq = vstack([eq_rows, csr_matrix(norm.reshape(1, -1))]).tocsr()
     b_eq = np.zeros(a_eq.shape[0])
     b_eq[-1] = 1.0
     n_ub = a_ub.shape[0]
@@ -858,14 +880,23 @@ def solve_lp(model: LPModel, friction: Optional[float] = None) -> LPResult:
         b_ub=np.zeros(n_ub) if n_ub else None,
         A_eq=a_eq,
         b_eq=b_eq,
-        bounds=(None, None),
+        bounds=[(None, None)] * ncol + [(0.0, None)] * n_ties,
         method="highs-ds",
     )
     runtime = time.perf_counter() - t0
     rows = n_ub + a_eq.shape[0]
     if res.status == 2:  # infeasible: no motion does work against the load
         return LPResult(
-            math.inf, "infeasible", [], [], np.zeros((nb, 6)), nb, rows, ncol, runtime, friction
+            math.inf,
+            "infeasible",
+            [],
+            [],
+            np.zeros((nb, 6)),
+            nb,
+            rows,
+            ncol + n_ties,
+            runtime,
+            friction,
         )
     if res.status == 3:
         raise GeometryError(
@@ -874,7 +905,7 @@ def solve_lp(model: LPModel, friction: Optional[float] = None) -> LPResult:
         )
     if res.status != 0:
         raise SolverError(f"{model.facade} {model.direction}: HiGHS: {res.message}")
-    x = np.asarray(res.x, dtype=float).reshape(nbody, 6)
+    x = np.asarray(res.x, dtype=float)[:ncol].reshape(nbody, 6)
     vel = np.zeros((nb, 6))
     for k, blk in enumerate(model.blocks):
         b = body[k]
@@ -884,7 +915,7 @@ def solve_lp(model: LPModel, friction: Optional[float] = None) -> LPResult:
             vel[k, 3:] = th
     moving, bodies = _bodies(model, vel)
     return LPResult(
-        float(res.fun), "optimal", moving, bodies, vel, nb, rows, ncol, runtime, friction
+        float(res.fun), "optimal", moving, bodies, vel, nb, rows, ncol + n_ties, runtime, friction
     )
 
 

@@ -257,6 +257,9 @@ class TiePoint:
         The crossing with the outer face [m].
     s, z : float
         The point in the façade's elevation [m].
+    pull : (3,) float
+        Horizontal unit vector of its pull on the façade: the façade's inward normal, towards
+        its anchorage inside the building.
     """
 
     index: int
@@ -265,6 +268,7 @@ class TiePoint:
     point: np.ndarray
     s: float
     z: float
+    pull: np.ndarray
 
 
 @dataclass
@@ -729,7 +733,16 @@ def _tie_points(
             s, _, z = (float(c) for c in f.to_frame(p))
             if not (-1e-9 <= s <= wall.length + 1e-9 and wall.z_lo - 1e-9 <= z <= wall.z_hi + 1e-9):
                 continue
-            out[wall.id].append(TiePoint(k, tie, wall.id, p, s, z))
+            # the bar pulls the façade towards its anchorage, inside the building (+e_n); a
+            # line with no part on that side is anchored outside. A line through the wall (a
+            # tie across the building meets several walls) keeps the inward pull.
+            if max(float((q - p) @ f.e_n) for q in (start, end)) <= 0.0:
+                raise GeometryError(
+                    f"{where}: the tie-bar runs outward from {wall.id}'s outer face; a tie-bar "
+                    "is anchored inside the building and pulls the wall towards it: draw it "
+                    "from the outer face into the building"
+                )
+            out[wall.id].append(TiePoint(k, tie, wall.id, p, s, z, f.e_n.copy()))
             met = True
         if not met:
             raise GeometryError(f"{where}: the tie-bar meets no wall's outer face")

@@ -7,7 +7,8 @@ rest to the work a unit horizontal load proportional to the masses does on it::
 
 with ``m`` the masses that weigh on the mechanism (blocks, bearing floors), ``m*`` those
 whose inertia it carries (also abutting floors), ``F_k`` the static forces (roof thrust
-outward, tie-bars inward) and ``d`` the horizontal load direction. It is exact for the
+outward on any motion; tie-bars inward, only on a motion that stretches them: a bar does not
+push) and ``d`` the horizontal load direction. It is exact for the
 actual block geometry; the rocking constants' ``lam = (K φ_cr - M_F)/(g Q)`` linearises the
 same mechanism about its critical rotation and differs from λ0 by a few per cent on squat
 blocks (issue #31).
@@ -47,6 +48,7 @@ def rotation_multiplier(
     point: np.ndarray,
     direction: np.ndarray,
     forces: Sequence[Force] = (),
+    ties: Sequence[Force] = (),
 ) -> float:
     """λ0 of a rigid body turning about a horizontal axis, tipping towards ``direction``.
 
@@ -62,7 +64,11 @@ def rotation_multiplier(
     direction : (3,) float
         Horizontal unit direction of the load and of the collapse.
     forces : sequence of (force, point)
-        Static forces [N] and where they act [m].
+        Static forces [N] and where they act [m], on any motion (thrusts).
+    ties : sequence of (force, point)
+        Tension-only forces [N] (tie-bars) and where they act [m]: each counts only where
+        the motion stretches its bar, i.e. moves its point against the force; on a motion
+        towards its anchorage the bar goes slack and carries nothing (a bar does not push).
 
     Returns
     -------
@@ -95,10 +101,14 @@ def rotation_multiplier(
     sx = float(weighing.S[0]) - weighing.mass * px
     sy = float(weighing.S[1]) - weighing.mass * py
     lift = ux * sy - uy * sx
-    for f, at in forces:
+    n_forces = len(forces)
+    for k, (f, at) in enumerate([*forces, *ties]):
         rx, ry, rz = float(at[0]) - px, float(at[1]) - py, float(at[2]) - pz
         vx, vy, vz = uy * rz, -ux * rz, ux * ry - uy * rx
-        lift -= (float(f[0]) * vx + float(f[1]) * vy + float(f[2]) * vz) / G
+        work = float(f[0]) * vx + float(f[1]) * vy + float(f[2]) * vz
+        if k >= n_forces and work >= 0.0:
+            continue  # a tie whose point moves towards its anchorage: slack
+        lift -= work / G
     sway = float(inertial.S[2]) - inertial.mass * pz
     if not sway > 0.0:
         return math.inf

@@ -352,8 +352,12 @@ def _tie_terms(mech: Mechanism, side: SideConstants) -> Optional[dict[str, Any]]
     Each tie pulls the façade inward with its force ``F`` at its point on the outer face:
     it enters ``M_F`` as ``-F (z cos α_c + x sin α_c)`` (theory Eq. 15) and the virtual
     work at rest as ``-F z`` (``alpha0 g S``), ``z`` its height above the axis and ``x`` its
-    distance from the axis towards the centre of mass.
+    distance from the axis towards the centre of mass. None on a negative side: a tie goes
+    slack on the swing towards its anchorage, and the builder leaves it out of that side's
+    constants (theory §1.8), so there is nothing to take out.
     """
+    if mech.negative is not None and side is mech.negative:
+        return None
     geo = mech.geometry or {}
     loaded = geo.get("loaded") if isinstance(geo, dict) else None
     pos = geo.get("positive") if isinstance(geo, dict) else None

@@ -5,8 +5,8 @@ Every reference here is independent of the code under test: hand-worked closed f
 numerical model that moves the blocks' corners, solves the closure with scipy, and takes
 every derivative of the potential energy by finite differences.
 
-``single_block_loaded`` is one-sided only (its two-sided rocking is refused,
-``tests/cad/test_mechanisms.py``), so it has no negative side to test.
+``single_block_loaded`` rocks two-sided only with tie-bars alone, and its negative side is
+then the plain wall's (the bars go slack on that swing): ``tests/cad/test_tie_pulls.py``.
 
 The file's sign convention (``shared_schema.constants``): ``I0``, ``K``, ``Q``, ``phi_cr``,
 ``p_eq``, ``lam`` and ``phi_ov`` are magnitudes on both sides; ``M_F`` is signed in the
