@@ -15,6 +15,7 @@ Python 3.9-clean: imported by Rhino 8.
 """
 
 import json
+import math
 from typing import Any, List, Literal, Optional, Union, cast
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
@@ -52,6 +53,13 @@ SEARCH_VERSIONS = ("1.0",)
 UNIT_MAX_M = 5.0
 #: Largest friction coefficient accepted (no masonry joint is rougher than 2).
 FRICTION_MAX = 2.0
+#: Plausible course height of a masonry unit, with its bed joint [m]: thin bricks and
+#: Roman bricks are about 4 cm, ashlar courses up to about 1 m; below 2 cm the bond angle
+#: atan(l_u / 2 h_u) runs towards 90 degrees and bounds nothing (issue #37).
+UNIT_HEIGHT_PLAUSIBLE = (0.02, 1.0)
+#: Plausible length of a masonry unit along the course [m]: a half brick is about 5 cm, an
+#: ashlar over 2 m is exceptional.
+UNIT_LENGTH_PLAUSIBLE = (0.05, 2.0)
 
 _STRICT = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
 
@@ -355,7 +363,30 @@ class SearchSpec(BaseModel):
             notes.append(quantity_note(lv.density, "density", f"levels[{k}].density"))
         for k, tie in enumerate(self.tie_bars):
             notes.append(quantity_note(tie.force, "force", f"tie_bars[{k}].force"))
+        units = [(f"junctions[{k}].unit", j.unit) for k, j in enumerate(self.junctions)]
+        if self.default_junction is not None:
+            units.append(("default_junction.unit", self.default_junction.unit))
+        for where, unit in units:
+            if unit is not None:
+                notes.extend(_unit_notes(unit, where))
         return [n for n in notes if n is not None]
+
+
+def _unit_notes(unit: Unit, where: str) -> List[str]:
+    """Warnings for a masonry unit of implausible size (each names its field)."""
+    notes = []
+    for name, value, (lo, hi), what in (
+        ("height", unit.height, UNIT_HEIGHT_PLAUSIBLE, "a course (unit and bed joint)"),
+        ("length", unit.length, UNIT_LENGTH_PLAUSIBLE, "a unit along its course"),
+    ):
+        if not lo <= value <= hi:
+            notes.append(
+                f"warning: {where}.{name} = {value:g} m is outside the plausible range "
+                f"[{lo:g}, {hi:g}] m for {what}; the bond angle atan(l_u / 2 h_u) = "
+                f"{math.degrees(math.atan(unit.length / (2.0 * unit.height))):.1f} deg bounds the "
+                "cracks through the return walls: check the unit's size and that it is in metres"
+            )
+    return notes
 
 
 def parse_search_spec(text: Union[str, bytes], source: str = "search spec") -> SearchSpec:

@@ -6,7 +6,7 @@ The wall (the spec's groups) is restrained at top and bottom. In its rocking pla
 * thickness ``b`` and height ``h`` come from the wall's extent (inner face at ``x = -b``);
 * the overburden N is the weight share of the objects bearing on the wall top (acting at the
   centroid of their contact with the wall, which fixes its eccentricity), or a given force
-  (acting on the wall's centre line);
+  (acting on the wall's centre line); ``overburden.xi`` puts it at ``xi b`` from H instead;
 * the intermediate hinge height follows Eq. 17, ``h_c = h / (1 + sqrt((N + f_mt l b) /
   (N + W + f_mt l b)))``, unless the spec gives ``hinge_height`` (the search's minimum of
   the exact λ0), and the wall is cut by the horizontal plane at ``h_c``;
@@ -110,6 +110,8 @@ def two_block_sides(
             meshes, body.meshes, f"{where}.overburden", contact_tolerance(scene)
         )
         x_p = float((point - o) @ out)
+    if ob is not None and ob.xi is not None:
+        x_p = -float(ob.xi) * b  # at xi b from H, on the axis's face (theory §2.3)
     f_mt = float(spec.f_mt or 0.0)
     given = getattr(spec, "hinge_height", None)
     if given is not None:

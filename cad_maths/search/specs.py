@@ -116,7 +116,11 @@ def candidate_spec(bld: Building, cand: Candidate, mech_id: str) -> Dict[str, An
         spec["groups"] = [_group(wall)]
         spec["hinge_height"] = float(cand.params["h1_m"])
         if wall.overburden is not None:
-            spec["overburden"] = wall.overburden.model_dump(exclude_none=True, exclude_unset=True)
+            ob = wall.overburden.model_dump(exclude_none=True, exclude_unset=True)
+            if cand.direction == "inward" and "xi" in ob:
+                # the search's xi is from the outer face, the mechanism's from its own H
+                ob["xi"] = 1.0 - float(ob["xi"])
+            spec["overburden"] = ob
         return spec
     groups = []
     planes: List[Tuple[Plane, List[Any]]] = []
