@@ -35,6 +35,7 @@ __all__ = [
     "SEARCH_VERSION",
     "SEARCH_VERSIONS",
     "Candidates",
+    "FirstMode",
     "Junction",
     "JunctionDefault",
     "Level",
@@ -53,6 +54,9 @@ SEARCH_VERSIONS = ("1.0",)
 UNIT_MAX_M = 5.0
 #: Largest friction coefficient accepted (no masonry joint is rougher than 2).
 FRICTION_MAX = 2.0
+#: Highest first-mode frequency of a building accepted [Hz] (a one-storey masonry
+#: building is about 10-20 Hz).
+FIRST_MODE_F_MAX = 100.0
 #: Plausible course height of a masonry unit, with its bed joint [m]: thin bricks and
 #: Roman bricks are about 4 cm, ashlar courses up to about 1 m; below 2 cm the bond angle
 #: atan(l_u / 2 h_u) runs towards 90 degrees and bounds nothing (issue #37).
@@ -275,6 +279,25 @@ class Ranking(BaseModel):
         return band
 
 
+class FirstMode(BaseModel):
+    """The building's first mode, for ranking each mechanism where it sits (theory §7).
+
+    Attributes
+    ----------
+    f_n : float
+        Natural frequency of the building's first mode [Hz].
+    h_e : float
+        Its effective (modal) height, ``sum(m h²)/sum(m h)`` [m].
+
+    Without it the site's ``building`` gives them (``T1``, or Circolare 2019 [C7.3.2] from
+    its height; ``h_e = H (2n + 1)/(3n)``, the linear first mode of ``n`` equal storeys).
+    """
+
+    model_config = _STRICT
+    f_n: float = Field(gt=0, le=FIRST_MODE_F_MAX, description="First-mode frequency [Hz].")
+    h_e: float = Field(gt=0, le=UNIT_MAX_M * 100, description="Effective (modal) height [m].")
+
+
 class SearchSpec(BaseModel):
     """A search spec file (see the module docstring).
 
@@ -298,6 +321,9 @@ class SearchSpec(BaseModel):
         Friction coefficient of the joints, for the sliding check [-].
     candidates, ranking
         Sampling and ranking options.
+    first_mode : FirstMode, optional
+        The building's first mode (f_n, h_e) for the mechanisms above ground (default: from
+        the site's ``building``).
     lp : bool
         Run the global upper-bound check (a linear programme over all candidate lines).
     """
@@ -315,6 +341,9 @@ class SearchSpec(BaseModel):
     friction: float = Field(default=0.6, gt=0, le=FRICTION_MAX, description="Joint friction [-].")
     candidates: Candidates = Field(default_factory=Candidates)
     ranking: Ranking = Field(default_factory=Ranking)
+    first_mode: Optional[FirstMode] = Field(
+        default=None, description="The building's first mode (f_n [Hz], h_e [m])."
+    )
     lp: bool = Field(default=True, description="Run the global upper-bound check.")
 
     @field_validator("search_version")

@@ -47,6 +47,7 @@ __all__ = [
     "Piece",
     "WorkEstimate",
     "enumerate_candidates",
+    "ground_height",
     "hinge_lines",
     "work_estimate",
 ]
@@ -191,6 +192,11 @@ class Candidate:
         Parameters whose optimum lies on a bound.
     notes : list of str
         What the candidate assumes.
+    hinge_z : float
+        Height of the base of the moving part (the hinge line; a two-block wall's or a
+        corner's base) in the scene [m].
+    z_base : float
+        Z: that height above the ground (``ground_height``) [m], 0 at ground level.
     """
 
     family: str
@@ -212,6 +218,7 @@ class Candidate:
     on_bound: List[str] = field(default_factory=list)
     notes: List[str] = field(default_factory=list)
     hinge_z: float = 0.0
+    z_base: float = 0.0
 
     @property
     def key(self) -> Tuple[Any, ...]:
@@ -231,6 +238,15 @@ class Candidate:
 
 def _tol(bld: Building) -> float:
     return HEIGHT_RTOL * max(bld.size, 1.0)
+
+
+def ground_height(bld: Building) -> float:
+    """Height of the ground [m]: the lowest base of the scene's walls.
+
+    Z of a mechanism (the height of the base of its moving part, theory §7.2 and §11.5) is
+    measured from it.
+    """
+    return min(w.z_lo for w in bld.walls.values())
 
 
 def hinge_lines(bld: Building, wall: Wall, spacing: Optional[float] = None) -> List[float]:
@@ -1041,6 +1057,10 @@ def enumerate_candidates(
             out.extend(_flexure_candidates(bld, wall, grid, notes, budget))
         if "corner" in spec.families and "outward" in spec.directions:
             out.extend(_corner_candidates(bld, wall, grid, notes, budget))
+    ground = ground_height(bld)
+    for c in out:
+        z = c.hinge_z - ground
+        c.z_base = z if z > _tol(bld) * 1e3 else 0.0
     seen = set()
     unique = []
     for c in out:
