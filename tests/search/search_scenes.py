@@ -26,12 +26,19 @@ EXAMPLE_SPEC = REPO / "examples" / "specs" / "search_facade.search.json"
 
 
 def two_block_wall(
-    out: Path, b: float = 0.3, h: float = 3.0, length: float = 1.0, name: str = "tb"
+    out: Path,
+    b: float = 0.3,
+    h: float = 3.0,
+    length: float = 1.0,
+    name: str = "tb",
+    slab_side: float = 1.0,
 ) -> Path:
-    """A wall x in [0, b] (outer face x = 0), y in [0, length], z in [0, h], a slab on top."""
+    """A wall x in [0, b], y in [0, length], z in [0, h], a slab on top running into +x
+    (outer face x = 0), or into -x with ``slab_side = -1`` (outer face x = b)."""
     bld = BUILD.Builder(name)
     bld.box("wall", "Walls", (0.0, 0.0, 0.0), (b, length, h), "brick")
-    bld.box("slab", "Floors", (0.0, 0.0, h), (3.0, length, h + 0.2), "concrete")
+    x0, x1 = (0.0, 3.0) if slab_side > 0 else (b - 3.0, b)
+    bld.box("slab", "Floors", (x0, 0.0, h), (x1, length, h + 0.2), "concrete")
     return bld.write(out / f"{name}.3dm")
 
 

@@ -121,6 +121,18 @@ def test_v1_without_overburden_the_limit_2b_over_h_is_named_and_not_reached(
         assert f"{2.0 * B / H:.6g}" in note  # the limit 2b/h, which it does not reach
 
 
+def test_v1_a_lone_walls_outward_side_is_away_from_the_slab_it_carries(tmp_path: Path) -> None:
+    """Issue #37: drawn with its slab on the -x side, the wall collapsed towards it."""
+    path = two_block_wall(tmp_path, B, H, L, name="mirrored", slab_side=-1.0)
+    docs = _flexure(path, {"force": W, "xi": 0.0})
+    out = docs["outward"]
+    assert out["direction_vector"] == pytest.approx([1.0, 0.0, 0.0], abs=1e-15)
+    h1, lam = closed_form_v1(W, 1.0)  # N at the outward top hinge, on the face x = b
+    assert out["lam0"] == pytest.approx(lam, rel=1e-12)
+    assert out["parameters"]["h1_m"] == pytest.approx(h1, rel=1e-9)
+    assert out["builder"]["agrees"]
+
+
 def test_v1_enumerated_candidates_carry_both_sides(scene_path: Path) -> None:
     spec = SearchSpec.model_validate(
         {
