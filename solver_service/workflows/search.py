@@ -134,7 +134,9 @@ Z_RULE = (
 NO_BUILDING_DATA = (
     "no building data (no building in the site file, no first_mode in the search spec): "
     "every mechanism is ranked on the ground motion, as if it stood on the ground, "
-    "including those above it; the code check of a mechanism above ground is incomplete"
+    "including those above it; the code check of a mechanism above ground is incomplete; "
+    "the constants written carry no height (amplification needs f_n and h_e), so "
+    "`rockmech check` on them takes every mechanism at ground level"
 )
 
 
