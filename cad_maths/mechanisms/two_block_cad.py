@@ -91,7 +91,7 @@ def two_block_sides(
     weight = float(body.props.mass) * G
     ob = spec.overburden
     n = 0.0
-    x_p = -0.5 * b  # a given force acts on the wall's centre line
+    x_p = -(0.5 if ob is None or ob.xi is None else float(ob.xi)) * b  # xi b from H, §2.3
     overburden_ids: List[str] = []
     notes: List[str] = []
     if ob is not None and ob.force is not None:
@@ -109,9 +109,7 @@ def two_block_sides(
         _, point, _ = largest_contact(
             meshes, body.meshes, f"{where}.overburden", contact_tolerance(scene)
         )
-        x_p = float((point - o) @ out)
-    if ob is not None and ob.xi is not None:
-        x_p = -float(ob.xi) * b  # at xi b from H, on the axis's face (theory §2.3)
+        x_p = float((point - o) @ out) if ob.xi is None else x_p  # else xi b from H
     f_mt = float(spec.f_mt or 0.0)
     given = getattr(spec, "hinge_height", None)
     if given is not None:
