@@ -15,6 +15,7 @@ Python 3.9-clean: imported by Rhino 8.
 """
 
 import json
+import math
 from typing import Any, List, Literal, Optional, Union, cast
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
@@ -36,6 +37,7 @@ __all__ = [
     "SEARCH_VERSION",
     "SEARCH_VERSIONS",
     "Candidates",
+    "FirstMode",
     "Junction",
     "JunctionDefault",
     "Level",
@@ -54,6 +56,16 @@ SEARCH_VERSIONS = ("1.0",)
 UNIT_MAX_M = 5.0
 #: Largest friction coefficient accepted (no masonry joint is rougher than 2).
 FRICTION_MAX = 2.0
+#: Highest first-mode frequency of a building accepted [Hz] (a one-storey masonry
+#: building is about 10-20 Hz).
+FIRST_MODE_F_MAX = 100.0
+#: Plausible course height of a masonry unit, with its bed joint [m]: thin bricks and
+#: Roman bricks are about 4 cm, ashlar courses up to about 1 m; below 2 cm the bond angle
+#: atan(l_u / 2 h_u) runs towards 90 degrees and bounds nothing (issue #37).
+UNIT_HEIGHT_PLAUSIBLE = (0.02, 1.0)
+#: Plausible length of a masonry unit along the course [m]: a half brick is about 5 cm, an
+#: ashlar over 2 m is exceptional.
+UNIT_LENGTH_PLAUSIBLE = (0.05, 2.0)
 
 _STRICT = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
 
@@ -269,6 +281,25 @@ class Ranking(BaseModel):
         return band
 
 
+class FirstMode(BaseModel):
+    """The building's first mode, for ranking each mechanism where it sits (theory §7).
+
+    Attributes
+    ----------
+    f_n : float
+        Natural frequency of the building's first mode [Hz].
+    h_e : float
+        Its effective (modal) height, ``sum(m h²)/sum(m h)`` [m].
+
+    Without it the site's ``building`` gives them (``T1``, or Circolare 2019 [C7.3.2] from
+    its height; ``h_e = H (2n + 1)/(3n)``, the linear first mode of ``n`` equal storeys).
+    """
+
+    model_config = _STRICT
+    f_n: float = Field(gt=0, le=FIRST_MODE_F_MAX, description="First-mode frequency [Hz].")
+    h_e: float = Field(gt=0, le=UNIT_MAX_M * 100, description="Effective (modal) height [m].")
+
+
 class SearchSpec(BaseModel):
     """A search spec file (see the module docstring).
 
@@ -292,6 +323,9 @@ class SearchSpec(BaseModel):
         Friction coefficient of the joints, for the sliding check [-].
     candidates, ranking
         Sampling and ranking options.
+    first_mode : FirstMode, optional
+        The building's first mode (f_n, h_e) for the mechanisms above ground (default: from
+        the site's ``building``).
     lp : bool
         Run the global upper-bound check (a linear programme over all candidate lines).
     """
@@ -309,6 +343,9 @@ class SearchSpec(BaseModel):
     friction: float = Field(default=0.6, gt=0, le=FRICTION_MAX, description="Joint friction [-].")
     candidates: Candidates = Field(default_factory=Candidates)
     ranking: Ranking = Field(default_factory=Ranking)
+    first_mode: Optional[FirstMode] = Field(
+        default=None, description="The building's first mode (f_n [Hz], h_e [m])."
+    )
     lp: bool = Field(default=True, description="Run the global upper-bound check.")
 
     @field_validator("search_version")
@@ -357,11 +394,34 @@ class SearchSpec(BaseModel):
             notes.append(quantity_note(lv.density, "density", f"levels[{k}].density"))
         for k, tie in enumerate(self.tie_bars):
             notes.append(quantity_note(tie.force, "force", f"tie_bars[{k}].force"))
+        units = [(f"junctions[{k}].unit", j.unit) for k, j in enumerate(self.junctions)]
+        if self.default_junction is not None:
+            units.append(("default_junction.unit", self.default_junction.unit))
+        for where, unit in units:
+            if unit is not None:
+                notes.extend(_unit_notes(unit, where))
         return [n for n in notes if n is not None]
 
 
 #: What a search spec must be, for the messages on empty, binary or non-UTF-8 files.
 SEARCH_SPEC_EXPECTED = 'a search spec (JSON, {"walls": [...], "levels": [...], ...})'
+
+
+def _unit_notes(unit: Unit, where: str) -> List[str]:
+    """Warnings for a masonry unit of implausible size (each names its field)."""
+    notes = []
+    for name, value, (lo, hi), what in (
+        ("height", unit.height, UNIT_HEIGHT_PLAUSIBLE, "a course (unit and bed joint)"),
+        ("length", unit.length, UNIT_LENGTH_PLAUSIBLE, "a unit along its course"),
+    ):
+        if not lo <= value <= hi:
+            notes.append(
+                f"warning: {where}.{name} = {value:g} m is outside the plausible range "
+                f"[{lo:g}, {hi:g}] m for {what}; the bond angle atan(l_u / 2 h_u) = "
+                f"{math.degrees(math.atan(unit.length / (2.0 * unit.height))):.1f} deg bounds the "
+                "cracks through the return walls: check the unit's size and that it is in metres"
+            )
+    return notes
 
 
 def parse_search_spec(text: Union[str, bytes], source: str = "search spec") -> SearchSpec:

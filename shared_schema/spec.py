@@ -312,7 +312,10 @@ class Overburden(_Weighed):
 
     With ``objects``, N is ``tributary`` times their weight; ``tributary`` defaults to 0.5
     (a slab spanning between the wall and one parallel support), and the output says when
-    that default was used.
+    that default was used. ``xi`` places N at ``xi b`` from the top hinge H of the positive
+    side (theory §2.3; a search spec measures it from the wall's outer face); without it a
+    force acts on the wall's centre line (``xi = 0.5``) and objects at the centroid of their
+    contact with the wall's top.
     """
 
     objects: Optional[List[Selector]] = Field(default=None, min_length=1)
@@ -321,6 +324,14 @@ class Overburden(_Weighed):
         default=TRIBUTARY_DEFAULT, gt=0, le=1, description="Share carried by the wall."
     )
     force: Optional[float] = Field(default=None, ge=0, description="Given overburden N [N].")
+    xi: Optional[float] = Field(
+        default=None,
+        ge=0,
+        le=1,
+        description="Where N acts: at xi b from the top hinge H of the positive side (theory "
+        "2.3; in a search spec, from the wall's outer face), b the thickness; default: the "
+        "centre line for a force, the objects' contact for objects.",
+    )
 
     @field_validator("force")
     @classmethod

@@ -6,7 +6,7 @@ The wall (the spec's groups) is restrained at top and bottom. In its rocking pla
 * thickness ``b`` and height ``h`` come from the wall's extent (inner face at ``x = -b``);
 * the overburden N is the weight share of the objects bearing on the wall top (acting at the
   centroid of their contact with the wall, which fixes its eccentricity), or a given force
-  (acting on the wall's centre line);
+  (acting on the wall's centre line); ``overburden.xi`` puts it at ``xi b`` from H instead;
 * the intermediate hinge height follows Eq. 17, ``h_c = h / (1 + sqrt((N + f_mt l b) /
   (N + W + f_mt l b)))``, unless the spec gives ``hinge_height`` (the search's minimum of
   the exact λ0), and the wall is cut by the horizontal plane at ``h_c``;
@@ -91,7 +91,7 @@ def two_block_sides(
     weight = float(body.props.mass) * G
     ob = spec.overburden
     n = 0.0
-    x_p = -0.5 * b  # a given force acts on the wall's centre line
+    x_p = -(0.5 if ob is None or ob.xi is None else float(ob.xi)) * b  # xi b from H, §2.3
     overburden_ids: List[str] = []
     notes: List[str] = []
     if ob is not None and ob.force is not None:
@@ -109,7 +109,7 @@ def two_block_sides(
         _, point, _ = largest_contact(
             meshes, body.meshes, f"{where}.overburden", contact_tolerance(scene)
         )
-        x_p = float((point - o) @ out)
+        x_p = float((point - o) @ out) if ob.xi is None else x_p  # else xi b from H
     f_mt = float(spec.f_mt or 0.0)
     given = getattr(spec, "hinge_height", None)
     if given is not None:

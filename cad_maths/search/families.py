@@ -41,7 +41,16 @@ from cad_maths.search.refine import minimise
 from shared_schema.errors import InputError
 from shared_schema.rules import G
 
-__all__ = ["Budget", "Candidate", "Piece", "enumerate_candidates", "hinge_lines"]
+__all__ = [
+    "Budget",
+    "Candidate",
+    "Piece",
+    "WorkEstimate",
+    "enumerate_candidates",
+    "ground_height",
+    "hinge_lines",
+    "work_estimate",
+]
 
 Plane = Tuple[np.ndarray, np.ndarray]  # (point [m], normal): keeps normal·(x - point) >= 0
 
@@ -53,6 +62,13 @@ BETA_MAX = math.radians(80.0)
 H1_RANGE = (0.02, 0.98)
 #: A block lighter than this fraction of its wall is no block (a sliver at an edge).
 MIN_MASS_FRACTION = 1e-9
+#: Where a given overburden force acts without ``xi``: on the wall's centre line, as a
+#: fraction of the thickness from the outer face (theory §2.3: the resultant at rest of a
+#: load spread over the whole top; the builder's rule for a force).
+OVERBURDEN_XI_DEFAULT = 0.5
+#: The limit of a two-block wall's λ0 as its hinge reaches the top is evaluated this close
+#: to it (as a fraction of the wall's height) to report it where the search stops short.
+H1_LIMIT_GAP = 1e-6
 
 
 class Budget:
@@ -176,6 +192,11 @@ class Candidate:
         Parameters whose optimum lies on a bound.
     notes : list of str
         What the candidate assumes.
+    hinge_z : float
+        Height of the base of the moving part (the hinge line; a two-block wall's or a
+        corner's base) in the scene [m].
+    z_base : float
+        Z: that height above the ground (``ground_height``) [m], 0 at ground level.
     """
 
     family: str
@@ -197,6 +218,7 @@ class Candidate:
     on_bound: List[str] = field(default_factory=list)
     notes: List[str] = field(default_factory=list)
     hinge_z: float = 0.0
+    z_base: float = 0.0
 
     @property
     def key(self) -> Tuple[Any, ...]:
@@ -216,6 +238,15 @@ class Candidate:
 
 def _tol(bld: Building) -> float:
     return HEIGHT_RTOL * max(bld.size, 1.0)
+
+
+def ground_height(bld: Building) -> float:
+    """Height of the ground [m]: the lowest base of the scene's walls.
+
+    Z of a mechanism (the height of the base of its moving part, theory §7.2 and §11.5) is
+    measured from it.
+    """
+    return min(w.z_lo for w in bld.walls.values())
 
 
 def hinge_lines(bld: Building, wall: Wall, spacing: Optional[float] = None) -> List[float]:
@@ -518,6 +549,59 @@ def _label(bld: Building, wall: Wall, z_h: float, wedges: bool, tol: float) -> s
     return "partial_overturning"
 
 
+@dataclass
+class _Plan:
+    """What a hinge line admits before any λ0 is evaluated (``_overturning_plan``)."""
+
+    why: str
+    family: str = ""
+    planes: List[Plane] = field(default_factory=list)
+    cut: Optional[Plane] = None
+    params: List[Tuple[str, ReturnWall, float, float]] = field(default_factory=list)
+    ties: List[TiePoint] = field(default_factory=list)
+
+    @property
+    def seeds(self) -> int:
+        """Exponent of the seed grid: the parameters whose range is not a point."""
+        return sum(1 for _, _, lo, hi in self.params if hi > lo)
+
+
+def _overturning_plan(bld: Building, wall: Wall, direction: str, z_h: float) -> _Plan:
+    """Admissibility, family, cut and wedge parameters of the overturning above ``z_h``."""
+    tol = _tol(bld) * 1e3
+    free = bld.free_standing(wall.id)
+    if direction == "inward" and not free:
+        return _Plan("the building (return walls, levels or ties) holds the wall's inner face")
+    f = wall.frame
+    returns = bld.returns.get(wall.id, []) if direction == "outward" else []
+    contacts = [c for c in bld.contacts.get(wall.id, []) if c.point[2] > z_h + tol]
+    tied = [c for c in contacts if c.level.tied]
+    if tied:
+        return _Plan(
+            f"the tied level {tied[0].level.id} holds the wall at z = {tied[0].point[2]:.3f} m"
+        )
+    held = [r.wall.id for r in returns if r.connection == "tied"]
+    if held:
+        return _Plan(f"the tied junction with {held[0]} holds the façade")
+    ties = [t for t in bld.ties.get(wall.id, []) if t.z > z_h + tol]
+    cut = _above(f.origin, z_h)
+    planes = [cut] if z_h > wall.z_lo + tol else []
+    if _region_mass(wall, planes) <= MIN_MASS_FRACTION * wall.mass:
+        return _Plan("nothing of the wall lies above the hinge line")
+    params: List[Tuple[str, ReturnWall, float, float]] = []
+    for r in returns:
+        if r.connection != "good":
+            continue
+        if _region_mass(r.wall, [cut]) <= MIN_MASS_FRACTION * r.wall.mass:
+            continue  # the return wall stops below the hinge line
+        dz = max(r.wall.z_hi - z_h, tol)
+        hi = min(max(r.beta_bond, math.atan(r.reach / dz)), BETA_MAX)
+        lo = min(r.beta_bond, hi)
+        params.append((f"beta_{r.end}_rad", r, lo, hi))
+    family = _label(bld, wall, z_h, bool(params), tol)
+    return _Plan("", family, planes, cut, params, ties)
+
+
 def overturning_template(
     bld: Building, wall: Wall, direction: str, z_h: float
 ) -> Tuple[Optional[Template], str]:
@@ -541,38 +625,13 @@ def overturning_template(
     why : str
         Why not (empty when admissible).
     """
-    tol = _tol(bld) * 1e3
-    free = bld.free_standing(wall.id)
-    if direction == "inward" and not free:
-        return None, "the building (return walls, levels or ties) holds the wall's inner face"
+    plan = _overturning_plan(bld, wall, direction, z_h)
+    if plan.why:
+        return None, plan.why
+    assert plan.cut is not None
+    cut, params = plan.cut, plan.params
     d, n_face = _direction(wall, direction)
     f = wall.frame
-    returns = bld.returns.get(wall.id, []) if direction == "outward" else []
-    contacts = [c for c in bld.contacts.get(wall.id, []) if c.point[2] > z_h + tol]
-    tied = [c for c in contacts if c.level.tied]
-    if tied:
-        return None, (
-            f"the tied level {tied[0].level.id} holds the wall at z = {tied[0].point[2]:.3f} m"
-        )
-    held = [r.wall.id for r in returns if r.connection == "tied"]
-    if held:
-        return None, f"the tied junction with {held[0]} holds the façade"
-    ties = [t for t in bld.ties.get(wall.id, []) if t.z > z_h + tol]
-    cut = _above(f.origin, z_h)
-    planes = [cut] if z_h > wall.z_lo + tol else []
-    if _region_mass(wall, planes) <= MIN_MASS_FRACTION * wall.mass:
-        return None, "nothing of the wall lies above the hinge line"
-    params: List[Tuple[str, ReturnWall, float, float]] = []
-    for r in returns:
-        if r.connection != "good":
-            continue
-        if _region_mass(r.wall, [cut]) <= MIN_MASS_FRACTION * r.wall.mass:
-            continue  # the return wall stops below the hinge line
-        dz = max(r.wall.z_hi - z_h, tol)
-        hi = min(max(r.beta_bond, math.atan(r.reach / dz)), BETA_MAX)
-        lo = min(r.beta_bond, hi)
-        params.append((f"beta_{r.end}_rad", r, lo, hi))
-    family = _label(bld, wall, z_h, bool(params), tol)
 
     def variable(x: Sequence[float]) -> List[Piece]:
         return [
@@ -581,18 +640,18 @@ def overturning_template(
 
     point = f.to_world(0.0, n_face, z_h)
     axis = np.array([point, f.to_world(wall.length, n_face, z_h)])
-    rocking = "two_sided" if free else "one_sided"
+    rocking = "two_sided" if bld.free_standing(wall.id) else "one_sided"
     tmpl = Template(
-        family,
+        plan.family,
         rocking,
         [p[0] for p in params],
         [(p[2], p[3]) for p in params],
-        [Piece(wall, planes)],
+        [Piece(wall, plan.planes)],
         variable,
         point,
         d,
         bld,
-        ties,
+        plan.ties,
         axis,
         z_h,
     )
@@ -626,24 +685,40 @@ def _rigid_candidates(
 
 
 def overburden_load(bld: Building, wall: Wall, d: np.ndarray) -> Tuple[float, float, List[str]]:
-    """N [N] on the wall's top and its position x [m] along ``d`` from the outer face."""
+    """N [N] on the wall's top and its position x [m] along ``d`` from the outer face.
+
+    Where N acts (theory §2.3): at ``xi b`` from the outer face where the overburden gives
+    ``xi``; else on the wall's centre line for a force (``OVERBURDEN_XI_DEFAULT``), at the
+    centroid of the objects' contact with the wall's top for objects (as the builder).
+    """
     ob = wall.overburden
     b = wall.frame.thickness
     if ob is None:
-        return 0.0, -0.5 * b, []
+        return 0.0, -OVERBURDEN_XI_DEFAULT * b, []
+    xi = getattr(ob, "xi", None)
+    notes: List[str] = []
     if ob.force is not None:
-        return float(ob.force), -0.5 * b, []
+        n = float(ob.force)
+        if xi is None:
+            notes.append(
+                f"{wall.id}.overburden.xi not given: N acts on the wall's centre line "
+                f"(xi = {OVERBURDEN_XI_DEFAULT:g}, the resultant of a load spread over the "
+                "whole top at rest; theory §2.3)"
+            )
+            return n, -OVERBURDEN_XI_DEFAULT * b, notes
+        return n, -float(xi) * b, notes
     objs = find_objects(bld.scene, ob.objects, f"{wall.id}.overburden")
     meshes = [bld.scene.mesh(o) for o in objs]
     n = ob.tributary * G * sum(mass_properties(m, ob.density).mass for m in meshes)
-    _, point, _ = largest_contact(meshes, [wall.mesh], f"{wall.id}.overburden", 1e-6)
-    x = float((np.asarray(point) - wall.frame.origin) @ d)
-    notes = []
     if "tributary" not in ob.model_fields_set:
         notes.append(
             f"{wall.id}.overburden: tributary not given; the wall carries the default "
             f"{ob.tributary:g} of the overburden's weight (N = {n:.6g} N)"
         )
+    if xi is not None:
+        return n, -float(xi) * b, notes
+    _, point, _ = largest_contact(meshes, [wall.mesh], f"{wall.id}.overburden", 1e-6)
+    x = float((np.asarray(point) - wall.frame.origin) @ d)
     return n, x, notes
 
 
@@ -684,61 +759,118 @@ def two_block_lam(
     return two_block_multiplier(planar(lo), planar(up), (0.0, 0.0), (-b, h1), (0.0, h), n, (x_p, h))
 
 
-def _flexure_candidates(
-    bld: Building, wall: Wall, grid: int, notes: List[str], budget: Budget
-) -> List[Candidate]:
+def _flexure_top(bld: Building, wall: Wall) -> Tuple[Optional[LevelContact], str]:
+    """Return the tied level that holds a wall's top for vertical flexure, or why none.
+
+    Returns
+    -------
+    top : LevelContact or None
+        The tied level at the wall's top (None: no two-block wall).
+    why : str
+        Why the family is not searched although a tied level holds the top (levels or
+        tie-bars load the wall between its restraints); empty otherwise.
+    """
     tol = _tol(bld) * 1e3
     contacts = bld.contacts.get(wall.id, [])
     top = [c for c in contacts if c.level.tied and c.z_range[1] >= wall.z_hi - tol]
     if not top:
-        return []
+        return None, ""
     others = [c for c in contacts if c not in top]
     if others or bld.ties.get(wall.id):
         ties = [f"tie_bars[{t.index}]" for t in bld.ties.get(wall.id, [])]
         what = ", ".join([c.level.id for c in others] + ties)
-        notes.append(
+        return None, (
             f"{wall.id} vertical_flexure: not searched, {what} load the wall between its "
             "restraints and the two-block wall carries only its overburden"
         )
+    return top[0], ""
+
+
+def _flexure_candidates(
+    bld: Building, wall: Wall, grid: int, notes: List[str], budget: Budget
+) -> List[Candidate]:
+    """Refine the two-block wall of a façade, each side asked for over its own h1.
+
+    The outward side turns about the outer face's base edge (hinges O, C, H of theory
+    §2.3 on the outer, inner, outer face), the inward side about the inner one (mirrored);
+    each is refined on its own hinge height, and its ``lam0_negative`` is the other side at
+    that height (what the builder computes for the mechanism's negative side).
+    """
+    top, why = _flexure_top(bld, wall)
+    if why:
+        notes.append(why)
+    if top is None:
         return []
-    d = -wall.frame.e_n
+    f = wall.frame
+    d = -f.e_n
     n, x_n, ob_notes = overburden_load(bld, wall, d)
+    b = f.thickness
     h = wall.z_hi - wall.z_lo
     bounds = (H1_RANGE[0] * h, H1_RANGE[1] * h)
-    budget.reserve(grid, f"{wall.id} vertical_flexure")
-    res = minimise(lambda x: two_block_lam(wall, x[0], d, n, x_n), [bounds], grid)
-    budget.spend(res.n_evaluations)
-    if not math.isfinite(res.value):
-        return []
-    h1 = res.x[0]
-    lam_neg = two_block_lam(wall, h1, d, n, x_n, mirrored=True)
-    f = wall.frame
-    axis = np.array([f.to_world(0.0, 0.0, wall.z_lo), f.to_world(wall.length, 0.0, wall.z_lo)])
-    cand = Candidate(
-        "vertical_flexure",
-        wall.id,
-        "outward",
-        "two_block",
-        "two_sided",
-        {"h1_m": h1},
-        {"h1_m": bounds},
-        [Piece(wall, [])],
-        axis,
-        d,
-        res.value,
-        overburden={"N": n, "x": x_n},
-        lam0_negative=lam_neg,
-        n_evaluations=res.n_evaluations,
-        on_bound=["h1_m"] if res.on_bound[0] else [],
-        notes=[
+    out: List[Candidate] = []
+    for direction in bld.spec.directions:
+        inward = direction == "inward"
+
+        def lam(x: Sequence[float], inward: bool = inward) -> float:
+            return two_block_lam(wall, x[0], d, n, x_n, mirrored=inward)
+
+        budget.reserve(grid, f"{wall.id} {direction} vertical_flexure")
+        res = minimise(lam, [bounds], grid)
+        budget.spend(res.n_evaluations)
+        if not math.isfinite(res.value):
+            continue
+        h1 = res.x[0]
+        face = wall.inner_face if inward else 0.0
+        axis = np.array(
+            [f.to_world(0.0, face, wall.z_lo), f.to_world(wall.length, face, wall.z_lo)]
+        )
+        cand_notes = [
             *ob_notes,
-            f"{wall.id}: held at the top by {top[0].level.id}; the two-block wall spans "
+            f"{wall.id}: held at the top by {top.level.id}; the two-block wall spans "
             "between the ground and that level (its return walls' restraint of the strip's "
             "edges is not counted)",
-        ],
-        hinge_z=wall.z_lo,
-    )
-    return [cand]
+        ]
+        if res.on_bound[0] and h1 >= bounds[1]:
+            limit = lam([h * (1.0 - H1_LIMIT_GAP)])
+            cand_notes.append(
+                f"{wall.id} {direction} vertical_flexure: λ0 falls as the hinge rises (N = "
+                f"{n:.6g} N at {-x_n / b if not inward else 1.0 + x_n / b:.3g} b from this "
+                f"side's top hinge); the search stops at h1 = {H1_RANGE[1]:g} h = {h1:.6g} m "
+                f"(λ0 = {res.value:.6g}), {100.0 * (res.value / limit - 1.0):.3g} % above the "
+                f"limit {limit:.6g} as h1 → h, which no mechanism reaches: there the middle "
+                "hinge C meets the restrained top hinge H and the strip locks (theory §2.3)"
+            )
+        out.append(
+            Candidate(
+                "vertical_flexure",
+                wall.id,
+                direction,
+                "two_block",
+                "two_sided",
+                {"h1_m": h1},
+                {"h1_m": bounds},
+                [Piece(wall, [])],
+                axis,
+                f.e_n.copy() if inward else d,
+                res.value,
+                overburden={"N": n, "x": x_n, "xi": -x_n / b},
+                lam0_negative=two_block_lam(wall, h1, d, n, x_n, mirrored=not inward),
+                n_evaluations=res.n_evaluations,
+                on_bound=["h1_m"] if res.on_bound[0] else [],
+                notes=cand_notes,
+                hinge_z=wall.z_lo,
+            )
+        )
+    return out
+
+
+def _corner_bounds(wall: Wall, r: ReturnWall) -> List[Tuple[float, float]]:
+    """Ranges of the corner's two crack angles [rad]: from the bond limit to the far edges."""
+    h = wall.z_hi - wall.z_lo
+    hi_a = min(max(r.beta_bond, math.atan(wall.length / h)), BETA_MAX)
+    dz = max(r.wall.z_hi - wall.z_lo, 1e-9)
+    hi_b = min(max(r.beta_bond, math.atan(r.reach / dz)), BETA_MAX)
+    return [(min(r.beta_bond, hi_a), hi_a), (min(r.beta_bond, hi_b), hi_b)]
 
 
 def _corner_candidates(
@@ -760,11 +892,7 @@ def _corner_candidates(
         d = d / float(np.linalg.norm(d))
         s_corner = min(0.0, r.span[0]) if r.end == "start" else max(wall.length, r.span[1])
         point = f.to_world(s_corner, 0.0, wall.z_lo)
-        h = wall.z_hi - wall.z_lo
-        hi_a = min(max(r.beta_bond, math.atan(wall.length / h)), BETA_MAX)
-        dz = max(r.wall.z_hi - wall.z_lo, 1e-9)
-        hi_b = min(max(r.beta_bond, math.atan(r.reach / dz)), BETA_MAX)
-        bounds = [(min(r.beta_bond, hi_a), hi_a), (min(r.beta_bond, hi_b), hi_b)]
+        bounds = _corner_bounds(wall, r)
 
         def pieces(x: Sequence[float], r: ReturnWall = r) -> List[Piece]:
             return [
@@ -794,6 +922,98 @@ def _corner_candidates(
     return out
 
 
+@dataclass
+class WorkEstimate:
+    """The least work a search will do, counted before any λ0 is evaluated.
+
+    Attributes
+    ----------
+    evaluations : int
+        Seed-grid evaluations of λ0 the refinements make at least (each refinement starts
+        with its whole seed grid, ``grid ** k`` for ``k`` parameters; the polish adds more).
+    lines : int
+        Candidate hinge lines, summed over the façades and directions searched.
+    refinements : int
+        Mechanisms that will be refined (admissible lines of the families asked for, the
+        two-block walls' sides, the corners).
+    complete : bool
+        False where the count stopped early, past ``limit`` (the numbers are then lower
+        bounds of the real ones).
+    """
+
+    evaluations: int = 0
+    lines: int = 0
+    refinements: int = 0
+    complete: bool = True
+
+    def describe(self) -> str:
+        """Return the estimate in words (for the work limit's message)."""
+        least = "" if self.complete else "at least "
+        return (
+            f"{least}{self.evaluations} evaluations of λ0 (the seed grids of {least}"
+            f"{self.refinements} refinements over {least}{self.lines} candidate hinge lines)"
+        )
+
+
+def _directions(bld: Building, wall: Wall) -> List[str]:
+    """Return the directions searched for a façade (a free-standing wall's: one)."""
+    dirs = list(bld.spec.directions)
+    return dirs[:1] if bld.free_standing(wall.id) else dirs
+
+
+def work_estimate(bld: Building, limit: Optional[int] = None) -> WorkEstimate:
+    """Count the least λ0 evaluations a search needs, before it evaluates any.
+
+    Parameters
+    ----------
+    bld : Building
+        The building and its spec.
+    limit : int, optional
+        Stop counting once past it (a millimetre spacing of hinge lines is refused at once).
+
+    Returns
+    -------
+    WorkEstimate
+    """
+    spec = bld.spec
+    grid = spec.candidates.grid
+    est = WorkEstimate()
+
+    def add(n: int) -> bool:
+        est.evaluations += n
+        est.refinements += 1
+        if limit is not None and est.evaluations > limit:
+            est.complete = False
+            return True
+        return False
+
+    for wall in bld.walls.values():
+        if not wall.is_facade:
+            continue
+        for direction in _directions(bld, wall):
+            lines = hinge_lines(bld, wall, spec.candidates.spacing)
+            est.lines += len(lines)
+            for z_h in lines:
+                plan = _overturning_plan(bld, wall, direction, z_h)
+                if plan.why or plan.family not in spec.families:
+                    continue
+                if add(grid**plan.seeds):
+                    return est
+        if "vertical_flexure" in spec.families and _flexure_top(bld, wall):
+            for _ in spec.directions:
+                if add(grid):
+                    return est
+        if "corner" in spec.families and "outward" in spec.directions:
+            for r in bld.returns.get(wall.id, []):
+                if not r.corner or r.connection != "good":
+                    continue
+                if bld.ties.get(wall.id) or bld.ties.get(r.wall.id):
+                    continue  # not searched (``_corner_candidates``)
+                if add(grid ** sum(1 for lo, hi in _corner_bounds(wall, r) if hi > lo)):
+                    return est
+    return est
+
+
 def enumerate_candidates(
     bld: Building, budget: Optional[Budget] = None
 ) -> Tuple[List[Candidate], List[str]]:
@@ -811,6 +1031,15 @@ def enumerate_candidates(
     spec = bld.spec
     grid = spec.candidates.grid
     budget = budget if budget is not None else Budget()
+    if budget.limit is not None:
+        est = work_estimate(bld, budget.limit)
+        if est.evaluations > budget.limit:
+            raise InputError(
+                f"the search needs {est.describe()}, more than the work limit's {budget.limit}; "
+                "ask for fewer families or directions, a coarser candidates.grid or a wider "
+                "candidates.spacing, or raise the work limit (counted before the search ran)",
+                "work_limit",
+            )
     notes: List[str] = []
     out: List[Candidate] = []
     for wall in bld.walls.values():
@@ -831,6 +1060,10 @@ def enumerate_candidates(
             out.extend(_flexure_candidates(bld, wall, grid, notes, budget))
         if "corner" in spec.families and "outward" in spec.directions:
             out.extend(_corner_candidates(bld, wall, grid, notes, budget))
+    ground = ground_height(bld)
+    for c in out:
+        z = c.hinge_z - ground
+        c.z_base = z if z > _tol(bld) * 1e3 else 0.0
     seen = set()
     unique = []
     for c in out:

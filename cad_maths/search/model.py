@@ -441,15 +441,31 @@ def _elevation(mesh: TriMesh, frame: WallFrame, name: str) -> List[np.ndarray]:
 
 
 def _orient(
-    mesh: TriMesh, centre: np.ndarray, size: float, name: str
+    mesh: TriMesh,
+    centre: np.ndarray,
+    size: float,
+    name: str,
+    levels: Optional[np.ndarray] = None,
 ) -> Tuple[WallFrame, List[np.ndarray], float, bool, List[str]]:
-    """Return the wall's frame (e_n into the building), elevation and prism check."""
+    """Return the wall's frame (e_n into the building), elevation and prism check.
+
+    ``levels`` is the mean point of the levels' solids: a lone wall (the walls' centre on
+    its own mid-plane) faces them with its inner side (issue #37: it carries them).
+    """
     v = mesh.vertices
     e_n, e_s = frame_from_mesh(v, mesh.faces, name)
     com = v.mean(axis=0)
     side = float((centre - com) @ e_n)
-    if abs(side) <= 1e-9 * size:
-        # A lone wall: a fixed rule (e_n towards +x, else +y) names its sides.
+    lone_notes: List[str] = []
+    toward = None if levels is None else float((levels - com) @ e_n)
+    if abs(side) <= 1e-9 * size and toward is not None and abs(toward) > 1e-9 * size:
+        flip = toward < 0.0
+        lone_notes.append(
+            f"{name}: a lone wall; its inner side is taken to face the levels it carries "
+            "(its outward mechanisms move away from them)"
+        )
+    elif abs(side) <= 1e-9 * size:
+        # A lone wall without levels: a fixed rule (e_n towards +x, else +y) names its sides.
         flip = e_n[0] < -1e-12 or (abs(e_n[0]) <= 1e-12 and e_n[1] < 0.0)
     else:
         flip = side < 0.0
@@ -464,7 +480,7 @@ def _orient(
     rings = _elevation(mesh, frame, name)
     area = float(ring_moments(rings)[0])
     volume = float(mass_properties(mesh, 1.0).volume)
-    notes: List[str] = []
+    notes: List[str] = lone_notes
     exact = abs(volume - area * t) <= PRISM_RTOL * volume
     if not exact:
         t_eff = volume / area
@@ -809,9 +825,15 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
     centre = np.sum([p.volume * np.asarray(p.com) for p in vols], axis=0) / sum(
         p.volume for p in vols
     )
+    level_points = [
+        scene.mesh(o).vertices
+        for k, lv in enumerate(spec.levels)
+        for o in _find(scene, lv.objects, f"levels[{k}].objects")
+    ]
+    levels = np.vstack(level_points).mean(axis=0) if level_points else None
     walls: Dict[str, Wall] = {}
     for w, obj, mesh, selector in raw:
-        frame, rings, volume, exact, wall_notes = _orient(mesh, centre, size, w.id)
+        frame, rings, volume, exact, wall_notes = _orient(mesh, centre, size, w.id, levels)
         notes.extend(wall_notes)
         z = mesh.vertices[:, 2]
         length = float(frame.to_frame(mesh.vertices)[:, 0].max())

@@ -89,7 +89,9 @@ def _name(cand: Candidate) -> str:
     return ", ".join(parts)
 
 
-def candidate_spec(bld: Building, cand: Candidate, mech_id: str) -> Dict[str, Any]:
+def candidate_spec(
+    bld: Building, cand: Candidate, mech_id: str, mode: Optional[Tuple[float, float]] = None
+) -> Dict[str, Any]:
     """One candidate as a mechanism of the spec file (plain data, ``MechanismSpec``'s form).
 
     Parameters
@@ -100,6 +102,9 @@ def candidate_spec(bld: Building, cand: Candidate, mech_id: str) -> Dict[str, An
         The refined candidate.
     mech_id : str
         The mechanism's id.
+    mode : (f_n [Hz], h_e [m]), optional
+        The building's first mode: a candidate above ground (``z_base > 0``) gets
+        ``amplification {f_n, h_e, h = Z}`` (theory §7); one at ground level none.
     """
     spec: Dict[str, Any] = {
         "id": mech_id,
@@ -111,12 +116,18 @@ def candidate_spec(bld: Building, cand: Candidate, mech_id: str) -> Dict[str, An
             "end": [float(v) for v in cand.axis[1]],
         },
     }
+    if mode is not None and cand.z_base > 0.0:
+        spec["amplification"] = {"f_n": mode[0], "h_e": mode[1], "h": cand.z_base}
     if cand.typology == "two_block":
         wall = cand.pieces[0].wall
         spec["groups"] = [_group(wall)]
         spec["hinge_height"] = float(cand.params["h1_m"])
         if wall.overburden is not None:
-            spec["overburden"] = wall.overburden.model_dump(exclude_none=True, exclude_unset=True)
+            ob = wall.overburden.model_dump(exclude_none=True, exclude_unset=True)
+            if cand.direction == "inward" and "xi" in ob:
+                # the search's xi is from the outer face, the mechanism's from its own H
+                ob["xi"] = 1.0 - float(ob["xi"])
+            spec["overburden"] = ob
         return spec
     groups = []
     planes: List[Tuple[Plane, List[Any]]] = []
@@ -164,12 +175,17 @@ def candidate_spec(bld: Building, cand: Candidate, mech_id: str) -> Dict[str, An
     return spec
 
 
-def spec_file(bld: Building, cands: Sequence[Candidate], ids: Sequence[str]) -> SpecFile:
-    """Return a validated spec file of candidates (points in metres)."""
+def spec_file(
+    bld: Building,
+    cands: Sequence[Candidate],
+    ids: Sequence[str],
+    mode: Optional[Tuple[float, float]] = None,
+) -> SpecFile:
+    """Return a validated spec file of candidates (points in metres; ``mode`` as above)."""
     return SpecFile.model_validate(
         {
             "units": "m",
-            "mechanisms": [candidate_spec(bld, c, i) for c, i in zip(cands, ids)],
+            "mechanisms": [candidate_spec(bld, c, i, mode) for c, i in zip(cands, ids)],
         }
     )
 
@@ -198,8 +214,12 @@ def build_candidates(
     ids: Sequence[str],
     *,
     scene_name: str = "search scene",
+    mode: Optional[Tuple[float, float]] = None,
 ) -> Tuple[Optional[ConstantsFile], List[MechanismFailure], Dict[str, Dict[str, Any]], SpecFile]:
     """Constants of candidates from the builder, and their agreement with the search.
+
+    ``mode`` (f_n [Hz], h_e [m]) is the building's first mode, written into the
+    ``amplification`` of every candidate above ground (``candidate_spec``).
 
     Returns
     -------
@@ -214,7 +234,7 @@ def build_candidates(
     spec : SpecFile
         The spec that was built.
     """
-    sf = spec_file(bld, cands, ids)
+    sf = spec_file(bld, cands, ids, mode)
     cf, failures = constants_and_failures(
         sf, bld.scene, scene_name=scene_name, spec_name="search.spec.json"
     )

@@ -549,9 +549,12 @@ def _no_curve(note: str) -> dict[str, Any]:
 class _Context:
     """What the checks of every mechanism share: spectra, limit states, T1, the method."""
 
-    def __init__(self, cf: ConstantsFile, site: SiteFile) -> None:
+    def __init__(
+        self, cf: ConstantsFile, site: SiteFile, heights: Optional[dict[str, float]] = None
+    ) -> None:
         check_site_inputs(cf, site)
         self.site = site
+        self.heights = dict(heights or {})
         self.method = site.local_mechanisms.method
         self.spectrum = site_spectrum(site)
         main = site.hazard.limit_state if site.hazard.code == "NTC2018" else "SLV"
@@ -735,6 +738,9 @@ def _mechanism_row(
 ) -> dict[str, Any]:
     if mech.amplification is not None:
         z, z_source = mech.amplification.h, "amplification.h (the mechanism's base)"
+    elif mech.id in ctx.heights:
+        z = ctx.heights[mech.id]
+        z_source = "the height of the mechanism's base in its scene (no amplification data)"
     else:
         z, z_source = 0.0, "ground level (the constants give no amplification.h)"
     sides: dict[str, Any] = {}
@@ -814,7 +820,9 @@ def _site_clauses(code: str) -> dict[str, str]:
     }
 
 
-def check_doc(cf: ConstantsFile, site: SiteFile) -> dict[str, Any]:
+def check_doc(
+    cf: ConstantsFile, site: SiteFile, heights: Optional[dict[str, float]] = None
+) -> dict[str, Any]:
     """Code checks of every mechanism of ``cf`` on ``site`` (theory §11).
 
     Parameters
@@ -823,6 +831,10 @@ def check_doc(cf: ConstantsFile, site: SiteFile) -> dict[str, Any]:
         Mechanisms; those with ``virtual_work`` per side can be checked.
     site : SiteFile
         Hazard (per limit state), FC, q, the building and the check's choices.
+    heights : dict of str to float, optional
+        Z [m] of mechanisms without ``amplification`` (by id), where the caller knows it
+        (``rockmech search``: the base of the moving part): above ground and without a
+        building in the site, their check is incomplete as for ``amplification.h > 0``.
 
     Returns
     -------
@@ -840,7 +852,7 @@ def check_doc(cf: ConstantsFile, site: SiteFile) -> dict[str, Any]:
     InputError
         Site choices that contradict the constants (``check_site_inputs``).
     """
-    ctx = _Context(cf, site)
+    ctx = _Context(cf, site, heights)
     spectrum = ctx.spectrum
     t = np.linspace(0.0, 4.0, 161)
     rows = [_mechanism_row(ctx, mech) for mech in cf.mechanisms]

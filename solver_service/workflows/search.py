@@ -37,7 +37,7 @@ import numpy as np
 from cad_maths.mechanisms.build import MechanismFailure
 from cad_maths.scenes import read_scene
 from cad_maths.search.engine import MISSED_GAP, SearchResult, run_search, sliding_check
-from cad_maths.search.families import Candidate
+from cad_maths.search.families import Candidate, ground_height
 from cad_maths.search.prism import segment_intervals
 from cad_maths.search.specs import AGREEMENT_RTOL, build_candidates
 from shared_schema.atomic import write_atomic
@@ -53,19 +53,24 @@ from shared_schema.version import __version__
 
 from ..core.envelope import OverturningLibrary
 from ..core.exact import simulate, simulate_batch
+from ..core.floor_spectra import participation_first_mode
 from ..report.search_figure import plot_search
 from .adapter import to_rocking_model
 from .assess import check_doc, read_site
+from .codecheck import T1_TOLERANCE, building_period
 from .documents import envelope_doc, log_grid
 from .inputs import read_record
 from .outputs import finite_json
 from .rundir import run_folder
+from .scaling import mechanism_scale_factor
 from .units import stamp
 
 __all__ = [
     "SCALE_GRID",
     "SearchRun",
+    "check_first_mode",
     "crack_patches",
+    "first_mode",
     "read_search_spec",
     "save_search",
     "scales_to_overturn",
@@ -130,6 +135,120 @@ def read_search_spec(path: Path) -> SearchSpec:
             f"{path.name}: {exc.reason}; expected {SEARCH_SPEC_EXPECTED}", "spec"
         ) from None
     return parse_search_spec(text, path.name)
+
+
+#: A site's building height this far (relative) from the scene's walls' gets a note.
+HEIGHT_NOTE_RTOL = 0.1
+#: Where Z is measured from, in the document.
+Z_RULE = (
+    "Z is the height of the base of a mechanism's moving part (its hinge line; a two-block "
+    "wall's or a corner's base) above the ground, the lowest base of the scene's walls"
+)
+#: The stated assumption of a search without building data.
+NO_BUILDING_DATA = (
+    "no building data (no building in the site file, no first_mode in the search spec): "
+    "every mechanism is ranked on the ground motion, as if it stood on the ground, "
+    "including those above it; the code check of a mechanism above ground is incomplete; "
+    "the constants written carry no height (amplification needs f_n and h_e), so "
+    "`rockmech check` on them takes every mechanism at ground level"
+)
+
+
+def first_mode(spec: SearchSpec, site: Any, bld: Any) -> dict[str, Any]:
+    """Return the building's first mode for the mechanisms above ground, and its source.
+
+    From the search spec's ``first_mode`` (f_n, h_e); else from the site's ``building``:
+    ``T1`` as the code check takes it (``codecheck.building_period``: ``building.T1``, else
+    Circolare 2019 [C7.3.2]) and ``h_e = H / γ1 = H (2n + 1)/(3n)``, the effective height
+    ``Σ m h² / Σ m h`` of the linear first mode of ``n`` equal storeys ([C7.2.10]'s γ1, so
+    that Eq. 28's ``h/h_e`` is the floor spectrum's ``γ1 ψ(z)``, theory §7.2, §11.5).
+
+    Returns
+    -------
+    dict
+        ``given`` (whether there is building data), ``f_n_hz``, ``T1_s``, ``T1_source``,
+        ``h_e_m``, ``h_e_source``, ``ground_z_m``, ``Z_rule`` and ``notes``; without data
+        the frequencies are None and ``notes`` states the ground-level assumption.
+
+    Raises
+    ------
+    InputError
+        ``first_mode.f_n`` whose period differs from the site's ``building.T1`` by more
+        than ``codecheck.T1_TOLERANCE`` (one period decides both the ranking and the check).
+    """
+    ground = ground_height(bld)
+    top = max(w.z_hi for w in bld.walls.values()) - ground
+    info: dict[str, Any] = {
+        "given": False,
+        "f_n_hz": None,
+        "T1_s": None,
+        "T1_source": None,
+        "h_e_m": None,
+        "h_e_source": None,
+        "ground_z_m": ground,
+        "Z_rule": Z_RULE,
+        "notes": [],
+    }
+    b = None if site is None else site.building
+    fm = spec.first_mode
+    if fm is not None:
+        check_first_mode(spec, site)
+        info.update(
+            given=True,
+            f_n_hz=fm.f_n,
+            T1_s=1.0 / fm.f_n,
+            T1_source="search spec first_mode.f_n (T1 = 1/f_n)",
+            h_e_m=fm.h_e,
+            h_e_source="search spec first_mode.h_e",
+        )
+    elif b is not None:
+        t1, t1_source = building_period(site)
+        n = int(b.storeys)
+        gamma = participation_first_mode(n)
+        info.update(
+            given=True,
+            f_n_hz=1.0 / t1,
+            T1_s=t1,
+            T1_source=t1_source,
+            h_e_m=b.height / gamma,
+            h_e_source=(
+                f"site building: h_e = H (2n + 1)/(3n) = {b.height:g} m x {1.0 / gamma:.6g} "
+                f"(n = {n}), the effective height of the linear first mode of equal storeys "
+                "(Circ. 2019 [C7.2.10]: gamma1 = 3n/(2n + 1), h_e = H/gamma1)"
+            ),
+        )
+    else:
+        info["notes"].append(NO_BUILDING_DATA)
+        return info
+    if b is not None and abs(b.height - top) > HEIGHT_NOTE_RTOL * b.height:
+        info["notes"].append(
+            f"the site's building.height = {b.height:g} m, the scene's walls reach {top:.4g} m "
+            "above their lowest base: Z is measured from that base and the floor spectrum's "
+            "psi = Z/H takes the site's H; check that both describe the same building"
+        )
+    return info
+
+
+def check_first_mode(spec: SearchSpec, site: Any) -> None:
+    """Refuse a search spec's ``first_mode.f_n`` that contradicts the site's ``building.T1``.
+
+    Raises
+    ------
+    InputError
+        On field ``first_mode.f_n``: the two periods differ by more than ``T1_TOLERANCE``.
+    """
+    fm = spec.first_mode
+    b = None if site is None else site.building
+    if fm is None or b is None or b.T1 is None:
+        return
+    t_fn = 1.0 / fm.f_n
+    if abs(t_fn - b.T1) > T1_TOLERANCE * b.T1:
+        raise InputError(
+            f"first_mode.f_n = {fm.f_n:g} Hz (1/f_n = {t_fn:.4g} s) conflicts with the site's "
+            f"building.T1 = {b.T1:g} s: one first period decides the ranking and the code "
+            "check; remove one or make them agree",
+            "first_mode.f_n",
+        )
 
 
 def _ids(n: int) -> list[str]:
@@ -315,6 +434,7 @@ def _candidate_doc(cand: Candidate, mid: str, rank: int, friction: float) -> dic
             {"tie_bar": t.index, "at_m": [float(v) for v in t.point], "force_N": t.tie.force}
             for t in cand.ties
         ],
+        "Z_m": cand.z_base,
         "n_evaluations": cand.n_evaluations,
         "sliding": sliding_check(cand, friction),
         "notes": list(cand.notes),
@@ -322,7 +442,11 @@ def _candidate_doc(cand: Candidate, mid: str, rank: int, friction: float) -> dic
     if cand.lam0_negative is not None:
         doc["lam0_negative"] = cand.lam0_negative
     if cand.overburden is not None:
-        doc["overburden"] = {"N": cand.overburden["N"], "x_m": cand.overburden["x"]}
+        doc["overburden"] = {
+            "N": cand.overburden["N"],
+            "x_m": cand.overburden["x"],
+            "xi_from_outer_face": cand.overburden["xi"],
+        }
     return doc
 
 
@@ -407,14 +531,24 @@ def _build_and_rank(
     scene_name: str,
     exact: bool,
     library: Optional[OverturningLibrary],
+    mode: Optional[tuple[float, float]] = None,
 ) -> _Ranked:
-    """Build the kept candidates and rank them by their overturning acceleration."""
+    """Build the kept candidates and rank them by their overturning acceleration.
+
+    ``mode`` (f_n [Hz], h_e [m]): every candidate above ground gets ``amplification
+    {f_n, h_e, h = Z}``, so its envelope is the ground-level one of theory §7.3
+    (``a_p,min^local / SF(f_p)``); those at ground level skip it.
+    """
     out = _Ranked()
     n_built = min(keep, len(result.candidates))
     if not n_built:
         return out
     cf, out.failures, agreement, out.spec_file = build_candidates(
-        result.building, result.candidates[:n_built], ids[:n_built], scene_name=scene_name
+        result.building,
+        result.candidates[:n_built],
+        ids[:n_built],
+        scene_name=scene_name,
+        mode=mode,
     )
     for f in out.failures:
         docs[f.id]["builder"] = {"error": f.message}
@@ -433,6 +567,16 @@ def _build_and_rank(
             "min_g": min(finite) if finite else None,
             "f_at_min_hz": float(f_p[values.index(min(finite))]) if finite else None,
         }
+        if "scale_factor" in entry:
+            # above ground: the local envelope and Eq. 28's SF(f_p) it was divided by
+            d["amplification"] = entry["amplification"]
+            d["overturning"]["a_p_min_local_g"] = entry["a_p_min_local_g"]
+            d["overturning"]["scale_factor"] = entry["scale_factor"]
+            d["overturning"]["band_score_local_g"] = _band_score(entry["a_p_min_local_g"])
+            d["overturning"]["sf_formula"] = (
+                "SF(f_p) = sqrt(1 + (R(f_p/f_n) h/h_e)^2), R the 5 % pulse response spectrum "
+                "(theory §7.1, Eq. 28)"
+            )
         a = agreement.get(mech.id, {})
         d["builder"] = {
             "lam0": a.get("lam0"),
@@ -471,27 +615,57 @@ def _build_and_rank(
 def _run_records(
     cf: ConstantsFile, top: list[str], motions: Sequence[Any], docs: dict[str, dict[str, Any]]
 ) -> list[dict[str, Any]]:
-    """Each record's smallest scale factor that overturns each top mechanism."""
+    """Each record's smallest scale factor that overturns each top mechanism.
+
+    A mechanism above ground (``amplification``) receives the record times Eq. 28's
+    ``SF = sqrt(1 + (S_a(1/f_n)/a_g h/h_e)^2)`` (theory §7.3, the record's own 5 % spectrum,
+    ``scaling.mechanism_scale_factor``): SF does not depend on the record's scale, so the
+    ground scale that overturns it is the local one over SF (``scale``; the local one is
+    ``scale_local``). Mechanisms at ground level take the record as it is.
+    """
     out: list[dict[str, Any]] = []
     sub = ConstantsFile(mechanisms=[m for m in cf.mechanisms if m.id in top])
-    order = [m.id for m in sub.mechanisms]
     for motion in motions:
         try:
             runs = scales_to_overturn(sub, motion)
+            factors = [mechanism_scale_factor(m, motion, "eq28") for m in sub.mechanisms]
         except RockmechError as exc:
             out.append({"record": motion.name, "note": f"not run: {exc}"})
             continue
         out.append({"record": motion.name, "pga_g": float(motion.pga_g), "dt": float(motion.dt)})
-        for mid, run in zip(order, runs):
-            docs[mid].setdefault("records", []).append({"record": motion.name, **run})
+        for mech, run, info in zip(sub.mechanisms, runs, factors):
+            if info is not None:
+                sf = float(info["value"])
+                local = run
+                run = {**run, "scale_local": local["scale"], "scale_factor": info}
+                if local["scale"] is not None:
+                    run["scale"] = local["scale"] / sf
+                    run["bracket"] = [v / sf for v in local["bracket"]]
+                    run["pga_g"] = local["pga_g"] / sf
+            docs[mech.id].setdefault("records", []).append({"record": motion.name, **run})
     return out
 
 
 def _run_check(
-    cf: ConstantsFile, top: list[str], site: Any, docs: dict[str, dict[str, Any]]
+    cf: ConstantsFile,
+    top: list[str],
+    site: Any,
+    docs: dict[str, dict[str, Any]],
 ) -> dict[str, Any]:
-    """Run the code check of the top mechanisms (α0 and the verdict beside the dynamics)."""
-    check = check_doc(ConstantsFile(mechanisms=[m for m in cf.mechanisms if m.id in top]), site)
+    """Run the code check of the top mechanisms (α0 and the verdict beside the dynamics).
+
+    Each mechanism is checked at its Z: with ``amplification`` on the floor spectrum there
+    (Circ. 2019 §C7.2.3); without building data a mechanism above ground gets its Z all the
+    same, so that its check says it is incomplete (as ``rockmech check``) rather than pass
+    on the ground's spectrum.
+    """
+    heights = {
+        mid: float(docs[mid]["Z_m"])
+        for mid in top
+        if docs[mid]["Z_m"] > 0.0 and "amplification" not in docs[mid]
+    }
+    sub = ConstantsFile(mechanisms=[m for m in cf.mechanisms if m.id in top])
+    check = check_doc(sub, site, heights)
     for row in check["mechanisms"]:
         lin = row["linear"]
         docs[row["id"]]["code_check"] = {
@@ -501,6 +675,8 @@ def _run_check(
             "nonlinear": row["nonlinear"],
             "Z": row["Z"],
             "Z_source": row["Z_source"],
+            "T1": row["T1"],
+            "T1_source": row["T1_source"],
         }
     return {"site": check["site"], "governing": check["governing"]}
 
@@ -571,9 +747,20 @@ ASSUMPTIONS = (
     "joints (the sliding flags say where friction would not hold)",
     "a crack through a return wall separates its wedge without friction (the macro-block "
     "model); good connections make it run at least at the bond angle",
-    "mechanisms are ranked on the ground motion: none carries amplification, so the code "
-    "check takes Z = 0 for every one",
 )
+
+
+def _height_assumption(info: dict[str, Any]) -> str:
+    """Return the document's assumption on where the mechanisms are ranked."""
+    if not info["given"]:
+        return NO_BUILDING_DATA
+    return (
+        "each mechanism is ranked where it sits: one above ground (Z > 0) on the motion "
+        f"amplified by the building's first mode (f_n = {info['f_n_hz']:.4g} Hz, from "
+        f"{info['T1_source']}; h_e = {info['h_e_m']:.4g} m, from {info['h_e_source']}) by "
+        "Eq. 28 (theory §7), records likewise, and the code check on the floor spectrum at Z "
+        "(Circ. 2019 §C7.2.3); one at ground level on the ground motion"
+    )
 
 
 def search_run(
@@ -631,7 +818,10 @@ def search_run(
             read_record(_resolve(r, spec_dir, f"ranking.records[{k}]"))
             for k, r in enumerate(rk.records)
         ]
+    check_first_mode(spec, site)  # before the search: a contradiction costs nothing
     result = run_search(scene, spec, max_evaluations=max_evaluations, max_lp_blocks=max_lp_blocks)
+    mode_info = first_mode(spec, site, result.building)
+    mode = (mode_info["f_n_hz"], mode_info["h_e_m"]) if mode_info["given"] else None
     t1 = time.perf_counter()
     cands = result.candidates
     ids = _ids(len(cands))
@@ -648,7 +838,7 @@ def search_run(
             f"max_mechanisms), not the {min(keep, len(cands))} candidates.keep asks for"
         )
         keep = max_built
-    ranked = _build_and_rank(result, keep, by_id, ids, f_p, scene_name, exact, library)
+    ranked = _build_and_rank(result, keep, by_id, ids, f_p, scene_name, exact, library, mode)
     t2 = time.perf_counter()
     top = ranked.dynamic[: rk.keep]
     cf = ranked.constants
@@ -688,10 +878,11 @@ def search_run(
             "code_check_s": t4 - t3,
             "total_s": t4 - t0,
         },
-        "assumptions": list(ASSUMPTIONS),
+        "building": mode_info,
+        "assumptions": [*ASSUMPTIONS, _height_assumption(mode_info)],
         # issue #36: a density of 1.8 (t/m^3?) was a note among ten; a warning, as in a spec
         "warnings": spec.plausibility_notes(),
-        "notes": notes + compare["summary"],
+        "notes": notes + mode_info["notes"] + compare["summary"],
     }
     return SearchRun(stamp(doc, "search"), ranked.spec_file, cf, result, dict(enumerate(ids)))
 

@@ -26,12 +26,19 @@ EXAMPLE_SPEC = REPO / "examples" / "specs" / "search_facade.search.json"
 
 
 def two_block_wall(
-    out: Path, b: float = 0.3, h: float = 3.0, length: float = 1.0, name: str = "tb"
+    out: Path,
+    b: float = 0.3,
+    h: float = 3.0,
+    length: float = 1.0,
+    name: str = "tb",
+    slab_side: float = 1.0,
 ) -> Path:
-    """A wall x in [0, b] (outer face x = 0), y in [0, length], z in [0, h], a slab on top."""
+    """A wall x in [0, b], y in [0, length], z in [0, h], a slab on top running into +x
+    (outer face x = 0), or into -x with ``slab_side = -1`` (outer face x = b)."""
     bld = BUILD.Builder(name)
     bld.box("wall", "Walls", (0.0, 0.0, 0.0), (b, length, h), "brick")
-    bld.box("slab", "Floors", (0.0, 0.0, h), (3.0, length, h + 0.2), "concrete")
+    x0, x1 = (0.0, 3.0) if slab_side > 0 else (b - 3.0, b)
+    bld.box("slab", "Floors", (x0, 0.0, h), (x1, length, h + 0.2), "concrete")
     return bld.write(out / f"{name}.3dm")
 
 
@@ -105,5 +112,46 @@ def wedge_spec(
     }
     if families is not None:
         doc["families"] = families
+    doc.update(extra)
+    return doc
+
+
+def three_storey_facade(out: Path, name: str = "storeys") -> Path:
+    """A three-storey façade (outer face x = 0; 8 m long, 10.5 m high, 0.5 m thick), two
+    return walls and a back wall, and three 0.2 m floors abutting its inner face at 3.5 m,
+    7 m and 10.3 m (the last one at the top)."""
+    t, length, h, reach, w = 0.5, 8.0, 10.5, 6.0, 0.45
+    bld = BUILD.Builder(name)
+    bld.box("facade", "Walls", (0.0, 0.0, 0.0), (t, length, h), "brick")
+    bld.box("left", "Walls", (t, 0.0, 0.0), (t + reach, w, h), "brick")
+    bld.box("right", "Walls", (t, length - w, 0.0), (t + reach, length, h), "brick")
+    bld.box("back", "Walls", (t + reach, 0.0, 0.0), (2 * t + reach, length, h), "brick")
+    for nm, z in (("floor_1", 3.5), ("floor_2", 7.0), ("floor_3", 10.3)):
+        bld.box(nm, "Floors", (t, w + 0.01, z), (t + reach, length - w - 0.01, z + 0.2), "concrete")
+    return bld.write(out / f"{name}.3dm")
+
+
+def three_storey_spec(**extra: Any) -> dict[str, Any]:
+    """The search spec of ``three_storey_facade``: poor junctions, the façade's overturning."""
+    doc: dict[str, Any] = {
+        "walls": [
+            {"id": "F", "object": "facade", "density": 1800.0},
+            {"id": "L", "object": "left", "density": 1800.0, "facade": False},
+            {"id": "R", "object": "right", "density": 1800.0, "facade": False},
+            {"id": "B", "object": "back", "density": 1800.0, "facade": False},
+        ],
+        "levels": [
+            {"id": "f1", "kind": "floor", "objects": ["floor_1"], "density": 2400.0,
+             "tributary": 0.5},
+            {"id": "f2", "kind": "floor", "objects": ["floor_2"], "density": 2400.0,
+             "tributary": 0.5},
+            {"id": "f3", "kind": "floor", "objects": ["floor_3"], "density": 2400.0,
+             "tributary": 0.5},
+        ],
+        "default_junction": {"connection": "poor"},
+        "families": ["overturning", "partial_overturning", "parapet"],
+        "directions": ["outward"],
+        "lp": False,
+    }  # fmt: skip
     doc.update(extra)
     return doc

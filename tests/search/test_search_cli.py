@@ -93,12 +93,54 @@ def test_cli_work_limit_refuses_before_searching(
     spec = write_spec(tmp_path / "s.json", wedge_spec("good", (0.25, 0.12)))
     res = runner.invoke(app, ["search", str(scene), str(spec), "-o", str(tmp_path / "o")])
     assert res.exit_code == 2
-    assert "error: work_limit:" in res.stderr and "more than 10 evaluations" in res.stderr
+    assert "error: work_limit:" in res.stderr and "more than the work limit's 10" in res.stderr
+    assert "counted before the search ran" in res.stderr
     res = runner.invoke(
         app,
         ["search", str(scene), str(spec), "-o", str(tmp_path / "o"), "--no-limits", "--no-figure"],
     )
     assert res.exit_code == 0, res.output
+
+
+def test_a_hinge_line_every_millimetre_is_refused_at_once_with_the_estimate(
+    tmp_path: Path,
+) -> None:
+    """Issue #37: the work estimate runs before the search (it took 35 s to refuse)."""
+    import time
+
+    doc = json.loads(EXAMPLE_SPEC.read_text())
+    doc["candidates"] = {"spacing": 0.001}
+    doc["ranking"].pop("site")
+    doc["ranking"].pop("records")
+    spec = write_spec(tmp_path / "mm.search.json", doc)
+    t0 = time.perf_counter()
+    with pytest.raises(InputError) as err:
+        rockmech.search_from_files(EXAMPLE_SCENE, spec)
+    elapsed = time.perf_counter() - t0
+    assert err.value.field == "work_limit"
+    msg = str(err.value)
+    assert "at least" in msg and "candidate hinge lines" in msg
+    assert "more than the work limit's 200000" in msg
+    least = int(msg.split("needs at least ")[1].split(" ")[0])
+    assert least > 200_000
+    assert elapsed < 10.0, elapsed  # reading the scene and counting; no λ0 was evaluated
+
+
+def test_the_work_estimate_is_a_lower_bound_of_the_search_s_work() -> None:
+    from cad_maths.scenes import read_scene
+    from cad_maths.search.families import Budget, enumerate_candidates, work_estimate
+    from cad_maths.search.model import building_from_scene
+    from solver_service.workflows.search import read_search_spec
+
+    bld = building_from_scene(read_scene(EXAMPLE_SCENE), read_search_spec(EXAMPLE_SPEC))
+    est = work_estimate(bld)
+    budget = Budget()
+    cands, _ = enumerate_candidates(bld, budget)
+    assert est.complete and 0 < est.evaluations <= budget.used
+    assert est.refinements >= len(cands)
+    # a limit just below the estimate refuses before any evaluation
+    with pytest.raises(InputError, match="counted before the search ran"):
+        enumerate_candidates(bld, Budget(est.evaluations - 1))
 
 
 def test_python_api_search_from_files(tmp_path: Path) -> None:
@@ -121,3 +163,32 @@ def test_python_api_search_from_files(tmp_path: Path) -> None:
         "search.png",
     }
     assert (tmp_path / "search.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize(
+    ("unit", "field"),
+    [
+        ((0.25, 0.001), "default_junction.unit.height"),
+        ((3.0, 0.12), "default_junction.unit.length"),
+    ],
+)
+def test_an_implausible_masonry_unit_gets_a_warning_naming_the_field(
+    tmp_path: Path, unit: tuple[float, float], field: str
+) -> None:
+    """Issue #37: a 1 mm course gave β_bond 89.6° and λ0 +53 % without a word."""
+    import math
+
+    scene = wedge_facade(tmp_path)
+    spec = write_spec(tmp_path / "s.json", wedge_spec("good", unit, families=["overturning"]))
+    run = rockmech.search_from_files(scene, spec)
+    (note,) = [n for n in run.doc["notes"] if field in n]
+    assert (
+        note.startswith("warning: ")
+        and f"{field} = {unit[0] if 'length' in field else unit[1]:g} m" in note
+    )
+    assert f"{math.degrees(math.atan(unit[0] / (2 * unit[1]))):.1f} deg" in note
+    # a plausible unit says nothing
+    spec = write_spec(
+        tmp_path / "t.json", wedge_spec("good", (0.25, 0.06), families=["overturning"])
+    )
+    assert not [n for n in rockmech.search_from_files(scene, spec).doc["notes"] if "unit." in n]
