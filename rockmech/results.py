@@ -263,12 +263,15 @@ class MechanismCheck:
     mechanism : str
         The mechanism's id.
     passes : bool or None
-        Both checks pass (None where a check could not run: see ``doc``).
+        Both checks pass at SLV (None where a check could not run: see ``doc``).
     linear_ratio, nonlinear_ratio : float or None
         Capacity over demand of the linear and the nonlinear kinematic check [-] (>= 1
         passes; None where the check did not run).
     z : float
         Height of the mechanism's base above the ground [m].
+    passes_slc : bool or None
+        The nonlinear check at SLC passes (§C8.7.1.2.1.6); None where the site gives no SLC
+        hazard or the check could not run. A mechanism can pass at SLV and fail at SLC.
     """
 
     mechanism: str
@@ -276,6 +279,7 @@ class MechanismCheck:
     linear_ratio: Optional[float]
     nonlinear_ratio: Optional[float]
     z: float
+    passes_slc: Optional[bool] = None
 
 
 def _ratio(check: dict[str, Any]) -> Optional[float]:
@@ -290,6 +294,7 @@ def _checks(doc: dict[str, Any]) -> tuple[MechanismCheck, ...]:
             linear_ratio=_ratio(m["linear"]),
             nonlinear_ratio=_ratio(m["nonlinear"]),
             z=float(m["Z"]),
+            passes_slc=m.get("passes_SLC"),
         )
         for m in doc["mechanisms"]
     )

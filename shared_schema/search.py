@@ -416,7 +416,7 @@ def _unit_notes(unit: Unit, where: str) -> List[str]:
     ):
         if not lo <= value <= hi:
             notes.append(
-                f"warning: {where}.{name} = {value:g} m is outside the plausible range "
+                f"{where}.{name} = {value:g} m is outside the plausible range "
                 f"[{lo:g}, {hi:g}] m for {what}; the bond angle atan(l_u / 2 h_u) = "
                 f"{math.degrees(math.atan(unit.length / (2.0 * unit.height))):.1f} deg bounds the "
                 "cracks through the return walls: check the unit's size and that it is in metres"

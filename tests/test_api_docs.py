@@ -109,6 +109,7 @@ def test_facade_analyses_give_the_command_lines_numbers(tmp_path: Path) -> None:
     for row, typed in zip(cli["mechanisms"], checks.mechanisms):
         assert typed.linear_ratio == row["linear"]["capacity_ratio"]
         assert typed.passes is row["passes"]
+        assert typed.passes_slc is row["nonlinear"]["SLC"]["passes"] is row["passes_SLC"]
     cli = _cli_json(
         [
             "envelope",

@@ -852,24 +852,11 @@ def solve_lp(model: LPModel, friction: Optional[float] = None) -> LPResult:
         if size > 0.0 and body[k] >= 0:
             b = body[k]
             cost[6 * b : 6 * b + 6] -= scale * size * _point_map(coms, b, p, f / size) / G
-    # A tie does work only while stretched: one more unknown t >= 0 per tie with
-    # t >= -pull·v(p), its bar's stretch rate, and T t / g in the cost. At the optimum
-    # t = max(0, stretch), so a slack bar (its point moving towards the anchorage) costs 0.
     ties = [(body[k], f, p) for k, f, p in model.ties if body[k] >= 0]
     n_ties = len(ties)
-    eq_rows = eq.matrix(coms, ncol)
-    if n_ties:
-        from scipy.sparse import hstack
-
-        stretch = np.zeros((n_ties, ncol + n_ties))
-        for r, (b, f, p) in enumerate(ties):
-            stretch[r, 6 * b : 6 * b + 6] = -_point_map(coms, b, p, f / float(np.linalg.norm(f)))
-            stretch[r, ncol + r] = -1.0
-        cost = np.concatenate([cost, [scale * float(np.linalg.norm(f)) / G for _, f, _ in ties]])
-        norm = np.concatenate([norm, np.zeros(n_ties)])
-        a_ub = vstack([hstack([a_ub, csr_matrix((a_ub.shape[0], n_ties))]), csr_matrix(stretch)])
-        a_ub = a_ub.tocsr()
-        eq_rows = hstack([eq_rows, csr_matrix((eq_rows.shape[0], n_ties))])
+    cost, norm, a_ub, eq_rows = _tie_columns(
+        ties, coms, scale, (cost, norm, a_ub, eq.matrix(coms, ncol))
+    )
     a_eq = vstack([eq_rows, csr_matrix(norm.reshape(1, -1))]).tocsr()
     b_eq = np.zeros(a_eq.shape[0])
     b_eq[-1] = 1.0
@@ -905,18 +892,53 @@ def solve_lp(model: LPModel, friction: Optional[float] = None) -> LPResult:
         )
     if res.status != 0:
         raise SolverError(f"{model.facade} {model.direction}: HiGHS: {res.message}")
-    x = np.asarray(res.x, dtype=float)[:ncol].reshape(nbody, 6)
-    vel = np.zeros((nb, 6))
+    vel = _velocities(model, body, coms, np.asarray(res.x, dtype=float)[:ncol].reshape(nbody, 6))
+    moving, bodies = _bodies(model, vel)
+    return LPResult(
+        float(res.fun), "optimal", moving, bodies, vel, nb, rows, ncol + n_ties, runtime, friction
+    )
+
+
+def _tie_columns(
+    ties: List[Tuple[int, Any, Any]],
+    coms: np.ndarray,
+    scale: float,
+    parts: Tuple[np.ndarray, np.ndarray, Any, Any],
+) -> Tuple[np.ndarray, np.ndarray, Any, Any]:
+    """Add the ties' columns to the programme's cost, normalisation and constraint rows.
+
+    A tie does work only while stretched: one more unknown t >= 0 per tie with
+    t >= -pull·v(p), its bar's stretch rate, and T t / g in the cost. At the optimum
+    t = max(0, stretch), so a slack bar (its point moving towards the anchorage) costs 0.
+    ``ties`` holds (body, force [N] as a vector along the pull, point [m]).
+    """
+    cost, norm, a_ub, eq_rows = parts
+    if not ties:
+        return cost, norm, a_ub, eq_rows
+    from scipy.sparse import csr_matrix, hstack, vstack
+
+    n_ties, ncol = len(ties), cost.size
+    stretch = np.zeros((n_ties, ncol + n_ties))
+    for r, (b, f, p) in enumerate(ties):
+        stretch[r, 6 * b : 6 * b + 6] = -_point_map(coms, b, p, f / float(np.linalg.norm(f)))
+        stretch[r, ncol + r] = -1.0
+    cost = np.concatenate([cost, [scale * float(np.linalg.norm(f)) / G for _, f, _ in ties]])
+    norm = np.concatenate([norm, np.zeros(n_ties)])
+    a_ub = vstack([hstack([a_ub, csr_matrix((a_ub.shape[0], n_ties))]), csr_matrix(stretch)])
+    eq_rows = hstack([eq_rows, csr_matrix((eq_rows.shape[0], n_ties))])
+    return cost, norm, a_ub.tocsr(), eq_rows
+
+
+def _velocities(model: LPModel, body: Any, coms: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Return each block's (centre-of-mass velocity, rotation rate) from its body's motion."""
+    vel = np.zeros((len(model.blocks), 6))
     for k, blk in enumerate(model.blocks):
         b = body[k]
         if b >= 0:
             u, th = x[b, :3], x[b, 3:]
             vel[k, :3] = u + np.cross(th, blk.lump.com - coms[b])
             vel[k, 3:] = th
-    moving, bodies = _bodies(model, vel)
-    return LPResult(
-        float(res.fun), "optimal", moving, bodies, vel, nb, rows, ncol + n_ties, runtime, friction
-    )
+    return vel
 
 
 def _bodies(model: LPModel, vel: np.ndarray) -> Tuple[List[int], List[List[int]]]:

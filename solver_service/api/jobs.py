@@ -50,7 +50,12 @@ from shared_schema.text import decode_text
 
 from ..core import codes
 from ..core.circ2019 import RECORD_POINTS, T_RECORD_MIN
-from ..core.envelope import OverturningLibrary
+from ..core.envelope import (
+    SERIAL_OMEGA,
+    OverturningLibrary,
+    boundary_curve,
+    governing_one_sided,
+)
 from ..core.exact import simulate, simulate_batch
 from ..core.excitation import Pulse, SampledAccel
 from ..core.model import G, RockingModel, check_positive
@@ -653,6 +658,13 @@ def run_warmup(job: WarmupJob, blobs: list[bytes], limits: dict[str, Any]) -> by
     acc = 3.0 * np.sin(np.linspace(0.0, 6.0, 61))
     simulate_batch([model], SampledAccel(acc, 0.01), [1.0])
     response_spectrum(acc, 0.01, [0.5])
+    # The exact envelopes' boundary search (/envelope, /assess): two-sided, directional and
+    # one-sided, one frequency at a time and the parallel grid (more than SERIAL_OMEGA).
+    # Left to the first request, their compilation outlasted a 5 s budget.
+    for omega in (np.array([5.0]), np.linspace(2.0, 8.0, SERIAL_OMEGA + 1)):
+        boundary_curve(omega, 0.9)
+        boundary_curve(omega, 0.9, direction=-1, eta_neg=0.8)
+        governing_one_sided(omega, 0.0)
     shared_library()
     return dumps({"ok": True})
 

@@ -998,6 +998,16 @@ def nonlinear_check_2019(
             out["d_y"], out["a_y"] = yp
             clauses.update({"d_y": CL["d_y"], "a_y": CL["a_y"]})
     clauses["curve"] = CL_LS["a"] + " with d = φ J/S; [C8.7.1.6] for a free-standing element"
+    _ties_and_floor(out, clauses, curve, demand_slv)
+    out["clauses"] = clauses
+    out["note"] = "; ".join(notes)
+    return out
+
+
+def _ties_and_floor(
+    out: dict[str, Any], clauses: dict[str, str], curve: CapacityCurve, demand: _Demand
+) -> None:
+    """Add the ties' line of the curve and the floor spectrum's terms, where there are any."""
     if curve.before is not None:
         clauses["ties_curve"] = _C + "C8.7.1.2.1.6: the ties' line until their failure rotation"
         out["ties_curve"] = {
@@ -1006,11 +1016,8 @@ def nonlinear_check_2019(
             "phi_break": curve.before[2],
             "d_break": curve.before[2] * curve.d_per_rad,
         }
-    if demand_slv.floor is not None:
-        terms = floor_acceleration(demand_slv.se_g, demand_slv.floor)
-        floor = _floor_terms(terms, demand_slv.floor)
+    if demand.floor is not None:
+        terms = floor_acceleration(demand.se_g, demand.floor)
+        floor = _floor_terms(terms, demand.floor)
         out["floor"] = floor
         clauses.update({f"floor.{k}": FLOOR_CLAUSES[k] for k in floor})
-    out["clauses"] = clauses
-    out["note"] = "; ".join(notes)
-    return out
