@@ -572,6 +572,8 @@ def _overturning_plan(bld: Building, wall: Wall, direction: str, z_h: float) -> 
     free = bld.free_standing(wall.id)
     if direction == "inward" and not free:
         return _Plan("the building (return walls, levels or ties) holds the wall's inner face")
+    if direction == "outward" and wall.held_by:
+        return _Plan(f"{wall.held_by[0][0]} stands against the wall's outer face")
     f = wall.frame
     returns = bld.returns.get(wall.id, []) if direction == "outward" else []
     contacts = [c for c in bld.contacts.get(wall.id, []) if c.point[2] > z_h + tol]
@@ -879,8 +881,8 @@ def _corner_candidates(
     out: List[Candidate] = []
     f = wall.frame
     for r in bld.returns.get(wall.id, []):
-        if not r.corner or r.connection != "good":
-            continue
+        if not r.corner or r.connection != "good" or wall.held_by or r.wall.held_by:
+            continue  # a held outer face: said where the plan is read
         if bld.ties.get(wall.id) or bld.ties.get(r.wall.id):
             notes.append(
                 f"{wall.id}/{r.wall.id} corner: not searched, tie-bars cross the corner's walls "
@@ -1005,7 +1007,7 @@ def work_estimate(bld: Building, limit: Optional[int] = None) -> WorkEstimate:
                     return est
         if "corner" in spec.families and "outward" in spec.directions:
             for r in bld.returns.get(wall.id, []):
-                if not r.corner or r.connection != "good":
+                if not r.corner or r.connection != "good" or wall.held_by or r.wall.held_by:
                     continue
                 if bld.ties.get(wall.id) or bld.ties.get(r.wall.id):
                     continue  # not searched (``_corner_candidates``)

@@ -38,6 +38,7 @@ from cad_maths.mechanisms.loaded import BEARING_ANGLE, contact_tolerance
 from cad_maths.mechanisms.single import find_objects
 from cad_maths.mechanisms.thrust import roof_thrust
 from cad_maths.scene_base import SceneObject
+from cad_maths.search.plan import Plan, outer_side, read_plan
 from cad_maths.search.prism import Lump, WallFrame, clip_rings, frame_from_mesh, ring_moments
 from cad_maths.search.scene import OPENINGS_SUFFIX, MemoryScene
 from shared_schema.errors import GeometryError, InputError
@@ -98,6 +99,13 @@ class Wall:
         Whether the solid is an exact prism.
     holes : list of (s0, s1, z0, z1)
         Bounding boxes of the openings in the elevation [m].
+    volume : float
+        Volume of the solid [m³].
+    held_by : list of (str, float, float)
+        Walls standing against the outer face: ``(wall id, s0, s1)`` with the stretch of the
+        face they cover [m]; the wall cannot move outward (``plan.Plan.read_faces``).
+    building : int
+        Index of its building in the plan (several buildings in one scene).
     """
 
     id: str
@@ -115,6 +123,8 @@ class Wall:
     exact: bool
     holes: List[Tuple[float, float, float, float]]
     volume: float
+    held_by: List[Tuple[str, float, float]] = field(default_factory=list)
+    building: int = 0
 
     @property
     def mesh(self) -> TriMesh:
@@ -442,33 +452,39 @@ def _elevation(mesh: TriMesh, frame: WallFrame, name: str) -> List[np.ndarray]:
 
 def _orient(
     mesh: TriMesh,
-    centre: np.ndarray,
+    plan: Plan,
     size: float,
     name: str,
     levels: Optional[np.ndarray] = None,
-) -> Tuple[WallFrame, List[np.ndarray], float, bool, List[str]]:
-    """Return the wall's frame (e_n into the building), elevation and prism check.
+) -> Tuple[WallFrame, List[np.ndarray], float, bool, List[str], Tuple[Any, int]]:
+    """Return the wall's frame (e_n into the building), elevation, prism check and plan.
 
-    ``levels`` is the mean point of the levels' solids: a lone wall (the walls' centre on
-    its own mid-plane) faces them with its inner side (issue #37: it carries them).
+    The last item is what holds the outer face (``Wall.held_by``) and the wall's building.
+    The outer face is the one the plan finds on the outside (``plan.outer_side``). A lone
+    wall (both faces outside) faces the levels it carries with its inner side (issue #37),
+    or, without levels, follows a fixed rule; an inner wall faces the centre of its
+    building's plan with its inner side.
     """
     v = mesh.vertices
     e_n, e_s = frame_from_mesh(v, mesh.faces, name)
     com = v.mean(axis=0)
-    side = float((centre - com) @ e_n)
-    lone_notes: List[str] = []
+    reading = plan.read_faces(name, e_n, e_s, v[:, :2])
+    outer, lone_notes = outer_side(reading, name)
     toward = None if levels is None else float((levels - com) @ e_n)
-    if abs(side) <= 1e-9 * size and toward is not None and abs(toward) > 1e-9 * size:
+    if outer is not None:
+        flip = outer == 1  # e_n points from the outer face into the building
+    elif reading.exposed[0] == 0.0:  # an inner wall: inner side towards its plan's centre
+        c = np.asarray(plan.parts[reading.building].centroid.coords[0]) + plan.origin
+        flip = float((c - com[:2]) @ e_n[:2]) < 0.0
+    elif toward is not None and abs(toward) > 1e-9 * size:
         flip = toward < 0.0
         lone_notes.append(
             f"{name}: a lone wall; its inner side is taken to face the levels it carries "
             "(its outward mechanisms move away from them)"
         )
-    elif abs(side) <= 1e-9 * size:
+    else:
         # A lone wall without levels: a fixed rule (e_n towards +x, else +y) names its sides.
         flip = e_n[0] < -1e-12 or (abs(e_n[0]) <= 1e-12 and e_n[1] < 0.0)
-    else:
-        flip = side < 0.0
     if flip:
         e_n, e_s = -e_n, -e_s
     e_z = np.array([0.0, 0.0, 1.0])
@@ -491,7 +507,22 @@ def _orient(
             "the search reports the difference"
         )
         frame = WallFrame(origin, e_s, e_n, e_z, t_eff)
-    return frame, rings, volume, exact, notes
+    held = _held_by(plan, reading.covered[1 if flip else 0], e_s if not flip else -e_s, frame)
+    return frame, rings, volume, exact, notes, (held, reading.building)
+
+
+def _held_by(
+    plan: Plan, covers: List[Tuple[str, float, float]], e_s_plan: np.ndarray, frame: WallFrame
+) -> List[Tuple[str, float, float]]:
+    """Return the plan's covers of the outer face, with ``s`` in the wall's frame [m]."""
+    out = []
+    for other, a, b in covers:
+        ends = []
+        for si in (a, b):
+            xy = plan.origin + si * np.asarray(e_s_plan[:2], dtype=float)
+            ends.append(float(frame.to_frame(np.array([xy[0], xy[1], frame.origin[2]]))[0]))
+        out.append((other, min(ends), max(ends)))
+    return out
 
 
 def _holes(rings: List[np.ndarray]) -> List[Tuple[float, float, float, float]]:
@@ -821,19 +852,27 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
         raw.append((w, obj, mesh, selector))
     verts = np.vstack([m.vertices for _, _, m, _ in raw])
     size = float(np.linalg.norm(verts.max(axis=0) - verts.min(axis=0)))
-    vols = [mass_properties(m, 1.0) for _, _, m, _ in raw]
-    centre = np.sum([p.volume * np.asarray(p.com) for p in vols], axis=0) / sum(
-        p.volume for p in vols
-    )
     level_points = [
         scene.mesh(o).vertices
         for k, lv in enumerate(spec.levels)
         for o in _find(scene, lv.objects, f"levels[{k}].objects")
     ]
+    plan = read_plan([(w.id, m.vertices) for w, _, m, _ in raw], level_points)
+    if len(plan.parts) > 1:
+        groups: Dict[int, List[str]] = {}
+        for w, _, _, _ in raw:
+            groups.setdefault(plan.building_of(w.id), []).append(w.id)
+        said = "; ".join(", ".join(ids) for _, ids in sorted(groups.items()))
+        notes.append(
+            f"the walls stand in {len(plan.parts)} separate buildings ({said}): each has its "
+            "own outline and outer faces"
+        )
     levels = np.vstack(level_points).mean(axis=0) if level_points else None
     walls: Dict[str, Wall] = {}
     for w, obj, mesh, selector in raw:
-        frame, rings, volume, exact, wall_notes = _orient(mesh, centre, size, w.id, levels)
+        frame, rings, volume, exact, wall_notes, (held, building) = _orient(
+            mesh, plan, size, w.id, levels
+        )
         notes.extend(wall_notes)
         z = mesh.vertices[:, 2]
         length = float(frame.to_frame(mesh.vertices)[:, 0].max())
@@ -853,7 +892,15 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
             exact,
             _holes(rings),
             volume,
+            held,
+            building,
         )
+        for other, a, b in held:
+            notes.append(
+                f"{w.id}: {other} stands against its outer face (s = {a:.3f}-{b:.3f} m of "
+                f"{length:.3f} m): {w.id} cannot move outward there, and its outward mechanisms "
+                "(the whole façade above a hinge line, its corners) are not searched"
+            )
     tol = max(contact_tolerance(scene), 1e-9 * size)
     returns = _returns(walls, spec, tol, notes)
     contacts, level_objects = _level_contacts(scene, spec, walls, tol, notes, memory)
