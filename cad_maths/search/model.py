@@ -852,12 +852,15 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
         raw.append((w, obj, mesh, selector))
     verts = np.vstack([m.vertices for _, _, m, _ in raw])
     size = float(np.linalg.norm(verts.max(axis=0) - verts.min(axis=0)))
-    level_points = [
-        scene.mesh(o).vertices
+    level_meshes = [
+        scene.mesh(o)
         for k, lv in enumerate(spec.levels)
         for o in _find(scene, lv.objects, f"levels[{k}].objects")
     ]
-    plan = read_plan([(w.id, m.vertices) for w, _, m, _ in raw], level_points)
+    level_points = [m.vertices for m in level_meshes]
+    plan = read_plan(
+        [(w.id, m.vertices) for w, _, m, _ in raw], [(m.vertices, m.faces) for m in level_meshes]
+    )
     if len(plan.parts) > 1:
         groups: Dict[int, List[str]] = {}
         for w, _, _, _ in raw:

@@ -163,17 +163,19 @@ class Plan:
         return [(w, min(v), max(v)) for w, v in sorted(spans.items())]
 
 
-def read_plan(walls: Sequence[Tuple[str, np.ndarray]], levels: Sequence[np.ndarray] = ()) -> Plan:
+def read_plan(
+    walls: Sequence[Tuple[str, np.ndarray]], levels: Sequence[Tuple[np.ndarray, np.ndarray]] = ()
+) -> Plan:
     """Read the plan of walls given by id and vertices.
 
     Parameters
     ----------
     walls : sequence of (str, (k, 3) float)
         Each wall's id and its solid's vertices [m].
-    levels : sequence of (k, 3) float
-        The vertices of each level's solid [m]: a space the walls enclose is a room where
-        levels cover at least ``ROOM_COVER`` of it, else a courtyard. Without levels every
-        enclosed space is a room.
+    levels : sequence of ((k, 3) float, (m, 3) int)
+        The vertices [m] and triangles of each level's solid: a space the walls enclose is
+        a room where levels cover at least ``ROOM_COVER`` of it, else a courtyard. Without
+        levels every enclosed space is a room.
 
     Returns
     -------
@@ -194,19 +196,38 @@ def read_plan(walls: Sequence[Tuple[str, np.ndarray]], levels: Sequence[np.ndarr
         for w, fp in footprints.items()
     }
     union = shapely.unary_union(list(grown.values()))
-    covers = [shapely.MultiPoint([tuple(p) for p in v[:, :2] - origin]).convex_hull for v in levels]
-    roofed = shapely.unary_union(covers) if covers else None
-    parts = []
+    roofed = _level_plan(shapely, levels, origin) if levels else None
+    # The spaces the walls enclose: the bounded parts of the complement of the walls. A
+    # space is a room (filled: part of its building) where the levels cover it, else a
+    # courtyard; nested rings (a courtyard's walls inside the outer walls) join through the
+    # rooms between them.
+    lo_x, lo_y, hi_x, hi_y = union.bounds
+    pad = max(hi_x - lo_x, hi_y - lo_y)
+    frame = shapely.box(lo_x - pad, lo_y - pad, hi_x + pad, hi_y + pad)
+    rooms = []
     yards = 0
-    for part in getattr(union, "geoms", [union]):
-        keep = []
-        for ring in part.interiors:
-            space = shapely.Polygon(ring)
-            if roofed is not None and space.intersection(roofed).area < ROOM_COVER * space.area:
-                keep.append(ring)  # a courtyard: no level covers it
-        yards += len(keep)
-        parts.append(shapely.Polygon(part.exterior, keep))
+    for space in getattr(frame.difference(union), "geoms", [frame.difference(union)]):
+        if space.exterior.coords[0] in frame.exterior.coords or space.touches(frame.exterior):
+            continue  # the outside
+        if roofed is None or space.intersection(roofed).area >= ROOM_COVER * space.area:
+            rooms.append(space)
+        else:
+            yards += 1
+    region = shapely.unary_union([union, *rooms])
+    parts = list(getattr(region, "geoms", [region]))
     return Plan(origin, footprints, grown, parts, gap, yards)
+
+
+def _level_plan(shapely: Any, levels: Sequence[Tuple[np.ndarray, np.ndarray]], origin: Any) -> Any:
+    """Return the union of the levels' triangles projected on the ground (their real plan)."""
+    tris = []
+    for v, f in levels:
+        xy = v[:, :2] - origin
+        for a, b, c in f:
+            tri = shapely.Polygon([tuple(xy[a]), tuple(xy[b]), tuple(xy[c])])
+            if tri.area > 0.0:
+                tris.append(tri)
+    return shapely.unary_union(tris)
 
 
 def _least_width(poly: Any) -> float:

@@ -155,3 +155,128 @@ def three_storey_spec(**extra: Any) -> dict[str, Any]:
     }  # fmt: skip
     doc.update(extra)
     return doc
+
+
+Plan2 = Sequence[tuple[float, float]]
+
+
+def ring_walls(ring: Plan2, t: float, prefix: str) -> list[tuple[str, Any, Any, float]]:
+    """The walls along a ring of outer-face corners, material on the left of each edge.
+
+    At a left turn (a convex corner of the material) the incoming wall runs to the corner and
+    the next one butts on its inner face; at a right turn (re-entrant) the incoming wall runs
+    on by ``t`` and the next one stands on its outer face. Returns (id, start, end, t): the
+    outer-face line of each wall, in plan [m].
+    """
+    import numpy as np
+
+    pts = [np.asarray(p, dtype=float) for p in ring]
+    n = len(pts)
+    out = []
+    for i in range(n):
+        a, b = pts[i], pts[(i + 1) % n]
+        d = (b - a) / float(np.linalg.norm(b - a))
+        prev, nxt = pts[i - 1], pts[(i + 2) % n]
+
+        def left_turn(p: Any, q: Any, r: Any) -> bool:
+            return float((q - p)[0] * (r - q)[1] - (q - p)[1] * (r - q)[0]) > 0.0
+
+        start = a + (t * d if left_turn(prev, a, b) else 0.0)
+        end = b + (0.0 if left_turn(a, b, nxt) else t * d)
+        out.append((f"{prefix}{i}", start, end, t))
+    return out
+
+
+def plan_scene(
+    out: Path,
+    walls: Sequence[tuple[str, Any, Any, float]],
+    h: float,
+    *,
+    rotate_deg: float = 0.0,
+    shift: tuple[float, float] = (0.0, 0.0),
+    mirror: bool = False,
+    slabs: Sequence[tuple[str, Plan2, Sequence[Plan2], float, float]] = (),
+    name: str = "plan",
+) -> Path:
+    """Walls (id, outer-face start, end, thickness; material on the left) of height ``h``.
+
+    ``slabs`` are horizontal levels (id, outline, holes, z0, z1). The whole scene is mirrored
+    in x = 0 (``mirror``), turned by ``rotate_deg`` about the vertical through the origin,
+    then moved by ``shift`` [m].
+    """
+    import math
+
+    import numpy as np
+
+    from cad_maths.geometry.polygon import triangulate_polygon
+
+    c, s = math.cos(math.radians(rotate_deg)), math.sin(math.radians(rotate_deg))
+    rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    flip = np.diag([-1.0, 1.0, 1.0]) if mirror else np.eye(3)
+    move = np.array([shift[0], shift[1], 0.0])
+
+    def place(v: Any) -> Any:
+        return v @ flip.T @ rot.T + move
+
+    bld = BUILD.Builder(name)
+    for wid, a, b, t in walls:
+        a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+        length = float(np.linalg.norm(b - a))
+        e_s = (b - a) / length
+        e_n = np.array([-e_s[1], e_s[0]])
+        v, f = BUILD.slab_solid(
+            (a[0], a[1], 0.0),
+            (e_s[0], e_s[1], 0.0),
+            (e_n[0], e_n[1], 0.0),
+            t,
+            [(0.0, 0.0), (length, 0.0), (length, h), (0.0, h)],
+        )
+        v = place(v)
+        if mirror:
+            f = f[:, ::-1]
+        bld.mesh(wid, "Walls", np.ascontiguousarray(v), np.ascontiguousarray(f), "brick")
+    for sid, outline, holes, z0, z1 in slabs:
+        rings = [np.asarray(outline, dtype=float)] + [np.asarray(hh, dtype=float) for hh in holes]
+        fixed = []
+        for k, r in enumerate(rings):
+            a2 = float(
+                np.dot(r[:, 0], np.roll(r[:, 1], -1)) - np.dot(np.roll(r[:, 0], -1), r[:, 1])
+            )
+            fixed.append(r if (a2 > 0.0) == (k == 0) else r[::-1])
+        pts = np.vstack(fixed)
+        m = len(pts)
+        tris = np.array(triangulate_polygon(fixed[0], fixed[1:]), dtype=np.int64)
+        bottom = np.column_stack([pts, np.full(m, z0)])
+        top = np.column_stack([pts, np.full(m, z1)])
+        faces = [tris[:, ::-1], tris + m]
+        start = 0
+        for r in fixed:
+            k = len(r)
+            for i in range(k):
+                p, q = start + i, start + (i + 1) % k
+                faces.append(np.array([[p, q, q + m], [p, q + m, p + m]]))
+            start += k
+        v = place(np.vstack([bottom, top]))
+        f = np.vstack(faces)
+        if mirror:
+            f = f[:, ::-1]
+        bld.mesh(sid, "Floors", np.ascontiguousarray(v), np.ascontiguousarray(f), "concrete")
+    return bld.write(out / f"{name}.3dm")
+
+
+def plan_spec(
+    ids: Sequence[str], connection: str = "poor", levels: Sequence[str] = (), **extra: Any
+) -> dict[str, Any]:
+    """A search spec for ``plan_scene``: every wall a façade of 1800 kg/m³, one connection."""
+    doc: dict[str, Any] = {
+        "walls": [{"id": i, "object": i, "density": 1800.0} for i in ids],
+        "default_junction": {"connection": connection, "unit": {"length": 0.25, "height": 0.12}},
+        "directions": ["outward"],
+        "families": ["overturning", "wedge_overturning"],
+    }
+    if levels:
+        doc["levels"] = [
+            {"id": lv, "objects": [lv], "density": 600.0, "kind": "floor"} for lv in levels
+        ]
+    doc.update(extra)
+    return doc

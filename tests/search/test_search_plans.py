@@ -1,0 +1,195 @@
+"""A gallery of plans (issue #37): each wall's outer face from the plan's topology.
+
+Every plan is drawn as rings of outer-face corners (``search_scenes.ring_walls``: material
+on the left of each edge) and searched through ``rockmech.search_from_files`` as drawn,
+turned by odd angles about the vertical, moved to georeferenced coordinates and mirrored.
+The references are written here, from the rings the test draws: a wall's outward normal is
+the right-hand normal of its edge; a wall at a right turn of its ring (a re-entrant corner)
+has the next wall standing on its outer face and cannot move outward; with poor junctions
+every other wall overturns alone, λ0 = t / h (its weight's lever t/2 over the load's h/2);
+with good ones, the wedge of the return wall is the polygon virtual work written below.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from search_scenes import plan_scene, plan_spec, ring_walls, write_spec
+
+import rockmech
+
+T, H = 0.5, 6.0
+PLANS: dict[str, list[list[tuple[float, float]]]] = {
+    "L_narrow": [[(0, 0), (10, 0), (10, 4), (4, 4), (4, 10), (0, 10)]],
+    "L_wide": [[(0, 0), (10, 0), (10, 7), (7, 7), (7, 10), (0, 10)]],
+    "T": [[(0, 0), (12, 0), (12, 4), (8, 4), (8, 10), (4, 10), (4, 4), (0, 4)]],
+    "U": [[(0, 0), (12, 0), (12, 10), (8, 10), (8, 4), (4, 4), (4, 10), (0, 10)]],
+    "two_buildings": [[(0, 0), (6, 0), (6, 5), (0, 5)], [(8, 0), (14, 0), (14, 5), (8, 5)]],
+}
+#: (angle [deg], shift [m], mirrored): as drawn, turned by odd angles, far away, mirrored.
+PLACES = [
+    (0.0, (0.0, 0.0), False),
+    (37.0, (4.0e5, 7.0e5), False),
+    (-123.4, (-3.5e5, 7.0e5), False),
+    (0.0, (0.0, 0.0), True),
+]
+
+
+def _left_turn(p: Any, q: Any, r: Any) -> bool:
+    p, q, r = (np.asarray(v, dtype=float) for v in (p, q, r))
+    return float((q - p)[0] * (r - q)[1] - (q - p)[1] * (r - q)[0]) > 0.0
+
+
+def _reference(rings: list[list[tuple[float, float]]]) -> tuple[dict[str, Any], dict[str, str]]:
+    """Each wall's outward unit normal in plan, and the held walls with the wall holding them."""
+    normals: dict[str, Any] = {}
+    held: dict[str, str] = {}
+    for k, ring in enumerate(rings):
+        n = len(ring)
+        for i in range(n):
+            a, b = np.asarray(ring[i], dtype=float), np.asarray(ring[(i + 1) % n], dtype=float)
+            d = (b - a) / float(np.linalg.norm(b - a))
+            normals[f"R{k}W{i}"] = np.array([d[1], -d[0]])
+            if not _left_turn(a, b, ring[(i + 2) % n]):
+                held[f"R{k}W{i}"] = f"R{k}W{(i + 1) % n}"
+    return normals, held
+
+
+def _place(vec: Any, angle: float, mirror: bool) -> Any:
+    v = np.array([-vec[0], vec[1]]) if mirror else np.asarray(vec, dtype=float)
+    c, s = math.cos(math.radians(angle)), math.sin(math.radians(angle))
+    return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
+
+
+def _walls(rings: list[list[tuple[float, float]]]) -> list[tuple[str, Any, Any, float]]:
+    return [w for k, ring in enumerate(rings) for w in ring_walls(ring, T, f"R{k}W")]
+
+
+def _search(tmp_path: Path, name: str, walls: Any, place: Any, **spec: Any) -> dict[str, Any]:
+    angle, shift, mirror = place
+    tag = f"{name}_{abs(int(angle))}_{int(mirror)}"
+    scene = plan_scene(
+        tmp_path, walls, spec.pop("h", H), rotate_deg=angle, shift=shift, mirror=mirror, name=tag
+    )
+    doc = plan_spec([w[0] for w in walls], **spec)
+    return rockmech.search_from_files(scene, write_spec(tmp_path / f"{tag}.json", doc)).doc
+
+
+@pytest.mark.parametrize("place", PLACES, ids=["drawn", "37deg_far", "-123deg_far", "mirrored"])
+@pytest.mark.parametrize("name", sorted(PLANS))
+def test_every_wall_of_a_plan_overturns_away_from_its_building(
+    tmp_path: Path, name: str, place: tuple[float, tuple[float, float], bool]
+) -> None:
+    rings = PLANS[name]
+    walls = _walls(rings)
+    normals, held = _reference(rings)
+    doc = _search(tmp_path, name, walls, place)
+    whole = {
+        c["facade"]: c
+        for c in doc["candidates"]
+        if c["family"] == "overturning" and c["parameters"]["hinge_height_m"] == 0.0
+    }
+    for wid, _, _, _ in walls:
+        if wid in held:
+            assert wid not in whole and not [c for c in doc["candidates"] if c["facade"] == wid]
+            (note,) = [
+                n for n in doc["notes"] if n.startswith(f"{wid}: {held[wid]} stands against")
+            ]
+            assert "cannot move outward" in note
+            continue
+        c = whole[wid]
+        assert c["lam0"] == pytest.approx(T / H, rel=1e-9, abs=0.0)
+        assert np.allclose(c["direction_vector"][:2], _place(normals[wid], place[0], place[2]))
+        assert abs(c["direction_vector"][2]) < 1e-12
+    # no corner of the re-entrant kind, nothing inside out: one candidate per free wall
+    assert len(doc["candidates"]) == len(walls) - len(held)
+    if len(rings) > 1:
+        assert any("2 separate buildings" in n for n in doc["notes"])
+    else:
+        assert not any("separate buildings" in n for n in doc["notes"])
+
+
+def _wedge_lam0(t: float, length: float, h: float, t_r: float, beta: float) -> float:
+    """λ0 of a façade (t × length × h) turning about its outer base edge with the triangular
+    wedge of a return wall (thickness t_r along the façade) cut at β from the vertical from
+    the junction's foot: virtual work of weights (lever n) against the load (lever z)."""
+    m_f = t * length * h
+    w = h * math.tan(beta)
+    m_w = t_r * h * w / 2.0
+    return (m_f * t / 2.0 + m_w * (t + w / 3.0)) / (m_f * h / 2.0 + m_w * 2.0 * h / 3.0)
+
+
+@pytest.mark.parametrize("place", PLACES[:3], ids=["drawn", "37deg_far", "-123deg_far"])
+def test_the_re_entrant_wing_of_an_l_takes_its_one_wedge(
+    tmp_path: Path, place: tuple[float, tuple[float, float], bool]
+) -> None:
+    """Issue #37: the narrow L's re-entrant walls were turned inside out (λ0 21-39 % high).
+
+    R0W3 (outer face x = 4 from y = 4 to 10) stands on R0W2's outer face at the re-entrant
+    corner and has a return wall only at its far end (R0W4, 3.5 m into the building): its
+    least outward mechanism is the overturning with that one wedge, at the bond angle.
+    """
+    h = 3.0
+    rings = PLANS["L_narrow"]
+    walls = _walls(rings)
+    doc = _search(tmp_path, "Lgood", walls, place, connection="good", h=h)
+    (c,) = [
+        c for c in doc["candidates"] if c["facade"] == "R0W3" and c["family"] == "wedge_overturning"
+    ]
+    beta_bond = math.atan(0.25 / (2 * 0.12))
+    beta_hi = math.atan(3.5 / h)
+    betas = np.linspace(beta_bond, beta_hi, 20001)
+    ref = min(_wedge_lam0(T, 6.0, h, T, b) for b in betas)
+    assert c["lam0"] == pytest.approx(ref, rel=1e-7)
+    (beta,) = [v for k, v in c["parameters"].items() if k.endswith("_rad")]
+    assert beta == pytest.approx(beta_bond, abs=1e-6)  # the least at the bond's bound
+    assert not [x for x in doc["candidates"] if x["facade"] == "R0W2"]  # held by R0W3
+    assert not [x for x in doc["candidates"] if x["family"] == "corner"]  # not asked
+
+
+def test_a_courtyard_block_faces_its_courtyard(tmp_path: Path) -> None:
+    """The walls round a courtyard face it; a floor over the rooms tells rooms from courtyard.
+
+    The courtyard's ring turns right at each corner (material outside it): each of its walls
+    runs on past the corner and the next stands on its courtyard face, which holds it. The
+    outer walls overturn outward alone (the floor's small share on their tops).
+    """
+    outer = [(0.0, 0.0), (14.0, 0.0), (14.0, 12.0), (0.0, 12.0)]
+    yard = [(4.0, 4.0), (4.0, 8.0), (10.0, 8.0), (10.0, 4.0)]  # clockwise: material outside
+    walls = ring_walls(outer, T, "O") + ring_walls(yard, T, "C")
+    slab = ("floor", outer, [yard], H, H + 0.2)
+    share = 0.01 * 600.0 * 0.2 * (14.0 * 12.0 - 6.0 * 4.0)  # tributary x the floor's mass [kg]
+    for angle, shift, _ in PLACES[:3]:
+        tag = f"yard_{abs(int(angle))}"
+        scene = plan_scene(
+            tmp_path, walls, H, rotate_deg=angle, shift=shift, slabs=[slab], name=tag
+        )
+        spec = plan_spec([w[0] for w in walls], levels=["floor"])
+        spec["levels"][0]["tributary"] = 0.01
+        doc = rockmech.search_from_files(scene, write_spec(tmp_path / f"{tag}.json", spec)).doc
+        notes = doc["notes"]
+        by_wall = {c["facade"]: c for c in doc["candidates"]}
+        for k, (wid, a, b, _) in enumerate(walls):
+            if wid.startswith("C"):
+                assert f"{wid}: its outer face is on a courtyard of its building" in notes
+                holder = walls[4 + (k - 4 + 1) % 4][0]
+                assert any(
+                    n.startswith(f"{wid}: {holder} stands against its outer face") for n in notes
+                )
+                assert wid not in by_wall
+                continue
+            c = by_wall[wid]
+            d = (np.asarray(b) - np.asarray(a)) / float(np.linalg.norm(np.asarray(b) - a))
+            assert np.allclose(
+                c["direction_vector"][:2], _place(np.array([d[1], -d[0]]), angle, False)
+            )
+            length = float(np.linalg.norm(np.asarray(b) - a))
+            m = 1800.0 * T * length * H
+            # the floor bears on the wall's whole top: its share acts at n = t/2, z = H
+            ref = (m + share) * (T / 2.0) / (m * H / 2.0 + share * H)
+            assert c["lam0"] == pytest.approx(ref, rel=1e-9)
+        assert not any("separate buildings" in n for n in notes)
