@@ -63,6 +63,11 @@ PRISM_RTOL = 1e-9
 FACE_COS = 0.5
 #: Largest angle between two walls' directions taken as perpendicular [rad].
 SQUARE_TOL = 1e-3
+#: Footprints sharing less than this fraction of the smaller one's area do not overlap (the
+#: rounding of a shared face).
+OVERLAP_RTOL = 1e-9
+#: The name a wall trimmed where it ran into another wall gains.
+TRIMMED = " (trimmed)"
 #: Namespace of the ids of walls with openings cut out of them.
 NAMESPACE = uuid.UUID("2b5d8c1e-6f0a-4f4e-9a3b-7d1c0e9f3a51")
 
@@ -546,7 +551,25 @@ def _cut_openings(
     ]
     if not hits:
         return wall_obj, mesh, []
-    manifold3d = require("manifold3d", "geometry", "to cut openings out of walls")
+    obj, cut, notes = _subtract(wall_obj, mesh, hits, name, OPENINGS_SUFFIX)
+    said = ", ".join(o.label() for o, _ in hits)
+    notes.append(
+        f"{name}: the openings {said} are cut out of the wall; the search's scene holds the "
+        f"result as a new object {obj.name!r} (id {obj.id}), which the search spec selects"
+    )
+    return obj, cut, notes
+
+
+def _subtract(
+    wall_obj: SceneObject,
+    mesh: TriMesh,
+    cutters: List[Tuple[SceneObject, TriMesh]],
+    name: str,
+    suffix: str,
+) -> Tuple[SceneObject, TriMesh, List[str]]:
+    """Return the wall less the cutters' solids (manifold3d), as a new object of the scene."""
+    manifold3d = require("manifold3d", "geometry", "to cut solids out of walls")
+    lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
     ref = 0.5 * (lo + hi)
 
     def solid(m: TriMesh) -> Any:
@@ -558,22 +581,101 @@ def _cut_openings(
         )
 
     body = solid(mesh)
-    for _, m in hits:
+    for _, m in cutters:
         body = body - solid(m)
     out = body.to_mesh64()
     verts = np.asarray(out.vert_properties, dtype=np.float64)[:, :3] + ref
     faces = np.asarray(out.tri_verts, dtype=np.int64)
-    new_id = str(uuid.uuid5(NAMESPACE, f"{wall_obj.id}/" + "/".join(o.id for o, _ in hits)))
-    new_name = (wall_obj.name or name) + OPENINGS_SUFFIX
+    new_id = str(uuid.uuid5(NAMESPACE, f"{wall_obj.id}/" + "/".join(o.id for o, _ in cutters)))
+    base = wall_obj.name or name
+    new_name = base if base.endswith(suffix) else base + suffix
     cut = TriMesh(verts, faces, new_name, {"id": new_id, "layer": wall_obj.layer, "kind": "mesh"})
     cut, notes = check_solid(cut)
     obj = SceneObject(new_id, new_name, wall_obj.layer, "mesh", dict(wall_obj.user_text), cut)
-    said = ", ".join(o.label() for o, _ in hits)
-    notes.append(
-        f"{name}: the openings {said} are cut out of the wall; the search's scene holds the "
-        f"result as a new object {new_name!r} (id {new_id}), which the search spec selects"
-    )
     return obj, cut, notes
+
+
+def _trim_overlaps(raw: List[Tuple[Any, SceneObject, TriMesh, Any]], notes: List[str]) -> None:
+    """Trim a wall drawn into another at its end (a CAD corner); refuse other overlaps.
+
+    Walls whose footprints overlap share volume. Where the shared part lies at one wall's
+    end and is no deeper along that wall than the other wall's thickness, the wall is read
+    as meeting the other's face: it is trimmed there (``_subtract``) and a note gives the
+    depth and the volume. Any other overlap is refused with both walls and the volume.
+    """
+    shapely = require("shapely", "geometry", "to read the plan of a search")
+    ref = np.vstack([m.vertices for _, _, m, _ in raw]).mean(axis=0)
+    feet = [
+        shapely.MultiPoint([tuple(p) for p in m.vertices[:, :2] - ref[:2]]).convex_hull
+        for _, _, m, _ in raw
+    ]
+    for i in range(len(raw)):
+        for j in range(i + 1, len(raw)):
+            shared = feet[i].intersection(feet[j])
+            small = OVERLAP_RTOL * min(feet[i].area, feet[j].area)
+            if shared.area <= small:
+                continue
+            zi, zj = raw[i][2].vertices[:, 2], raw[j][2].vertices[:, 2]
+            dz = min(float(zi.max()), float(zj.max())) - max(float(zi.min()), float(zj.min()))
+            if dz <= 0.0:
+                continue
+            volume = shared.area * dz
+            for k, o in ((j, i), (i, j)):  # the later wall is trimmed first
+                depth = _end_depth(feet[k], shared)
+                if depth is not None and depth <= _least_side(feet[o]) * (1.0 + 1e-9):
+                    w, obj, mesh, _ = raw[k]
+                    new, cut, warn = _subtract(obj, mesh, [(raw[o][1], raw[o][2])], w.id, TRIMMED)
+                    notes.extend(warn)
+                    notes.append(
+                        f"{w.id} runs {depth:.3f} m into {raw[o][0].id} ({volume:.3g} m³ shared): "
+                        f"read as meeting its face, and trimmed there; the search's scene holds "
+                        f"the trimmed wall as a new object {new.name!r}, which the spec selects"
+                    )
+                    raw[k] = (w, new, cut, new.name)
+                    feet[k] = shapely.MultiPoint(
+                        [tuple(p) for p in cut.vertices[:, :2] - ref[:2]]
+                    ).convex_hull
+                    break
+            else:
+                raise GeometryError(
+                    f"the walls {raw[i][0].id} and {raw[j][0].id} overlap by {volume:.3g} m³, "
+                    "not at one wall's end within the other's thickness: redraw them to meet "
+                    "face to face (a wall is one solid, and two walls share no volume)"
+                )
+
+
+def _end_depth(foot: Any, shared: Any) -> Optional[float]:
+    """How far the shared part reaches into a wall from one of its ends [m], or None.
+
+    None where the shared part does not start at an end of the wall's footprint (it lies
+    in the wall's middle, or covers it all).
+    """
+    rect = np.asarray(foot.minimum_rotated_rectangle.exterior.coords, dtype=float)
+    sides = np.diff(rect[:3], axis=0)
+    axis = sides[int(np.argmax(np.linalg.norm(sides, axis=1)))]
+    axis = axis / float(np.linalg.norm(axis))
+    along = np.asarray(foot.exterior.coords, dtype=float) @ axis
+    part = (
+        np.asarray(shared.exterior.coords, dtype=float) @ axis
+        if shared.geom_type == "Polygon"
+        else None
+    )
+    if part is None:
+        return None
+    lo, hi = float(along.min()), float(along.max())
+    a, b = float(part.min()), float(part.max())
+    eps = 1e-9 * (hi - lo)
+    if a <= lo + eps and b < hi - eps:
+        return b - lo
+    if b >= hi - eps and a > lo + eps:
+        return hi - a
+    return None
+
+
+def _least_side(foot: Any) -> float:
+    """Return the smaller side of a footprint's least rotated rectangle [m]."""
+    rect = np.asarray(foot.minimum_rotated_rectangle.exterior.coords, dtype=float)
+    return float(np.linalg.norm(np.diff(rect[:3], axis=0), axis=1).min())
 
 
 def _unit_angle(unit: Any) -> float:
@@ -595,40 +697,44 @@ def _junction(spec: Any, a: str, b: str) -> Tuple[str, Optional[Any], str]:
 
 
 def _return_at(
-    a: Wall, b: Wall, tol: float
-) -> Optional[Tuple[str, bool, Tuple[float, float], float]]:
-    """Tell whether wall b meets façade a at one of a's ends: (end, corner, span, reach) or None.
+    a: Wall, b: Wall, tol: float, join: float = 0.0
+) -> Optional[Tuple[str, bool, Tuple[float, float], float, float]]:
+    """Tell whether wall b meets façade a at one of a's ends.
 
-    Two arrangements count: b's end face on a's inner face near a's end (b abuts a), or
-    a's end face on b's side face (a butts into b, which runs past a's end). ``corner``:
-    the two walls are flush at the outside.
+    Returns ``(end, corner, span, reach, gap)`` or None. Two arrangements count: b's end
+    face on a's inner face near a's end (b abuts a), or a's end face on b's side face (a
+    butts into b, which runs past a's end). ``corner``: the two walls are flush at the
+    outside. Faces up to ``join`` apart [m] (the plan's joining gap) meet; ``gap`` is how
+    far apart they are drawn [m].
     """
     fa = a.frame
     if abs(abs(float(b.frame.e_n @ fa.e_s)) - 1.0) > SQUARE_TOL:
         return None
+    near = max(tol, join)
     local = fa.to_frame(b.mesh.vertices)
     s0, s1 = float(local[:, 0].min()), float(local[:, 0].max())
     n0, n1 = float(local[:, 1].min()), float(local[:, 1].max())
     z0, z1 = float(local[:, 2].min()), float(local[:, 2].max())
     t_a = float(fa.to_frame(a.mesh.vertices)[:, 1].max())
-    if z1 <= a.z_lo + tol or z0 >= a.z_hi - tol or n1 <= t_a + tol:
+    if z1 <= a.z_lo + tol or z0 >= a.z_hi - tol or n1 <= t_a + near:
         return None
-    if abs(n0 - t_a) <= tol and s0 >= -tol and s1 <= a.length + tol:
-        if s0 <= fa.thickness + tol:
-            return "start", abs(s0) <= tol, (s0, s1), n1 - t_a
-        if s1 >= a.length - fa.thickness - tol:
-            return "end", abs(s1 - a.length) <= tol, (s0, s1), n1 - t_a
-        return "middle", False, (s0, s1), n1 - t_a
-    if n0 <= tol:
-        if abs(s1) <= tol:
-            return "start", abs(n0) <= tol, (s0, s1), n1 - t_a
-        if abs(s0 - a.length) <= tol:
-            return "end", abs(n0) <= tol, (s0, s1), n1 - t_a
+    if abs(n0 - t_a) <= near and s0 >= -near and s1 <= a.length + near:
+        gap = abs(n0 - t_a)
+        if s0 <= fa.thickness + near:
+            return "start", abs(s0) <= near, (s0, s1), n1 - t_a, gap
+        if s1 >= a.length - fa.thickness - near:
+            return "end", abs(s1 - a.length) <= near, (s0, s1), n1 - t_a, gap
+        return "middle", False, (s0, s1), n1 - t_a, gap
+    if n0 <= near:
+        if abs(s1) <= near:
+            return "start", abs(n0) <= near, (s0, s1), n1 - t_a, abs(s1)
+        if abs(s0 - a.length) <= near:
+            return "end", abs(n0) <= near, (s0, s1), n1 - t_a, abs(s0 - a.length)
     return None
 
 
 def _returns(
-    walls: Dict[str, Wall], spec: Any, tol: float, notes: List[str]
+    walls: Dict[str, Wall], spec: Any, tol: float, notes: List[str], join: float = 0.0
 ) -> Dict[str, List[ReturnWall]]:
     out: Dict[str, List[ReturnWall]] = {w: [] for w in walls}
     listed = {tuple(sorted(j.walls)) for j in spec.junctions}
@@ -637,11 +743,18 @@ def _returns(
         for b in walls.values():
             if b.id == a.id:
                 continue
-            found = _return_at(a, b, tol)
+            found = _return_at(a, b, tol, join)
             if found is None:
                 continue
-            end, corner, span, reach = found
-            met.add(tuple(sorted([a.id, b.id])))
+            end, corner, span, reach, gap = found
+            pair = tuple(sorted([a.id, b.id]))
+            if gap > tol and pair not in met:
+                notes.append(
+                    f"{b.id} and {a.id} are drawn {1000 * gap:.3g} mm apart: read as meeting "
+                    f"(walls up to {1000 * join:.3g} mm apart join, a tenth of the thinner one's "
+                    "thickness)"
+                )
+            met.add(pair)
             if not a.is_facade:
                 continue
             if end == "middle":
@@ -848,8 +961,10 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
                 m, warn = check_solid(scene.mesh(o))
                 notes.extend(warn)
                 memory.add(SceneObject(o.id, o.name, o.layer, "mesh", dict(o.user_text), m))
-        memory.add(obj)
         raw.append((w, obj, mesh, selector))
+    _trim_overlaps(raw, notes)
+    for _, obj, _, _ in raw:
+        memory.add(obj)
     verts = np.vstack([m.vertices for _, _, m, _ in raw])
     size = float(np.linalg.norm(verts.max(axis=0) - verts.min(axis=0)))
     level_meshes = [
@@ -905,7 +1020,7 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
                 "(the whole façade above a hinge line, its corners) are not searched"
             )
     tol = max(contact_tolerance(scene), 1e-9 * size)
-    returns = _returns(walls, spec, tol, notes)
+    returns = _returns(walls, spec, tol, notes, plan.gap)
     contacts, level_objects = _level_contacts(scene, spec, walls, tol, notes, memory)
     ties = _tie_points(scene, spec, walls, memory)
     return Building(memory, walls, returns, contacts, ties, notes, spec, level_objects, tol)

@@ -193,3 +193,62 @@ def test_a_courtyard_block_faces_its_courtyard(tmp_path: Path) -> None:
             ref = (m + share) * (T / 2.0) / (m * H / 2.0 + share * H)
             assert c["lam0"] == pytest.approx(ref, rel=1e-9)
         assert not any("separate buildings" in n for n in notes)
+
+
+def _wedge_box_scene(tmp_path: Path, gap: float, name: str, middle: bool = False) -> Path:
+    """``wedge_facade`` drawn as boxes, its return walls ``gap`` off the façade's inner face
+    (negative: running into it); ``middle`` adds a cross wall through the façade's middle."""
+    from search_scenes import BUILD
+
+    b = BUILD.Builder(name)
+    b.box("facade", "Walls", (0.0, 0.0, 0.0), (0.5, 8.0, 9.0), "brick")
+    b.box("left", "Walls", (0.5 + gap, 0.0, 0.0), (12.5 + gap, 0.5, 9.0), "brick")
+    b.box("right", "Walls", (0.5 + gap, 7.5, 0.0), (12.5 + gap, 8.0, 9.0), "brick")
+    if middle:
+        b.box("cross", "Walls", (-1.0, 3.75, 0.0), (12.5, 4.25, 9.0), "brick")
+    return b.write(tmp_path / f"{name}.3dm")
+
+
+def _wedge_doc(tmp_path: Path, scene: Path, **spec: Any) -> dict[str, Any]:
+    from search_scenes import wedge_spec
+
+    doc = wedge_spec("good", families=["overturning", "wedge_overturning"], **spec)
+    return rockmech.search_from_files(scene, write_spec(tmp_path / "s.json", doc)).doc
+
+
+def test_walls_drawn_a_little_apart_or_into_each_other_meet_and_the_notes_say_so(
+    tmp_path: Path,
+) -> None:
+    """Issue #37: return walls 2 mm short, or 10 cm into the façade, lost their junctions."""
+    touching = _wedge_doc(tmp_path, _wedge_box_scene(tmp_path, 0.0, "touch"))
+    best = touching["candidates"][0]
+    assert best["family"] == "wedge_overturning"
+    short = _wedge_doc(tmp_path, _wedge_box_scene(tmp_path, 0.002, "short"))
+    assert short["candidates"][0]["family"] == "wedge_overturning"
+    # the wedge starts 2 mm further in: λ0 within a part in 1e4 of the touching walls'
+    assert short["candidates"][0]["lam0"] == pytest.approx(best["lam0"], rel=1e-3)
+    for wall in ("L", "R"):
+        assert f"{wall} and F are drawn 2 mm apart: read as meeting" in " ".join(short["notes"])
+    into = _wedge_doc(tmp_path, _wedge_box_scene(tmp_path, -0.1, "into"))
+    assert into["candidates"][0]["lam0"] == pytest.approx(best["lam0"], rel=1e-12)
+    for wall in ("L", "R"):
+        (note,) = [n for n in into["notes"] if n.startswith(f"{wall} runs 0.100 m into F")]
+        assert "(0.45 m³ shared)" in note  # 0.1 x 0.5 x 9 m
+    # beyond the joining gap (a tenth of 0.5 m) the walls are apart, and the notes say so
+    apart = _wedge_doc(tmp_path, _wedge_box_scene(tmp_path, 0.06, "apart"))
+    assert any("3 separate buildings" in n for n in apart["notes"])
+    assert apart["candidates"][0]["lam0"] == pytest.approx(0.5 / 9.0, rel=1e-12)
+
+
+def test_walls_overlapping_in_their_middles_are_refused_with_the_volume(tmp_path: Path) -> None:
+    scene = _wedge_box_scene(tmp_path, 0.0, "cross", middle=True)
+    spec = {"walls": [{"id": "X", "object": "cross", "density": 1800.0, "facade": False}]}
+    with pytest.raises(rockmech.GeometryError) as err:
+        _wedge_doc(tmp_path, scene, **{"walls": _wedge_walls() + spec["walls"]})
+    assert "the walls F and X overlap by 2.25 m³" in str(err.value)  # 0.5 x 0.5 x 9 m
+
+
+def _wedge_walls() -> list[dict[str, Any]]:
+    from search_scenes import wedge_spec
+
+    return list(wedge_spec()["walls"])
