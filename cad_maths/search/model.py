@@ -22,6 +22,7 @@
 Python 3.9-clean: imported by Rhino 8.
 """
 
+import dataclasses
 import math
 import uuid
 from dataclasses import dataclass, field
@@ -67,9 +68,15 @@ __all__ = [
 #: A wall whose volume equals its elevation area times its thickness to this relative
 #: tolerance is an exact prism (the search's geometry is then the builder's, to rounding).
 PRISM_RTOL = 1e-9
-#: A wall whose faces lean less than this (tan, dn/dz) is plumb; more is idealised plumb with
-#: a note (``_axes_notes``): a nanometre per metre, far below any drawing's care.
-LEAN_MIN = 1e-9
+#: A wall whose top is offset from its base by less than this fraction of its thickness is
+#: read as drawn (a scan's relief, a trowel's wander: it moves the bare wall's λ0 by less than
+#: this fraction, and the builder's comparison still reports it); more is out of plumb, read
+#: as the plumb prism on its base with a note (``_lean_note``).
+LEAN_RTOL = 0.01
+#: A wall that is not a prism has its base within this fraction of its height of its lowest
+#: point: its idealised prism's outer face is the base's (where it rocks; a scan's relief above
+#: it does not move the hinge), as the builder's axis must touch the base (``TOUCH_RTOL``).
+BASE_RTOL = 1e-3
 #: Smallest |cos| between a face normal and the thickness direction for a face of the outer
 #: side (faces within 60 degrees).
 FACE_COS = 0.5
@@ -507,10 +514,14 @@ def _orient(
         axes = axes.flipped()
         e_n, e_s = axes.e_n, axes.e_s
     e_z = np.array([0.0, 0.0, 1.0])
-    leans = abs(axes.lean) > LEAN_MIN
     z_lo = float(v[:, 2].min())
-    # a wall out of plumb is read as the plumb prism on its base (n measured off its lean)
-    n = v @ e_n - (axes.lean * (v[:, 2] - z_lo) if leans else 0.0)
+    n = v @ e_n
+    offset = abs(axes.lean) * (float(v[:, 2].max()) - z_lo)
+    leans = offset > LEAN_RTOL * float(n.max() - n.min() - offset)
+    if leans:  # out of plumb: read as the plumb prism on its base (n measured off the lean)
+        n = n - axes.lean * (v[:, 2] - z_lo)
+    else:
+        axes = dataclasses.replace(axes, lean=0.0)
     s = v @ e_s
     t = float(n.max() - n.min())
     origin = float(s.min()) * e_s + float(n.min()) * e_n
@@ -527,9 +538,12 @@ def _orient(
         notes.append(
             f"{name}: not a prism of constant thickness (volume {volume:.6g} m³, outer face "
             f"{area:.6g} m² x {t:.6g} m): the search idealises it with the thickness "
-            f"{t_eff:.6g} m that keeps its mass; the constants come from the real solid and "
-            "the search reports the difference"
+            f"{t_eff:.6g} m that keeps its mass, its outer face on its base's (the edge it "
+            "rocks about); the constants come from the real solid and the search reports the "
+            "difference"
         )
+        base = v[:, 2] <= z_lo + BASE_RTOL * height[0]
+        origin = float(s.min()) * e_s + float(n[base].min()) * e_n
         frame = WallFrame(origin, e_s, e_n, e_z, t_eff)
     held = _held_by(plan, reading.covered[1 if flip else 0], e_s if not flip else -e_s, frame)
     return frame, rings, volume, exact, notes, (held, reading.building)
@@ -563,7 +577,7 @@ def _axes_notes(axes: WallAxes, name: str, height: Tuple[float, float], t: float
             "overturns first; its overturning across the longer side (λ0 "
             f"{long_side / short_side:.3g} times as large for the bare block) is not searched"
         )
-    if abs(axes.lean) > LEAN_MIN:
+    if axes.lean != 0.0:
         notes.append(_lean_note(axes, name, height, t))
     return notes
 
@@ -598,6 +612,11 @@ def _lean_note(axes: WallAxes, name: str, height: Tuple[float, float], t: float)
         f"reports the difference (for the bare wall overturning outward about its base, the "
         f"real λ0 is {ratio:.3g} times the prism's)"
     )
+    if way == "outward":
+        said += (
+            "; leaning outward, the real wall resists outward overturning less than the plumb "
+            "prism: read the builder's λ0"
+        )
     if abs(shift) >= 0.5 * t:
         said += (
             f"; its centre of mass lies beyond its base's {'inner' if shift > 0.0 else 'outer'} "
