@@ -311,3 +311,35 @@ def test_the_doc_json_of_a_pier_is_the_same_when_turned(tmp_path: Path) -> None:
         for key in ("lam0", "mass_kg", "lam_linearised"):
             assert c[key] == pytest.approx(first[key], rel=1e-9), key
         assert json.dumps(c["parameters"]) == json.dumps(first["parameters"])
+
+
+@pytest.mark.parametrize("place", PLACES[:2], ids=PLACE_IDS[:2])
+def test_a_square_pier_carrying_a_level_moves_away_from_it(
+    tmp_path: Path, place: tuple[float, tuple[float, float], bool]
+) -> None:
+    """A slab on the pier reaching 2 m out along +x: the pier's thickness is taken along x
+    (the side facing its level), it overturns along -x, and the builder agrees."""
+    b = 1.0
+    slab = _prism(_rect(0.0, 0.0, 3.0, b), [], 0.2)
+    slab = (slab[0] + np.array([0.0, 0.0, H]), slab[1])
+    angle, shift, mirror = place
+    m = _placement(angle, mirror)
+    bld = BUILD.Builder("pier_slab")
+    for wid, (v, f), layer in (("P", _prism(_rect(0.0, 0.0, b, b), [], H), "Walls"),
+                               ("S", slab, "Floors")):  # fmt: skip
+        v = v @ m.T + np.array([shift[0], shift[1], 0.0])
+        bld.mesh(wid, layer, np.ascontiguousarray(v), np.ascontiguousarray(f), "brick")
+    scene = bld.write(tmp_path / "pier_slab.3dm")
+    doc = {
+        "walls": [{"id": "P", "object": "P", "density": 1800.0}],
+        "levels": [{"id": "S", "kind": "floor", "objects": ["S"], "density": 2400.0}],
+        "families": ["overturning"],
+        "directions": ["outward"],
+        "ranking": {"n_frequencies": 20, "records": []},
+    }
+    out = rockmech.search_from_files(scene, write_spec(tmp_path / "s.json", doc)).doc
+    c = _whole(out)["P"]
+    assert np.allclose(c["direction_vector"], m @ np.array([-1.0, 0.0, 0.0]), atol=1e-9)
+    assert c["builder"]["agrees"], c["builder"]
+    (note,) = [n for n in out["notes"] if n.startswith("P: a square pier")]
+    assert "the side that faces the levels it carries" in note
