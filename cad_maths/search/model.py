@@ -22,6 +22,7 @@
 Python 3.9-clean: imported by Rhino 8.
 """
 
+import dataclasses
 import math
 import uuid
 from dataclasses import dataclass, field
@@ -39,7 +40,16 @@ from cad_maths.mechanisms.single import find_objects
 from cad_maths.mechanisms.thrust import roof_thrust
 from cad_maths.scene_base import SceneObject
 from cad_maths.search.plan import Plan, outer_side, read_plan
-from cad_maths.search.prism import Lump, WallFrame, clip_rings, frame_from_mesh, ring_moments
+from cad_maths.search.prism import (
+    PIER_ASPECT_MIN,
+    PLUMB_TOL_DEG,
+    Lump,
+    WallAxes,
+    WallFrame,
+    clip_rings,
+    frame_from_mesh,
+    ring_moments,
+)
 from cad_maths.search.scene import OPENINGS_SUFFIX, MemoryScene
 from shared_schema.errors import GeometryError, InputError
 from shared_schema.extras import require
@@ -58,6 +68,15 @@ __all__ = [
 #: A wall whose volume equals its elevation area times its thickness to this relative
 #: tolerance is an exact prism (the search's geometry is then the builder's, to rounding).
 PRISM_RTOL = 1e-9
+#: A wall whose top is offset from its base by less than this fraction of its thickness is
+#: read as drawn (a scan's relief, a trowel's wander: it moves the bare wall's λ0 by less than
+#: this fraction, and the builder's comparison still reports it); more is out of plumb, read
+#: as the plumb prism on its base with a note (``_lean_note``).
+LEAN_RTOL = 0.01
+#: A wall that is not a prism has its base within this fraction of its height of its lowest
+#: point: its idealised prism's outer face is the base's (where it rocks; a scan's relief above
+#: it does not move the hinge), as the builder's axis must touch the base (``TOUCH_RTOL``).
+BASE_RTOL = 1e-3
 #: Smallest |cos| between a face normal and the thickness direction for a face of the outer
 #: side (faces within 60 degrees).
 FACE_COS = 0.5
@@ -471,8 +490,9 @@ def _orient(
     building's plan with its inner side.
     """
     v = mesh.vertices
-    e_n, e_s = frame_from_mesh(v, mesh.faces, name)
     com = v.mean(axis=0)
+    axes = frame_from_mesh(v, mesh.faces, name, None if levels is None else levels - com)
+    e_n, e_s = axes.e_n, axes.e_s
     reading = plan.read_faces(name, e_n, e_s, v[:, :2])
     outer, lone_notes = outer_side(reading, name)
     toward = None if levels is None else float((levels - com) @ e_n)
@@ -491,9 +511,17 @@ def _orient(
         # A lone wall without levels: a fixed rule (e_n towards +x, else +y) names its sides.
         flip = e_n[0] < -1e-12 or (abs(e_n[0]) <= 1e-12 and e_n[1] < 0.0)
     if flip:
-        e_n, e_s = -e_n, -e_s
+        axes = axes.flipped()
+        e_n, e_s = axes.e_n, axes.e_s
     e_z = np.array([0.0, 0.0, 1.0])
+    z_lo = float(v[:, 2].min())
     n = v @ e_n
+    offset = abs(axes.lean) * (float(v[:, 2].max()) - z_lo)
+    leans = offset > LEAN_RTOL * float(n.max() - n.min() - offset)
+    if leans:  # out of plumb: read as the plumb prism on its base (n measured off the lean)
+        n = n - axes.lean * (v[:, 2] - z_lo)
+    else:
+        axes = dataclasses.replace(axes, lean=0.0)
     s = v @ e_s
     t = float(n.max() - n.min())
     origin = float(s.min()) * e_s + float(n.min()) * e_n
@@ -501,19 +529,101 @@ def _orient(
     rings = _elevation(mesh, frame, name)
     area = float(ring_moments(rings)[0])
     volume = float(mass_properties(mesh, 1.0).volume)
-    notes: List[str] = lone_notes
-    exact = abs(volume - area * t) <= PRISM_RTOL * volume
-    if not exact:
+    moments = ring_moments(rings)
+    height = (float(v[:, 2].max()) - z_lo, float(moments[2] / moments[0]) - z_lo)
+    notes: List[str] = lone_notes + _axes_notes(axes, name, height, t)
+    exact = abs(volume - area * t) <= PRISM_RTOL * volume and not leans
+    if abs(volume - area * t) > PRISM_RTOL * volume:
         t_eff = volume / area
         notes.append(
             f"{name}: not a prism of constant thickness (volume {volume:.6g} m³, outer face "
             f"{area:.6g} m² x {t:.6g} m): the search idealises it with the thickness "
-            f"{t_eff:.6g} m that keeps its mass; the constants come from the real solid and "
-            "the search reports the difference"
+            f"{t_eff:.6g} m that keeps its mass, its outer face on its base's (the edge it "
+            "rocks about); the constants come from the real solid and the search reports the "
+            "difference"
         )
+        base = v[:, 2] <= z_lo + BASE_RTOL * height[0]
+        origin = float(s.min()) * e_s + float(n[base].min()) * e_n
         frame = WallFrame(origin, e_s, e_n, e_z, t_eff)
     held = _held_by(plan, reading.covered[1 if flip else 0], e_s if not flip else -e_s, frame)
     return frame, rings, volume, exact, notes, (held, reading.building)
+
+
+def _axes_notes(axes: WallAxes, name: str, height: Tuple[float, float], t: float) -> List[str]:
+    """Return the notes of a pier's frame and of a wall read as plumb (``prism.frame_from_mesh``).
+
+    ``height`` is the wall's height and its elevation's centroid height above its base [m];
+    ``t`` the thickness of its plumb prism [m].
+    """
+    notes = []
+    long_side, short_side = axes.plan
+    if axes.square:
+        rule = (
+            "the side that faces the levels it carries"
+            if axes.rule == "levels"
+            else "the side nearer the x axis (a fixed rule)"
+        )
+        notes.append(
+            f"{name}: a square pier ({long_side:.3f} x {short_side:.3f} m in plan), which "
+            f"overturns alike across either side as a bare block: its thickness is taken "
+            f"across {rule}, and only that direction is searched (a load that differs by "
+            "direction, a roof's thrust, needs a mechanism spec for the other)"
+        )
+    elif axes.pier:
+        notes.append(
+            f"{name}: a pier ({long_side:.3f} x {short_side:.3f} m in plan, sides in a ratio "
+            f"{long_side / short_side:.3g} below {PIER_ASPECT_MIN:g}): its thickness is read "
+            f"across its shorter side ({short_side:.3f} m), about which the bare block "
+            "overturns first; its overturning across the longer side (λ0 "
+            f"{long_side / short_side:.3g} times as large for the bare block) is not searched"
+        )
+    if axes.lean != 0.0:
+        notes.append(_lean_note(axes, name, height, t))
+    return notes
+
+
+def _lean_note(axes: WallAxes, name: str, height: Tuple[float, float], t: float) -> str:
+    """Return the note of a wall out of plumb, read as the plumb prism on its base (module doc).
+
+    Notes
+    -----
+    The real solid's centre of mass lies ``lean * z_c`` off the prism's along ``e_n``
+    (``z_c`` the centroid's height above the base): for the whole wall overturning outward
+    about its base as a bare wall, the real λ0 is ``(t + 2 lean z_c) / t`` times the
+    prism's ``t / h`` (above 1 for a lean inward).
+    """
+    h, z_c = height
+    deg = math.degrees(math.atan(abs(axes.lean)))
+    way = "inward" if axes.lean > 0.0 else "outward"
+    shift = axes.lean * z_c
+    lo, hi = (math.degrees(math.atan(x)) for x in axes.lean_faces)
+    faces = (
+        f" (its outer face {lo:.2f} and its inner face {hi:.2f} degrees: a batter)"
+        if abs(lo - hi) > 1e-6
+        else ""
+    )
+    ratio = (t + 2.0 * shift) / t
+    said = (
+        f"{name}: {deg:.2f} degrees out of plumb{faces}, its top {abs(axes.lean) * h:.3f} m "
+        f"{way} of its base over its {h:.3f} m height (within {PLUMB_TOL_DEG:g} degrees): the "
+        f"search idealises it as a plumb prism standing on its base, of the same mass "
+        f"({t:.3f} m thick across; the real solid's centre of mass lies {abs(shift):.3f} m "
+        f"{way} of the prism's); the builder's constants use the real solid, and the search "
+        f"reports the difference (for the bare wall overturning outward about its base, the "
+        f"real λ0 is {ratio:.3g} times the prism's)"
+    )
+    if way == "outward":
+        said += (
+            "; leaning outward, the real wall resists outward overturning less than the plumb "
+            "prism: read the builder's λ0"
+        )
+    if abs(shift) >= 0.5 * t:
+        said += (
+            f"; its centre of mass lies beyond its base's {'inner' if shift > 0.0 else 'outer'} "
+            "edge: alone it would fall, and it stands only as the walls and levels around it "
+            "hold it"
+        )
+    return said
 
 
 def _held_by(

@@ -29,7 +29,10 @@ import numpy as np
 from shared_schema.errors import GeometryError
 
 __all__ = [
+    "PIER_ASPECT_MIN",
+    "PLUMB_TOL_DEG",
     "Lump",
+    "WallAxes",
     "WallFrame",
     "clip_rings",
     "point_lump",
@@ -47,6 +50,25 @@ Axes = Tuple[List[float], List[float], List[float], List[float]]
 #: Rings up to this many vertices are integrated and clipped in plain Python (faster than
 #: numpy's per-call overhead on the few vertices of a block); longer ones (scans) in numpy.
 LOOP_MAX = 64
+#: Faces within this angle of the vertical are a wall's sides [deg]: an old wall's lean, or a
+#: survey's tilt, of a few degrees is read as the wall it is (idealised plumb, with a note);
+#: beyond it the lean is the wall's geometry (a mechanism's, not a drawing's), and is refused.
+PLUMB_TOL_DEG = 5.0
+#: Faces flatter than this from the vertical are tops and bottoms (a gable's slopes) [deg].
+SIDE_TILT_MAX_DEG = 45.0
+#: A footprint whose least enclosing rectangle has sides in a ratio below this is a pier: the
+#: doubled-angle average of its faces, (a - b) / (a + b) of their area, is under a fifth and
+#: vanishes on a square, so its thickness is read across the rectangle's shorter side.
+PIER_ASPECT_MIN = 1.5
+#: A pier's section filling its least rectangle to this fraction is that rectangle (chamfered
+#: arrises, a survey's relief); less is a round or polygonal pier or several walls.
+PIER_FILL_RTOL = 0.02
+#: A pier's sides equal to this relative tolerance make it square (rounding of a turned plan).
+PIER_SQUARE_RTOL = 1e-6
+#: A face leaning on e_n by at least this cosine is one of the two faces whose lean is measured.
+FACE_LEAN_COS = 0.5
+#: The mid-height section moves off a vertex height closer than this fraction of the height.
+SECTION_RTOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -387,44 +409,304 @@ class WallFrame:
         return cast(np.ndarray, cached)
 
 
-def frame_from_mesh(
-    vertices: np.ndarray, faces: np.ndarray, name: str
-) -> Tuple[np.ndarray, np.ndarray]:
-    """Thickness and length directions of a vertical slab from its faces.
+@dataclass(frozen=True)
+class WallAxes:
+    """How a wall's solid stands in plan: its thickness direction, its lean, its footprint.
 
-    The thickness direction is the horizontal axis of the vertical faces that carry the most
-    area (the two large faces of a wall, whatever its openings), found by averaging each
-    vertical face's horizontal normal on the doubled angle (so that n and -n agree).
+    Attributes
+    ----------
+    e_n, e_s : (3,) float
+        Unit horizontal vectors: through the thickness (sign not yet fixed) and along the
+        wall.
+    lean : float
+        ``dn/dz`` of the wall's mid-plane along ``e_n`` [-]: the tangent of its lean out of
+        plumb (0 for a plumb wall), the mean of its two faces'.
+    lean_faces : (float, float)
+        ``dn/dz`` of the face at the lower ``n`` and of the face at the higher ``n`` [-].
+    plan : (float, float)
+        Longer and shorter side of the least rectangle holding the footprint at mid-height [m].
+    pier : bool
+        The footprint's sides are in a ratio below ``PIER_ASPECT_MIN``: ``e_n`` is read
+        across its shorter side, not from its faces.
+    square : bool
+        A pier whose two sides are equal (``PIER_SQUARE_RTOL``): ``e_n`` follows the stated
+        rule (``frame_from_mesh``).
+    rule : {"", "levels", "fixed"}
+        Which rule set a square pier's axis: towards its levels, or the fixed one.
+    """
+
+    e_n: np.ndarray
+    e_s: np.ndarray
+    lean: float = 0.0
+    lean_faces: Tuple[float, float] = (0.0, 0.0)
+    plan: Tuple[float, float] = (0.0, 0.0)
+    pier: bool = False
+    square: bool = False
+    rule: str = ""
+
+    def flipped(self) -> "WallAxes":
+        """Return the axes with ``e_n`` and ``e_s`` reversed (the lean reads the other way)."""
+        lo, hi = self.lean_faces
+        return WallAxes(
+            -self.e_n,
+            -self.e_s,
+            -self.lean,
+            (-hi, -lo),
+            self.plan,
+            self.pier,
+            self.square,
+            self.rule,
+        )
+
+
+def frame_from_mesh(
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    name: str,
+    prefer: Optional[np.ndarray] = None,
+) -> WallAxes:
+    """Thickness and length directions of a wall's solid, its lean and its footprint.
+
+    A wall is a slab standing within ``PLUMB_TOL_DEG`` of plumb: its faces within that
+    angle of the vertical are its sides. Its footprint is the horizontal section at
+    mid-height, in its own principal frame (the least rectangle that holds it):
+
+    * sides in a ratio of at least ``PIER_ASPECT_MIN``: a wall; the thickness direction is
+      the horizontal axis of the side faces that carry the most area (its two large faces,
+      whatever its openings), their horizontal normals averaged on the doubled angle (so
+      that n and -n agree);
+    * a smaller ratio: a pier, whose faces no longer tell its thickness (a square's
+      doubled-angle average vanishes). A footprint that fills its rectangle (to
+      ``PIER_FILL_RTOL``) is read across its shorter side, about which the bare block
+      overturns first; a square one (sides equal to ``PIER_SQUARE_RTOL``) across the side
+      that faces ``prefer`` (the levels it carries), else across the side nearer the x axis
+      (a fixed rule: the two are alike for the bare block). Any other footprint (round,
+      polygonal, several walls drawn as one solid) is refused.
+
+    Parameters
+    ----------
+    vertices : (k, 3) float
+        The solid's vertices [m].
+    faces : (m, 3) int
+        Its triangles, outward.
+    name : str
+        The wall's id, for the messages.
+    prefer : (3,) float, optional
+        A horizontal direction that picks a square pier's axis (towards its levels).
 
     Returns
     -------
-    e_n, e_s : (3,) float
-        Unit horizontal vectors; ``e_n`` along the thickness (sign not yet fixed).
+    WallAxes
 
     Raises
     ------
     GeometryError
-        The object has no vertical faces (not a wall).
+        Most of the object's side area leans beyond ``PLUMB_TOL_DEG`` (or none is within
+        it: a sphere, a cone, a wall out of plumb), or its footprint is a pier's that is not
+        a rectangle.
     """
-    tri = vertices[faces]
+    v = np.asarray(vertices, dtype=float)
+    centre = v.mean(axis=0)
+    tri = (v - centre)[faces]
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     area2 = np.linalg.norm(normal, axis=1)
     ok = area2 > 0.0
     unit = np.zeros_like(normal)
     unit[ok] = normal[ok] / area2[ok, None]
-    vertical = ok & (np.abs(unit[:, 2]) < 1e-6)
-    if not np.any(vertical):
-        raise GeometryError(f"{name}: the object has no vertical faces; a wall is a vertical slab")
-    ang = np.arctan2(unit[vertical, 1], unit[vertical, 0])
-    w = area2[vertical]
-    c2 = float(np.sum(w * np.cos(2.0 * ang)))
-    s2 = float(np.sum(w * np.sin(2.0 * ang)))
-    theta = 0.5 * math.atan2(s2, c2)
-    e_n = np.array([math.cos(theta), math.sin(theta), 0.0])
+    tilt = np.degrees(np.arcsin(np.clip(np.abs(unit[:, 2]), 0.0, 1.0)))
+    vertical = ok & (tilt <= PLUMB_TOL_DEG)
+    leaning = ok & (tilt > PLUMB_TOL_DEG) & (tilt < SIDE_TILT_MAX_DEG)
+    _check_plumb(name, area2, tilt, vertical, leaning)
+    section = _mid_section(v - centre, faces, unit)
+    plan = (0.0, 0.0)
+    pier = square = False
+    rule = ""
+    if section is not None:
+        axis, long_side, short_side, filled = section
+        plan = (long_side, short_side)
+        if short_side > 0.0 and long_side < PIER_ASPECT_MIN * short_side:
+            pier = True
+            if filled < 1.0 - PIER_FILL_RTOL:
+                raise GeometryError(
+                    f"{name}: its footprint at mid-height ({long_side:.3f} x {short_side:.3f} m "
+                    f"in plan, sides in a ratio {long_side / short_side:.3g} below "
+                    f"{PIER_ASPECT_MIN:g}) fills {100 * filled:.0f} % of the least rectangle "
+                    "holding it: a round or polygonal pier or tower, or several walls drawn as "
+                    "one solid, whose thickness direction the search cannot tell (it reads "
+                    "walls as slabs). Split it into walls (one solid per side), or analyse it "
+                    "as a rigid block with a mechanism spec (`rockmech constants`)"
+                )
+            e_n, rule = _pier_axis(axis, long_side, short_side, prefer)
+            square = bool(rule)
+    if not pier:
+        ang = np.arctan2(unit[vertical, 1], unit[vertical, 0])
+        w = area2[vertical]
+        c2 = float(np.sum(w * np.cos(2.0 * ang)))
+        s2 = float(np.sum(w * np.sin(2.0 * ang)))
+        theta = 0.5 * math.atan2(s2, c2)
+        e_n = np.array([math.cos(theta), math.sin(theta), 0.0])
     # Snap to the axes when the wall is drawn along them (exact frames for exact walls).
     for k in range(2):
         if abs(abs(e_n[k]) - 1.0) < 1e-12:
             e_n = np.zeros(3)
             e_n[k] = 1.0
     e_s = np.array([-e_n[1], e_n[0], 0.0])
-    return e_n, e_s
+    lo, hi = _face_leans(unit, area2, vertical, e_n)
+    return WallAxes(e_n, e_s, 0.5 * (lo + hi), (lo, hi), plan, pier, square, rule)
+
+
+def _check_plumb(
+    name: str, area2: np.ndarray, tilt: np.ndarray, vertical: np.ndarray, leaning: np.ndarray
+) -> None:
+    """Refuse a solid whose side area leans mostly beyond ``PLUMB_TOL_DEG`` (module doc)."""
+    a_vert = float(np.sum(area2[vertical]))
+    a_lean = float(np.sum(area2[leaning]))
+    if a_vert > 0.0 and a_lean <= a_vert:
+        return
+    if a_lean > 0.0:
+        mean = float(np.sum(area2[leaning] * tilt[leaning]) / a_lean)
+        share = 100.0 * a_lean / (a_lean + a_vert)
+        said = (
+            f"{share:.0f} % of its side faces lean more than {PLUMB_TOL_DEG:g} degrees from the "
+            f"vertical ({mean:.1f} degrees on average)"
+        )
+    else:
+        said = f"none of its faces is within {SIDE_TILT_MAX_DEG:g} degrees of the vertical"
+    raise GeometryError(
+        f"{name}: {said}; a wall is a slab standing within {PLUMB_TOL_DEG:g} degrees of plumb "
+        "(read as plumb, with a note). Select the wall's own solid; redraw a wall whose lean is "
+        "a drawing's error plumb; analyse a wall leaning more, or a block of another shape, "
+        "with a mechanism spec (`rockmech constants`); give a roof, a vault or a dome as a "
+        "level, not a wall"
+    )
+
+
+def _mid_section(
+    v: np.ndarray, faces: np.ndarray, unit: np.ndarray
+) -> Optional[Tuple[np.ndarray, float, float, float]]:
+    """Return the solid's horizontal section at mid-height in its least enclosing rectangle.
+
+    Returns ``(axis, long, short, filled)``: the unit direction (3,) of the rectangle's
+    shorter side, its longer and shorter sides [m], and the section's area over the
+    rectangle's [-]; None where no face crosses mid-height (a flat solid).
+
+    Notes
+    -----
+    Each face crossing the plane ``z = z_m`` cuts it along a segment, oriented along
+    ``e_z × m`` (``m`` the face's outward normal) so that the material lies on its left;
+    the section's area is then ``Σ (p × q) / 2`` over the segments (Green's theorem).
+    ``z_m`` is moved off any vertex height to the middle of the nearest gap.
+    """
+    z = v[:, 2]
+    z_lo, z_hi = float(z.min()), float(z.max())
+    z_m = 0.5 * (z_lo + z_hi)
+    levels = np.unique(z)
+    eps = SECTION_RTOL * (z_hi - z_lo)
+    if np.any(np.abs(levels - z_m) <= eps):
+        below = levels[levels < z_m - eps]
+        if len(below) == 0:
+            return None
+        z_m = 0.5 * (float(below.max()) + float(levels[levels >= z_m - eps].min()))
+    d = v[faces, 2] - z_m  # (m, 3): no vertex lies on the plane
+    side = d > 0.0
+    cut = np.flatnonzero(np.any(side, axis=1) & ~np.all(side, axis=1))
+    if len(cut) == 0:
+        return None
+    seg = np.zeros((len(cut), 2, 2))
+    for k, (f, dd) in enumerate(zip(faces[cut], d[cut])):
+        pts = []
+        for i in range(3):
+            j = (i + 1) % 3
+            if (dd[i] > 0.0) != (dd[j] > 0.0):
+                w = dd[i] / (dd[i] - dd[j])
+                pts.append(v[f[i], :2] + w * (v[f[j], :2] - v[f[i], :2]))
+        seg[k] = pts
+    m = unit[cut]
+    along = np.column_stack([-m[:, 1], m[:, 0]])
+    dirn = seg[:, 1] - seg[:, 0]
+    flip = np.einsum("ij,ij->i", dirn, along) < 0.0
+    seg[flip] = seg[flip][:, ::-1]
+    p, q = seg[:, 0], seg[:, 1]
+    area = 0.5 * float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
+    hull = _convex_hull(seg.reshape(-1, 2))
+    if len(hull) < 3:
+        return None
+    best: Optional[Tuple[float, np.ndarray, float, float]] = None
+    for a, b in zip(hull, np.roll(hull, -1, axis=0)):
+        u = (b - a) / float(np.linalg.norm(b - a))
+        w2 = np.array([-u[1], u[0]])
+        ext_u = float(np.ptp(hull @ u))
+        ext_w = float(np.ptp(hull @ w2))
+        if best is None or ext_u * ext_w < best[0] * (1.0 - 1e-12):
+            best = (ext_u * ext_w, u, ext_u, ext_w)
+    assert best is not None
+    rect, u, ext_u, ext_w = best
+    short_dir = u if ext_u <= ext_w else np.array([-u[1], u[0]])
+    axis = np.array([short_dir[0], short_dir[1], 0.0])
+    return axis, max(ext_u, ext_w), min(ext_u, ext_w), area / rect if rect > 0.0 else 0.0
+
+
+def _convex_hull(points: np.ndarray) -> np.ndarray:
+    """Convex hull of 2-D points, counter-clockwise (Andrew's monotone chain)."""
+    pts = np.unique(points, axis=0)
+    if len(pts) < 3:
+        return pts
+    order = np.lexsort((pts[:, 1], pts[:, 0]))
+    pts = pts[order].tolist()
+
+    def cross(o: List[float], a: List[float], b: List[float]) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower: List[List[float]] = []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0.0:
+            lower.pop()
+        lower.append(p)
+    upper: List[List[float]] = []
+    for p in reversed(pts):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0.0:
+            upper.pop()
+        upper.append(p)
+    return np.asarray(lower[:-1] + upper[:-1], dtype=float)
+
+
+def _pier_axis(
+    axis: np.ndarray, long_side: float, short_side: float, prefer: Optional[np.ndarray]
+) -> Tuple[np.ndarray, str]:
+    """Return a pier's thickness direction and, for a square one, the rule that chose it.
+
+    Across its shorter side (rule ""); a square's across the side that faces ``prefer``
+    ("levels"), else across the side nearer the x axis ("fixed"; at 45 degrees, the one
+    whose normal has x and y of one sign).
+    """
+    if long_side - short_side > PIER_SQUARE_RTOL * long_side:
+        return axis, ""
+    other = np.array([-axis[1], axis[0], 0.0])
+    if prefer is not None:
+        a, b = abs(float(prefer @ axis)), abs(float(prefer @ other))
+        if abs(a - b) > PIER_SQUARE_RTOL * max(a, b, 1e-300):
+            return (axis if a > b else other), "levels"
+    ax, bx = abs(float(axis[0])), abs(float(other[0]))
+    if abs(ax - bx) > 1e-12:
+        return (axis if ax > bx else other), "fixed"
+    return (axis if axis[0] * axis[1] > 0.0 else other), "fixed"
+
+
+def _face_leans(
+    unit: np.ndarray, area2: np.ndarray, vertical: np.ndarray, e_n: np.ndarray
+) -> Tuple[float, float]:
+    """``dn/dz`` of the faces at the lower and at the higher ``n`` (area-weighted) [-].
+
+    A face with outward unit normal ``m`` runs ``n(z) = (c - m_z z) / m_n``: ``dn/dz =
+    -m_z / m_n``, with ``m_n = m · e_n``.
+    """
+    m_n = unit @ e_n
+    out = []
+    for sign in (-1.0, 1.0):
+        pick = vertical & (sign * m_n >= FACE_LEAN_COS)
+        if not np.any(pick):
+            out.append(0.0)
+            continue
+        slope = -unit[pick, 2] / m_n[pick]
+        out.append(float(np.sum(area2[pick] * slope) / np.sum(area2[pick])))
+    return out[0], out[1]
