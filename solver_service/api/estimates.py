@@ -22,9 +22,11 @@ interval (or a pulse of ``1/f_p`` seconds) into segments of at most ``1/p_eq`` s
   ``PULSE_POINTS_PER_CORE_S``);
 * time histories: per mechanism side and scale factor, ``(n - 1) max(1, ceil(p_eq dt))``;
 * an assessment: the time histories of every record at every multiple (one more run per
-  record for the HTML page's figures), then, once the check has given each mechanism's
-  matching band (in the compute process), ``BAND_POINTS`` spectrum periods per mechanism and
-  record of ``(n - 1) max(1, ceil(STEPS_PER_PERIOD dt / T))`` steps each.
+  record for the HTML page's figures) and the exact envelopes of its envelope margin
+  (``ASSESS_ENVELOPE``, with the pulse scale factors of the mechanisms above ground),
+  then, once the check has given each mechanism's matching band (in the compute process),
+  ``BAND_POINTS`` spectrum periods per mechanism and record of
+  ``(n - 1) max(1, ceil(STEPS_PER_PERIOD dt / T))`` steps each.
 
 An assessment's HTML page draws ``1 + n_mechanisms (2 + n_records)`` figures; it is refused
 when they cannot be drawn within the budget at ``FIGURES_PER_S`` or would make the page
@@ -46,6 +48,7 @@ from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 
 from ..workflows.limits import (  # the numbers and estimates shared with the command line
+    ASSESS_ENVELOPE,
     FIGURES_PER_S,
     N_SCAN,
     RATE_MARGIN,
@@ -227,7 +230,16 @@ def _assess(job: Any, cf: ConstantsFile, limits: dict[str, Any], html: bool) -> 
         worst = history_steps(cf, n, dt, 1, worst=True)
         check_work(worst, limits, "the time history", f"records[{i}]")
         steps += history_steps(cf, n, dt, runs)
-    check_time(limits, "the time histories", "records", history_steps=steps)
+    # then the envelope margin: exact envelopes of every mechanism, and the pulse scale
+    # factors of those above ground (issue #36's fuzz run: 3.4 s of an /assess went there)
+    check_time(
+        limits,
+        "the time histories and the envelope margins",
+        "records",
+        history_steps=steps,
+        envelope_steps=envelope_steps(cf, *ASSESS_ENVELOPE, exact=True),
+        pulse_points=scale_factor_points(cf, *ASSESS_ENVELOPE),
+    )
     if not html:
         return
     figures = assess_figures(len(cf.mechanisms), len(job.records))

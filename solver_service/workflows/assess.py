@@ -37,6 +37,7 @@ from .codecheck import (
 )
 from .documents import envelope_doc, log_grid
 from .inputs import read_site_file
+from .limits import ASSESS_ENVELOPE
 from .scaling import mechanism_scale_factor
 from .verdict import conclusion
 
@@ -258,7 +259,7 @@ def assessment_doc(
     multiples = check_multiples(multiples)
     doc = check_doc(cf, site)
     spectrum = site_spectrum(site)
-    freq = np.asarray(f_p if f_p is not None else log_grid(0.1, 10.0, 120), dtype=float)
+    freq = np.asarray(f_p if f_p is not None else log_grid(*ASSESS_ENVELOPE), dtype=float)
     # The design scale of each record per mechanism (its band comes from the code check).
     matched: list[list[Any]] = []
     for row in doc["mechanisms"]:

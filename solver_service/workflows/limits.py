@@ -52,6 +52,7 @@ from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 
 __all__ = [
+    "ASSESS_ENVELOPE",
     "CLI_BUDGET_S",
     "DEFAULT_LIMITS",
     "ENVELOPE_STEPS_PER_CORE_S",
@@ -400,6 +401,11 @@ def _outside_sum(p: float, f_min: float, f_max: float, n: int) -> float:
     k_lo = min(n, max(0, math.ceil(lo)))  # i < k_lo: below the grid
     k_hi = max(k_lo, min(n, max(0, math.floor(hi) + 1)))  # i >= k_hi: above it
     return _index_sum(p, f_min, ratio, 0, k_lo) + _index_sum(p, f_min, ratio, k_hi, n)
+
+
+#: The envelope margin of an assessment: its pulse frequencies (f_min [Hz], f_max [Hz], n),
+#: exact envelopes of every mechanism (``workflows.assess.assessment_doc``).
+ASSESS_ENVELOPE = (0.1, 10.0, 120)
 
 
 def envelope_steps(

@@ -76,7 +76,7 @@ strategies: constants, site, records) it happened on every run, never in the ser
 
 Schema-valid but absurd requests (a two-sample record 11 hours long, p_eq = 1e300) are
 refused up front with 422 by the service's work bound (``20 x ROCKMECH_MAX_SAMPLES``
-closed-form steps per run); the server gets a 10 s budget and small size limits, so that
+closed-form steps per run); the server gets a 5 s budget and small size limits, so that
 nothing can keep it busy. ``ROCKMECH_MAX_SAMPLES`` is 50,000: the longest pulse the schema
 allows (1e6 steps) stays within its work bound, as it does at the default settings. The run
 is bounded (``MAX_EXAMPLES`` per operation, fixed seed); the server log must hold no
@@ -111,7 +111,7 @@ POSITIVE_DATA_OPERATIONS = (
     r"schema/kinematic-constants\.json",
 )
 #: The server's compute budget per request [s] (the hooks read it too: the work estimates).
-COMPUTE_TIMEOUT_S = 10
+COMPUTE_TIMEOUT_S = 5
 #: The server's ``ROCKMECH_MAX_SAMPLES`` (the hooks read it: a record's work bound).
 MAX_SAMPLES = 50_000
 #: The hooks module: positive cases that break a rule JSON Schema cannot state are dropped.
