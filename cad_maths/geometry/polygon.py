@@ -7,7 +7,7 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
-__all__ = ["newell", "triangulate_polygon"]
+__all__ = ["newell", "orient_rings", "triangulate_polygon"]
 
 # A triangulation whose area differs from the polygon's by more than this fraction is rejected.
 AREA_RTOL = 1e-9
@@ -39,6 +39,27 @@ def _area2(p: np.ndarray) -> float:
     """Twice the signed area of a polygon (n, 2), positive counter-clockwise."""
     x, y = p[:, 0], p[:, 1]
     return float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def orient_rings(rings: Sequence[np.ndarray]) -> List[np.ndarray]:
+    """Return a polygon's rings with the outer one counter-clockwise and the holes clockwise.
+
+    Parameters
+    ----------
+    rings : sequence of (n, 2) float
+        The outer boundary first, then the holes, each in either orientation.
+
+    Returns
+    -------
+    list of (n, 2) float
+        The same rings (reversed where needed): the material lies on the left of each edge.
+
+    Examples
+    --------
+    >>> orient_rings([np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]])])[0].tolist()
+    [[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]
+    """
+    return [r if (_area2(r) > 0.0) == (k == 0) else r[::-1] for k, r in enumerate(rings)]
 
 
 def triangulate_polygon(

@@ -39,7 +39,7 @@ from cad_maths.mechanisms.loaded import BEARING_ANGLE, contact_tolerance
 from cad_maths.mechanisms.single import find_objects
 from cad_maths.mechanisms.thrust import roof_thrust
 from cad_maths.scene_base import SceneObject
-from cad_maths.search.plan import Plan, outer_side, read_plan
+from cad_maths.search.plan import Plan, footprint, least_width, outer_side, read_plan
 from cad_maths.search.prism import (
     PIER_ASPECT_MIN,
     PLUMB_TOL_DEG,
@@ -713,12 +713,8 @@ def _trim_overlaps(raw: List[Tuple[Any, SceneObject, TriMesh, Any]], notes: List
     as meeting the other's face: it is trimmed there (``_subtract``) and a note gives the
     depth and the volume. Any other overlap is refused with both walls and the volume.
     """
-    shapely = require("shapely", "geometry", "to read the plan of a search")
-    ref = np.vstack([m.vertices for _, _, m, _ in raw]).mean(axis=0)
-    feet = [
-        shapely.MultiPoint([tuple(p) for p in m.vertices[:, :2] - ref[:2]]).convex_hull
-        for _, _, m, _ in raw
-    ]
+    ref = np.vstack([m.vertices for _, _, m, _ in raw]).mean(axis=0)[:2]
+    feet = [footprint(m.vertices, ref) for _, _, m, _ in raw]
     for i in range(len(raw)):
         for j in range(i + 1, len(raw)):
             shared = feet[i].intersection(feet[j])
@@ -732,7 +728,7 @@ def _trim_overlaps(raw: List[Tuple[Any, SceneObject, TriMesh, Any]], notes: List
             volume = shared.area * dz
             for k, o in ((j, i), (i, j)):  # the later wall is trimmed first
                 depth = _end_depth(feet[k], shared)
-                if depth is not None and depth <= _least_side(feet[o]) * (1.0 + 1e-9):
+                if depth is not None and depth <= least_width(feet[o]) * (1.0 + 1e-9):
                     w, obj, mesh, _ = raw[k]
                     new, cut, warn = _subtract(obj, mesh, [(raw[o][1], raw[o][2])], w.id, TRIMMED)
                     notes.extend(warn)
@@ -742,9 +738,7 @@ def _trim_overlaps(raw: List[Tuple[Any, SceneObject, TriMesh, Any]], notes: List
                         f"the trimmed wall as a new object {new.name!r}, which the spec selects"
                     )
                     raw[k] = (w, new, cut, new.name)
-                    feet[k] = shapely.MultiPoint(
-                        [tuple(p) for p in cut.vertices[:, :2] - ref[:2]]
-                    ).convex_hull
+                    feet[k] = footprint(cut.vertices, ref)
                     break
             else:
                 raise GeometryError(
@@ -780,12 +774,6 @@ def _end_depth(foot: Any, shared: Any) -> Optional[float]:
     if b >= hi - eps and a > lo + eps:
         return hi - a
     return None
-
-
-def _least_side(foot: Any) -> float:
-    """Return the smaller side of a footprint's least rotated rectangle [m]."""
-    rect = np.asarray(foot.minimum_rotated_rectangle.exterior.coords, dtype=float)
-    return float(np.linalg.norm(np.diff(rect[:3], axis=0), axis=1).min())
 
 
 def _unit_angle(unit: Any) -> float:

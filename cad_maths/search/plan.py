@@ -187,9 +187,9 @@ def read_plan(
     footprints: Dict[str, Any] = {}
     thick: List[float] = []
     for wid, v in walls:
-        hull = shapely.MultiPoint([tuple(p) for p in v[:, :2] - origin]).convex_hull
+        hull = footprint(v, origin)
         footprints[wid] = hull
-        thick.append(_least_width(hull))
+        thick.append(least_width(hull))
     gap = GAP_RTOL * max(min(thick), 0.0)
     grown = {
         w: fp.buffer(0.5 * gap, join_style="mitre") if gap > 0.0 else fp
@@ -230,7 +230,26 @@ def _level_plan(shapely: Any, levels: Sequence[Tuple[np.ndarray, np.ndarray]], o
     return shapely.unary_union(tris)
 
 
-def _least_width(poly: Any) -> float:
+def footprint(vertices: np.ndarray, origin: np.ndarray) -> Any:
+    """Return a solid's footprint: the convex hull of its vertices in plan, about ``origin``.
+
+    Parameters
+    ----------
+    vertices : (k, 3) float
+        The solid's vertices [m].
+    origin : (2,) float
+        The plan origin [m] the footprint is relative to (the scene's centre: small
+        coordinates for a georeferenced scene).
+
+    Returns
+    -------
+    shapely.Polygon
+    """
+    shapely = require("shapely", "geometry", "to read the plan of a search")
+    return shapely.MultiPoint([tuple(p) for p in vertices[:, :2] - origin]).convex_hull
+
+
+def least_width(poly: Any) -> float:
     """Return the smaller side of a footprint's least rotated rectangle [m] (0: a line)."""
     rect = poly.minimum_rotated_rectangle
     coords = np.asarray(getattr(rect, "exterior", rect).coords, dtype=float)

@@ -265,16 +265,13 @@ def slab_solid(
     fills ``0 <= n <= thickness`` along ``e_n``. Openings are through-holes.
     """
     # rockmech's own triangulation (exact vertices); the examples need the package anyway
-    from cad_maths.geometry.polygon import triangulate_polygon
+    from cad_maths.geometry.polygon import orient_rings, triangulate_polygon
 
     o, es, en = (np.asarray(v, dtype=np.float64) for v in (origin, e_s, e_n))
     ez = np.array([0.0, 0.0, 1.0])
     rings = [np.asarray(outer, dtype=np.float64)] + [np.asarray(h, dtype=np.float64) for h in holes]
     # outer counter-clockwise, holes clockwise in (s, z): material on the left of each edge
-    fixed = []
-    for k, r in enumerate(rings):
-        a2 = float(np.dot(r[:, 0], np.roll(r[:, 1], -1)) - np.dot(np.roll(r[:, 0], -1), r[:, 1]))
-        fixed.append(r if (a2 > 0.0) == (k == 0) else r[::-1])
+    fixed = orient_rings(rings)
     pts2 = np.vstack(fixed)
     n = len(pts2)
     front = o + pts2[:, :1] * es + pts2[:, 1:] * ez

@@ -187,6 +187,38 @@ def ring_walls(ring: Plan2, t: float, prefix: str) -> list[tuple[str, Any, Any, 
     return out
 
 
+def plan_prism(
+    outline: Sequence[tuple[float, float]],
+    holes: Sequence[Sequence[tuple[float, float]]],
+    z0: float,
+    z1: float,
+    lean: float = 0.0,
+) -> tuple[Any, Any]:
+    """A closed mesh (vertices, triangles) of a plan polygon with holes extruded from ``z0``
+    to ``z1``, its top moved by ``(z1 - z0) * lean`` along x (a prism out of plumb)."""
+    import numpy as np
+
+    from cad_maths.geometry.polygon import orient_rings, triangulate_polygon
+
+    rings = orient_rings(
+        [np.asarray(outline, dtype=float)] + [np.asarray(r, dtype=float) for r in holes]
+    )
+    pts = np.vstack(rings)
+    m = len(pts)
+    tris = np.array(triangulate_polygon(rings[0], rings[1:]), dtype=np.int64)
+    bottom = np.column_stack([pts, np.full(m, z0)])
+    top = np.column_stack([pts[:, 0] + (z1 - z0) * lean, pts[:, 1], np.full(m, z1)])
+    faces = [tris[:, ::-1], tris + m]
+    start = 0
+    for r in rings:
+        k = len(r)
+        for i in range(k):
+            p, q = start + i, start + (i + 1) % k
+            faces.append(np.array([[p, q, q + m], [p, q + m, p + m]]))
+        start += k
+    return np.vstack([bottom, top]), np.vstack(faces)
+
+
 def plan_scene(
     out: Path,
     walls: Sequence[tuple[str, Any, Any, float]],
@@ -207,8 +239,6 @@ def plan_scene(
     import math
 
     import numpy as np
-
-    from cad_maths.geometry.polygon import triangulate_polygon
 
     c, s = math.cos(math.radians(rotate_deg)), math.sin(math.radians(rotate_deg))
     rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
@@ -236,28 +266,8 @@ def plan_scene(
             f = f[:, ::-1]
         bld.mesh(wid, "Walls", np.ascontiguousarray(v), np.ascontiguousarray(f), "brick")
     for sid, outline, holes, z0, z1 in slabs:
-        rings = [np.asarray(outline, dtype=float)] + [np.asarray(hh, dtype=float) for hh in holes]
-        fixed = []
-        for k, r in enumerate(rings):
-            a2 = float(
-                np.dot(r[:, 0], np.roll(r[:, 1], -1)) - np.dot(np.roll(r[:, 0], -1), r[:, 1])
-            )
-            fixed.append(r if (a2 > 0.0) == (k == 0) else r[::-1])
-        pts = np.vstack(fixed)
-        m = len(pts)
-        tris = np.array(triangulate_polygon(fixed[0], fixed[1:]), dtype=np.int64)
-        bottom = np.column_stack([pts, np.full(m, z0)])
-        top = np.column_stack([pts, np.full(m, z1)])
-        faces = [tris[:, ::-1], tris + m]
-        start = 0
-        for r in fixed:
-            k = len(r)
-            for i in range(k):
-                p, q = start + i, start + (i + 1) % k
-                faces.append(np.array([[p, q, q + m], [p, q + m, p + m]]))
-            start += k
-        v = place(np.vstack([bottom, top]))
-        f = np.vstack(faces)
+        v, f = plan_prism(outline, holes, z0, z1)
+        v = place(v)
         if mirror:
             f = f[:, ::-1]
         bld.mesh(sid, "Floors", np.ascontiguousarray(v), np.ascontiguousarray(f), "concrete")

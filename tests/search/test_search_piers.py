@@ -22,11 +22,10 @@ from typing import Any, Sequence
 
 import numpy as np
 import pytest
-from search_scenes import BUILD, write_spec
+from search_scenes import BUILD, plan_prism, write_spec
 from typer.testing import CliRunner
 
 import rockmech
-from cad_maths.geometry.polygon import triangulate_polygon
 from solver_service.cli import app
 
 runner = CliRunner()
@@ -47,25 +46,7 @@ Ring = Sequence[tuple[float, float]]
 def _prism(outline: Ring, holes: Sequence[Ring], h: float, lean: float = 0.0) -> Any:
     """A closed mesh of a plan polygon (with holes) extruded from z = 0 to h, its section
     moved by ``z * lean`` along x (a prism out of plumb)."""
-    rings = [np.asarray(outline, dtype=float)] + [np.asarray(r, dtype=float) for r in holes]
-    fixed = []
-    for k, r in enumerate(rings):
-        a2 = float(np.dot(r[:, 0], np.roll(r[:, 1], -1)) - np.dot(np.roll(r[:, 0], -1), r[:, 1]))
-        fixed.append(r if (a2 > 0.0) == (k == 0) else r[::-1])
-    pts = np.vstack(fixed)
-    m = len(pts)
-    tris = np.array(triangulate_polygon(fixed[0], fixed[1:]), dtype=np.int64)
-    bottom = np.column_stack([pts, np.zeros(m)])
-    top = np.column_stack([pts[:, 0] + h * lean, pts[:, 1], np.full(m, h)])
-    faces = [tris[:, ::-1], tris + m]
-    start = 0
-    for r in fixed:
-        k = len(r)
-        for i in range(k):
-            p, q = start + i, start + (i + 1) % k
-            faces.append(np.array([[p, q, q + m], [p, q + m, p + m]]))
-        start += k
-    return np.vstack([bottom, top]), np.vstack(faces)
+    return plan_prism(outline, holes, 0.0, h, lean)
 
 
 def _placement(angle: float, mirror: bool) -> Any:
