@@ -7,5 +7,6 @@ check ``archive_3dm``), mesh geometry (``geometry``), the mechanism builders
 (``mechanisms``) and the automatic mechanism search (``search``). Imports ``shared_schema``
 only (and numpy, scipy, rhino3dm, trimesh, manifold3d, shapely).
 
-Rhino 8 imports this package: everything here must stay CPython 3.9-clean (see STYLE.md).
+Rhino 8 imports this package: everything here must stay CPython 3.9-clean
+(CONTRIBUTING.md, "The house").
 """

@@ -1,6 +1,7 @@
 """The kinematic-constants file: the constants of each rocking mechanism of a structure.
 
-The file is what the Rhino side writes and the solver reads (STYLE.md, habit 5). It holds,
+The file is what the Rhino side writes and the solver reads (CONTRIBUTING.md, "The house").
+It holds,
 per mechanism, the constants of the linearised rocking equation (docs/theory.md §1) for the
 positive side and, when the mechanism is not symmetric, the negative side.
 

@@ -1,7 +1,7 @@
 """Convert validated kinematic constants (pydantic, ``shared_schema``) to solver models.
 
 This is the only place where the pydantic models of ``shared_schema.constants`` meet
-``solver_service.core``, which stays free of pydantic (STYLE.md, dependency rule).
+``solver_service.core``, which stays free of pydantic (docs/architecture.md, floor 1).
 
 Notation
 --------

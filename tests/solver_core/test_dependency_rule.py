@@ -1,4 +1,7 @@
-"""``solver_service.core`` imports without FastAPI, pydantic or Rhino (STYLE.md dependency rule)."""
+"""``solver_service.core`` imports without FastAPI, pydantic or Rhino.
+
+The rule is floor 1's in docs/architecture.md.
+"""
 
 from __future__ import annotations
 
