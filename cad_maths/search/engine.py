@@ -19,13 +19,25 @@ from cad_maths.search.model import Building, building_from_scene
 from shared_schema.errors import InputError
 from shared_schema.rules import G
 
-__all__ = ["MISSED_GAP", "LPCheck", "SearchResult", "run_search", "sliding_check"]
+__all__ = [
+    "MISSED_GAP",
+    "RANK_RTOL",
+    "LPCheck",
+    "SearchResult",
+    "rank_order",
+    "run_search",
+    "sliding_check",
+]
 
 #: The check's multiplier this far below the best catalogue mechanism's (relative) means the
 #: catalogue missed a mechanism (issue #31: 1 %).
 MISSED_GAP = 0.01
 #: The friction variant of the check this far below the rocking one says sliding governs.
 SLIDING_GAP = 0.01
+#: Scores within this fraction of each other tie in a ranking: the earlier candidate (in the
+#: order the search enumerates them, which the scene's placement does not change) ranks
+#: first, so that rounding in a turned or far-away scene cannot swap two equal mechanisms.
+RANK_RTOL = 1e-9
 
 
 @dataclass
@@ -134,6 +146,40 @@ def sliding_check(cand: Candidate, friction: float) -> Optional[Dict[str, Any]]:
     }
 
 
+def rank_order(scores: List[float], rtol: float = RANK_RTOL) -> List[int]:
+    """Return the indices of ``scores`` from least to greatest, near-ties in index order.
+
+    Scores are sorted; every run of neighbours within ``rtol`` (relative) of the one
+    before is then put in index order.
+
+    Parameters
+    ----------
+    scores : list of float
+        One score per item (``inf`` last).
+    rtol : float
+        Relative difference below which two neighbouring scores tie.
+
+    Returns
+    -------
+    list of int
+
+    Examples
+    --------
+    >>> rank_order([0.3, 0.1 + 1e-12, 0.1, 0.2])
+    [1, 2, 3, 0]
+    """
+    order = sorted(range(len(scores)), key=lambda k: (scores[k], k))
+    out: List[int] = []
+    run: List[int] = []
+    for k in order:
+        if run and not scores[k] - scores[run[-1]] <= rtol * abs(scores[run[-1]]):
+            out.extend(sorted(run))
+            run = []
+        run.append(k)
+    out.extend(sorted(run))
+    return out
+
+
 def _lines(
     cands: List[Candidate], facade: str, direction: str
 ) -> Tuple[List[float], Dict[str, List[float]]]:
@@ -192,7 +238,7 @@ def run_search(
         flag = sliding_check(c, spec.friction)
         if flag is not None:
             c.notes.append(flag["note"])
-    order = sorted(range(len(cands)), key=lambda k: (cands[k].lam0, k))
+    order = rank_order([c.lam0 for c in cands])
     cands = [cands[k] for k in order]
     t2 = time.perf_counter()
     checks: List[LPCheck] = []

@@ -56,6 +56,10 @@ SLIVER_RTOL = 1e-10
 #: A contact shorter than this (relative to the building's size) is a touch at a vertex, not
 #: an interface (the side probes see such touches as slivers about as long as their offset).
 CONTACT_RTOL = 1e-6
+#: Candidate lines closer than this are one line: heights relative to the building's size,
+#: crack angles in radians. (Refined candidates of one mechanism may sit 1e-9 apart in a
+#: scene far from the origin; two such lines would cut slivers the probes cannot see.)
+LINE_RTOL = 1e-6
 #: A block moves in the LP's mechanism when its speed exceeds this fraction of the largest.
 MOVING_RTOL = 1e-7
 
@@ -434,7 +438,7 @@ def facade_lp_model(
     wall = bld.walls[facade]
     f = wall.frame
     d = -f.e_n if direction == "outward" else f.e_n.copy()
-    zs = sorted(set(hinge_lines(bld, wall, bld.spec.candidates.spacing)) | set(heights))
+    zs = _merged([*hinge_lines(bld, wall, bld.spec.candidates.spacing), *heights], bld.size)
     returns = bld.returns.get(facade, []) if direction == "outward" else []
     blocks: List[LPBlock] = list(_cells(wall, zs, []))
     wall_blocks: Dict[str, List[int]] = {facade: list(range(len(blocks)))}
@@ -445,8 +449,9 @@ def facade_lp_model(
         betas = set(angles.get(r.wall.id, ()) if angles else ())
         if r.connection == "good":
             betas.add(r.beta_bond)
-        diag = _diagonals(wall, r, zs, sorted(betas), n_face, crack_axes)
-        lines["diagonals"][r.wall.id] = sorted(float(b) for b in betas)
+        kept = _merged(betas, 1.0)
+        diag = _diagonals(wall, r, zs, kept, n_face, crack_axes)
+        lines["diagonals"][r.wall.id] = kept
         start = len(blocks)
         blocks.extend(_cells(r.wall, zs, diag))
         wall_blocks[r.wall.id] = list(range(start, len(blocks)))
@@ -462,6 +467,15 @@ def facade_lp_model(
     model = LPModel(blocks, interfaces, [], [], [], [], d, facade, direction, lines)
     _load(bld, wall, model, wall_blocks, loads, overburden)
     return model
+
+
+def _merged(values: Any, size: float) -> List[float]:
+    """Return the values sorted, those within ``LINE_RTOL * size`` of a kept one dropped."""
+    out: List[float] = []
+    for v in sorted(float(x) for x in values):
+        if not out or v - out[-1] > LINE_RTOL * size:
+            out.append(v)
+    return out
 
 
 def _diagonals(

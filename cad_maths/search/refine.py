@@ -30,7 +30,10 @@ ROOT_XTOL = 1e-13
 #: Relative difference of λ0 within which the derivative's root is preferred to Brent's point.
 ROOT_FTOL = 1e-12
 #: A parameter this close to a bound (relative to the range) is tried on the bound itself.
-SNAP_RTOL = 1e-9
+SNAP_RTOL = 1e-7
+#: ... and put there when λ0 on the bound is at most this fraction above (rounding: λ0 of a
+#: scene a kilometre from the origin is known to a few 1e-10).
+SNAP_FTOL = 1e-9
 #: Alternating one-parameter polishes after Nelder-Mead (two parameters).
 POLISH_ROUNDS = 3
 
@@ -206,8 +209,9 @@ def _snap(
 ) -> Tuple[List[float], float]:
     """Put a parameter that ends within ``SNAP_RTOL`` of a bound exactly on it, if no worse.
 
-    Nelder-Mead and the polishes approach a minimum on a bound from inside; λ0 there is flat
-    to rounding, so the last ulps are decided by the value at the bound itself.
+    No worse: λ0 on the bound at most ``SNAP_FTOL`` (relative) above. Nelder-Mead and the
+    polishes approach a minimum on a bound from inside; λ0 there is flat to rounding, so the
+    last ulps are decided by the value at the bound itself.
     """
     for k, (lo, hi) in enumerate(bounds):
         span = hi - lo
@@ -216,7 +220,7 @@ def _snap(
                 y = list(x)
                 y[k] = b
                 vy = f(y)
-                if vy <= v + ROOT_FTOL * abs(v):
+                if vy <= v + SNAP_FTOL * abs(v):
                     x, v = y, vy
     return x, v
 

@@ -36,7 +36,13 @@ import numpy as np
 
 from cad_maths.mechanisms.build import MechanismFailure
 from cad_maths.scenes import read_scene
-from cad_maths.search.engine import MISSED_GAP, SearchResult, run_search, sliding_check
+from cad_maths.search.engine import (
+    MISSED_GAP,
+    SearchResult,
+    rank_order,
+    run_search,
+    sliding_check,
+)
 from cad_maths.search.families import Candidate, ground_height
 from cad_maths.search.prism import segment_intervals
 from cad_maths.search.specs import AGREEMENT_RTOL, build_candidates
@@ -602,11 +608,13 @@ def _build_and_rank(
                 "constants"
             )
 
-    def score(mid: str) -> tuple[float, float]:
+    def score(mid: str) -> float:
         s = docs[mid]["overturning"]["band_score_g"]
-        return (math.inf if s is None else s, docs[mid]["lam0"])
+        return math.inf if s is None else float(s)
 
-    out.dynamic = sorted([m.id for m in cf.mechanisms], key=score)
+    # near-ties in the band score go by the static rank (the order of the built mechanisms)
+    built = [m.id for m in cf.mechanisms]
+    out.dynamic = [built[k] for k in rank_order([score(mid) for mid in built])]
     for r, mid in enumerate(out.dynamic):
         docs[mid]["rank_dynamic"] = r + 1
     return out
