@@ -17,7 +17,10 @@
   as the builder finds it): a horizontal contact bears, a vertical one abuts; a roof that
   is not tied thrusts outward (``thrust.roof_thrust``, span and rise from its bounding box
   in the wall's frame, as the builder computes them);
-* a tie-bar meets a façade where its line crosses the façade's outer face.
+* a tie-bar meets a façade where its line crosses the façade's outer face;
+* the ground is the lowest wall base: a wall stands on it (within ``GROUND_RTOL`` of its
+  thickness) or on a level, read as fixed on the level, which is no load on it; a wall
+  standing on nothing, or drawn on another wall's top, is refused (``_check_bases``).
 
 Python 3.9-clean: imported by Rhino 8.
 """
@@ -1264,7 +1267,9 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
         A selector that matches nothing (or several objects for a wall), a junction the
         spec does not give, a listed junction whose walls do not meet.
     GeometryError
-        A wall that is not a vertical slab, a level or tie-bar that touches no wall.
+        A wall that is not a vertical slab, a selector that matches no solid (or no line for
+        a tie-bar), a level or tie-bar that touches no wall (with the gap to the nearest
+        wall), a wall above the ground that stands on no level, a wall on another's top.
     """
     # the spec's implausible values are warnings of the search's document (issue #36), not notes
     notes: List[str] = []
