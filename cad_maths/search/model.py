@@ -17,7 +17,10 @@
   as the builder finds it): a horizontal contact bears, a vertical one abuts; a roof that
   is not tied thrusts outward (``thrust.roof_thrust``, span and rise from its bounding box
   in the wall's frame, as the builder computes them);
-* a tie-bar meets a façade where its line crosses the façade's outer face.
+* a tie-bar meets a façade where its line crosses the façade's outer face;
+* the ground is the lowest wall base: a wall stands on it (within ``GROUND_RTOL`` of its
+  thickness) or on a level, read as fixed on the level, which is no load on it; a wall
+  standing on nothing, or drawn on another wall's top, is refused (``_check_bases``).
 
 Python 3.9-clean: imported by Rhino 8.
 """
@@ -85,6 +88,13 @@ SQUARE_TOL = 1e-3
 #: Footprints sharing less than this fraction of the smaller one's area do not overlap (the
 #: rounding of a shared face).
 OVERLAP_RTOL = 1e-9
+#: A wall whose base is within this fraction of its thickness of the ground (the lowest wall
+#: base) stands on the ground, as walls that close join (``plan.GAP_RTOL``); higher, it must
+#: stand on a level, or it is refused.
+GROUND_RTOL = 0.1
+#: Walls drawn further apart than the joining gap but within this fraction of the thinner
+#: one's thickness nearly meet: a note gives the gap and reads them as not meeting.
+NEAR_RTOL = 1.0
 #: The name a wall trimmed where it ran into another wall gains.
 TRIMMED = " (trimmed)"
 #: Namespace of the ids of walls with openings cut out of them.
@@ -187,6 +197,10 @@ class Wall:
             cached = float(self.frame.to_frame(self.mesh.vertices)[:, 1].max())
             self.__dict__["_inner"] = cached
         return float(cached)
+
+    def to_end(self, s: float) -> np.ndarray:
+        """Plan point (2,) of the wall's centre line at ``s`` along it [m]."""
+        return np.asarray(self.frame.to_world(s, 0.5 * self.frame.thickness, 0.0)[:2], dtype=float)
 
     @property
     def mass(self) -> float:
@@ -378,6 +392,27 @@ def _find(scene: Any, selectors: Sequence[Any], where: str) -> List[SceneObject]
         if exc.field == "selector":
             raise InputError(exc.reason, where) from None
         raise
+
+
+def _solid(scene: Any, obj: SceneObject, selector: Any, where: str) -> Tuple[TriMesh, List[str]]:
+    """Return the object's checked solid, naming its selector when it is no solid.
+
+    ``where`` is the spec's field (``walls[0].object``) and ``selector`` what it gave: the
+    message says what the selector matched (a line, an open mesh) and what to select.
+    """
+    try:
+        return check_solid(scene.mesh(obj))
+    except GeometryError as exc:
+        raise GeometryError(f"{where}: {selector!r} matches {exc}") from None
+
+
+def _line(scene: Any, obj: SceneObject, selector: Any, where: str) -> Tuple[np.ndarray, np.ndarray]:
+    """Return the object's end points, naming its selector when it is no line."""
+    try:
+        start, end = scene.line(obj)
+    except GeometryError as exc:
+        raise GeometryError(f"{where}: {selector!r} matches {exc}") from None
+    return np.asarray(start, dtype=float), np.asarray(end, dtype=float)
 
 
 def _one_object(scene: Any, selector: Any, where: str) -> SceneObject:
@@ -888,24 +923,56 @@ def _returns(
     return out
 
 
+def _read_levels(scene: Any, spec: Any) -> List[Tuple[List[SceneObject], List[TriMesh], List[str]]]:
+    """Each level's objects, checked solids and their warnings, in spec order."""
+    out = []
+    for k, level in enumerate(spec.levels):
+        where = f"levels[{k}].objects"
+        objs = _find(scene, level.objects, where)
+        meshes, warns = [], []
+        for obj, sel in zip(objs, _selectors_of(scene, level.objects, objs)):
+            mesh, warn = _solid(scene, obj, sel, where)
+            meshes.append(mesh)
+            warns.extend(warn)
+        out.append((objs, meshes, warns))
+    return out
+
+
+def _selectors_of(scene: Any, selectors: Sequence[Any], objs: Sequence[SceneObject]) -> List[Any]:
+    """Return the selector that found each object (``_find`` keeps their order)."""
+    out: List[Any] = []
+    for sel in selectors:
+        out.extend([sel] * len(scene.find(sel)))
+    return out if len(out) == len(objs) else [list(selectors)] * len(objs)
+
+
 def _level_contacts(
-    scene: Any,
     spec: Any,
     walls: Dict[str, Wall],
     tol: float,
     notes: List[str],
     memory: MemoryScene,
-) -> Tuple[Dict[str, List[LevelContact]], Dict[str, List[SceneObject]]]:
+    read: List[Tuple[List[SceneObject], List[TriMesh], List[str]]],
+    plan: Plan,
+) -> Tuple[
+    Dict[str, List[LevelContact]],
+    Dict[str, List[SceneObject]],
+    Dict[str, List[Tuple[str, float]]],
+]:
+    """Return the levels' contacts per wall, their objects, and the levels walls stand on.
+
+    A level whose top meets a wall's base (a horizontal contact, the level below) is what
+    the wall stands on, not a load on it: the third item gives, per wall, ``(level id, area
+    [m²])`` of such contacts.
+    """
     out: Dict[str, List[LevelContact]] = {w: [] for w in walls}
     objects: Dict[str, List[SceneObject]] = {}
+    under: Dict[str, List[Tuple[str, float]]] = {}
     for k, level in enumerate(spec.levels):
         where = f"levels[{k}]"
-        objs = _find(scene, level.objects, f"{where}.objects")
-        meshes = []
-        for obj in objs:
-            mesh, warn = check_solid(scene.mesh(obj))
-            notes.extend(f"{where}: {w}" for w in warn)
-            meshes.append(mesh)
+        objs, meshes, warns = read[k]
+        notes.extend(f"{where}: {w}" for w in warns)
+        for obj, mesh in zip(objs, meshes):
             memory.add(SceneObject(obj.id, obj.name, obj.layer, "mesh", dict(obj.user_text), mesh))
         objects[level.id] = objs
         total = sum(mass_properties(m, level.density).mass for m in meshes)
@@ -914,14 +981,20 @@ def _level_contacts(
             float(max(m.vertices[:, 2].max() for m in meshes)),
         )
         touched = []
+        carried = []
         for wall in walls.values():
             regions = []
             for m in meshes:
                 hit = contact_region(m, wall.mesh, tol=tol)
-                if hit is not None:
+                if hit is None:
+                    continue
+                if _is_base(hit, wall, m, tol):
+                    under.setdefault(wall.id, []).append((level.id, float(hit[0])))
+                    carried.append(wall.id)
+                else:
                     regions.append(hit)
             if not regions:
-                continue  # this level does not touch this wall
+                continue  # this level does not touch this wall, or only carries it
             area, point, normal, _ = max(regions, key=lambda r: r[0])
             # A roof's share always bears where it touches (as the builder takes it).
             bearing = level.kind == "roof" or abs(float(normal[2])) >= math.cos(BEARING_ANGLE)
@@ -952,17 +1025,184 @@ def _level_contacts(
                 )
             )
             touched.append(wall.id)
+        if not touched and carried:
+            raise GeometryError(
+                f"{where} ({level.id}): the walls {', '.join(sorted(set(carried)))} stand on it, "
+                "and it rests on no wall: a level is carried by walls (on their tops or against "
+                "their faces); the ground or a foundation is not a level: remove it from levels"
+            )
         if not touched:
             raise GeometryError(
                 f"{where} ({level.id}): touches no wall (no shared face with any wall solid "
-                f"within {1000 * tol:.3g} mm)"
+                f"within {1000 * tol:.3g} mm); {_nearest_wall(meshes, walls, plan)}: draw it "
+                "onto the walls that carry it (its underside on their tops, or its edge against "
+                "their inner faces), or remove it from levels"
             )
         if "tributary" not in level.model_fields_set:
             notes.append(
                 f"{where} ({level.id}): tributary not given; each wall it touches carries the "
                 f"default {level.tributary:g} of its weight and inertia"
             )
-    return out, objects
+    return out, objects, under
+
+
+def _is_base(hit: Tuple[Any, ...], wall: Wall, level: TriMesh, tol: float) -> bool:
+    """Tell whether a level's contact with a wall is the wall's base on the level's top."""
+    _, point, normal, _ = hit
+    return (
+        float(normal[2]) >= math.cos(BEARING_ANGLE)
+        and abs(float(point[2]) - wall.z_lo) <= tol
+        and float(level.vertices[:, 2].max()) <= wall.z_lo + tol
+    )
+
+
+def _separation(a: np.ndarray, b: np.ndarray, plan: Plan) -> Tuple[float, float, float]:
+    """Distance between two solids given by their vertices, as vertical prisms [m].
+
+    Returns ``(distance, in plan, in height)``: the footprints' distance (convex hulls in
+    plan) and the gap between the height ranges (0 where they overlap); exact for solids
+    that are vertical prisms on convex footprints, as walls and slabs are.
+    """
+    d_plan = float(footprint(a, plan.origin).distance(footprint(b, plan.origin)))
+    lo_a, hi_a = float(a[:, 2].min()), float(a[:, 2].max())
+    lo_b, hi_b = float(b[:, 2].min()), float(b[:, 2].max())
+    dz = max(lo_b - hi_a, lo_a - hi_b, 0.0)
+    return math.hypot(d_plan, dz), d_plan, dz
+
+
+def _nearest_wall(meshes: Sequence[TriMesh], walls: Dict[str, Wall], plan: Plan) -> str:
+    """Say which wall is nearest a level, how far, and which way."""
+    v = np.vstack([m.vertices for m in meshes])
+    best = min(walls.values(), key=lambda w: _separation(v, w.mesh.vertices, plan)[0])
+    dist, d_plan, dz = _separation(v, best.mesh.vertices, plan)
+    parts = []
+    if dz > 0.0:
+        above = float(v[:, 2].min()) >= best.z_hi
+        parts.append(
+            f"{dz:.3f} m {'above its top' if above else 'below its base'}"
+            if above or float(v[:, 2].max()) <= best.z_lo
+            else f"{dz:.3f} m apart in height"
+        )
+    if d_plan > 0.0:
+        parts.append(f"{d_plan:.3f} m off it in plan")
+    said = (
+        " and ".join(parts)
+        if parts
+        else "overlapping it (solids that interpenetrate share no face)"
+    )
+    return f"the nearest wall, {best.id}, is {dist:.3f} m from it ({said})"
+
+
+def _check_bases(
+    walls: Dict[str, Wall],
+    under: Dict[str, List[Tuple[str, float]]],
+    levels: Sequence[TriMesh],
+    plan: Plan,
+    tol: float,
+    notes: List[str],
+) -> float:
+    """Check that every wall stands on the ground or on a level; return the ground [m].
+
+    The ground is the lowest wall base. A wall whose base is within ``GROUND_RTOL`` of its
+    thickness of it stands on the ground; a higher one must stand on a level of the spec
+    (read as fixed on it, with a note). A wall drawn on another wall's top, or standing on
+    nothing, is refused.
+    """
+    ground = min(w.z_lo for w in walls.values())
+    for k, w in enumerate(walls.values()):
+        rise = w.z_lo - ground
+        where = f"walls[{k}] ({w.id})"
+        if rise <= max(tol, GROUND_RTOL * w.frame.thickness):
+            if rise > tol:
+                notes.append(
+                    f"{w.id}: its base is {1000 * rise:.3g} mm above the ground (the lowest wall "
+                    f"base, z = {ground:.3f} m): read as standing on the ground (a base within "
+                    "a tenth of the wall's thickness of it does)"
+                )
+            continue
+        said = (
+            f"its base at z = {w.z_lo:.3f} m is {rise:.3f} m above the ground, the lowest wall "
+            f"base (z = {ground:.3f} m)"
+        )
+        if w.id in under:
+            ids = sorted({lv for lv, _ in under[w.id]})
+            area = sum(a for _, a in under[w.id])
+            foot = float(plan.footprints[w.id].area)
+            cover = f" over {100 * min(area / foot, 1.0):.0f} % of its footprint" if foot else ""
+            notes.append(
+                f"{w.id}: stands on the level {', '.join(ids)}{cover}; {said}: its base is "
+                f"read as fixed on it (its mechanisms rock about its base there, Z "
+                f"{rise:.3f} m above the ground), and the level is no load on it; the walls "
+                f"under the level do not carry {w.id}'s weight (the search loads a wall with "
+                "the levels it carries only)"
+            )
+            continue
+        for o in walls.values():
+            if o.id == w.id or abs(o.z_hi - w.z_lo) > tol:
+                continue
+            hit = contact_region(o.mesh, w.mesh, tol=tol)
+            if hit is not None and float(hit[2][2]) >= math.cos(BEARING_ANGLE):
+                raise GeometryError(
+                    f"{where}: stands on {o.id}'s top ({said}): the search "
+                    f"reads a wall as one solid from the ground up (a wall drawn on another "
+                    f"neither loads it nor moves with it): join {w.id} and {o.id} into one solid"
+                )
+        foot = plan.footprints[w.id]
+        below = [
+            (w.z_lo - float(m.vertices[:, 2].max()), label)
+            for m, label in [(o.mesh, o.id) for o in walls.values() if o.id != w.id]
+            + [(m, "a level") for m in levels]
+            if float(m.vertices[:, 2].max()) <= w.z_lo + tol
+            and footprint(m.vertices, plan.origin).intersection(foot).area
+            > OVERLAP_RTOL * foot.area
+        ]
+        nearest = (
+            f"the nearest solid under it, {min(below)[1]}, is {min(below)[0]:.3f} m below its base"
+            if below
+            else "nothing of the spec is drawn under it"
+        )
+        raise GeometryError(
+            f"{where}: {said}, and it stands on no level or wall ({nearest}): the search reads "
+            f"every wall from the ground up, or standing on a level of the spec: draw {w.id} "
+            "down to the ground (the lowest wall base), or onto the level that carries it"
+        )
+    return ground
+
+
+def _near_misses(walls: Dict[str, Wall], plan: Plan, tol: float, notes: List[str]) -> None:
+    """Note the walls drawn apart by more than the joining gap but less than a thickness.
+
+    Such walls are read as not meeting (each is free-standing where it stops short of the
+    other); the note gives the gap, so that a corner drawn short does not pass unseen.
+    """
+    ws = list(walls.values())
+    for i, a in enumerate(ws):
+        for b in ws[i + 1 :]:
+            if min(a.z_hi, b.z_hi) - max(a.z_lo, b.z_lo) <= tol:
+                continue
+            gap = float(plan.footprints[a.id].distance(plan.footprints[b.id]))
+            near = NEAR_RTOL * min(a.frame.thickness, b.frame.thickness)
+            if not max(plan.gap, tol) < gap <= near:
+                continue
+            # the wall whose end faces the other: its end nearest the other's footprint
+            ends = []
+            for x, y in ((a, b), (b, a)):
+                for s in (0.0, x.length):
+                    p = x.to_end(s)
+                    d = float(plan.footprints[y.id].distance(_point(p - plan.origin)))
+                    ends.append((d, x, y, s))
+            _, x, y, s = min(ends, key=lambda e: e[0])
+            notes.append(
+                f"{x.id}'s end (s = {s:.3f} m) stops {1000 * gap:.3g} mm short of {y.id}, beyond "
+                f"the joining gap ({1000 * plan.gap:.3g} mm, a tenth of the thinnest wall's "
+                f"thickness): read as not meeting, {x.id} free-standing at that end (no junction "
+                f"with {y.id}); draw {x.id} to meet {y.id} if the two are bonded or abut"
+            )
+
+
+def _point(xy: np.ndarray) -> Any:
+    shapely = require("shapely", "geometry", "to read the plan of a search")
+    return shapely.Point(float(xy[0]), float(xy[1]))
 
 
 def _tie_points(
@@ -972,7 +1212,7 @@ def _tie_points(
     for k, tie in enumerate(spec.tie_bars):
         where = f"tie_bars[{k}]"
         obj = _find(scene, [tie.object], f"{where}.object")[0]
-        start, end = scene.line(obj)
+        start, end = _line(scene, obj, tie.object, f"{where}.object")
         memory.add(SceneObject(obj.id, obj.name, obj.layer, "line", {}, (start, end)))
         met = False
         for wall in walls.values():
@@ -1027,7 +1267,9 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
         A selector that matches nothing (or several objects for a wall), a junction the
         spec does not give, a listed junction whose walls do not meet.
     GeometryError
-        A wall that is not a vertical slab, a level or tie-bar that touches no wall.
+        A wall that is not a vertical slab, a selector that matches no solid (or no line for
+        a tie-bar), a level or tie-bar that touches no wall (with the gap to the nearest
+        wall), a wall above the ground that stands on no level, a wall on another's top.
     """
     # the spec's implausible values are warnings of the search's document (issue #36), not notes
     notes: List[str] = []
@@ -1035,14 +1277,14 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
     openings: List[Tuple[SceneObject, TriMesh]] = []
     for k, sel in enumerate(spec.openings):
         for obj in _find(scene, [sel], f"openings[{k}]"):
-            mesh, warn = check_solid(scene.mesh(obj))
+            mesh, warn = _solid(scene, obj, sel, f"openings[{k}]")
             notes.extend(warn)
             openings.append((obj, mesh))
     raw: List[Tuple[Any, SceneObject, TriMesh, Any]] = []
     for k, w in enumerate(spec.walls):
         where = f"walls[{k}] ({w.id})"
         obj = _one_object(scene, w.object, f"walls[{k}].object")
-        mesh, warn = check_solid(scene.mesh(obj))
+        mesh, warn = _solid(scene, obj, w.object, f"walls[{k}].object")
         notes.extend(warn)
         selector: Any = w.object
         if openings:
@@ -1055,8 +1297,9 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
         if obj.geometry is not mesh:
             obj = SceneObject(obj.id, obj.name, obj.layer, obj.kind, dict(obj.user_text), mesh)
         if w.overburden is not None and w.overburden.objects is not None:
-            for o in _find(scene, w.overburden.objects, f"walls[{k}].overburden.objects"):
-                m, warn = check_solid(scene.mesh(o))
+            at = f"walls[{k}].overburden.objects"
+            for o in _find(scene, w.overburden.objects, at):
+                m, warn = _solid(scene, o, w.overburden.objects, at)
                 notes.extend(warn)
                 memory.add(SceneObject(o.id, o.name, o.layer, "mesh", dict(o.user_text), m))
         raw.append((w, obj, mesh, selector))
@@ -1065,11 +1308,8 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
         memory.add(obj)
     verts = np.vstack([m.vertices for _, _, m, _ in raw])
     size = float(np.linalg.norm(verts.max(axis=0) - verts.min(axis=0)))
-    level_meshes = [
-        scene.mesh(o)
-        for k, lv in enumerate(spec.levels)
-        for o in _find(scene, lv.objects, f"levels[{k}].objects")
-    ]
+    level_read = _read_levels(scene, spec)
+    level_meshes = [m for _, meshes, _ in level_read for m in meshes]
     level_points = [m.vertices for m in level_meshes]
     plan = read_plan(
         [(w.id, m.vertices) for w, _, m, _ in raw], [(m.vertices, m.faces) for m in level_meshes]
@@ -1119,6 +1359,10 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
             )
     tol = max(contact_tolerance(scene), 1e-9 * size)
     returns = _returns(walls, spec, tol, notes, plan.gap)
-    contacts, level_objects = _level_contacts(scene, spec, walls, tol, notes, memory)
+    _near_misses(walls, plan, tol, notes)
+    contacts, level_objects, under = _level_contacts(
+        spec, walls, tol, notes, memory, level_read, plan
+    )
+    _check_bases(walls, under, level_meshes, plan, tol, notes)
     ties = _tie_points(scene, spec, walls, memory)
     return Building(memory, walls, returns, contacts, ties, notes, spec, level_objects, tol)

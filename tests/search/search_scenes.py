@@ -229,12 +229,14 @@ def plan_scene(
     mirror: bool = False,
     slabs: Sequence[tuple[str, Plan2, Sequence[Plan2], float, float]] = (),
     name: str = "plan",
+    heights: Optional[dict[str, tuple[float, float]]] = None,
 ) -> Path:
     """Walls (id, outer-face start, end, thickness; material on the left) of height ``h``.
 
-    ``slabs`` are horizontal levels (id, outline, holes, z0, z1). The whole scene is mirrored
-    in x = 0 (``mirror``), turned by ``rotate_deg`` about the vertical through the origin,
-    then moved by ``shift`` [m].
+    ``heights`` gives some walls their own base and top ``(z0, z1)`` [m] instead of
+    ``(0, h)``. ``slabs`` are horizontal levels (id, outline, holes, z0, z1). The whole scene
+    is mirrored in x = 0 (``mirror``), turned by ``rotate_deg`` about the vertical through
+    the origin, then moved by ``shift`` [m].
     """
     import math
 
@@ -254,12 +256,13 @@ def plan_scene(
         length = float(np.linalg.norm(b - a))
         e_s = (b - a) / length
         e_n = np.array([-e_s[1], e_s[0]])
+        z0, z1 = (heights or {}).get(wid, (0.0, h))
         v, f = BUILD.slab_solid(
-            (a[0], a[1], 0.0),
+            (a[0], a[1], z0),
             (e_s[0], e_s[1], 0.0),
             (e_n[0], e_n[1], 0.0),
             t,
-            [(0.0, 0.0), (length, 0.0), (length, h), (0.0, h)],
+            [(0.0, 0.0), (length, 0.0), (length, z1 - z0), (0.0, z1 - z0)],
         )
         v = place(v)
         if mirror:
