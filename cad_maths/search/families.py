@@ -331,13 +331,16 @@ def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = 
     tol = max(bld.contact_tol, 0.0)
     out: Hits = dict(best or {})
     for piece in pieces:
+        # the half-spaces' coefficients as floats, once per piece (not once per region)
+        planes = [
+            (float(n[0]), float(n[1]), float(n[2]), float(p[0]), float(p[1]), float(p[2]))
+            for p, n in piece.planes
+        ]
         for c in bld.contacts.get(piece.wall.id, []):
-            for region in c.regions:
+            for j, region in enumerate(c.regions):
                 rings = list(region.rings)
                 u, v, o = region.u.tolist(), region.v.tolist(), region.origin.tolist()
-                for point, normal in piece.planes:
-                    m0, m1, m2 = (float(x) for x in normal)
-                    p0, p1, p2 = (float(x) for x in point)
+                for m0, m1, m2, p0, p1, p2 in planes:
                     rings = clip_rings(
                         rings,
                         m0 * u[0] + m1 * u[1] + m2 * u[2],
@@ -347,10 +350,13 @@ def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = 
                 area, su, sv = (float(x) for x in ring_moments(rings)[:3])
                 if not area > 0.0:
                     continue
-                pts = np.vstack(rings) if len(rings) > 1 else rings[0]
-                extent = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
-                if area <= tol * extent:
-                    continue  # a touch along a line (the builder's MIN_WIDTH_FACTOR)
+                # clipping only shrinks a region: past the whole region's extent the touch
+                # test passes without measuring the clipped part
+                if area <= tol * bld.region_extent((piece.wall.id, c.index, j), region.rings):
+                    pts = np.vstack(rings) if len(rings) > 1 else rings[0]
+                    extent = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
+                    if area <= tol * extent:
+                        continue  # a touch along a line (the builder's MIN_WIDTH_FACTOR)
                 k = c.index
                 if k not in out or area > out[k][0]:
                     centroid = region.origin + (su / area) * region.u + (sv / area) * region.v

@@ -351,6 +351,7 @@ class Building:
     level_objects: Dict[str, List[SceneObject]] = field(default_factory=dict)
     contact_tol: float = 0.0
     _thrusts: Dict[Tuple[int, Tuple[float, ...]], float] = field(default_factory=dict)
+    _extents: Dict[Tuple[str, int, int], float] = field(default_factory=dict)
 
     def roof_thrust(self, contact: "LevelContact", d: np.ndarray) -> float:
         """Outward thrust of a roof on a mechanism collapsing along ``d`` [N].
@@ -369,6 +370,17 @@ class Building:
                 contact.weight, float(ext[0]), float(abs(ext[2])), not contact.level.pushes
             )
         return self._thrusts[key]
+
+    def region_extent(self, key: Tuple[str, int, int], rings: Sequence[np.ndarray]) -> float:
+        """Larger side of the bounding box of a level's contact region with a wall [m].
+
+        ``key`` (wall id, level index, region index) names the region; the value is
+        computed once per building.
+        """
+        if key not in self._extents:
+            pts = np.vstack(list(rings))
+            self._extents[key] = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
+        return self._extents[key]
 
     @property
     def size(self) -> float:

@@ -258,9 +258,8 @@ def segment_intervals(
     """
     d = np.asarray(p1, dtype=float) - np.asarray(p0, dtype=float)
     cuts = [0.0, 1.0]
-    for ring in rings:
-        a = ring
-        b = np.roll(ring, -1, axis=0)
+    ends = [(ring, np.roll(ring, -1, axis=0)) for ring in rings]
+    for a, b in ends:
         e = b - a
         den = d[0] * e[:, 1] - d[1] * e[:, 0]
         w = a - p0
@@ -270,12 +269,23 @@ def segment_intervals(
         hit = ok & (v >= -1e-12) & (v <= 1.0 + 1e-12) & (u > 0.0) & (u < 1.0)
         cuts.extend(float(x) for x in u[hit])
     cuts = sorted(set(cuts))
+    pieces = [(lo, hi) for lo, hi in zip(cuts[:-1], cuts[1:]) if hi - lo > 1e-12]
+    if not pieces:
+        return []
+    # the winding number at every piece's middle at once (``winding``'s rule, point-wise)
+    mids = (
+        np.asarray(p0, dtype=float) + np.array([0.5 * (lo + hi) for lo, hi in pieces])[:, None] * d
+    )
+    px, pz = mids[:, :1], mids[:, 1:]
+    total = np.zeros(len(pieces), dtype=np.int64)
+    for a, b in ends:
+        up = (a[:, 1] <= pz) & (b[:, 1] > pz)
+        down = (a[:, 1] > pz) & (b[:, 1] <= pz)
+        cross = (b[:, 0] - a[:, 0]) * (pz - a[:, 1]) - (px - a[:, 0]) * (b[:, 1] - a[:, 1])
+        total += np.sum(up & (cross > 0.0), axis=1) - np.sum(down & (cross < 0.0), axis=1)
     spans: List[Tuple[float, float]] = []
-    for lo, hi in zip(cuts[:-1], cuts[1:]):
-        if hi - lo <= 1e-12:
-            continue
-        mid = np.asarray(p0, dtype=float) + 0.5 * (lo + hi) * d
-        if winding(rings, mid) != 0:
+    for (lo, hi), inside in zip(pieces, total.tolist()):
+        if inside != 0:
             if spans and abs(spans[-1][1] - lo) <= 1e-12:
                 spans[-1] = (spans[-1][0], hi)
             else:

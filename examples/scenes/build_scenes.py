@@ -623,6 +623,253 @@ def search_facade(out: Path) -> Path:
     return b.write(out / "search_facade.3dm")
 
 
+# ---------------------------------------------------------------------- the palazzo
+# A benchmark scene (issue #37), not a shipped example: ``palazzo(out)`` writes it and
+# ``palazzo_spec()`` gives its search spec.
+
+#: The block's outer-face plan, x and y [m]: a rectangle, counter-clockwise.
+PALAZZO_SIZE = (32.0, 24.0)
+#: The courtyard's faces, (x0, x1, y0, y1) [m].
+PALAZZO_YARD = (7.0, 25.0, 7.0, 17.0)
+#: Thickness of the outer, courtyard and cross walls [m].
+PALAZZO_T = {"outer": 0.6, "yard": 0.5, "cross": 0.4}
+#: Storey height [m] and number of storeys.
+PALAZZO_STOREY, PALAZZO_STOREYS = 3.5, 4
+#: Floor and roof slab thickness [m].
+PALAZZO_SLAB = 0.25
+#: The roof's density, a timber roof's smeared over the slab [kg/m³].
+PALAZZO_ROOF_DENSITY = 600.0
+#: Window width, sill above the storey's base and height [m].
+PALAZZO_WINDOW = (1.2, 0.9, 1.8)
+#: Middle cross walls of the long (south, north) and short (west, east) wings.
+PALAZZO_CROSS = (5, 2)
+
+
+def plan_prism(
+    outline: Sequence[Tuple[float, float]],
+    holes: Sequence[Sequence[Tuple[float, float]]],
+    z0: float,
+    z1: float,
+    lean: float = 0.0,
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Return a closed mesh of a plan polygon with holes extruded from ``z0`` to ``z1``.
+
+    The top is moved by ``(z1 - z0) * lean`` along x (a prism out of plumb).
+    """
+    from cad_maths.geometry.polygon import orient_rings, triangulate_polygon
+
+    rings = orient_rings(
+        [np.asarray(outline, dtype=float)] + [np.asarray(r, dtype=float) for r in holes]
+    )
+    pts = np.vstack(rings)
+    m = len(pts)
+    tris = np.array(triangulate_polygon(rings[0], rings[1:]), dtype=np.int64)
+    bottom = np.column_stack([pts, np.full(m, z0)])
+    top = np.column_stack([pts[:, 0] + (z1 - z0) * lean, pts[:, 1], np.full(m, z1)])
+    faces = [tris[:, ::-1], tris + m]
+    start = 0
+    for r in rings:
+        k = len(r)
+        for i in range(k):
+            p, q = start + i, start + (i + 1) % k
+            faces.append(np.array([[p, q, q + m], [p, q + m, p + m]]))
+        start += k
+    return np.vstack([bottom, top]), np.vstack(faces)
+
+
+def _spread(lo: float, hi: float, n: int, t: float) -> List[float]:
+    """Return the starts of ``n`` walls of thickness ``t`` cutting [lo, hi] into equal rooms."""
+    room = (hi - lo - n * t) / (n + 1)
+    return [lo + (k + 1) * room + k * t for k in range(n)]
+
+
+def palazzo_walls() -> List[Tuple[str, Tuple[float, float], Tuple[float, float], float]]:
+    """Return the palazzo's walls: (id, outer-face start, end, thickness), material left.
+
+    The outer ring (``O0`` south, ``O1`` east, ``O2`` north, ``O3`` west) runs
+    counter-clockwise; at each corner the next wall butts on the previous one's inner face.
+    The courtyard's south and north walls (``CS``, ``CN``) run through its corners and the
+    west and east ones (``CW``, ``CE``) stand between them, on their courtyard faces. Cross
+    walls (``X…``) join the two rings: one on each side of each courtyard corner (in line
+    with the courtyard wall it abuts, at that wall's end), and ``PALAZZO_CROSS`` more across
+    each wing.
+    """
+    lx, ly = PALAZZO_SIZE
+    x0, x1, y0, y1 = PALAZZO_YARD
+    to, ty, tx = PALAZZO_T["outer"], PALAZZO_T["yard"], PALAZZO_T["cross"]
+    walls = [
+        ("O0", (to, 0.0), (lx, 0.0), to),
+        ("O1", (lx, to), (lx, ly), to),
+        ("O2", (lx - to, ly), (0.0, ly), to),
+        ("O3", (0.0, ly - to), (0.0, 0.0), to),
+        ("CS", (x1 + ty, y0), (x0 - ty, y0), ty),
+        ("CN", (x0 - ty, y1), (x1 + ty, y1), ty),
+        ("CW", (x0, y0), (x0, y1), ty),
+        ("CE", (x1, y1), (x1, y0), ty),
+    ]
+    # cross walls: material on the left of the line, from the outer ring to the courtyard's
+    south, north, west, east = (to, y0 - ty), (y1 + ty, ly - to), (to, x0 - ty), (x1 + ty, lx - to)
+    crosses = [
+        (x0 - ty, ty, "S"), (x1, ty, "S"), (x0 - ty, ty, "N"), (x1, ty, "N"),
+        (y0, ty, "W"), (y1 - ty, ty, "W"), (y0, ty, "E"), (y1 - ty, ty, "E"),
+    ]  # fmt: skip
+    n_long, n_short = PALAZZO_CROSS
+    crosses += [(s, tx, w) for w in "SN" for s in _spread(x0, x1, n_long, tx)]
+    crosses += [(s, tx, w) for w in "WE" for s in _spread(y0 + ty, y1 - ty, n_short, tx)]
+    for k, (s, t, wing) in enumerate(crosses):
+        if wing in "SN":  # along y at x in [s, s + t]: the line x = s, walking -y
+            a, b = south if wing == "S" else north
+            walls.append((f"X{k}", (s, b), (s, a), t))
+        else:  # along x at y in [s, s + t]: the line y = s, walking +x
+            a, b = west if wing == "W" else east
+            walls.append((f"X{k}", (a, s), (b, s), t))
+    return walls
+
+
+def palazzo_rooms() -> List[Tuple[float, float, float, float]]:
+    """Return the rooms between the rings and the cross walls, (x0, x1, y0, y1) [m]."""
+    lx, ly = PALAZZO_SIZE
+    x0, x1, y0, y1 = PALAZZO_YARD
+    to, ty, tx = PALAZZO_T["outer"], PALAZZO_T["yard"], PALAZZO_T["cross"]
+    n_long, n_short = PALAZZO_CROSS
+
+    def gaps(lo: float, hi: float, n: int, t: float) -> List[Tuple[float, float]]:
+        cuts = [lo] + [v for s in _spread(lo, hi, n, t) for v in (s, s + t)] + [hi]
+        return list(zip(cuts[0::2], cuts[1::2]))
+
+    rooms = [
+        (to, x0 - ty, to, y0), (x1 + ty, lx - to, to, y0),
+        (to, x0 - ty, y1, ly - to), (x1 + ty, lx - to, y1, ly - to),
+    ]  # fmt: skip
+    rooms += [(a, b, to, y0 - ty) for a, b in gaps(x0, x1, n_long, tx)]
+    rooms += [(a, b, y1 + ty, ly - to) for a, b in gaps(x0, x1, n_long, tx)]
+    rooms += [(to, x0 - ty, a, b) for a, b in gaps(y0 + ty, y1 - ty, n_short, tx)]
+    rooms += [(x1 + ty, lx - to, a, b) for a, b in gaps(y0 + ty, y1 - ty, n_short, tx)]
+    return rooms
+
+
+def palazzo_windows() -> Dict[str, List[Tuple[float, float, float, float]]]:
+    """Return each wall's windows in its own elevation, (s0, s1, z0, z1) [m] (s from its start).
+
+    Windows are centred on the rooms behind them: three a storey on the south front, two
+    on the north, one on the east and west; one a storey on the courtyard's south and north
+    walls and one on the top two storeys of its west and east walls (40 in all).
+    """
+    lx, ly = PALAZZO_SIZE
+    x0, x1, y0, y1 = PALAZZO_YARD
+    to, ty = PALAZZO_T["outer"], PALAZZO_T["yard"]
+    w, sill, hw = PALAZZO_WINDOW
+    rooms = palazzo_rooms()
+    south = sorted((a + b) / 2 for a, b, c, _ in rooms if c == to and x0 <= a and b <= x1)
+    north = sorted((a + b) / 2 for a, b, c, _ in rooms if c == y1 + ty and x0 <= a and b <= x1)
+    west = sorted((c + d) / 2 for a, _, c, d in rooms if a == to and y0 <= c and d <= y1)
+    # centres along each wall's own s (walls' starts: see palazzo_walls)
+    along = {
+        "O0": [south[0] - to, south[2] - to, south[-1] - to],
+        "O2": [lx - to - north[1], lx - to - north[-2]],
+        "O1": [west[1] - to],
+        "O3": [ly - to - west[1]],
+        "CS": [x1 + ty - south[3]],
+        "CN": [north[2] - (x0 - ty)],
+        "CW": [west[1] - y0],
+        "CE": [y1 - west[1]],
+    }
+    out: Dict[str, List[Tuple[float, float, float, float]]] = {}
+    for wid, centres in along.items():
+        storeys = range(2, PALAZZO_STOREYS) if wid in ("CW", "CE") else range(PALAZZO_STOREYS)
+        out[wid] = [
+            (c - w / 2, c + w / 2, k * PALAZZO_STOREY + sill, k * PALAZZO_STOREY + sill + hw)
+            for k in storeys
+            for c in centres
+        ]
+    return out
+
+
+def palazzo(out: Path, name: str = "palazzo") -> Path:
+    """Write the palazzo block: ``<out>/<name>.3dm``.
+
+    Walls (layer ``Walls``, meshes named by their ids, see ``palazzo_walls``) of
+    ``PALAZZO_STOREYS`` storeys with their windows as voids; a floor slab in every room at
+    each storey (``floor_<k>_<room>``, layer ``Floors``, abutting the room's walls); a roof
+    slab over the wall tops with the courtyard as a hole (``roof``, layer ``Roof``).
+    """
+    b = Builder(name)
+    h = PALAZZO_STOREY * PALAZZO_STOREYS
+    windows = palazzo_windows()
+    for wid, start, end, t in palazzo_walls():
+        a, e = np.asarray(start), np.asarray(end)
+        length = float(np.linalg.norm(e - a))
+        e_s = (e - a) / length
+        v, f = slab_solid(
+            (a[0], a[1], 0.0),
+            (e_s[0], e_s[1], 0.0),
+            (-e_s[1], e_s[0], 0.0),
+            t,
+            [(0.0, 0.0), (length, 0.0), (length, h), (0.0, h)],
+            [[(s0, z0), (s1, z0), (s1, z1), (s0, z1)] for s0, s1, z0, z1 in windows.get(wid, [])],
+        )
+        b.mesh(wid, "Walls", v, f, "brick")
+    for k in range(1, PALAZZO_STOREYS):
+        z = k * PALAZZO_STOREY
+        for j, (xa, xb, ya, yb) in enumerate(palazzo_rooms()):
+            b.box(f"floor_{k}_{j}", "Floors", (xa, ya, z), (xb, yb, z + PALAZZO_SLAB), "concrete")
+    lx, ly = PALAZZO_SIZE
+    x0, x1, y0, y1 = PALAZZO_YARD
+    v, f = plan_prism(
+        [(0.0, 0.0), (lx, 0.0), (lx, ly), (0.0, ly)],
+        [[(x0, y0), (x0, y1), (x1, y1), (x1, y0)]],
+        h,
+        h + PALAZZO_SLAB,
+    )
+    b.mesh("roof", "Roof", v, f, "concrete")
+    return b.write(out / f"{name}.3dm")
+
+
+def palazzo_spec() -> Dict[str, object]:
+    """Return the palazzo's search spec: walls of 1800 kg/m³, every room's floor a level.
+
+    Each room's floor at each storey is a level of its own (``floor_<k>_<room>``, concrete,
+    half its mass on each wall it abuts: a one-way slab), so that a wall carries the rooms
+    beside it, not a whole storey. The roof, one slab on every wall's top, is a light roof
+    (``PALAZZO_ROOF_DENSITY``, no thrust) of which each wall carries an equal share
+    (``1 / n_walls``; the spec has one share per level). The outer ring's south-east and
+    north-west corners and the courtyard walls' junctions with the cross walls at their
+    ends are good (bond 0.25 x 0.12 m); every other junction is poor (``default_junction``).
+    """
+    walls = palazzo_walls()
+    levels: List[Dict[str, object]] = [
+        {
+            "id": f"floor_{k}_{j}",
+            "kind": "floor",
+            "objects": [f"floor_{k}_{j}"],
+            "density": 2400.0,
+            "tributary": 0.5,
+        }
+        for k in range(1, PALAZZO_STOREYS)
+        for j in range(len(palazzo_rooms()))
+    ]
+    levels.append(
+        {
+            "id": "roof",
+            "kind": "roof",
+            "objects": ["roof"],
+            "density": PALAZZO_ROOF_DENSITY,
+            "tributary": 1.0 / len(walls),
+            "thrust": False,
+        }
+    )
+    good = [["O0", "O1"], ["O2", "O3"]]
+    yard_ends = {"CS": ("X0", "X1"), "CN": ("X2", "X3"), "CW": ("X4", "X5"), "CE": ("X6", "X7")}
+    good += [[c, x] for c, xs in yard_ends.items() for x in xs]
+    unit = {"length": 0.25, "height": 0.12}
+    return {
+        "walls": [{"id": w[0], "object": w[0], "density": 1800.0} for w in walls],
+        "levels": levels,
+        "junctions": [{"walls": pair, "connection": "good", "unit": unit} for pair in good],
+        "default_junction": {"connection": "poor"},
+    }
+
+
 SCENES = {
     "rect_wall": rect_wall,
     "statue_column": statue_column,

@@ -187,36 +187,8 @@ def ring_walls(ring: Plan2, t: float, prefix: str) -> list[tuple[str, Any, Any, 
     return out
 
 
-def plan_prism(
-    outline: Sequence[tuple[float, float]],
-    holes: Sequence[Sequence[tuple[float, float]]],
-    z0: float,
-    z1: float,
-    lean: float = 0.0,
-) -> tuple[Any, Any]:
-    """A closed mesh (vertices, triangles) of a plan polygon with holes extruded from ``z0``
-    to ``z1``, its top moved by ``(z1 - z0) * lean`` along x (a prism out of plumb)."""
-    import numpy as np
-
-    from cad_maths.geometry.polygon import orient_rings, triangulate_polygon
-
-    rings = orient_rings(
-        [np.asarray(outline, dtype=float)] + [np.asarray(r, dtype=float) for r in holes]
-    )
-    pts = np.vstack(rings)
-    m = len(pts)
-    tris = np.array(triangulate_polygon(rings[0], rings[1:]), dtype=np.int64)
-    bottom = np.column_stack([pts, np.full(m, z0)])
-    top = np.column_stack([pts[:, 0] + (z1 - z0) * lean, pts[:, 1], np.full(m, z1)])
-    faces = [tris[:, ::-1], tris + m]
-    start = 0
-    for r in rings:
-        k = len(r)
-        for i in range(k):
-            p, q = start + i, start + (i + 1) % k
-            faces.append(np.array([[p, q, q + m], [p, q + m, p + m]]))
-        start += k
-    return np.vstack([bottom, top]), np.vstack(faces)
+#: A closed mesh of a plan polygon with holes extruded in z (the builder's ``plan_prism``).
+plan_prism = BUILD.plan_prism
 
 
 def plan_scene(
