@@ -29,7 +29,7 @@ import dataclasses
 import math
 import uuid
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Tuple, cast
+from typing import Any, Dict, List, Optional, Sequence, Set, Tuple, cast
 
 import numpy as np
 
@@ -879,11 +879,12 @@ def _return_at(
 
 
 def _returns(
-    walls: Dict[str, Wall], spec: Any, tol: float, notes: List[str], join: float = 0.0
+    walls: Dict[str, Wall], spec: Any, tol: float, notes: List[str], plan: Plan
 ) -> Dict[str, List[ReturnWall]]:
     out: Dict[str, List[ReturnWall]] = {w: [] for w in walls}
     listed = {tuple(sorted(j.walls)) for j in spec.junctions}
-    met = set()
+    met: Set[Tuple[str, str]] = set()
+    join = plan.gap
     for a in walls.values():
         for b in walls.values():
             if b.id == a.id:
@@ -892,7 +893,7 @@ def _returns(
             if found is None:
                 continue
             end, corner, span, reach, gap = found
-            pair = tuple(sorted([a.id, b.id]))
+            pair = (min(a.id, b.id), max(a.id, b.id))
             if gap > tol and pair not in met:
                 notes.append(
                     f"{b.id} and {a.id} are drawn {1000 * gap:.3g} mm apart: read as meeting "
@@ -912,6 +913,7 @@ def _returns(
             connection, unit, _ = _junction(spec, a.id, b.id)
             beta = _unit_angle(unit) if connection == "good" and unit is not None else 0.0
             out[a.id].append(ReturnWall(b, end, connection, beta, corner, span, reach))
+    _unjoined(walls, plan, tol, notes, met, listed)
     for pair in sorted(listed - met):
         raise InputError(
             f"the junction {list(pair)} is listed, but those walls do not meet (one wall's end "
@@ -1212,6 +1214,57 @@ def _near_misses(walls: Dict[str, Wall], plan: Plan, tol: float, notes: List[str
             )
 
 
+def _unjoined(
+    walls: Dict[str, Wall],
+    plan: Plan,
+    tol: float,
+    notes: List[str],
+    met: Set[Tuple[str, str]],
+    listed: Set[Tuple[str, ...]],
+) -> None:
+    """Say which walls touch in plan but form no junction the search can use.
+
+    The search reads a junction where one wall's end face stands on the other's face and the
+    two are square (``_return_at``). Walls that meet at another angle, or along a joint face
+    that is neither wall's (a mitre), are searched free at that corner: their mechanisms
+    without the other wall, which a good connection could only make stronger. A junction the
+    spec lists there is refused with the reason.
+    """
+    ws = list(walls.values())
+    for i, a in enumerate(ws):
+        for b in ws[i + 1 :]:
+            pair = (min(a.id, b.id), max(a.id, b.id))
+            if pair in met or min(a.z_hi, b.z_hi) - max(a.z_lo, b.z_lo) <= tol:
+                continue
+            shared = plan.grown[a.id].intersection(plan.grown[b.id])
+            width = max(plan.gap, tol)
+            if shared.area <= 0.5 * width * min(a.frame.thickness, b.frame.thickness):
+                continue  # apart, or touching at a point
+            cos = min(abs(float(a.frame.e_s @ b.frame.e_s)), 1.0)
+            angle = math.degrees(math.acos(cos))
+            if abs(cos) > math.sin(SQUARE_TOL):
+                why = (
+                    f"meet at {180.0 - angle:.1f}° / {angle:.1f}° (not square): the search's "
+                    "wedge and corner families take square junctions only"
+                )
+            else:
+                why = (
+                    "touch, but neither's end face stands on the other's face (a mitred or "
+                    "odd-shaped joint): the search reads no junction there; to search their "
+                    "wedges, draw one wall through the corner and the other butting on it"
+                )
+            if pair in listed:
+                raise InputError(
+                    f"the junction {list(pair)} is listed, but the walls {why}; remove it from "
+                    "junctions to search them free at that corner",
+                    "junctions",
+                )
+            notes.append(
+                f"{a.id} and {b.id} {why}; each is searched free at that corner (its "
+                "mechanisms without the other wall, which a connection could only make stronger)"
+            )
+
+
 def _point(xy: np.ndarray) -> Any:
     shapely = require("shapely", "geometry", "to read the plan of a search")
     return shapely.Point(float(xy[0]), float(xy[1]))
@@ -1370,7 +1423,7 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
                 "(the whole façade above a hinge line, its corners) are not searched"
             )
     tol = max(contact_tolerance(scene), 1e-9 * size)
-    returns = _returns(walls, spec, tol, notes, plan.gap)
+    returns = _returns(walls, spec, tol, notes, plan)
     _near_misses(walls, plan, tol, notes)
     contacts, level_objects, under = _level_contacts(
         spec, walls, tol, notes, memory, level_read, plan

@@ -56,6 +56,9 @@ LOOP_MAX = 64
 PLUMB_TOL_DEG = 5.0
 #: Faces flatter than this from the vertical are tops and bottoms (a gable's slopes) [deg].
 SIDE_TILT_MAX_DEG = 45.0
+#: A wall's thickness direction comes from its side faces within this angle of their mean
+#: direction [deg] (its two long faces, not oblique or mitred ends, nor reveals).
+SIDE_WINDOW_DEG = 20.0
 #: A footprint whose least enclosing rectangle has sides in a ratio below this is a pier: the
 #: doubled-angle average of its faces, (a - b) / (a + b) of their area, is under a fifth and
 #: vanishes on a square, so its thickness is read across the rectangle's shorter side.
@@ -484,7 +487,8 @@ def frame_from_mesh(
     * sides in a ratio of at least ``PIER_ASPECT_MIN``: a wall; the thickness direction is
       the horizontal axis of the side faces that carry the most area (its two large faces,
       whatever its openings), their horizontal normals averaged on the doubled angle (so
-      that n and -n agree);
+      that n and -n agree), then averaged again over the faces within ``SIDE_WINDOW_DEG``
+      of that mean (so that oblique or mitred ends do not tilt it);
     * a smaller ratio: a pier, whose faces no longer tell its thickness (a square's
       doubled-angle average vanishes). A footprint that fills its rectangle (to
       ``PIER_FILL_RTOL``) is read across its shorter side, about which the bare block
@@ -551,9 +555,12 @@ def frame_from_mesh(
     if not pier:
         ang = np.arctan2(unit[vertical, 1], unit[vertical, 0])
         w = area2[vertical]
-        c2 = float(np.sum(w * np.cos(2.0 * ang)))
-        s2 = float(np.sum(w * np.sin(2.0 * ang)))
-        theta = 0.5 * math.atan2(s2, c2)
+        theta = _doubled_mean(ang, w)
+        # again on the long faces alone: oblique or mitred ends would tilt the mean
+        off = np.abs(np.angle(np.exp(2j * (ang - theta)))) / 2.0
+        near = off <= math.radians(SIDE_WINDOW_DEG)
+        if np.any(near):
+            theta = _doubled_mean(ang[near], w[near])
         e_n = np.array([math.cos(theta), math.sin(theta), 0.0])
     # Snap to the axes when the wall is drawn along them (exact frames for exact walls).
     for k in range(2):
@@ -563,6 +570,13 @@ def frame_from_mesh(
     e_s = np.array([-e_n[1], e_n[0], 0.0])
     lo, hi = _face_leans(unit, area2, vertical, e_n)
     return WallAxes(e_n, e_s, 0.5 * (lo + hi), (lo, hi), plan, pier, square, rule)
+
+
+def _doubled_mean(ang: np.ndarray, w: np.ndarray) -> float:
+    """Return the weighted mean of axial directions (angles [rad], n and -n alike) [rad]."""
+    c2 = float(np.sum(w * np.cos(2.0 * ang)))
+    s2 = float(np.sum(w * np.sin(2.0 * ang)))
+    return 0.5 * math.atan2(s2, c2)
 
 
 def _check_plumb(

@@ -202,10 +202,12 @@ def plan_scene(
     slabs: Sequence[tuple[str, Plan2, Sequence[Plan2], float, float]] = (),
     name: str = "plan",
     heights: Optional[dict[str, tuple[float, float]]] = None,
+    footprints: Sequence[tuple[str, Plan2]] = (),
 ) -> Path:
     """Walls (id, outer-face start, end, thickness; material on the left) of height ``h``.
 
-    ``heights`` gives some walls their own base and top ``(z0, z1)`` [m] instead of
+    ``footprints`` are more walls (id, plan polygon) drawn as prisms from 0 to ``h`` (oblique
+    or mitred ends). ``heights`` gives some walls their own base and top ``(z0, z1)`` [m] instead of
     ``(0, h)``. ``slabs`` are horizontal levels (id, outline, holes, z0, z1). The whole scene
     is mirrored in x = 0 (``mirror``), turned by ``rotate_deg`` about the vertical through
     the origin, then moved by ``shift`` [m].
@@ -236,6 +238,12 @@ def plan_scene(
             t,
             [(0.0, 0.0), (length, 0.0), (length, z1 - z0), (0.0, z1 - z0)],
         )
+        v = place(v)
+        if mirror:
+            f = f[:, ::-1]
+        bld.mesh(wid, "Walls", np.ascontiguousarray(v), np.ascontiguousarray(f), "brick")
+    for wid, ring in footprints:
+        v, f = plan_prism(ring, [], 0.0, h)
         v = place(v)
         if mirror:
             f = f[:, ::-1]

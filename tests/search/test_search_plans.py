@@ -252,3 +252,132 @@ def _wedge_walls() -> list[dict[str, Any]]:
     from search_scenes import wedge_spec
 
     return list(wedge_spec()["walls"])
+
+
+#: A trapezoid plan: outer corners (0, 0) 100°, (10, 0) 90°, (10, Y) 90°, (X3, Y) 80°; the
+#: walls W0 (along y = 0), W1 (x = 10), W2 (y = Y) and W3 (the oblique one) of three
+#: thicknesses. W1 butts between W0's and W2's inner faces (square corners); W0 and W2 run
+#: to W3's outer face, their ends cut along it; W3 butts between their inner faces, its
+#: ends cut along them: a parallelogram in plan, an exact prism of thickness t3.
+ANGLE = math.radians(100.0)
+Y, X3 = 8.0 * math.sin(ANGLE), 8.0 * math.cos(ANGLE)
+THICK = {"W0": 0.4, "W1": 0.5, "W2": 0.6, "W3": 0.5}
+
+
+def _trapezoid() -> dict[str, list[tuple[float, float]]]:
+    cot, sin = 1.0 / math.tan(ANGLE), math.sin(ANGLE)
+    t0, t1, t2, t3 = (THICK[w] for w in ("W0", "W1", "W2", "W3"))
+    y1, y2 = t0, Y - t2
+    return {
+        "W0": [(0.0, 0.0), (10.0, 0.0), (10.0, t0), (t0 * cot, t0)],
+        "W1": [(10.0 - t1, y1), (10.0, y1), (10.0, y2), (10.0 - t1, y2)],
+        "W2": [(10.0, y2), (10.0, Y), (X3, Y), (y2 * cot, y2)],
+        "W3": [
+            (y1 * cot, y1),
+            (y1 * cot + t3 / sin, y1),
+            (y2 * cot + t3 / sin, y2),
+            (y2 * cot, y2),
+        ],
+    }
+
+
+def _centroid_depth(ring: list[tuple[float, float]], normal: Any, point: Any) -> float:
+    """Depth of a polygon's centroid behind the line through ``point`` with outward
+    ``normal`` (shoelace moments) [m]."""
+    p = np.asarray(ring, dtype=float)
+    x, y = p[:, 0], p[:, 1]
+    xn, yn = np.roll(x, -1), np.roll(y, -1)
+    cross = x * yn - xn * y
+    area = cross.sum() / 2.0
+    c = np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / (6.0 * area)
+    return float(-(c - np.asarray(point)) @ np.asarray(normal))
+
+
+@pytest.mark.parametrize("place", PLACES, ids=["drawn", "37deg_far", "-123deg_far", "mirrored"])
+def test_a_trapezoid_plan_with_a_100_degree_corner_and_three_thicknesses(
+    tmp_path: Path, place: tuple[float, tuple[float, float], bool]
+) -> None:
+    """Each wall overturns away from the plan about its outer base edge; the oblique corners
+    are said to be searched without their junction. References: λ0 = 2 d / h with d the
+    depth of the footprint's centroid behind the outer face (polygon moments written here):
+    t/h for the rectangle W1 and the parallelogram W3, the trapezoids W0 and W2 by their
+    moments (the builder, on the real solid; the search's idealised prism is within 0.5 %,
+    and the candidate says that the builder differs)."""
+    h = 6.0
+    quads = _trapezoid()
+    outward = {
+        "W0": (np.array([0.0, -1.0]), (0.0, 0.0)),
+        "W1": (np.array([1.0, 0.0]), (10.0, 0.0)),
+        "W2": (np.array([0.0, 1.0]), (10.0, Y)),
+        "W3": (np.array([-math.sin(ANGLE), math.cos(ANGLE)]), (0.0, 0.0)),
+    }
+    angle, shift, mirror = place
+    tag = f"trap_{abs(int(angle))}_{int(mirror)}"
+    scene = plan_scene(
+        tmp_path, [], h, rotate_deg=angle, shift=shift, mirror=mirror, name=tag,
+        footprints=sorted(quads.items()),
+    )  # fmt: skip
+    doc = rockmech.search_from_files(
+        scene, write_spec(tmp_path / f"{tag}.json", plan_spec(sorted(quads)))
+    ).doc
+    by_wall = {c["facade"]: c for c in doc["candidates"] if c["family"] == "overturning"}
+    assert sorted(by_wall) == sorted(quads)
+    for wid, (normal, point) in outward.items():
+        c = by_wall[wid]
+        ref = 2.0 * _centroid_depth(quads[wid], normal, point) / h
+        assert np.allclose(c["direction_vector"][:2], _place(normal, angle, mirror), atol=1e-9)
+        assert c["builder"]["lam0"] == pytest.approx(ref, rel=1e-9, abs=0.0), wid
+        if wid in ("W1", "W3"):
+            assert ref == pytest.approx(THICK[wid] / h, rel=1e-12)
+            assert c["lam0"] == pytest.approx(ref, rel=1e-9, abs=0.0), wid
+            assert doc["input"]["walls"][wid]["exact_prism"] is True
+        else:  # an oblique end: idealised with the thickness that keeps its mass, said so
+            assert c["lam0"] == pytest.approx(ref, rel=5e-3), wid
+            assert any(
+                n.startswith(f"{wid}: not a prism of constant thickness") for n in doc["notes"]
+            )
+            assert c["builder"]["agrees"] is False
+            assert any(n.startswith("the builder's exact λ0") for n in c["notes"])
+    for a in ("W0", "W2"):
+        (note,) = [n for n in doc["notes"] if n.startswith(f"{a} and W3 meet at")]
+        assert note.startswith(f"{a} and W3 meet at 100.0° / 80.0° (not square)")
+        assert "each is searched free at that corner" in note
+    assert not [n for n in doc["notes"] if "W1 and" in n and "meet at" in n]
+
+
+def test_a_listed_junction_at_an_oblique_corner_is_refused_with_the_angle(tmp_path: Path) -> None:
+    quads = _trapezoid()
+    scene = plan_scene(tmp_path, [], 6.0, footprints=sorted(quads.items()), name="trap_listed")
+    spec = plan_spec(sorted(quads), connection="good")
+    spec["junctions"] = [
+        {"walls": ["W3", "W0"], "connection": "good", "unit": {"length": 0.25, "height": 0.12}}
+    ]
+    with pytest.raises(rockmech.InputError) as err:
+        rockmech.search_from_files(scene, write_spec(tmp_path / "listed.json", spec))
+    assert "the junction ['W0', 'W3'] is listed, but the walls meet at 100.0° / 80.0°" in str(
+        err.value
+    )
+    assert "remove it from junctions" in str(err.value)
+
+
+def test_mitred_corners_are_said_to_form_no_junction(tmp_path: Path) -> None:
+    """A box of four walls mitred at its corners (each wall the trapezoid between the outer
+    and inner rings): no junction, and the notes say why and what to draw instead."""
+    outer = [(0.0, 0.0), (8.0, 0.0), (8.0, 6.0), (0.0, 6.0)]
+    t = 0.5
+    inner = [(t, t), (8.0 - t, t), (8.0 - t, 6.0 - t), (t, 6.0 - t)]
+    quads = {
+        f"M{i}": [outer[i], outer[(i + 1) % 4], inner[(i + 1) % 4], inner[i]] for i in range(4)
+    }
+    scene = plan_scene(tmp_path, [], 6.0, footprints=sorted(quads.items()), name="mitred")
+    doc = rockmech.search_from_files(
+        scene, write_spec(tmp_path / "mitred.json", plan_spec(sorted(quads), connection="good"))
+    ).doc
+    assert doc["input"]["junctions"] == []
+    for i in range(4):
+        a, b = sorted([f"M{i}", f"M{(i + 1) % 4}"])
+        assert any(
+            n.startswith(f"{a} and {b} touch, but neither's end face stands on the other's face")
+            for n in doc["notes"]
+        )
+    assert {c["family"] for c in doc["candidates"]} == {"overturning"}
