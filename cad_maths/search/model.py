@@ -261,7 +261,8 @@ class LevelContact:
     point : (3,) float
         Contact centroid [m].
     mass : float
-        Share carried by the wall, ``tributary`` times the level's mass [kg].
+        Share carried by the wall, ``tributary`` times the mass of the level's solids that
+        touch it (a level drawn as several slabs loads each wall with the slabs on it) [kg].
     thrust : float
         Outward roof thrust at the contact [N] (0 for floors and tied trusses).
     z_range : (float, float)
@@ -273,6 +274,9 @@ class LevelContact:
         The level's solids.
     weight : float
         The level's whole weight [N].
+    objects : list of selector
+        The level's objects that touch the wall (``{"id": ...}``), where they are fewer
+        than the level's; empty: all of them.
     """
 
     level: Any
@@ -287,6 +291,7 @@ class LevelContact:
     regions: List[Any] = field(default_factory=list)
     meshes: List[TriMesh] = field(default_factory=list)
     weight: float = 0.0
+    objects: List[Any] = field(default_factory=list)
 
 
 @dataclass
@@ -989,7 +994,8 @@ def _level_contacts(
         for obj, mesh in zip(objs, meshes):
             memory.add(SceneObject(obj.id, obj.name, obj.layer, "mesh", dict(obj.user_text), mesh))
         objects[level.id] = objs
-        total = sum(mass_properties(m, level.density).mass for m in meshes)
+        masses = [mass_properties(m, level.density).mass for m in meshes]
+        total = sum(masses)
         z_range = (
             float(min(m.vertices[:, 2].min() for m in meshes)),
             float(max(m.vertices[:, 2].max() for m in meshes)),
@@ -998,7 +1004,8 @@ def _level_contacts(
         carried = []
         for wall in walls.values():
             regions = []
-            for m in meshes:
+            on = []  # the level's solids that load this wall
+            for i, m in enumerate(meshes):
                 hit = contact_region(m, wall.mesh, tol=tol)
                 if hit is None:
                     continue
@@ -1007,6 +1014,7 @@ def _level_contacts(
                     carried.append(wall.id)
                 else:
                     regions.append(hit)
+                    on.append(i)
             if not regions:
                 continue  # this level does not touch this wall, or only carries it
             area, point, normal, _ = max(regions, key=lambda r: r[0])
@@ -1030,12 +1038,13 @@ def _level_contacts(
                     bearing,
                     float(area),
                     np.asarray(point, dtype=float),
-                    level.tributary * total,
+                    level.tributary * sum(masses[i] for i in on),
                     thrust,
                     z_range,
                     [r[3] for r in regions],
                     meshes,
                     G * total,
+                    [{"id": objs[i].id} for i in on] if len(on) < len(meshes) else [],
                 )
             )
             touched.append(wall.id)
@@ -1055,7 +1064,7 @@ def _level_contacts(
         if "tributary" not in level.model_fields_set:
             notes.append(
                 f"{where} ({level.id}): tributary not given; each wall it touches carries the "
-                f"default {level.tributary:g} of its weight and inertia"
+                f"default {level.tributary:g} of the weight and inertia of its solids on that wall"
             )
     return out, objects, under
 

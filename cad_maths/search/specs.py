@@ -162,7 +162,8 @@ def candidate_spec(
         floors = []
         for c in cand.contacts:
             lv = c.level
-            entry = {"objects": list(lv.objects), "density": lv.density, "tributary": lv.tributary}
+            objects = list(c.contact.objects) if c.contact.objects else list(lv.objects)
+            entry = {"objects": objects, "density": lv.density, "tributary": lv.tributary}
             if lv.kind == "roof":
                 spec["roof"] = {**entry, "tied": not lv.pushes}
             else:

@@ -381,3 +381,42 @@ def test_mitred_corners_are_said_to_form_no_junction(tmp_path: Path) -> None:
             for n in doc["notes"]
         )
     assert {c["family"] for c in doc["candidates"]} == {"overturning"}
+
+
+def test_a_level_drawn_as_several_slabs_loads_each_wall_with_the_slabs_on_it(
+    tmp_path: Path,
+) -> None:
+    """One floor drawn as two slabs (one per room of a box split by a cross wall): each wall
+    carries ``tributary`` of the slabs it touches, not of the whole level (before, the west
+    wall carried half of both rooms' floor). Reference: the wall and its share at the top's
+    centre line, λ0 = (m + share)(t/2) / (m h/2 + share h); the builder agrees."""
+    outer = [(0.0, 0.0), (12.0, 0.0), (12.0, 6.0), (0.0, 6.0)]
+    walls = ring_walls(outer, T, "R0W")
+    cross = ("X", [(5.75, T), (6.25, T), (6.25, 6.0 - T), (5.75, 6.0 - T)])
+    slabs = [
+        ("slab1", [(0.0, 0.0), (6.0, 0.0), (6.0, 6.0), (0.0, 6.0)], [], H, H + 0.2),
+        ("slab2", [(6.0, 0.0), (12.0, 0.0), (12.0, 6.0), (6.0, 6.0)], [], H, H + 0.2),
+    ]
+    for angle, shift, mirror in PLACES[:2]:
+        tag = f"rooms_{abs(int(angle))}"
+        scene = plan_scene(
+            tmp_path, walls, H, rotate_deg=angle, shift=shift, mirror=mirror, slabs=slabs,
+            footprints=[cross], name=tag,
+        )  # fmt: skip
+        spec = plan_spec([w[0] for w in walls] + ["X"])
+        spec["levels"] = [
+            {"id": "floor", "kind": "floor", "objects": ["slab1", "slab2"], "density": 600.0,
+             "tributary": 0.5}
+        ]  # fmt: skip
+        doc = rockmech.search_from_files(scene, write_spec(tmp_path / f"{tag}.json", spec)).doc
+        by_wall = {c["facade"]: c for c in doc["candidates"] if c["family"] == "overturning"}
+        share = 0.5 * 600.0 * 0.2 * 6.0 * 6.0  # half of one room's slab [kg]
+        for wid in ("R0W1", "R0W3"):  # the east and west walls: one room's slab each
+            (w,) = [x for x in walls if x[0] == wid]
+            length = float(np.linalg.norm(np.asarray(w[2]) - np.asarray(w[1])))
+            m = 1800.0 * T * length * H
+            ref = (m + share) * (T / 2.0) / (m * H / 2.0 + share * H)
+            c = by_wall[wid]
+            assert [lv["mass_kg"] for lv in c["levels"]] == [pytest.approx(share, rel=1e-9)]
+            assert c["lam0"] == pytest.approx(ref, rel=1e-9), wid
+            assert c["builder"]["agrees"] is True, wid
