@@ -579,7 +579,9 @@ def _overturning_plan(bld: Building, wall: Wall, direction: str, z_h: float) -> 
     if direction == "inward" and not free:
         return _Plan("the building (return walls, levels or ties) holds the wall's inner face")
     if direction == "outward" and wall.held_by:
-        return _Plan(f"{wall.held_by[0][0]} stands against the wall's outer face")
+        holders = sorted({h[0] for h in wall.held_by})
+        verb = "stands" if len(holders) == 1 else "stand"
+        return _Plan(f"{' and '.join(holders)} {verb} against the wall's outer face")
     f = wall.frame
     returns = bld.returns.get(wall.id, []) if direction == "outward" else []
     contacts = [c for c in bld.contacts.get(wall.id, []) if c.point[2] > z_h + tol]

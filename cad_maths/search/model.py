@@ -83,6 +83,9 @@ BASE_RTOL = 1e-3
 #: Smallest |cos| between a face normal and the thickness direction for a face of the outer
 #: side (faces within 60 degrees).
 FACE_COS = 0.5
+#: An inner wall whose centre lies within this fraction of the building's size of the plan's
+#: centre line (across the wall) is on it: its sides follow a fixed rule, said in a note.
+CENTRE_RTOL = 1e-6
 #: Largest angle between two walls' directions taken as perpendicular [rad].
 SQUARE_TOL = 1e-3
 #: Footprints sharing less than this fraction of the smaller one's area do not overlap (the
@@ -552,7 +555,17 @@ def _orient(
         flip = outer == 1  # e_n points from the outer face into the building
     elif reading.exposed[0] == 0.0:  # an inner wall: inner side towards its plan's centre
         c = np.asarray(plan.parts[reading.building].centroid.coords[0]) + plan.origin
-        flip = float((c - com[:2]) @ e_n[:2]) < 0.0
+        ahead = float((c - com[:2]) @ e_n[:2])
+        if abs(ahead) <= CENTRE_RTOL * size:
+            # on the centre line: a fixed rule (e_n towards +x, else +y) names its sides
+            flip = e_n[0] < -1e-12 or (abs(e_n[0]) <= 1e-12 and e_n[1] < 0.0)
+            lone_notes.append(
+                f"{name}: an inner wall on its building's centre line; its sides are named by "
+                "a fixed rule (its inner side towards +x, else +y): 'outward' and 'inward' "
+                "are the two directions across it"
+            )
+        else:
+            flip = ahead < 0.0
     elif toward is not None and abs(toward) > 1e-9 * size:
         flip = toward < 0.0
         lone_notes.append(
@@ -902,8 +915,8 @@ def _returns(
             if gap > tol and pair not in met:
                 notes.append(
                     f"{b.id} and {a.id} are drawn {1000 * gap:.3g} mm apart: read as meeting "
-                    f"(walls up to {1000 * join:.3g} mm apart join, a tenth of the thinner one's "
-                    "thickness)"
+                    f"(walls up to {1000 * join:.3g} mm apart join, a tenth of the thinnest "
+                    "wall's thickness)"
                 )
             met.add(pair)
             if not a.is_facade:
