@@ -261,7 +261,7 @@ def segment_intervals(
     """
     d = np.asarray(p1, dtype=float) - np.asarray(p0, dtype=float)
     cuts = [0.0, 1.0]
-    ends = [(ring, np.roll(ring, -1, axis=0)) for ring in rings]
+    ends = [(ring, np.concatenate((ring[1:], ring[:1]))) for ring in rings]
     for a, b in ends:
         e = b - a
         den = d[0] * e[:, 1] - d[1] * e[:, 0]
@@ -302,7 +302,7 @@ def winding(rings: Sequence[np.ndarray], p: np.ndarray) -> int:
     px, pz = float(p[0]), float(p[1])
     for ring in rings:
         a = ring
-        b = np.roll(ring, -1, axis=0)
+        b = np.concatenate((ring[1:], ring[:1]))
         up = (a[:, 1] <= pz) & (b[:, 1] > pz)
         down = (a[:, 1] > pz) & (b[:, 1] <= pz)
         cross = (b[:, 0] - a[:, 0]) * (pz - a[:, 1]) - (px - a[:, 0]) * (b[:, 1] - a[:, 1])
