@@ -219,3 +219,43 @@ def test_records_are_scaled_up_to_the_mechanisms_height(scene: Path, tmp_path: P
                 assert rec["scale"] * info["value"] == pytest.approx(rec["scale_local"], rel=1e-12)
             seen += 1
     assert seen >= 1
+
+
+def test_a_tie_at_the_top_storey_raises_every_mechanism_it_crosses(
+    scene: Path, tmp_path: Path
+) -> None:
+    """The three-storey façade with a 30 kN tie-bar at 9 m (a line through its outer face):
+    the tie does work F (z_t − z_h) per unit rotation of every mechanism whose hinge lies
+    below it, none above. Reference (virtual work per unit rotation about the hinge at z_h,
+    written here): λ0 = [W t/2 + F (z_t − z_h)⁺ / g] / [W (h − z_h)/2 + Σ m_f (z_f − z_h)]
+    with W the façade's mass above z_h and m_f the floors' shares (tributary 0.5, abutting:
+    inertia only) at their contact's centroid z_f above z_h. The LP check holds the best."""
+    import rhino3dm as r3
+
+    from solver_service.core.model import G
+
+    f3dm = r3.File3dm.Read(str(scene))
+    attrs = r3.ObjectAttributes()
+    attrs.Name = "tie"
+    f3dm.Objects.AddLine(r3.Point3d(-0.2, 4.0, 9.0), r3.Point3d(6.5, 4.0, 9.0), attrs)
+    tied = tmp_path / "tied.3dm"
+    assert f3dm.Write(str(tied), 7)
+    force, z_t = 30000.0, 9.0
+    spec = three_storey_spec(tie_bars=[{"object": "tie", "force": force}], lp=True)
+    doc = search_from_files(tied, write_spec(tmp_path / "tied.json", spec)).doc
+    t, length, h = 0.5, 8.0, 10.5
+    m_f = 0.5 * 2400.0 * 6.0 * (8.0 - 2 * 0.45 - 0.02) * 0.2
+    floors = (3.6, 7.1, 10.4)  # the 0.2 m floors abutting from 3.5, 7.0 and 10.3 m
+    assert {c["family"] for c in doc["candidates"]} == {"overturning", "partial_overturning"}
+    for c in doc["candidates"]:
+        z_h = c["parameters"]["hinge_height_m"]
+        w = 1800.0 * t * length * (h - z_h)
+        num = w * t / 2.0 + force * max(z_t - z_h, 0.0) / G
+        den = w * (h - z_h) / 2.0 + sum(m_f * (z - z_h) for z in floors if z > z_h)
+        assert c["lam0"] == pytest.approx(num / den, rel=1e-9), z_h
+        assert bool(c["tie_bars"]) is (z_t > z_h)
+    hinges = sorted(c["parameters"]["hinge_height_m"] for c in doc["candidates"])
+    assert hinges == [0.0, 3.5, 3.7, 7.0, 7.2, 10.3]
+    (lp,) = doc["lp"]
+    assert lp["status"] == "optimal" and lp["missed"] is False
+    assert lp["lam"] <= lp["best_catalogue_lam0"] * (1.0 + 1e-9)

@@ -107,6 +107,11 @@ def test_every_wall_of_a_plan_overturns_away_from_its_building(
         assert abs(c["direction_vector"][2]) < 1e-12
     # no corner of the re-entrant kind, nothing inside out: one candidate per free wall
     assert len(doc["candidates"]) == len(walls) - len(held)
+    # the LP check of every façade holds the catalogue's best: its bound, nothing missed
+    assert sorted(x["facade"] for x in doc["lp"]) == sorted(whole)
+    for x in doc["lp"]:
+        assert x["status"] == "optimal" and x["missed"] is False, x["facade"]
+        assert x["lam"] == pytest.approx(T / H, rel=1e-9), x["facade"]
     if len(rings) > 1:
         assert any("2 separate buildings" in n for n in doc["notes"])
     else:
