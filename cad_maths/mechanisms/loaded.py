@@ -77,11 +77,31 @@ def contact_tolerance(scene: Any) -> float:
     return tol if tol > 0.0 else CONTACT_TOL
 
 
+#: Face directions of each solid tried as separating axes (the largest faces first).
+SEPARATION_AXES = 64
+
+
 def _separation(a: Any, b: Any) -> float:
-    """Gap (> 0) or overlap (< 0) of two solids' bounding boxes along the clearest axis [m]."""
-    lo_a, hi_a = a.vertices.min(axis=0), a.vertices.max(axis=0)
-    lo_b, hi_b = b.vertices.min(axis=0), b.vertices.max(axis=0)
-    return float(np.max(np.maximum(lo_b - hi_a, lo_a - hi_b)))
+    """Gap (> 0) or overlap (< 0) of two solids along the clearest of their face normals [m].
+
+    The separating-axis reading of the solids' convex hulls: along each face normal of
+    either solid (the largest ``SEPARATION_AXES`` faces of each) the gap between their
+    extents; the largest is the gap (for solids that face each other it is the distance
+    between the faces, whatever the scene's orientation), and where every axis overlaps,
+    the least overlap.
+    """
+    axes = [np.eye(3)]
+    for m in (a, b):
+        tri = m.vertices[m.faces]
+        normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        size = np.linalg.norm(normal, axis=1)
+        keep = np.argsort(-size)[:SEPARATION_AXES]
+        keep = keep[size[keep] > 0.0]
+        axes.append(normal[keep] / size[keep, None])
+    n = np.vstack(axes)
+    pa, pb = a.vertices @ n.T, b.vertices @ n.T
+    gaps = np.maximum(pb.min(axis=0) - pa.max(axis=0), pa.min(axis=0) - pb.max(axis=0))
+    return float(gaps.max())
 
 
 def largest_contact(
@@ -107,8 +127,8 @@ def largest_contact(
         )
         raise GeometryError(
             f"{where}: touches no wall (no shared face with the mechanism's solids within the "
-            f"tolerance {1000 * tol:.3g} mm): its bounding box and the nearest wall solid's "
-            f"show {how}"
+            f"tolerance {1000 * tol:.3g} mm): between it and the nearest wall solid, across "
+            f"their faces, {how}"
         )
     return best
 

@@ -63,3 +63,34 @@ def test_a_floor_touching_no_wall_says_how_far(tmp_path: Path, dz: float, words:
     assert "F.floors[0]: touches no wall" in text
     assert "within the tolerance 0.1 mm" in text
     assert words in text
+
+
+@pytest.mark.parametrize("angle", [0.0, 37.0, -123.4])
+def test_the_gap_is_measured_across_the_faces_in_a_turned_scene(
+    tmp_path: Path, angle: float
+) -> None:
+    """A slab drawn 30 mm short of the wall's inner face, the scene turned about the
+    vertical: the message gives the 30 mm gap at every angle (the bounding boxes of the
+    turned solids overlap, and an axis-aligned reading called it an overlap)."""
+    import math
+
+    import numpy as np
+
+    c, s = math.cos(math.radians(angle)), math.sin(math.radians(angle))
+
+    def turned(v: Any) -> Any:
+        return np.column_stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1], v[:, 2]])
+
+    b = BUILD.Builder(f"turned{int(angle)}")
+    for name, layer, ring, z0, z1 in (
+        ("wall", "Walls", [(0.0, 0.0), (0.5, 0.0), (0.5, 1.0), (0.0, 1.0)], 0.0, 3.0),
+        ("slab", "Floors", [(0.53, 0.0), (3.5, 0.0), (3.5, 1.0), (0.53, 1.0)], 2.8, 3.0),
+    ):
+        v, f = BUILD.plan_prism(ring, [], z0, z1)
+        b.mesh(name, layer, np.ascontiguousarray(turned(v)), np.ascontiguousarray(f), "brick")
+    end = turned(np.array([[0.5, 0.0, 0.0], [0.5, 1.0, 0.0]]))
+    b.line("axis", "Axes", tuple(end[0]), tuple(end[1]))
+    with pytest.raises(GeometryError) as err:
+        run(Scene.from_3dm(b.write(tmp_path / "turned.3dm")))
+    assert "touches no wall" in str(err.value)
+    assert "a gap of 30 mm" in str(err.value)
