@@ -112,6 +112,10 @@ T_RECORD_MIN = 0.05
 #: (log-spaced from T_SCAN_MIN [s], corners added), and the relative tolerance on the
 #: period of the refined maximum.
 T_SCAN_MIN, DEMAND_SCAN_POINTS, DEMAND_XATOL = 0.01, 200, 1e-10
+#: Spectral displacements within this fraction of the largest are taken as equal: the demand
+#: is read at the shortest such period (on a plateau the largest is flat, and the period
+#: where a scan finds it would otherwise turn on rounding).
+DEMAND_RTOL = 1e-9
 #: Periods of the records' demand over [T0, T_SLV] (log-spaced, both ends included).
 RECORD_POINTS = 40
 #: Periods scanned for the spectrum's peak when a free-standing element's T0 is unknown:
@@ -283,7 +287,7 @@ class _Demand:
         t = np.unique(np.asarray([lo, hi, *inside, *scan], dtype=np.float64))
         t = t[(t >= lo) & (t <= hi)]
         disp, _ = self.displacement(t, xi_percent)
-        k = int(np.argmax(disp))
+        k = int(np.argmax(disp >= float(disp.max()) * (1.0 - DEMAND_RTOL)))
         t_best, d_best = float(t[k]), float(disp[k])
         if smooth and 0 < k < t.size - 1:
             # Imported here: only a check at height refines, and scipy.optimize is heavy.
@@ -295,7 +299,7 @@ class _Demand:
                 method="bounded",
                 options={"xatol": DEMAND_XATOL * float(t[k])},
             )
-            if -float(res.fun) > d_best:
+            if -float(res.fun) > d_best * (1.0 + DEMAND_RTOL):
                 t_best, d_best = float(res.x), -float(res.fun)
         rule_at = self.displacement([t_best], xi_percent)[1][0]
         if t_best >= hi * (1.0 - 1e-12):
