@@ -315,7 +315,7 @@ def _corner_plane(facade: Wall, end: str, z: float, beta: float) -> Plane:
 
 
 def _region_mass(wall: Wall, planes: Sequence[Plane]) -> float:
-    return float(ring_moments(wall.region(planes))[0]) * wall.frame.thickness * wall.density
+    return float(ring_moments(wall.region(planes))[0]) * wall.frame.thickness * wall.lump_density
 
 
 Hits = Dict[int, Tuple[float, np.ndarray, LevelContact, Any]]

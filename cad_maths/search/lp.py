@@ -256,7 +256,9 @@ def _cells(
         for rings, cons in pieces:
             if float(ring_moments(rings)[0]) > SLIVER_RTOL * area:
                 blocks.append(
-                    LPBlock(wall.id, rings, wall.frame.prism_lump(rings, wall.density), k, cons)
+                    LPBlock(
+                        wall.id, rings, wall.frame.prism_lump(rings, wall.lump_density), k, cons
+                    )
                 )
     return blocks
 

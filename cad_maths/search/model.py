@@ -6,9 +6,10 @@
 * every wall is one solid, taken as a right prism: its elevation (outer boundary, openings
   as holes) in its own frame (``s`` along it, ``n`` through it from the outer face, ``z``
   up; ``e_n`` points into the building) and its thickness. A wall that is not an exact
-  prism (a pocket, a scan's relief) is idealised with the thickness ``V/A`` that keeps its
-  mass, and a note says so; the builder still computes its constants from the real solid,
-  and the search reports the difference;
+  prism (a pocket, a scan's relief, an oblique end) is idealised with twice its centroid's
+  depth behind its base's outer face as thickness and the density that keeps its mass
+  (theory §10.9), and a note says so; the builder still computes its constants from the
+  real solid, and the search reports the difference;
 * a wall B whose end face abuts the inner face of a façade A at one of A's ends is a
   return wall of A there, with the connection the spec gives (good: a crack through B runs
   at least at the bond angle ``atan(l_u / 2 h_u)`` from the vertical; poor: A parts from
@@ -143,6 +144,9 @@ class Wall:
         face they cover [m]; the wall cannot move outward (``plan.Plan.read_faces``).
     building : int
         Index of its building in the plan (several buildings in one scene).
+    prism_density : float
+        Density of its idealised prism [kg/m³]: ``density``, or for a wall that is not an
+        exact prism the density that keeps its mass at the idealised thickness (0: the same).
     """
 
     id: str
@@ -162,6 +166,12 @@ class Wall:
     volume: float
     held_by: List[Tuple[str, float, float]] = field(default_factory=list)
     building: int = 0
+    prism_density: float = 0.0
+
+    @property
+    def lump_density(self) -> float:
+        """Density of the idealised prism [kg/m³] (the spec's for an exact prism)."""
+        return self.prism_density or self.density
 
     @property
     def mesh(self) -> TriMesh:
@@ -190,7 +200,7 @@ class Wall:
 
     def lump(self, planes: Sequence[Tuple[np.ndarray, np.ndarray]]) -> Lump:
         """Mass moments of the part of the wall the half-spaces keep."""
-        return self.frame.prism_lump(self.region(planes), self.density)
+        return self.frame.prism_lump(self.region(planes), self.lump_density)
 
     @property
     def inner_face(self) -> float:
@@ -208,7 +218,7 @@ class Wall:
     @property
     def mass(self) -> float:
         """Mass of the idealised prism [kg]."""
-        return float(self.density * self.frame.thickness * ring_moments(self.rings)[0])
+        return float(self.lump_density * self.frame.thickness * ring_moments(self.rings)[0])
 
 
 @dataclass
@@ -535,10 +545,11 @@ def _orient(
     size: float,
     name: str,
     levels: Optional[np.ndarray] = None,
-) -> Tuple[WallFrame, List[np.ndarray], float, bool, List[str], Tuple[Any, int]]:
+) -> Tuple[WallFrame, List[np.ndarray], float, bool, List[str], Tuple[Any, int, float]]:
     """Return the wall's frame (e_n into the building), elevation, prism check and plan.
 
-    The last item is what holds the outer face (``Wall.held_by``) and the wall's building.
+    The last item is what holds the outer face (``Wall.held_by``), the wall's building and
+    the factor on its density that keeps the idealised prism's mass (1 for an exact prism).
     The outer face is the one the plan finds on the outside (``plan.outer_side``). A lone
     wall (both faces outside) faces the levels it carries with its inner side (issue #37),
     or, without levels, follows a fixed rule; an inner wall faces the centre of its
@@ -598,20 +609,27 @@ def _orient(
     height = (float(v[:, 2].max()) - z_lo, float(moments[2] / moments[0]) - z_lo)
     notes: List[str] = lone_notes + _axes_notes(axes, name, height, t)
     exact = abs(volume - area * t) <= PRISM_RTOL * volume and not leans
+    scale = 1.0
     if abs(volume - area * t) > PRISM_RTOL * volume:
-        t_eff = volume / area
+        base = v[:, 2] <= z_lo + BASE_RTOL * height[0]
+        origin = float(s.min()) * e_s + float(n[base].min()) * e_n
+        # twice the depth of the solid's centroid behind its base's outer face: the prism
+        # overturns about that edge as the solid does; a density that keeps its mass
+        com = mass_properties(mesh, 1.0).com
+        depth = float((com - origin) @ e_n) - (axes.lean * (float(com[2]) - z_lo) if leans else 0.0)
+        t_eff = 2.0 * depth if 0.0 < depth <= t else volume / area
+        scale = volume / (area * t_eff)
         notes.append(
             f"{name}: not a prism of constant thickness (volume {volume:.6g} m³, outer face "
             f"{area:.6g} m² x {t:.6g} m): the search idealises it with the thickness "
-            f"{t_eff:.6g} m that keeps its mass, its outer face on its base's (the edge it "
-            "rocks about); the constants come from the real solid and the search reports the "
-            "difference"
+            f"{t_eff:.6g} m, twice its centroid's depth behind its base's outer face (the edge "
+            f"it rocks about), and {scale:.6g} times its density, so that the prism keeps its "
+            "mass and overturns as the solid does; the constants come from the real solid and "
+            "the search reports the difference"
         )
-        base = v[:, 2] <= z_lo + BASE_RTOL * height[0]
-        origin = float(s.min()) * e_s + float(n[base].min()) * e_n
         frame = WallFrame(origin, e_s, e_n, e_z, t_eff)
     held = _held_by(plan, reading.covered[1 if flip else 0], e_s if not flip else -e_s, frame)
-    return frame, rings, volume, exact, notes, (held, reading.building)
+    return frame, rings, volume, exact, notes, (held, reading.building, scale)
 
 
 def _axes_notes(axes: WallAxes, name: str, height: Tuple[float, float], t: float) -> List[str]:
@@ -1413,7 +1431,7 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
     levels = np.vstack(level_points).mean(axis=0) if level_points else None
     walls: Dict[str, Wall] = {}
     for w, obj, mesh, selector in raw:
-        frame, rings, volume, exact, wall_notes, (held, building) = _orient(
+        frame, rings, volume, exact, wall_notes, (held, building, scale) = _orient(
             mesh, plan, size, w.id, levels
         )
         notes.extend(wall_notes)
@@ -1437,6 +1455,7 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
             volume,
             held,
             building,
+            w.density * scale if scale != 1.0 else 0.0,
         )
         for other, a, b in held:
             notes.append(
