@@ -228,3 +228,15 @@ def best_of(
         if sum(times) > budget_s:
             break
     return min(times), times, out
+
+
+def build_scenes() -> Any:
+    """Load the example scenes' builder, ``examples/scenes/build_scenes.py`` (not a package)."""
+    import importlib.util
+
+    path = REPO / "examples" / "scenes" / "build_scenes.py"
+    spec = importlib.util.spec_from_file_location("rockmech_build_scenes", path)
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod

@@ -65,6 +65,7 @@ if str(REPO) not in sys.path:
 # RSS on Linux (vfork + exec), so a heavy parent would inflate every worker's figure.
 from _docs import (  # noqa: E402  (benchmarks/ is not a package)
     DOC_MD,
+    build_scenes,
     fmt_time,
     load_average,
     machine_info,
@@ -77,7 +78,6 @@ from _docs import (  # noqa: E402  (benchmarks/ is not a package)
 EXAMPLE_3DM = REPO / "examples" / "scenes" / "scan_wall.3dm"
 SPEC_JSON = REPO / "examples" / "specs" / "scan_wall.spec.json"
 #: The script that builds the example scenes (its mesh construction is reused).
-BUILD_SCENES = REPO / "examples" / "scenes" / "build_scenes.py"
 #: Grid cells (thickness, length, height) of the large wall: 1,007,552 triangles.
 LARGE_CELLS = (1, 448, 560)
 #: Grid cells of the large wall in a quick run: 302,084 triangles.
@@ -119,15 +119,8 @@ MB = 1e6
 # ------------------------------------------------------------------------------------------
 
 
-def _build_scenes() -> Any:
-    """Import ``examples/scenes/build_scenes.py`` (not a package) as a module."""
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("rockmech_build_scenes", BUILD_SCENES)
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+#: The example scenes' builder module, loaded on call (``_docs.build_scenes``).
+_build_scenes = build_scenes
 
 
 def scan_wall_mesh(bs: Any, cells: tuple[int, int, int]) -> tuple[Any, Any]:

@@ -50,7 +50,6 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMB
     os.environ[_var] = "1"
 
 import argparse  # noqa: E402 (the thread pins above must come before numpy loads)
-import importlib.util  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import resource  # noqa: E402
@@ -69,7 +68,7 @@ REPO = HERE.parent
 if str(HERE) not in sys.path:
     sys.path.insert(0, str(HERE))
 
-from _docs import DOC_MD, fmt_time, machine_info, write_section  # noqa: E402
+from _docs import DOC_MD, build_scenes, fmt_time, machine_info, write_section  # noqa: E402
 
 from cad_maths.scenes import read_scene  # noqa: E402
 from cad_maths.search.engine import run_search  # noqa: E402
@@ -109,7 +108,6 @@ WALL_LIMITED = {"palazzo_cli"}
 #: Runs of the whole command (the first is reported as the cold one; best of the others).
 CLI_RUNS = 3
 #: The example scenes' builder, which writes the palazzo.
-BUILD_SCENES = REPO / "examples" / "scenes" / "build_scenes.py"
 
 
 def best_of(fn: Callable[[], Any], repeats: int = REPEATS) -> tuple[float, float, float, Any]:
@@ -377,13 +375,8 @@ def report(
     return "\n".join(out)
 
 
-def _build_scenes() -> Any:
-    """Load the example scenes' builder module (``examples/`` is not a package)."""
-    spec = importlib.util.spec_from_file_location("build_scenes_bench", BUILD_SCENES)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+#: The example scenes' builder module, loaded on call (``_docs.build_scenes``).
+_build_scenes = build_scenes
 
 
 def _rockmech() -> str:

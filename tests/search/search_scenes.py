@@ -273,3 +273,22 @@ def plan_spec(
         ]
     doc.update(extra)
     return doc
+
+
+def cli_refusal(scene: Path, spec: Path, out: Path) -> str:
+    """Run ``rockmech search`` on input it must refuse; return its one error line.
+
+    The command exits with 2, prints no traceback and one ``error: ...`` line, and writes
+    no ``search.json``.
+    """
+    from typer.testing import CliRunner
+
+    from solver_service.cli import app
+
+    res = CliRunner().invoke(app, ["search", str(scene), str(spec), "-o", str(out / "o")])
+    assert res.exit_code == 2, res.output
+    assert "Traceback" not in res.stderr
+    lines = [ln for ln in res.stderr.splitlines() if ln.startswith("error: ")]
+    assert len(lines) == 1, res.stderr
+    assert not (out / "o" / "search.json").exists()
+    return lines[0]

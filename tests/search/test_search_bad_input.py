@@ -19,13 +19,10 @@ from pathlib import Path
 from typing import Any, Optional, Sequence
 
 import pytest
-from search_scenes import BUILD, plan_scene, plan_spec, write_spec
-from typer.testing import CliRunner
+from search_scenes import BUILD, cli_refusal, plan_scene, plan_spec, write_spec
 
 import rockmech
-from solver_service.cli import app
 
-runner = CliRunner()
 T, H = 0.5, 4.0
 #: (angle [deg], shift [m]): as drawn, and turned by an odd angle and moved far away.
 PLACES = [(0.0, (0.0, 0.0)), (37.0, (4.0e5, -4.0e5))]
@@ -68,16 +65,11 @@ def _spec(out: Path, ids: Sequence[str], levels: Sequence[str] = (), **extra: An
 def _refused(out: Path, scene: Path, spec: Path) -> str:
     """Run the command and the Python entry point on input they must refuse; return the
     CLI's one error line (the Python error carries the same message)."""
-    res = runner.invoke(app, ["search", str(scene), str(spec), "-o", str(out / "o")])
-    assert res.exit_code == 2, res.output
-    assert "Traceback" not in res.stderr
-    lines = [ln for ln in res.stderr.splitlines() if ln.startswith("error: ")]
-    assert len(lines) == 1, res.stderr
-    assert not (out / "o" / "search.json").exists()
+    line = cli_refusal(scene, spec, out)
     with pytest.raises(rockmech.RockmechError) as err:
         rockmech.search_from_files(scene, spec)
-    assert lines[0] == f"error: {err.value}"
-    return lines[0]
+    assert line == f"error: {err.value}"
+    return line
 
 
 def _whole(doc: dict[str, Any], wall: str) -> dict[str, Any]:

@@ -22,13 +22,10 @@ from typing import Any, Sequence
 
 import numpy as np
 import pytest
-from search_scenes import BUILD, plan_prism, write_spec
-from typer.testing import CliRunner
+from search_scenes import BUILD, cli_refusal, plan_prism, write_spec
 
 import rockmech
-from solver_service.cli import app
 
-runner = CliRunner()
 H = 4.0
 #: (angle [deg], shift [m], mirrored): as drawn, turned by odd angles and moved far (the
 #: second 1e6 m from the origin), mirrored.
@@ -93,13 +90,7 @@ def _refused(tmp_path: Path, solids: dict[str, Any]) -> str:
     """Run the command on a scene it must refuse; return its error line."""
     scene = _scene(tmp_path, solids)
     spec = _spec(tmp_path, list(solids))
-    res = runner.invoke(app, ["search", str(scene), str(spec), "-o", str(tmp_path / "o")])
-    assert res.exit_code == 2, res.output
-    assert "Traceback" not in res.stderr
-    lines = [ln for ln in res.stderr.splitlines() if ln.startswith("error: ")]
-    assert len(lines) == 1, res.stderr
-    assert not (tmp_path / "o" / "search.json").exists()
-    return lines[0]
+    return cli_refusal(scene, spec, tmp_path)
 
 
 # --- piers ----------------------------------------------------------------------------------
