@@ -378,6 +378,40 @@ def _bar(spec: RetrofitSpec, force: float) -> tuple[Optional[BarChoice], str]:
     )
 
 
+def _criteria(
+    checker: _Checker, before: dict[str, Any], height: float, t_max: float
+) -> dict[str, Optional[float]]:
+    """Return the least force [N] per criterion (None: no force up to ``t_max`` suffices)."""
+    vw = checker.mech.positive.virtual_work
+    assert vw is not None
+    pos = before["sides"]["positive"]
+    lin = pos["linear"]
+    criteria: dict[str, Optional[float]] = {}
+    if lin.get("status") == "ok" and lin["passes"] is not None:
+        # [C8.7.1.1]: α0 affine in T, the demand independent of it, the ratio ∝ α0.
+        r0, a0 = float(lin["capacity_ratio"]), float(lin["alpha0"])
+        t_lin = 0.0 if r0 >= 1.0 else (a0 / r0 - a0) * G * vw.S / height
+        criteria["linear SLV"] = t_lin * (1.0 + LINEAR_NUDGE)
+    non = pos["nonlinear"]
+    if non.get("status") != "ok":
+        return criteria
+    for ls in ("SLV", "SLC"):
+        if non.get(ls, {}).get("passes") is None:
+            continue
+
+        def ok(t: float, ls: str = ls) -> bool:
+            row = checker.row(t, height, verified=True)
+            chk = row["sides"]["positive"]["nonlinear"]
+            return bool(chk.get("status") == "ok" and chk[ls]["passes"])
+
+        if non[ls]["passes"]:
+            criteria[f"nonlinear {ls}"] = 0.0
+            continue
+        hi0 = max(criteria.get("linear SLV") or 0.0, 1e-3 * G * vw.mass)
+        criteria[f"nonlinear {ls}"] = _least_force(ok, hi0, t_max)[0]
+    return criteria
+
+
 def _option(
     checker: _Checker,
     spec: RetrofitSpec,
@@ -403,34 +437,12 @@ def _option(
                 "changes no check; put it at or below the top"
             ],
         )
-    pos = before["sides"]["positive"]
     vw = mech.positive.virtual_work
     assert vw is not None
     t_max = (ALPHA0_MAX - vw.alpha0) * G * vw.S / height
-    lin = pos["linear"]
-    criteria: dict[str, Optional[float]] = {}
+    lin = before["sides"]["positive"]["linear"]
     e_star = float(lin["e_star"]) if lin.get("status") == "ok" else None
-    if lin.get("status") == "ok" and lin["passes"] is not None:
-        r0, a0 = float(lin["capacity_ratio"]), float(lin["alpha0"])
-        t_lin = 0.0 if r0 >= 1.0 else (a0 / r0 - a0) * G * vw.S / height
-        criteria["linear SLV"] = t_lin * (1.0 + LINEAR_NUDGE)
-    non = pos["nonlinear"]
-    if non.get("status") == "ok":
-        for ls in ("SLV", "SLC"):
-            if non.get(ls, {}).get("passes") is None:
-                continue
-
-            def ok(t: float, ls: str = ls) -> bool:
-                row = checker.row(t, height, verified=True)
-                chk = row["sides"]["positive"]["nonlinear"]
-                return bool(chk.get("status") == "ok" and chk[ls]["passes"])
-
-            if non[ls]["passes"]:
-                criteria[f"nonlinear {ls}"] = 0.0
-                continue
-            hi0 = max(criteria.get("linear SLV") or 0.0, 1e-3 * G * vw.mass)
-            t_nl, _ = _least_force(ok, hi0, t_max)
-            criteria[f"nonlinear {ls}"] = t_nl
+    criteria = _criteria(checker, before, height, t_max)
     t_lin_v = criteria.get("linear SLV")
     t_slv, t_slc = criteria.get("nonlinear SLV"), criteria.get("nonlinear SLC")
     common = {
