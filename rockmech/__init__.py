@@ -42,6 +42,9 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from shared_schema.extras import MissingExtra as MissingExtra
     from shared_schema.io import load_constants as load_constants
     from shared_schema.io import save_constants as save_constants
+    from shared_schema.retrofit import RetrofitDoc as RetrofitDoc
+    from shared_schema.retrofit import RetrofitSpec as RetrofitSpec
+    from shared_schema.retrofit import read_retrofit_spec as read_retrofit_spec
     from shared_schema.site import SiteFile as SiteFile
     from solver_service.core.envelope import (
         critical_bands as critical_bands,
@@ -119,6 +122,9 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from .analysis import (
         read_site as read_site,
     )
+    from .analysis import (
+        retrofit as retrofit,
+    )
     from .results import AssessmentResult as AssessmentResult
     from .results import CheckResult as CheckResult
     from .results import CriticalBand as CriticalBand
@@ -157,6 +163,10 @@ _SOURCES = {
     "ida": "rockmech.analysis",
     "check": "rockmech.analysis",
     "assess": "rockmech.analysis",
+    "retrofit": "rockmech.analysis",
+    "RetrofitSpec": "shared_schema.retrofit",
+    "RetrofitDoc": "shared_schema.retrofit",
+    "read_retrofit_spec": "shared_schema.retrofit",
     "RockingResult": "solver_service.core.result",
     "BatchResult": "solver_service.core.exact",
     "HistoryResult": "rockmech.results",

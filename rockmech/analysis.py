@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, Optional, Union
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.retrofit import RetrofitDoc, RetrofitSpec, read_retrofit_spec
 from shared_schema.site import SiteFile
 from solver_service.core.exact import simulate
 from solver_service.core.excitation import Pulse
@@ -28,6 +29,7 @@ from solver_service.workflows import inputs as _inputs
 from solver_service.workflows import tables as _tables
 from solver_service.workflows.adapter import models_from_file
 from solver_service.workflows.documents import envelope_doc, frequency_grid, history_doc
+from solver_service.workflows.retrofit import retrofit_doc
 from solver_service.workflows.scaling import Building
 from solver_service.workflows.units import stamp
 
@@ -46,6 +48,7 @@ __all__ = [
     "read_constants",
     "read_record",
     "read_site",
+    "retrofit",
 ]
 
 #: A file path, as a string or a ``Path``.
@@ -419,3 +422,32 @@ def assess(
         multiples=_assess.check_multiples(list(multiples)),
     )
     return AssessmentResult.from_doc(stamp(doc, "assess"))
+
+
+def retrofit(
+    constants: Constants,
+    site: Union[SiteFile, PathLike],
+    spec: Union[RetrofitSpec, PathLike],
+) -> RetrofitDoc:
+    """Find the least tie force that makes each failing mechanism pass the 2019 code checks.
+
+    Parameters
+    ----------
+    constants : ConstantsFile, str or Path
+        The mechanisms (``virtual_work`` and geometry per side: ``rockmech constants``).
+    site : SiteFile, str or Path
+        The site: hazard (SLV, and SLC where given), FC, q.
+    spec : RetrofitSpec, str or Path
+        The retrofit spec: steel grade and bars on offer, the anchorage resistance with its
+        source, candidate tie heights per mechanism [m].
+
+    Returns
+    -------
+    RetrofitDoc
+        Per mechanism: ``status``, the checks ``before``, per candidate height the least tie
+        force ``T_star_N`` [N] and its ``governing`` criterion, ``e_star``, the ``bar``, the
+        ``anchorage`` check, the steel mass [kg] and the checks ``after`` (docs/theory.md
+        §11.12).
+    """
+    rspec = spec if isinstance(spec, RetrofitSpec) else read_retrofit_spec(Path(spec))
+    return retrofit_doc(_constants(constants), _site(site), rspec)

@@ -161,7 +161,7 @@ def test_no_citation_of_the_old_reference_remains() -> None:
     ("text", "expected"),
     [
         ("(theory §2.3)", []),
-        ("(theory §11.12)", ["§11.12"]),
+        ("(theory §11.19)", ["§11.19"]),
         ("docs/theory.md §2.9", ["§2.9"]),
         ("theory §1.8, §6.3 and §12", ["§12"]),
         ("theory §6-§13", ["§13"]),

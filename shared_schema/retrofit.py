@@ -1,0 +1,396 @@
+"""The retrofit spec (tie-bars to design) and the retrofit document (docs/theory.md §11.12).
+
+The spec says where ties may go and what they are made of:
+
+* ``steel``: the grade (``S235``, ``S275``, ``S355``: NTC 2018 Tab. 4.2.I) and the bar
+  diameters on offer [mm];
+* ``anchorage``: the design resistance of one tie's anchorage [N] with the source it comes
+  from (plate punching, pull-out: rockmech has no masonry formula of its own and invents
+  none); a mechanism may give its own;
+* ``mechanisms``: per mechanism id, the candidate tie heights above its hinge [m] (default:
+  one tie at the top of the moving part), the number of bars at that height sharing the
+  force, and the bar length for the steel mass [m].
+
+The document holds, per mechanism, the least tie force that makes the Circolare 2019 checks
+pass, the criterion that governs it, the bar, the anchorage check, the steel mass, and the
+checks before and after with their clauses.
+
+The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` forms.
+"""
+
+from pathlib import Path
+from typing import Any, Dict, List, Literal, Mapping, Optional, Tuple, Union
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from shared_schema.constants import input_error_from_validation, json_document
+from shared_schema.errors import InputError
+from shared_schema.text import decode_text
+
+__all__ = [
+    "ANCHORAGE_MAX_N",
+    "GAMMA_M0",
+    "STEEL_DENSITY",
+    "STEEL_GRADES",
+    "Anchorage",
+    "AnchorageCheck",
+    "BarChoice",
+    "CheckFigures",
+    "MechanismRetrofit",
+    "MechanismTies",
+    "RetrofitDoc",
+    "RetrofitSpec",
+    "Steel",
+    "TieOption",
+    "bar_strengths",
+    "parse_retrofit_spec",
+    "read_retrofit_spec",
+]
+
+#: NTC 2018 Tab. 4.2.I (UNI EN 10025-2): f_yk, f_tk [N/mm²] for a nominal thickness t ≤ 40 mm
+#: and for 40 mm < t ≤ 80 mm (a round bar's thickness read as its diameter).
+STEEL_GRADES: Dict[str, Tuple[Tuple[float, float], Tuple[float, float]]] = {
+    "S235": ((235.0, 360.0), (215.0, 360.0)),
+    "S275": ((275.0, 430.0), (255.0, 410.0)),
+    "S355": ((355.0, 510.0), (335.0, 470.0)),
+}
+#: NTC 2018 Tab. 4.2.I: the thickness where the second row starts, and the table's end [mm].
+THICKNESS_SPLIT_MM, THICKNESS_MAX_MM = 40.0, 80.0
+#: NTC 2018 Tab. 4.2.VII: γ_M0, the partial factor of the yield resistance [4.2.6].
+GAMMA_M0 = 1.05
+#: Density of structural steel [kg/m³] (EN 1993-1-1 §3.2.6), for the steel mass.
+STEEL_DENSITY = 7850.0
+#: An anchorage resistance above this is refused as a mistake (units?) [N]: 5 MN is some
+#: twenty times what a masonry anchorage plate is ever designed for.
+ANCHORAGE_MAX_N = 5.0e6
+#: Tie heights and bar lengths above these are refused as mistakes [m].
+HEIGHT_MAX_M, LENGTH_MAX_M = 200.0, 300.0
+#: Bars at one height sharing the force: at most this many.
+BARS_MAX = 20
+
+_MODEL = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
+
+
+def bar_strengths(grade: str, diameter_mm: float) -> Tuple[float, float, str]:
+    """Return ``f_yk``, ``f_tk`` [N/mm²] of a round bar and the row of Tab. 4.2.I used.
+
+    Raises
+    ------
+    InputError
+        A grade not in the table, or a diameter beyond its 80 mm.
+
+    Examples
+    --------
+    >>> bar_strengths("S275", 20.0)[:2]
+    (275.0, 430.0)
+    """
+    if grade not in STEEL_GRADES:
+        raise InputError(
+            f"grade {grade!r} is not in NTC 2018 Tab. 4.2.I; use one of " + ", ".join(STEEL_GRADES),
+            "steel.grade",
+        )
+    thin, thick = STEEL_GRADES[grade]
+    if diameter_mm <= THICKNESS_SPLIT_MM:
+        return thin[0], thin[1], "NTC 2018 Tab. 4.2.I, t ≤ 40 mm"
+    if diameter_mm <= THICKNESS_MAX_MM:
+        return thick[0], thick[1], "NTC 2018 Tab. 4.2.I, 40 mm < t ≤ 80 mm"
+    raise InputError(
+        f"a {diameter_mm:g} mm bar is beyond NTC 2018 Tab. 4.2.I (t ≤ 80 mm)",
+        "steel.diameters_mm",
+    )
+
+
+class Anchorage(BaseModel):
+    """The design resistance of one tie's anchorage, with its source.
+
+    Attributes
+    ----------
+    capacity_N : float
+        Design resistance of one anchorage (plate punching, plate bending, pull-out,
+        whichever is least) [N], > 0.
+    source : str
+        Where the number comes from (a calculation, a test, a document): rockmech has no
+        anchorage formula and reports this beside the check.
+    """
+
+    model_config = ConfigDict(
+        **_MODEL, json_schema_extra={"description": "One tie's anchorage resistance."}
+    )
+
+    capacity_N: float = Field(
+        gt=0, le=ANCHORAGE_MAX_N, description="Design resistance of one anchorage [N]."
+    )
+    source: str = Field(
+        min_length=3, max_length=500, description="Where the resistance comes from (required)."
+    )
+
+    @field_validator("source")
+    @classmethod
+    def _source_says_something(cls, v: str) -> str:
+        if len(v.strip()) < 3:
+            raise ValueError("give the source of the anchorage resistance (a few words at least)")
+        return v.strip()
+
+
+class Steel(BaseModel):
+    """The tie-bars' steel and the bar sizes on offer.
+
+    Attributes
+    ----------
+    grade : str
+        ``"S235"``, ``"S275"`` or ``"S355"`` (NTC 2018 Tab. 4.2.I).
+    diameters_mm : list of float
+        Round-bar diameters on offer [mm], each in (0, 80].
+    """
+
+    model_config = ConfigDict(
+        **_MODEL, json_schema_extra={"description": "Steel grade and bar diameters on offer."}
+    )
+
+    grade: Literal["S235", "S275", "S355"] = Field(description="Steel grade, NTC 2018 Tab. 4.2.I.")
+    diameters_mm: List[float] = Field(
+        min_length=1, max_length=50, description="Bar diameters on offer [mm], each in (0, 80]."
+    )
+
+    @field_validator("diameters_mm")
+    @classmethod
+    def _diameters_in_table(cls, v: List[float]) -> List[float]:
+        for d in v:
+            if not 0.0 < d <= THICKNESS_MAX_MM:
+                raise ValueError(
+                    f"bar diameter {d:g} mm is outside (0, 80] mm (NTC 2018 Tab. 4.2.I)"
+                )
+        return sorted(set(v))
+
+
+class MechanismTies(BaseModel):
+    """Where ties may go on one mechanism.
+
+    Attributes
+    ----------
+    heights_m : list of float, optional
+        Candidate tie heights above the mechanism's hinge [m], each tried alone; default one
+        tie at the top of the moving part.
+    bars : int
+        Bars at that height sharing the force equally (along the wall) [-], default 1.
+    length_m : float, optional
+        Length of one bar [m], for the steel mass; without it the mass is given per metre.
+    anchorage : Anchorage, optional
+        This mechanism's anchorage resistance; default the spec's.
+    """
+
+    model_config = ConfigDict(
+        **_MODEL, json_schema_extra={"description": "Candidate ties of one mechanism."}
+    )
+
+    heights_m: Optional[List[float]] = Field(
+        None,
+        min_length=1,
+        max_length=20,
+        description="Candidate tie heights above the hinge [m]; default the moving part's top.",
+    )
+    bars: int = Field(1, ge=1, le=BARS_MAX, description="Bars at the height sharing the force.")
+    length_m: Optional[float] = Field(
+        None, gt=0, le=LENGTH_MAX_M, description="Length of one bar [m] (steel mass)."
+    )
+    anchorage: Optional[Anchorage] = Field(
+        None, description="This mechanism's anchorage resistance; default the spec's."
+    )
+
+    @field_validator("heights_m")
+    @classmethod
+    def _heights_positive(cls, v: Optional[List[float]]) -> Optional[List[float]]:
+        for h in v or []:
+            if not 0.0 < h <= HEIGHT_MAX_M:
+                raise ValueError(f"tie height {h:g} m is outside (0, {HEIGHT_MAX_M:g}] m")
+        return v
+
+
+class RetrofitSpec(BaseModel):
+    """A retrofit spec: the steel, the anchorage and the candidate ties per mechanism.
+
+    Examples
+    --------
+    >>> spec = parse_retrofit_spec(
+    ...     '{"steel": {"grade": "S275", "diameters_mm": [16, 20]},'
+    ...     ' "anchorage": {"capacity_N": 60000, "source": "plate punching, calc. 12"}}'
+    ... )
+    >>> spec.steel.grade, spec.mechanisms
+    ('S275', {})
+    """
+
+    model_config = ConfigDict(
+        **_MODEL,
+        json_schema_extra={"description": "Tie-bars to design for failing mechanisms."},
+    )
+
+    steel: Steel = Field(description="Steel grade and bar diameters on offer.")
+    anchorage: Anchorage = Field(description="One tie's anchorage resistance, with its source.")
+    mechanisms: Dict[str, MechanismTies] = Field(
+        default_factory=dict,
+        description="Per mechanism id: candidate ties (mechanisms not listed: the default).",
+    )
+
+
+def parse_retrofit_spec(source: Union[str, bytes, Mapping[str, Any]]) -> RetrofitSpec:
+    """Validate a retrofit spec given as JSON text, the bytes of a file, or plain data.
+
+    Raises
+    ------
+    InputError
+        Malformed JSON or an invalid value; the message names the field
+        (``anchorage.source: Field required``).
+    """
+    if isinstance(source, RetrofitSpec):
+        return source
+    if isinstance(source, (str, bytes)):
+        if isinstance(source, bytes):
+            source = decode_text(source, "the retrofit spec", "retrofit", "a retrofit spec (JSON)")
+        data = json_document(source)
+        try:
+            return RetrofitSpec.model_validate_json(source)
+        except ValidationError as exc:
+            raise input_error_from_validation(exc, data) from exc
+    try:
+        return RetrofitSpec.model_validate(source)
+    except ValidationError as exc:
+        raise input_error_from_validation(exc, source) from exc
+
+
+def read_retrofit_spec(path: Union[str, "Path"]) -> RetrofitSpec:
+    """Read and validate a retrofit spec file (JSON)."""
+    p = Path(path)
+    try:
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read {p.name}: {exc.strerror}", "retrofit") from None
+    return parse_retrofit_spec(raw)
+
+
+# --- the document ---------------------------------------------------------------------
+
+_DOC = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+
+class CheckFigures(BaseModel):
+    """A mechanism's Circolare 2019 checks, as the retrofit reads them (one side or all).
+
+    Ratios are capacity/demand (``a_g,X/a_g``) [-]; a verdict is None where the check was
+    not evaluated (no SLC hazard in the site file, a check that did not run).
+    """
+
+    model_config = _DOC
+
+    linear_ratio: Optional[float] = Field(None, description="Linear check, SLV [-].")
+    linear_passes: Optional[bool] = None
+    SLV_ratio: Optional[float] = Field(None, description="Nonlinear check, SLV [-].")
+    SLV_passes: Optional[bool] = None
+    SLC_ratio: Optional[float] = Field(None, description="Nonlinear check, SLC [-].")
+    SLC_passes: Optional[bool] = None
+    alpha0: Optional[float] = Field(None, description="Activation multiplier [-].")
+    e_star: Optional[float] = Field(None, description="Participating mass fraction [-].")
+    ties: Optional[str] = Field(None, description="How the check counted the ties.")
+    clauses: Dict[str, str] = Field(default_factory=dict)
+    notes: List[str] = Field(default_factory=list)
+
+    @property
+    def passes(self) -> Optional[bool]:
+        """Whether every evaluated check passes (None when none was evaluated)."""
+        got = [v for v in (self.linear_passes, self.SLV_passes, self.SLC_passes) if v is not None]
+        return all(got) if got else None
+
+
+class BarChoice(BaseModel):
+    """The smallest bar on offer whose yield resistance carries the force."""
+
+    model_config = _DOC
+
+    grade: str
+    diameter_mm: float
+    area_mm2: float = Field(description="Gross area π d²/4 [mm²].")
+    f_yk: float = Field(description="Yield strength [N/mm²] (Tab. 4.2.I).")
+    f_tk: float = Field(description="Tensile strength [N/mm²] (Tab. 4.2.I).")
+    gamma_M0: float
+    N_pl_Rd_N: float = Field(description="A f_yk/γ_M0 [N] (NTC 2018 [4.2.6]).")
+    force_N: float = Field(description="The force one bar carries [N].")
+    utilisation: float = Field(description="force_N/N_pl_Rd_N [-] (NTC 2018 [4.2.5]).")
+    clauses: Dict[str, str] = Field(default_factory=dict)
+
+
+class AnchorageCheck(BaseModel):
+    """One tie's force against the user's anchorage resistance."""
+
+    model_config = _DOC
+
+    capacity_N: float
+    source: str
+    force_N: float
+    passes: bool
+
+
+class TieOption(BaseModel):
+    """One candidate tie height of a mechanism and what it takes there."""
+
+    model_config = _DOC
+
+    height_m: float = Field(description="Height of the tie above the hinge [m].")
+    height_source: str
+    status: Literal["designed", "not_carried", "no_force_suffices", "above_moving_part"]
+    T_linear_N: Optional[float] = Field(None, description="Least T for the linear check [N].")
+    T_nonlinear_SLV_N: Optional[float] = Field(
+        None, description="Least T for the nonlinear SLV check, tie verified [N]."
+    )
+    T_nonlinear_SLC_N: Optional[float] = Field(
+        None, description="Least T for the nonlinear SLC check, tie verified [N]."
+    )
+    T_star_N: Optional[float] = Field(None, description="The larger of the criteria [N].")
+    governing: Optional[str] = Field(None, description="The criterion that gives T_star_N.")
+    e_star: Optional[float] = Field(None, description="e* of the checks ([C8.7.1.5]) [-].")
+    bars: int = Field(description="Bars at this height sharing T_star_N.")
+    bar: Optional[BarChoice] = None
+    anchorage: Optional[AnchorageCheck] = None
+    verified: bool = Field(
+        description="Bar and anchorage carry the force: the tie counts up to collapse."
+    )
+    steel_mass_kg: Optional[float] = Field(None, description="Steel of the bars [kg].")
+    steel_mass_per_m_kg: Optional[float] = Field(
+        None, description="Steel of the bars per metre of length [kg/m]."
+    )
+    after: Optional[CheckFigures] = None
+    decisions: List[str] = Field(default_factory=list)
+
+
+class MechanismRetrofit(BaseModel):
+    """One mechanism: its checks before, the tie options, the chosen one."""
+
+    model_config = _DOC
+
+    id: str
+    name: str
+    typology: str
+    status: Literal[
+        "passes", "designed", "not_achievable", "not_applicable", "not_checked", "not_evaluated"
+    ]
+    before: CheckFigures
+    options: List[TieOption] = Field(default_factory=list)
+    chosen: Optional[int] = Field(None, description="Index of the chosen option (least T).")
+    decisions: List[str] = Field(default_factory=list)
+
+
+class RetrofitDoc(BaseModel):
+    """The retrofit document: per mechanism the least tie force and what it takes."""
+
+    model_config = _DOC
+
+    standard: str
+    steel: Dict[str, Any]
+    decisions: List[str]
+    mechanisms: List[MechanismRetrofit]
+
+    def mechanism(self, mechanism_id: str) -> MechanismRetrofit:
+        """Return the mechanism with this id."""
+        for m in self.mechanisms:
+            if m.id == mechanism_id:
+                return m
+        known = ", ".join(repr(m.id) for m in self.mechanisms)
+        raise InputError(f"no mechanism with id {mechanism_id!r}; the document has {known}", "id")

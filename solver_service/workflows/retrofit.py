@@ -1,0 +1,678 @@
+"""The retrofit document: the least tie force that makes each failing mechanism pass.
+
+``retrofit_doc`` takes a constants file, a site and a retrofit spec
+(``shared_schema.retrofit``). For every mechanism that fails the Circolare 2019 checks
+(``codecheck.check_doc``: the linear check at SLV, the nonlinear check at SLV and, where the
+site gives its hazard, at SLC) and every candidate tie height, it finds the least tie force
+``T*`` (docs/theory.md §11.12):
+
+* linear check: ``α0`` is affine in ``T`` ([C8.7.1.1]: the tie's virtual work ``T h_t`` per
+  unit rotation) and the demand does not depend on it, so
+  ``T_lin = (α0/ratio − α0) g S / h_t`` in closed form, with the check's own ``e*``;
+* nonlinear check: bisection on ``T`` (to ``T_REL_TOL``) with the tie counted up to collapse
+  (``ties: verified``, §C8.7.1.2.1.6), for the SLV and the SLC apart;
+
+``T*`` is the largest, and the criterion that gives it is named. Then the smallest bar on
+offer whose yield resistance ``N_pl,Rd = A f_yk/γ_M0`` (NTC 2018 [4.2.6]) carries its share,
+the anchorage against the user's resistance, and the steel mass. Only when the bar and the
+anchorage carry ``T*`` is the tie counted as verified; otherwise the check after it leaves
+the tie out of ``d0`` and the document says so. Each mechanism is rechecked with its tie.
+
+A tie is added to the positive side's constants exactly as the builder adds a tie-bar
+(theory §2.2, Eq. 15: ``M_F −= T h_t cos α_c`` on the outer face through the hinge;
+``α0 += T h_t/(g S)``; ``φ_ov``, ``λ`` by Eq. 16) and, where it is not verified, listed in
+the geometry's elements so that the check takes it out of ``d0`` (theory §11.7). A tie pulls
+on the outward swing only (theory §1.8): the negative side of a two-sided mechanism is the
+mechanism without it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Optional
+
+from shared_schema.constants import ConstantsFile, Mechanism
+from shared_schema.errors import InputError, RockmechError
+from shared_schema.retrofit import (
+    GAMMA_M0,
+    STEEL_DENSITY,
+    AnchorageCheck,
+    BarChoice,
+    CheckFigures,
+    MechanismRetrofit,
+    MechanismTies,
+    RetrofitDoc,
+    RetrofitSpec,
+    TieOption,
+    bar_strengths,
+)
+from shared_schema.site import MechanismOptions, SiteFile
+
+from ..core.circ2019 import CIRC2019
+from ..core.model import G
+from .codecheck import check_doc
+
+__all__ = [
+    "ALPHA0_MAX",
+    "RETROFIT_DECISIONS",
+    "SINGLE_BLOCK_TYPOLOGIES",
+    "T_REL_TOL",
+    "retrofit_doc",
+    "with_tie",
+]
+
+#: Relative width of the bracket at which the bisection on T stops (the issue's 0.5 %): the
+#: reported T is the bracket's passing end.
+T_REL_TOL = 0.005
+#: The bisection's largest tie force: the one that brings α0 to this [-]. A mechanism
+#: that still fails there is reported as not stopped by a tie at that height.
+ALPHA0_MAX = 2.0
+#: The linear T is nudged up by this relative amount so that the check at T reads ≥ 1
+#: despite rounding (the closed form lands on ratio = 1 exactly).
+LINEAR_NUDGE = 1e-9
+#: Typologies whose one block turns about the hinge: a tie at height h_t above it moves
+#: h_t per unit rotation. Multi-block mechanisms need each block's share, which the
+#: constants do not carry.
+SINGLE_BLOCK_TYPOLOGIES = ("single_block", "single_block_loaded", "user_defined")
+#: The element label of the tie the retrofit adds.
+TIE_LABEL = "retrofit.tie"
+
+RETROFIT_DECISIONS = [
+    "The tie is a constant force T on the outer face through the hinge, at height h_t above "
+    "it (the builder's tie-bar, theory §2.2): α0 gains T h_t/(g S) ([C8.7.1.1]), M_F loses "
+    "T h_t cos α_c (Eq. 15).",
+    "e* ([C8.7.1.5]) does not depend on T (static forces are not in it); it is the code "
+    "check's (site local_mechanisms.e_star: one term per block by default, e* = 1 for one "
+    "block) and is reported with every T.",
+    "FC divides the whole α0 ([C8.7.1.8]), the new tie's share included, as the text reads.",
+    "The linear T* is closed form (α0 affine in T, the demand independent of it); the "
+    "nonlinear T* is a bisection on T to 0.5 %, with the tie verified to hold up to "
+    "collapse (C8.7.1.2.1.6); T* is the largest of the criteria evaluated.",
+    "A tie counts as verified only when its bar (NTC 2018 [4.2.6], γ_M0 of Tab. 4.2.VII) "
+    "and its anchorage (the user's resistance and source) carry its share of T*; "
+    "otherwise the check after leaves it out of d0 and the mechanism is not made to pass.",
+    "The capacity-design rule NTC 2018 [4.2.8] (N_pl,Rd ≤ N_u,Rd of the threaded ends) and "
+    "the bar's elongation up to collapse are not checked: the ends and their stress area "
+    "are the designer's.",
+    "A tie pulls on the outward swing only (theory §1.8): the negative side of a two-sided "
+    "mechanism is unchanged, and if it fails no tie makes the mechanism pass.",
+    "Bars at one height share T* equally; the steel mass is per metre unless the spec "
+    "gives the bar length (the constants do not carry where the bar is anchored).",
+]
+
+_CL = {
+    "linear_ratio": "Circ. 2019 C8.7.1.2.1.7: a_g,SLV/a_g (linear kinematic analysis)",
+    "SLV_ratio": "Circ. 2019 C8.7.1.2.1.8: a_g,SLV/a_g (nonlinear, a_g,SLV ≥ a_g,SLD)",
+    "SLC_ratio": "Circ. 2019 C8.7.1.2.1.8: a_g,SLC/a_g (nonlinear)",
+    "alpha0": "Circ. 2019 C8.7.1.2.1.1 [C8.7.1.1]",
+    "e_star": "Circ. 2019 C8.7.1.2.1.3 [C8.7.1.5]",
+    "ties": "Circ. 2019 C8.7.1.2.1.6 (actions verified present up to collapse)",
+}
+_BAR_CLAUSES = {
+    "f_yk": "NTC 2018 Tab. 4.2.I (UNI EN 10025-2)",
+    "gamma_M0": "NTC 2018 Tab. 4.2.VII",
+    "N_pl_Rd_N": "NTC 2018 §4.2.4.1.2.1 [4.2.6]: N_pl,Rd = A f_yk/γ_M0",
+    "utilisation": "NTC 2018 [4.2.5]: N_Ed/N_t,Rd ≤ 1",
+}
+
+
+# --- one tie on a mechanism -----------------------------------------------------------
+
+
+def _single_block_problem(mech: Mechanism) -> Optional[str]:
+    """Why a tie cannot be put on this mechanism's constants, or None."""
+    if mech.typology not in SINGLE_BLOCK_TYPOLOGIES:
+        return (
+            f"typology {mech.typology}: a tie's virtual displacement on a chain of blocks "
+            "needs each block's share, which the constants do not carry; only single-block "
+            "mechanisms are retrofitted in this version"
+        )
+    side = mech.positive
+    if side.virtual_work is None or side.K is None or side.M_F is None or side.phi_cr is None:
+        return (
+            "the constants give no virtual_work or physical form (K, M_F, phi_cr) on the "
+            "positive side: compute them from the geometry with `rockmech constants`"
+        )
+    geo = mech.geometry if isinstance(mech.geometry, dict) else {}
+    pos = geo.get("positive")
+    if not isinstance(pos, dict) or "axis_point_m" not in pos or "com_m" not in geo:
+        return (
+            "the constants' geometry gives no hinge (positive.axis_point_m) or centre of mass "
+            "(com_m): compute them from the geometry with `rockmech constants`"
+        )
+    return None
+
+
+def _top_height(mech: Mechanism) -> tuple[Optional[float], str]:
+    """Height of the moving part's top above the hinge [m], and where it comes from."""
+    geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
+    h = geo.get("h_m")
+    if isinstance(h, (int, float)) and not isinstance(h, bool):
+        return float(h), "the geometry's h_m"
+    got = geo.get("positive")
+    pos: dict[str, Any] = got if isinstance(got, dict) else {}
+    r, a = pos.get("R_m"), pos.get("alpha_rad")
+    if isinstance(r, (int, float)) and isinstance(a, (int, float)):
+        return (
+            2.0 * float(r) * math.cos(float(a)),
+            "the rectangle of the block's R and alpha (2 R cos α)",
+        )
+    return None, "the constants' geometry gives no height of the moving part"
+
+
+def with_tie(mech: Mechanism, force: float, height: float, *, listed: bool) -> Mechanism:
+    """Return the mechanism with a tie of ``force`` [N] at ``height`` [m] above the hinge.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        A single-block mechanism in physical form with ``virtual_work`` and its geometry.
+    force : float
+        The tie's force [N], ≥ 0.
+    height : float
+        Its height above the hinge on the outer face through the hinge [m], > 0.
+    listed : bool
+        Whether to list the tie in ``geometry.loaded.elements`` (the code check then takes it
+        out of ``d0`` unless the mechanism's ties are verified, theory §11.7).
+
+    Notes
+    -----
+    Theory §2.2: a tie pulls inward at a point of the outer face at height ``z`` above the
+    hinge (``x = 0``), so Eq. 15 gives ``M_F,tie = −T z cos α_c`` with ``α_c = φ_cr``, and
+    [C8.7.1.1] ``α0 += T z/(g S)``; Eq. 16 gives ``φ_ov = φ_cr − M_F/K`` and
+    ``λ = (K φ_cr − M_F)/(g Q)``. The negative side of a two-sided mechanism is the
+    mechanism's own: the tie is slack on that swing (theory §1.8).
+    """
+    side = mech.positive
+    vw = side.virtual_work
+    assert vw is not None and side.K is not None and side.M_F is not None
+    assert side.phi_cr is not None and side.Q is not None
+    m_f = side.M_F - force * height * math.cos(side.phi_cr)
+    new_vw = vw.model_copy(update={"alpha0": vw.alpha0 + force * height / (G * vw.S)})
+    new_pos = side.model_copy(
+        update={
+            "M_F": m_f,
+            "phi_ov": side.phi_cr - m_f / side.K,
+            "lam": (side.K * side.phi_cr - m_f) / (G * side.Q),
+            "virtual_work": new_vw,
+        }
+    )
+    update: dict[str, Any] = {"positive": new_pos}
+    if mech.rocking == "two_sided" and mech.negative is None:
+        update["negative"] = side  # the mirror image, without the tie
+    geo: dict[str, Any] = dict(mech.geometry) if isinstance(mech.geometry, dict) else {}
+    if listed:
+        loaded: dict[str, Any] = dict(geo.get("loaded") or {})
+        loaded.setdefault("alpha_c_rad", side.phi_cr)
+        pos = geo["positive"]
+        axis = [float(v) for v in pos["axis_point_m"]]
+        at = [axis[0], axis[1], axis[2] + height]
+        elements = list(loaded.get("elements") or [])
+        elements.append({"element": TIE_LABEL, "kind": "tie_bar", "force_N": force, "at_m": at})
+        loaded["elements"] = elements
+        geo["loaded"] = loaded
+    update["geometry"] = geo
+    return Mechanism.model_validate(mech.model_copy(update=update).model_dump())
+
+
+def _has_ties(mech: Mechanism) -> bool:
+    """Whether the constants' geometry lists tie-bars (theory §11.7)."""
+    geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
+    loaded = geo.get("loaded")
+    elements = loaded.get("elements") if isinstance(loaded, dict) else None
+    listed: list[Any] = elements if isinstance(elements, list) else []
+    return any(isinstance(e, dict) and e.get("kind") == "tie_bar" for e in listed)
+
+
+def _unlist_ties(mech: Mechanism) -> Mechanism:
+    """Return the mechanism with its listed tie-bars baked in (counted up to collapse)."""
+    geo: dict[str, Any] = dict(mech.geometry) if isinstance(mech.geometry, dict) else {}
+    loaded = geo.get("loaded")
+    if not isinstance(loaded, dict):
+        return mech
+    loaded = dict(loaded)
+    elements = loaded.get("elements")
+    loaded["elements"] = [
+        e
+        for e in (elements if isinstance(elements, list) else [])
+        if not (isinstance(e, dict) and e.get("kind") == "tie_bar")
+    ]
+    geo["loaded"] = loaded
+    return mech.model_copy(update={"geometry": geo})
+
+
+# --- the checks of one mechanism ------------------------------------------------------
+
+
+class _Checker:
+    """Runs the code check of one mechanism with a tie, as ``check_doc`` does."""
+
+    def __init__(self, cf: ConstantsFile, site: SiteFile, mech: Mechanism) -> None:
+        self.cf = cf
+        self.site = site
+        self.mech = mech
+        lm = site.local_mechanisms
+        self.options = lm.mechanisms.get(mech.id) or MechanismOptions()
+        self.runs = 0
+
+    def _site(self, options: MechanismOptions) -> SiteFile:
+        lm = self.site.local_mechanisms.model_copy(update={"mechanisms": {self.mech.id: options}})
+        return self.site.model_copy(update={"local_mechanisms": lm})
+
+    def row(self, force: float, height: float, verified: bool) -> dict[str, Any]:
+        """Return the check row of the mechanism with the tie (``force`` 0: as it stands)."""
+        self.runs += 1
+        mech, opts = self.mech, self.options
+        if force > 0.0:
+            if verified and (opts.ties == "verified" or not _has_ties(mech)):
+                # Listed and verified: the check names the tie and counts it in d0.
+                mech = with_tie(mech, force, height, listed=True)
+                opts = opts.model_copy(update={"ties": "verified"})
+            elif verified:
+                # The existing ties are not verified: the new one, baked into the
+                # constants but not listed, stays in d0 while they are taken out.
+                mech = with_tie(mech, force, height, listed=False)
+            else:
+                if opts.ties == "verified":
+                    # The existing ties stay counted; only the new one is taken out of d0.
+                    mech = _unlist_ties(mech)
+                    opts = opts.model_copy(update={"ties": "not_verified"})
+                mech = with_tie(mech, force, height, listed=True)
+        cf = self.cf.model_copy(update={"mechanisms": [mech]})
+        doc = check_doc(cf, self._site(opts))
+        row: dict[str, Any] = doc["mechanisms"][0]
+        return row
+
+
+def _figures(checks: dict[str, Any]) -> CheckFigures:
+    """Return the figures of a side's (or a row's governing) linear and nonlinear checks."""
+    lin, non = checks["linear"], checks["nonlinear"]
+    fig = CheckFigures(clauses=dict(_CL))
+    notes: list[str] = []
+    if lin.get("status") == "ok":
+        fig.linear_ratio = float(lin["capacity_ratio"])
+        fig.linear_passes = lin["passes"]
+        fig.alpha0 = float(lin["alpha0"])
+        fig.e_star = float(lin["e_star"])
+    else:
+        notes.append("linear check not run: " + str(lin.get("note", "")))
+    if non.get("status") == "ok":
+        fig.SLV_ratio = float(non["capacity_ratio"])
+        fig.SLV_passes = non["passes"]
+        slc = non.get("SLC")
+        if isinstance(slc, dict):
+            fig.SLC_ratio = float(slc["capacity_ratio"])
+            fig.SLC_passes = slc.get("passes")
+        ties = non.get("ties") or {}
+        if ties.get("present"):
+            fig.ties = str(ties.get("rule", ties.get("treatment", "")))
+    else:
+        notes.append("nonlinear check not run: " + str(non.get("note", "")))
+    fig.notes = notes + [n for n in (lin.get("notes") or []) + (non.get("notes") or []) if n]
+    return fig
+
+
+def _row_figures(row: dict[str, Any]) -> CheckFigures:
+    return _figures({"linear": row["linear"], "nonlinear": row["nonlinear"]})
+
+
+# --- the least force ------------------------------------------------------------------
+
+
+def _least_force(ok: Any, hi0: float, t_max: float) -> tuple[Optional[float], int]:
+    """Least T in (0, t_max] with ``ok(T)``, by doubling from ``hi0`` then bisection.
+
+    Returns the bracket's passing end (within ``T_REL_TOL`` of the least) and the number of
+    evaluations; None when ``ok(t_max)`` is false.
+    """
+    runs = 0
+    lo, hi = 0.0, min(max(hi0, t_max * 1e-6), t_max)
+    while True:
+        runs += 1
+        if ok(hi):
+            break
+        lo = hi
+        if hi >= t_max:
+            return None, runs
+        hi = min(2.0 * hi, t_max)
+    while hi - lo > T_REL_TOL * hi:
+        mid = 0.5 * (lo + hi)
+        runs += 1
+        if ok(mid):
+            hi = mid
+        else:
+            lo = mid
+    return hi, runs
+
+
+def _bar(spec: RetrofitSpec, force: float) -> tuple[Optional[BarChoice], str]:
+    """Return the smallest bar on offer whose N_pl,Rd carries ``force`` [N], or why none does."""
+    grade = spec.steel.grade
+    best = None
+    for d in spec.steel.diameters_mm:
+        f_yk, f_tk, row = bar_strengths(grade, d)
+        area = math.pi * d * d / 4.0
+        n_pl = area * f_yk / GAMMA_M0
+        if n_pl >= force:
+            best = BarChoice(
+                grade=grade,
+                diameter_mm=d,
+                area_mm2=area,
+                f_yk=f_yk,
+                f_tk=f_tk,
+                gamma_M0=GAMMA_M0,
+                N_pl_Rd_N=n_pl,
+                force_N=force,
+                utilisation=force / n_pl,
+                clauses={**_BAR_CLAUSES, "f_yk": row},
+            )
+            break
+    if best is not None:
+        return best, ""
+    d = spec.steel.diameters_mm[-1]
+    f_yk, _, _ = bar_strengths(grade, d)
+    n_pl = math.pi * d * d / 4.0 * f_yk / GAMMA_M0
+    return None, (
+        f"no bar on offer carries {force:.4g} N: the largest, Ø{d:g} {grade}, has N_pl,Rd = "
+        f"{n_pl:.4g} N (NTC 2018 [4.2.6]); offer larger bars or more bars at the height"
+    )
+
+
+def _criteria(
+    checker: _Checker, before: dict[str, Any], height: float, t_max: float
+) -> dict[str, Optional[float]]:
+    """Return the least force [N] per criterion (None: no force up to ``t_max`` suffices)."""
+    vw = checker.mech.positive.virtual_work
+    assert vw is not None
+    pos = before["sides"]["positive"]
+    lin = pos["linear"]
+    criteria: dict[str, Optional[float]] = {}
+    if lin.get("status") == "ok" and lin["passes"] is not None:
+        # [C8.7.1.1]: α0 affine in T, the demand independent of it, the ratio ∝ α0.
+        r0, a0 = float(lin["capacity_ratio"]), float(lin["alpha0"])
+        t_lin = 0.0 if r0 >= 1.0 else (a0 / r0 - a0) * G * vw.S / height
+        criteria["linear SLV"] = t_lin * (1.0 + LINEAR_NUDGE)
+    non = pos["nonlinear"]
+    if non.get("status") != "ok":
+        return criteria
+    for ls in ("SLV", "SLC"):
+        if non.get(ls, {}).get("passes") is None:
+            continue
+
+        def ok(t: float, ls: str = ls) -> bool:
+            row = checker.row(t, height, verified=True)
+            chk = row["sides"]["positive"]["nonlinear"]
+            return bool(chk.get("status") == "ok" and chk[ls]["passes"])
+
+        if non[ls]["passes"]:
+            criteria[f"nonlinear {ls}"] = 0.0
+            continue
+        hi0 = max(criteria.get("linear SLV") or 0.0, 1e-3 * G * vw.mass)
+        criteria[f"nonlinear {ls}"] = _least_force(ok, hi0, t_max)[0]
+    return criteria
+
+
+def _option(
+    checker: _Checker,
+    spec: RetrofitSpec,
+    ties: MechanismTies,
+    before: dict[str, Any],
+    height: float,
+    height_source: str,
+    top: Optional[float],
+) -> TieOption:
+    mech = checker.mech
+    n = ties.bars
+    decisions: list[str] = []
+    if top is not None and height > top * (1.0 + 1e-9):
+        return TieOption(
+            height_m=height,
+            height_source=height_source,
+            status="above_moving_part",
+            bars=n,
+            verified=False,
+            decisions=[
+                f"the tie at {height:g} m is above the moving part (its top is {top:.4g} m "
+                "above the hinge): it meets no block that moves, so it restrains nothing and "
+                "changes no check; put it at or below the top"
+            ],
+        )
+    vw = mech.positive.virtual_work
+    assert vw is not None
+    t_max = (ALPHA0_MAX - vw.alpha0) * G * vw.S / height
+    lin = before["sides"]["positive"]["linear"]
+    e_star = float(lin["e_star"]) if lin.get("status") == "ok" else None
+    criteria = _criteria(checker, before, height, t_max)
+    t_lin_v = criteria.get("linear SLV")
+    t_slv, t_slc = criteria.get("nonlinear SLV"), criteria.get("nonlinear SLC")
+    common = {
+        "height_m": height,
+        "height_source": height_source,
+        "T_linear_N": t_lin_v,
+        "T_nonlinear_SLV_N": t_slv,
+        "T_nonlinear_SLC_N": t_slc,
+        "e_star": e_star,
+        "bars": n,
+    }
+    stuck = [k for k, v in criteria.items() if v is None]
+    if stuck:
+        return TieOption(
+            **common,
+            status="no_force_suffices",
+            verified=False,
+            decisions=[
+                f"no tie force at {height:g} m up to {t_max:.4g} N (α0 = {ALPHA0_MAX:g}) makes "
+                f"the {', '.join(stuck)} check pass"
+            ],
+        )
+    governing, t_star = max(
+        ((k, v) for k, v in criteria.items() if v is not None), key=lambda p: p[1]
+    )
+    per_bar = t_star / n
+    bar, bar_note = _bar(spec, per_bar)
+    anc_spec = ties.anchorage or spec.anchorage
+    anchorage = AnchorageCheck(
+        capacity_N=anc_spec.capacity_N,
+        source=anc_spec.source,
+        force_N=per_bar,
+        passes=per_bar <= anc_spec.capacity_N,
+    )
+    if bar_note:
+        decisions.append(bar_note)
+    if not anchorage.passes:
+        decisions.append(
+            f"the anchorage resistance {anc_spec.capacity_N:.4g} N ({anc_spec.source}) is "
+            f"below the {per_bar:.4g} N of one tie: more bars at the height, or a stronger "
+            "anchorage"
+        )
+    verified = bar is not None and anchorage.passes
+    if not verified:
+        decisions.append(
+            "the tie is not verified to hold up to collapse (C8.7.1.2.1.6): the check after "
+            "leaves it out of d0, and the mechanism is not made to pass"
+        )
+    after_row = checker.row(t_star, height, verified=verified)
+    after = _row_figures(after_row)
+    if e_star is not None:
+        decisions.append(
+            f"T* = {t_star:.6g} N, governed by the {governing} check, with e* = {e_star:.4g} "
+            "([C8.7.1.5] as the code check sums it)"
+        )
+    neg = before["sides"].get("negative")
+    if neg is not None:
+        nf = _figures(neg)
+        if nf.passes is False:
+            decisions.append(
+                "the negative (inward) side fails and a tie, slack on that swing (theory "
+                "§1.8), does not help it: the mechanism still fails there"
+            )
+    area = 0.0 if bar is None else bar.area_mm2 * 1e-6
+    per_m = n * area * STEEL_DENSITY if bar is not None else None
+    mass = None
+    if per_m is not None and ties.length_m is not None:
+        mass = per_m * ties.length_m
+    elif per_m is not None:
+        decisions.append("steel mass per metre: the spec gives no bar length (length_m)")
+    return TieOption(
+        **common,
+        status="designed" if verified and after.passes else "not_carried",
+        T_star_N=t_star,
+        governing=governing,
+        bar=bar,
+        anchorage=anchorage,
+        verified=verified,
+        steel_mass_kg=mass,
+        steel_mass_per_m_kg=per_m,
+        after=after,
+        decisions=decisions,
+    )
+
+
+def _failing(fig: CheckFigures) -> bool:
+    return False in (fig.linear_passes, fig.SLV_passes, fig.SLC_passes)
+
+
+def _mechanism(
+    cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec, mech: Mechanism, row: dict[str, Any]
+) -> MechanismRetrofit:
+    before = _row_figures(row)
+    head = {"id": mech.id, "name": mech.name, "typology": mech.typology, "before": before}
+    if before.linear_ratio is None and before.SLV_ratio is None:
+        return MechanismRetrofit(
+            **head, status="not_checked", decisions=["the code check did not run", *before.notes]
+        )
+    if not _failing(before):
+        if before.SLV_passes is None and before.linear_passes is None:
+            return MechanismRetrofit(
+                **head,
+                status="not_evaluated",
+                decisions=["the site's checks are not evaluated (see the notes)"],
+            )
+        return MechanismRetrofit(
+            **head, status="passes", decisions=["passes every check evaluated: needs no tie"]
+        )
+    if not _failing(_figures(row["sides"]["positive"])):
+        return MechanismRetrofit(
+            **head,
+            status="not_achievable",
+            decisions=[
+                "only the negative (inward) side fails: a tie is slack on that swing "
+                "(theory §1.8) and cannot help it"
+            ],
+        )
+    problem = _single_block_problem(mech)
+    if problem is not None:
+        return MechanismRetrofit(**head, status="not_applicable", decisions=[problem])
+    ties = spec.mechanisms.get(mech.id) or MechanismTies()
+    top, top_source = _top_height(mech)
+    if ties.heights_m is not None:
+        heights = [(h, f"retrofit spec mechanisms.{mech.id}.heights_m") for h in ties.heights_m]
+    elif top is not None:
+        heights = [(top, f"default: the top of the moving part ({top_source})")]
+    else:
+        raise InputError(
+            f"mechanism {mech.id}: {top_source}; give the tie heights",
+            f"mechanisms.{mech.id}.heights_m",
+        )
+    checker = _Checker(cf, site, mech)
+    options = [_option(checker, spec, ties, row, h, src, top) for h, src in heights]
+    done = [i for i, o in enumerate(options) if o.status == "designed"]
+    chosen = min(done, key=lambda i: (options[i].T_star_N or 0.0, i)) if done else None
+    decisions = []
+    if chosen is not None:
+        o = options[chosen]
+        assert o.bar is not None and o.T_star_N is not None
+        decisions.append(
+            f"{o.bars} Ø{o.bar.diameter_mm:g} {o.bar.grade} tie(s) at {o.height_m:g} m, "
+            f"{o.T_star_N:.4g} N in all ({o.governing} governs): the least force of the "
+            "options that make every check pass"
+        )
+    else:
+        decisions.append("no tie option makes every check pass (see each option's decisions)")
+    return MechanismRetrofit(
+        **head,
+        status="designed" if chosen is not None else "not_achievable",
+        options=options,
+        chosen=chosen,
+        decisions=decisions,
+    )
+
+
+def retrofit_doc(cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec) -> RetrofitDoc:
+    """Find the least tie force per failing mechanism, the bar and the checks after it.
+
+    Parameters
+    ----------
+    cf : ConstantsFile
+        Mechanisms with ``virtual_work`` and their geometry (``rockmech constants``).
+    site : SiteFile
+        Hazard (SLV, and SLC where given), FC, q, the check's choices.
+    spec : RetrofitSpec
+        Steel, bars on offer, anchorage resistance, candidate tie heights per mechanism.
+
+    Returns
+    -------
+    RetrofitDoc
+        Per mechanism: ``status``, the checks ``before``, per candidate height the least
+        forces per criterion [N], ``T_star_N`` [N] and its ``governing`` criterion, ``e_star``,
+        the ``bar``, the ``anchorage`` check, the steel mass [kg] and the checks ``after``.
+
+    Raises
+    ------
+    InputError
+        The spec names a mechanism the constants do not have; the site contradicts the
+        constants (``codecheck.check_site_inputs``); a default tie height with no height of
+        the moving part in the constants.
+    """
+    ids = [m.id for m in cf.mechanisms]
+    for key in spec.mechanisms:
+        if key not in ids:
+            raise InputError(
+                f"no mechanism {key!r} in the constants (ids: {', '.join(sorted(ids))})",
+                f"mechanisms.{key}",
+            )
+    for d in spec.steel.diameters_mm:
+        bar_strengths(spec.steel.grade, d)
+    if site.local_mechanisms.method != "circ2019":
+        raise InputError(
+            "the retrofit follows the Circolare 2019 checks; set local_mechanisms.method to "
+            "circ2019",
+            "local_mechanisms.method",
+        )
+    doc = check_doc(cf, site)
+    rows = doc["mechanisms"]
+    out = []
+    for mech, row in zip(cf.mechanisms, rows):
+        try:
+            out.append(_mechanism(cf, site, spec, mech, row))
+        except InputError:
+            raise
+        except RockmechError as exc:
+            out.append(
+                MechanismRetrofit(
+                    id=mech.id,
+                    name=mech.name,
+                    typology=mech.typology,
+                    status="not_applicable",
+                    before=_row_figures(row),
+                    decisions=[str(exc)],
+                )
+            )
+    f_yk = {d: bar_strengths(spec.steel.grade, d)[0] for d in spec.steel.diameters_mm}
+    steel = {
+        "grade": spec.steel.grade,
+        "diameters_mm": list(spec.steel.diameters_mm),
+        "f_yk": {f"{d:g}": v for d, v in f_yk.items()},
+        "gamma_M0": GAMMA_M0,
+        "density_kg_m3": STEEL_DENSITY,
+        "clauses": {
+            **_BAR_CLAUSES,
+            "density_kg_m3": "EN 1993-1-1 §3.2.6",
+        },
+    }
+    return RetrofitDoc(
+        standard=CIRC2019 + "; NTC 2018 §4.2.4.1.2.1 (tie-bars)",
+        steel=steel,
+        decisions=RETROFIT_DECISIONS,
+        mechanisms=out,
+    )
