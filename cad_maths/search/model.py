@@ -6,8 +6,8 @@
 * every wall is one solid, taken as a right prism: its elevation (outer boundary, openings
   as holes) in its own frame (``s`` along it, ``n`` through it from the outer face, ``z``
   up; ``e_n`` points into the building) and its thickness. A wall that is not an exact
-  prism (a pocket, a scan's relief, an oblique end) is idealised with twice its centroid's
-  depth behind its base's outer face as thickness and the density that keeps its mass
+  prism (a pocket, a scan's relief, an oblique end, a lean) is idealised as the prism on its
+  base that keeps its mass and the lesser lever of its weight about the base's edges
   (theory §10.9), and a note says so; the builder still computes its constants from the
   real solid, and the search reports the difference;
 * a wall B whose end face abuts the inner face of a façade A at one of A's ends is a
@@ -607,36 +607,45 @@ def _orient(
     volume = float(mass_properties(mesh, 1.0).volume)
     moments = ring_moments(rings)
     height = (float(v[:, 2].max()) - z_lo, float(moments[2] / moments[0]) - z_lo)
-    notes: List[str] = lone_notes + _axes_notes(axes, name, height, t)
     exact = abs(volume - area * t) <= PRISM_RTOL * volume and not leans
-    scale = 1.0
-    if abs(volume - area * t) > PRISM_RTOL * volume:
+    prism = abs(volume - area * t) <= PRISM_RTOL * volume
+    t_eff, scale = t, 1.0
+    if leans or not prism:
+        # The idealised prism on the base keeps the solid's mass and the lesser of its
+        # weight's two levers about the base's edges: twice that lever is its thickness, a
+        # density keeps the mass (theory §10.9). It overturns as the solid does the way
+        # the solid resists least, and no less than the solid the other way.
         base = v[:, 2] <= z_lo + BASE_RTOL * height[0]
-        origin = float(s.min()) * e_s + float(n[base].min()) * e_n
-        # twice the depth of the solid's centroid behind its base's outer face: the prism
-        # overturns about that edge as the solid does; a density that keeps its mass
-        com = mass_properties(mesh, 1.0).com
-        depth = float((com - origin) @ e_n) - (axes.lean * (float(com[2]) - z_lo) if leans else 0.0)
-        t_eff = 2.0 * depth if 0.0 < depth <= t else volume / area
+        lo, hi = float(n[base].min()), float(n[base].max())
+        origin = float(s.min()) * e_s + lo * e_n
+        depth = float(mass_properties(mesh, 1.0).com @ e_n) - lo  # the lean's shift included
+        lever = min(depth, (hi - lo) - depth)
+        t_eff = 2.0 * lever if lever > 0.0 else (t if leans else volume / area)
         scale = volume / (area * t_eff)
+        frame = WallFrame(origin, e_s, e_n, e_z, t_eff)
+    notes: List[str] = lone_notes + _axes_notes(axes, name, height, t, t_eff)
+    if not prism:
         notes.append(
             f"{name}: not a prism of constant thickness (volume {volume:.6g} m³, outer face "
             f"{area:.6g} m² x {t:.6g} m): the search idealises it with the thickness "
-            f"{t_eff:.6g} m, twice its centroid's depth behind its base's outer face (the edge "
-            f"it rocks about), and {scale:.6g} times its density, so that the prism keeps its "
-            "mass and overturns as the solid does; the constants come from the real solid and "
-            "the search reports the difference"
+            f"{t_eff:.6g} m, twice the lesser lever of its weight about its base's edges "
+            f"(the centroid's depth behind the outer one, or before the inner one), and "
+            f"{scale:.6g} times its density, so that the prism keeps its mass and overturns "
+            "as the solid does the way it resists least; the constants come from the real "
+            "solid and the search reports the difference"
         )
-        frame = WallFrame(origin, e_s, e_n, e_z, t_eff)
     held = _held_by(plan, reading.covered[1 if flip else 0], e_s if not flip else -e_s, frame)
     return frame, rings, volume, exact, notes, (held, reading.building, scale)
 
 
-def _axes_notes(axes: WallAxes, name: str, height: Tuple[float, float], t: float) -> List[str]:
+def _axes_notes(
+    axes: WallAxes, name: str, height: Tuple[float, float], t: float, t_eff: float
+) -> List[str]:
     """Return the notes of a pier's frame and of a wall read as plumb (``prism.frame_from_mesh``).
 
     ``height`` is the wall's height and its elevation's centroid height above its base [m];
-    ``t`` the thickness of its plumb prism [m].
+    ``t`` the wall's thickness across (its plumb section) and ``t_eff`` its idealised
+    prism's [m].
     """
     notes = []
     long_side, short_side = axes.plan
@@ -661,19 +670,22 @@ def _axes_notes(axes: WallAxes, name: str, height: Tuple[float, float], t: float
             f"{long_side / short_side:.3g} times as large for the bare block) is not searched"
         )
     if axes.lean != 0.0:
-        notes.append(_lean_note(axes, name, height, t))
+        notes.append(_lean_note(axes, name, height, t, t_eff))
     return notes
 
 
-def _lean_note(axes: WallAxes, name: str, height: Tuple[float, float], t: float) -> str:
-    """Return the note of a wall out of plumb, read as the plumb prism on its base (module doc).
+def _lean_note(
+    axes: WallAxes, name: str, height: Tuple[float, float], t: float, t_eff: float
+) -> str:
+    """Return the note of a wall out of plumb, read as a plumb prism on its base (module doc).
 
     Notes
     -----
-    The real solid's centre of mass lies ``lean * z_c`` off the prism's along ``e_n``
+    The real solid's centre of mass lies ``lean * z_c`` off its base's middle along ``e_n``
     (``z_c`` the centroid's height above the base): for the whole wall overturning outward
-    about its base as a bare wall, the real λ0 is ``(t + 2 lean z_c) / t`` times the
-    prism's ``t / h`` (above 1 for a lean inward).
+    about its base as a bare wall, the real λ0 is ``(t + 2 lean z_c) / t`` times a plumb
+    prism's ``t / h`` (above 1 for a lean inward). The idealised prism, ``t_eff`` thick,
+    keeps the lesser of the weight's two levers about the base's edges (theory §10.9).
     """
     h, z_c = height
     deg = math.degrees(math.atan(abs(axes.lean)))
@@ -689,17 +701,14 @@ def _lean_note(axes: WallAxes, name: str, height: Tuple[float, float], t: float)
     said = (
         f"{name}: {deg:.2f} degrees out of plumb{faces}, its top {abs(axes.lean) * h:.3f} m "
         f"{way} of its base over its {h:.3f} m height (within {PLUMB_TOL_DEG:g} degrees): the "
-        f"search idealises it as a plumb prism standing on its base, of the same mass "
-        f"({t:.3f} m thick across; the real solid's centre of mass lies {abs(shift):.3f} m "
-        f"{way} of the prism's); the builder's constants use the real solid, and the search "
-        f"reports the difference (for the bare wall overturning outward about its base, the "
-        f"real λ0 is {ratio:.3g} times the prism's)"
+        f"search idealises it as a plumb prism standing on its base, of the same mass, "
+        f"{t_eff:.3f} m thick: twice the lesser lever of its weight about its base's edges "
+        f"(the wall is {t:.3f} m thick across, and its centre of mass lies {abs(shift):.3f} m "
+        f"{way} of its base's middle); the builder's constants use the real solid, and the "
+        f"search reports the difference (for the bare wall overturning outward about its "
+        f"base, the real λ0 is {ratio:.3g} times a plumb {t:.3f} m prism's, "
+        f"{(t + 2.0 * shift) / t_eff:.3g} times the idealised one's)"
     )
-    if way == "outward":
-        said += (
-            "; leaning outward, the real wall resists outward overturning less than the plumb "
-            "prism: read the builder's λ0"
-        )
     if abs(shift) >= 0.5 * t:
         said += (
             f"; its centre of mass lies beyond its base's {'inner' if shift > 0.0 else 'outer'} "

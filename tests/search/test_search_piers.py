@@ -198,8 +198,10 @@ def test_a_wall_out_of_plumb_is_idealised_plumb_with_a_note(
 ) -> None:
     """A 0.5 x 4 x 6 m wall sheared 3 degrees across its thickness (its top 0.314 m over).
 
-    The search reports the plumb prism on its base, λ0 = t / h; the builder, on the real
-    solid, λ0 = (t -/+ δ) / h for a top leaning with / against the motion.
+    The search idealises it as the plumb prism on its base that keeps the lesser lever of
+    its weight about the base's edges, λ0 = (t - δ) / h either way (exact when the top
+    leans with the motion, on the safe side against it); the builder, on the real solid,
+    λ0 = (t -/+ δ) / h for a top leaning with / against the motion.
     """
     tan = math.tan(math.radians(lean_deg))
     delta = H_W * abs(tan)
@@ -207,7 +209,7 @@ def test_a_wall_out_of_plumb_is_idealised_plumb_with_a_note(
     scene = _scene(tmp_path, {"W": solid}, place)
     doc = rockmech.search_from_files(scene, _spec(tmp_path, ["W"])).doc
     c = _whole(doc)["W"]
-    assert c["lam0"] == pytest.approx(T_W / H_W, rel=1e-9, abs=0.0)
+    assert c["lam0"] == pytest.approx((T_W - delta) / H_W, rel=1e-8, abs=0.0)
     assert c["mass_kg"] == pytest.approx(1800.0 * T_W * L_W * H_W, rel=1e-9)
     lean_dir = _placement(place[0], place[2]) @ np.array([math.copysign(1.0, tan), 0.0, 0.0])
     with_motion = float(np.dot(c["direction_vector"], lean_dir)) > 0.0
@@ -219,12 +221,14 @@ def test_a_wall_out_of_plumb_is_idealised_plumb_with_a_note(
     way = "outward" if with_motion else "inward"
     assert note.startswith(f"W: 3.00 degrees out of plumb, its top {delta:.3f} m {way} of its base")
     assert "the builder's constants use the real solid" in note
-    assert f"real λ0 is {real / (T_W / H_W):.3g} times the prism's" in note
-    assert ("read the builder's λ0" in note) == with_motion
+    assert f"real λ0 is {real / (T_W / H_W):.3g} times a plumb 0.500 m prism's" in note
+    assert f"{real / ((T_W - delta) / H_W):.3g} times the idealised one's" in note
+    assert f"of the same mass, {T_W - delta:.3f} m thick" in note
     assert not any("not a prism" in n for n in doc["notes"])
-    # the global check runs on the plumb prism and holds the catalogue's optimum
+    # the global check runs on the idealised prism and holds the catalogue's optimum
     (lp,) = doc["lp"]
-    assert lp["status"] == "optimal" and lp["lam"] == pytest.approx(T_W / H_W, rel=1e-9)
+    assert lp["status"] == "optimal"
+    assert lp["lam"] == pytest.approx((T_W - delta) / H_W, rel=1e-8)
 
 
 def test_a_wall_leaning_beyond_the_tolerance_is_refused(tmp_path: Path) -> None:

@@ -306,8 +306,9 @@ def test_a_trapezoid_plan_with_a_100_degree_corner_and_three_thicknesses(
     are said to be searched without their junction. References: λ0 = 2 d / h with d the
     depth of the footprint's centroid behind the outer face (polygon moments written here):
     t/h for the rectangle W1 and the parallelogram W3, the trapezoids W0 and W2 by their
-    moments (the search idealises them keeping their mass and their centroid's depth; the
-    builder, on the real solid, agrees)."""
+    moments (the builder, on the real solid); the search idealises them keeping their mass
+    and the lesser lever of their weight about the base's edges, λ0 = 2 min(d, t - d) / h:
+    exact where the centroid lies nearer the outer face, below the solid's otherwise)."""
     h = 6.0
     quads = _trapezoid()
     outward = {
@@ -329,17 +330,21 @@ def test_a_trapezoid_plan_with_a_100_degree_corner_and_three_thicknesses(
     assert sorted(by_wall) == sorted(quads)
     for wid, (normal, point) in outward.items():
         c = by_wall[wid]
-        ref = 2.0 * _centroid_depth(quads[wid], normal, point) / h
+        depth = _centroid_depth(quads[wid], normal, point)
+        ref = 2.0 * depth / h
         assert np.allclose(c["direction_vector"][:2], _place(normal, angle, mirror), atol=1e-9)
         assert c["builder"]["lam0"] == pytest.approx(ref, rel=1e-9, abs=0.0), wid
-        assert c["lam0"] == pytest.approx(ref, rel=1e-9, abs=0.0), wid
-        assert c["builder"]["agrees"] is True, wid
         if wid in ("W1", "W3"):
             assert ref == pytest.approx(THICK[wid] / h, rel=1e-12)
+            assert c["lam0"] == pytest.approx(ref, rel=1e-9, abs=0.0), wid
+            assert c["builder"]["agrees"] is True, wid
             assert doc["input"]["walls"][wid]["exact_prism"] is True
-        else:  # an oblique end: idealised keeping its mass and its centroid's depth, said so
+        else:  # an oblique end: idealised with the lesser lever of its weight, said so
+            lever = min(depth, THICK[wid] - depth)
+            assert c["lam0"] == pytest.approx(2.0 * lever / h, rel=1e-9, abs=0.0), wid
+            assert c["lam0"] <= ref * (1.0 + 1e-9)  # never above the solid's (to rounding)
             (note,) = [n for n in doc["notes"] if n.startswith(f"{wid}: not a prism")]
-            assert "twice its centroid's depth behind its base's outer face" in note
+            assert "twice the lesser lever of its weight about its base's edges" in note
     for a in ("W0", "W2"):
         (note,) = [n for n in doc["notes"] if n.startswith(f"{a} and W3 meet at")]
         assert note.startswith(f"{a} and W3 meet at 100.0° / 80.0° (not square)")
