@@ -62,6 +62,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/geometry_speed.py
 	$(BIN)/python benchmarks/records_speed.py
 	$(BIN)/python benchmarks/load.py
+	$(BIN)/python benchmarks/cli_start.py
 
 ## Numerics report (docs/numerics.md, docs/img/, solver_service/data/linearisation_map.npz):
 ## work precision of every integrator, stiff cases, linearisation map, extreme-case sweep.

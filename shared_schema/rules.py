@@ -41,8 +41,10 @@ __all__ = [
     "ENVELOPE_METHODS",
     "F_N_RANGE",
     "F_P_RANGE",
+    "IM_MEASURES",
     "LAM_RANGE",
     "LENGTH_UNITS",
+    "PEAKS_FILE",
     "PRINTABLE_PATTERN",
     "PULSE_SHAPES",
     "P_EQ_RANGE",
@@ -150,6 +152,12 @@ PULSE_SHAPES: Tuple[str, ...] = ("sine", "cosine")
 #: frequency, the default) or ``library`` (the fast mode: the interpolated library, exact
 #: where it cannot interpolate safely; docs/envelopes.md).
 ENVELOPE_METHODS: Tuple[str, ...] = ("exact", "library")
+
+#: Intensity measures of an incremental dynamic analysis, with their units: ``scale`` (the
+#: factor on each record) or ``pga`` (the record's peak ground acceleration, in g).
+IM_MEASURES: Dict[str, str] = {"scale": "-", "pga": "g"}
+#: Name of the per-run peaks file ``rockmech ida --peaks`` writes into ``--out`` (Parquet).
+PEAKS_FILE = "ida_peaks.parquet"
 
 # Plausible ranges of the numbers a pulse request gives directly (the REST service's
 # ``/pulse``; its OpenAPI schema states them). Each bound lies far past any masonry body and

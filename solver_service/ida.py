@@ -67,6 +67,7 @@ from shared_schema.atomic import temp_name
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 from shared_schema.extras import require
+from shared_schema.rules import IM_MEASURES, PEAKS_FILE
 from shared_schema.version import __version__
 
 from .core.exact import single_threaded
@@ -90,9 +91,6 @@ __all__ = [
     "run_task",
 ]
 
-#: Intensity measures and their units.
-IM_MEASURES = {"scale": "-", "pga": "g"}
-
 #: Seconds to wait for a Dask scheduler, and for its first worker, before giving up.
 CONNECT_TIMEOUT_S = 10.0
 #: Work of one task aimed at [s]: per-task costs (a few ms on Dask) stay under 1 % of it.
@@ -111,8 +109,6 @@ TASKS_PER_WORKER = 8
 TASK_STEPS_PER_S = 1.0e8
 #: Address schemes of a Dask scheduler that rockmech connects to.
 SCHEMES = ("tcp", "tls", "ws", "wss")
-#: Name of the per-run peaks file the command line writes into ``--out`` (``--peaks``).
-PEAKS_FILE = "ida_peaks.parquet"
 #: Rows of the peaks file gathered before they are written as one row group.
 ROW_GROUP_ROWS = 1 << 20
 #: Tasks a Dask worker holds per thread (one running, the next ones ready).

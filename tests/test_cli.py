@@ -871,7 +871,7 @@ def test_a_file_output_whose_folder_cannot_be_made_is_one_line_before_any_work(
 def test_full_disk_and_permission_errors_are_one_line(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from solver_service import cli
+    from shared_schema import io
     from solver_service.workflows import outputs
 
     def full(path: object, data: object) -> None:
@@ -890,7 +890,7 @@ def test_full_disk_and_permission_errors_are_one_line(
     def denied(path: object, data: object) -> None:
         raise PermissionError(errno.EACCES, "Permission denied", str(path))
 
-    monkeypatch.setattr(cli, "save_constants", denied)
+    monkeypatch.setattr(io, "save_constants", denied)
     table = tmp_path / "t.csv"
     table.write_text("id,name,p_eq,lam,eta\nW1,wall,2.0,0.2,0.9\n")
     res = runner.invoke(app, ["constants-table", str(table), "-o", str(tmp_path / "c.json")])

@@ -353,12 +353,12 @@ def test_cli_serve_without_the_service_extra_exits_2_with_the_install_line(
 
 def test_cli_names_the_extra_of_a_stray_missing_module(monkeypatch: pytest.MonkeyPatch) -> None:
     # The safety net of the CLI: a heavy import that bypasses require() still gets the line.
-    from solver_service import cli
+    from solver_service.workflows import documents
 
     def boom(*args: object, **kwargs: object) -> None:
         raise ModuleNotFoundError("No module named 'trimesh'", name="trimesh")
 
-    monkeypatch.setattr(cli, "boundary_doc", boom)
+    monkeypatch.setattr(documents, "boundary_doc", boom)
     line = _one_line_error(["boundary", "--omega", "5", "--eta", "0.9"])
     assert line.endswith("pip install 'rockmech[geometry]'") and "trimesh" in line
 

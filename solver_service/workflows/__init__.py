@@ -6,6 +6,8 @@ Each module is named for a domain noun:
   scenes with their specs);
 - ``documents``: JSON-ready documents of every analysis (pulse, record, envelope, boundary,
   history), the ones ``rockmech ... --json`` prints and the service returns;
+- ``pulse``: the pulse analysis, apart so that a pulse loads the exact solver and no more
+  (``documents`` re-exports it);
 - ``scaling``: scale factors of records up the structure and the batched runs that use them;
 - ``outputs``: files written from documents (JSON, CSV, PNG), atomically.
 

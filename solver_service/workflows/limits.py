@@ -46,10 +46,12 @@ import sys
 import threading
 import time
 from collections.abc import Iterable, Iterator
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
-from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
+
+if TYPE_CHECKING:  # annotations only: the command line's --help reads the limits (#38)
+    from shared_schema.constants import ConstantsFile
 
 __all__ = [
     "ASSESS_ENVELOPE",

@@ -6,7 +6,6 @@ matplotlib is imported by ``solver_service.report.plots`` only when a plot is dr
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 from typing import Any, Optional
 
@@ -18,7 +17,7 @@ from shared_schema.constants import ConstantsFile
 from ..ida import ida_csv
 from ..report.plots import plot_envelopes, plot_fragility, plot_ratio_histories, plot_record
 from .documents import envelope_doc, history_doc
-from .units import stamp
+from .units import finite_json, stamp
 
 __all__ = [
     "envelope_csv",
@@ -28,23 +27,6 @@ __all__ = [
     "write_ida",
     "write_record",
 ]
-
-
-def finite_json(value: Any) -> Any:
-    """Replace non-finite floats by None and numpy scalars by Python numbers, recursively.
-
-    ``json.dumps`` never calls ``default`` for floats, so NaN and infinity must be cleaned
-    before serialising (``allow_nan=False`` then guards the result).
-    """
-    if isinstance(value, dict):
-        return {str(k): finite_json(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [finite_json(v) for v in value]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
 
 
 def envelope_csv(doc: dict[str, Any]) -> str:

@@ -6,16 +6,21 @@ of each quantity whose name does not say it (a name ending in ``_g``, ``_s``, ``
 ``_hz`` states its unit itself; ``-`` is dimensionless). The kinematic-constants file
 carries the same two (``ConstantsFile.units``, ``ConstantsFile.rockmech_version``).
 
-``DOCUMENT_UNITS`` is the one home of these blocks; ``stamp`` adds one to a document.
+``DOCUMENT_UNITS`` is the one home of these blocks; ``stamp`` adds one to a document, and
+``finite_json`` makes a document JSON-ready (no NaN, no numpy scalars) before it is printed or
+written.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
+
+import numpy as np
 
 from shared_schema.version import __version__
 
-__all__ = ["DOCUMENT_UNITS", "VERSION_KEY", "stamp"]
+__all__ = ["DOCUMENT_UNITS", "VERSION_KEY", "finite_json", "stamp"]
 
 #: Key of the producing version in every document.
 VERSION_KEY = "rockmech_version"
@@ -123,3 +128,20 @@ def stamp(doc: dict[str, Any], kind: str) -> dict[str, Any]:
     units = {**DOCUMENT_UNITS[kind], **doc.get("units", {})}
     rest = {k: v for k, v in doc.items() if k not in ("units", VERSION_KEY)}
     return {VERSION_KEY: doc.get(VERSION_KEY, __version__), "units": units, **rest}
+
+
+def finite_json(value: Any) -> Any:
+    """Replace non-finite floats by None and numpy scalars by Python numbers, recursively.
+
+    ``json.dumps`` never calls ``default`` for floats, so NaN and infinity must be cleaned
+    before serialising (``allow_nan=False`` then guards the result).
+    """
+    if isinstance(value, dict):
+        return {str(k): finite_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite_json(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value

@@ -1,0 +1,49 @@
+"""The ``rockmech`` command line.
+
+Every command validates its inputs up front; a bad argument exits with status 2 and a
+one-line reason on stderr (``error: <field>: <what is wrong>``), and so does a missing
+optional extra (the message gives its ``pip install 'rockmech[<extra>]'`` line). Results go
+to stdout, warnings, notes and progress to stderr. With ``--json`` a command prints exactly
+one JSON document to stdout. SI units throughout, except where an option name says
+otherwise (``--a-p-g`` is in g); every ``--help`` shows the units in brackets.
+
+The package loads what a command needs: ``errors`` (one-line errors), ``options`` (the
+shared options and option groups), ``output`` (tables, notes, JSON), ``app`` (the typer
+application and ``--version``) and one module per family of commands, each of which imports
+its workflows inside the command's body, when it runs. ``rockmech --help`` and a one-pulse
+``rockmech pulse`` load neither the envelopes, nor scipy.optimize, nor ``cad_maths``, nor
+matplotlib (tests/test_cli_imports.py; docs/benchmarks.md times them).
+"""
+
+from __future__ import annotations
+
+from . import check, envelope, history, ida, pulse, search, tools
+from .app import app
+from .options import MORE_SCALES
+
+__all__ = ["app", "main"]
+
+# The commands, in the order ``rockmech --help`` lists them.
+app.command()(pulse.pulse)
+app.command(context_settings=MORE_SCALES)(history.history)
+app.command("record")(history.record_info)
+app.command()(ida.ida)
+app.command()(search.constants)
+app.command("constants-table")(search.constants_table)
+app.command(context_settings=MORE_SCALES)(envelope.envelope)
+app.command()(pulse.boundary)
+app.add_typer(tools.library_app, name="library")
+tools.library_app.command("build")(tools.library_build)
+app.command()(tools.demo)
+app.command()(tools.examples)
+app.command(context_settings=MORE_SCALES)(envelope.report)
+app.command()(tools.serve)
+app.command()(tools.kernels)
+app.command()(check.check)
+app.command()(check.assess)
+app.command()(search.search)
+
+
+def main() -> None:  # pragma: no cover - console entry point
+    """Entry point of the ``rockmech`` console script."""
+    app()

@@ -1,0 +1,201 @@
+"""``rockmech ida``: incremental dynamic analysis, locally or on a Dask cluster.
+
+The command imports the IDA (``solver_service.ida``: planning, the local and Dask back
+ends) and its writer when it runs.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from shared_schema.extras import require
+from shared_schema.rules import IM_MEASURES, PEAKS_FILE
+
+from ..workflows.rundir import check_folder_target, run_folder
+from .errors import fail, note, user_errors
+from .history import record_size
+from .options import (
+    CONSTANTS_ARG,
+    JSON_OPT,
+    LIMITS,
+    RECORD_OPTIONS,
+    SCALING,
+    Limits,
+    RecordOptions,
+    Scaling,
+    criterion_opt,
+    grouped,
+)
+from .output import choices, g4, out_note, print_json, record_warning, skipped_notes, table
+
+__all__ = ["ida"]
+
+
+@user_errors
+@grouped
+def ida(
+    constants: Path = CONSTANTS_ARG,
+    records: Optional[list[Path]] = typer.Argument(
+        None, help="Record files (any supported format); or --record-spec."
+    ),
+    record_spec: Optional[Path] = typer.Option(
+        None,
+        "--record-spec",
+        help="CSV (columns file, format, units, dt, channel, component) or JSON list of "
+        "records, each with its own options; file names relative to the spec.",
+    ),
+    scales: str = typer.Option(
+        ...,
+        "--scales",
+        help="Intensity levels: a list 0.25,0.5,1,2 or a log range start:stop:n (0.1:3:20).",
+    ),
+    im: str = typer.Option(
+        "scale",
+        "--im",
+        metavar=choices(IM_MEASURES),
+        help="Intensity measure: scale (factor on each record) or pga [g].",
+    ),
+    reading: RecordOptions = RECORD_OPTIONS,
+    scaling: Scaling = SCALING,
+    criterion: Optional[str] = criterion_opt("Overturning verdict: ratio (default) or exact."),
+    scheduler: Optional[str] = typer.Option(
+        None,
+        "--scheduler",
+        help="dask.distributed scheduler address (tcp://host:8786); default: run locally.",
+    ),
+    timeout: float = typer.Option(
+        10.0, "--timeout", help="Seconds to wait for the Dask scheduler to answer [s]."
+    ),
+    jobs: Optional[int] = typer.Option(
+        None, "--jobs", help="Threads of a local run, >= 1 (default: one per usable core)."
+    ),
+    progress: Optional[bool] = typer.Option(
+        None, "--progress/--no-progress", help="Progress bar (default: on a terminal)."
+    ),
+    out: Optional[Path] = typer.Option(
+        None, "--out", help="Folder for ida.json, ida.csv and ida.png (fragility curves)."
+    ),
+    peaks: bool = typer.Option(
+        False,
+        "--peaks",
+        help=f"Also write every run's peak to {PEAKS_FILE} in --out (needs the parquet extra).",
+    ),
+    limits: Limits = LIMITS,
+    as_json: bool = JSON_OPT,
+) -> None:
+    """Incremental dynamic analysis: overturned fraction per intensity and fragility fits."""
+    # long: the progress bar and the summary table
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
+
+    # The IDA, its inputs and its writer are loaded when the command runs (#38).
+    from .. import ida as workflow
+
+    # The solver's own check of a positive number.
+    from ..core.model import check_positive
+
+    # The readers and the writer of the IDA's files.
+    from ..workflows import inputs, outputs, units
+
+    levels = workflow.parse_levels(scales)
+    limits.check(scales=len(levels))
+    if out is not None:
+        check_folder_target(out)
+    if peaks:
+        if out is None:
+            fail(f"peaks: --peaks writes {PEAKS_FILE} into the --out folder; give --out DIR")
+        require("pyarrow.parquet", "parquet", "for ida --peaks")
+    cf = inputs.read_constants(constants, time_domain=True)
+    motions = [reading.read(p) for p in records or []]
+    specs = inputs.read_record_spec(record_spec) if record_spec else []
+    motions += [spec.read(on_warning=record_warning) for spec in specs]
+    if not motions:
+        fail("records: give record files or --record-spec")
+    limits.check(cf, scales=len(levels), record=record_size(motions), records=len(motions))
+    console = Console(stderr=True)
+    show = console.is_terminal if progress is None else progress
+    bar = Progress(
+        "[progress.description]{task.description}",
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        disable=not show,
+        transient=True,
+    )
+    task = bar.add_task("runs", total=None)
+    seen = [0, 0]  # runs done, runs in all
+
+    def advance(done: int, total: int) -> None:
+        seen[:] = [done, total]
+        bar.update(task, completed=done, total=total)
+
+    try:
+        # With --peaks the output folder's stage is open during the run (the peaks stream
+        # into it); a stopped run leaves the folder as it was.
+        with contextlib.ExitStack() as stack:
+            folder = functools.partial(run_folder, on_note=out_note)
+            stage = stack.enter_context(folder(out)) if out is not None and peaks else None
+            with bar:
+                doc = workflow.run_ida(
+                    cf,
+                    motions,
+                    levels,
+                    im=im,
+                    sf=scaling.sf,
+                    building=scaling.building,
+                    criterion=criterion,
+                    scheduler=scheduler,
+                    progress=advance,
+                    timeout=check_positive(timeout, "timeout"),
+                    jobs=jobs,
+                    peaks=None if stage is None else stage / PEAKS_FILE,
+                )
+            if out is not None:
+                stage = stage or stack.enter_context(folder(out))
+                outputs.write_ida(doc, stage, title=f"Fragility: {constants.name}")
+    except KeyboardInterrupt:
+        where = "its tasks on the cluster were cancelled" if scheduler else "no task is left"
+        done = f"{seen[0]} of {seen[1]}" if seen[1] else "0"
+        note(f"interrupted: stopped after {done} runs; {where}; nothing written")
+        raise typer.Exit(code=130) from None
+    skipped_notes(doc)
+    if as_json:
+        print_json(units.stamp(doc, "ida"))
+        return
+    backend = doc["backend"]
+    where = (
+        f"locally on {backend['jobs']} threads"
+        if backend["kind"] == "local"
+        else f"on Dask at {backend['scheduler']} ({backend['threads']} worker threads)"
+    )
+    typer.echo(
+        f"{doc['runs']} runs ({len(motions)} records x {len(levels)} levels x "
+        f"{len(doc['mechanisms'])} mechanisms) {where} in {doc['runtime_s']:.2f} s "
+        f"({backend['tasks']} tasks, overhead {100 * backend['overhead_fraction']:.1f} % of "
+        f"task time); largest error estimate {doc['max_error_estimate']:.1e}"
+    )
+    if backend.get("settings_differ"):
+        note(
+            "note: the Dask workers run without rockmech's settings, which keep Dask's own "
+            f"background work off the cores ({'; '.join(backend['settings_differ'])}); "
+            'see docs/cluster.md, "Dask\'s settings"'
+        )
+    unit = doc["intensity"]["units"]
+    rows, notes = [], []
+    for mech in doc["mechanisms"]:
+        fit = mech["fragility"]
+        rows.append([str(mech["id"]), g4(fit.get("median")), g4(fit.get("beta"))])
+        if "note" in fit:
+            notes.append(f"  {mech['id']}: {fit['note']}")
+    for line in table(["mechanism", f"median [{unit}]", "beta [-]"], rows) + notes:
+        typer.echo(line)
+    if out is not None:
+        typer.echo(
+            f"wrote {out / 'ida.json'}, ida.csv, ida.png" + (f", {PEAKS_FILE}" if peaks else "")
+        )

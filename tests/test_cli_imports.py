@@ -1,0 +1,82 @@
+"""The command line loads what the command needs (issue #38).
+
+Each case runs the typer app in a fresh interpreter, in-process there, and then reads that
+interpreter's ``sys.modules``: ``rockmech --help``, ``--version`` and a one-pulse ``rockmech
+pulse`` must not load scipy.optimize (the envelopes' root finders), ``cad_maths`` (the CAD
+readers and the search) or matplotlib (the plots). A command that needs them still loads
+them when it runs, which the last cases check, so that the probe can see a heavy import.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+#: Packages the light commands must not load (a module or any of its submodules).
+HEAVY = ("scipy.optimize", "cad_maths", "matplotlib")
+#: One two-sided pulse (eta given: a two-sided pulse without one is refused).
+PULSE = ["pulse", "--p-eq", "2", "--lam", "0.2", "--a-p-g", "0.3", "--f-p", "1", "--eta", "0.9"]
+
+# Runs the app on argv in this fresh interpreter, then prints its exit code and, as JSON,
+# the loaded modules that are one of HEAVY or inside one.
+PROBE = """
+import json, sys
+from solver_service.cli import app
+try:
+    app(sys.argv[1:], prog_name="rockmech")
+    code = 0
+except SystemExit as exc:
+    code = exc.code
+heavy = sorted(m for m in sys.modules for h in HEAVY if m == h or m.startswith(h + "."))
+print(json.dumps({"code": code, "heavy": heavy}), file=sys.stderr)
+"""
+
+
+def _loaded(argv: list[str], cwd: Path = ROOT) -> tuple[int, list[str], str]:
+    """Run ``rockmech argv`` in a fresh interpreter: exit code, heavy modules, stdout."""
+    code = f"HEAVY = {HEAVY!r}\n" + PROBE
+    res = subprocess.run(
+        [sys.executable, "-c", code, *argv], capture_output=True, text=True, cwd=cwd
+    )
+    last = res.stderr.strip().splitlines()[-1]
+    found = json.loads(last)
+    return found["code"], found["heavy"], res.stdout
+
+
+@pytest.mark.parametrize(
+    "argv", [["--help"], ["--version"], PULSE], ids=["help", "version", "pulse"]
+)
+def test_light_commands_load_no_optimiser_cad_or_plotting(argv: list[str]) -> None:
+    code, heavy, stdout = _loaded(argv)
+    assert code == 0, stdout
+    assert stdout.strip(), "the command printed nothing"
+    assert heavy == []
+
+
+def test_the_pulse_command_still_answers() -> None:
+    # p_eq = 2 rad/s, lam = 0.2, a_p = 0.3 g at 1 Hz: Omega = 2 pi / 2 = pi and A = 0.3 / 0.2.
+    code, _, stdout = _loaded(PULSE)
+    assert code == 0
+    assert "Omega = 3.142, A = 1.5" in stdout
+
+
+def test_the_probe_sees_a_command_that_loads_the_envelopes() -> None:
+    # rockmech boundary needs the envelopes' boundary (scipy.optimize's root finders).
+    code, heavy, stdout = _loaded(["boundary", "--omega", "5", "--eta", "0.9"])
+    assert code == 0, stdout
+    assert "scipy.optimize" in heavy
+
+
+def test_the_probe_sees_a_command_that_loads_the_cad_readers(tmp_path: Path) -> None:
+    # rockmech constants reads the scene with cad_maths; the refusal of a missing file comes
+    # after its readers are loaded.
+    argv = ["constants", "missing.3dm", "missing.json", "-o", "c.json"]
+    code, heavy, _ = _loaded(argv, cwd=tmp_path)
+    assert code == 2
+    assert any(m == "cad_maths" or m.startswith("cad_maths.") for m in heavy)
+    assert list(tmp_path.iterdir()) == []
