@@ -38,6 +38,7 @@ from shared_schema.paths import PATH_TYPES, PathLike, as_path
 from shared_schema.rules import check_positive
 
 from ..core.model import G
+from ..core.records import GroundMotion
 from ..core.spectra import response_spectrum
 from ..workflows.documents import envelope_doc, history_doc
 from ..workflows.scaling import Building, dense_runs
@@ -507,7 +508,6 @@ def build_report(
 def _report_inputs(cf: Any, motion: Any) -> tuple[ConstantsFile, Any]:
     """Return the constants and the record of a report, read where given as paths."""
     # read here, not at import: the readers pull in the scene readers (cad_maths)
-    from ..core.records import GroundMotion
     from ..workflows.inputs import read_constants, read_record
 
     if not isinstance(cf, ConstantsFile):
