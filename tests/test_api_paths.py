@@ -104,9 +104,7 @@ READERS = [
         lambda p: rockmech.history(p, RECORD, scales=[1.0]),
         "constants",
     ),
-    Slot(
-        "history", "record", RECORD, lambda p: rockmech.history(WALLS, p, scales=[1.0]), "record"
-    ),
+    Slot("history", "record", RECORD, lambda p: rockmech.history(WALLS, p, scales=[1.0]), "record"),
     Slot("envelope", "constants", WALLS, lambda p: rockmech.envelope(p, n=3), "constants"),
     Slot(
         "ida",
