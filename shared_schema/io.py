@@ -101,7 +101,7 @@ def save_constants(path: PathLike, model: ConstantsFile) -> None:
     target = as_path(path, "path")
     text = stamped(model).model_dump_json(indent=2, exclude_none=True) + "\n"
     if target.is_dir():
-        raise InputError("is a folder, not a constants file", str(target))
+        raise InputError("cannot write constants file: it is a folder", str(target))
     try:
         write_atomic(target, text)
     except OSError as exc:

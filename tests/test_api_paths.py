@@ -299,7 +299,9 @@ def test_writers_take_str_targets(tmp_path: Path) -> None:
 
 def test_writers_refuse_a_folder_for_a_file_and_a_non_path(tmp_path: Path) -> None:
     cf = rockmech.read_constants(WALLS)
-    with pytest.raises(rockmech.InputError, match="is a folder, not a constants file") as info:
+    with pytest.raises(
+        rockmech.InputError, match="cannot write constants file: it is a folder"
+    ) as info:
         rockmech.save_constants(str(tmp_path), cf)
     assert info.value.field == str(tmp_path)
     with pytest.raises(rockmech.InputError, match=r"^path: is a folder, not a file: "):
