@@ -15,6 +15,7 @@ from cad_maths.scene_3dm import Scene
 from cad_maths.scene_base import BaseScene
 from cad_maths.scene_mesh import SCAN_FORMATS, MeshScene, unit_ratio
 from shared_schema.errors import InputError
+from shared_schema.paths import readable_file
 
 __all__ = ["SCENE_FORMATS", "read_scene"]
 
@@ -22,6 +23,8 @@ __all__ = ["SCENE_FORMATS", "read_scene"]
 SCENE_FORMATS = ("3dm", *SCAN_FORMATS)
 #: Model-unit names of a .3dm file saved without units (read as metres by default).
 UNITLESS_3DM = ("none", "unset")
+#: What :func:`read_scene` reads, in words, for the message on anything else.
+SCENE_SOURCES = "a path (str or os.PathLike, e.g. pathlib.Path) or the file's bytes"
 
 
 def read_scene(
@@ -54,8 +57,9 @@ def read_scene(
     Raises
     ------
     InputError
-        Unknown format, unreadable file (field ``"scene"``), or missing, unknown or
-        contradicting ``units`` (field ``"units"``).
+        Unknown format; a missing file, a folder, an unreadable file or a ``source`` that is
+        neither a path (``str``, ``os.PathLike``) nor bytes (field ``"scene"``, naming the
+        path); or missing, unknown or contradicting ``units`` (field ``"units"``).
 
     Examples
     --------
@@ -70,7 +74,8 @@ def read_scene(
             raise InputError("a scene given as bytes needs its file name", "scene")
         label = name
     else:
-        label = name or os.fspath(source)
+        source = readable_file(source, "scene", SCENE_SOURCES)
+        label = name or str(source)
     ext = os.path.splitext(label)[1].lower().lstrip(".")
     if ext not in SCENE_FORMATS:
         raise InputError(

@@ -3,19 +3,21 @@
 Every function calls the workflow the command line and the REST service call, so a script,
 the command line and the service give the same numbers; each returns a typed result
 (``rockmech.results``) that keeps the command's whole JSON document in ``doc``. Inputs may
-be given as objects (``ConstantsFile``, ``GroundMotion``, ``SiteFile``) or as file paths.
+be given as objects (``ConstantsFile``, ``GroundMotion``, ``SiteFile``) or as file paths,
+each a ``str`` or an ``os.PathLike`` (``pathlib.Path``); a missing file, a folder or an
+argument of another type is an ``InputError`` naming the argument (and the path).
 
 SI units, except where a name says otherwise (``a_p_g`` in g).
 """
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
-from pathlib import Path
 from typing import Any, Optional, Union
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.errors import InputError
+from shared_schema.paths import PATH_TYPES, PathLike, as_path, is_path
 from shared_schema.retrofit import RetrofitDoc, RetrofitSpec, read_retrofit_spec
 from shared_schema.site import SiteFile
 from solver_service.core.exact import simulate
@@ -51,8 +53,6 @@ __all__ = [
     "retrofit",
 ]
 
-#: A file path, as a string or a ``Path``.
-PathLike = Union[str, "os.PathLike[str]"]
 #: Constants given as an object or as a file (JSON, or a ``.csv``/``.xlsx`` table).
 Constants = Union[ConstantsFile, PathLike]
 #: A record given as an object or as a file (format detected; a two-column file in g).
@@ -74,7 +74,7 @@ def read_constants(path: PathLike) -> ConstantsFile:
         Every mechanism with its constants per side (``mech.positive.p_eq`` [rad/s],
         ``.lam`` [-], ``.phi_ov`` [rad]).
     """
-    return _inputs.read_constants(Path(path))
+    return _inputs.read_constants(as_path(path, "constants"))
 
 
 def constants_from_table(path: PathLike) -> ConstantsFile:
@@ -90,7 +90,7 @@ def constants_from_table(path: PathLike) -> ConstantsFile:
     -------
     ConstantsFile
     """
-    return _tables.constants_from_table(Path(path))
+    return _tables.constants_from_table(as_path(path, "table"))
 
 
 def constants_from_scene(
@@ -113,11 +113,13 @@ def constants_from_scene(
     -------
     ConstantsFile
     """
-    return _inputs.constants_from_files(Path(scene), Path(spec), units)
+    return _inputs.constants_from_files(as_path(scene, "scene"), as_path(spec, "spec"), units)
 
 
 def _constants(constants: Constants) -> ConstantsFile:
-    return constants if isinstance(constants, ConstantsFile) else read_constants(constants)
+    if isinstance(constants, ConstantsFile):
+        return constants
+    return read_constants(as_path(constants, "constants", "a ConstantsFile or " + PATH_TYPES))
 
 
 def load_models(constants: Constants) -> list[RockingModel]:
@@ -167,11 +169,24 @@ def read_record(
     GroundMotion
         ``accel`` [m/s²] at ``dt`` [s]; ``pga_g`` [g]; ``warnings`` (implausible values).
     """
-    return _inputs.read_record(Path(path), format, units, dt, channel, component)
+    return _inputs.read_record(as_path(path, "record"), format, units, dt, channel, component)
 
 
-def _record(record: Record) -> GroundMotion:
-    return record if isinstance(record, GroundMotion) else read_record(record)
+def _record(record: Record, field: str = "record") -> GroundMotion:
+    if isinstance(record, GroundMotion):
+        return record
+    return read_record(as_path(record, field, "a GroundMotion or " + PATH_TYPES))
+
+
+def _records(records: Sequence[Record]) -> list[GroundMotion]:
+    # one path (a str is a sequence of characters) or one record where a list belongs
+    if is_path(records) or isinstance(records, GroundMotion):
+        raise InputError(
+            "must be a sequence of records (GroundMotion objects or paths), got one record; "
+            "give a list of it ([record])",
+            "records",
+        )
+    return [_record(r, f"records[{k}]") for k, r in enumerate(records)]
 
 
 def read_site(path: PathLike) -> SiteFile:
@@ -186,11 +201,13 @@ def read_site(path: PathLike) -> SiteFile:
     -------
     SiteFile
     """
-    return _assess.read_site(Path(path))
+    return _assess.read_site(as_path(path, "site"))
 
 
 def _site(site: Union[SiteFile, PathLike]) -> SiteFile:
-    return site if isinstance(site, SiteFile) else read_site(site)
+    if isinstance(site, SiteFile):
+        return site
+    return read_site(as_path(site, "site", "a SiteFile or " + PATH_TYPES))
 
 
 def pulse(
@@ -352,7 +369,7 @@ def ida(
     """
     doc = run_ida(
         _constants(constants),
-        [_record(r) for r in records],
+        _records(records),
         [float(v) for v in levels],
         im=im,
         sf=sf,
@@ -414,7 +431,7 @@ def assess(
         The checks (as ``check``), and per mechanism ``survives_design`` and
         ``first_overturning_multiple`` [-].
     """
-    motions: list[Any] = [_record(r) for r in records]
+    motions: list[Any] = list(_records(records))
     doc = _assess.assessment_doc(
         _constants(constants),
         _site(site),
@@ -449,5 +466,9 @@ def retrofit(
         ``anchorage`` check, the steel mass [kg] and the checks ``after`` (docs/theory.md
         §11.12).
     """
-    rspec = spec if isinstance(spec, RetrofitSpec) else read_retrofit_spec(Path(spec))
+    rspec = (
+        spec
+        if isinstance(spec, RetrofitSpec)
+        else read_retrofit_spec(as_path(spec, "spec", "a RetrofitSpec or " + PATH_TYPES))
+    )
     return retrofit_doc(_constants(constants), _site(site), rspec)

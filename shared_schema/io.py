@@ -6,12 +6,10 @@ Errors are ``InputError`` and name the file; validation errors also name the mec
 (index and id) and the field.
 """
 
-import os
-from pathlib import Path
-
-from shared_schema.atomic import PathLike, write_atomic
+from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile, parse_constants
 from shared_schema.errors import InputError
+from shared_schema.paths import PathLike, as_path
 from shared_schema.text import decode_text
 from shared_schema.version import __version__
 
@@ -49,11 +47,14 @@ def load_constants(path: PathLike) -> ConstantsFile:
     Raises
     ------
     InputError
-        If the file is missing, unreadable, empty or binary, is not JSON, or holds invalid
-        values. The message starts with the file name; for invalid values it then names the
+        If the path is not a ``str`` or ``os.PathLike`` (field ``constants``), or the file is
+        missing, a folder, unreadable, empty or binary, is not JSON, or holds invalid values.
+        The message starts with the file name; for invalid values it then names the
         mechanism and the field, e.g. ``walls.json: mechanisms[1] (id 'W2').positive.p_eq: ...``.
     """
-    file = Path(path)
+    file = as_path(path, "constants")
+    if file.is_dir():
+        raise InputError("is a folder, not a constants file", str(file))
     try:
         raw = file.read_bytes()
     except FileNotFoundError:
@@ -89,17 +90,21 @@ def save_constants(path: PathLike, model: ConstantsFile) -> None:
     Raises
     ------
     InputError
-        If the file cannot be written (e.g. its directory does not exist).
+        If the path is not a ``str`` or ``os.PathLike`` (field ``path``), or the file cannot
+        be written (e.g. its directory does not exist, or it is a folder).
 
     Notes
     -----
     The JSON is built completely before anything is written, so a serialisation error
     leaves the previous file untouched. Output: indent 2, UTF-8, trailing newline.
     """
+    target = as_path(path, "path")
     text = stamped(model).model_dump_json(indent=2, exclude_none=True) + "\n"
+    if target.is_dir():
+        raise InputError("cannot write constants file: it is a folder", str(target))
     try:
-        write_atomic(path, text)
+        write_atomic(target, text)
     except OSError as exc:
         raise InputError(
-            f"cannot write constants file: {exc.strerror or exc}", os.fspath(path)
+            f"cannot write constants file: {exc.strerror or exc}", str(target)
         ) from exc

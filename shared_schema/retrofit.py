@@ -25,6 +25,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from shared_schema.constants import input_error_from_validation, json_document
 from shared_schema.errors import InputError
+from shared_schema.paths import readable_file
 from shared_schema.text import decode_text
 
 __all__ = [
@@ -258,8 +259,8 @@ def parse_retrofit_spec(source: Union[str, bytes, Mapping[str, Any]]) -> Retrofi
 
 
 def read_retrofit_spec(path: Union[str, "Path"]) -> RetrofitSpec:
-    """Read and validate a retrofit spec file (JSON)."""
-    p = Path(path)
+    """Read and validate a retrofit spec file (JSON): a ``str`` or ``os.PathLike``."""
+    p = readable_file(path, "retrofit")
     try:
         raw = p.read_bytes()
     except OSError as exc:

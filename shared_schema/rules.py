@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Dict, NamedTuple, Optional, Sequence, Tuple, Union
 
 from shared_schema.errors import InputError
+from shared_schema.paths import readable_file
 
 __all__ = [
     "ACCEL_MAX_G",
@@ -408,14 +409,10 @@ def check_non_negative(value: object, name: str) -> float:
 def check_file(path: Union[str, "os.PathLike[str]"], label: str) -> Path:
     """Return ``path`` as a Path if it names a readable file; raise ``InputError`` naming ``label``.
 
-    A folder is reported as a folder, not as a missing file.
+    ``shared_schema.paths.readable_file``: a ``str`` or ``os.PathLike``; a folder is reported
+    as a folder, not as a missing file, and anything but a path as the type it is.
     """
-    p = Path(path)
-    if p.is_dir():
-        raise InputError(f"is a folder, not a file: {p}", label)
-    if not p.is_file():
-        raise InputError(f"file not found: {p}", label)
-    return p
+    return readable_file(path, label)
 
 
 def check_choice(value: object, choices: Tuple[str, ...], name: str) -> str:

@@ -30,6 +30,7 @@ from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 from shared_schema.extras import MissingExtra
 from shared_schema.io import load_constants, save_constants
+from shared_schema.paths import PathLike, as_path
 
 from .core.model import G
 from .core.records import GroundMotion
@@ -78,7 +79,7 @@ _NOT_EXAMPLES = ("*.py", "*.pyc")
 
 
 def copy_examples(
-    dest: Path = Path("examples"), on_note: Optional[Callable[[str], None]] = None
+    dest: PathLike = Path("examples"), on_note: Optional[Callable[[str], None]] = None
 ) -> list[Path]:
     """Copy the bundled examples into ``dest``, so that the README's commands run from a wheel.
 
@@ -90,7 +91,7 @@ def copy_examples(
 
     Parameters
     ----------
-    dest : Path
+    dest : str or os.PathLike
         The folder to copy into (created if missing).
     on_note : callable, optional
         Called with each note of the output folder (``run_folder``).
@@ -100,6 +101,7 @@ def copy_examples(
     list of Path
         The files written, under ``dest``.
     """
+    dest = as_path(dest, "dest")
     source = examples_dir()
     files = sorted(
         p
@@ -113,7 +115,7 @@ def copy_examples(
             target = stage / path.relative_to(source)
             target.parent.mkdir(parents=True, exist_ok=True)
             target.write_bytes(path.read_bytes())
-    return [Path(dest) / path.relative_to(source) for path in files]
+    return [dest / path.relative_to(source) for path in files]
 
 
 #: The bundled examples folder (see ``examples_dir``).

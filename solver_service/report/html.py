@@ -27,15 +27,18 @@ import platform
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Optional, Union
+from typing import Any, Optional
 
 import numpy as np
 
 from shared_schema.atomic import write_atomic
+from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError, RockmechError
+from shared_schema.paths import PATH_TYPES, PathLike, as_path
 from shared_schema.rules import check_positive
 
 from ..core.model import G
+from ..core.records import GroundMotion
 from ..core.spectra import response_spectrum
 from ..workflows.documents import envelope_doc, history_doc
 from ..workflows.scaling import Building, dense_runs
@@ -415,12 +418,13 @@ def build_report(
 
     Parameters
     ----------
-    cf : ConstantsFile
-        The mechanisms.
+    cf : ConstantsFile, str or os.PathLike
+        The mechanisms, or a constants file or table to read (``read_constants``).
     f_p : (n,) float
         Pulse frequencies of the envelopes [Hz].
-    motion : GroundMotion, optional
-        A record: adds its spectrum and the time histories.
+    motion : GroundMotion, str or os.PathLike, optional
+        A record, or a record file to read (``read_record``'s defaults): adds its spectrum
+        and the time histories.
     scales : sequence of float
         Scale factors on the record [-].
     history : dict, optional
@@ -446,8 +450,10 @@ def build_report(
     ------
     InputError
         Invalid history options, or options given without a record
-        (``check_history_options``).
+        (``check_history_options``); a file that cannot be read, or a ``cf`` or ``motion``
+        of another type (naming it).
     """
+    cf, motion = _report_inputs(cf, motion)
     check_history_options(scales, history, motion)
     env, envelopes = envelope_doc(cf, np.asarray(f_p, dtype=float), method=method, library=library)
     hist = None
@@ -499,9 +505,40 @@ def build_report(
     )
 
 
-def write_report(path: Union[str, Path], text: str) -> Path:
-    """Write the report atomically and return its path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_atomic(path, text)
-    return path
+def _report_inputs(cf: Any, motion: Any) -> tuple[ConstantsFile, Any]:
+    """Return the constants and the record of a report, read where given as paths."""
+    # read here, not at import: the readers pull in the scene readers (cad_maths)
+    from ..workflows.inputs import read_constants, read_record
+
+    if not isinstance(cf, ConstantsFile):
+        cf = read_constants(as_path(cf, "cf", "a ConstantsFile or " + PATH_TYPES))
+    if motion is not None and not isinstance(motion, GroundMotion):
+        motion = read_record(as_path(motion, "motion", "a GroundMotion or " + PATH_TYPES))
+    return cf, motion
+
+
+def write_report(path: PathLike, text: str) -> Path:
+    """Write the report atomically and return its path.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The HTML file (its folder is created if missing); it is replaced atomically.
+    text : str
+        The page (``build_report``).
+
+    Raises
+    ------
+    InputError
+        ``path`` is not a ``str`` or ``os.PathLike``, is a folder, or cannot be written
+        (field ``path``, naming it).
+    """
+    target = as_path(path, "path")
+    if target.is_dir():
+        raise InputError(f"is a folder, not a file: {target}", "path")
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        write_atomic(target, text)
+    except OSError as exc:
+        raise InputError(f"cannot write {target}: {exc.strerror or exc}", "path") from None
+    return target

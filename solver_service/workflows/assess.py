@@ -12,7 +12,6 @@ note in its row; it never stops the others.
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Any, Optional, Sequence
 
 import numpy as np
@@ -20,6 +19,7 @@ import numpy as np
 from shared_schema.api import MAX_ASSESS_MULTIPLES, MULTIPLE_MAX
 from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError, RockmechError
+from shared_schema.paths import PathLike
 from shared_schema.rules import check_number
 from shared_schema.site import SiteFile
 
@@ -64,7 +64,7 @@ BAND_LOW, BAND_HIGH = 0.5, 1.5
 BAND_POINTS = 40
 
 
-def read_site(path: Path) -> SiteFile:
+def read_site(path: PathLike) -> SiteFile:
     """Read and validate a site file (``inputs.read_site_file``); errors name ``site``."""
     return read_site_file(path)
 

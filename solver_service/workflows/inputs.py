@@ -20,6 +20,7 @@ from shared_schema.api import time_domain_problem
 from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.io import load_constants
+from shared_schema.paths import PathLike, as_path
 from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, check_file, check_positive
 from shared_schema.site import SITE_EXPECTED, SiteFile, site_from_text
 from shared_schema.spec import parse_spec
@@ -46,7 +47,7 @@ SPEC_FIELDS = ("file", "format", "units", "dt", "channel", "component")
 
 
 def read_record(
-    path: Path,
+    path: PathLike,
     fmt: Optional[str] = None,
     units: Optional[str] = None,
     dt: Optional[float] = None,
@@ -64,7 +65,7 @@ def read_record(
 
     Parameters
     ----------
-    path : Path
+    path : str or os.PathLike
         The record file.
     fmt, units, dt, channel, component
         As ``GroundMotion.from_file``; ``units`` defaults to g for a two-column file (the
@@ -73,6 +74,7 @@ def read_record(
     on_warning : callable, optional
         Called with each warning (the CLI prints ``warning: record: ...`` on stderr).
     """
+    path = as_path(path, "record")
     fmt = fmt or detect_format(path)
     if units is None and fmt == "two_column":
         units = "g"
@@ -135,12 +137,12 @@ def _spec_rows(path: Path, text: str) -> list[tuple[str, dict[str, Any]]]:
     return out
 
 
-def read_record_spec(path: Path) -> list[RecordSpec]:
+def read_record_spec(path: PathLike) -> list[RecordSpec]:
     """Read a list of records, each with its own format, units, dt, channel or component.
 
     Parameters
     ----------
-    path : Path
+    path : str or os.PathLike
         A CSV file with a header row naming some of ``SPEC_FIELDS`` (``file`` required;
         empty cells mean "detect" or "not given"), or a JSON list of objects with those
         keys. Relative file names are taken from the spec's folder.
@@ -151,7 +153,7 @@ def read_record_spec(path: Path) -> list[RecordSpec]:
         An unknown column or key, a row without ``file``, a ``dt`` that is not a positive
         number, or an unknown format or units; the message names the row and the column.
     """
-    check_file(path, "record_spec")
+    path = check_file(path, "record_spec")
     text = decode_text(path.read_bytes(), path.name, "record_spec", RECORD_SPEC_EXPECTED)
     rows = _spec_rows(path, text)
     if not rows:
@@ -271,12 +273,12 @@ def _wrong_file(path: Path, expected: str, where: str) -> Optional[InputError]:
     )
 
 
-def read_constants(path: Path, *, time_domain: bool = False) -> ConstantsFile:
+def read_constants(path: PathLike, *, time_domain: bool = False) -> ConstantsFile:
     """Read and validate a kinematic-constants file, or a constants table (``.csv``, ``.xlsx``).
 
     Parameters
     ----------
-    path : Path
+    path : str or os.PathLike
         The file.
     time_domain : bool
         Also hold every mechanism to the ranges of a time-domain analysis (each side's
@@ -290,7 +292,7 @@ def read_constants(path: Path, *, time_domain: bool = False) -> ConstantsFile:
         ``solver_service.workflows.tables``). A site file, spec or scene given instead is
         named as such (the arguments were swapped).
     """
-    check_file(path, "constants")
+    path = check_file(path, "constants")
     if is_table(path):
         return constants_from_table(path, time_domain=time_domain)
     try:
@@ -309,13 +311,13 @@ def read_constants(path: Path, *, time_domain: bool = False) -> ConstantsFile:
     return cf
 
 
-def read_site_file(path: Path) -> SiteFile:
+def read_site_file(path: PathLike) -> SiteFile:
     """Read and validate a site file (``shared_schema.site.read_site``); field ``site``.
 
     A constants file or another of rockmech's inputs given instead is named as such (the
     arguments of ``check`` or ``assess`` were swapped).
     """
-    check_file(path, "site")
+    path = check_file(path, "site")
     text = decode_text(path.read_bytes(), path.name, "site", SITE_EXPECTED)
     try:
         return site_from_text(text, path.name)
@@ -334,9 +336,12 @@ def read_site_file(path: Path) -> SiteFile:
 SPEC_EXPECTED = 'a mechanism spec (JSON, {"mechanisms": [...]})'
 
 
-def _spec_and_scene(scene: Path, spec: Path, units: Optional[str]) -> tuple[Any, Any]:
-    for label, path in (("scene", scene), ("spec", spec)):
-        check_file(path, label)
+def _spec_and_scene(
+    scene_path: PathLike, spec_path: PathLike, units: Optional[str]
+) -> tuple[Path, Path, Any, Any]:
+    """Check and read a scene and its spec: ``(scene path, spec path, spec, scene)``."""
+    scene = check_file(scene_path, "scene")
+    spec = check_file(spec_path, "spec")
     scene_is_json = scene.suffix.lower() == ".json"
     if spec.suffix.lower().lstrip(".") in SCENE_FORMATS:
         where = (
@@ -354,39 +359,44 @@ def _spec_and_scene(scene: Path, spec: Path, units: Optional[str]) -> tuple[Any,
             "scene",
         )
     text = decode_text(spec.read_bytes(), spec.name, "spec", SPEC_EXPECTED)
-    return parse_spec(text, spec.name), read_scene(scene, units=units)
+    return scene, spec, parse_spec(text, spec.name), read_scene(scene, units=units)
 
 
-def constants_from_files(scene: Path, spec: Path, units: Optional[str] = None) -> ConstantsFile:
+def constants_from_files(
+    scene: PathLike, spec: PathLike, units: Optional[str] = None
+) -> ConstantsFile:
     """Kinematic constants of every mechanism of a spec file from the solids of a scene file.
 
     Parameters
     ----------
-    scene : Path
+    scene : str or os.PathLike
         Rhino ``.3dm`` file (read with rhino3dm) or a scan mesh (``.ply``, ``.obj``, ``.stl``,
         ``.off``, read with trimesh; ``cad_maths.scenes.read_scene``).
-    spec : Path
+    spec : str or os.PathLike
         Mechanism spec (JSON); relative paths inside it are taken from its folder.
     units : {"mm", "cm", "m", "in", "ft"}, optional
         Length unit of a scan mesh (required there; a ``.3dm`` states its own).
 
     Raises
     ------
+    InputError
+        A missing or unreadable scene or spec (field ``scene`` or ``spec``, naming the path),
+        or a path that is not a ``str`` or ``os.PathLike``.
     RockmechError
         If any mechanism fails; the message lists every failed mechanism.
     """
-    spec_file, scene_obj = _spec_and_scene(scene, spec, units)
+    scene_file, spec_path, spec_file, scene_obj = _spec_and_scene(scene, spec, units)
     return constants_from_spec(
         spec_file,
         scene_obj,
-        scene_name=scene.name,
-        spec_name=spec.name,
-        spec_dir=spec.parent,
+        scene_name=scene_file.name,
+        spec_name=spec_path.name,
+        spec_dir=spec_path.parent,
     )
 
 
 def constants_keep_going(
-    scene: Path, spec: Path, units: Optional[str] = None
+    scene: PathLike, spec: PathLike, units: Optional[str] = None
 ) -> tuple[ConstantsFile, list[MechanismFailure]]:
     """Like ``constants_from_files``, but keep the mechanisms that succeed.
 
@@ -402,13 +412,13 @@ def constants_keep_going(
     RockmechError
         If the files cannot be read, or if every mechanism fails (nothing to write).
     """
-    spec_file, scene_obj = _spec_and_scene(scene, spec, units)
+    scene_file, spec_path, spec_file, scene_obj = _spec_and_scene(scene, spec, units)
     cf, failures = constants_and_failures(
         spec_file,
         scene_obj,
-        scene_name=scene.name,
-        spec_name=spec.name,
-        spec_dir=spec.parent,
+        scene_name=scene_file.name,
+        spec_name=spec_path.name,
+        spec_dir=spec_path.parent,
     )
     if cf is None:
         raise failures_error(failures, len(spec_file.mechanisms))

@@ -35,6 +35,7 @@ from typing import Any, Optional, Sequence, Union
 import numpy as np
 
 from cad_maths.mechanisms.build import MechanismFailure
+from cad_maths.scene_base import BaseScene
 from cad_maths.scenes import read_scene
 from cad_maths.search.engine import (
     MISSED_GAP,
@@ -51,8 +52,10 @@ from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import require
 from shared_schema.io import save_constants, stamped
+from shared_schema.paths import PATH_TYPES, PathLike, as_path, is_path
 from shared_schema.rules import check_file
 from shared_schema.search import SearchSpec, parse_search_spec
+from shared_schema.site import SiteFile
 from shared_schema.spec import SpecFile
 from shared_schema.text import decode_text
 from shared_schema.version import __version__
@@ -60,6 +63,7 @@ from shared_schema.version import __version__
 from ..core.envelope import OverturningLibrary
 from ..core.exact import simulate, simulate_batch
 from ..core.floor_spectra import participation_first_mode
+from ..core.records import GroundMotion
 from ..report.search_figure import plot_search
 from .adapter import to_rocking_model
 from .assess import check_doc, read_site
@@ -126,13 +130,19 @@ class SearchRun:
 SEARCH_SPEC_EXPECTED = 'a search spec (JSON, {"walls": [...], "levels": [...], ...})'
 
 
-def read_search_spec(path: Path) -> SearchSpec:
+def read_search_spec(path: PathLike) -> SearchSpec:
     """Read and validate a search spec file; errors name the spec and the field.
 
     An empty, binary (gzip, a workbook) or non-UTF-8 file is told as such, naming the file
-    (``shared_schema.text.decode_text``; issue #36), as every other input file.
+    (``shared_schema.text.decode_text``; issue #36), as every other input file; a missing
+    file or a folder names the path (field ``spec``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The search spec (JSON).
     """
-    check_file(path, "spec")
+    path = check_file(path, "spec")
     text = decode_text(path.read_bytes(), path.name, "spec", SEARCH_SPEC_EXPECTED)
     try:
         json_document(text)  # malformed JSON: one line
@@ -771,13 +781,74 @@ def _height_assumption(info: dict[str, Any]) -> str:
     )
 
 
+def _search_spec(spec: Any, source: str) -> SearchSpec:
+    """Return a search spec given as a ``SearchSpec`` or a dict (validated as a file is)."""
+    if isinstance(spec, SearchSpec):
+        return spec
+    if isinstance(spec, dict):
+        try:
+            text = json.dumps(spec, allow_nan=False)
+        except (TypeError, ValueError) as exc:
+            raise InputError(
+                f"a spec given as a dict holds JSON values only: {exc}", "spec"
+            ) from None
+        return parse_search_spec(text, source)
+    hint = "; read a file with rockmech.read_search_spec(path)" if is_path(spec) else ""
+    raise InputError(
+        f"must be a SearchSpec or a dict of its fields, got {type(spec).__name__}{hint}", "spec"
+    )
+
+
+def _scene_object(scene: Any) -> BaseScene:
+    """Return ``scene`` if it is a scene read by ``read_scene``; else say what to pass."""
+    if isinstance(scene, BaseScene):
+        return scene
+    hint = (
+        "; read the file with rockmech.read_scene(path), or search files with "
+        "rockmech.search_from_files(scene, spec)"
+        if is_path(scene)
+        else ""
+    )
+    raise InputError(
+        f"must be a scene (rockmech.read_scene), got {type(scene).__name__}{hint}", "scene"
+    )
+
+
+def _site_object(site: Any, field_name: str) -> Any:
+    """Return a site given as a ``SiteFile``, or read it from a site file's path."""
+    if site is None or isinstance(site, SiteFile):
+        return site
+    return read_site(as_path(site, field_name, "a SiteFile or " + PATH_TYPES))
+
+
+def _motion_objects(motions: Any, field_name: str) -> Optional[list[Any]]:
+    """Return records given as ``GroundMotion`` objects, or read them from their paths."""
+    if motions is None:
+        return None
+    if is_path(motions) or isinstance(motions, GroundMotion):
+        raise InputError(
+            "must be a sequence of records (GroundMotion objects or paths), got one record; "
+            "give a list of it ([record])",
+            field_name,
+        )
+    out = []
+    for k, m in enumerate(motions):
+        where = f"{field_name}[{k}]"
+        out.append(
+            m
+            if isinstance(m, GroundMotion)
+            else read_record(as_path(m, where, "a GroundMotion or " + PATH_TYPES))
+        )
+    return out
+
+
 def search_run(
     scene: Any,
-    spec: SearchSpec,
+    spec: Union[SearchSpec, dict[str, Any]],
     *,
     scene_name: str = "scene",
     spec_name: str = "search spec",
-    spec_dir: Optional[Path] = None,
+    spec_dir: Optional[PathLike] = None,
     site: Any = None,
     motions: Optional[Sequence[Any]] = None,
     exact: bool = False,
@@ -792,15 +863,16 @@ def search_run(
     ----------
     scene : BaseScene
         The scene (``cad_maths.scenes.read_scene``).
-    spec : SearchSpec
-        The search spec.
+    spec : SearchSpec or dict
+        The search spec (``read_search_spec``), or a dict of its fields, validated as a file
+        is (errors name ``spec_name`` and the field).
     scene_name, spec_name : str
         For the document's provenance.
-    spec_dir : Path, optional
+    spec_dir : str or os.PathLike, optional
         Folder of the spec: its ``ranking.site`` and ``ranking.records`` are relative to it.
-    site : SiteFile, optional
+    site : SiteFile, str or os.PathLike, optional
         The site for the code check (default: the spec's ``ranking.site``).
-    motions : sequence of GroundMotion, optional
+    motions : sequence of GroundMotion, str or os.PathLike, optional
         Records (default: the spec's ``ranking.records``).
     exact : bool
         Envelopes by the exact solver instead of the library.
@@ -816,14 +888,25 @@ def search_run(
     Returns
     -------
     SearchRun
+
+    Raises
+    ------
+    InputError
+        A scene that is not one, a spec that is neither a ``SearchSpec`` nor a valid dict, a
+        path that is not ``str`` or ``os.PathLike``, a missing or unreadable file.
     """
     t0 = time.perf_counter()
+    scene = _scene_object(scene)
+    spec = _search_spec(spec, spec_name)
+    folder = None if spec_dir is None else as_path(spec_dir, "spec_dir")
+    site = _site_object(site, "site")
+    motions = _motion_objects(motions, "motions")
     rk = spec.ranking
     if site is None and rk.site is not None:
-        site = read_site(_resolve(rk.site, spec_dir, "ranking.site"))
+        site = read_site(_resolve(rk.site, folder, "ranking.site"))
     if motions is None:
         motions = [
-            read_record(_resolve(r, spec_dir, f"ranking.records[{k}]"))
+            read_record(_resolve(r, folder, f"ranking.records[{k}]"))
             for k, r in enumerate(rk.records)
         ]
     check_first_mode(spec, site)  # before the search: a contradiction costs nothing
@@ -1011,17 +1094,27 @@ def write_search(run: SearchRun, out_dir: Path, *, figure: bool = True) -> list[
     return out
 
 
-def save_search(run: SearchRun, out: Union[str, Path], *, figure: bool = True) -> list[Path]:
+def save_search(run: SearchRun, out: PathLike, *, figure: bool = True) -> list[Path]:
     """Write a search's files into the folder ``out`` as ``rockmech search --out`` does.
 
     Through ``rundir.run_folder``: only rockmech's own outputs in ``out`` are replaced, as
     one set; every other file there stays as it was.
+
+    Parameters
+    ----------
+    run : SearchRun
+        The search (``search_from_files``, ``search_run``).
+    out : str or os.PathLike
+        The folder (created if missing).
+    figure : bool
+        Also draw ``search.png``.
 
     Returns
     -------
     list of Path
         The files written, in ``out`` (as ``write_search``).
     """
+    out = as_path(out, "out")
     notes: list[str] = []
     with run_folder(out, on_note=notes.append) as tmp:
         names = [p.name for p in write_search(run, tmp, figure=figure)]
@@ -1031,12 +1124,12 @@ def save_search(run: SearchRun, out: Union[str, Path], *, figure: bool = True) -
 
 
 def search_from_files(
-    scene: Path,
-    spec: Path,
+    scene: PathLike,
+    spec: PathLike,
     *,
     units: Optional[str] = None,
-    site: Optional[Path] = None,
-    records: Sequence[Path] = (),
+    site: Optional[PathLike] = None,
+    records: Sequence[PathLike] = (),
     exact: bool = False,
     limits: bool = True,
 ) -> SearchRun:
@@ -1044,33 +1137,36 @@ def search_from_files(
 
     Parameters
     ----------
-    scene : Path
+    scene : str or os.PathLike
         A ``.3dm`` file, or a scan mesh (``.ply``, ``.obj``, ``.stl``, ``.off``) with ``units``.
-    spec : Path
+    spec : str or os.PathLike
         The search spec (JSON); its ``ranking.site`` and ``ranking.records`` are relative to
         its folder.
     units : str, optional
         Length unit of a scan mesh.
-    site : Path, optional
+    site : str or os.PathLike, optional
         A site file, instead of the spec's ``ranking.site``.
-    records : sequence of Path
+    records : sequence of str or os.PathLike
         Records, instead of the spec's ``ranking.records`` (formats detected).
     exact : bool
         Envelopes by the exact solver instead of the library.
     limits : bool
         Apply the work limits (``MAX_EVALUATIONS``, ``MAX_LP_BLOCKS``).
     """
-    check_file(scene, "scene")
-    search_spec = read_search_spec(spec)
-    scene_obj = read_scene(scene, units=units)
+    scene_path = check_file(scene, "scene")
+    spec_path = as_path(spec, "spec")
+    search_spec = read_search_spec(spec_path)
+    scene_obj = read_scene(scene_path, units=units)
+    site_obj = None if site is None else read_site(as_path(site, "site"))
+    motions = _motion_objects(records, "records")
     return search_run(
         scene_obj,
         search_spec,
-        scene_name=scene.name,
-        spec_name=spec.name,
-        spec_dir=spec.parent,
-        site=None if site is None else read_site(site),
-        motions=[read_record(r) for r in records] if records else None,
+        scene_name=scene_path.name,
+        spec_name=spec_path.name,
+        spec_dir=spec_path.parent,
+        site=site_obj,
+        motions=motions or None,
         exact=exact,
         max_evaluations=MAX_EVALUATIONS if limits else None,
         max_lp_blocks=MAX_LP_BLOCKS if limits else None,

@@ -30,6 +30,8 @@ from typing import Any, Optional
 from shared_schema.api import time_domain_problem
 from shared_schema.constants import ConstantsFile, parse_constants
 from shared_schema.errors import InputError
+from shared_schema.paths import PathLike
+from shared_schema.rules import check_file
 from shared_schema.text import decimal_point, decode_text, delimiter_of
 
 __all__ = [
@@ -93,9 +95,9 @@ _UNIT = re.compile(r"^(.*?)\s*[\[(]\s*([^\])]*)\s*[\])]\s*$")
 _FOLDED = {k.casefold(): k for k in COLUMNS}
 
 
-def is_table(path: Path) -> bool:
+def is_table(path: PathLike) -> bool:
     """Tell a constants table (``.csv``, ``.xlsx``) from a constants JSON by its suffix."""
-    return path.suffix.lower() in TABLE_SUFFIXES
+    return Path(path).suffix.lower() in TABLE_SUFFIXES
 
 
 def _column(title: str, col: int) -> tuple[str, float]:
@@ -220,12 +222,12 @@ def _row_error(exc: InputError, row: int, titles: dict[str, str], name: str) -> 
     return InputError(f"{name} {label}: {exc.reason}", "table")
 
 
-def constants_from_table(path: Path, *, time_domain: bool = False) -> ConstantsFile:
+def constants_from_table(path: PathLike, *, time_domain: bool = False) -> ConstantsFile:
     """Read a constants table (``.csv`` or ``.xlsx``) into a validated constants file.
 
     Parameters
     ----------
-    path : Path
+    path : str or os.PathLike
         The table; see the module docstring for its columns.
     time_domain : bool
         Also hold each row to the ranges of a time-domain analysis (``p_eq``, ``lam``, the
@@ -241,7 +243,7 @@ def constants_from_table(path: Path, *, time_domain: bool = False) -> ConstantsF
     Raises
     ------
     InputError
-        Missing file, unknown suffix, openpyxl missing for ``.xlsx`` (with the ``pip
+        Missing file, a folder, unknown suffix, openpyxl missing for ``.xlsx`` (with the ``pip
         install`` line), an unknown column or unit, or a bad cell; every message names the
         row (as the spreadsheet numbers it) and the column. Field ``table``.
     """
@@ -251,7 +253,7 @@ def constants_from_table(path: Path, *, time_domain: bool = False) -> ConstantsF
     return cf
 
 
-def checked_table(path: Path) -> tuple[ConstantsFile, Optional[InputError]]:
+def checked_table(path: PathLike) -> tuple[ConstantsFile, Optional[InputError]]:
     """Read a constants table; also return the error a time-domain analysis would give it.
 
     Returns
@@ -262,8 +264,7 @@ def checked_table(path: Path) -> tuple[ConstantsFile, Optional[InputError]]:
         The first value outside the ranges of a time-domain analysis, naming its row and
         column (``shared_schema.api.time_domain_problem``), or None.
     """
-    if not path.is_file():
-        raise InputError(f"table file not found: {path}", "table")
+    path = check_file(path, "table")
     suffix = path.suffix.lower()
     if suffix not in TABLE_SUFFIXES:
         raise InputError(f"{path.name}: a table is .csv or .xlsx, got {suffix!r}", "table")
