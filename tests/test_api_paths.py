@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import re
+import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +33,18 @@ FACADE = EX / "scenes" / "facade.3dm"
 FACADE_SPEC = EX / "specs" / "facade.spec.json"
 SEARCH_SCENE = EX / "scenes" / "search_facade.3dm"
 SEARCH_SPEC = EX / "specs" / "search_facade.search.json"
+#: A retrofit spec (none is bundled: its anchorage resistance is the engineer's), written
+#: once for the session.
+RETROFIT = Path(tempfile.mkdtemp(prefix="rockmech-api-paths-")) / "retrofit.json"
+RETROFIT.write_text(
+    json.dumps(
+        {
+            "steel": {"grade": "S275", "diameters_mm": [16, 20, 24]},
+            "anchorage": {"capacity_N": 80000, "source": "a test's stated value"},
+        }
+    ),
+    encoding="utf-8",
+)
 #: The message of a path argument of another type (shared_schema.paths.PATH_TYPES).
 NOT_A_PATH = r"must be (a \w+ or )?a path \(str or os\.PathLike"
 
@@ -125,6 +138,23 @@ READERS = [
     Slot("check", "site", SITE, lambda p: rockmech.check(CHURCH, p), "site"),
     Slot("assess", "constants", CHURCH, lambda p: rockmech.assess(p, SITE), "constants"),
     Slot("assess", "site", SITE, lambda p: rockmech.assess(CHURCH, p), "site"),
+    Slot(
+        "retrofit",
+        "constants",
+        CHURCH,
+        lambda p: rockmech.retrofit(p, SITE, RETROFIT),
+        "constants",
+    ),
+    Slot("retrofit", "site", SITE, lambda p: rockmech.retrofit(CHURCH, p, RETROFIT), "site"),
+    Slot(
+        "retrofit",
+        "spec",
+        RETROFIT,
+        lambda p: rockmech.retrofit(CHURCH, SITE, p),
+        "retrofit",
+        "spec",
+    ),
+    Slot("read_retrofit_spec", "path", RETROFIT, rockmech.read_retrofit_spec, "retrofit"),
     Slot(
         "build_report",
         "cf",
