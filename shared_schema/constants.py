@@ -57,6 +57,8 @@ from typing import (
     Optional,
     Sequence,
     Tuple,
+    Type,
+    TypeVar,
     Union,
     get_args,
 )
@@ -88,6 +90,7 @@ from shared_schema.rules import (
     schema_version_problem,
 )
 from shared_schema.spec import TYPOLOGIES, Amplification
+from shared_schema.text import decode_text
 from shared_schema.validation import validation_lines
 
 __all__ = [
@@ -1039,6 +1042,37 @@ def json_document(text: str) -> Any:
         raise InputError(f"invalid JSON: {exc}") from None
     except RecursionError:
         raise InputError(f"invalid JSON: nested deeper than {MAX_JSON_DEPTH} levels") from None
+
+
+_Doc = TypeVar("_Doc", bound=BaseModel)
+
+
+def validate_document(model: Type[_Doc], source: Any, what: str, field: str, expected: str) -> _Doc:
+    """Validate a document given as a model, JSON text, the bytes of a file, or plain data.
+
+    Bytes are decoded by ``shared_schema.text.decode_text`` (``what``, ``field`` and
+    ``expected`` word its messages on an empty, binary or non-UTF text); JSON is decoded
+    by ``json_document``; a validation error becomes an ``InputError`` naming the field.
+
+    Raises
+    ------
+    InputError
+        Bytes that are not text, malformed JSON or an invalid value.
+    """
+    if isinstance(source, model):
+        return source
+    if isinstance(source, (str, bytes)):
+        if isinstance(source, bytes):
+            source = decode_text(source, what, field, expected)
+        data = json_document(source)
+        try:
+            return model.model_validate_json(source)
+        except ValidationError as exc:
+            raise input_error_from_validation(exc, data) from exc
+    try:
+        return model.model_validate(source)
+    except ValidationError as exc:
+        raise input_error_from_validation(exc, source) from exc
 
 
 def _json_invalid_fields(exc: ValidationError, data: Any) -> ValidationError:

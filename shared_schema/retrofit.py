@@ -21,12 +21,11 @@ The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` 
 from pathlib import Path
 from typing import Any, Dict, List, Literal, Mapping, Optional, Tuple, Union
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from shared_schema.constants import input_error_from_validation, json_document
+from shared_schema.constants import validate_document
 from shared_schema.errors import InputError
 from shared_schema.paths import readable_file
-from shared_schema.text import decode_text
 
 __all__ = [
     "ANCHORAGE_MAX_N",
@@ -242,20 +241,9 @@ def parse_retrofit_spec(source: Union[str, bytes, Mapping[str, Any]]) -> Retrofi
         Malformed JSON or an invalid value; the message names the field
         (``anchorage.source: Field required``).
     """
-    if isinstance(source, RetrofitSpec):
-        return source
-    if isinstance(source, (str, bytes)):
-        if isinstance(source, bytes):
-            source = decode_text(source, "the retrofit spec", "retrofit", "a retrofit spec (JSON)")
-        data = json_document(source)
-        try:
-            return RetrofitSpec.model_validate_json(source)
-        except ValidationError as exc:
-            raise input_error_from_validation(exc, data) from exc
-    try:
-        return RetrofitSpec.model_validate(source)
-    except ValidationError as exc:
-        raise input_error_from_validation(exc, source) from exc
+    return validate_document(
+        RetrofitSpec, source, "the retrofit spec", "retrofit", "a retrofit spec (JSON)"
+    )
 
 
 def read_retrofit_spec(path: Union[str, "Path"]) -> RetrofitSpec:

@@ -27,7 +27,6 @@ from pydantic import (
     BeforeValidator,
     ConfigDict,
     Field,
-    ValidationError,
     model_validator,
 )
 from pydantic_core import PydanticCustomError
@@ -35,9 +34,8 @@ from pydantic_core import PydanticCustomError
 from shared_schema.constants import (
     JsonInt,
     SchemaVersion,
-    input_error_from_validation,
-    json_document,
     schema_version_field,
+    validate_document,
     whole_number,
 )
 from shared_schema.errors import InputError
@@ -540,20 +538,7 @@ def parse_site(source: Union[str, bytes, Mapping[str, Any]]) -> SiteFile:
         Bytes that are not text, malformed JSON or an invalid value; the message names the
         field (``hazard.NTC2018.a_g: Input should be greater than 0``).
     """
-    if isinstance(source, SiteFile):
-        return source
-    if isinstance(source, (str, bytes)):
-        if isinstance(source, bytes):
-            source = decode_text(source, "the site file", "site", SITE_EXPECTED)
-        data = json_document(source)
-        try:
-            return SiteFile.model_validate_json(source)
-        except ValidationError as exc:
-            raise input_error_from_validation(exc, data) from exc
-    try:
-        return SiteFile.model_validate(source)
-    except ValidationError as exc:
-        raise input_error_from_validation(exc, source) from exc
+    return validate_document(SiteFile, source, "the site file", "site", SITE_EXPECTED)
 
 
 def site_from_text(text: str, name: str) -> SiteFile:
