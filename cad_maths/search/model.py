@@ -604,11 +604,12 @@ def _orient(
     frame = WallFrame(origin, e_s, e_n, e_z, t)
     rings = _elevation(mesh, frame, name)
     area = float(ring_moments(rings)[0])
-    volume = float(mass_properties(mesh, 1.0).volume)
+    props = mass_properties(mesh, 1.0)
+    volume = float(props.volume)
     moments = ring_moments(rings)
     height = (float(v[:, 2].max()) - z_lo, float(moments[2] / moments[0]) - z_lo)
-    exact = abs(volume - area * t) <= PRISM_RTOL * volume and not leans
     prism = abs(volume - area * t) <= PRISM_RTOL * volume
+    exact = prism and not leans
     t_eff, scale = t, 1.0
     if leans or not prism:
         # The idealised prism on the base keeps the solid's mass and the lesser of its
@@ -618,7 +619,7 @@ def _orient(
         base = v[:, 2] <= z_lo + BASE_RTOL * height[0]
         lo, hi = float(n[base].min()), float(n[base].max())
         origin = float(s.min()) * e_s + lo * e_n
-        depth = float(mass_properties(mesh, 1.0).com @ e_n) - lo  # the lean's shift included
+        depth = float(props.com @ e_n) - lo  # the lean's shift included
         lever = min(depth, (hi - lo) - depth)
         t_eff = 2.0 * lever if lever > 0.0 else (t if leans else volume / area)
         scale = volume / (area * t_eff)
