@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
 from cad_maths.search.families import Budget, Candidate, enumerate_candidates
-from cad_maths.search.lp import LPModel, LPResult, facade_lp_model, solve_lp
+from cad_maths.search.lp import LPModel, LPResult, facade_lp_model, solve_check
 from cad_maths.search.model import Building, building_from_scene
 from shared_schema.errors import InputError
 from shared_schema.rules import G
@@ -267,8 +267,7 @@ def run_search(
                     "or no candidates.spacing, or raise the work limit",
                     "work_limit",
                 )
-            res = solve_lp(model)
-            fric = solve_lp(model, friction=spec.friction)
+            res, fric = solve_check(model, spec.friction)
             best = min(c.lam0 for c in along if c.facade == facade and c.direction == direction)
             gap = (best - res.lam) / best if math.isfinite(res.lam) and best > 0 else 0.0
             lam_f = fric.lam if math.isfinite(fric.lam) else None

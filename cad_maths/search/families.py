@@ -34,7 +34,14 @@ import numpy as np
 from cad_maths.geometry.massprops import mass_properties
 from cad_maths.mechanisms.loaded import BEARING_ANGLE, largest_contact
 from cad_maths.mechanisms.single import find_objects
-from cad_maths.search.model import Building, LevelContact, ReturnWall, TiePoint, Wall
+from cad_maths.search.model import (
+    Building,
+    LevelContact,
+    RegionTable,
+    ReturnWall,
+    TiePoint,
+    Wall,
+)
 from cad_maths.search.multiplier import Force, rotation_multiplier, two_block_multiplier
 from cad_maths.search.prism import Lump, clip_rings, point_lump, ring_moments
 from cad_maths.search.refine import minimise
@@ -321,6 +328,31 @@ def _region_mass(wall: Wall, planes: Sequence[Plane]) -> float:
 Hits = Dict[int, Tuple[float, np.ndarray, LevelContact, Any]]
 
 
+#: A vertex within this fraction of the regions' largest coordinate of a half-space's plane
+#: is clipped exactly rather than screened (the screen's rounding differs from the clip's).
+SCREEN_RTOL = 1e-9
+
+
+def _screen(table: RegionTable, planes: Sequence[Plane]) -> Tuple[List[bool], List[bool]]:
+    """Which regions lie wholly inside every half-space, and which wholly outside one.
+
+    One product of the regions' vertices with the planes' normals replaces a clip per
+    region and plane; vertices near a plane (``SCREEN_RTOL``) leave the region to the clip.
+    """
+    k = len(table.entries)
+    if not planes:
+        return [True] * k, [False] * k
+    normals = np.array([n for _, n in planes], dtype=float)
+    offsets = np.einsum("ij,ij->i", normals, np.array([p for p, _ in planes], dtype=float))
+    f = table.vertices @ normals.T - offsets
+    margin = SCREEN_RTOL * table.scale * float(np.abs(normals).sum(axis=1).max())
+    lo = np.minimum.reduceat(f, table.starts, axis=0)
+    hi = np.maximum.reduceat(f, table.starts, axis=0)
+    whole = [bool(x) for x in np.all(lo > margin, axis=1)]
+    clear = [bool(x) for x in np.any(hi < -margin, axis=1)]
+    return whole, clear
+
+
 def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = None) -> Hits:
     """Each level's largest contact with the moving parts: level -> (area, centroid, ...).
 
@@ -331,14 +363,25 @@ def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = 
     tol = max(bld.contact_tol, 0.0)
     out: Hits = dict(best or {})
     for piece in pieces:
+        table = bld.region_table(piece.wall.id)
+        if not table.entries:
+            continue
         # the half-spaces' coefficients as floats, once per piece (not once per region)
         planes = [
             (float(n[0]), float(n[1]), float(n[2]), float(p[0]), float(p[1]), float(p[2]))
             for p, n in piece.planes
         ]
-        for c in bld.contacts.get(piece.wall.id, []):
-            for j, region in enumerate(c.regions):
-                rings = list(region.rings)
+        whole, clear = _screen(table, piece.planes)
+        for r, (c, j, region) in enumerate(table.entries):
+            if clear[r]:
+                continue  # every vertex well outside one half-space: nothing of it moves
+            rings = list(region.rings)
+            if whole[r]:
+                moments = table.moments[r]
+                if moments is None:
+                    moments = table.moments[r] = tuple(float(x) for x in ring_moments(rings)[:3])
+                area, su, sv = moments
+            else:
                 u, v, o = region.u.tolist(), region.v.tolist(), region.origin.tolist()
                 for m0, m1, m2, p0, p1, p2 in planes:
                     rings = clip_rings(
@@ -348,19 +391,19 @@ def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = 
                         m0 * (o[0] - p0) + m1 * (o[1] - p1) + m2 * (o[2] - p2),
                     )
                 area, su, sv = (float(x) for x in ring_moments(rings)[:3])
-                if not area > 0.0:
-                    continue
-                # clipping only shrinks a region: past the whole region's extent the touch
-                # test passes without measuring the clipped part
-                if area <= tol * bld.region_extent((piece.wall.id, c.index, j), region.rings):
-                    pts = np.vstack(rings) if len(rings) > 1 else rings[0]
-                    extent = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
-                    if area <= tol * extent:
-                        continue  # a touch along a line (the builder's MIN_WIDTH_FACTOR)
-                k = c.index
-                if k not in out or area > out[k][0]:
-                    centroid = region.origin + (su / area) * region.u + (sv / area) * region.v
-                    out[k] = (area, centroid, c, region)
+            if not area > 0.0:
+                continue
+            # clipping only shrinks a region: past the whole region's extent the touch
+            # test passes without measuring the clipped part
+            if area <= tol * bld.region_extent((piece.wall.id, c.index, j), region.rings):
+                pts = np.vstack(rings) if len(rings) > 1 else rings[0]
+                extent = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
+                if area <= tol * extent:
+                    continue  # a touch along a line (the builder's MIN_WIDTH_FACTOR)
+            k = c.index
+            if k not in out or area > out[k][0]:
+                centroid = region.origin + (su / area) * region.u + (sv / area) * region.v
+                out[k] = (area, centroid, c, region)
     return out
 
 

@@ -30,6 +30,7 @@ would govern.
 Python 3.9-clean: imported by Rhino 8.
 """
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -168,6 +169,10 @@ class LPResult:
         Solve time [s].
     friction : float or None
         μ of the associative-friction variant, None for rocking only.
+    from_friction : bool
+        A rocking-only result read off the friction programme's optimum, at which no joint
+        slides (``solve_check``): ``n_rows``, ``n_columns`` and ``runtime_s`` are that
+        programme's.
     """
 
     lam: float
@@ -180,6 +185,7 @@ class LPResult:
     n_columns: int
     runtime_s: float
     friction: Optional[float] = None
+    from_friction: bool = False
 
 
 # --- geometry of the arrangement -------------------------------------------------------------
@@ -811,16 +817,80 @@ def solve_lp(model: LPModel, friction: Optional[float] = None) -> LPResult:
     SolverError
         HiGHS fails for another reason than an infeasible programme.
     """
-    from scipy.optimize import linprog  # scipy: loaded with the check only
+    return _run(model, _programme(model, friction))[0]
+
+
+#: The no-sliding check is read off the friction programme's optimum where no joint slides
+#: in it: every no-sliding row within this fraction of the row's largest term (theory §10.9).
+SLIP_RTOL = 1e-9
+
+
+def solve_check(model: LPModel, friction: float) -> Tuple[LPResult, LPResult]:
+    """Solve the check without and with sliding, the friction programme first.
+
+    The friction programme relaxes the rocking-only one (its joints may also slide), so
+    where its optimum slides at no joint, that motion is feasible for the rocking-only
+    programme and optimal there too: its result is the rocking-only one, and the second
+    programme is not solved (``LPResult.from_friction``). Otherwise both are solved.
+
+    Parameters
+    ----------
+    model : LPModel
+        The blocks and their contacts.
+    friction : float
+        μ of the sliding check.
+
+    Returns
+    -------
+    (LPResult, LPResult)
+        The rocking-only check and the sliding check, as ``solve_lp`` gives them.
+    """
+    prog = _programme(model, friction)
+    fric, x = _run(model, prog)
+    if fric.status == "infeasible":
+        # the rocking-only programme's motions are among the friction programme's
+        return dataclasses.replace(fric, friction=None, from_friction=True), fric
+    if x is not None and _slides_nowhere(prog.slip, x):
+        return dataclasses.replace(fric, friction=None, from_friction=True), fric
+    return solve_lp(model), fric
+
+
+def _slides_nowhere(rows: Any, x: np.ndarray) -> bool:
+    """Tell whether a motion meets every hinge joint's no-sliding rows (``SLIP_RTOL``)."""
+    if rows is None or rows.shape[0] == 0:
+        return True
+    v = x[: rows.shape[1]]
+    slip = np.abs(rows @ v)
+    terms = abs(rows) @ np.abs(v)
+    return float(slip.max()) <= SLIP_RTOL * max(float(terms.max()), 1e-300)
+
+
+@dataclass
+class _Programme:
+    """The check's linear programme, assembled (``_programme``)."""
+
+    cost: np.ndarray
+    a_ub: Any
+    a_eq: Any
+    b_eq: np.ndarray
+    n_ties: int
+    body: List[int]
+    coms: np.ndarray
+    friction: Optional[float]
+    slip: Any  # the rocking-only rows of the hinge joints (friction programme only)
+    t0: float
+
+
+def _programme(model: LPModel, friction: Optional[float]) -> _Programme:
+    """Assemble the check's programme (``solve_lp``'s docstring)."""
     from scipy.sparse import csr_matrix, vstack
 
     t0 = time.perf_counter()
-    nb = len(model.blocks)
     body, refs = _glued_bodies(model)
     nbody = len(refs)
     ncol = 6 * nbody
     coms = np.array([model.blocks[r].lump.com for r in refs]) if nbody else np.zeros((0, 3))
-    ub, eq = _Rows(), _Rows()
+    ub, eq, slip = _Rows(), _Rows(), _Rows()
 
     def bid(block: int) -> int:
         return -1 if block < 0 else body[block]
@@ -851,6 +921,10 @@ def solve_lp(model: LPModel, friction: Optional[float] = None) -> LPResult:
             eq.add(bj, bi, c, t2)
             eq.twist(bj, bi, n)
             continue
+        c = itf.points.mean(axis=0)
+        slip.add(bj, bi, c, t1)
+        slip.add(bj, bi, c, t2)
+        slip.twist(bj, bi, n)
         for p in itf.points:
             for tk in (t1, t2):  # n·Δv >= μ |t·Δv|: an outer pyramid of the friction cone
                 ub.add(bj, bi, p, -n + friction * tk)
@@ -893,7 +967,32 @@ def solve_lp(model: LPModel, friction: Optional[float] = None) -> LPResult:
     a_eq = vstack([eq_rows, csr_matrix(norm.reshape(1, -1))]).tocsr()
     b_eq = np.zeros(a_eq.shape[0])
     b_eq[-1] = 1.0
+    return _Programme(
+        cost,
+        a_ub,
+        a_eq,
+        b_eq,
+        n_ties,
+        body,
+        coms,
+        friction,
+        slip.matrix(coms, ncol) if friction is not None else None,
+        t0,
+    )
+
+
+def _run(model: LPModel, prog: _Programme) -> Tuple[LPResult, Optional[np.ndarray]]:
+    """Solve an assembled programme with HiGHS; the result and the solution vector."""
+    from scipy.optimize import linprog  # scipy: loaded with the check only
+
+    cost, a_ub, a_eq, b_eq = prog.cost, prog.a_ub, prog.a_eq, prog.b_eq
+    n_ties, body, coms, friction = prog.n_ties, prog.body, prog.coms, prog.friction
+    nb = len(model.blocks)
+    ncol = cost.size - n_ties
+    nbody = ncol // 6
+    t0 = prog.t0
     n_ub = a_ub.shape[0]
+
     res = linprog(
         cost,
         A_ub=a_ub if n_ub else None,
@@ -906,17 +1005,20 @@ def solve_lp(model: LPModel, friction: Optional[float] = None) -> LPResult:
     runtime = time.perf_counter() - t0
     rows = n_ub + a_eq.shape[0]
     if res.status == 2:  # infeasible: no motion does work against the load
-        return LPResult(
-            math.inf,
-            "infeasible",
-            [],
-            [],
-            np.zeros((nb, 6)),
-            nb,
-            rows,
-            ncol + n_ties,
-            runtime,
-            friction,
+        return (
+            LPResult(
+                math.inf,
+                "infeasible",
+                [],
+                [],
+                np.zeros((nb, 6)),
+                nb,
+                rows,
+                ncol + n_ties,
+                runtime,
+                friction,
+            ),
+            None,
         )
     if res.status == 3:
         raise GeometryError(
@@ -925,11 +1027,13 @@ def solve_lp(model: LPModel, friction: Optional[float] = None) -> LPResult:
         )
     if res.status != 0:
         raise SolverError(f"{model.facade} {model.direction}: HiGHS: {res.message}")
-    vel = _velocities(model, body, coms, np.asarray(res.x, dtype=float)[:ncol].reshape(nbody, 6))
+    x = np.asarray(res.x, dtype=float)
+    vel = _velocities(model, body, coms, x[:ncol].reshape(nbody, 6))
     moving, bodies = _bodies(model, vel)
-    return LPResult(
+    result = LPResult(
         float(res.fun), "optimal", moving, bodies, vel, nb, rows, ncol + n_ties, runtime, friction
     )
+    return result, x
 
 
 def _tie_columns(

@@ -338,6 +338,36 @@ class TiePoint:
 
 
 @dataclass
+class RegionTable:
+    """A wall's level contact regions, stacked for screening (``Building.region_table``).
+
+    Attributes
+    ----------
+    entries : list of (LevelContact, int, ContactPlane)
+        Each region with its contact and its index in the contact's ``regions``.
+    vertices : (n, 3) float
+        Every region's ring vertices in world coordinates [m], region after region.
+    starts : (k,) int
+        Index in ``vertices`` of each region's first vertex.
+    scale : float
+        Largest coordinate magnitude of the vertices, at least 1 [m].
+    moments : list of (float, float, float) or None
+        Each whole region's area [m²] and first moments [m³] in its own (u, v), once
+        computed.
+    """
+
+    entries: List[Tuple["LevelContact", int, Any]]
+    vertices: np.ndarray
+    starts: np.ndarray
+    scale: float
+    moments: List[Optional[Tuple[float, ...]]] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if not self.moments:
+            self.moments = [None] * len(self.entries)
+
+
+@dataclass
 class Building:
     """What the search knows of the building.
 
@@ -370,6 +400,7 @@ class Building:
     contact_tol: float = 0.0
     _thrusts: Dict[Tuple[int, Tuple[float, ...]], float] = field(default_factory=dict)
     _extents: Dict[Tuple[str, int, int], float] = field(default_factory=dict)
+    _region_tables: Dict[str, "RegionTable"] = field(default_factory=dict)
 
     def roof_thrust(self, contact: "LevelContact", d: np.ndarray) -> float:
         """Outward thrust of a roof on a mechanism collapsing along ``d`` [N].
@@ -399,6 +430,32 @@ class Building:
             pts = np.vstack(list(rings))
             self._extents[key] = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
         return self._extents[key]
+
+    def region_table(self, wall: str) -> "RegionTable":
+        """Every level contact region of a wall with its vertices in world coordinates.
+
+        Computed once per wall; ``families.contact_hits`` screens whole regions against a
+        moving part's half-spaces with it before it clips any.
+        """
+        if wall not in self._region_tables:
+            entries: List[Tuple[LevelContact, int, Any]] = []
+            points: List[np.ndarray] = []
+            starts: List[int] = []
+            n = 0
+            for c in self.contacts.get(wall, []):
+                for j, region in enumerate(c.regions):
+                    flat = np.vstack(list(region.rings))
+                    world = region.origin + flat[:, :1] * region.u + flat[:, 1:2] * region.v
+                    entries.append((c, j, region))
+                    points.append(world)
+                    starts.append(n)
+                    n += len(world)
+            vertices = np.vstack(points) if points else np.zeros((0, 3))
+            scale = float(np.abs(vertices).max()) if len(vertices) else 0.0
+            self._region_tables[wall] = RegionTable(
+                entries, vertices, np.array(starts, dtype=np.intp), max(scale, 1.0)
+            )
+        return self._region_tables[wall]
 
     @property
     def size(self) -> float:

@@ -259,19 +259,21 @@ def segment_intervals(
         Sorted, disjoint intervals of ``u`` where the segment runs through the region's
         interior or along its boundary with material on at least one side.
     """
+    if len(rings) == 0:
+        return []
     d = np.asarray(p1, dtype=float) - np.asarray(p0, dtype=float)
-    cuts = [0.0, 1.0]
-    ends = [(ring, np.concatenate((ring[1:], ring[:1]))) for ring in rings]
-    for a, b in ends:
-        e = b - a
-        den = d[0] * e[:, 1] - d[1] * e[:, 0]
-        w = a - p0
-        ok = np.abs(den) > 1e-300
-        u = np.where(ok, (w[:, 0] * e[:, 1] - w[:, 1] * e[:, 0]) / np.where(ok, den, 1.0), np.nan)
-        v = np.where(ok, (w[:, 0] * d[1] - w[:, 1] * d[0]) / np.where(ok, den, 1.0), np.nan)
-        hit = ok & (v >= -1e-12) & (v <= 1.0 + 1e-12) & (u > 0.0) & (u < 1.0)
-        cuts.extend(float(x) for x in u[hit])
-    cuts = sorted(set(cuts))
+    # every ring's edges at once: the cuts and the winding numbers are sums over edges
+    a = np.concatenate(list(rings)) if len(rings) > 1 else np.asarray(rings[0])
+    b = np.concatenate([np.roll(ring, -1, axis=0) for ring in rings])
+    e = b - a
+    den = d[0] * e[:, 1] - d[1] * e[:, 0]
+    w = a - p0
+    ok = np.abs(den) > 1e-300
+    safe = np.where(ok, den, 1.0)
+    u = np.where(ok, (w[:, 0] * e[:, 1] - w[:, 1] * e[:, 0]) / safe, np.nan)
+    v = np.where(ok, (w[:, 0] * d[1] - w[:, 1] * d[0]) / safe, np.nan)
+    hit = ok & (v >= -1e-12) & (v <= 1.0 + 1e-12) & (u > 0.0) & (u < 1.0)
+    cuts = sorted({0.0, 1.0, *u[hit].tolist()})
     pieces = [(lo, hi) for lo, hi in zip(cuts[:-1], cuts[1:]) if hi - lo > 1e-12]
     if not pieces:
         return []
@@ -280,12 +282,10 @@ def segment_intervals(
         np.asarray(p0, dtype=float) + np.array([0.5 * (lo + hi) for lo, hi in pieces])[:, None] * d
     )
     px, pz = mids[:, :1], mids[:, 1:]
-    total = np.zeros(len(pieces), dtype=np.int64)
-    for a, b in ends:
-        up = (a[:, 1] <= pz) & (b[:, 1] > pz)
-        down = (a[:, 1] > pz) & (b[:, 1] <= pz)
-        cross = (b[:, 0] - a[:, 0]) * (pz - a[:, 1]) - (px - a[:, 0]) * (b[:, 1] - a[:, 1])
-        total += np.sum(up & (cross > 0.0), axis=1) - np.sum(down & (cross < 0.0), axis=1)
+    up = (a[:, 1] <= pz) & (b[:, 1] > pz)
+    down = (a[:, 1] > pz) & (b[:, 1] <= pz)
+    cross = (b[:, 0] - a[:, 0]) * (pz - a[:, 1]) - (px - a[:, 0]) * (b[:, 1] - a[:, 1])
+    total = np.sum(up & (cross > 0.0), axis=1) - np.sum(down & (cross < 0.0), axis=1)
     spans: List[Tuple[float, float]] = []
     for (lo, hi), inside in zip(pieces, total.tolist()):
         if inside != 0:

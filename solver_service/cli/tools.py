@@ -36,7 +36,7 @@ def library_build(
             "shipped library; the installed package is never written)."
         ),
     ),
-    n_omega: int = typer.Option(400, "--n-omega", help="Omega points, log-spaced in [0.05, 50]."),
+    n_omega: int = typer.Option(533, "--n-omega", help="Omega points, log-spaced in [0.05, 500]."),
     eta_step: float = typer.Option(0.02, "--eta-step", help="Step of eta in [0, 1]."),
 ) -> None:
     """Compute A_min(Omega; eta) for eta in [0, 1] and the one-sided curve (about 4 s)."""

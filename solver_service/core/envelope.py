@@ -102,8 +102,10 @@ MAX_EDGES = 64
 SERIAL_OMEGA = 16
 #: No scan point known in advance (``_kernels.search``'s ``known``).
 _NO_KNOWN = np.zeros(0, dtype=np.bool_)
-#: Library grid: Omega points (log-spaced in [0.05, 50]) and eta step.
-LIBRARY_OMEGA = (0.05, 50.0, 400)
+#: Library grid: Omega points (log-spaced in [0.05, 500], 133 a decade) and eta step. Up to
+#: 500: a tall wall (p_eq about 1 rad/s) meets Omega = 63 at a 10 Hz pulse, and the
+#: one-sided curve stays finite up to about 400 (A_min about Omega/2 < A_MAX).
+LIBRARY_OMEGA = (0.05, 500.0, 533)
 LIBRARY_ETA_STEP = 0.02
 #: The library shipped with the package (never rewritten by rockmech: ``user_library_path``).
 LIBRARY_PATH = Path(__file__).resolve().parents[1] / "data" / "overturning_library.npz"
@@ -651,7 +653,7 @@ def build_library(
     Parameters
     ----------
     omega, eta : array_like, optional
-        Grids; default ``LIBRARY_OMEGA`` (400 log-spaced in [0.05, 50]) and eta from 0 to 1
+        Grids; default ``LIBRARY_OMEGA`` (533 log-spaced in [0.05, 500]) and eta from 0 to 1
         in steps of ``LIBRARY_ETA_STEP``.
     shape : {"sine", "cosine"}
         Pulse shape.

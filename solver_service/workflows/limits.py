@@ -90,7 +90,7 @@ __all__ = [
 #: The fast mode's library grid of Omega = 2 pi f_p / p_eq: (first, last, points)
 #: (``core.envelope.LIBRARY_OMEGA``; a test checks they agree). Frequencies outside it are
 #: computed with the exact integrator.
-LIBRARY_OMEGA = (0.05, 50.0, 400)
+LIBRARY_OMEGA = (0.05, 500.0, 533)
 #: Margin of the up-front estimates over the rates below [-]: work is refused when it
 #: cannot finish within the budget even this many times faster than measured, on every
 #: core. 2: the newest desktop cores are up to about twice as fast per core as the
