@@ -17,7 +17,7 @@ matplotlib (tests/test_cli_imports.py; docs/benchmarks.md times them).
 
 from __future__ import annotations
 
-from . import check, envelope, history, ida, pulse, search, tools
+from . import check, envelope, history, ida, pulse, retrofit, search, tools
 from .app import app
 from .options import MORE_SCALES
 
@@ -41,6 +41,7 @@ app.command()(tools.serve)
 app.command()(tools.kernels)
 app.command()(check.check)
 app.command()(check.assess)
+app.command()(retrofit.retrofit)
 app.command()(search.search)
 
 

@@ -52,6 +52,8 @@ from shared_schema.errors import InputError
 
 if TYPE_CHECKING:  # annotations only: the command line's --help reads the limits (#38)
     from shared_schema.constants import ConstantsFile
+    from shared_schema.retrofit import RetrofitSpec
+    from shared_schema.site import SiteFile
 
 __all__ = [
     "ASSESS_ENVELOPE",
@@ -65,6 +67,8 @@ __all__ = [
     "PULSE_POINTS_PER_CORE_S",
     "P_EQ_PLAUSIBLE",
     "RATE_MARGIN",
+    "RETROFIT_BISECTION_STEPS",
+    "RETROFIT_CHECKS_PER_S",
     "SPECTRUM_GRID_PER_PERIOD",
     "SPECTRUM_STEPS_PER_CORE_S",
     "SPECTRUM_SUBSTEPS",
@@ -74,12 +78,14 @@ __all__ = [
     "TimeLimitExceeded",
     "active_time_limit",
     "check_count",
+    "check_retrofit_work",
     "check_run",
     "cores",
     "directional",
     "envelope_steps",
     "history_steps",
     "mechanism_sides",
+    "retrofit_checks",
     "scale_factor_points",
     "shortest_time",
     "spectrum_steps",
@@ -111,6 +117,15 @@ PULSE_POINTS_PER_CORE_S = 2.1e6
 HISTORY_STEPS_PER_CORE_S = 7.4e7
 #: Elastic response spectra, sub-steps (El Centro at 1000 periods): 1.82e8/s.
 SPECTRUM_STEPS_PER_CORE_S = 1.8e8
+#: The 2019 code checks of a retrofit's bisections, run one after another on one thread
+#: (``benchmarks/retrofit.py``: the bundled church, each check of a mechanism with a trial
+#: tie, its façades with 10 tie heights each): 1.19e3/s. Recorded in docs/benchmarks.md,
+#: section ``retrofit`` (a test checks the constant against it).
+RETROFIT_CHECKS_PER_S = 1.2e3
+#: Bisection steps of one nonlinear criterion of a retrofit, at the least: the bracket
+#: halves from half its passing end to ``workflows.retrofit.T_REL_TOL`` of it,
+#: ``ceil(log2(0.5 / T_REL_TOL))`` (a test checks the copy).
+RETROFIT_BISECTION_STEPS = 7
 #: The assessment page's figures, drawn on one thread (the church_geometry page on El
 #: Centro, 13 figures): 4.51/s.
 FIGURES_PER_S = 4.5
@@ -279,7 +294,10 @@ WORK_KINDS: dict[str, tuple[float, str]] = {
     "history_steps": (HISTORY_STEPS_PER_CORE_S, "closed-form steps of time histories"),
     "spectrum_steps": (SPECTRUM_STEPS_PER_CORE_S, "sub-steps of response spectra"),
     "figures": (FIGURES_PER_S, "figures"),
+    "retrofit_checks": (RETROFIT_CHECKS_PER_S, "code checks of a retrofit's bisections"),
 }
+#: The kinds of work done on one thread, whatever the cores.
+SERIAL_KINDS = ("figures", "retrofit_checks")
 
 
 def _kinds(work: dict[str, float]) -> list[tuple[str, float]]:
@@ -301,12 +319,12 @@ def shortest_time(**work: float) -> float:
     Notes
     -----
     Each kind at ``RATE_MARGIN`` times its measured rate per core, on every core (the
-    figures on one).
+    ``SERIAL_KINDS`` on one).
     """
     seconds = 0.0
     for kind, amount in _kinds(work):
         rate = WORK_KINDS[kind][0] * RATE_MARGIN
-        seconds += amount / (rate if kind == "figures" else rate * cores())
+        seconds += amount / (rate if kind in SERIAL_KINDS else rate * cores())
     return seconds
 
 
@@ -574,4 +592,69 @@ def check_run(
             f"its time limit of {budget_s:g} s; ask for less work{fast}, give {TIME_LIMIT} "
             f"with more seconds, or {NO_LIMITS} to lift the limit",
             field,
+        )
+
+
+def retrofit_checks(cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec) -> int:
+    """Return the code checks a retrofit plans, before any is run.
+
+    The plan counts every mechanism as failing every check (which fail is known only once
+    the checks run): per candidate tie height (the spec's, or the one default height), the
+    check after the tie and, per nonlinear limit state the site gives (SLV, and SLC where
+    ``hazard.limit_states`` has it), the ``RETROFIT_BISECTION_STEPS`` checks a bisection on
+    the tie force takes at the least.
+
+    Examples
+    --------
+    >>> from shared_schema.constants import parse_constants
+    >>> from shared_schema.retrofit import parse_retrofit_spec
+    >>> from shared_schema.site import parse_site
+    >>> cf = parse_constants('{"mechanisms": [{"id": "W", "p_eq": 2.0, "lam": 0.1}]}')
+    >>> site = parse_site('{"hazard": {"code": "NTC2018", "a_g": 0.2, "F0": 2.4,'
+    ...                   ' "Tc_star": 0.3, "soil": "C", "FC": 1.35}}')
+    >>> spec = parse_retrofit_spec('{"steel": {"grade": "S275", "diameters_mm": [16]},'
+    ...     ' "anchorage": {"capacity_N": 6e4, "source": "test R-1"},'
+    ...     ' "mechanisms": {"W": {"heights_m": [3.0, 5.0]}}}')
+    >>> retrofit_checks(cf, site, spec)  # 2 heights x (1 after + 7 bisection steps, SLV)
+    16
+    """
+    states = 1 + int("SLC" in (getattr(site.hazard, "limit_states", None) or {}))
+    per_option = 1 + states * RETROFIT_BISECTION_STEPS
+    total = 0
+    for mech in cf.mechanisms:
+        ties = spec.mechanisms.get(mech.id)
+        heights = ties.heights_m if ties is not None and ties.heights_m is not None else [0.0]
+        total += len(heights) * per_option
+    return total
+
+
+def check_retrofit_work(
+    cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec, budget_s: float, how: str
+) -> None:
+    """Refuse a retrofit whose planned code checks cannot finish within ``budget_s`` [s].
+
+    Parameters
+    ----------
+    cf, site, spec
+        The retrofit's inputs (``retrofit_checks`` counts the plan).
+    budget_s : float
+        The time budget [s]: the service's compute timeout, the command's time limit.
+    how : str
+        How the user lifts or raises the budget, ending the message.
+
+    Raises
+    ------
+    InputError
+        Naming ``spec`` (the tie heights set the work), the count and the budget.
+    """
+    n = retrofit_checks(cf, site, spec)
+    seconds = shortest_time(retrofit_checks=n)
+    if seconds > budget_s:
+        raise InputError(
+            f"the retrofit plans {n} code checks ({len(cf.mechanisms)} mechanisms counted as "
+            f"failing, their tie heights, {RETROFIT_BISECTION_STEPS} bisection steps per limit "
+            f"state): at least {seconds:.3g} s even at {RATE_MARGIN:g} times the "
+            f"{RETROFIT_CHECKS_PER_S:g} checks/s measured, past the budget of {budget_s:g} s; "
+            f"give fewer tie heights or mechanisms, or {how}",
+            "spec",
         )

@@ -385,13 +385,20 @@ def _conflicts(out: Path, new: dict[str, str], old: dict[str, str]) -> str:
     return ""
 
 
-def _commit(out: Path, stage: Path, token: str, field: str) -> list[str]:
-    """Swap the stage's files into ``out`` as a set; return notes for the user."""
+def _commit(out: Path, stage: Path, token: str, field: str, keep_others: bool = False) -> list[str]:
+    """Swap the stage's files into ``out`` as a set; return notes for the user.
+
+    With ``keep_others`` the files of earlier runs that this run does not write stay (and
+    stay listed as rockmech's); otherwise they are removed where still as rockmech wrote them.
+    """
     state = out / STATE_DIR
     notes: list[str] = []
     _recover_locked(out)
     old: dict[str, str] = dict(owned_files(out))
     new = _staged(stage)
+    kept_files = {k: v for k, v in old.items() if k not in new} if keep_others else {}
+    if keep_others:
+        old = {k: v for k, v in old.items() if k in new}
     why = _conflicts(out, new, old)
     if why:
         raise InputError(f"{why}: move it away or give another folder; nothing was written", field)
@@ -431,7 +438,7 @@ def _commit(out: Path, stage: Path, token: str, field: str) -> list[str]:
             "version": MANIFEST_VERSION,
             "rockmech": __version__,
             "run": token,
-            "files": new,
+            "files": {**kept_files, **new},
         }
         write_atomic(state / MANIFEST_NAME, json.dumps(done, indent=1) + "\n")  # commit point
     except BaseException:
@@ -447,6 +454,7 @@ def run_folder(
     out: Union[str, Path],
     field: str = "out",
     on_note: Optional[Callable[[str], None]] = None,
+    keep_others: bool = False,
 ) -> Iterator[Path]:
     """Yield a fresh stage folder to write a run into; on success its files go into ``out``.
 
@@ -464,6 +472,10 @@ def run_folder(
         Called with each note for the user (a swap a killed run left and that this run
         ended, an old output the user changed and that is left as it is). Without it the
         notes are issued as ``UserWarning``.
+    keep_others : bool
+        Keep the outputs of earlier runs that this run does not write (a command that adds
+        one file to a run's folder, ``rockmech retrofit``'s ``retrofit.json``); by default
+        the run's files replace the earlier set.
 
     Raises
     ------
@@ -509,7 +521,7 @@ def run_folder(
     try:
         yield stage
         with _locked(state / LOCK_NAME, LOCK_WAIT_S, "writing to", field):
-            notes = _commit(target, stage, token, field)
+            notes = _commit(target, stage, token, field, keep_others)
     except OSError as exc:
         raise InputError(f"cannot write to {target}: {os_reason(exc)}", field) from None
     finally:

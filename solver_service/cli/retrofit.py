@@ -1,0 +1,125 @@
+"""``rockmech retrofit``: the least tie force that makes each failing mechanism pass.
+
+The command imports its workflow (the code checks, the retrofit) when it runs.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from ..workflows.rundir import check_folder_target, run_folder
+from .errors import user_errors
+from .options import CONSTANTS_ARG, LIMITS, Limits, grouped
+from .output import out_note, status
+from .output import table as table_lines
+
+__all__ = ["retrofit"]
+
+#: The limits this command takes: the time limit and --no-limits.
+RETROFIT_LIMITS = LIMITS.only("no_limits", "time_limit")
+
+
+def _kn(value: Optional[float]) -> str:
+    return "-" if value is None else f"{value / 1e3:.4g}"
+
+
+def _ratio(value: Optional[float]) -> str:
+    return "-" if value is None else f"{value:.3f}"
+
+
+@user_errors
+@grouped
+def retrofit(
+    constants: Path = CONSTANTS_ARG,
+    site: Path = typer.Option(..., "--site", help="Site file (SITE.json): hazard, FC, q."),
+    spec: Path = typer.Option(
+        ...,
+        "--spec",
+        help="Retrofit spec (JSON): steel grade and bar diameters [mm], the anchorage "
+        "resistance [N] with its source, tie heights above each hinge [m].",
+    ),
+    out: Optional[Path] = typer.Option(
+        None,
+        "-o",
+        "--out",
+        help="Folder to write retrofit.json into (only that file is replaced).",
+    ),
+    limits: Limits = RETROFIT_LIMITS,
+    as_json: bool = typer.Option(False, "--json", help="Print the retrofit document."),
+) -> None:
+    """Tie-bars for every mechanism that fails the 2019 checks: least force, bar, checks after."""
+    # The retrofit spec's reader is loaded when the command runs.
+    from shared_schema.retrofit import read_retrofit_spec
+
+    # The table's rows (the document summarised) are loaded when the command prints.
+    from ..report.retrofit import retrofit_summary
+
+    # The constants and site readers are loaded when the command runs.
+    from ..workflows import assess, inputs
+
+    # The up-front work estimate.
+    from ..workflows.limits import NO_LIMITS, TIME_LIMIT, check_retrofit_work
+
+    # The retrofit (the code checks, scipy) is loaded when the command runs.
+    from ..workflows.retrofit import retrofit_doc
+
+    # The document's file.
+    from ..workflows.retrofit_files import RETROFIT_FILE, retrofit_json, write_retrofit
+
+    if out is not None:
+        check_folder_target(out)
+    cf = inputs.read_constants(constants)
+    site_file = assess.read_site(site)
+    rspec = read_retrofit_spec(spec)
+    if not limits.no_limits:
+        check_retrofit_work(
+            cf,
+            site_file,
+            rspec,
+            limits.time_limit,
+            f"give {TIME_LIMIT} with more seconds, or {NO_LIMITS}",
+        )
+    with status("retrofit: code checks and tie forces"):
+        doc = retrofit_doc(cf, site_file, rspec)
+    if out is not None:
+        # Only retrofit.json is replaced: the other outputs in the folder stay.
+        with run_folder(out, on_note=out_note, keep_others=True) as tmp:
+            write_retrofit(tmp, doc)
+    if as_json:
+        typer.echo(retrofit_json(doc), nl=False)
+        if out is not None:
+            typer.echo(f"wrote {out / RETROFIT_FILE}", err=True)
+        return
+    summary = retrofit_summary(doc)
+    rows = []
+    for row in summary:
+        o = row.option
+        rows.append(
+            [
+                row.id,
+                row.status,
+                "-" if o is None else f"{o.height_m:.4g}",
+                _kn(None if o is None else o.T_star_N),
+                "-" if o is None or o.governing is None else o.governing,
+                row.bar_text,
+                f"{_ratio(row.before_ratio)} -> {_ratio(row.after_ratio)}",
+            ]
+        )
+    headers = [
+        "mechanism",
+        "status",
+        "h_t [m]",
+        "T* [kN]",
+        "governs",
+        "bars",
+        "least a_g ratio",
+    ]
+    for line in table_lines(headers, rows):
+        typer.echo(line)
+    for row in summary:
+        typer.echo(f"  {row.sentence}")
+    if out is not None:
+        typer.echo(f"wrote {out / RETROFIT_FILE}")

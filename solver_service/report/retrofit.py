@@ -1,0 +1,182 @@
+"""The retrofit document in a few words: one summary per mechanism (table rows, sentences).
+
+``retrofit_summary`` reads a ``RetrofitDoc`` (``workflows.retrofit.retrofit_doc``) into one
+plain row per mechanism: its status, the chosen tie (height above the hinge [m], bars, bar
+size and grade, ``T*`` [N] in all and per bar, the governing criterion) and the least of its
+capacity/demand ratios (``a_g,X/a_g``) before and after the tie. ``rockmech retrofit``
+prints these rows as its table and the assessment report's page one shows them
+(``rockmech assess --retrofit retrofit.json``), with a sentence per failing mechanism:
+"2 Ø20 S275 ties at 7.2 m, 29 kN each, make F1 pass: a_g,SLV/a_g nonlinear 0.40 → 1.02".
+
+Light on purpose (the document's model only): the command line loads it when it prints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+from shared_schema.errors import InputError
+from shared_schema.retrofit import CheckFigures, MechanismRetrofit, RetrofitDoc, TieOption
+
+__all__ = ["RATIO_LABELS", "RetrofitRow", "check_retrofit_ids", "retrofit_summary"]
+
+#: How each ratio of ``CheckFigures`` is named, in the order they are compared.
+RATIO_LABELS = {
+    "linear_ratio": "a_g,SLV/a_g linear",
+    "SLV_ratio": "a_g,SLV/a_g nonlinear",
+    "SLC_ratio": "a_g,SLC/a_g nonlinear",
+}
+#: What each mechanism status means, in words.
+STATUS_WORDS = {
+    "passes": "passes: needs no tie",
+    "designed": "tie designed",
+    "not_achievable": "no tie option makes it pass",
+    "not_applicable": "not retrofitted by a tie",
+    "not_checked": "code check did not run",
+    "not_evaluated": "checks not evaluated",
+}
+
+
+@dataclass(frozen=True)
+class RetrofitRow:
+    """One mechanism of a retrofit document, summarised.
+
+    Attributes
+    ----------
+    id, name, status : str
+        The mechanism and its retrofit status (``MechanismRetrofit.status``).
+    option : TieOption, optional
+        The chosen tie (designed), else the first option that has a force, else None.
+    before_ratio, after_ratio : float, optional
+        The least capacity/demand ratio of the checks evaluated, before and with the tie [-].
+    before_label, after_label : str
+        Which ratio that is (``RATIO_LABELS``).
+    reason : str
+        The mechanism's first decision (why it has no tie, what was chosen).
+    """
+
+    id: str
+    name: str
+    status: str
+    option: Optional[TieOption]
+    before_ratio: Optional[float]
+    before_label: str
+    after_ratio: Optional[float]
+    after_label: str
+    reason: str
+
+    @property
+    def status_words(self) -> str:
+        """The status in words."""
+        return STATUS_WORDS.get(self.status, self.status)
+
+    @property
+    def bar_text(self) -> str:
+        """``"2 Ø20 S275"`` (bars, diameter, grade), or ``"-"`` without a bar."""
+        o = self.option
+        if o is None or o.bar is None:
+            return "-"
+        return f"{o.bars} Ø{o.bar.diameter_mm:g} {o.bar.grade}"
+
+    @property
+    def sentence(self) -> str:
+        """One sentence: the tie that makes the mechanism pass, or why there is none."""
+        o = self.option
+        if self.status == "designed" and o is not None and o.bar is not None:
+            t_star = o.T_star_N or 0.0
+            many = o.bars > 1
+            return (
+                f"{self.bar_text} {'ties' if many else 'tie'} at {o.height_m:.3g} m, "
+                f"{t_star / o.bars / 1e3:.3g} kN{' each' if many else ''}, "
+                f"{'make' if many else 'makes'} {self.id} pass: {self.before_label} "
+                f"{_ratio(self.before_ratio)} → {_ratio(self.after_ratio)}"
+                + (
+                    ""
+                    if self.after_label == self.before_label
+                    else f" (then {self.after_label} is the least)"
+                )
+            )
+        return f"{self.id}: {self.status_words}: {self.reason}"
+
+
+def _ratio(value: Optional[float]) -> str:
+    return "-" if value is None else f"{value:.2f}"
+
+
+def _least(fig: Optional[CheckFigures]) -> tuple[Optional[float], str]:
+    """Return the least ratio of the checks evaluated and its label (None, "" when none)."""
+    if fig is None:
+        return None, ""
+    got = [(getattr(fig, k), label) for k, label in RATIO_LABELS.items()]
+    got = [(v, label) for v, label in got if v is not None]
+    if not got:
+        return None, ""
+    value, label = min(got, key=lambda p: p[0])
+    return float(value), label
+
+
+def _option(m: MechanismRetrofit) -> Optional[TieOption]:
+    if m.chosen is not None:
+        return m.options[m.chosen]
+    return next((o for o in m.options if o.T_star_N is not None), None)
+
+
+def retrofit_summary(doc: RetrofitDoc) -> list[RetrofitRow]:
+    """Return one ``RetrofitRow`` per mechanism of ``doc``, in its order.
+
+    Examples
+    --------
+    >>> from shared_schema.retrofit import CheckFigures, MechanismRetrofit, RetrofitDoc
+    >>> m = MechanismRetrofit(id="W", name="wall", typology="single_block", status="passes",
+    ...                       before=CheckFigures(linear_ratio=1.3, SLV_ratio=1.1),
+    ...                       decisions=["passes every check evaluated: needs no tie"])
+    >>> row = retrofit_summary(RetrofitDoc(standard="", steel={}, decisions=[],
+    ...                                    mechanisms=[m]))[0]
+    >>> row.before_ratio, row.before_label
+    (1.1, 'a_g,SLV/a_g nonlinear')
+    >>> row.sentence
+    'W: passes: needs no tie: passes every check evaluated: needs no tie'
+    """
+    rows = []
+    for m in doc.mechanisms:
+        option = _option(m)
+        before, before_label = _least(m.before)
+        after, after_label = _least(option.after if option is not None else None)
+        reason = m.decisions[0] if m.decisions else ""
+        if m.status == "not_achievable" and m.options:
+            why = [d for o in m.options for d in o.decisions[:1]]
+            reason = "; ".join(why) or reason
+        rows.append(
+            RetrofitRow(
+                id=m.id,
+                name=m.name,
+                status=m.status,
+                option=option,
+                before_ratio=before,
+                before_label=before_label,
+                after_ratio=after,
+                after_label=after_label,
+                reason=reason,
+            )
+        )
+    return rows
+
+
+def check_retrofit_ids(doc: RetrofitDoc, ids: list[str]) -> None:
+    """Refuse a retrofit document whose mechanisms are not those of the constants.
+
+    Raises
+    ------
+    InputError
+        A mechanism of the document the constants do not have (field ``retrofit``): the
+        document was made from other constants.
+    """
+    missing = [m.id for m in doc.mechanisms if m.id not in ids]
+    if missing:
+        raise InputError(
+            f"the retrofit document's mechanism(s) {', '.join(missing)} are not in the "
+            f"constants (ids: {', '.join(ids)}); give the retrofit.json made from these "
+            "constants",
+            "retrofit",
+        )
