@@ -25,7 +25,7 @@ from solver_service.core.excitation import Pulse
 from solver_service.core.model import RockingModel
 from solver_service.core.records import GroundMotion
 from solver_service.core.result import RockingResult
-from solver_service.ida import run_ida
+from solver_service.workflows.ida.run import run_ida
 from solver_service.workflows import assess as _assess
 from solver_service.workflows import inputs as _inputs
 from solver_service.workflows import tables as _tables

@@ -24,7 +24,7 @@ from matplotlib.text import Text
 
 from shared_schema.constants import ConstantsFile
 from solver_service.demo import run_demo
-from solver_service.ida import run_ida
+from solver_service.workflows.ida.run import run_ida
 from solver_service.report.assess import assess_report
 from solver_service.report.html import build_report
 from solver_service.workflows.assess import read_site

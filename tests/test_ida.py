@@ -23,11 +23,11 @@ from typer.testing import CliRunner
 
 from shared_schema.errors import InputError
 from shared_schema.io import load_constants
-from solver_service import ida
+from solver_service.workflows.ida import run as ida
 from solver_service.cli import app
 from solver_service.core.exact import simulate
 from solver_service.core.records import GroundMotion
-from solver_service.ida import (
+from solver_service.workflows.ida.run import (
     MIN_TASK_S,
     PEAKS_FILE,
     TASK_S,

@@ -94,7 +94,7 @@ def ida(
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     # The IDA, its inputs and its writer are loaded when the command runs (#38).
-    from .. import ida as workflow
+    from ..workflows.ida import run as workflow
 
     # The solver's own check of a positive number.
     from ..core.model import check_positive

@@ -70,14 +70,14 @@ from shared_schema.extras import require
 from shared_schema.rules import IM_MEASURES, PEAKS_FILE
 from shared_schema.version import __version__
 
-from .core.exact import single_threaded
-from .core.fragility import fit_lognormal
-from .core.model import RockingModel, check_positive
-from .core.records import GroundMotion
-from .workflows.adapter import to_rocking_model
-from .workflows.documents import time_domain_mechanisms
-from .workflows.limits import P_EQ_PLAUSIBLE, history_steps
-from .workflows.scaling import Building, run_scaled
+from ...core.exact import single_threaded
+from ...core.fragility import fit_lognormal
+from ...core.model import RockingModel, check_positive
+from ...core.records import GroundMotion
+from ..adapter import to_rocking_model
+from ..documents import time_domain_mechanisms
+from ..limits import P_EQ_PLAUSIBLE, history_steps
+from ..scaling import Building, run_scaled
 
 __all__ = [
     "IM_MEASURES",
