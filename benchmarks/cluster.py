@@ -201,7 +201,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     import dask
     from distributed import Client, LocalCluster
 
-    from solver_service.ida import (
+    from solver_service.workflows.ida import (
         DASK_SETTINGS,
         TASK_STEPS_PER_S,
         available_cores,

@@ -139,7 +139,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     from distributed import LocalCluster
 
     from solver_service.core.spectra import response_spectrum
-    from solver_service.ida import run_ida
+    from solver_service.workflows.ida import run_ida
 
     n_rec, n_lev = (8, 10) if args.quick else (N_RECORDS, N_LEVELS)
     info = machine_info(("numpy", "scipy", "numba", "distributed"))

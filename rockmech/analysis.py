@@ -25,12 +25,12 @@ from solver_service.core.excitation import Pulse
 from solver_service.core.model import RockingModel
 from solver_service.core.records import GroundMotion
 from solver_service.core.result import RockingResult
-from solver_service.ida import run_ida
 from solver_service.workflows import assess as _assess
 from solver_service.workflows import inputs as _inputs
 from solver_service.workflows import tables as _tables
 from solver_service.workflows.adapter import models_from_file
 from solver_service.workflows.documents import envelope_doc, frequency_grid, history_doc
+from solver_service.workflows.ida import run_ida
 from solver_service.workflows.retrofit import retrofit_doc
 from solver_service.workflows.scaling import Building
 from solver_service.workflows.units import stamp

@@ -324,7 +324,7 @@ class VirtualWork(BaseModel):
 
     @model_validator(mode="after")
     def _check_bound(self) -> "VirtualWork":
-        # The code check divides by both (core.kinematic.participating_mass): issue #19,
+        # The code check divides by both (codes.circ2009.participating_mass): issue #19,
         # S = 1e-200 made e* = 0 and the check a ZeroDivisionError.
         m_star = self.S * self.S / self.J
         e_star = m_star / self.mass

@@ -1,7 +1,7 @@
 """`rockmech check` and the check document: verdicts, notes instead of aborts, JSON names.
 
 The numbers of the Circolare 2019 checks are worked by hand in
-``tests/solver_core/test_circ2019.py``; here: what reaches the user, end to end.
+``tests/codes/test_circ2019.py``; here: what reaches the user, end to end.
 """
 
 import json

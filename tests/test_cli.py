@@ -400,7 +400,7 @@ def test_history_reads_peer_at2(shared_records: Path) -> None:
 
 
 def test_history_with_eq28_scales_only_the_amplified_mechanisms(tmp_path: Path) -> None:
-    from solver_service.core.codes import sf_eq28
+    from solver_service.codes.scale_factors import sf_eq28
     from solver_service.core.spectra import response_spectrum
 
     constants = tmp_path / "c.json"

@@ -23,21 +23,22 @@ from typer.testing import CliRunner
 
 from shared_schema.errors import InputError
 from shared_schema.io import load_constants
-from solver_service import ida
 from solver_service.cli import app
+from solver_service.cli.ida import parse_levels
 from solver_service.core.exact import simulate
 from solver_service.core.records import GroundMotion
-from solver_service.ida import (
+from solver_service.workflows import ida
+from solver_service.workflows.adapter import models_from_file
+from solver_service.workflows.ida import (
     MIN_TASK_S,
     PEAKS_FILE,
     TASK_S,
     available_cores,
-    parse_levels,
     plan_tasks,
     run_ida,
     task_seconds,
 )
-from solver_service.workflows.adapter import models_from_file
+from solver_service.workflows.ida import dask as ida_dask
 from solver_service.workflows.limits import TimeLimitExceeded, time_limit
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -314,7 +315,7 @@ def test_a_scheduler_without_workers_or_with_another_rockmech_is_a_clear_error(
     with distributed.LocalCluster(
         n_workers=1, processes=False, protocol="tcp", **NO_DASHBOARD
     ) as cluster:
-        monkeypatch.setattr(ida, "worker_version", lambda: "0.0.1")
+        monkeypatch.setattr(ida_dask, "worker_version", lambda: "0.0.1")
         with pytest.raises(InputError, match=r"runs rockmech 0\.0\.1, this machine"):
             run_ida(cf, motions[:1], [1.0], scheduler=cluster.scheduler_address)
 
@@ -359,7 +360,7 @@ def test_a_malformed_scheduler_address_is_refused_before_any_connection(
 
 @pytest.mark.parametrize("address", ["tcp://sched.example:8786", "10.0.0.5:8786", "tls://h:1"])
 def test_well_formed_addresses_pass_the_address_check(address: str) -> None:
-    ida._check_address(address)
+    ida_dask._check_address(address)
 
 
 def test_cli_ida_writes_json_csv_plot_and_peaks(tmp_path: Path, elcentro_path: Path) -> None:
@@ -477,7 +478,7 @@ def test_a_half_built_dask_future_says_nothing_when_collected(
     # a Dask run installs drops exactly that and passes every other unraisable error on.
     distributed = pytest.importorskip("distributed")
     seen: list[Any] = []
-    hook = ida._QuietHalfBuilt(seen.append)
+    hook = ida_dask._QuietHalfBuilt(seen.append)
     old = sys.unraisablehook
     sys.unraisablehook = hook
     try:
@@ -507,7 +508,7 @@ def _stopped_in_the_first_fill(
     """
     distributed = pytest.importorskip("distributed")
     calls: list[int] = []
-    fill = ida._DaskFeed.fill
+    fill = ida_dask._DaskFeed.fill
 
     def interrupted_fill(feed: Any) -> None:
         if not calls:
@@ -515,7 +516,7 @@ def _stopped_in_the_first_fill(
         fill(feed)
         calls.append(len(feed.running))  # reached: the signal did not cut the call
 
-    monkeypatch.setattr(ida._DaskFeed, "fill", interrupted_fill)
+    monkeypatch.setattr(ida_dask._DaskFeed, "fill", interrupted_fill)
     limited = time_limit(limit) if limit is not None else contextlib.nullcontext()
     with distributed.LocalCluster(
         n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", **NO_DASHBOARD

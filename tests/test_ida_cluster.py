@@ -58,7 +58,7 @@ def _dotted(tree: dict[str, Any], prefix: str = "") -> dict[str, Any]:
 def test_the_settings_docs_give_are_the_ones_rockmech_checks() -> None:
     from dask.config import collect_env
 
-    from solver_service.ida import DASK_SETTINGS, _same_setting
+    from solver_service.workflows.ida.dask import DASK_SETTINGS, _same_setting
 
     tree, env = _docs_settings()
     for given in (_dotted(tree), _dotted(collect_env(env))):  # read as Dask reads them

@@ -48,8 +48,8 @@ from shared_schema.site import read_site
 from shared_schema.spec import parse_spec
 from shared_schema.text import decode_text
 
-from ..core import codes
-from ..core.circ2019 import RECORD_POINTS, T_RECORD_MIN
+from ..codes import scale_factors as codes
+from ..codes.circ2019 import RECORD_POINTS, T_RECORD_MIN
 from ..core.envelope import (
     SERIAL_OMEGA,
     OverturningLibrary,
@@ -374,7 +374,7 @@ def run_spectrum(job: SpectrumJob, blobs: list[bytes], limits: dict[str, Any]) -
 def scale_factor_doc(
     request: Union[Eq28Request, Ec8Request, NzsRequest], limits: dict[str, Any]
 ) -> dict[str, Any]:
-    """Return a code or paper scale factor (``solver_service.core.codes``) with its inputs."""
+    """Return a code or paper scale factor (``codes.scale_factors``) with its inputs."""
     if isinstance(request, Ec8Request):
         return codes.sf_ec8(request.z, request.H, request.T_a, request.T_1, request.S)
     if isinstance(request, NzsRequest):

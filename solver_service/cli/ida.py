@@ -1,18 +1,22 @@
 """``rockmech ida``: incremental dynamic analysis, locally or on a Dask cluster.
 
-The command imports the IDA (``solver_service.ida``: planning, the local and Dask back
-ends) and its writer when it runs.
+The command imports the IDA (``solver_service.workflows.ida``: planning, the local and Dask
+back ends) and its writer when it runs; the ``--scales`` text is parsed here
+(``parse_levels``: a list or a log range).
 """
 
 from __future__ import annotations
 
 import contextlib
 import functools
+import math
+import re
 from pathlib import Path
 from typing import Optional
 
 import typer
 
+from shared_schema.errors import InputError
 from shared_schema.extras import require
 from shared_schema.rules import IM_MEASURES, PEAKS_FILE
 
@@ -33,7 +37,111 @@ from .options import (
 )
 from .output import choices, g4, out_note, print_json, record_warning, skipped_notes, table
 
-__all__ = ["ida"]
+__all__ = ["MAX_RANGE_LEVELS", "ida", "parse_levels"]
+
+MAX_RANGE_LEVELS = 1_000_000
+
+
+def _range_levels(text: str) -> list[float]:
+    """Levels of a log range ``start:stop:n``; each fault is named (issue #36).
+
+    Examples
+    --------
+    >>> [round(v, 6) for v in _range_levels("0.1:10:3")]
+    [0.1, 1.0, 10.0]
+    """
+    parts = text.split(":")
+    example = "e.g. 0.1:3:20 (20 levels from 0.1 to 3)"
+    if len(parts) != 3:
+        raise InputError(
+            f"a log range is three numbers start:stop:n, {example}; got {text!r} "
+            f"({len(parts)} parts)",
+            "scales",
+        )
+    names = ("start", "stop")
+    bounds = []
+    for name, part in zip(names, parts[:2]):
+        try:
+            value = float(part)
+        except ValueError:
+            raise InputError(
+                f"the range's {name} {part.strip()!r} is not a number, in {text!r}; {example}",
+                "scales",
+            ) from None
+        if not math.isfinite(value):
+            raise InputError(f"the range's {name} must be finite, got {part.strip()!r}", "scales")
+        bounds.append(value)
+    lo, hi = bounds
+    try:
+        count = int(parts[2])
+    except ValueError:
+        raise InputError(
+            f"the range's n (the number of levels, its third number) must be a whole number, "
+            f"got {parts[2].strip()!r} in {text!r}; {example}",
+            "scales",
+        ) from None
+    if count < 2:
+        raise InputError(
+            f"the range {text!r} asks for {count} levels: n (its third number) must be at "
+            f"least 2; for one level give the level itself ({parts[0].strip()})",
+            "scales",
+        )
+    if count > MAX_RANGE_LEVELS:
+        raise InputError(
+            f"the range {text!r} asks for {count} levels, more than {MAX_RANGE_LEVELS:,}; "
+            "n (its third number) is the number of levels",
+            "scales",
+        )
+    if lo <= 0.0:
+        raise InputError(
+            f"the range {text!r} starts at {lo:g}: a log range's start must be > 0 (levels "
+            "are spaced evenly on a log scale, and log 0 is -infinity); start at the smallest "
+            "intensity of interest, e.g. 0.05",
+            "scales",
+        )
+    if lo >= hi:
+        fix = (
+            f"write the smaller first, {parts[1].strip()}:{parts[0].strip()}:{count}"
+            if lo > hi
+            else "give a stop above the start"
+        )
+        raise InputError(
+            f"the range {text!r} starts at {lo:g} and stops at {hi:g}: the start must be "
+            f"below the stop; {fix}",
+            "scales",
+        )
+    import numpy as np  # here, not at the top: `rockmech --help` loads no numpy for this
+
+    return [float(v) for v in np.geomspace(lo, hi, count)]
+
+
+def parse_levels(text: str) -> list[float]:
+    """Parse intensity levels: ``"0.1,0.2,0.5"`` or a log range ``"0.1:3:20"`` (start:stop:n).
+
+    Raises
+    ------
+    InputError
+        Text that is neither form, a list with an empty item (``0.5,,1``: the position is
+        named, never skipped), or a range whose fault is named (``_range_levels``); field
+        ``scales``.
+    """
+    if ":" in text:
+        return _range_levels(text)
+    try:
+        items = re.split(r"\s*,\s*|\s+", text.strip()) if text.strip() else []
+        empty = [k for k, item in enumerate(items, start=1) if not item]
+        if not empty:
+            return [float(v) for v in items]
+    except ValueError:
+        raise InputError(
+            f"expected a list like 0.1,0.2,0.5 or a log range start:stop:n, got {text!r}",
+            "scales",
+        ) from None
+    # issue #25: "0.5,,1" was read as 0.5,1
+    raise InputError(
+        f"item {empty[0]} of {text!r} is empty; give one number between each two commas",
+        "scales",
+    )
 
 
 @user_errors
@@ -93,16 +201,16 @@ def ida(
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
-    # The IDA, its inputs and its writer are loaded when the command runs (#38).
-    from .. import ida as workflow
-
     # The solver's own check of a positive number.
     from ..core.model import check_positive
 
     # The readers and the writer of the IDA's files.
     from ..workflows import inputs, outputs, units
 
-    levels = workflow.parse_levels(scales)
+    # The IDA, its inputs and its writer are loaded when the command runs (#38).
+    from ..workflows.ida import run as workflow
+
+    levels = parse_levels(scales)
     limits.check(scales=len(levels))
     if out is not None:
         check_folder_target(out)

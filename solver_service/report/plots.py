@@ -361,7 +361,7 @@ def plot_fragility(doc: dict[str, Any], path: Union[str, Path], *, title: str = 
     Parameters
     ----------
     doc : dict
-        The document of ``solver_service.ida.run_ida``.
+        The document of ``solver_service.workflows.ida.run_ida``.
     path : str or Path
         Output file (.png or .svg); written atomically.
     title : str

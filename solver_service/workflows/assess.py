@@ -23,8 +23,8 @@ from shared_schema.paths import PathLike
 from shared_schema.rules import check_number
 from shared_schema.site import SiteFile
 
+from ..codes.hazard import ElasticSpectrum
 from ..core.exact import simulate
-from ..core.hazard import ElasticSpectrum
 from ..core.pulses import largest_pulse
 from ..core.spectra import response_spectrum
 from .adapter import to_rocking_model

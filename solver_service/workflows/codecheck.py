@@ -2,10 +2,10 @@
 
 ``check_doc`` runs, for every mechanism of a constants file and every stored side, the
 linear check (SLV, §C8.7.1.2.1.7) and the nonlinear check (SLV and SLC, §C8.7.1.2.1.6 and
-.8) of the Circolare 21 gennaio 2019 n. 7 (``core.circ2019``), or on request the 2009 forms
-(``core.kinematic``, ``method: "circ2009"``), against the site's NTC 2018 or EN 1998-1
+.8) of the Circolare 21 gennaio 2019 n. 7 (``codes.circ2019``), or on request the 2009 forms
+(``codes.circ2009``, ``method: "circ2009"``), against the site's NTC 2018 or EN 1998-1
 spectrum; mechanisms above ground get the floor spectrum of §C7.2.3
-(``core.floor_spectra``). This module makes the choices the text leaves to the engineer,
+(``codes.floor_spectra``). This module makes the choices the text leaves to the engineer,
 each from the site file (``local_mechanisms``, ``building``) or the text's default, and
 says in the document which one it made: the building's first period, which mechanisms are
 free-standing and their data, the ties (docs/theory.md §11). A mechanism that cannot be
@@ -24,7 +24,14 @@ from shared_schema.constants import ConstantsFile, Mechanism, SideConstants
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.site import MechanismOptions, SiteFile
 
-from ..core.circ2019 import (
+from ..codes.circ2009 import (
+    Building,
+    VirtualWork,
+    linear_check,
+    nonlinear_check,
+    participating_mass,
+)
+from ..codes.circ2019 import (
     CIRC2019,
     KAPPA_CANTILEVER,
     KAPPA_SIMPLY_SUPPORTED,
@@ -35,15 +42,8 @@ from ..core.circ2019 import (
     linear_check_2019,
     nonlinear_check_2019,
 )
-from ..core.floor_spectra import FloorModel, participation_first_mode
-from ..core.hazard import ElasticSpectrum, ec8_spectrum, ntc_spectrum
-from ..core.kinematic import (
-    Building,
-    VirtualWork,
-    linear_check,
-    nonlinear_check,
-    participating_mass,
-)
+from ..codes.floor_spectra import FloorModel, participation_first_mode
+from ..codes.hazard import ElasticSpectrum, ec8_spectrum, ntc_spectrum
 from ..core.model import G
 from .verdict import conclusion
 

@@ -14,9 +14,9 @@ import numpy as np
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile
 
-from ..ida import ida_csv
 from ..report.plots import plot_envelopes, plot_fragility, plot_ratio_histories, plot_record
 from .documents import envelope_doc, history_doc
+from .ida.document import ida_csv
 from .units import finite_json, stamp
 
 __all__ = [

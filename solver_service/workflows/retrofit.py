@@ -48,7 +48,7 @@ from shared_schema.retrofit import (
 )
 from shared_schema.site import MechanismOptions, SiteFile
 
-from ..core.circ2019 import CIRC2019
+from ..codes.circ2019 import CIRC2019
 from ..core.model import G
 from .codecheck import check_doc
 

@@ -14,7 +14,7 @@ from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError
 from shared_schema.rules import SF_METHODS, G, check_choice, check_non_negative, check_positive
 
-from ..core.codes import check_height, sf_ec8, sf_eq28, sf_nzs
+from ..codes.scale_factors import check_height, sf_ec8, sf_eq28, sf_nzs
 from ..core.exact import BatchResult, simulate, simulate_batch
 from ..core.spectra import response_spectrum
 from .adapter import to_rocking_model
@@ -38,7 +38,7 @@ class Building:
     ----------
     height : float, optional
         Height of the building above its foundation, ``H`` (EC8) or ``h_n`` (NZS) [m], > 0
-        and at most ``core.codes.BUILDING_HEIGHT_MAX_M``.
+        and at most ``codes.scale_factors.BUILDING_HEIGHT_MAX_M``.
     soil_factor : float
         EC8 soil factor ``S`` [-], > 0; 1 gives the bare amplification.
     element_period : float
@@ -104,7 +104,7 @@ def mechanism_scale_factor(
     Returns
     -------
     dict or None
-        ``{"value", "method", "formula", "inputs"}`` (``solver_service.core.codes``).
+        ``{"value", "method", "formula", "inputs"}`` (``solver_service.codes.scale_factors``).
     """
     check_choice(sf, SF_METHODS, "sf")
     amp = mech.amplification

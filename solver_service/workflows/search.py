@@ -60,9 +60,9 @@ from shared_schema.spec import SpecFile
 from shared_schema.text import decode_text
 from shared_schema.version import __version__
 
+from ..codes.floor_spectra import participation_first_mode
 from ..core.envelope import OverturningLibrary
 from ..core.exact import simulate, simulate_batch
-from ..core.floor_spectra import participation_first_mode
 from ..core.records import GroundMotion
 from ..report.search_figure import plot_search
 from .adapter import to_rocking_model

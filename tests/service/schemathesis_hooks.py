@@ -7,9 +7,9 @@ a setting of the server, which JSON Schema has no keyword for. Positive test cas
 break one are dropped here; negative test cases are left as they are, so the service still
 has to refuse them. Each rule is the service's own, called or mirrored, with its reason:
 
-- ``/scale-factor`` (``scale_factor_ok``): ``ec8``: ``z <= H`` (``core.codes.sf_ec8``; EN
+- ``/scale-factor`` (``scale_factor_ok``): ``ec8``: ``z <= H`` (``codes.scale_factors.sf_ec8``; EN
   1998-1 §4.3.5.2 has no element above the building), ``nzs``: ``h_i <= h_n``
-  (``core.codes.sf_nzs``; NZS 1170.5 §8.3 likewise); ``eq28`` from a record: at most
+  (``codes.scale_factors.sf_nzs``; NZS 1170.5 §8.3 likewise); ``eq28`` from a record: at most
   ``ROCKMECH_MAX_SAMPLES`` samples, and the spectrum at ``T_n = 1/f_n`` within the work
   bound: ``(samples - 1) * max(1, ceil(STEPS_PER_PERIOD * f_n * dt))`` closed-form steps at
   most ``WORK_PER_SAMPLE * ROCKMECH_MAX_SAMPLES`` (``api.jobs.check_record_work``): a period

@@ -13,7 +13,7 @@ from api_helpers import EXAMPLES, cli_json, without_runtime
 from servers import TEST_SETTINGS
 
 from shared_schema.export import build_schema
-from solver_service.core import codes
+from solver_service.codes import scale_factors as codes
 from solver_service.core.records import GroundMotion
 from solver_service.workflows.units import stamp
 

@@ -35,7 +35,8 @@ from shared_schema.errors import InputError
 from shared_schema.site import SiteFile
 from solver_service.api.jobs import history_options, scale_factor_doc
 from solver_service.cli import app
-from solver_service.core import codes, exact
+from solver_service.codes import scale_factors as codes
+from solver_service.core import exact
 from solver_service.core.records import GroundMotion
 from solver_service.report.html import check_history_options
 from solver_service.workflows import assess

@@ -30,5 +30,5 @@ router = APIRouter(tags=["solver"])
 async def scale_factor(
     request: Annotated[ScaleFactorRequest, json_body(ScaleFactorRequest)], pool: PoolDep
 ) -> Response:
-    """Return the factor, its formula and its inputs (``solver_service.core.codes``)."""
+    """Return the factor, its formula and its inputs (``solver_service.codes.scale_factors``)."""
     return await compute(pool, ScaleFactorJob(request=request))

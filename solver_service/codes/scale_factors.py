@@ -22,8 +22,8 @@ from typing import Any
 from shared_schema.errors import InputError
 from shared_schema.rules import BUILDING_HEIGHT_MAX_M
 
-from .amplification import scale_factor
-from .model import check_non_negative, check_positive
+from ..core.amplification import scale_factor
+from ..core.model import check_non_negative, check_positive
 
 __all__ = ["BUILDING_HEIGHT_MAX_M", "check_height", "sf_ec8", "sf_eq28", "sf_nzs"]
 

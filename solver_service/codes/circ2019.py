@@ -53,6 +53,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.errors import InputError
 
+from ..core.model import G, check_number, check_positive
+from ..core.spectra import response_spectrum
+from .circ2009 import VirtualWork, participating_mass
 from .floor_spectra import (
     FLOOR_A,
     FLOOR_B,
@@ -62,9 +65,6 @@ from .floor_spectra import (
     floor_spectrum,
 )
 from .hazard import ElasticSpectrum
-from .kinematic import VirtualWork, participating_mass
-from .model import G, check_number, check_positive
-from .spectra import response_spectrum
 
 __all__ = [
     "CIRC2019",

@@ -10,14 +10,14 @@ from cad_maths.geometry.massprops import MassProps
 from cad_maths.mechanisms.loaded import _constants
 from cad_maths.mechanisms.single import Body, rocking_side
 from shared_schema.errors import InputError
-from solver_service.core.hazard import ec8_spectrum, ntc_spectrum
-from solver_service.core.kinematic import (
+from solver_service.codes.circ2009 import (
     Building,
     VirtualWork,
     linear_check,
     nonlinear_check,
     participating_mass,
 )
+from solver_service.codes.hazard import ec8_spectrum, ntc_spectrum
 
 G = 9.80665
 
@@ -109,7 +109,7 @@ def test_hand_worked_loaded_wall() -> None:
     assert vw["alpha0"] == pytest.approx(alpha0_hand, rel=1e-9)
     # Circ. 2019 [C8.7.1.5] by blocks: the wall and what it carries are one term.
     assert vw["J_blocks"] == pytest.approx(s_hand**2 / 12140.0, rel=1e-9)
-    # The 2009 forms (core.kinematic) sum over the solid, as before.
+    # The 2009 forms (codes.circ2009) sum over the solid, as before.
     integral = VirtualWork(vw["alpha0"], vw["mass"], vw["S"], vw["J"])
     out = linear_check(integral, ntc_spectrum(0.15, 2.5, 0.3), FC=1.35)
     e_hand = s_hand**2 / j_hand / 12140.0

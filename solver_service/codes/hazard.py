@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.errors import InputError
 
-from .model import G, check_non_negative, check_positive
+from ..core.model import G, check_non_negative, check_positive
 
 __all__ = [
     "EC8_TABLE",

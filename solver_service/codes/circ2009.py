@@ -1,7 +1,7 @@
 """The 2009 forms of the kinematic checks (Circolare 617/2009 C8A.4; theory §11.8).
 
 Kept for comparison only (``local_mechanisms.method: "circ2009"``); the checks rockmech
-runs by default are the Circolare 2019's (``core.circ2019``). Also the virtual-work
+runs by default are the Circolare 2019's (``codes.circ2019``). Also the virtual-work
 quantities both use (``VirtualWork``, ``participating_mass``; theory §11.1).
 
 Pure numerics: the virtual-work quantities of a mechanism side (``alpha0``, ``mass``, ``S``,
@@ -32,8 +32,8 @@ import numpy as np
 
 from shared_schema.errors import InputError
 
+from ..core.model import G, check_number, check_positive
 from .hazard import ElasticSpectrum
-from .model import G, check_number, check_positive
 
 __all__ = [
     "DS_FRACTION",

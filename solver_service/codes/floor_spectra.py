@@ -46,8 +46,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.errors import InputError
 
+from ..core.model import G, check_non_negative, check_positive
 from .hazard import damping_eta
-from .model import G, check_non_negative, check_positive
 
 __all__ = [
     "FLOOR_A",

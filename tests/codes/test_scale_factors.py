@@ -7,8 +7,8 @@ import doctest
 import pytest
 
 from shared_schema.errors import InputError
-from solver_service.core import codes
-from solver_service.core.codes import sf_ec8, sf_eq28, sf_nzs
+from solver_service.codes import scale_factors as codes
+from solver_service.codes.scale_factors import sf_ec8, sf_eq28, sf_nzs
 
 
 @pytest.mark.parametrize(("pga_g", "expected"), [(0.155, 1.595), (0.158, 1.576)])

@@ -19,8 +19,8 @@ import pytest
 from shared_schema.constants import parse_constants
 from shared_schema.errors import InputError
 from shared_schema.site import parse_site
-from solver_service.core.floor_spectra import FloorModel, floor_displacement, floor_spectrum
-from solver_service.core.hazard import ntc_spectrum
+from solver_service.codes.floor_spectra import FloorModel, floor_displacement, floor_spectrum
+from solver_service.codes.hazard import ntc_spectrum
 from solver_service.workflows.codecheck import check_doc
 
 G = 9.80665
@@ -525,7 +525,8 @@ def test_issue_t1_and_long_period_numbers_with_the_2009_forms() -> None:
 
 def test_records_demand_is_the_largest_over_t0_to_t_slv() -> None:
     """A record with its energy at 0.8 s: the largest S_De over [T0, T_SLV] is there."""
-    from solver_service.core.circ2019 import (
+    from solver_service.codes.circ2009 import VirtualWork
+    from solver_service.codes.circ2019 import (
         RECORD_POINTS,
         CapacityCurve,
         CodeDemand,
@@ -533,7 +534,6 @@ def test_records_demand_is_the_largest_over_t0_to_t_slv() -> None:
         RecordDemand,
         nonlinear_check_2019,
     )
-    from solver_service.core.kinematic import VirtualWork
     from solver_service.core.spectra import response_spectrum
 
     b, h, m = 0.5, 6.0, RHO * 0.5 * 6.0 * 4.0
