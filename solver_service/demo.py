@@ -110,7 +110,7 @@ def copy_examples(
         and "__pycache__" not in p.parts
         and not any(p.match(pattern) for pattern in _NOT_EXAMPLES)
     )
-    with run_folder(dest, on_note=on_note) as stage:
+    with run_folder(dest, on_note=on_note, command="examples") as stage:
         for path in files:
             target = stage / path.relative_to(source)
             target.parent.mkdir(parents=True, exist_ok=True)

@@ -77,7 +77,7 @@ def envelope(
     kind = "exact envelopes" if method == "exact" else "envelopes (fast mode, library)"
     with (
         status(f"{kind}: {len(cf.mechanisms)} mechanisms x {frequencies.n} frequencies"),
-        run_folder(out, on_note=out_note) as tmp,
+        run_folder(out, on_note=out_note, command="envelope") as tmp,
     ):
         doc = outputs.write_envelope(
             cf,

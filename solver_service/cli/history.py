@@ -104,7 +104,7 @@ def history(
     runs = len(factors) * len(cf.mechanisms)
     with status(f"history: {runs} runs of {motion.name}"):
         if out is not None:
-            with run_folder(out, on_note=out_note) as tmp:
+            with run_folder(out, on_note=out_note, command="history") as tmp:
                 doc = outputs.write_history(cf, motion, factors, tmp, **options)
         else:
             doc = documents.history_doc(cf, motion, factors, **options)
@@ -177,7 +177,7 @@ def record_info(
             motion, periods, zeta, n_pulses=pulses, f_min=f_min, f_max=f_max
         )
     if out is not None:
-        with run_folder(out, on_note=out_note) as tmp:
+        with run_folder(out, on_note=out_note, command="record") as tmp:
             outputs.write_record(motion, doc, spectrum, found, tmp)
     if as_json:
         print_json(doc)

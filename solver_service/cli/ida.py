@@ -247,7 +247,7 @@ def ida(
         # With --peaks the output folder's stage is open during the run (the peaks stream
         # into it); a stopped run leaves the folder as it was.
         with contextlib.ExitStack() as stack:
-            folder = functools.partial(run_folder, on_note=out_note)
+            folder = functools.partial(run_folder, on_note=out_note, command="ida")
             stage = stack.enter_context(folder(out)) if out is not None and peaks else None
             with bar:
                 doc = workflow.run_ida(

@@ -86,7 +86,7 @@ def retrofit(
         doc = retrofit_doc(cf, site_file, rspec)
     if out is not None:
         # Only retrofit.json is replaced: the other outputs in the folder stay.
-        with run_folder(out, on_note=out_note, keep_others=True) as tmp:
+        with run_folder(out, on_note=out_note, command="retrofit") as tmp:
             write_retrofit(tmp, doc)
     if as_json:
         typer.echo(retrofit_json(doc), nl=False)

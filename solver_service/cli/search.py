@@ -164,7 +164,7 @@ def search(
             exact=exact,
             limits=not limits.no_limits,
         )
-        with run_folder(out, on_note=out_note) as tmp:
+        with run_folder(out, on_note=out_note, command="search") as tmp:
             write_search(run, tmp, figure=figure)
     doc = run.doc
     for warning in doc["warnings"]:

@@ -90,7 +90,7 @@ def demo(
     # The demo's analyses are loaded when the command runs (#38).
     from ..demo import run_demo
 
-    with run_folder(out, on_note=out_note) as tmp:
+    with run_folder(out, on_note=out_note, command="demo") as tmp:
         written = run_demo(tmp, record, on_skip=lambda text: note(f"note: {text}"))
     paths = {kind: out / path.relative_to(tmp) for kind, path in written.items()}
     for kind, path in paths.items():

@@ -2,10 +2,12 @@
 
 The folder a user names with ``--out`` may hold anything: notes, field data, a whole
 ``~/Documents``. A run writes into it only the files it makes itself, and keeps a list of
-them, with their SHA-256, in a small manifest, ``<out>/.rockmech/manifest.json``. The next
-run into the same folder replaces those files and removes the ones it no longer writes,
-**only where they are still as rockmech wrote them**; every other file and folder is left
-byte for byte as it was.
+them, with their SHA-256 and the command that wrote them, in a small manifest,
+``<out>/.rockmech/manifest.json``. The next run of the same command into the same folder
+replaces those files and removes the ones it no longer writes, **only where they are still as
+rockmech wrote them**; the files of other commands stay (a ``rockmech envelope`` run into the
+folder of a ``rockmech history`` run keeps the history's files), and every other file and
+folder is left byte for byte as it was.
 
 How a run is written (``run_folder``):
 
@@ -217,6 +219,16 @@ def _read_json(path: Path) -> dict[str, Any]:
     return doc
 
 
+def _owners(out: Path) -> dict[str, str]:
+    """Return which command wrote each of rockmech's files in ``out`` (relative path -> name).
+
+    Files listed by a manifest that predates the record of commands have no entry: they
+    belong to no command, so no run removes them unless it writes them anew.
+    """
+    owners = _read_json(out / STATE_DIR / MANIFEST_NAME).get("commands", {})
+    return {str(k): str(v) for k, v in owners.items()} if isinstance(owners, dict) else {}
+
+
 def owned_files(out: Union[str, Path]) -> dict[str, str]:
     """Return the files rockmech wrote in ``out``: relative POSIX path -> SHA-256.
 
@@ -385,20 +397,21 @@ def _conflicts(out: Path, new: dict[str, str], old: dict[str, str]) -> str:
     return ""
 
 
-def _commit(out: Path, stage: Path, token: str, field: str, keep_others: bool = False) -> list[str]:
+def _commit(out: Path, stage: Path, token: str, field: str, command: str) -> list[str]:
     """Swap the stage's files into ``out`` as a set; return notes for the user.
 
-    With ``keep_others`` the files of earlier runs that this run does not write stay (and
-    stay listed as rockmech's); otherwise they are removed where still as rockmech wrote them.
+    The files the earlier runs of ``command`` wrote and this run does not are removed where
+    still as rockmech wrote them; the files of other commands stay, listed as theirs.
     """
     state = out / STATE_DIR
     notes: list[str] = []
     _recover_locked(out)
-    old: dict[str, str] = dict(owned_files(out))
+    every: dict[str, str] = dict(owned_files(out))
+    owners = _owners(out)
     new = _staged(stage)
-    kept_files = {k: v for k, v in old.items() if k not in new} if keep_others else {}
-    if keep_others:
-        old = {k: v for k, v in old.items() if k in new}
+    old = {k: v for k, v in every.items() if k in new or owners.get(k) == command}
+    kept_files = {k: v for k, v in every.items() if k not in old}
+    kept_owners = {k: owners[k] for k in kept_files if k in owners}
     why = _conflicts(out, new, old)
     if why:
         raise InputError(f"{why}: move it away or give another folder; nothing was written", field)
@@ -439,6 +452,7 @@ def _commit(out: Path, stage: Path, token: str, field: str, keep_others: bool = 
             "rockmech": __version__,
             "run": token,
             "files": {**kept_files, **new},
+            "commands": {**kept_owners, **dict.fromkeys(new, command)},
         }
         write_atomic(state / MANIFEST_NAME, json.dumps(done, indent=1) + "\n")  # commit point
     except BaseException:
@@ -454,13 +468,14 @@ def run_folder(
     out: Union[str, Path],
     field: str = "out",
     on_note: Optional[Callable[[str], None]] = None,
-    keep_others: bool = False,
+    command: str = "",
 ) -> Iterator[Path]:
     """Yield a fresh stage folder to write a run into; on success its files go into ``out``.
 
-    Only the files the run writes, and the files earlier runs wrote there (listed in the
-    folder's manifest and unchanged since), are replaced or removed: everything else in
-    ``out`` stays as it was. See the module's docstring for how the set is swapped.
+    Only the files the run writes, and the files earlier runs of the same command wrote
+    there (listed in the folder's manifest and unchanged since), are replaced or removed:
+    everything else in ``out`` stays as it was, the other commands' outputs included. See
+    the module's docstring for how the set is swapped.
 
     Parameters
     ----------
@@ -472,10 +487,10 @@ def run_folder(
         Called with each note for the user (a swap a killed run left and that this run
         ended, an old output the user changed and that is left as it is). Without it the
         notes are issued as ``UserWarning``.
-    keep_others : bool
-        Keep the outputs of earlier runs that this run does not write (a command that adds
-        one file to a run's folder, ``rockmech retrofit``'s ``retrofit.json``); by default
-        the run's files replace the earlier set.
+    command : str
+        The command that writes the run (``"search"``, ``"history"``, ...), recorded in the
+        manifest: a run replaces the set its own command wrote there before and keeps the
+        other commands' files.
 
     Raises
     ------
@@ -521,7 +536,7 @@ def run_folder(
     try:
         yield stage
         with _locked(state / LOCK_NAME, LOCK_WAIT_S, "writing to", field):
-            notes = _commit(target, stage, token, field, keep_others)
+            notes = _commit(target, stage, token, field, command)
     except OSError as exc:
         raise InputError(f"cannot write to {target}: {os_reason(exc)}", field) from None
     finally:

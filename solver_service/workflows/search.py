@@ -1116,7 +1116,7 @@ def save_search(run: SearchRun, out: PathLike, *, figure: bool = True) -> list[P
     """
     out = as_path(out, "out")
     notes: list[str] = []
-    with run_folder(out, on_note=notes.append) as tmp:
+    with run_folder(out, on_note=notes.append, command="search") as tmp:
         names = [p.name for p in write_search(run, tmp, figure=figure)]
     for note in notes:
         warnings.warn(note, UserWarning, stacklevel=2)

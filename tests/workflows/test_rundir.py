@@ -311,7 +311,7 @@ def _killed_run(k: int, argv: list[str]) -> tuple[int, int]:
 
 def _old_set(folder: Path) -> None:
     """Outputs of an earlier run: two the new run replaces and one it no longer writes."""
-    with run_folder(folder) as tmp:
+    with run_folder(folder, command="envelope") as tmp:
         (tmp / "envelope.json").write_text('{"old": true}')
         (tmp / "envelope.csv").write_text("old\n")
         (tmp / "legacy").mkdir()
@@ -355,6 +355,51 @@ def test_a_run_killed_at_any_step_leaves_the_old_set_or_the_new_one(tmp_path: Pa
         _assert_foreign_intact(out)
         assert _outputs(out) == new, k
     assert seen == {"old", "new"}  # the kills fell on both sides of the commit point
+
+
+def test_a_command_keeps_the_other_commands_outputs(tmp_path: Path) -> None:
+    _plant(tmp_path)
+    with run_folder(tmp_path, command="history") as tmp:
+        (tmp / "history.json").write_text("h1")
+        (tmp / "history.csv").write_text("h1")
+    with run_folder(tmp_path, command="envelope") as tmp:
+        (tmp / "envelope.json").write_text("e1")
+    # The envelope run adds its file and keeps the history's.
+    assert _outputs(tmp_path) == {
+        "history.json": b"h1",
+        "history.csv": b"h1",
+        "envelope.json": b"e1",
+    }
+    # A second history run replaces the history's set (history.csv is no longer written)
+    # and keeps the envelope's file.
+    with run_folder(tmp_path, command="history") as tmp:
+        (tmp / "history.json").write_text("h2")
+    assert _outputs(tmp_path) == {"history.json": b"h2", "envelope.json": b"e1"}
+    _assert_foreign_intact(tmp_path)
+    owners = json.loads((tmp_path / STATE_DIR / "manifest.json").read_text())["commands"]
+    assert owners == {"history.json": "history", "envelope.json": "envelope"}
+    # A file one command wrote and another writes anew changes hands.
+    with run_folder(tmp_path, command="envelope") as tmp:
+        (tmp / "history.json").write_text("e2")
+        (tmp / "envelope.json").write_text("e2")
+    owners = json.loads((tmp_path / STATE_DIR / "manifest.json").read_text())["commands"]
+    assert owners == {"history.json": "envelope", "envelope.json": "envelope"}
+    assert set(owned_files(tmp_path)) == {"history.json", "envelope.json"}
+
+
+def test_a_manifest_without_commands_loses_nothing(tmp_path: Path) -> None:
+    """Files listed by an older manifest (no commands recorded) are kept unless rewritten."""
+    with run_folder(tmp_path) as tmp:
+        (tmp / "a.json").write_text("1")
+        (tmp / "b.json").write_text("1")
+    manifest = tmp_path / STATE_DIR / "manifest.json"
+    doc = json.loads(manifest.read_text())
+    del doc["commands"]
+    manifest.write_text(json.dumps(doc))
+    with run_folder(tmp_path, command="search") as tmp:
+        (tmp / "a.json").write_text("2")
+    assert _outputs(tmp_path) == {"a.json": b"2", "b.json": b"1"}
+    assert set(owned_files(tmp_path)) == {"a.json", "b.json"}
 
 
 def test_the_manifest_names_the_producing_version(tmp_path: Path) -> None:
