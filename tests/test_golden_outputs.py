@@ -2,7 +2,8 @@
 
 Every command of the ``rockmech`` command line that gives a JSON document runs on the bundled
 examples, and its document is compared with ``tests/golden/outputs.json``: every text, key and
-integer exactly, every float to ``FLOAT_RTOL`` (1e-12: the last bits of a float depend on the
+integer exactly, the order of the keys and the type of every value (``1`` is not ``1.0``), every
+float to ``FLOAT_RTOL`` (1e-12: the last bits of a float depend on the
 machine's vector instructions, not on the code). Only what
 depends on the clock or the machine is left out (``TIMING_KEYS``). A refactoring keeps this
 test green without touching the file; a change that means to change results regenerates it
@@ -114,6 +115,9 @@ def _differences(old: Any, new: Any, where: str = "") -> list[str]:
     if isinstance(old, dict) and isinstance(new, dict):
         out = [f"{where}.{k}: only before" for k in old.keys() - new.keys()]
         out += [f"{where}.{k}: only after" for k in new.keys() - old.keys()]
+        before, after = [k for k in old if k in new], [k for k in new if k in old]
+        if before != after:
+            out.append(f"{where}: keys in another order: {before} -> {after}")
         for k in old.keys() & new.keys():
             out += _differences(old[k], new[k], f"{where}.{k}")
         return out
@@ -121,6 +125,9 @@ def _differences(old: Any, new: Any, where: str = "") -> list[str]:
         return [
             d for i, (a, b) in enumerate(zip(old, new)) for d in _differences(a, b, f"{where}[{i}]")
         ]
+    if type(old) is not type(new):  # 1 and 1.0 are different documents
+        was, now = type(old).__name__, type(new).__name__
+        return [f"{where}: {was} {str(old)[:60]} -> {now} {str(new)[:60]}"]
     if isinstance(old, float) and isinstance(new, float) and old != new:
         if abs(old - new) <= FLOAT_RTOL * max(abs(old), abs(new), FLOAT_FLOOR):
             return []
@@ -150,7 +157,8 @@ if __name__ == "__main__":
         documents = run_all(Path(d))
     GOLDEN.parent.mkdir(exist_ok=True)
     # One line per document (git stores it compressed; the test prints the differences).
-    lines = [f" {json.dumps(k)}: {json.dumps(v, sort_keys=True)}" for k, v in documents.items()]
+    # The keys in the order the document has them: the test compares that order too.
+    lines = [f" {json.dumps(k)}: {json.dumps(v)}" for k, v in documents.items()]
     about = "tests/test_golden_outputs.py: the fixed set's documents, bit for bit"
     text = '{"about": ' + json.dumps(about) + ',\n"documents": {\n' + ",\n".join(lines) + "\n}}\n"
     GOLDEN.write_text(text, encoding="utf-8")
