@@ -318,6 +318,7 @@ def _old_set(folder: Path) -> None:
         (tmp / "legacy" / "old_only.txt").write_text("old only\n")
 
 
+@pytest.mark.slow  # one run killed at each of its file changes: a minute or more
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="kills a forked child (POSIX only)")
 def test_a_run_killed_at_any_step_leaves_the_old_set_or_the_new_one(tmp_path: Path) -> None:
     argv = ["envelope", str(CHURCH), "--n", "12", "--fast", "--out"]  # the files, not the maths
