@@ -15,6 +15,9 @@ The document holds, per mechanism, the least tie force that makes the Circolare 
 pass, the criterion that governs it, the bar, the anchorage check, the steel mass, and the
 checks before and after with their clauses.
 
+The spec's JSON Schema is ``shared_schema/jsonschema/retrofit.schema.json``
+(``python -m shared_schema.export``).
+
 The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` forms.
 """
 
