@@ -143,6 +143,13 @@ def test_every_endpoint_and_hops_component_names_units_and_version(
         ("POST", "/api/v1/assess"): {
             "json": {"constants": geometry, "site": site, "records": [record], "multiples": [1]}
         },
+        ("POST", "/api/v1/retrofit"): {
+            "json": {
+                "constants": geometry,
+                "site": site,
+                "spec": json.loads(RETROFIT_SPEC.read_text()),
+            }
+        },
         ("POST", "/api/v1/search"): {
             "files": {
                 "scene": (SEARCH_SCENE.name, SEARCH_SCENE.read_bytes(), "application/octet-stream"),
