@@ -11,10 +11,11 @@ keeps a mechanism's section on one page where it fits. ``print_pdf`` prints the 
 with headless Chromium.
 
 With a retrofit (``rockmech assess --retrofit``: a retrofit spec, or the ``retrofit.json``
-``rockmech retrofit`` wrote), page one also carries the retrofit table: per mechanism the tie
+``rockmech retrofit`` wrote), page one ends with the retrofit table: per mechanism the tie
 that makes it pass (bars, diameter, grade, height, ``T*``, the governing criterion) and its
-least ``a_g,X/a_g`` before and with the tie, with one sentence each; the document then holds
-the retrofit document under ``retrofit``.
+least ``a_g,X/a_g`` before and with the tie, a mark where the records raise the demand above
+the spectrum's the tie was sized on; a section after page one gives one sentence each, the
+steel and the anchorage's source. The document then holds the retrofit under ``retrofit``.
 
 A folder given as ``template_dir`` overrides the packaged ``assess.html.j2`` (a firm's
 layout); it receives the same context.
@@ -952,6 +953,10 @@ def render_assessment(
     return _render(template_dir, context)
 
 
+#: The colour of a retrofit status on page one (the others, in red: no tie makes it pass).
+_RETROFIT_CLASS = {"designed": "ok", "passes": "ok", "not_checked": "na", "not_evaluated": "na"}
+
+
 def _kn(value: Optional[float]) -> str:
     return "–" if value is None else sig(value / 1e3, 3)
 
@@ -993,7 +998,7 @@ def _retrofit_context(
                     if r.after_label in ("", r.before_label)
                     else f"{r.before_label} → {r.after_label}"
                 ),
-                "cls": "ok" if r.status in ("designed", "passes") else "ko",
+                "cls": _RETROFIT_CLASS.get(r.status, "ko"),
                 "sentence": r.sentence,
                 "records_note": notes.get(r.id, ""),
             }
