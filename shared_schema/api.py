@@ -31,6 +31,7 @@ from pydantic_core import PydanticCustomError
 
 from shared_schema.constants import Amplification, ConstantsFile, JsonInt, Mechanism
 from shared_schema.errors import InputError
+from shared_schema.retrofit import RetrofitDoc, RetrofitSpec
 from shared_schema.rules import (
     A_P_G_MAX,
     ACCEL_MAX_G,
@@ -99,6 +100,8 @@ __all__ = [
     "ReportForm",
     "ReportOptions",
     "ReportRequest",
+    "RetrofitRequest",
+    "RetrofitResponse",
     "ScaleFactorRequest",
     "ScaleFactorResponse",
     "SearchForm",
@@ -883,6 +886,23 @@ class CheckRequest(BaseModel):
     site: SiteFile = Field(description="The site file (SITE.json): hazard, FC, q, building.")
 
 
+class RetrofitRequest(BaseModel):
+    """Tie-bars for the mechanisms that fail the 2019 checks (``rockmech retrofit``)."""
+
+    model_config = _REQUEST
+
+    constants: ConstantsFile = Field(
+        description="The kinematic-constants file; mechanisms need virtual_work and their "
+        "geometry (hinge, centre of mass) for a tie to be put on them."
+    )
+    site: SiteFile = Field(description="The site file (SITE.json): hazard, FC, q, building.")
+    spec: RetrofitSpec = Field(
+        description="The retrofit spec: steel grade and bar diameters [mm], one tie's "
+        "anchorage resistance [N] with its source, candidate tie heights per mechanism [m] "
+        "(schema: shared_schema/jsonschema/retrofit.schema.json)."
+    )
+
+
 class AssessRequest(BaseModel):
     """Code checks beside rocking dynamics on records scaled to the site (``rockmech assess``)."""
 
@@ -1240,6 +1260,9 @@ class AssessResponse(CheckResponse):
     )
     multiples: List[Optional[float]] = Field(description="Multiples of the design scale run.")
 
+
+#: The retrofit endpoint answers with the retrofit document (``retrofit.json``).
+RetrofitResponse = RetrofitDoc
 
 #: The constants endpoint answers with a kinematic-constants file.
 ConstantsResponse = ConstantsFile

@@ -1,11 +1,12 @@
-"""Export the JSON Schemas of the constants file, the site file, the search and mechanism specs.
+"""Export the JSON Schemas of the input files: constants, site, search, mechanism, retrofit.
 
 Run ``python -m shared_schema.export`` after changing ``shared_schema.constants``,
-``shared_schema.site``, ``shared_schema.search`` or ``shared_schema.spec``; it writes
+``shared_schema.site``, ``shared_schema.search``, ``shared_schema.spec`` or
+``shared_schema.retrofit``; it writes
 ``shared_schema/jsonschema/kinematic_constants.schema.json``,
-``shared_schema/jsonschema/site.schema.json``, ``shared_schema/jsonschema/search.schema.json``
-and ``shared_schema/jsonschema/spec.schema.json`` (one ``oneOf`` branch per typology, from
-``shared_schema.spec.TYPOLOGY_SPECS``).
+``shared_schema/jsonschema/site.schema.json``, ``shared_schema/jsonschema/search.schema.json``,
+``shared_schema/jsonschema/spec.schema.json`` (one ``oneOf`` branch per typology, from
+``shared_schema.spec.TYPOLOGY_SPECS``) and ``shared_schema/jsonschema/retrofit.schema.json``.
 With ``--check`` it writes nothing and exits 1 when a file on disk differs from the models (a
 test does the same).
 """
@@ -20,20 +21,24 @@ from pydantic import BaseModel
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.io import write_atomic
+from shared_schema.retrofit import RetrofitSpec
 from shared_schema.search import SearchSpec
 from shared_schema.site import SiteFile
 from shared_schema.spec import SpecFile
 
 __all__ = [
+    "RETROFIT_SCHEMA_PATH",
     "SCHEMA_PATH",
     "SEARCH_SCHEMA_PATH",
     "SITE_SCHEMA_PATH",
     "SPEC_SCHEMA_PATH",
+    "build_retrofit_schema",
     "build_schema",
     "build_search_schema",
     "build_site_schema",
     "build_spec_schema",
     "main",
+    "render_retrofit_schema",
     "render_schema",
     "render_search_schema",
     "render_site_schema",
@@ -51,6 +56,9 @@ SEARCH_SCHEMA_PATH = SCHEMA_PATH.parent / "search.schema.json"
 
 #: Where the exported mechanism-spec schema lives.
 SPEC_SCHEMA_PATH = SCHEMA_PATH.parent / "spec.schema.json"
+
+#: Where the exported retrofit-spec schema lives.
+RETROFIT_SCHEMA_PATH = SCHEMA_PATH.parent / "retrofit.schema.json"
 
 #: JSON Schema dialect pydantic generates.
 DIALECT = "https://json-schema.org/draft/2020-12/schema"
@@ -124,6 +132,16 @@ def render_spec_schema() -> str:
     return json.dumps(build_spec_schema(), sort_keys=True, indent=2, ensure_ascii=False) + "\n"
 
 
+def build_retrofit_schema() -> Dict[str, Any]:
+    """Return the JSON Schema of ``RetrofitSpec`` (draft 2020-12) as a dict."""
+    return _schema_of(RetrofitSpec, "rockmech retrofit spec")
+
+
+def render_retrofit_schema() -> str:
+    """Return the retrofit-spec schema as the text stored on disk."""
+    return json.dumps(build_retrofit_schema(), sort_keys=True, indent=2, ensure_ascii=False) + "\n"
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     """Write the schema files, or with ``--check`` report whether they are up to date.
 
@@ -164,12 +182,19 @@ def main(argv: Optional[List[str]] = None) -> int:
         default=SPEC_SCHEMA_PATH,
         help=f"mechanism-spec schema file (default: {SPEC_SCHEMA_PATH})",
     )
+    parser.add_argument(
+        "--retrofit-output",
+        type=Path,
+        default=RETROFIT_SCHEMA_PATH,
+        help=f"retrofit-spec schema file (default: {RETROFIT_SCHEMA_PATH})",
+    )
     args = parser.parse_args(argv)
     pairs = (
         (Path(args.output), render_schema()),
         (Path(args.site_output), render_site_schema()),
         (Path(args.search_output), render_search_schema()),
         (Path(args.spec_output), render_spec_schema()),
+        (Path(args.retrofit_output), render_retrofit_schema()),
     )
     status = 0
     for output, text in pairs:

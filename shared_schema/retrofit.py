@@ -15,6 +15,9 @@ The document holds, per mechanism, the least tie force that makes the Circolare 
 pass, the criterion that governs it, the bar, the anchorage check, the steel mass, and the
 checks before and after with their clauses.
 
+The spec's JSON Schema is ``shared_schema/jsonschema/retrofit.schema.json``
+(``python -m shared_schema.export``).
+
 The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` forms.
 """
 
@@ -26,10 +29,12 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator
 from shared_schema.constants import validate_document
 from shared_schema.errors import InputError
 from shared_schema.paths import readable_file
+from shared_schema.version import __version__
 
 __all__ = [
     "ANCHORAGE_MAX_N",
     "GAMMA_M0",
+    "RETROFIT_UNITS",
     "STEEL_DENSITY",
     "STEEL_GRADES",
     "Anchorage",
@@ -366,11 +371,55 @@ class MechanismRetrofit(BaseModel):
     decisions: List[str] = Field(default_factory=list)
 
 
+#: The units of the retrofit document's quantities whose names do not state them (a name
+#: ending in ``_N``, ``_m``, ``_mm``, ``_kg`` states its own; ``-`` is dimensionless): the
+#: ``units`` block every rockmech document carries (``solver_service.workflows.units``).
+RETROFIT_UNITS: Dict[str, str] = {
+    "T_linear_N": "N",
+    "T_nonlinear_SLV_N": "N",
+    "T_nonlinear_SLC_N": "N",
+    "T_star_N": "N",
+    "capacity_N": "N",
+    "force_N": "N",
+    "N_pl_Rd_N": "N",
+    "height_m": "m",
+    "length_m": "m",
+    "diameter_mm": "mm",
+    "diameters_mm": "mm",
+    "area_mm2": "mm2",
+    "f_yk": "N/mm2",
+    "f_tk": "N/mm2",
+    "gamma_M0": "-",
+    "utilisation": "-",
+    "steel_mass_kg": "kg",
+    "steel_mass_per_m_kg": "kg/m",
+    "density_kg_m3": "kg/m3",
+    "linear_ratio": "-",
+    "SLV_ratio": "-",
+    "SLC_ratio": "-",
+    "alpha0": "-",
+    "e_star": "-",
+}
+
+
 class RetrofitDoc(BaseModel):
-    """The retrofit document: per mechanism the least tie force and what it takes."""
+    """The retrofit document: per mechanism the least tie force and what it takes.
+
+    Like every rockmech document it starts with ``rockmech_version`` (the version that wrote
+    it) and ``units`` (``RETROFIT_UNITS``), both filled in when the document is made.
+    """
 
     model_config = _DOC
 
+    rockmech_version: str = Field(
+        default_factory=lambda: __version__,
+        max_length=100,
+        description="Version of rockmech that wrote the document.",
+    )
+    units: Dict[str, str] = Field(
+        default_factory=lambda: dict(RETROFIT_UNITS),
+        description="Unit of each quantity whose name does not state it ('-': none).",
+    )
     standard: str
     steel: Dict[str, Any]
     decisions: List[str]

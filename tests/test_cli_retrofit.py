@@ -117,6 +117,39 @@ def test_the_file_is_the_python_apis_document(wall: dict[str, Path], tmp_path: P
     ).encode("utf-8")
 
 
+def test_the_document_is_stamped_like_every_other(wall: dict[str, Path]) -> None:
+    from shared_schema.version import __version__
+    from solver_service.workflows.retrofit_files import parse_retrofit_doc
+    from solver_service.workflows.units import DOCUMENT_UNITS
+
+    res = runner.invoke(app, _args(wall, "--json"))
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    # The version and the units first, as ``workflows.units.stamp`` puts them.
+    assert list(doc)[:2] == ["rockmech_version", "units"]
+    assert doc["rockmech_version"] == __version__
+    assert doc["units"] == DOCUMENT_UNITS["retrofit"]
+    assert doc["units"]["T_star_N"] == "N" and doc["units"]["f_yk"] == "N/mm2"
+    # Every number whose name does not end in its unit has one in the block (counts aside).
+    unnamed: set[str] = set()
+
+    def walk(value: Any, key: str = "") -> None:
+        if isinstance(value, dict):
+            for k, v in value.items():
+                walk(v, key if k.isdigit() else k)  # f_yk per diameter: {"12": 275.0}
+        elif isinstance(value, list):
+            for v in value:
+                walk(v, key)
+        elif isinstance(value, float):
+            unnamed.add(key)
+
+    walk({k: v for k, v in doc.items() if k != "units"})
+    assert unnamed and unnamed <= set(doc["units"]), unnamed - set(doc["units"])
+    # Read back as a retrofit document, the stamp kept.
+    back = parse_retrofit_doc(res.stdout)
+    assert back.rockmech_version == __version__ and back.units == doc["units"]
+
+
 def test_the_table_names_the_tie_and_the_ratios(wall: dict[str, Path]) -> None:
     res = runner.invoke(app, _args(wall))
     assert res.exit_code == 0, res.output

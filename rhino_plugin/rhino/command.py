@@ -10,12 +10,15 @@ import Rhino
 
 from rhino_plugin.flows.analyse import AnalysisResult, analyse_flow
 from rhino_plugin.flows.mechanisms import CommandResult, run_mechanism_command
+from rhino_plugin.flows.prompter import Cancelled
+from rhino_plugin.flows.retrofit import RETROFIT_LAYER, RetrofitFlowResult, retrofit_flow
 from rhino_plugin.flows.search import SEARCH_LAYER, SearchFlowResult, search_flow
 from rhino_plugin.rhino.docscene import DocScene
 from rhino_plugin.rhino.draw import draw_marks
 from rhino_plugin.rhino.prompts import RhinoPrompter
+from shared_schema.errors import RockmechError
 
-__all__ = ["SERVICE_URL_KEY", "run_analyse", "run_mechanism", "run_search"]
+__all__ = ["SERVICE_URL_KEY", "run_analyse", "run_mechanism", "run_retrofit", "run_search"]
 
 #: Document user text holding the REST service URL (set with Rhino's SetDocumentUserText).
 SERVICE_URL_KEY = "rockmech_service_url"
@@ -108,4 +111,30 @@ def run_search() -> Optional[SearchFlowResult]:
         n = draw_marks(doc, result.marks, layer=SEARCH_LAYER)
         Rhino.RhinoApp.WriteLine(f"RM_Search: {n} objects on layer '{SEARCH_LAYER}'")
         _show_plot(result)
+    return result
+
+
+def run_retrofit() -> Optional[RetrofitFlowResult]:
+    """RM_Retrofit on the active document: retrofit, write <model>.retrofit/, draw the ties."""
+    doc = _saved_doc("RM_Retrofit")
+    if doc is None:
+        return None
+    path = str(doc.Path)
+    ask = RhinoPrompter(doc)
+    try:
+        result = retrofit_flow(
+            ask,
+            os.path.dirname(path),
+            stem=os.path.splitext(os.path.basename(path))[0],
+            unit_scale=Rhino.RhinoMath.UnitScale(doc.ModelUnitSystem, Rhino.UnitSystem.Meters),
+            service_url=doc.Strings.GetValue(SERVICE_URL_KEY) or None,
+        )
+    except Cancelled:
+        Rhino.RhinoApp.WriteLine("RM_Retrofit: cancelled.")
+        return None
+    except (RockmechError, ValueError) as exc:
+        Rhino.RhinoApp.WriteLine(f"RM_Retrofit: {exc}")
+        return None
+    n = draw_marks(doc, result.marks, layer=RETROFIT_LAYER)
+    Rhino.RhinoApp.WriteLine(f"RM_Retrofit: {n} objects on layer '{RETROFIT_LAYER}'")
     return result

@@ -28,6 +28,10 @@ interval (or a pulse of ``1/f_p`` seconds) into segments of at most ``1/p_eq`` s
   ``BAND_POINTS`` spectrum periods per mechanism and record of
   ``(n - 1) max(1, ceil(STEPS_PER_PERIOD dt / T))`` steps each.
 
+A retrofit is counted in 2019 code checks (``workflows.limits.retrofit_checks``: per
+mechanism and candidate tie height, the check after the tie and the bisection steps per limit
+state), at ``RETROFIT_CHECKS_PER_S``, as ``rockmech retrofit`` counts them for its time limit.
+
 An assessment's HTML page draws ``1 + n_mechanisms (2 + n_records)`` figures; it is refused
 when they cannot be drawn within the budget at ``FIGURES_PER_S`` or would make the page
 larger than ``ROCKMECH_MAX_ANSWER_BYTES`` at ``ANSWER_BYTES_PER_FIGURE``.
@@ -43,7 +47,7 @@ from __future__ import annotations
 import math
 from typing import Any, Optional
 
-from shared_schema.api import AssessRequest, EnvelopeRequest, PulseRequest
+from shared_schema.api import AssessRequest, EnvelopeRequest, PulseRequest, RetrofitRequest
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 
@@ -53,6 +57,7 @@ from ..workflows.limits import (  # the numbers and estimates shared with the co
     N_SCAN,
     RATE_MARGIN,
     WORK_PER_SAMPLE,
+    check_retrofit_work,
     cores,
     envelope_steps,
     history_steps,
@@ -78,6 +83,7 @@ __all__ = [
     "estimate_history",
     "estimate_pulse",
     "estimate_report",
+    "estimate_retrofit",
     "estimate_scale_factor",
     "estimate_spectrum",
     "history_steps",
@@ -321,6 +327,21 @@ def estimate_assess(job: AssessRequest, limits: dict[str, Any]) -> None:
 def estimate_assess_page(job: AssessRequest, limits: dict[str, Any]) -> None:
     """Bound the assessment page (HTML or PDF): the time histories and the figures."""
     _assess(job, job.constants, limits, True)
+
+
+def estimate_retrofit(job: RetrofitRequest, limits: dict[str, Any]) -> None:
+    """Bound a retrofit: its planned code checks (``workflows.limits.retrofit_checks``)."""
+    budget = limits.get("budget_s")
+    if budget is None:
+        return
+    check_retrofit_work(
+        job.constants,
+        job.site,
+        job.spec,
+        budget,
+        "run rockmech retrofit with the command line (ROCKMECH_COMPUTE_TIMEOUT_S is the "
+        "service's budget per request)",
+    )
 
 
 def estimate_scale_factor(job: Any, limits: dict[str, Any]) -> None:

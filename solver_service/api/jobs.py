@@ -74,6 +74,8 @@ from ..workflows.documents import (
 )
 from ..workflows.inputs import SPEC_EXPECTED, read_record
 from ..workflows.outputs import finite_json
+from ..workflows.retrofit import retrofit_doc
+from ..workflows.retrofit_files import retrofit_json
 from ..workflows.scaling import Building
 from ..workflows.search import MAX_LP_BLOCKS, search_run
 from ..workflows.units import stamp
@@ -97,6 +99,7 @@ from .jobspec import (
     PulseJob,
     RecordUpload,
     ReportJob,
+    RetrofitJob,
     ScaleFactorJob,
     SceneJob,
     SearchJob,
@@ -541,6 +544,35 @@ def run_check(job: CheckJob, blobs: list[bytes], limits: dict[str, Any]) -> byte
     """Answer ``rockmech check --json``'s document."""
     cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
     return dumps(stamp(check_doc(cf, job.site), "check"))
+
+
+#: The sections of a retrofit request that a retrofit's own errors name without the
+#: request's key (the CLI's words are relative to the spec or site file).
+_RETROFIT_SECTIONS = {
+    "mechanisms": "spec",
+    "steel": "spec",
+    "anchorage": "spec",
+    "local_mechanisms": "site",
+    "building": "site",
+    "hazard": "site",
+}
+
+
+def run_retrofit(job: RetrofitJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer ``rockmech retrofit --json``'s document: the bytes of its ``retrofit.json``.
+
+    An error the retrofit raises about the spec or the site names the field as the request
+    holds it (``spec.mechanisms.F9``, ``site.local_mechanisms.method``).
+    """
+    cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
+    try:
+        doc = retrofit_doc(cf, job.site, job.spec)
+    except InputError as exc:
+        head = (exc.field or "").split(".", 1)[0]
+        if head not in _RETROFIT_SECTIONS:
+            raise
+        raise InputError(exc.reason, f"{_RETROFIT_SECTIONS[head]}.{exc.field}") from None
+    return retrofit_json(doc).encode("utf-8")
 
 
 def _assess_inputs(

@@ -32,6 +32,7 @@ from shared_schema.api import (
     PulseRequest,
     RecordSamples,
     ReportOptions,
+    RetrofitRequest,
     ScaleFactorRequest,
     SpectrumOptions,
 )
@@ -45,6 +46,7 @@ from .estimates import (
     estimate_history,
     estimate_pulse,
     estimate_report,
+    estimate_retrofit,
     estimate_scale_factor,
     estimate_spectrum,
 )
@@ -63,6 +65,7 @@ __all__ = [
     "PulseJob",
     "RecordUpload",
     "ReportJob",
+    "RetrofitJob",
     "ScaleFactorJob",
     "SceneJob",
     "SearchJob",
@@ -207,6 +210,12 @@ class AssessPdfJob(AssessRequest, Job):
     kind: Literal["assess_pdf"] = "assess_pdf"
 
 
+class RetrofitJob(RetrofitRequest, Job):
+    """``rockmech retrofit --json``: the retrofit document."""
+
+    kind: Literal["retrofit"] = "retrofit"
+
+
 class WarmupJob(Job):
     """Load every kernel once, before a compute process takes work."""
 
@@ -272,6 +281,7 @@ JOB_KINDS = _by_kind(
     JobKind(AssessHtmlJob, "run_assess_html", estimate_assess_page, media_type=_HTML),
     JobKind(AssessPdfJob, "run_assess_pdf", estimate_assess_page, media_type="application/pdf"),
     JobKind(SearchJob, "run_search"),
+    JobKind(RetrofitJob, "run_retrofit", estimate_retrofit),
     JobKind(WarmupJob, "run_warmup"),
 )
 

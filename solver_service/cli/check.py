@@ -100,6 +100,12 @@ def assess(
     template_dir: Optional[Path] = typer.Option(
         None, "--template-dir", help="Folder whose assess.html.j2 overrides the layout."
     ),
+    retrofit: Optional[Path] = typer.Option(
+        None,
+        "--retrofit",
+        help="Retrofit spec (JSON), or the retrofit.json of rockmech retrofit: page one "
+        "shows the tie-bars that make each failing mechanism pass.",
+    ),
     as_json: bool = typer.Option(False, "--json", help="Also print the assessment JSON."),
 ) -> None:
     """Assessment report: code checks beside rocking dynamics for every mechanism."""
@@ -119,10 +125,18 @@ def assess(
     check_file_target(out)
     cf, site_file = inputs.read_constants(constants, time_domain=True), workflow.read_site(site)
     motions = [reading.read(r) for r in record]
+    rspec = None
+    if retrofit is not None:
+        # The retrofit spec's (or retrofit.json's) reader, only with --retrofit.
+        from ..workflows.retrofit_files import read_retrofit_input
+
+        rspec = read_retrofit_input(retrofit)
     sources = [
         input_source("constants", constants.name, constants.read_bytes()),
         input_source("site", site.name, site.read_bytes()),
     ] + [input_source("record", r.name, r.read_bytes()) for r in record]
+    if retrofit is not None:
+        sources.append(input_source("retrofit", retrofit.name, retrofit.read_bytes()))
     options = {
         "multiples": multiple,
         "units": reading.units,
@@ -140,6 +154,7 @@ def assess(
             sources=sources,
             options=options,
             template_dir=template_dir,
+            retrofit=rspec,
         )
     # With --json, stdout carries exactly one JSON document; the file notes go to stderr.
     typer.echo(f"wrote {write_report(out, text)}", err=as_json)

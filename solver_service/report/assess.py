@@ -10,6 +10,13 @@ histories at the design scale cropped to the motion); then provenance as tables.
 keeps a mechanism's section on one page where it fits. ``print_pdf`` prints the page to PDF
 with headless Chromium.
 
+With a retrofit (``rockmech assess --retrofit``: a retrofit spec, or the ``retrofit.json``
+``rockmech retrofit`` wrote), page one ends with the retrofit table: per mechanism the tie
+that makes it pass (bars, diameter, grade, height, ``T*``, the governing criterion) and its
+least ``a_g,X/a_g`` before and with the tie, a mark where the records raise the demand above
+the spectrum's the tie was sized on; a section after page one gives one sentence each, the
+steel and the anchorage's source. The document then holds the retrofit under ``retrofit``.
+
 A folder given as ``template_dir`` overrides the packaged ``assess.html.j2`` (a firm's
 layout); it receives the same context.
 """
@@ -27,12 +34,13 @@ import subprocess
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Optional, Union
 
 import numpy as np
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError, RockmechError
+from shared_schema.retrofit import RetrofitDoc, RetrofitSpec
 from shared_schema.site import SiteFile
 from shared_schema.version import __version__
 
@@ -43,6 +51,7 @@ from ..workflows.assess import assessment_doc, site_spectrum
 from ..workflows.scaling import mechanism_scale_factor
 from ..workflows.verdict import ratio_label, worst_pulse
 from .plots import load_pyplot, plain, save_figure_atomic
+from .retrofit import assessment_retrofit, records_notes, retrofit_summary
 
 __all__ = [
     "TEMPLATE_NAME",
@@ -688,8 +697,11 @@ def reproduce_commands(
     """
     names = {"constants": "constants.json", "site": "site.json"}
     records: list[str] = []
+    retrofit: Optional[str] = None
     for src in sources:
-        if src["role"] in names:
+        if src["role"] == "retrofit":
+            retrofit = _file_name(src["name"], "retrofit.json")
+        elif src["role"] in names:
             names[src["role"]] = _file_name(src["name"], names[src["role"]])
         elif src["role"] == "record":
             records.append(_file_name(src["name"], f"record{len(records) + 1}.csv"))
@@ -706,6 +718,8 @@ def reproduce_commands(
         if opts.get(key) is not None:
             args.append(f"{flag} {shlex.quote(str(opts[key]))}")
     args += [f"--multiple {sig(k)}" for k in opts.get("multiples", [])]
+    if retrofit is not None:
+        args.append(f"--retrofit {shlex.quote(retrofit)}")
     c, s = shlex.quote(names["constants"]), shlex.quote(names["site"])
     out = [
         {
@@ -913,6 +927,7 @@ def render_assessment(
             )
     project = site.project.model_dump()
     context = {
+        "retrofit": _retrofit_context(doc.get("retrofit"), doc["mechanisms"]),
         "title": project.get("title") or "Seismic assessment of local collapse mechanisms",
         "project": project,
         "generated": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
@@ -938,6 +953,74 @@ def render_assessment(
     return _render(template_dir, context)
 
 
+#: The colour of a retrofit status on page one (the others, in red: no tie makes it pass).
+_RETROFIT_CLASS = {"designed": "ok", "passes": "ok", "not_checked": "na", "not_evaluated": "na"}
+
+
+def _kn(value: Optional[float]) -> str:
+    return "–" if value is None else sig(value / 1e3, 3)
+
+
+def _retrofit_context(
+    data: Optional[dict[str, Any]], mechanisms: list[dict[str, Any]]
+) -> Optional[dict[str, Any]]:
+    """Return page one's retrofit table (rows, sentences, steel and anchorage), or None.
+
+    ``data`` is the document's ``retrofit`` (a retrofit document as data), absent without
+    ``--retrofit``; ``mechanisms`` the assessment's rows (``records_notes``).
+    """
+    if data is None:
+        return None
+    rdoc = RetrofitDoc.model_validate(data)
+    notes = records_notes(rdoc, mechanisms)
+    rows = []
+    for r in retrofit_summary(rdoc):
+        o = r.option
+        tie = "–"
+        if o is not None and o.bar is not None:
+            tie = f"{r.bar_text} at {o.height_m:.3g} m"
+        elif o is not None:
+            tie = f"at {o.height_m:.3g} m (no bar on offer)"
+        per_bar = None if o is None or o.T_star_N is None else o.T_star_N / o.bars
+        rows.append(
+            {
+                "id": r.id,
+                "status": r.status,
+                "status_words": r.status_words,
+                "tie": tie,
+                "T_star_kN": _kn(None if o is None else o.T_star_N),
+                "T_bar_kN": _kn(per_bar),
+                "governs": "–" if o is None or o.governing is None else o.governing,
+                "before": "–" if r.before_ratio is None else sig(r.before_ratio, 3),
+                "after": "–" if r.after_ratio is None else sig(r.after_ratio, 3),
+                "label": (
+                    r.before_label
+                    if r.after_label in ("", r.before_label)
+                    else f"{r.before_label} → {r.after_label}"
+                ),
+                "cls": _RETROFIT_CLASS.get(r.status, "ko"),
+                "sentence": r.sentence,
+                "records_note": notes.get(r.id, ""),
+            }
+        )
+    anchorages = sorted(
+        {
+            (o.anchorage.capacity_N, o.anchorage.source)
+            for m in rdoc.mechanisms
+            for o in m.options
+            if o.anchorage is not None
+        }
+    )
+    return {
+        "rows": rows,
+        "records_ids": [r["id"] for r in rows if r["records_note"]],
+        "grade": rdoc.steel.get("grade", ""),
+        "gamma_M0": rdoc.steel.get("gamma_M0"),
+        "anchorages": [{"capacity_kN": _kn(c), "source": src} for c, src in anchorages],
+        "standard": rdoc.standard,
+    }
+
+
 def assess_report(
     cf: ConstantsFile,
     site: SiteFile,
@@ -947,6 +1030,7 @@ def assess_report(
     sources: Sequence[dict[str, Any]] = (),
     options: Optional[dict[str, Any]] = None,
     template_dir: Optional[Path] = None,
+    retrofit: Union[RetrofitSpec, RetrofitDoc, None] = None,
 ) -> tuple[dict[str, Any], str]:
     """Return the assessment document and its HTML page (for ``rockmech assess`` and REST).
 
@@ -956,6 +1040,10 @@ def assess_report(
         As ``workflows.assess.assessment_doc``.
     sources, options, template_dir
         As ``render_assessment``.
+    retrofit : RetrofitSpec or RetrofitDoc, optional
+        A retrofit spec (the retrofit is run on ``cf`` and ``site``) or a ``retrofit.json``
+        made from them (checked: ``report.retrofit.check_retrofit_matches``): the document
+        holds it under ``retrofit`` and page one shows its table.
 
     Returns
     -------
@@ -964,6 +1052,9 @@ def assess_report(
     """
     _render(template_dir)  # a user template's syntax error before the analysis runs
     doc = assessment_doc(cf, site, motions, multiples=multiples)
+    if retrofit is not None:
+        made = assessment_retrofit(cf, site, retrofit)
+        doc["retrofit"] = made.model_dump(mode="json")
     text = render_assessment(
         doc, cf, site, motions, sources=sources, options=options, template_dir=template_dir
     )

@@ -13,13 +13,34 @@ Light on purpose (the document's model only): the command line loads it when it 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-from typing import Optional
+from typing import Any, Optional, Union
 
+from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
-from shared_schema.retrofit import CheckFigures, MechanismRetrofit, RetrofitDoc, TieOption
+from shared_schema.retrofit import (
+    CheckFigures,
+    MechanismRetrofit,
+    RetrofitDoc,
+    RetrofitSpec,
+    TieOption,
+)
+from shared_schema.site import SiteFile
 
-__all__ = ["RATIO_LABELS", "RetrofitRow", "check_retrofit_ids", "retrofit_summary"]
+__all__ = [
+    "RATIO_LABELS",
+    "RetrofitRow",
+    "assessment_retrofit",
+    "check_retrofit_ids",
+    "check_retrofit_matches",
+    "records_notes",
+    "retrofit_summary",
+]
+
+#: Relative difference above which a retrofit document's "before" ratio is not the
+#: assessment's own: the document was made from other constants or another site [-].
+MATCH_RTOL = 1e-9
 
 #: How each ratio of ``CheckFigures`` is named, in the order they are compared.
 RATIO_LABELS = {
@@ -180,3 +201,135 @@ def check_retrofit_ids(doc: RetrofitDoc, ids: list[str]) -> None:
             "constants",
             "retrofit",
         )
+
+
+def _check_ratios(row: dict[str, Any]) -> dict[str, Optional[float]]:
+    """Return an assessment row's governing ratios, named as ``CheckFigures`` names them."""
+    lin, non = row.get("linear") or {}, row.get("nonlinear") or {}
+    out: dict[str, Optional[float]] = {"linear_ratio": None, "SLV_ratio": None, "SLC_ratio": None}
+    if lin.get("status") == "ok":
+        out["linear_ratio"] = lin.get("capacity_ratio")
+    if non.get("status") == "ok":
+        out["SLV_ratio"] = non.get("capacity_ratio")
+        slc = non.get("SLC")
+        if isinstance(slc, dict):
+            out["SLC_ratio"] = slc.get("capacity_ratio")
+    return out
+
+
+def check_retrofit_matches(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> None:
+    """Refuse a retrofit document that was not made from this assessment's inputs.
+
+    Parameters
+    ----------
+    doc : RetrofitDoc
+        A ``retrofit.json`` read back.
+    rows : list of dict
+        The mechanism rows of the code checks (``codecheck.check_doc(cf, site)``), without
+        the records' demand: the checks the retrofit ran.
+
+    Raises
+    ------
+    InputError
+        (field ``retrofit``) A mechanism of the document the constants do not have, or one
+        whose checks before the tie (``before``: a_g,X/a_g) are not the assessment's own to
+        ``MATCH_RTOL``: the document was made from other constants or another site.
+    """
+    check_retrofit_ids(doc, [str(r["id"]) for r in rows])
+    by_id = {str(r["id"]): r for r in rows}
+    for m in doc.mechanisms:
+        here = _check_ratios(by_id[m.id])
+        for key, label in RATIO_LABELS.items():
+            theirs, ours = getattr(m.before, key), here[key]
+            same = (theirs is None and ours is None) or (
+                theirs is not None
+                and ours is not None
+                and math.isclose(theirs, ours, rel_tol=MATCH_RTOL, abs_tol=0.0)
+            )
+            if not same:
+                raise InputError(
+                    f"the retrofit document's {m.id} has {label} {_ratio(theirs)} before the "
+                    f"tie where these inputs give {_ratio(ours)}: it was made from other "
+                    "constants or another site; run rockmech retrofit again on these files, or "
+                    "give the retrofit spec",
+                    "retrofit",
+                )
+
+
+def assessment_retrofit(
+    cf: ConstantsFile, site: SiteFile, source: Union[RetrofitSpec, RetrofitDoc]
+) -> RetrofitDoc:
+    """Return the retrofit a report shows: computed from a spec, or a document checked.
+
+    Parameters
+    ----------
+    cf, site
+        The assessment's constants and site.
+    source : RetrofitSpec or RetrofitDoc
+        A retrofit spec (the retrofit is run on ``cf`` and ``site``, as ``rockmech retrofit``
+        runs it) or a ``retrofit.json``, checked against the code checks of ``cf`` on
+        ``site`` (``check_retrofit_matches``; the checks without the records' demand, as
+        the retrofit runs them).
+
+    Raises
+    ------
+    InputError
+        The spec's errors, their field under ``retrofit.`` (``retrofit.mechanisms.F9``);
+        a document made from other inputs (``retrofit``).
+    """
+    if isinstance(source, RetrofitDoc):
+        # The code checks (the retrofit's own, without records) to compare the document with.
+        from ..workflows.codecheck import check_doc
+
+        check_retrofit_matches(source, check_doc(cf, site)["mechanisms"])
+        return source
+    # The retrofit (its bisections on the code checks) is loaded only when a spec is given.
+    from ..workflows.retrofit import retrofit_doc
+
+    try:
+        return retrofit_doc(cf, site, source)
+    except InputError as exc:
+        head = (exc.field or "").split(".", 1)[0]
+        if head in ("mechanisms", "steel", "anchorage"):
+            raise InputError(exc.reason, f"retrofit.{exc.field}") from None
+        raise
+
+
+def records_notes(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> dict[str, str]:
+    """Say where the assessment's records raise a demand the retrofit did not size for.
+
+    The retrofit runs the code checks on the site spectrum; with records, an assessment's
+    nonlinear check also takes their largest spectral displacement (Circ. 2019 C8.7.1.2.1.8),
+    so its ratio may be lower than the retrofit's "before".
+
+    Parameters
+    ----------
+    doc : RetrofitDoc
+        The retrofit.
+    rows : list of dict
+        The assessment's mechanism rows (``assessment_doc(...)["mechanisms"]``).
+
+    Returns
+    -------
+    dict
+        ``{mechanism id: sentence}`` for the mechanisms whose nonlinear ratio differs.
+    """
+    by_id = {str(r["id"]): r for r in rows}
+    notes = {}
+    for m in doc.mechanisms:
+        row = by_id.get(m.id)
+        if row is None:
+            continue
+        here = _check_ratios(row)
+        for key in ("SLV_ratio", "SLC_ratio"):
+            theirs, ours = getattr(m.before, key), here[key]
+            if theirs is None or ours is None:
+                continue
+            if not math.isclose(theirs, ours, rel_tol=MATCH_RTOL, abs_tol=0.0):
+                notes[m.id] = (
+                    f"with the records' demand (Circ. 2019 C8.7.1.2.1.8) this assessment's "
+                    f"{RATIO_LABELS[key]} is {ours:.3g}; the retrofit's {theirs:.3g} is the "
+                    "site spectrum's alone: the tie is sized without the records"
+                )
+                break
+    return notes

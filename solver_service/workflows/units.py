@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from shared_schema.retrofit import RETROFIT_UNITS
 from shared_schema.version import __version__
 
 __all__ = ["DOCUMENT_UNITS", "VERSION_KEY", "finite_json", "stamp"]
@@ -104,6 +105,7 @@ DOCUMENT_UNITS: dict[str, dict[str, str]] = {
         "angle": "rad",
     },
 }
+DOCUMENT_UNITS["retrofit"] = dict(RETROFIT_UNITS)
 DOCUMENT_UNITS["assess"] = {
     **DOCUMENT_UNITS["check"],
     **DOCUMENT_UNITS["history"],

@@ -35,6 +35,7 @@ COMMANDS = [
     "RM_Analyse",
     "RM_LoadedWall",
     "RM_MultiBlock",
+    "RM_Retrofit",
     "RM_Search",
     "RM_SingleBlock",
     "RM_TwoBlock",

@@ -300,6 +300,7 @@ def test_operations_have_readable_ids_and_tags(client: httpx.Client) -> None:
     assert ops["/api/v1/constants"] == ("constants", ["geometry"])
     assert ops["/api/v1/check"] == ("check", ["assessment"])
     assert ops["/api/v1/assess"] == ("assess", ["assessment"])
+    assert ops["/api/v1/retrofit"] == ("retrofit", ["assessment"])
     assert [t["name"] for t in api["tags"]] == [
         "service",
         "solver",

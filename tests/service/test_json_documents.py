@@ -33,6 +33,7 @@ SCENE = EXAMPLES / "scenes" / "rect_wall.3dm"
 SPEC = EXAMPLES / "specs" / "rect_wall.spec.json"
 SEARCH_SCENE = EXAMPLES / "scenes" / "search_facade.3dm"
 SEARCH_SPEC = EXAMPLES / "specs" / "search_facade.search.json"
+RETROFIT_SPEC = EXAMPLES / "specs" / "church.retrofit.json"
 
 
 def _stamped(doc: Any, where: str) -> None:
@@ -76,11 +77,10 @@ def test_every_command_and_file_names_units_and_version(tmp_path: Path) -> None:
                    "--multiple", "1", "-o", str(out / "assess.html")],
         "search": ["search", str(SEARCH_SCENE), str(SEARCH_SPEC), "--no-figure",
                    "-o", str(out / "search")],
+        "retrofit": ["retrofit", str(GEOMETRY), "--site", str(SITE), "--spec",
+                     str(RETROFIT_SPEC), "--out", str(out / "retrofit")],
     }  # fmt: skip
-    # Known gap (issue #39, open): the retrofit document has no rockmech_version/units stamp yet;
-    # its --json output is tested against the API's document in tests/test_cli_retrofit.py.
-    unstamped = {"retrofit"}
-    assert set(runs) == _json_commands() - unstamped
+    assert set(runs) == _json_commands()
     for name, argv in runs.items():
         res = runner.invoke(app, [*argv, "--json"])
         assert res.exit_code == 0, (name, res.output)
@@ -142,6 +142,13 @@ def test_every_endpoint_and_hops_component_names_units_and_version(
         ("POST", "/api/v1/check"): {"json": {"constants": geometry, "site": site}},
         ("POST", "/api/v1/assess"): {
             "json": {"constants": geometry, "site": site, "records": [record], "multiples": [1]}
+        },
+        ("POST", "/api/v1/retrofit"): {
+            "json": {
+                "constants": geometry,
+                "site": site,
+                "spec": json.loads(RETROFIT_SPEC.read_text()),
+            }
         },
         ("POST", "/api/v1/search"): {
             "files": {
