@@ -227,7 +227,7 @@ def retrofit_flow(
         doc = retrofit_doc(cf, site, spec)
         where = "the Python API"
     out = os.path.join(folder, f"{stem}.retrofit")
-    with run_folder(out, on_note=ask.message, keep_others=True) as tmp:
+    with run_folder(out, on_note=ask.message, command="retrofit") as tmp:
         write_retrofit(tmp, doc)
     path = os.path.join(out, RETROFIT_FILE)
     result = RetrofitFlowResult(
