@@ -283,6 +283,13 @@ def test_tying_one_wall_moves_the_governing_mechanism_to_the_other(tmp_path: Pat
     assert rows["W"].tied and rows["W"].after is not None and rows["W"].after >= 1.0 - 1e-9
     assert rows["V"].after == rows["V"].before == nxt.after_margin
     assert f"with the ties in, V governs: margin {nxt.after_margin:.3f}" in res.stdout
+    # The order of the mechanisms changes nothing.
+    cf = rockmech.read_constants(constants)
+    flipped = cf.model_copy(update={"mechanisms": cf.mechanisms[::-1]})
+    again = rockmech.retrofit(flipped, site, spec).governs_next
+    assert again is not None
+    assert (again.before, again.after, again.after_margin) == ("W", "V", nxt.after_margin)
+    assert {r.id: r for r in again.rows} == rows
 
 
 def test_the_church_on_five_records(shared_records: Path) -> None:

@@ -669,7 +669,9 @@ def _mechanism(
         )
     problem = _single_block_problem(mech)
     if problem is not None:
-        return MechanismRetrofit(**head, status="not_applicable", decisions=[problem])
+        return MechanismRetrofit(
+            **head, status="not_applicable", decisions=[problem, *record_notes]
+        )
     ties = spec.mechanisms.get(mech.id) or MechanismTies()
     top, top_source = _top_height(mech)
     if ties.heights_m is not None:
@@ -698,6 +700,7 @@ def _mechanism(
         )
     else:
         decisions.append("no tie option makes every check pass (see each option's decisions)")
+    decisions += record_notes
     return MechanismRetrofit(
         **head,
         status="designed" if chosen is not None else "not_achievable",
