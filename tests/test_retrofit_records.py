@@ -311,3 +311,31 @@ def test_the_church_on_five_records(shared_records: Path) -> None:
                     assert a.overturning_scale >= b.overturning_scale
     nxt = doc.governs_next
     assert nxt is not None and nxt.before == "F1" and nxt.after not in ("F1", "F2")
+
+
+def test_the_search_goes_on_where_the_verdict_flips_back_just_above(
+    wall: dict[str, Path],
+) -> None:
+    """A verdict that is not monotonic in T: survives in [1000, 1003) N and from 1100 N.
+
+    The least force whose neighbours half a percent below and above read (overturns,
+    survives, survives) is the first grid force at or above 1100 N; the search must not stop
+    in the narrow window, where T*(1 + 0.005) overturns again.
+    """
+    from solver_service.workflows.retrofit_records import MechanismRecords, force_grid_ratio
+
+    class Windowed(MechanismRecords):
+        def _survives(self, rec: Any, with_tie: Any, force: float) -> bool:
+            return 1000.0 <= force < 1003.0 or force >= 1100.0
+
+    cf = rockmech.read_constants(wall["constants"])
+    site = rockmech.read_site(wall["site"])
+    recs = Windowed(cf.mechanisms[0], {"nonlinear": {"status": "none"}}, [], site)
+    # Started at 1001.5 N, inside the window: it survives there and the force below does not.
+    found, runs, flip = recs._search(None, None, 1001.5, 1e5, start_overturns=None)
+    assert found is not None and 1100.0 <= found < 1100.0 * force_grid_ratio()
+    assert [f["overturned"] for f in flip] == [True, False, False]
+    assert flip[0]["force_N"] < 1100.0 and runs == recs.runs <= 3 * RUNS_PER_RECORD
+    # Nothing up to the largest force: None.
+    none, _, _ = recs._search(None, None, 10.0, 500.0, start_overturns=None)
+    assert none is None
