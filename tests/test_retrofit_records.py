@@ -339,3 +339,23 @@ def test_the_search_goes_on_where_the_verdict_flips_back_just_above(
     # Nothing up to the largest force: None.
     none, _, _ = recs._search(None, None, 10.0, 500.0, start_overturns=None)
     assert none is None
+
+
+def test_the_table_gives_the_records_margin_before_and_after(
+    wall: dict[str, Path], wall_doc: dict[str, Any]
+) -> None:
+    res = runner.invoke(
+        app,
+        ["retrofit", str(wall["constants"]), "--site", str(wall["site"]), "--spec",
+         str(wall["spec"]), "--record", str(ELCENTRO)],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    (m,) = wall_doc["mechanisms"]
+    before = m["records_before"][0]["multiple"]
+    after = m["options"][m["chosen"]]["records_after"][0]["multiple"]
+    assert before < 1.0 < after
+    line = (
+        f"  W: records' least overturning/design scale {before:.3f} (elcentro_NS) -> "
+        f"{after:.3f} (elcentro_NS)"
+    )
+    assert line in res.stdout.splitlines()

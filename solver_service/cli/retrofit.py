@@ -6,7 +6,7 @@ The command imports its workflow (the code checks, the retrofit) when it runs.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional, Sequence
 
 import typer
 
@@ -28,6 +28,26 @@ def _kn(value: Optional[float]) -> str:
 
 def _ratio(value: Optional[float]) -> str:
     return "-" if value is None else f"{value:.3f}"
+
+
+def _least(scales: Sequence[Any]) -> Optional[Any]:
+    got = [s for s in scales if s.multiple is not None]
+    return min(got, key=lambda s: s.multiple) if got else None
+
+
+def _records_line(m: Any) -> str:
+    """Return a mechanism's line: its records' least overturning/design scale, before -> after."""
+    first = _least(m.records_before)
+    after = None
+    if m.chosen is not None:
+        after = _least(m.options[m.chosen].records_after)
+    name = "-" if first is None else first.record
+    return (
+        f"  {m.id}: records' least overturning/design scale "
+        f"{_ratio(None if first is None else first.multiple)} ({name}) -> "
+        f"{_ratio(None if after is None else after.multiple)}"
+        + ("" if after is None else f" ({after.record})")
+    )
 
 
 @user_errors
@@ -132,6 +152,9 @@ def retrofit(
         typer.echo(line)
     for row in summary:
         typer.echo(f"  {row.sentence}")
+    for m in doc.mechanisms:
+        if m.records_before:
+            typer.echo(_records_line(m))
     nxt = doc.governs_next
     if nxt is not None and nxt.after is not None and nxt.after_margin is not None:
         typer.echo(
