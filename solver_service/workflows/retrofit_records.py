@@ -223,8 +223,8 @@ class MechanismRecords:
         for _ in range(len(self.records) + MAX_RESTARTS):
             failing = []
             for rec, tie in zip(self.records, ties):
-                if rec.design is None or force <= 0.0:
-                    continue
+                if rec.design is None or force <= 0.0 or tie.T_star_N == force:
+                    continue  # not run, no tie, or its own search survived at this force
                 tie.runs += 1
                 if not self._count(rec, with_tie, force):
                     failing.append((rec, tie))
@@ -270,8 +270,10 @@ class MechanismRecords:
                 note="survives at the design scale as it stands: needs no tie",
             )
         s_ov = sc.overturning_scale
-        assert s_ov is not None  # it overturns at the design scale, so on the grid
-        t0 = (lam0 * rec.design / s_ov - lam0) / slope if s_ov < rec.design else 0.0
+        # The grid may step over the design scale's overturning (s_ov None or above it).
+        t0 = 0.0
+        if s_ov is not None and s_ov < rec.design:
+            t0 = (lam0 * rec.design / s_ov - lam0) / slope
         # λ0 s_d/s_ov at or below λ0 (a record that overturns at the design scale only):
         # start one grid step of λ above λ0.
         t0 = max(t0, T_REL_TOL * lam0 / slope)
