@@ -32,6 +32,7 @@ from solver_service.workflows.adapter import models_from_file
 from solver_service.workflows.documents import envelope_doc, frequency_grid, history_doc
 from solver_service.workflows.ida import run_ida
 from solver_service.workflows.retrofit import retrofit_doc
+from solver_service.workflows.retrofit_records import read_retrofit_records
 from solver_service.workflows.scaling import Building
 from solver_service.workflows.units import stamp
 
@@ -445,6 +446,7 @@ def retrofit(
     constants: Constants,
     site: Union[SiteFile, PathLike],
     spec: Union[RetrofitSpec, PathLike],
+    records: Optional[Sequence[Record]] = None,
 ) -> RetrofitDoc:
     """Find the least tie force that makes each failing mechanism pass the 2019 code checks.
 
@@ -456,7 +458,11 @@ def retrofit(
         The site: hazard (SLV, and SLC where given), FC, q.
     spec : RetrofitSpec, str or Path
         The retrofit spec: steel grade and bars on offer, the anchorage resistance with its
-        source, candidate tie heights per mechanism [m].
+        source, candidate tie heights per mechanism [m], the records (relative to its folder
+        when it is a file).
+    records : sequence of GroundMotion, str or Path, optional
+        Records (files: formats detected) instead of the spec's ``records``: each tied
+        mechanism must survive every one at its design scale, by the exact solver.
 
     Returns
     -------
@@ -466,9 +472,14 @@ def retrofit(
         ``anchorage`` check, the steel mass [kg] and the checks ``after`` (docs/theory.md
         §11.12).
     """
-    rspec = (
-        spec
-        if isinstance(spec, RetrofitSpec)
-        else read_retrofit_spec(as_path(spec, "spec", "a RetrofitSpec or " + PATH_TYPES))
-    )
-    return retrofit_doc(_constants(constants), _site(site), rspec)
+    spec_dir = None
+    if isinstance(spec, RetrofitSpec):
+        rspec = spec
+    else:
+        spec_path = as_path(spec, "spec", "a RetrofitSpec or " + PATH_TYPES)
+        rspec, spec_dir = read_retrofit_spec(spec_path), spec_path.parent
+    if records is not None and len(records) > 0:
+        motions = _records(records)
+    else:
+        motions = read_retrofit_records(rspec, spec_dir)
+    return retrofit_doc(_constants(constants), _site(site), rspec, motions)

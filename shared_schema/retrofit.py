@@ -9,7 +9,9 @@ The spec says where ties may go and what they are made of:
   none); a mechanism may give its own;
 * ``mechanisms``: per mechanism id, the candidate tie heights above its hinge [m] (default:
   one tie at the top of the moving part), the number of bars at that height sharing the
-  force, and the bar length for the steel mass [m].
+  force, and the bar length for the steel mass [m];
+* ``records``: ground-motion record files (relative to the spec's folder; formats detected)
+  that each mechanism, once tied, must survive at its design scale by the exact solver.
 
 The document holds, per mechanism, the least tie force that makes the Circolare 2019 checks
 pass, the criterion that governs it, the bar, the anchorage check, the steel mass, and the
@@ -41,8 +43,12 @@ __all__ = [
     "AnchorageCheck",
     "BarChoice",
     "CheckFigures",
+    "GoverningNext",
+    "GoverningRow",
     "MechanismRetrofit",
     "MechanismTies",
+    "RecordScale",
+    "RecordTie",
     "RetrofitDoc",
     "RetrofitSpec",
     "Steel",
@@ -235,6 +241,12 @@ class RetrofitSpec(BaseModel):
         default_factory=dict,
         description="Per mechanism id: candidate ties (mechanisms not listed: the default).",
     )
+    records: List[str] = Field(
+        default_factory=list,
+        max_length=50,
+        description="Record files each tied mechanism must survive at its design scale "
+        "(relative to the spec's folder).",
+    )
 
 
 def parse_retrofit_spec(source: Union[str, bytes, Mapping[str, Any]]) -> RetrofitSpec:
@@ -322,6 +334,57 @@ class AnchorageCheck(BaseModel):
     passes: bool
 
 
+class RecordScale(BaseModel):
+    """One record on one mechanism: its design scale and the least scale that overturns it.
+
+    ``design_scale`` matches the record's 5 % spectrum to the site's over the mechanism's
+    band (the assessment's, ``workflows.assess.record_scale_factor``); the factor up the
+    structure (Eq. 28) multiplies both scales. ``overturning_scale`` is the least scale of
+    the record that overturns the mechanism (the first of a log grid, bisected; every grid
+    scale below it survives), None when none up to the grid's top does.
+    """
+
+    model_config = _DOC
+
+    record: str
+    design_scale: Optional[float] = Field(None, description="Record scale at the design level [-].")
+    height_factor: Optional[float] = Field(None, description="Eq. 28 factor up the structure [-].")
+    overturning_scale: Optional[float] = Field(
+        None, description="Least record scale that overturns [-] (None: none on the grid)."
+    )
+    multiple: Optional[float] = Field(
+        None, description="overturning_scale/design_scale [-] (None: none overturns)."
+    )
+    passes: Optional[bool] = Field(
+        None, description="No scale up to the design one overturns (multiple > 1)."
+    )
+    survives_design: Optional[bool] = Field(
+        None, description="The run at the design scale does not overturn."
+    )
+    runs: int = Field(0, description="Exact runs made (the grid, the bisection, the design).")
+    note: Optional[str] = None
+
+
+class RecordTie(BaseModel):
+    """The least tie force with which one record no longer overturns at its design scale."""
+
+    model_config = _DOC
+
+    record: str
+    T_star_N: Optional[float] = Field(
+        None, description="Least force [N] on the grid of ratio 1/(1 − 0.005) (None: none)."
+    )
+    T_start_N: Optional[float] = Field(
+        None, description="Where the grid starts: λ(T) = λ0 s_design/s_ov [N]."
+    )
+    runs: int = Field(0, description="Exact runs at the design scale the search made.")
+    flip: List[Dict[str, Any]] = Field(
+        default_factory=list,
+        description="Verdicts at T*(1 − 0.005), T*, T*(1 + 0.005): force_N, overturned.",
+    )
+    note: Optional[str] = None
+
+
 class TieOption(BaseModel):
     """One candidate tie height of a mechanism and what it takes there."""
 
@@ -337,6 +400,10 @@ class TieOption(BaseModel):
     T_nonlinear_SLC_N: Optional[float] = Field(
         None, description="Least T for the nonlinear SLC check, tie verified [N]."
     )
+    T_records_N: Optional[float] = Field(
+        None, description="Least T for every record at its design scale (exact solver) [N]."
+    )
+    records: List[RecordTie] = Field(default_factory=list, description="Per record.")
     T_star_N: Optional[float] = Field(None, description="The larger of the criteria [N].")
     governing: Optional[str] = Field(None, description="The criterion that gives T_star_N.")
     e_star: Optional[float] = Field(None, description="e* of the checks ([C8.7.1.5]) [-].")
@@ -351,6 +418,9 @@ class TieOption(BaseModel):
         None, description="Steel of the bars per metre of length [kg/m]."
     )
     after: Optional[CheckFigures] = None
+    records_after: List[RecordScale] = Field(
+        default_factory=list, description="The records with the tie at T_star_N."
+    )
     decisions: List[str] = Field(default_factory=list)
 
 
@@ -366,6 +436,9 @@ class MechanismRetrofit(BaseModel):
         "passes", "designed", "not_achievable", "not_applicable", "not_checked", "not_evaluated"
     ]
     before: CheckFigures
+    records_before: List[RecordScale] = Field(
+        default_factory=list, description="The records on the mechanism as it stands."
+    )
     options: List[TieOption] = Field(default_factory=list)
     chosen: Optional[int] = Field(None, description="Index of the chosen option (least T).")
     decisions: List[str] = Field(default_factory=list)
@@ -399,7 +472,43 @@ RETROFIT_UNITS: Dict[str, str] = {
     "SLC_ratio": "-",
     "alpha0": "-",
     "e_star": "-",
+    "before_margin": "-",
+    "after_margin": "-",
 }
+
+
+class GoverningRow(BaseModel):
+    """One mechanism's least margin, before the intervention and after it."""
+
+    model_config = _DOC
+
+    id: str
+    tied: bool = Field(description="The intervention ties this mechanism (its chosen option).")
+    before_margin: Optional[float] = Field(None, description="Least margin before [-].")
+    before_criterion: Optional[str] = None
+    after_margin: Optional[float] = Field(None, description="Least margin after [-].")
+    after_criterion: Optional[str] = None
+
+
+class GoverningNext(BaseModel):
+    """The mechanism that governs before and after the intervention, and its margin.
+
+    A margin is a capacity over a demand [-]: the code checks' ``a_g,X/a_g`` and, with
+    records, the least ``overturning_scale/design_scale``; a mechanism's margin is its
+    least, and the one that governs has the least of all (below 1: it fails).
+    """
+
+    model_config = _DOC
+
+    before: Optional[str] = Field(None, description="The governing mechanism as it stands.")
+    before_margin: Optional[float] = None
+    before_criterion: Optional[str] = None
+    after: Optional[str] = Field(None, description="The governing one with the ties in.")
+    after_margin: Optional[float] = None
+    after_criterion: Optional[str] = None
+    moved: bool = Field(description="Another mechanism governs after the intervention.")
+    rows: List[GoverningRow] = Field(default_factory=list)
+    basis: List[str] = Field(default_factory=list)
 
 
 class RetrofitDoc(BaseModel):
@@ -423,7 +532,13 @@ class RetrofitDoc(BaseModel):
     standard: str
     steel: Dict[str, Any]
     decisions: List[str]
+    records: List[Dict[str, Any]] = Field(
+        default_factory=list, description="The records: name, PGA [g], dt [s], duration [s]."
+    )
     mechanisms: List[MechanismRetrofit]
+    governs_next: Optional[GoverningNext] = Field(
+        None, description="What governs before and after the intervention."
+    )
 
     def mechanism(self, mechanism_id: str) -> MechanismRetrofit:
         """Return the mechanism with this id."""

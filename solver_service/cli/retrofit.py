@@ -6,14 +6,14 @@ The command imports its workflow (the code checks, the retrofit) when it runs.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional, Sequence
 
 import typer
 
 from ..workflows.rundir import check_folder_target, run_folder
 from .errors import user_errors
 from .options import CONSTANTS_ARG, LIMITS, Limits, grouped
-from .output import out_note, status
+from .output import out_note, record_warning, status
 from .output import table as table_lines
 
 __all__ = ["retrofit"]
@@ -30,6 +30,26 @@ def _ratio(value: Optional[float]) -> str:
     return "-" if value is None else f"{value:.3f}"
 
 
+def _least(scales: Sequence[Any]) -> Optional[Any]:
+    got = [s for s in scales if s.multiple is not None]
+    return min(got, key=lambda s: s.multiple) if got else None
+
+
+def _records_line(m: Any) -> str:
+    """Return a mechanism's line: its records' least overturning/design scale, before -> after."""
+    first = _least(m.records_before)
+    after = None
+    if m.chosen is not None:
+        after = _least(m.options[m.chosen].records_after)
+    name = "-" if first is None else first.record
+    return (
+        f"  {m.id}: records' least overturning/design scale "
+        f"{_ratio(None if first is None else first.multiple)} ({name}) -> "
+        f"{_ratio(None if after is None else after.multiple)}"
+        + ("" if after is None else f" ({after.record})")
+    )
+
+
 @user_errors
 @grouped
 def retrofit(
@@ -40,6 +60,12 @@ def retrofit(
         "--spec",
         help="Retrofit spec (JSON): steel grade and bar diameters [mm], the anchorage "
         "resistance [N] with its source, tie heights above each hinge [m].",
+    ),
+    record: list[Path] = typer.Option(
+        [],
+        "--record",
+        help="Record(s) each tied mechanism must survive at its design scale, by the exact "
+        "solver (formats detected; default: the spec's records).",
     ),
     out: Optional[Path] = typer.Option(
         None,
@@ -69,11 +95,15 @@ def retrofit(
     # The document's file.
     from ..workflows.retrofit_files import RETROFIT_FILE, retrofit_json, write_retrofit
 
+    # The records' reader.
+    from ..workflows.retrofit_records import read_retrofit_records
+
     if out is not None:
         check_folder_target(out)
     cf = inputs.read_constants(constants)
     site_file = assess.read_site(site)
     rspec = read_retrofit_spec(spec)
+    motions = read_retrofit_records(rspec, spec.parent, record, on_warning=record_warning)
     if not limits.no_limits:
         check_retrofit_work(
             cf,
@@ -81,9 +111,10 @@ def retrofit(
             rspec,
             limits.time_limit,
             f"give {TIME_LIMIT} with more seconds, or {NO_LIMITS}",
+            motions,
         )
     with status("retrofit: code checks and tie forces"):
-        doc = retrofit_doc(cf, site_file, rspec)
+        doc = retrofit_doc(cf, site_file, rspec, motions)
     if out is not None:
         # Only retrofit.json is replaced: the other outputs in the folder stay.
         with run_folder(out, on_note=out_note, command="retrofit") as tmp:
@@ -121,5 +152,14 @@ def retrofit(
         typer.echo(line)
     for row in summary:
         typer.echo(f"  {row.sentence}")
+    for m in doc.mechanisms:
+        if m.records_before:
+            typer.echo(_records_line(m))
+    nxt = doc.governs_next
+    if nxt is not None and nxt.after is not None and nxt.after_margin is not None:
+        typer.echo(
+            f"with the ties in, {nxt.after} governs: margin {nxt.after_margin:.3f} "
+            f"({nxt.after_criterion}); before, {nxt.before} at {nxt.before_margin:.3f}"
+        )
     if out is not None:
         typer.echo(f"wrote {out / RETROFIT_FILE}")

@@ -46,7 +46,7 @@ import sys
 import threading
 import time
 from collections.abc import Iterable, Iterator
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Any, Optional, Sequence
 
 from shared_schema.errors import InputError
 
@@ -69,6 +69,8 @@ __all__ = [
     "RATE_MARGIN",
     "RETROFIT_BISECTION_STEPS",
     "RETROFIT_CHECKS_PER_S",
+    "RETROFIT_RECORD_RUNS",
+    "RETROFIT_SCALE_RUNS",
     "SPECTRUM_GRID_PER_PERIOD",
     "SPECTRUM_STEPS_PER_CORE_S",
     "SPECTRUM_SUBSTEPS",
@@ -86,6 +88,7 @@ __all__ = [
     "history_steps",
     "mechanism_sides",
     "retrofit_checks",
+    "retrofit_record_runs",
     "scale_factor_points",
     "shortest_time",
     "spectrum_steps",
@@ -122,6 +125,13 @@ SPECTRUM_STEPS_PER_CORE_S = 1.8e8
 #: tie, its façades with 10 tie heights each): 1.19e3/s. Recorded in docs/benchmarks.md,
 #: section ``retrofit`` (a test checks the constant against it).
 RETROFIT_CHECKS_PER_S = 1.2e3
+#: Exact runs at the design scale one record's search on the tie force plans (the
+#: benchmark's target, ``benchmarks/retrofit.py``).
+RETROFIT_RECORD_RUNS = 20
+#: Exact runs one least overturning scale takes: the log grid of scales and the bisection
+#: to ``scaling.SCALE_RTOL`` (about 12 halvings from the grid's ratio 1.124), and the run
+#: at the design scale.
+RETROFIT_SCALE_RUNS = 60 + 12 + 1
 #: Bisection steps of one nonlinear criterion of a retrofit, at the least: the bracket
 #: halves from half its passing end to ``workflows.retrofit.T_REL_TOL`` of it,
 #: ``ceil(log2(0.5 / T_REL_TOL))`` (a test checks the copy).
@@ -628,8 +638,39 @@ def retrofit_checks(cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec) -> in
     return total
 
 
+def retrofit_record_runs(cf: ConstantsFile, spec: RetrofitSpec) -> int:
+    """Return the exact runs of one record a retrofit plans, before any is run.
+
+    Per mechanism (every one counted as failing): its least overturning scale as it stands
+    (``RETROFIT_SCALE_RUNS``) and, per candidate tie height, the ``RETROFIT_RECORD_RUNS``
+    of the search on the tie force and the overturning scale with the tie.
+
+    Examples
+    --------
+    >>> from shared_schema.constants import parse_constants
+    >>> from shared_schema.retrofit import parse_retrofit_spec
+    >>> cf = parse_constants('{"mechanisms": [{"id": "W", "p_eq": 2.0, "lam": 0.1}]}')
+    >>> spec = parse_retrofit_spec('{"steel": {"grade": "S275", "diameters_mm": [16]},'
+    ...     ' "anchorage": {"capacity_N": 6e4, "source": "test R-1"},'
+    ...     ' "mechanisms": {"W": {"heights_m": [3.0, 5.0]}}}')
+    >>> retrofit_record_runs(cf, spec)  # 73 + 2 x (20 + 73)
+    259
+    """
+    total = 0
+    for mech in cf.mechanisms:
+        ties = spec.mechanisms.get(mech.id)
+        heights = ties.heights_m if ties is not None and ties.heights_m is not None else [0.0]
+        total += RETROFIT_SCALE_RUNS + len(heights) * (RETROFIT_RECORD_RUNS + RETROFIT_SCALE_RUNS)
+    return total
+
+
 def check_retrofit_work(
-    cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec, budget_s: float, how: str
+    cf: ConstantsFile,
+    site: SiteFile,
+    spec: RetrofitSpec,
+    budget_s: float,
+    how: str,
+    motions: Sequence[Any] = (),
 ) -> None:
     """Refuse a retrofit whose planned code checks cannot finish within ``budget_s`` [s].
 
@@ -637,6 +678,8 @@ def check_retrofit_work(
     ----------
     cf, site, spec
         The retrofit's inputs (``retrofit_checks`` counts the plan).
+    motions : sequence of GroundMotion
+        The records: each adds ``retrofit_record_runs`` runs of its longest mechanism.
     budget_s : float
         The time budget [s]: the service's compute timeout, the command's time limit.
     how : str
@@ -648,7 +691,18 @@ def check_retrofit_work(
         Naming ``spec`` (the tie heights set the work), the count and the budget.
     """
     n = retrofit_checks(cf, site, spec)
-    seconds = shortest_time(retrofit_checks=n)
+    runs = retrofit_record_runs(cf, spec) if motions else 0
+    steps = sum(history_steps(cf, m.accel.n, m.dt, 1, worst=True) * runs for m in motions)
+    seconds = shortest_time(retrofit_checks=n, history_steps=steps)
+    if seconds > budget_s and steps > 0:
+        raise InputError(
+            f"the retrofit plans {n} code checks and {runs} exact runs of each of "
+            f"{len(motions)} records ({work_words(retrofit_checks=n, history_steps=steps)}): "
+            f"at least {seconds:.3g} s even at {RATE_MARGIN:g} times the rates measured, past "
+            f"the budget of {budget_s:g} s; give fewer tie heights, mechanisms or records, "
+            f"or {how}",
+            "spec",
+        )
     if seconds > budget_s:
         raise InputError(
             f"the retrofit plans {n} code checks ({len(cf.mechanisms)} mechanisms counted as "

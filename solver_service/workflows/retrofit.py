@@ -28,8 +28,9 @@ mechanism without it.
 
 from __future__ import annotations
 
+import functools
 import math
-from typing import Any, Optional
+from typing import Any, Optional, Sequence
 
 from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError, RockmechError
@@ -39,8 +40,12 @@ from shared_schema.retrofit import (
     AnchorageCheck,
     BarChoice,
     CheckFigures,
+    GoverningNext,
+    GoverningRow,
     MechanismRetrofit,
     MechanismTies,
+    RecordScale,
+    RecordTie,
     RetrofitDoc,
     RetrofitSpec,
     TieOption,
@@ -51,12 +56,14 @@ from shared_schema.site import MechanismOptions, SiteFile
 from ..codes.circ2019 import CIRC2019
 from ..core.model import G
 from .codecheck import check_doc
+from .retrofit_records import RECORD_DECISIONS, MechanismRecords, tie_slope
 
 __all__ = [
     "ALPHA0_MAX",
     "RETROFIT_DECISIONS",
     "SINGLE_BLOCK_TYPOLOGIES",
     "T_REL_TOL",
+    "governs_next",
     "retrofit_doc",
     "with_tie",
 ]
@@ -412,6 +419,67 @@ def _criteria(
     return criteria
 
 
+def _carried(
+    spec: RetrofitSpec, ties: MechanismTies, per_bar: float, decisions: list[str]
+) -> tuple[Optional[BarChoice], AnchorageCheck, bool]:
+    """Return the bar, the anchorage check and whether they carry one tie's ``per_bar`` [N].
+
+    What they cannot carry is added to ``decisions``.
+    """
+    bar, bar_note = _bar(spec, per_bar)
+    anc_spec = ties.anchorage or spec.anchorage
+    anchorage = AnchorageCheck(
+        capacity_N=anc_spec.capacity_N,
+        source=anc_spec.source,
+        force_N=per_bar,
+        passes=per_bar <= anc_spec.capacity_N,
+    )
+    if bar_note:
+        decisions.append(bar_note)
+    if not anchorage.passes:
+        decisions.append(
+            f"the anchorage resistance {anc_spec.capacity_N:.4g} N ({anc_spec.source}) is "
+            f"below the {per_bar:.4g} N of one tie: more bars at the height, or a stronger "
+            "anchorage"
+        )
+    verified = bar is not None and anchorage.passes
+    if not verified:
+        decisions.append(
+            "the tie is not verified to hold up to collapse (C8.7.1.2.1.6): the check after "
+            "leaves it out of d0, and the mechanism is not made to pass"
+        )
+    return bar, anchorage, verified
+
+
+def _together(
+    recs: MechanismRecords,
+    mech: Mechanism,
+    height: float,
+    governing: str,
+    t_star: float,
+    t_max: float,
+    ties: list[RecordTie],
+) -> Optional[tuple[str, float, list[RecordScale]]]:
+    """Run the records at the largest criterion's force, raise it where one overturns.
+
+    Returns the governing criterion, the force [N] and the records with the tie at it, or
+    None where no force up to ``t_max`` makes every record survive there (``ties`` keep
+    the runs and notes of the search, in place).
+    """
+
+    def tied(force: float) -> Mechanism:
+        return with_tie(mech, force, height, listed=False)
+
+    if governing == "records":  # tie_forces ran them together at this force
+        return governing, t_star, recs.scales(tied(t_star))
+    t_all, _ = recs.together(tied, t_star, t_max, ties)
+    if t_all is None:
+        return None
+    if t_all > t_star:
+        governing, t_star = "records", t_all
+    return governing, t_star, recs.scales(tied(t_star))
+
+
 def _option(
     checker: _Checker,
     spec: RetrofitSpec,
@@ -420,6 +488,8 @@ def _option(
     height: float,
     height_source: str,
     top: Optional[float],
+    recs: Optional[MechanismRecords] = None,
+    records_before: Sequence[RecordScale] = (),
 ) -> TieOption:
     mech = checker.mech
     n = ties.bars
@@ -443,6 +513,11 @@ def _option(
     lin = before["sides"]["positive"]["linear"]
     e_star = float(lin["e_star"]) if lin.get("status") == "ok" else None
     criteria = _criteria(checker, before, height, t_max)
+    record_ties: list[RecordTie] = []
+    if recs is not None and recs.records:
+        tied = functools.partial(with_tie, mech, height=height, listed=False)
+        slope = tie_slope(mech, height)
+        criteria["records"], record_ties = recs.tie_forces(tied, slope, records_before, t_max)
     t_lin_v = criteria.get("linear SLV")
     t_slv, t_slc = criteria.get("nonlinear SLV"), criteria.get("nonlinear SLC")
     common = {
@@ -453,6 +528,8 @@ def _option(
         "T_nonlinear_SLC_N": t_slc,
         "e_star": e_star,
         "bars": n,
+        "T_records_N": criteria.get("records"),
+        "records": record_ties,
     }
     stuck = [k for k, v in criteria.items() if v is None]
     if stuck:
@@ -468,29 +545,23 @@ def _option(
     governing, t_star = max(
         ((k, v) for k, v in criteria.items() if v is not None), key=lambda p: p[1]
     )
-    per_bar = t_star / n
-    bar, bar_note = _bar(spec, per_bar)
-    anc_spec = ties.anchorage or spec.anchorage
-    anchorage = AnchorageCheck(
-        capacity_N=anc_spec.capacity_N,
-        source=anc_spec.source,
-        force_N=per_bar,
-        passes=per_bar <= anc_spec.capacity_N,
-    )
-    if bar_note:
-        decisions.append(bar_note)
-    if not anchorage.passes:
-        decisions.append(
-            f"the anchorage resistance {anc_spec.capacity_N:.4g} N ({anc_spec.source}) is "
-            f"below the {per_bar:.4g} N of one tie: more bars at the height, or a stronger "
-            "anchorage"
-        )
-    verified = bar is not None and anchorage.passes
-    if not verified:
-        decisions.append(
-            "the tie is not verified to hold up to collapse (C8.7.1.2.1.6): the check after "
-            "leaves it out of d0, and the mechanism is not made to pass"
-        )
+    records_after: list[RecordScale] = []
+    if recs is not None and recs.records:
+        together = _together(recs, mech, height, governing, t_star, t_max, record_ties)
+        common["records"] = record_ties
+        if together is None:
+            return TieOption(
+                **common,
+                status="no_force_suffices",
+                verified=False,
+                decisions=[
+                    f"with the {t_star:.6g} N the {governing} check needs, a record "
+                    f"overturns at its design scale and no force up to {t_max:.4g} N "
+                    "above it survives"
+                ],
+            )
+        governing, t_star, records_after = together
+    bar, anchorage, verified = _carried(spec, ties, t_star / n, decisions)
     after_row = checker.row(t_star, height, verified=verified)
     after = _row_figures(after_row)
     if e_star is not None:
@@ -524,6 +595,7 @@ def _option(
         steel_mass_kg=mass,
         steel_mass_per_m_kg=per_m,
         after=after,
+        records_after=records_after,
         decisions=decisions,
     )
 
@@ -532,26 +604,61 @@ def _failing(fig: CheckFigures) -> bool:
     return False in (fig.linear_passes, fig.SLV_passes, fig.SLC_passes)
 
 
+def _records(
+    mech: Mechanism, row: dict[str, Any], site: SiteFile, motions: Sequence[Any]
+) -> tuple[Optional[MechanismRecords], list[RecordScale], list[str]]:
+    """Return the records of one mechanism as it stands, or why they cannot run on it."""
+    if not motions:
+        return None, [], []
+    try:
+        recs = MechanismRecords(mech, row, motions, site)
+        return recs, recs.scales(mech), []
+    except RockmechError as exc:
+        return None, [], [f"the records are not run on this mechanism: {exc}"]
+
+
+def _records_fail(scales: Sequence[RecordScale]) -> bool:
+    return any(sc.survives_design is False for sc in scales)
+
+
 def _mechanism(
-    cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec, mech: Mechanism, row: dict[str, Any]
+    cf: ConstantsFile,
+    site: SiteFile,
+    spec: RetrofitSpec,
+    mech: Mechanism,
+    row: dict[str, Any],
+    motions: Sequence[Any] = (),
 ) -> MechanismRetrofit:
     before = _row_figures(row)
-    head = {"id": mech.id, "name": mech.name, "typology": mech.typology, "before": before}
+    recs, records_before, record_notes = _records(mech, row, site, motions)
+    head = {
+        "id": mech.id,
+        "name": mech.name,
+        "typology": mech.typology,
+        "before": before,
+        "records_before": records_before,
+    }
     if before.linear_ratio is None and before.SLV_ratio is None:
         return MechanismRetrofit(
-            **head, status="not_checked", decisions=["the code check did not run", *before.notes]
+            **head,
+            status="not_checked",
+            decisions=["the code check did not run", *before.notes, *record_notes],
         )
-    if not _failing(before):
+    records_fail = _records_fail(records_before)
+    if not _failing(before) and not records_fail:
         if before.SLV_passes is None and before.linear_passes is None:
             return MechanismRetrofit(
                 **head,
                 status="not_evaluated",
                 decisions=["the site's checks are not evaluated (see the notes)"],
             )
+        said = "passes every check evaluated"
+        if records_before:
+            said += " and survives every record at its design scale"
         return MechanismRetrofit(
-            **head, status="passes", decisions=["passes every check evaluated: needs no tie"]
+            **head, status="passes", decisions=[f"{said}: needs no tie", *record_notes]
         )
-    if not _failing(_figures(row["sides"]["positive"])):
+    if not records_fail and not _failing(_figures(row["sides"]["positive"])):
         return MechanismRetrofit(
             **head,
             status="not_achievable",
@@ -562,7 +669,9 @@ def _mechanism(
         )
     problem = _single_block_problem(mech)
     if problem is not None:
-        return MechanismRetrofit(**head, status="not_applicable", decisions=[problem])
+        return MechanismRetrofit(
+            **head, status="not_applicable", decisions=[problem, *record_notes]
+        )
     ties = spec.mechanisms.get(mech.id) or MechanismTies()
     top, top_source = _top_height(mech)
     if ties.heights_m is not None:
@@ -575,7 +684,9 @@ def _mechanism(
             f"mechanisms.{mech.id}.heights_m",
         )
     checker = _Checker(cf, site, mech)
-    options = [_option(checker, spec, ties, row, h, src, top) for h, src in heights]
+    options = [
+        _option(checker, spec, ties, row, h, src, top, recs, records_before) for h, src in heights
+    ]
     done = [i for i, o in enumerate(options) if o.status == "designed"]
     chosen = min(done, key=lambda i: (options[i].T_star_N or 0.0, i)) if done else None
     decisions = []
@@ -589,6 +700,7 @@ def _mechanism(
         )
     else:
         decisions.append("no tie option makes every check pass (see each option's decisions)")
+    decisions += record_notes
     return MechanismRetrofit(
         **head,
         status="designed" if chosen is not None else "not_achievable",
@@ -598,7 +710,9 @@ def _mechanism(
     )
 
 
-def retrofit_doc(cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec) -> RetrofitDoc:
+def retrofit_doc(
+    cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec, motions: Sequence[Any] = ()
+) -> RetrofitDoc:
     """Find the least tie force per failing mechanism, the bar and the checks after it.
 
     Parameters
@@ -609,6 +723,9 @@ def retrofit_doc(cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec) -> Retro
         Hazard (SLV, and SLC where given), FC, q, the check's choices.
     spec : RetrofitSpec
         Steel, bars on offer, anchorage resistance, candidate tie heights per mechanism.
+    motions : sequence of GroundMotion
+        Records (``spec.records`` as the front ends read them): each tied mechanism must
+        survive every one at its design scale (``workflows.retrofit_records``).
 
     Returns
     -------
@@ -644,7 +761,7 @@ def retrofit_doc(cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec) -> Retro
     out = []
     for mech, row in zip(cf.mechanisms, rows):
         try:
-            out.append(_mechanism(cf, site, spec, mech, row))
+            out.append(_mechanism(cf, site, spec, mech, row, motions))
         except InputError:
             raise
         except RockmechError as exc:
@@ -673,6 +790,103 @@ def retrofit_doc(cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec) -> Retro
     return RetrofitDoc(
         standard=CIRC2019 + "; NTC 2018 §4.2.4.1.2.1 (tie-bars)",
         steel=steel,
-        decisions=RETROFIT_DECISIONS,
+        decisions=RETROFIT_DECISIONS + (RECORD_DECISIONS if motions else []),
+        records=[
+            {
+                "name": m.name,
+                "pga_g": float(m.pga_g),
+                "dt": float(m.dt),
+                "duration": float(m.duration),
+            }
+            for m in motions
+        ],
         mechanisms=out,
+        governs_next=governs_next(out),
+    )
+
+
+# --- what governs next ----------------------------------------------------------------
+
+GOVERNS_BASIS = [
+    "A mechanism's margin is its least capacity/demand: the code checks' a_g,X/a_g "
+    "(linear, nonlinear SLV and SLC where evaluated) and, with records, the least "
+    "overturning scale over the design scale of each record; the least margin governs.",
+    "After the intervention, a mechanism with a chosen tie takes its checks and records "
+    "with the tie; every other is as it stands: each tie acts on the mechanism it is "
+    "designed for (the constants carry no tie line shared between mechanisms).",
+]
+
+
+def _margin(
+    fig: Optional[CheckFigures], scales: Sequence[RecordScale]
+) -> tuple[Optional[float], Optional[str]]:
+    """Return the least margin and its criterion (None: nothing evaluated)."""
+    found: list[tuple[float, str]] = []
+    if fig is not None:
+        for value, name in (
+            (fig.linear_ratio, "linear SLV"),
+            (fig.SLV_ratio, "nonlinear SLV"),
+            (fig.SLC_ratio, "nonlinear SLC"),
+        ):
+            if value is not None:
+                found.append((value, name))
+    for sc in scales:
+        if sc.multiple is not None:
+            found.append((sc.multiple, f"record {sc.record}"))
+    if not found:
+        return None, None
+    value, name = min(found, key=lambda p: p[0])
+    return value, name
+
+
+def governs_next(mechanisms: Sequence[MechanismRetrofit]) -> GoverningNext:
+    """Name the mechanism that governs before and after the intervention, and its margin.
+
+    Parameters
+    ----------
+    mechanisms : sequence of MechanismRetrofit
+        The retrofit's mechanisms, in file order (ties broken by it).
+
+    Returns
+    -------
+    GoverningNext
+        The governing mechanism and its least margin [-] before and after, whether it
+        moved, and every mechanism's row.
+    """
+    rows = []
+    for m in mechanisms:
+        b, b_name = _margin(m.before, m.records_before)
+        tied = m.chosen is not None
+        if tied:
+            assert m.chosen is not None
+            o = m.options[m.chosen]
+            a, a_name = _margin(o.after, o.records_after if m.records_before else [])
+        else:
+            a, a_name = b, b_name
+        rows.append(
+            GoverningRow(
+                id=m.id,
+                tied=tied,
+                before_margin=b,
+                before_criterion=b_name,
+                after_margin=a,
+                after_criterion=a_name,
+            )
+        )
+
+    def least(which: str) -> Optional[GoverningRow]:
+        got = [r for r in rows if getattr(r, which) is not None]
+        return min(got, key=lambda r: getattr(r, which)) if got else None
+
+    first, then = least("before_margin"), least("after_margin")
+    return GoverningNext(
+        before=None if first is None else first.id,
+        before_margin=None if first is None else first.before_margin,
+        before_criterion=None if first is None else first.before_criterion,
+        after=None if then is None else then.id,
+        after_margin=None if then is None else then.after_margin,
+        after_criterion=None if then is None else then.after_criterion,
+        moved=first is not None and then is not None and first.id != then.id,
+        rows=rows,
+        basis=GOVERNS_BASIS,
     )

@@ -8,7 +8,9 @@ code factors (docs/theory.md §7.3-7.4). Mechanisms at ground level are not scal
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Any, Optional, Sequence
+
+import numpy as np
 
 from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError
@@ -20,14 +22,22 @@ from ..core.spectra import response_spectrum
 from .adapter import to_rocking_model
 
 __all__ = [
+    "SCALE_GRID",
+    "SCALE_RTOL",
     "SF_METHODS",
     "Building",
     "dense_runs",
     "factor_groups",
+    "least_overturning_scales",
     "mechanism_scale_factor",
     "option_notes",
     "run_scaled",
 ]
+
+#: Scale factors of a record tried for overturning: log-spaced (lowest, highest, count).
+SCALE_GRID = (0.05, 50.0, 60)
+#: Relative width to which the first overturning scale factor is bisected.
+SCALE_RTOL = 1e-3
 
 
 @dataclass(frozen=True)
@@ -218,3 +228,86 @@ def dense_runs(
         )
         runs.append((mech.id, effective, res))
     return runs
+
+
+def least_overturning_scales(
+    models: Sequence[Any],
+    motion: Any,
+    factors: Optional[Sequence[float]] = None,
+    grid: tuple[float, float, int] = SCALE_GRID,
+    stretch: Optional[Sequence[float]] = None,
+) -> list[dict[str, Any]]:
+    """Find the smallest scale factor of a record that overturns each model (exact solver).
+
+    Parameters
+    ----------
+    models : sequence of RockingModel
+        The solver's models.
+    motion : GroundMotion
+        The record.
+    factors : sequence of float, optional
+        Per model, the scale factor up the structure that multiplies the record's scale
+        (``mechanism_scale_factor``; default 1: the record as given).
+    grid : (float, float, int)
+        Scale factors of the record tried: log-spaced from the first to the second, that many.
+    stretch : sequence of float, optional
+        Per model, a factor on the grid's scales (default 1). A block whose ``λ`` and
+        ``φ_ov`` grow by ``c`` responds to the record scaled by ``c s`` as it did to ``s``
+        (theory §2.2): with the grid stretched by ``c`` its runs are the same, and the
+        scale found is ``c`` times the one before (a fixed grid may step over a narrow
+        window of overturning at one ``λ`` and not at the other).
+
+    Returns
+    -------
+    list of dict
+        Per model: ``scale`` (the record's scale [-], before the factor up the structure;
+        None when none up to the grid's top overturns), the bracket ``[safe, overturns]``
+        it was bisected in (relative width ``SCALE_RTOL``), ``pga_g`` (the record's PGA at
+        that scale [g]), the criterion and ``runs`` (exact runs made, the grid's included).
+
+    Notes
+    -----
+    Overturning is not monotonic in the scale (a stronger record may rock a block back):
+    the scale reported is the first on the grid that overturns, refined between it and the
+    grid point below, which did not. Every scale below it on the grid survives.
+    """
+    ups = [1.0] * len(models) if factors is None else [float(f) for f in factors]
+    stretches = [1.0] * len(models) if stretch is None else [float(c) for c in stretch]
+    base = np.geomspace(grid[0], grid[1], int(grid[2]))
+    groups: dict[tuple[float, float], list[int]] = {}
+    for i, key in enumerate(zip(ups, stretches)):
+        groups.setdefault(key, []).append(i)
+    out: list[dict[str, Any]] = [{} for _ in models]
+    for (up, c), members in groups.items():
+        scales = base * c
+        batch = simulate_batch([models[i] for i in members], motion.accel, scales * up)
+        for row, i in enumerate(members):
+            out[i] = _refine(models[i], motion, up, scales, batch.overturned[row], batch.criterion)
+    return out
+
+
+def _refine(
+    model: Any, motion: Any, up: float, scales: Any, overturned: Any, criterion: str
+) -> dict[str, Any]:
+    """Bisect between the first grid scale that overturns and the one below it."""
+    runs = len(scales)
+    hit = np.flatnonzero(overturned)
+    if hit.size == 0:
+        return {"scale": None, "bracket": None, "pga_g": None, "criterion": criterion, "runs": runs}
+    k = int(hit[0])
+    hi = float(scales[k])
+    lo = float(scales[k - 1]) if k > 0 else 0.0
+    while hi - lo > SCALE_RTOL * hi:
+        mid = 0.5 * (lo + hi) if lo > 0.0 else 0.5 * hi
+        runs += 1
+        if simulate(model, motion.accel, scale=mid * up).overturned:
+            hi = mid
+        else:
+            lo = mid
+    return {
+        "scale": hi,
+        "bracket": [lo, hi],
+        "pga_g": hi * float(motion.pga_g),
+        "criterion": criterion,
+        "runs": runs,
+    }

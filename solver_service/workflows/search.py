@@ -62,7 +62,6 @@ from shared_schema.version import __version__
 
 from ..codes.floor_spectra import participation_first_mode
 from ..core.envelope import OverturningLibrary
-from ..core.exact import simulate, simulate_batch
 from ..core.records import GroundMotion
 from ..report.search_figure import plot_search
 from .adapter import to_rocking_model
@@ -72,7 +71,7 @@ from .documents import envelope_doc, log_grid
 from .inputs import read_record
 from .outputs import finite_json
 from .rundir import run_folder
-from .scaling import mechanism_scale_factor
+from .scaling import SCALE_GRID, least_overturning_scales, mechanism_scale_factor
 from .units import stamp
 
 __all__ = [
@@ -95,10 +94,6 @@ __all__ = [
 MAX_EVALUATIONS = 200_000
 #: Work limit of one global check [macro-blocks] (about 1 s for 300 on one core).
 MAX_LP_BLOCKS = 2_000
-#: Scale factors of a record tried for overturning: log-spaced (lowest, highest, count).
-SCALE_GRID = (0.05, 50.0, 60)
-#: Relative width to which the first overturning scale factor is bisected.
-SCALE_RTOL = 1e-3
 
 
 @dataclass
@@ -300,34 +295,8 @@ def scales_to_overturn(
     grid point below, which did not.
     """
     models = [to_rocking_model(m) for m in cf.mechanisms]
-    scales = np.geomspace(grid[0], grid[1], int(grid[2]))
-    batch = simulate_batch(models, motion.accel, scales)
-    out: list[dict[str, Any]] = []
-    for i, model in enumerate(models):
-        hit = np.flatnonzero(batch.overturned[i])
-        if hit.size == 0:
-            out.append(
-                {"scale": None, "bracket": None, "pga_g": None, "criterion": batch.criterion}
-            )
-            continue
-        k = int(hit[0])
-        hi = float(scales[k])
-        lo = float(scales[k - 1]) if k > 0 else 0.0
-        while hi - lo > SCALE_RTOL * hi:
-            mid = 0.5 * (lo + hi) if lo > 0.0 else 0.5 * hi
-            if simulate(model, motion.accel, scale=mid).overturned:
-                hi = mid
-            else:
-                lo = mid
-        out.append(
-            {
-                "scale": hi,
-                "bracket": [lo, hi],
-                "pga_g": hi * float(motion.pga_g),
-                "criterion": batch.criterion,
-            }
-        )
-    return out
+    found = least_overturning_scales(models, motion, grid=grid)
+    return [{k: v for k, v in f.items() if k != "runs"} for f in found]
 
 
 def crack_patches(cand: Candidate) -> list[dict[str, Any]]:
