@@ -13,11 +13,11 @@ SI units, except where a name says otherwise (``a_p_g`` in g).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, Optional, Union
+from typing import TYPE_CHECKING, Any, Optional, Union
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
-from shared_schema.paths import PATH_TYPES, PathLike, as_path, is_path
+from shared_schema.paths import PATH_TYPES, PathLike, as_path, is_path, readable_file
 from shared_schema.retrofit import RetrofitDoc, RetrofitSpec, read_retrofit_spec
 from shared_schema.site import SiteFile
 from solver_service.core.exact import simulate
@@ -27,7 +27,6 @@ from solver_service.core.records import GroundMotion
 from solver_service.core.result import RockingResult
 from solver_service.workflows import assess as _assess
 from solver_service.workflows import inputs as _inputs
-from solver_service.workflows import tables as _tables
 from solver_service.workflows.adapter import models_from_file
 from solver_service.workflows.documents import envelope_doc, frequency_grid, history_doc
 from solver_service.workflows.ida import run_ida
@@ -37,20 +36,25 @@ from solver_service.workflows.units import stamp
 
 from .results import AssessmentResult, CheckResult, EnvelopeResult, HistoryResult, IDAResult
 
+if TYPE_CHECKING:  # the search's types; its workflow is imported when a search runs
+    from cad_maths.scene_base import BaseScene
+    from shared_schema.search import SearchSpec
+    from solver_service.workflows.search import SearchRun
+
 __all__ = [
     "assess",
     "check",
     "constants_from_scene",
-    "constants_from_table",
     "envelope",
     "history",
     "ida",
-    "load_models",
+    "models_from_constants",
     "pulse",
     "read_constants",
     "read_record",
     "read_site",
     "retrofit",
+    "search",
 ]
 
 #: Constants given as an object or as a file (JSON, or a ``.csv``/``.xlsx`` table).
@@ -66,7 +70,9 @@ def read_constants(path: PathLike) -> ConstantsFile:
     ----------
     path : str or Path
         A ``.json`` constants file, or a ``.csv``/``.xlsx`` table with one mechanism per row
-        (``.xlsx`` needs the ``tables`` extra).
+        (``.xlsx`` needs the ``tables`` extra): ``id``, ``rocking``, ``p_eq`` [rad/s],
+        ``lam`` [-], ``eta`` [-], optional ``phi_ov`` [rad], ``f_n`` [Hz], ``h_e`` [m],
+        ``h`` [m], ... (units in the column titles).
 
     Returns
     -------
@@ -75,22 +81,6 @@ def read_constants(path: PathLike) -> ConstantsFile:
         ``.lam`` [-], ``.phi_ov`` [rad]).
     """
     return _inputs.read_constants(as_path(path, "constants"))
-
-
-def constants_from_table(path: PathLike) -> ConstantsFile:
-    """Read a constants table (``.csv``, or ``.xlsx`` with the ``tables`` extra).
-
-    Parameters
-    ----------
-    path : str or Path
-        One mechanism per row: ``id``, ``rocking``, ``p_eq`` [rad/s], ``lam`` [-],
-        ``eta`` [-], optional ``phi_ov`` [rad], ``f_n`` [Hz], ``h_e`` [m], ``h`` [m], ...
-
-    Returns
-    -------
-    ConstantsFile
-    """
-    return _tables.constants_from_table(as_path(path, "table"))
 
 
 def constants_from_scene(
@@ -122,7 +112,7 @@ def _constants(constants: Constants) -> ConstantsFile:
     return read_constants(as_path(constants, "constants", "a ConstantsFile or " + PATH_TYPES))
 
 
-def load_models(constants: Constants) -> list[RockingModel]:
+def models_from_constants(constants: Constants) -> list[RockingModel]:
     """Return the solver's models of every mechanism of a constants file.
 
     Parameters
@@ -223,7 +213,8 @@ def pulse(
     Parameters
     ----------
     model : RockingModel
-        The mechanism (``RockingModel.symmetric`` or one of ``load_models``); needs ``eta``.
+        The mechanism (``RockingModel.symmetric`` or one of ``models_from_constants``);
+        needs ``eta``.
     a_p_g : float
         Signed pulse amplitude [g]; > 0 first pushes towards negative rotation (Housner).
     f_p : float
@@ -332,7 +323,7 @@ def ida(
     records: Sequence[Record],
     levels: Sequence[float],
     *,
-    im: str = "scale",
+    measure: str = "scale",
     sf: str = "none",
     building_height: Optional[float] = None,
     criterion: Optional[str] = None,
@@ -350,10 +341,10 @@ def ida(
     records : sequence of GroundMotion, str or Path
         The records, at least one.
     levels : sequence of float
-        Intensity levels, each > 0: scale factors [-] (``im="scale"``) or PGAs [g]
-        (``im="pga"``).
-    im : {"scale", "pga"}
-        Intensity measure.
+        Intensity levels, each > 0: scale factors [-] (``measure="scale"``) or PGAs [g]
+        (``measure="pga"``).
+    measure : {"scale", "pga"}
+        The intensity measure (``IDAResult.measure``, ``rockmech ida --measure``).
     sf, building_height, criterion
         As ``history``.
     scheduler : str, optional
@@ -364,14 +355,14 @@ def ida(
     Returns
     -------
     IDAResult
-        ``levels``, ``fraction`` overturned per mechanism [-], ``fragility`` (median in the
-        measure's units, ``beta`` [-]).
+        ``measure``, ``levels``, ``fraction`` overturned per mechanism [-], ``fragility``
+        (median in the measure's units, ``beta`` [-]).
     """
     doc = run_ida(
         _constants(constants),
         _records(records),
         [float(v) for v in levels],
-        im=im,
+        measure=measure,
         sf=sf,
         building=Building(building_height),
         criterion=criterion,
@@ -472,3 +463,93 @@ def retrofit(
         else read_retrofit_spec(as_path(spec, "spec", "a RetrofitSpec or " + PATH_TYPES))
     )
     return retrofit_doc(_constants(constants), _site(site), rspec)
+
+
+def search(
+    scene: Union[BaseScene, PathLike],
+    spec: Union[SearchSpec, dict[str, Any], PathLike],
+    *,
+    units: Optional[str] = None,
+    site: Union[SiteFile, PathLike, None] = None,
+    records: Optional[Sequence[Record]] = None,
+    spec_dir: Optional[PathLike] = None,
+    exact: bool = False,
+    limits: bool = True,
+) -> SearchRun:
+    """Find, build and rank a façade's rocking mechanisms (as ``rockmech search``).
+
+    Needs the ``geometry`` extra. The walls of the scene become candidate mechanisms,
+    refined on their static multiplier λ0 [-], built, and ranked by their overturning
+    acceleration over the spec's pulse band [g]; the best run the records and the code check
+    the spec names (docs/search.md).
+
+    Parameters
+    ----------
+    scene : scene object, str or Path
+        A scene (``read_scene``), or a Rhino ``.3dm`` file or a scan mesh (``.ply``,
+        ``.obj``, ``.stl``, ``.off``; give ``units``) to read.
+    spec : SearchSpec, dict, str or Path
+        The search spec: a file (JSON; its ``ranking.site`` and ``ranking.records`` are
+        taken from its folder), a ``SearchSpec`` (``read_search_spec``) or a dict of its
+        fields, validated as a file is.
+    units : {"mm", "cm", "m", "in", "ft"}, optional
+        Length unit of a scan mesh file (a ``.3dm`` states its own).
+    site : SiteFile, str or Path, optional
+        The site for the code check, instead of the spec's ``ranking.site``.
+    records : sequence of GroundMotion, str or Path, optional
+        The records, instead of the spec's ``ranking.records`` (None: the spec's; an empty
+        list: none).
+    spec_dir : str or Path, optional
+        The folder the spec's ``ranking.site`` and ``ranking.records`` are relative to
+        (default: the spec file's folder; none for a spec given as an object).
+    exact : bool
+        Envelopes by the exact integrator instead of the fast mode (the overturning
+        library, labelled in ``rankings.envelope_method``).
+    limits : bool
+        Apply the work limits of the command line (a search past them is refused before it
+        runs; ``InputError`` on ``work_limit``).
+
+    Returns
+    -------
+    SearchRun
+        ``doc`` (``search.json``: ``candidates`` with λ0 [-], ``rankings`` ``static`` and
+        ``dynamic``, ``records``, ``code_check``, ``timings`` [s]), ``constants`` of the
+        mechanisms built (``ConstantsFile``), ``spec_file``; ``write_search`` writes them.
+    """
+    from cad_maths.scene_base import BaseScene
+    from cad_maths.scenes import read_scene
+    from shared_schema.search import SearchSpec
+    from solver_service.workflows import search as _search
+
+    if isinstance(scene, BaseScene):
+        if units is not None:
+            raise InputError(
+                "applies to a scene file; the scene given is already read (read_scene(path, "
+                "units=...))",
+                "units",
+            )
+        scene_obj, scene_name = scene, "scene"
+    else:
+        expected = "a scene (rockmech.read_scene) or " + PATH_TYPES
+        scene_path = readable_file(scene, "scene", expected)
+        scene_obj, scene_name = read_scene(scene_path, units=units), scene_path.name
+    if isinstance(spec, (SearchSpec, dict)):
+        spec_obj: Union[SearchSpec, dict[str, Any]] = spec
+        spec_name, folder = "search spec", spec_dir
+    else:
+        expected = "a SearchSpec, a dict of its fields or " + PATH_TYPES
+        spec_path = as_path(spec, "spec", expected)
+        spec_obj, spec_name = _search.read_search_spec(spec_path), spec_path.name
+        folder = spec_path.parent if spec_dir is None else spec_dir
+    return _search.search_run(
+        scene_obj,
+        spec_obj,
+        scene_name=scene_name,
+        spec_name=spec_name,
+        spec_dir=folder,
+        site=None if site is None else _site(site),
+        motions=None if records is None else _records(records),
+        exact=exact,
+        max_evaluations=_search.MAX_EVALUATIONS if limits else None,
+        max_lp_blocks=_search.MAX_LP_BLOCKS if limits else None,
+    )

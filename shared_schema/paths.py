@@ -5,7 +5,8 @@ Every public function that reads or writes a file takes ``str`` or ``os.PathLike
 anything else with an ``InputError`` naming the argument and the type it got (never a
 ``TypeError`` or an ``AttributeError`` from deep inside a reader); :func:`readable_file`
 also checks that the path names a file that can be read, and says which of "not found",
-"a folder" or "cannot be read" it is, naming the path.
+"a folder" or "cannot be read" it is, naming the path; :func:`readable_folder` does the same
+for a folder an argument names (files are read from it).
 
 No third-party imports, and Python 3.9-clean (Rhino 8 imports it).
 """
@@ -16,7 +17,7 @@ from typing import Union
 
 from shared_schema.errors import InputError
 
-__all__ = ["PATH_TYPES", "PathLike", "as_path", "is_path", "readable_file"]
+__all__ = ["PATH_TYPES", "PathLike", "as_path", "is_path", "readable_file", "readable_folder"]
 
 #: A file path: a string or an ``os.PathLike`` (``pathlib.Path``).
 PathLike = Union[str, "os.PathLike[str]"]
@@ -131,3 +132,46 @@ def readable_file(value: object, field: str, expected: str = PATH_TYPES) -> Path
     except OSError as exc:
         raise InputError(f"cannot be read: {path}: {exc.strerror or exc}", field) from None
     return path
+
+
+def readable_folder(value: object, field: str, expected: str = PATH_TYPES) -> Path:
+    """Return ``value`` as a ``Path`` if it names an existing folder; else ``InputError``.
+
+    For an argument that names a folder files are read from (a spec's folder, against which
+    its relative paths are taken).
+
+    Parameters
+    ----------
+    value : str or os.PathLike
+        The path argument as the caller gave it (:func:`as_path`).
+    field : str
+        The argument's name, for the message.
+    expected : str
+        What the argument may be, in words (:func:`as_path`).
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    InputError
+        Field ``field``; the message names the path: ``folder not found: <path>``, ``is a
+        file, not a folder: <path>`` or ``cannot be read: <path>: <reason>``.
+
+    Examples
+    --------
+    >>> readable_folder("no such folder", "spec_dir")
+    Traceback (most recent call last):
+    ...
+    shared_schema.errors.InputError: spec_dir: folder not found: no such folder
+    """
+    path = as_path(value, field, expected)
+    try:
+        if path.is_dir():
+            return path
+        if path.exists():
+            raise InputError(f"is a file, not a folder: {path}", field)
+    except OSError as exc:
+        raise InputError(f"cannot be read: {path}: {exc.strerror or exc}", field) from None
+    raise InputError(f"folder not found: {path}", field)

@@ -18,14 +18,13 @@ checks before and after with their clauses.
 The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` forms.
 """
 
-from pathlib import Path
 from typing import Any, Dict, List, Literal, Mapping, Optional, Tuple, Union
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from shared_schema.constants import validate_document
 from shared_schema.errors import InputError
-from shared_schema.paths import readable_file
+from shared_schema.paths import PathLike, readable_file
 
 __all__ = [
     "ANCHORAGE_MAX_N",
@@ -246,7 +245,7 @@ def parse_retrofit_spec(source: Union[str, bytes, Mapping[str, Any]]) -> Retrofi
     )
 
 
-def read_retrofit_spec(path: Union[str, "Path"]) -> RetrofitSpec:
+def read_retrofit_spec(path: PathLike) -> RetrofitSpec:
     """Read and validate a retrofit spec file (JSON): a ``str`` or ``os.PathLike``."""
     p = readable_file(path, "retrofit")
     try:
