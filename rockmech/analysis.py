@@ -4,20 +4,32 @@ Every function calls the workflow the command line and the REST service call, so
 the command line and the service give the same numbers; each returns a typed result
 (``rockmech.results``) that keeps the command's whole JSON document in ``doc``. Inputs may
 be given as objects (``ConstantsFile``, ``GroundMotion``, ``SiteFile``) or as file paths,
-each a ``str`` or an ``os.PathLike`` (``pathlib.Path``); a missing file, a folder or an
-argument of another type is an ``InputError`` naming the argument (and the path).
+each a ``str`` or an ``os.PathLike`` (``pathlib.Path``); a JSON document (constants, a site,
+a retrofit or search spec) also as an open file (``shared_schema.paths.read_source``). A
+missing file, a folder or an argument of another type is an ``InputError`` naming the
+argument (and the path).
 
 SI units, except where a name says otherwise (``a_p_g`` in g).
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, Optional, Union
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
-from shared_schema.paths import PATH_TYPES, PathLike, as_path, is_path, readable_file
+from shared_schema.paths import (
+    PATH_TYPES,
+    SOURCE_TYPES,
+    PathLike,
+    Source,
+    as_path,
+    is_file_object,
+    is_path,
+    readable_file,
+)
 from shared_schema.retrofit import RetrofitDoc, RetrofitSpec, read_retrofit_spec
 from shared_schema.site import SiteFile
 from solver_service.core.exact import simulate
@@ -57,19 +69,23 @@ __all__ = [
     "search",
 ]
 
-#: Constants given as an object or as a file (JSON, or a ``.csv``/``.xlsx`` table).
-Constants = Union[ConstantsFile, PathLike]
+#: Constants given as an object or as a file (JSON, or a ``.csv``/``.xlsx`` table); an open
+#: file is read as JSON.
+Constants = Union[ConstantsFile, Source]
+#: A site given as an object or as a file (a path or an open file).
+Site = Union[SiteFile, Source]
 #: A record given as an object or as a file (format detected; a two-column file in g).
 Record = Union[GroundMotion, PathLike]
 
 
-def read_constants(path: PathLike) -> ConstantsFile:
+def read_constants(path: Source) -> ConstantsFile:
     """Read and validate a kinematic-constants file (JSON) or a constants table.
 
     Parameters
     ----------
-    path : str or Path
-        A ``.json`` constants file, or a ``.csv``/``.xlsx`` table with one mechanism per row
+    path : str, Path or open file
+        A ``.json`` constants file (a path, or an open file: ``open(p, "rb")``,
+        ``io.BytesIO``), or the path of a ``.csv``/``.xlsx`` table with one mechanism per row
         (``.xlsx`` needs the ``tables`` extra): ``id``, ``rocking``, ``p_eq`` [rad/s],
         ``lam`` [-], ``eta`` [-], optional ``phi_ov`` [rad], ``f_n`` [Hz], ``h_e`` [m],
         ``h`` [m], ... (units in the column titles).
@@ -80,7 +96,7 @@ def read_constants(path: PathLike) -> ConstantsFile:
         Every mechanism with its constants per side (``mech.positive.p_eq`` [rad/s],
         ``.lam`` [-], ``.phi_ov`` [rad]).
     """
-    return _inputs.read_constants(as_path(path, "constants"))
+    return _inputs.read_constants(path)
 
 
 def constants_from_scene(
@@ -109,7 +125,9 @@ def constants_from_scene(
 def _constants(constants: Constants) -> ConstantsFile:
     if isinstance(constants, ConstantsFile):
         return constants
-    return read_constants(as_path(constants, "constants", "a ConstantsFile or " + PATH_TYPES))
+    if not is_file_object(constants):
+        as_path(constants, "constants", "a ConstantsFile or " + SOURCE_TYPES)
+    return read_constants(constants)
 
 
 def models_from_constants(constants: Constants) -> list[RockingModel]:
@@ -117,7 +135,7 @@ def models_from_constants(constants: Constants) -> list[RockingModel]:
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The constants, or a constants file or table to read.
 
     Returns
@@ -179,25 +197,27 @@ def _records(records: Sequence[Record]) -> list[GroundMotion]:
     return [_record(r, f"records[{k}]") for k, r in enumerate(records)]
 
 
-def read_site(path: PathLike) -> SiteFile:
+def read_site(path: Source) -> SiteFile:
     """Read and validate a site file (NTC 2018 or EC8 hazard, FC, q, the building).
 
     Parameters
     ----------
-    path : str or Path
+    path : str, Path or open file
         The site JSON file.
 
     Returns
     -------
     SiteFile
     """
-    return _assess.read_site(as_path(path, "site"))
+    return _assess.read_site(path)
 
 
-def _site(site: Union[SiteFile, PathLike]) -> SiteFile:
+def _site(site: Site) -> SiteFile:
     if isinstance(site, SiteFile):
         return site
-    return read_site(as_path(site, "site", "a SiteFile or " + PATH_TYPES))
+    if not is_file_object(site):
+        as_path(site, "site", "a SiteFile or " + SOURCE_TYPES)
+    return read_site(site)
 
 
 def pulse(
@@ -249,7 +269,7 @@ def history(
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms (each needs ``eta``; one without it is listed in ``skipped``).
     record : GroundMotion, str or Path
         The record (a file is read with ``read_record``'s defaults).
@@ -297,7 +317,7 @@ def envelope(
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms.
     f_min, f_max : float
         Frequency range [Hz], ``0 < f_min < f_max``.
@@ -336,7 +356,7 @@ def ida(
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms (each needs ``eta``).
     records : sequence of GroundMotion, str or Path
         The records, at least one.
@@ -372,16 +392,16 @@ def ida(
     return IDAResult.from_doc(stamp(doc, "ida"))
 
 
-def check(constants: Constants, site: Union[SiteFile, PathLike]) -> CheckResult:
+def check(constants: Constants, site: Site) -> CheckResult:
     """NTC 2018 / Circolare 2019 §C8.7.1 kinematic checks of every mechanism on a site.
 
     As ``rockmech check --json``; mechanisms need ``virtual_work`` per side.
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms.
-    site : SiteFile, str or Path
+    site : SiteFile, str, Path or open file
         The site: hazard (NTC 2018 or EC8), FC, q, the building.
 
     Returns
@@ -396,7 +416,7 @@ def check(constants: Constants, site: Union[SiteFile, PathLike]) -> CheckResult:
 
 def assess(
     constants: Constants,
-    site: Union[SiteFile, PathLike],
+    site: Site,
     records: Sequence[Record] = (),
     *,
     multiples: Sequence[float] = (0.5, 1.0, 1.5, 2.0),
@@ -407,9 +427,9 @@ def assess(
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms.
-    site : SiteFile, str or Path
+    site : SiteFile, str, Path or open file
         The site.
     records : sequence of GroundMotion, str or Path
         Records for the dynamic verdict (none: the checks and envelope margins only).
@@ -434,18 +454,18 @@ def assess(
 
 def retrofit(
     constants: Constants,
-    site: Union[SiteFile, PathLike],
-    spec: Union[RetrofitSpec, PathLike],
+    site: Site,
+    spec: Union[RetrofitSpec, Source],
 ) -> RetrofitDoc:
     """Find the least tie force that makes each failing mechanism pass the 2019 code checks.
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms (``virtual_work`` and geometry per side: ``rockmech constants``).
-    site : SiteFile, str or Path
+    site : SiteFile, str, Path or open file
         The site: hazard (SLV, and SLC where given), FC, q.
-    spec : RetrofitSpec, str or Path
+    spec : RetrofitSpec, str, Path or open file
         The retrofit spec: steel grade and bars on offer, the anchorage resistance with its
         source, candidate tie heights per mechanism [m].
 
@@ -460,17 +480,21 @@ def retrofit(
     rspec = (
         spec
         if isinstance(spec, RetrofitSpec)
-        else read_retrofit_spec(as_path(spec, "spec", "a RetrofitSpec or " + PATH_TYPES))
+        else read_retrofit_spec(
+            spec
+            if is_file_object(spec)
+            else as_path(spec, "spec", "a RetrofitSpec or " + SOURCE_TYPES)
+        )
     )
     return retrofit_doc(_constants(constants), _site(site), rspec)
 
 
 def search(
     scene: Union[BaseScene, PathLike],
-    spec: Union[SearchSpec, dict[str, Any], PathLike],
+    spec: Union[SearchSpec, dict[str, Any], Source],
     *,
     units: Optional[str] = None,
-    site: Union[SiteFile, PathLike, None] = None,
+    site: Optional[Site] = None,
     records: Optional[Sequence[Record]] = None,
     spec_dir: Optional[PathLike] = None,
     exact: bool = False,
@@ -488,13 +512,13 @@ def search(
     scene : scene object, str or Path
         A scene (``read_scene``), or a Rhino ``.3dm`` file or a scan mesh (``.ply``,
         ``.obj``, ``.stl``, ``.off``; give ``units``) to read.
-    spec : SearchSpec, dict, str or Path
+    spec : SearchSpec, dict, str, Path or open file
         The search spec: a file (JSON; its ``ranking.site`` and ``ranking.records`` are
         taken from its folder), a ``SearchSpec`` (``read_search_spec``) or a dict of its
         fields, validated as a file is.
     units : {"mm", "cm", "m", "in", "ft"}, optional
         Length unit of a scan mesh file (a ``.3dm`` states its own).
-    site : SiteFile, str or Path, optional
+    site : SiteFile, str, Path or open file, optional
         The site for the code check, instead of the spec's ``ranking.site``.
     records : sequence of GroundMotion, str or Path, optional
         The records, instead of the spec's ``ranking.records`` (None: the spec's; an empty
@@ -536,8 +560,12 @@ def search(
     if isinstance(spec, (SearchSpec, dict)):
         spec_obj: Union[SearchSpec, dict[str, Any]] = spec
         spec_name, folder = "search spec", spec_dir
+    elif is_file_object(spec):  # an open file: its paths are taken from spec_dir
+        label = getattr(spec, "name", None)
+        spec_name = os.path.basename(label) if isinstance(label, str) and label else "search spec"
+        spec_obj, folder = _search.read_search_spec(spec), spec_dir
     else:
-        expected = "a SearchSpec, a dict of its fields or " + PATH_TYPES
+        expected = "a SearchSpec, a dict of its fields or " + SOURCE_TYPES
         spec_path = as_path(spec, "spec", expected)
         spec_obj, spec_name = _search.read_search_spec(spec_path), spec_path.name
         folder = spec_path.parent if spec_dir is None else spec_dir

@@ -24,7 +24,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from shared_schema.constants import validate_document
 from shared_schema.errors import InputError
-from shared_schema.paths import PathLike, readable_file
+from shared_schema.paths import Source, read_source
 
 __all__ = [
     "ANCHORAGE_MAX_N",
@@ -245,13 +245,12 @@ def parse_retrofit_spec(source: Union[str, bytes, Mapping[str, Any]]) -> Retrofi
     )
 
 
-def read_retrofit_spec(path: PathLike) -> RetrofitSpec:
-    """Read and validate a retrofit spec file (JSON): a ``str`` or ``os.PathLike``."""
-    p = readable_file(path, "retrofit")
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise InputError(f"cannot read {p.name}: {exc.strerror}", "retrofit") from None
+def read_retrofit_spec(path: Source) -> RetrofitSpec:
+    """Read and validate a retrofit spec (JSON) from a path or an open file; field ``retrofit``.
+
+    ``path`` is a ``str``, an ``os.PathLike`` or an open file (``paths.read_source``).
+    """
+    raw, _ = read_source(path, "retrofit")
     return parse_retrofit_spec(raw)
 
 

@@ -17,6 +17,7 @@ non-path, naming the argument.
 from __future__ import annotations
 
 import inspect
+import io
 import json
 import re
 import tempfile
@@ -427,11 +428,72 @@ def test_an_argument_that_is_no_path_is_an_input_error_naming_it(
     assert info.value.field == (slot.type_field or slot.field)
 
 
-@pytest.mark.parametrize("slot", READERS[:3], ids=IDS[:3])
-def test_an_open_file_is_refused_with_its_path_asked_for(slot: Slot) -> None:
+def _takes_open_files(slot: Slot) -> bool:
+    """A JSON document (constants, a site, a retrofit or search spec) is read from an open file."""
+    parameter = inspect.signature(getattr(rockmech, slot.function)).parameters[slot.argument]
+    typed = re.search(r"\b(Source|Constants|Site)\b|\bIO\[", str(parameter.annotation))
+    return typed is not None and slot.example.suffix == ".json"
+
+
+OPEN_FILE_READERS = [slot for slot in READERS if _takes_open_files(slot)]
+PATH_ONLY_READERS = [slot for slot in READERS if not _takes_open_files(slot)]
+
+
+def test_the_open_file_readers_are_the_json_documents() -> None:
+    documents = {(s.function, s.argument) for s in OPEN_FILE_READERS}
+    assert {
+        ("read_constants", "path"),
+        ("read_site", "path"),
+        ("read_search_spec", "path"),
+        ("read_retrofit_spec", "path"),
+        ("check", "site"),
+        ("retrofit", "spec"),
+        ("search", "spec"),
+    } <= documents
+    assert ("read_record", "path") not in documents and ("read_scene", "source") not in documents
+
+
+@pytest.mark.parametrize("mode", ["rb", "r", "bytesio"])
+@pytest.mark.parametrize("slot", OPEN_FILE_READERS, ids=[s.id for s in OPEN_FILE_READERS])
+def test_an_open_file_reads_as_its_path_does(slot: Slot, mode: str) -> None:
+    if slot.function == "search" and slot.argument == "spec":
+        pytest.skip("an open spec has no folder: test_search_reads_an_open_spec_with_its_folder")
+    want = canonical(slot.call(slot.example))
+    if mode == "bytesio":
+        got = slot.call(io.BytesIO(slot.example.read_bytes()))
+    else:
+        with slot.example.open(mode, encoding=None if mode == "rb" else "utf-8") as handle:
+            got = slot.call(handle)
+    assert canonical(got) == want
+
+
+def test_search_reads_an_open_spec_with_its_folder() -> None:
+    with SEARCH_SPEC.open("rb") as handle:
+        run = rockmech.search(SEARCH_SCENE, handle, spec_dir=SEARCH_SPEC.parent)
+    assert canonical(run) == canonical(rockmech.search(SEARCH_SCENE, SEARCH_SPEC))
+    with SEARCH_SPEC.open("rb") as handle:  # the spec names its site relative to its folder
+        with pytest.raises(rockmech.InputError, match=r"^ranking\.site: .*not found"):
+            rockmech.search(SEARCH_SCENE, handle)
+
+
+@pytest.mark.parametrize("slot", PATH_ONLY_READERS, ids=[s.id for s in PATH_ONLY_READERS])
+def test_an_open_file_where_a_path_belongs_is_refused(slot: Slot) -> None:
     with slot.example.open("rb") as handle:
-        with pytest.raises(rockmech.InputError, match=r"got an open file .*pass the file's path"):
+        with pytest.raises(rockmech.InputError) as info:
             slot.call(handle)
+    assert re.search(r"open file\b.*pass the (file's )?path", str(info.value)), str(info.value)
+
+
+def test_an_open_file_that_cannot_be_read_is_an_input_error_naming_it(tmp_path: Path) -> None:
+    with SITE.open("rb") as handle:
+        pass  # closed
+    with pytest.raises(rockmech.InputError, match=r"^site: cannot be read: ntc_site\.json: "):
+        rockmech.read_site(handle)
+    with (tmp_path / "w.json").open("wb") as handle:
+        with pytest.raises(rockmech.InputError, match=r"^constants: cannot be read: w\.json"):
+            rockmech.read_constants(handle)
+    with pytest.raises(rockmech.InputError, match=r"^site: <open file> is empty"):
+        rockmech.read_site(io.BytesIO(b""))
 
 
 def test_a_single_record_where_a_list_belongs_is_refused() -> None:

@@ -53,7 +53,15 @@ from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import require
 from shared_schema.io import stamped, write_constants
-from shared_schema.paths import PATH_TYPES, PathLike, as_path, is_path, readable_folder
+from shared_schema.paths import (
+    PATH_TYPES,
+    PathLike,
+    Source,
+    as_path,
+    is_path,
+    read_source,
+    readable_folder,
+)
 from shared_schema.rules import check_file
 from shared_schema.search import SearchSpec, parse_search_spec
 from shared_schema.site import SiteFile
@@ -131,7 +139,7 @@ class SearchRun:
 SEARCH_SPEC_EXPECTED = 'a search spec (JSON, {"walls": [...], "levels": [...], ...})'
 
 
-def read_search_spec(path: PathLike) -> SearchSpec:
+def read_search_spec(path: Source) -> SearchSpec:
     """Read and validate a search spec file; errors name the spec and the field.
 
     An empty, binary (gzip, a workbook) or non-UTF-8 file is told as such, naming the file
@@ -140,18 +148,18 @@ def read_search_spec(path: PathLike) -> SearchSpec:
 
     Parameters
     ----------
-    path : str or os.PathLike
-        The search spec (JSON).
+    path : str, os.PathLike or file object
+        The search spec (JSON), as a path or an open file (``paths.read_source``). Its
+        ``ranking.site`` and ``ranking.records`` are relative to its folder: give that folder
+        to ``search`` as ``spec_dir``.
     """
-    path = check_file(path, "spec")
-    text = decode_text(path.read_bytes(), path.name, "spec", SEARCH_SPEC_EXPECTED)
+    raw, name = read_source(path, "spec")
+    text = decode_text(raw, name, "spec", SEARCH_SPEC_EXPECTED)
     try:
         json_document(text)  # malformed JSON: one line
     except InputError as exc:
-        raise InputError(
-            f"{path.name}: {exc.reason}; expected {SEARCH_SPEC_EXPECTED}", "spec"
-        ) from None
-    return parse_search_spec(text, path.name)
+        raise InputError(f"{name}: {exc.reason}; expected {SEARCH_SPEC_EXPECTED}", "spec") from None
+    return parse_search_spec(text, name)
 
 
 #: A site's building height this far (relative) from the scene's walls' gets a note.
