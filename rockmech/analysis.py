@@ -18,8 +18,10 @@ import os
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, Optional, Union
 
+import numpy as np
+
 from shared_schema.constants import ConstantsFile
-from shared_schema.errors import InputError
+from shared_schema.errors import InputError, wrong_type
 from shared_schema.paths import (
     PATH_TYPES,
     SOURCE_TYPES,
@@ -180,6 +182,19 @@ def read_record(
     return _inputs.read_record(as_path(path, "record"), format, units, dt, channel, component)
 
 
+def _numbers(values: Sequence[float], field: str) -> list[float]:
+    """Return a sequence of numbers as floats; refuse one number, a str or another type."""
+    if isinstance(values, (str, bytes)) or not isinstance(values, (Sequence, np.ndarray)):
+        hint = f"give a list of it: [{values!r}]" if isinstance(values, (int, float)) else ""
+        raise wrong_type(values, field, "a sequence of numbers", hint)
+    out = []
+    for k, value in enumerate(values):
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+            raise wrong_type(value, f"{field}[{k}]", "a number")
+        out.append(float(value))
+    return out
+
+
 def _record(record: Record, field: str = "record") -> GroundMotion:
     if isinstance(record, GroundMotion):
         return record
@@ -293,7 +308,7 @@ def history(
     doc = history_doc(
         _constants(constants),
         _record(record),
-        [float(s) for s in scales],
+        _numbers(scales, "scales"),
         sf=sf,
         building=Building(building_height),
         criterion=criterion,
@@ -381,7 +396,7 @@ def ida(
     doc = run_ida(
         _constants(constants),
         _records(records),
-        [float(v) for v in levels],
+        _numbers(levels, "levels"),
         measure=measure,
         sf=sf,
         building=Building(building_height),
@@ -447,7 +462,7 @@ def assess(
         _constants(constants),
         _site(site),
         motions,
-        multiples=_assess.check_multiples(list(multiples)),
+        multiples=_assess.check_multiples(_numbers(multiples, "multiples")),
     )
     return AssessmentResult.from_doc(stamp(doc, "assess"))
 

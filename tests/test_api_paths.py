@@ -651,3 +651,88 @@ def test_the_ida_intensity_measure_has_one_name() -> None:
         rockmech.ida(WALLS, [RECORD], levels=[1.0], measure="pgv", jobs=1)
     with pytest.raises(TypeError, match="'im'"):
         rockmech.ida(WALLS, [RECORD], levels=[1.0], im="pga")  # type: ignore[call-arg]
+
+
+# Arguments of another type, for the functions that take no path: an InputError naming the
+# argument, saying what it takes and, where there is one, how to get it from what was given.
+
+
+def _motion() -> Any:
+    return rockmech.read_record(RECORD)
+
+
+def _model() -> Any:
+    return rockmech.models_from_constants(_CF)[0]
+
+
+WRONG_TYPES: dict[str, list[tuple[Callable[[], Any], str, str]]] = {
+    "pulse": [
+        (lambda: rockmech.pulse(_CF, 0.3, 1.0), "model", r"got ConstantsFile; .*models_from_const"),
+        (lambda: rockmech.pulse("W1", 0.3, 1.0), "model", r"got str; build one with"),
+    ],
+    "simulate": [
+        (lambda: rockmech.simulate(_model(), _motion()), "excitation", r"its \.accel"),
+        (lambda: rockmech.simulate(_model(), str(RECORD)), "excitation", r"read_record\(path\)"),
+        (lambda: rockmech.simulate(_CF.mechanisms[0], _motion().accel), "model", "Mechanism"),
+    ],
+    "simulate_batch": [
+        (lambda: rockmech.simulate_batch(_model(), _motion().accel, [1.0]), "models", r"\[model\]"),
+        (lambda: rockmech.simulate_batch([_CF], _motion().accel, [1.0]), "models[0]", "Constants"),
+    ],
+    "solve_pulse": [(lambda: rockmech.solve_pulse("p_eq=2"), "request", r"a dict of its fields")],
+    "mechanism_envelope": [
+        (lambda: rockmech.mechanism_envelope(_CF, [1.0]), "model", r"models_from_constants"),
+    ],
+    "critical_bands": [
+        (lambda: rockmech.critical_bands("W1"), "envelopes", r"sequence of Envelopes, got str"),
+        (lambda: rockmech.critical_bands([_model()]), "envelopes[0]", r"mechanism_envelope\("),
+        (
+            lambda: rockmech.critical_bands(rockmech.mechanism_envelope(_model(), [1.0])),
+            "envelopes",
+            r"\[envelope\]",
+        ),
+    ],
+    "extract_pulses": [(lambda: rockmech.extract_pulses(_motion()), "accel", r"its \.accel")],
+    "largest_pulse": [(lambda: rockmech.largest_pulse(str(RECORD)), "accel", r"read_record")],
+    "response_spectrum": [
+        (lambda: rockmech.response_spectrum("acc", 0.02, [1.0]), "acc", r"must be numbers"),
+    ],
+}
+#: Functions of NO_PATH without arguments to get wrong.
+NO_ARGUMENTS = {"examples_dir", "kernel_status"}
+CASES = [(name, k) for name, cases in WRONG_TYPES.items() for k in range(len(cases))]
+
+
+def test_every_function_without_a_path_has_its_wrong_types_tried() -> None:
+    assert set(WRONG_TYPES) | NO_ARGUMENTS == set(NO_PATH)
+    for name in NO_ARGUMENTS:
+        assert not inspect.signature(getattr(rockmech, name)).parameters, name
+
+
+@pytest.mark.parametrize(("name", "k"), CASES, ids=[f"{n}-{k}" for n, k in CASES])
+def test_an_argument_of_another_type_is_an_input_error_saying_what_it_takes(
+    name: str, k: int
+) -> None:
+    call, field, words = WRONG_TYPES[name][k]
+    with pytest.raises(rockmech.InputError, match=words) as info:
+        call()
+    assert info.value.field == field, str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("call", "field", "words"),
+    [
+        (lambda: rockmech.history(WALLS, RECORD, scales=1.0), "scales", r"\[1\.0\]"),
+        (lambda: rockmech.history(WALLS, RECORD, scales=["a"]), "scales[0]", "a number"),
+        (lambda: rockmech.ida(WALLS, [RECORD], levels="1,2"), "levels", "got str"),
+        (lambda: rockmech.assess(CHURCH, SITE, multiples=2), "multiples", r"\[2\]"),
+        (lambda: rockmech.write_search("run", "out"), "run", r"rockmech\.search\("),
+    ],
+    ids=["scales-number", "scales-str", "levels-str", "multiples-number", "write_search-run"],
+)
+def test_numbers_and_runs_of_another_type_are_refused(
+    call: Callable[[], Any], field: str, words: str
+) -> None:
+    with pytest.raises(rockmech.InputError, match=words) as info:
+        call()
+    assert info.value.field == field, str(info.value)

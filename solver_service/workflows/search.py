@@ -50,7 +50,7 @@ from cad_maths.search.prism import segment_intervals
 from cad_maths.search.specs import AGREEMENT_RTOL, build_candidates
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile, json_document
-from shared_schema.errors import InputError, RockmechError
+from shared_schema.errors import InputError, RockmechError, wrong_type
 from shared_schema.extras import require
 from shared_schema.io import stamped, write_constants
 from shared_schema.paths import (
@@ -1123,6 +1123,8 @@ def write_search(run: SearchRun, out: PathLike, *, figure: bool = True) -> list[
     list of Path
         The files written, in ``out`` (as ``write_search_files``).
     """
+    if not isinstance(run, SearchRun):
+        raise wrong_type(run, "run", "a SearchRun", "rockmech.search(scene, spec) gives one")
     out = as_path(out, "out")
     notes: list[str] = []
     with run_folder(out, on_note=notes.append) as tmp:
