@@ -555,9 +555,17 @@ def search(
         ``dynamic``, ``records``, ``code_check``, ``timings`` [s]), ``constants`` of the
         mechanisms built (``ConstantsFile``), ``spec_file``; ``write_search`` writes them.
     """
+    # The search needs the geometry extra (cad_maths, rhino3dm, trimesh): loaded when one
+    # runs, so that the other analyses load without it.
     from cad_maths.scene_base import BaseScene
+
+    # The scene reader, from the same extra.
     from cad_maths.scenes import read_scene
+
+    # The search spec's model, with the search.
     from shared_schema.search import SearchSpec
+
+    # The search's workflow (its figure, the 3dm writer).
     from solver_service.workflows import search as _search
 
     if isinstance(scene, BaseScene):
