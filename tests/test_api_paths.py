@@ -16,6 +16,7 @@ non-path, naming the argument.
 
 from __future__ import annotations
 
+import functools
 import inspect
 import io
 import json
@@ -286,13 +287,10 @@ def _search_files(out: Any) -> dict[str, bytes]:
     return files
 
 
-_RUNS: list[Any] = []
-
-
+@functools.cache
 def _search_run() -> Any:
-    if not _RUNS:
-        _RUNS.append(rockmech.search(SEARCH_SCENE, SEARCH_SPEC, records=[]))
-    return _RUNS[0]
+    """One search for the writers' tests, which compare two writes of it (no records: quick)."""
+    return rockmech.search(SEARCH_SCENE, SEARCH_SPEC, records=[])
 
 
 TARGETS = [
