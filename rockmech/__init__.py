@@ -40,8 +40,7 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
         SolverError as SolverError,
     )
     from shared_schema.extras import MissingExtra as MissingExtra
-    from shared_schema.io import load_constants as load_constants
-    from shared_schema.io import save_constants as save_constants
+    from shared_schema.io import write_constants as write_constants
     from shared_schema.retrofit import RetrofitDoc as RetrofitDoc
     from shared_schema.retrofit import RetrofitSpec as RetrofitSpec
     from shared_schema.retrofit import read_retrofit_spec as read_retrofit_spec
@@ -79,12 +78,9 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
         write_report as write_report,
     )
     from solver_service.workflows.documents import solve_pulse as solve_pulse
-    from solver_service.workflows.inputs import constants_from_files as constants_from_files
     from solver_service.workflows.search import SearchRun as SearchRun
     from solver_service.workflows.search import read_search_spec as read_search_spec
-    from solver_service.workflows.search import save_search as save_search
-    from solver_service.workflows.search import search_from_files as search_from_files
-    from solver_service.workflows.search import search_run as search_run
+    from solver_service.workflows.search import write_search as write_search
 
     from .analysis import (
         assess as assess,
@@ -96,9 +92,6 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
         constants_from_scene as constants_from_scene,
     )
     from .analysis import (
-        constants_from_table as constants_from_table,
-    )
-    from .analysis import (
         envelope as envelope,
     )
     from .analysis import (
@@ -108,7 +101,7 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
         ida as ida,
     )
     from .analysis import (
-        load_models as load_models,
+        models_from_constants as models_from_constants,
     )
     from .analysis import (
         pulse as pulse,
@@ -124,6 +117,9 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     )
     from .analysis import (
         retrofit as retrofit,
+    )
+    from .analysis import (
+        search as search,
     )
     from .results import AssessmentResult as AssessmentResult
     from .results import CheckResult as CheckResult
@@ -143,16 +139,14 @@ _SOURCES = {
     "GeometryError": "shared_schema.errors",
     "SolverError": "shared_schema.errors",
     "MissingExtra": "shared_schema.extras",
-    # The kinematic-constants file.
+    # The kinematic-constants file: read_* reads a file, write_* writes one, the object
+    # first and the path second (#38).
     "ConstantsFile": "shared_schema.constants",
-    "load_constants": "shared_schema.io",
-    "save_constants": "shared_schema.io",
-    "constants_from_files": "solver_service.workflows.inputs",
-    # Reading inputs: constants (file, table, scene), models, records, sites.
     "read_constants": "rockmech.analysis",
-    "constants_from_table": "rockmech.analysis",
+    "write_constants": "shared_schema.io",
+    # Constants from a scene, the solver's models from constants; records, sites.
     "constants_from_scene": "rockmech.analysis",
-    "load_models": "rockmech.analysis",
+    "models_from_constants": "rockmech.analysis",
     "read_record": "rockmech.analysis",
     "read_site": "rockmech.analysis",
     "SiteFile": "shared_schema.site",
@@ -196,10 +190,9 @@ _SOURCES = {
     "largest_pulse": "solver_service.core.pulses",
     "response_spectrum": "solver_service.core.spectra",
     # The automatic search of a façade's mechanisms (issue #31).
+    "search": "rockmech.analysis",
     "SearchRun": "solver_service.workflows.search",
-    "search_from_files": "solver_service.workflows.search",
-    "search_run": "solver_service.workflows.search",
-    "save_search": "solver_service.workflows.search",
+    "write_search": "solver_service.workflows.search",
     "read_search_spec": "solver_service.workflows.search",
     "read_scene": "cad_maths.scenes",
     # Reports and the bundled examples.

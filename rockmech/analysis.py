@@ -4,20 +4,34 @@ Every function calls the workflow the command line and the REST service call, so
 the command line and the service give the same numbers; each returns a typed result
 (``rockmech.results``) that keeps the command's whole JSON document in ``doc``. Inputs may
 be given as objects (``ConstantsFile``, ``GroundMotion``, ``SiteFile``) or as file paths,
-each a ``str`` or an ``os.PathLike`` (``pathlib.Path``); a missing file, a folder or an
-argument of another type is an ``InputError`` naming the argument (and the path).
+each a ``str`` or an ``os.PathLike`` (``pathlib.Path``); a JSON document (constants, a site,
+a retrofit or search spec) also as an open file (``shared_schema.paths.read_source``). A
+missing file, a folder or an argument of another type is an ``InputError`` naming the
+argument (and the path).
 
 SI units, except where a name says otherwise (``a_p_g`` in g).
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
-from typing import Any, Optional, Union
+from typing import TYPE_CHECKING, Any, Optional, Union
+
+import numpy as np
 
 from shared_schema.constants import ConstantsFile
-from shared_schema.errors import InputError
-from shared_schema.paths import PATH_TYPES, PathLike, as_path, is_path
+from shared_schema.errors import InputError, wrong_type
+from shared_schema.paths import (
+    PATH_TYPES,
+    SOURCE_TYPES,
+    PathLike,
+    Source,
+    as_path,
+    is_file_object,
+    is_path,
+    readable_file,
+)
 from shared_schema.retrofit import RetrofitDoc, RetrofitSpec, read_retrofit_spec
 from shared_schema.site import SiteFile
 from solver_service.core.exact import simulate
@@ -27,7 +41,6 @@ from solver_service.core.records import GroundMotion
 from solver_service.core.result import RockingResult
 from solver_service.workflows import assess as _assess
 from solver_service.workflows import inputs as _inputs
-from solver_service.workflows import tables as _tables
 from solver_service.workflows.adapter import models_from_file
 from solver_service.workflows.documents import envelope_doc, frequency_grid, history_doc
 from solver_service.workflows.ida import run_ida
@@ -38,36 +51,47 @@ from solver_service.workflows.units import stamp
 
 from .results import AssessmentResult, CheckResult, EnvelopeResult, HistoryResult, IDAResult
 
+if TYPE_CHECKING:  # the search's types; its workflow is imported when a search runs
+    from cad_maths.scene_base import BaseScene
+    from shared_schema.search import SearchSpec
+    from solver_service.workflows.search import SearchRun
+
 __all__ = [
     "assess",
     "check",
     "constants_from_scene",
-    "constants_from_table",
     "envelope",
     "history",
     "ida",
-    "load_models",
+    "models_from_constants",
     "pulse",
     "read_constants",
     "read_record",
     "read_site",
     "retrofit",
+    "search",
 ]
 
-#: Constants given as an object or as a file (JSON, or a ``.csv``/``.xlsx`` table).
-Constants = Union[ConstantsFile, PathLike]
+#: Constants given as an object or as a file (JSON, or a ``.csv``/``.xlsx`` table); an open
+#: file is read as JSON.
+Constants = Union[ConstantsFile, Source]
+#: A site given as an object or as a file (a path or an open file).
+Site = Union[SiteFile, Source]
 #: A record given as an object or as a file (format detected; a two-column file in g).
 Record = Union[GroundMotion, PathLike]
 
 
-def read_constants(path: PathLike) -> ConstantsFile:
+def read_constants(path: Source) -> ConstantsFile:
     """Read and validate a kinematic-constants file (JSON) or a constants table.
 
     Parameters
     ----------
-    path : str or Path
-        A ``.json`` constants file, or a ``.csv``/``.xlsx`` table with one mechanism per row
-        (``.xlsx`` needs the ``tables`` extra).
+    path : str, Path or open file
+        A ``.json`` constants file (a path, or an open file: ``open(p, "rb")``,
+        ``io.BytesIO``), or the path of a ``.csv``/``.xlsx`` table with one mechanism per row
+        (``.xlsx`` needs the ``tables`` extra): ``id``, ``rocking``, ``p_eq`` [rad/s],
+        ``lam`` [-], ``eta`` [-], optional ``phi_ov`` [rad], ``f_n`` [Hz], ``h_e`` [m],
+        ``h`` [m], ... (units in the column titles).
 
     Returns
     -------
@@ -75,23 +99,7 @@ def read_constants(path: PathLike) -> ConstantsFile:
         Every mechanism with its constants per side (``mech.positive.p_eq`` [rad/s],
         ``.lam`` [-], ``.phi_ov`` [rad]).
     """
-    return _inputs.read_constants(as_path(path, "constants"))
-
-
-def constants_from_table(path: PathLike) -> ConstantsFile:
-    """Read a constants table (``.csv``, or ``.xlsx`` with the ``tables`` extra).
-
-    Parameters
-    ----------
-    path : str or Path
-        One mechanism per row: ``id``, ``rocking``, ``p_eq`` [rad/s], ``lam`` [-],
-        ``eta`` [-], optional ``phi_ov`` [rad], ``f_n`` [Hz], ``h_e`` [m], ``h`` [m], ...
-
-    Returns
-    -------
-    ConstantsFile
-    """
-    return _tables.constants_from_table(as_path(path, "table"))
+    return _inputs.read_constants(path)
 
 
 def constants_from_scene(
@@ -120,15 +128,17 @@ def constants_from_scene(
 def _constants(constants: Constants) -> ConstantsFile:
     if isinstance(constants, ConstantsFile):
         return constants
-    return read_constants(as_path(constants, "constants", "a ConstantsFile or " + PATH_TYPES))
+    if not is_file_object(constants):
+        as_path(constants, "constants", "a ConstantsFile or " + SOURCE_TYPES)
+    return read_constants(constants)
 
 
-def load_models(constants: Constants) -> list[RockingModel]:
+def models_from_constants(constants: Constants) -> list[RockingModel]:
     """Return the solver's models of every mechanism of a constants file.
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The constants, or a constants file or table to read.
 
     Returns
@@ -173,6 +183,19 @@ def read_record(
     return _inputs.read_record(as_path(path, "record"), format, units, dt, channel, component)
 
 
+def _numbers(values: Sequence[float], field: str) -> list[float]:
+    """Return a sequence of numbers as floats; refuse one number, a str or another type."""
+    if isinstance(values, (str, bytes)) or not isinstance(values, (Sequence, np.ndarray)):
+        hint = f"give a list of it: [{values!r}]" if isinstance(values, (int, float)) else ""
+        raise wrong_type(values, field, "a sequence of numbers", hint)
+    out = []
+    for k, value in enumerate(values):
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+            raise wrong_type(value, f"{field}[{k}]", "a number")
+        out.append(float(value))
+    return out
+
+
 def _record(record: Record, field: str = "record") -> GroundMotion:
     if isinstance(record, GroundMotion):
         return record
@@ -190,25 +213,27 @@ def _records(records: Sequence[Record]) -> list[GroundMotion]:
     return [_record(r, f"records[{k}]") for k, r in enumerate(records)]
 
 
-def read_site(path: PathLike) -> SiteFile:
+def read_site(path: Source) -> SiteFile:
     """Read and validate a site file (NTC 2018 or EC8 hazard, FC, q, the building).
 
     Parameters
     ----------
-    path : str or Path
+    path : str, Path or open file
         The site JSON file.
 
     Returns
     -------
     SiteFile
     """
-    return _assess.read_site(as_path(path, "site"))
+    return _assess.read_site(path)
 
 
-def _site(site: Union[SiteFile, PathLike]) -> SiteFile:
+def _site(site: Site) -> SiteFile:
     if isinstance(site, SiteFile):
         return site
-    return read_site(as_path(site, "site", "a SiteFile or " + PATH_TYPES))
+    if not is_file_object(site):
+        as_path(site, "site", "a SiteFile or " + SOURCE_TYPES)
+    return read_site(site)
 
 
 def pulse(
@@ -224,7 +249,8 @@ def pulse(
     Parameters
     ----------
     model : RockingModel
-        The mechanism (``RockingModel.symmetric`` or one of ``load_models``); needs ``eta``.
+        The mechanism (``RockingModel.symmetric`` or one of ``models_from_constants``);
+        needs ``eta``.
     a_p_g : float
         Signed pulse amplitude [g]; > 0 first pushes towards negative rotation (Housner).
     f_p : float
@@ -259,7 +285,7 @@ def history(
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms (each needs ``eta``; one without it is listed in ``skipped``).
     record : GroundMotion, str or Path
         The record (a file is read with ``read_record``'s defaults).
@@ -283,7 +309,7 @@ def history(
     doc = history_doc(
         _constants(constants),
         _record(record),
-        [float(s) for s in scales],
+        _numbers(scales, "scales"),
         sf=sf,
         building=Building(building_height),
         criterion=criterion,
@@ -307,7 +333,7 @@ def envelope(
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms.
     f_min, f_max : float
         Frequency range [Hz], ``0 < f_min < f_max``.
@@ -333,7 +359,7 @@ def ida(
     records: Sequence[Record],
     levels: Sequence[float],
     *,
-    im: str = "scale",
+    measure: str = "scale",
     sf: str = "none",
     building_height: Optional[float] = None,
     criterion: Optional[str] = None,
@@ -346,15 +372,15 @@ def ida(
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms (each needs ``eta``).
     records : sequence of GroundMotion, str or Path
         The records, at least one.
     levels : sequence of float
-        Intensity levels, each > 0: scale factors [-] (``im="scale"``) or PGAs [g]
-        (``im="pga"``).
-    im : {"scale", "pga"}
-        Intensity measure.
+        Intensity levels, each > 0: scale factors [-] (``measure="scale"``) or PGAs [g]
+        (``measure="pga"``).
+    measure : {"scale", "pga"}
+        The intensity measure (``IDAResult.measure``, ``rockmech ida --measure``).
     sf, building_height, criterion
         As ``history``.
     scheduler : str, optional
@@ -365,14 +391,14 @@ def ida(
     Returns
     -------
     IDAResult
-        ``levels``, ``fraction`` overturned per mechanism [-], ``fragility`` (median in the
-        measure's units, ``beta`` [-]).
+        ``measure``, ``levels``, ``fraction`` overturned per mechanism [-], ``fragility``
+        (median in the measure's units, ``beta`` [-]).
     """
     doc = run_ida(
         _constants(constants),
         _records(records),
-        [float(v) for v in levels],
-        im=im,
+        _numbers(levels, "levels"),
+        measure=measure,
         sf=sf,
         building=Building(building_height),
         criterion=criterion,
@@ -382,16 +408,16 @@ def ida(
     return IDAResult.from_doc(stamp(doc, "ida"))
 
 
-def check(constants: Constants, site: Union[SiteFile, PathLike]) -> CheckResult:
+def check(constants: Constants, site: Site) -> CheckResult:
     """NTC 2018 / Circolare 2019 §C8.7.1 kinematic checks of every mechanism on a site.
 
     As ``rockmech check --json``; mechanisms need ``virtual_work`` per side.
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms.
-    site : SiteFile, str or Path
+    site : SiteFile, str, Path or open file
         The site: hazard (NTC 2018 or EC8), FC, q, the building.
 
     Returns
@@ -406,7 +432,7 @@ def check(constants: Constants, site: Union[SiteFile, PathLike]) -> CheckResult:
 
 def assess(
     constants: Constants,
-    site: Union[SiteFile, PathLike],
+    site: Site,
     records: Sequence[Record] = (),
     *,
     multiples: Sequence[float] = (0.5, 1.0, 1.5, 2.0),
@@ -417,9 +443,9 @@ def assess(
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms.
-    site : SiteFile, str or Path
+    site : SiteFile, str, Path or open file
         The site.
     records : sequence of GroundMotion, str or Path
         Records for the dynamic verdict (none: the checks and envelope margins only).
@@ -437,26 +463,26 @@ def assess(
         _constants(constants),
         _site(site),
         motions,
-        multiples=_assess.check_multiples(list(multiples)),
+        multiples=_assess.check_multiples(_numbers(multiples, "multiples")),
     )
     return AssessmentResult.from_doc(stamp(doc, "assess"))
 
 
 def retrofit(
     constants: Constants,
-    site: Union[SiteFile, PathLike],
-    spec: Union[RetrofitSpec, PathLike],
+    site: Site,
+    spec: Union[RetrofitSpec, Source],
     records: Optional[Sequence[Record]] = None,
 ) -> RetrofitDoc:
     """Find the least tie force that makes each failing mechanism pass the 2019 code checks.
 
     Parameters
     ----------
-    constants : ConstantsFile, str or Path
+    constants : ConstantsFile, str, Path or open file
         The mechanisms (``virtual_work`` and geometry per side: ``rockmech constants``).
-    site : SiteFile, str or Path
+    site : SiteFile, str, Path or open file
         The site: hazard (SLV, and SLC where given), FC, q.
-    spec : RetrofitSpec, str or Path
+    spec : RetrofitSpec, str, Path or open file
         The retrofit spec: steel grade and bars on offer, the anchorage resistance with its
         source, candidate tie heights per mechanism [m], the records (relative to its folder
         when it is a file).
@@ -475,11 +501,115 @@ def retrofit(
     spec_dir = None
     if isinstance(spec, RetrofitSpec):
         rspec = spec
+    elif is_file_object(spec):  # an open file: its records are read from the current folder
+        rspec = read_retrofit_spec(spec)
     else:
-        spec_path = as_path(spec, "spec", "a RetrofitSpec or " + PATH_TYPES)
+        spec_path = as_path(spec, "spec", "a RetrofitSpec or " + SOURCE_TYPES)
         rspec, spec_dir = read_retrofit_spec(spec_path), spec_path.parent
     if records is not None and len(records) > 0:
         motions = _records(records)
     else:
         motions = read_retrofit_records(rspec, spec_dir)
     return retrofit_doc(_constants(constants), _site(site), rspec, motions)
+
+
+def search(
+    scene: Union[BaseScene, PathLike],
+    spec: Union[SearchSpec, dict[str, Any], Source],
+    *,
+    units: Optional[str] = None,
+    site: Optional[Site] = None,
+    records: Optional[Sequence[Record]] = None,
+    spec_dir: Optional[PathLike] = None,
+    exact: bool = False,
+    limits: bool = True,
+) -> SearchRun:
+    """Find, build and rank a façade's rocking mechanisms (as ``rockmech search``).
+
+    Needs the ``geometry`` extra. The walls of the scene become candidate mechanisms,
+    refined on their static multiplier λ0 [-], built, and ranked by their overturning
+    acceleration over the spec's pulse band [g]; the best run the records and the code check
+    the spec names (docs/search.md).
+
+    Parameters
+    ----------
+    scene : scene object, str or Path
+        A scene (``read_scene``), or a Rhino ``.3dm`` file or a scan mesh (``.ply``,
+        ``.obj``, ``.stl``, ``.off``; give ``units``) to read.
+    spec : SearchSpec, dict, str, Path or open file
+        The search spec: a file (JSON; its ``ranking.site`` and ``ranking.records`` are
+        taken from its folder), a ``SearchSpec`` (``read_search_spec``) or a dict of its
+        fields, validated as a file is.
+    units : {"mm", "cm", "m", "in", "ft"}, optional
+        Length unit of a scan mesh file (a ``.3dm`` states its own).
+    site : SiteFile, str, Path or open file, optional
+        The site for the code check, instead of the spec's ``ranking.site``.
+    records : sequence of GroundMotion, str or Path, optional
+        The records, instead of the spec's ``ranking.records`` (None: the spec's; an empty
+        list: none).
+    spec_dir : str or Path, optional
+        The folder the spec's ``ranking.site`` and ``ranking.records`` are relative to
+        (default: the spec file's folder; none for a spec given as an object).
+    exact : bool
+        Envelopes by the exact integrator instead of the fast mode (the overturning
+        library, labelled in ``rankings.envelope_method``).
+    limits : bool
+        Apply the work limits of the command line (a search past them is refused before it
+        runs; ``InputError`` on ``work_limit``).
+
+    Returns
+    -------
+    SearchRun
+        ``doc`` (``search.json``: ``candidates`` with λ0 [-], ``rankings`` ``static`` and
+        ``dynamic``, ``records``, ``code_check``, ``timings`` [s]), ``constants`` of the
+        mechanisms built (``ConstantsFile``), ``spec_file``; ``write_search`` writes them.
+    """
+    # The search needs the geometry extra (cad_maths, rhino3dm, trimesh): loaded when one
+    # runs, so that the other analyses load without it.
+    from cad_maths.scene_base import BaseScene
+
+    # The scene reader, from the same extra.
+    from cad_maths.scenes import read_scene
+
+    # The search spec's model, with the search.
+    from shared_schema.search import SearchSpec
+
+    # The search's workflow (its figure, the 3dm writer).
+    from solver_service.workflows import search as _search
+
+    if isinstance(scene, BaseScene):
+        if units is not None:
+            raise InputError(
+                "applies to a scene file; the scene given is already read (read_scene(path, "
+                "units=...))",
+                "units",
+            )
+        scene_obj, scene_name = scene, "scene"
+    else:
+        expected = "a scene (rockmech.read_scene) or " + PATH_TYPES
+        scene_path = readable_file(scene, "scene", expected)
+        scene_obj, scene_name = read_scene(scene_path, units=units), scene_path.name
+    if isinstance(spec, (SearchSpec, dict)):
+        spec_obj: Union[SearchSpec, dict[str, Any]] = spec
+        spec_name, folder = "search spec", spec_dir
+    elif is_file_object(spec):  # an open file: its paths are taken from spec_dir
+        label = getattr(spec, "name", None)
+        spec_name = os.path.basename(label) if isinstance(label, str) and label else "search spec"
+        spec_obj, folder = _search.read_search_spec(spec), spec_dir
+    else:
+        expected = "a SearchSpec, a dict of its fields or " + SOURCE_TYPES
+        spec_path = as_path(spec, "spec", expected)
+        spec_obj, spec_name = _search.read_search_spec(spec_path), spec_path.name
+        folder = spec_path.parent if spec_dir is None else spec_dir
+    return _search.search_run(
+        scene_obj,
+        spec_obj,
+        scene_name=scene_name,
+        spec_name=spec_name,
+        spec_dir=folder,
+        site=None if site is None else _site(site),
+        motions=None if records is None else _records(records),
+        exact=exact,
+        max_evaluations=_search.MAX_EVALUATIONS if limits else None,
+        max_lp_blocks=_search.MAX_LP_BLOCKS if limits else None,
+    )

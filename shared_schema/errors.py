@@ -10,7 +10,14 @@ without importing pydantic.
 
 from typing import Optional
 
-__all__ = ["GeometryError", "InputError", "RockmechError", "SolverError", "per_side_error"]
+__all__ = [
+    "GeometryError",
+    "InputError",
+    "RockmechError",
+    "SolverError",
+    "per_side_error",
+    "wrong_type",
+]
 
 
 class RockmechError(Exception):
@@ -69,3 +76,26 @@ def per_side_error(
     else:
         where = f"use .positive.{name} (= {positive!r}) or .negative.{name} (= {negative!r})"
     return AttributeError(f"{owner} has no {name} of its own: the constants live per side; {where}")
+
+
+def wrong_type(value: object, field: str, expected: str, hint: str = "") -> InputError:
+    """Build the error for an argument of another type: what it takes, what it got, the fix.
+
+    Parameters
+    ----------
+    value : object
+        The argument as given.
+    field : str
+        The argument's name.
+    expected : str
+        What it takes, in words (``"a RockingModel"``).
+    hint : str
+        How to get one from what was given, if there is a way (appended after ``;``).
+
+    Examples
+    --------
+    >>> str(wrong_type("W1", "model", "a RockingModel", "models_from_constants(cf) gives them"))
+    'model: must be a RockingModel, got str; models_from_constants(cf) gives them'
+    """
+    tail = f"; {hint}" if hint else ""
+    return InputError(f"must be {expected}, got {type(value).__name__}{tail}", field)

@@ -17,9 +17,9 @@ __all__ = [
     "CONSTANTS_EXPECTED",
     "load_constants",
     "parse_constants",
-    "save_constants",
     "stamped",
     "write_atomic",
+    "write_constants",
 ]
 
 
@@ -76,35 +76,43 @@ def stamped(model: ConstantsFile) -> ConstantsFile:
     return model.model_copy(update={"rockmech_version": __version__})
 
 
-def save_constants(path: PathLike, model: ConstantsFile) -> None:
+def write_constants(constants: ConstantsFile, path: PathLike) -> None:
     """Write a kinematic-constants file atomically.
 
     Parameters
     ----------
-    path : str or os.PathLike
-        Target file; it is replaced atomically.
-    model : ConstantsFile
+    constants : ConstantsFile
         The constants. Absent optional values (``None``) are omitted, so an optional
         section that was not given does not appear in the file.
+    path : str or os.PathLike
+        Target file; it is replaced atomically.
 
     Raises
     ------
     InputError
-        If the path is not a ``str`` or ``os.PathLike`` (field ``path``), or the file cannot
-        be written (e.g. its directory does not exist, or it is a folder).
+        If ``constants`` is not a ``ConstantsFile`` (field ``constants``; the object comes
+        first, the path second), the path is not a ``str`` or ``os.PathLike`` (field
+        ``path``), or the file cannot be written (e.g. its folder does not exist, or it is
+        a folder; field ``path``, the message naming it).
 
     Notes
     -----
     The JSON is built completely before anything is written, so a serialisation error
     leaves the previous file untouched. Output: indent 2, UTF-8, trailing newline.
     """
+    if not isinstance(constants, ConstantsFile):
+        first = isinstance(path, ConstantsFile)
+        hint = "; the constants come first: write_constants(constants, path)" if first else ""
+        raise InputError(
+            f"must be a ConstantsFile, got {type(constants).__name__}{hint}", "constants"
+        )
     target = as_path(path, "path")
-    text = stamped(model).model_dump_json(indent=2, exclude_none=True) + "\n"
+    text = stamped(constants).model_dump_json(indent=2, exclude_none=True) + "\n"
     if target.is_dir():
-        raise InputError("cannot write constants file: it is a folder", str(target))
+        raise InputError(f"cannot write constants file: it is a folder: {target}", "path")
     try:
         write_atomic(target, text)
     except OSError as exc:
         raise InputError(
-            f"cannot write constants file: {exc.strerror or exc}", str(target)
+            f"cannot write constants file: {target}: {exc.strerror or exc}", "path"
         ) from exc

@@ -23,14 +23,13 @@ The spec's JSON Schema is ``shared_schema/jsonschema/retrofit.schema.json``
 The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` forms.
 """
 
-from pathlib import Path
 from typing import Any, Dict, List, Literal, Mapping, Optional, Tuple, Union
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from shared_schema.constants import validate_document
 from shared_schema.errors import InputError
-from shared_schema.paths import readable_file
+from shared_schema.paths import Source, read_source
 from shared_schema.version import __version__
 
 __all__ = [
@@ -263,13 +262,12 @@ def parse_retrofit_spec(source: Union[str, bytes, Mapping[str, Any]]) -> Retrofi
     )
 
 
-def read_retrofit_spec(path: Union[str, "Path"]) -> RetrofitSpec:
-    """Read and validate a retrofit spec file (JSON): a ``str`` or ``os.PathLike``."""
-    p = readable_file(path, "retrofit")
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise InputError(f"cannot read {p.name}: {exc.strerror}", "retrofit") from None
+def read_retrofit_spec(path: Source) -> RetrofitSpec:
+    """Read and validate a retrofit spec (JSON) from a path or an open file; field ``retrofit``.
+
+    ``path`` is a ``str``, an ``os.PathLike`` or an open file (``paths.read_source``).
+    """
+    raw, _ = read_source(path, "retrofit")
     return parse_retrofit_spec(raw)
 
 

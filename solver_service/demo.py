@@ -29,7 +29,7 @@ from typing import Any, Optional
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 from shared_schema.extras import MissingExtra
-from shared_schema.io import load_constants, save_constants
+from shared_schema.io import load_constants, write_constants
 from shared_schema.paths import PathLike, as_path
 
 from .core.model import G
@@ -79,19 +79,19 @@ _NOT_EXAMPLES = ("*.py", "*.pyc")
 
 
 def copy_examples(
-    dest: PathLike = Path("examples"), on_note: Optional[Callable[[str], None]] = None
+    out: PathLike = Path("examples"), on_note: Optional[Callable[[str], None]] = None
 ) -> list[Path]:
-    """Copy the bundled examples into ``dest``, so that the README's commands run from a wheel.
+    """Copy the bundled examples into ``out``, so that the README's commands run from a wheel.
 
-    ``dest`` gets the layout of the repository's ``examples/`` (``constants/``, ``records/``,
+    ``out`` gets the layout of the repository's ``examples/`` (``constants/``, ``records/``,
     ``scenes/``, ``sites/``, ``specs/``). The copy is a rockmech run like any other
     (``workflows.rundir.run_folder``): it replaces only the files an earlier copy wrote and
     that are unchanged since; a file of the user's in the way stops it with one line naming
-    the file, and nothing else in ``dest`` is touched.
+    the file, and nothing else in ``out`` is touched.
 
     Parameters
     ----------
-    dest : str or os.PathLike
+    out : str or os.PathLike
         The folder to copy into (created if missing).
     on_note : callable, optional
         Called with each note of the output folder (``run_folder``).
@@ -99,9 +99,9 @@ def copy_examples(
     Returns
     -------
     list of Path
-        The files written, under ``dest``.
+        The files written, under ``out``.
     """
-    dest = as_path(dest, "dest")
+    dest = as_path(out, "out")
     source = examples_dir()
     files = sorted(
         p
@@ -235,7 +235,7 @@ def run_demo(
     record = GroundMotion.from_two_column(record_path, units="g")
     cf = demo_constants()
     constants_path = out_dir / "constants.json"
-    save_constants(constants_path, cf)
+    write_constants(cf, constants_path)
     write_history(
         cf,
         record,
@@ -268,7 +268,7 @@ def facade_from_scene(out_dir: Path) -> dict[str, Path]:
     spec_path = EXAMPLES_DIR / "specs" / "facade.spec.json"
     cf = constants_from_files(scene_path, spec_path)
     constants_path = out_dir / "facade_constants.json"
-    save_constants(constants_path, cf)
+    write_constants(cf, constants_path)
     write_envelope(
         cf,
         frequency_grid(0.1, 10.0, 200),

@@ -1,8 +1,9 @@
-"""docs/api.md runs as written, from ``import rockmech`` alone (#28).
+"""docs/api.md runs as written, from ``import rockmech`` alone (#28, #38).
 
-Every function of ``rockmech.__all__`` is shown there in an example, the page runs as a
-doctest in a fresh process in an empty folder, and the facade's analyses give the command
-line's numbers (the same workflow, checked against ``rockmech ... --json``).
+Every function of ``rockmech.__all__`` is shown there in an example and named in its table,
+the page runs as a doctest in a fresh process in an empty folder (in the quick suite), and
+the facade's analyses give the command line's numbers (the same workflow, checked against
+``rockmech ... --json``).
 """
 
 from __future__ import annotations
@@ -35,18 +36,40 @@ def _code_lines() -> list[str]:
     ]
 
 
-def test_every_public_function_is_shown_in_an_example() -> None:
-    code = "\n".join(_code_lines())
-    functions = [
+def _functions() -> list[str]:
+    return [
         name
         for name in rockmech.__all__
         if name != "__version__"
         and callable(getattr(rockmech, name))
         and not inspect.isclass(getattr(rockmech, name))
     ]
+
+
+def test_every_public_function_is_shown_in_an_example() -> None:
+    code = "\n".join(_code_lines())
+    functions = _functions()
     assert len(functions) >= 25
     missing = [name for name in functions if f"rockmech.{name}(" not in code]
     assert not missing, f"docs/api.md shows no call of {missing}"
+
+
+def test_every_public_function_is_in_the_table() -> None:
+    page = API_MD.read_text(encoding="utf-8")
+    table = "\n".join(line for line in page.splitlines() if line.startswith("| `"))
+    missing = [name for name in _functions() if f"`{name}(" not in table]
+    assert not missing, f"docs/api.md's table does not name {missing}"
+
+
+def test_the_names_follow_one_verb_scheme() -> None:
+    """read_* reads, write_* writes (the object first), no load_/save_ alias (#38)."""
+    names = _functions()
+    assert not [n for n in names if n.startswith(("load_", "save_", "get_"))], names
+    for name in (n for n in names if n.startswith("write_")):
+        first = next(iter(inspect.signature(getattr(rockmech, name)).parameters))
+        assert first not in {"path", "out", "dest"}, f"{name}: the object comes first"
+    assert "measure" in inspect.signature(rockmech.ida).parameters
+    assert "im" not in inspect.signature(rockmech.ida).parameters
 
 
 def test_the_examples_use_the_facade_alone() -> None:
@@ -58,8 +81,8 @@ def test_the_examples_use_the_facade_alone() -> None:
     assert not inner, inner
 
 
-@pytest.mark.slow
 def test_docs_api_runs_as_a_doctest_in_an_empty_folder(tmp_path: Path) -> None:
+    """In the quick suite: the page runs in about 9 s (one search, one report's figures)."""
     code = (
         "import doctest, sys\n"
         f"r = doctest.testfile({str(API_MD)!r}, module_relative=False, "
@@ -68,7 +91,7 @@ def test_docs_api_runs_as_a_doctest_in_an_empty_folder(tmp_path: Path) -> None:
         "sys.exit(1 if r.failed else 0)\n"
     )
     res = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=600
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=300
     )
     assert res.returncode == 0, res.stdout[-4000:]
     attempted, failed = map(int, res.stdout.split()[-2:])

@@ -712,7 +712,7 @@ def test_choice_options_list_the_vocabularies_of_shared_schema_rules() -> None:
         ("history", "--sf"): SF_METHODS,
         ("history", "--units"): tuple(RECORD_UNITS),
         ("history", "--format"): RECORD_FORMATS,
-        ("ida", "--im"): ("scale", "pga"),
+        ("ida", "--measure"): ("scale", "pga"),
         ("boundary", "--shape"): PULSE_SHAPES,
     }
     for (command, option), values in expected.items():
@@ -887,10 +887,10 @@ def test_full_disk_and_permission_errors_are_one_line(
         "ida/.rockmech/lock",
     ]
 
-    def denied(path: object, data: object) -> None:
+    def denied(model: object, path: object) -> None:
         raise PermissionError(errno.EACCES, "Permission denied", str(path))
 
-    monkeypatch.setattr(io, "save_constants", denied)
+    monkeypatch.setattr(io, "write_constants", denied)
     table = tmp_path / "t.csv"
     table.write_text("id,name,p_eq,lam,eta\nW1,wall,2.0,0.2,0.9\n")
     res = runner.invoke(app, ["constants-table", str(table), "-o", str(tmp_path / "c.json")])

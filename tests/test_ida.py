@@ -205,7 +205,7 @@ def test_results_are_identical_on_every_cutting_and_number_of_threads(
 def test_pga_intensity_scales_each_record_to_the_level(motions: list[GroundMotion]) -> None:
     cf = load_constants(CONSTANTS)
     levels = [0.1, 0.3, 0.6]
-    doc = run_ida(cf, motions, levels, im="pga")
+    doc = run_ida(cf, motions, levels, measure="pga")
     assert doc["intensity"]["units"] == "g"
     model = models_from_file(cf)[0]
     expected = [
@@ -392,7 +392,7 @@ def test_cli_ida_writes_json_csv_plot_and_peaks(tmp_path: Path, elcentro_path: P
         (["--scales", "abc"], "scales: expected a list"),
         (["--scales", "0,1"], "scales[0]"),
         (["--scales", "1,1"], "repeated"),
-        (["--scales", "1", "--im", "pgv"], "im: must be one of"),
+        (["--scales", "1", "--measure", "pgv"], "measure: must be one of"),
         (["--scales", "1", "--timeout", "0"], "timeout"),
         (["--scales", "1", "--jobs", "0"], "jobs: must be a whole number >= 1"),
         (["--scales", "1", "--peaks"], "peaks: --peaks writes ida_peaks.parquet into the --out"),

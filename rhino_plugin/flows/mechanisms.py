@@ -29,7 +29,7 @@ from rhino_plugin.flows.marks import check_marks
 from rhino_plugin.flows.prompter import Cancelled, Point, Prompter
 from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError, RockmechError
-from shared_schema.io import save_constants
+from shared_schema.io import write_constants
 from shared_schema.rules import check_number, quantity_problem
 from shared_schema.spec import (
     TRIBUTARY_DEFAULT,
@@ -524,7 +524,7 @@ def write_outputs(spec_path: str, spec_text: str, constants_path: str, constants
     except OSError as exc:
         raise InputError(f"cannot write the spec file: {exc.strerror or exc}", spec_path) from exc
     try:
-        save_constants(constants_path, constants)
+        write_constants(constants, constants_path)
     except BaseException:
         if previous is None:
             try:

@@ -24,7 +24,7 @@ from shared_schema.errors import InputError
 from shared_schema.search import parse_search_spec
 from shared_schema.site import parse_site
 from solver_service.workflows.rundir import run_folder
-from solver_service.workflows.search import read_search_spec, search_run, write_search
+from solver_service.workflows.search import read_search_spec, search_run, write_search_files
 
 __all__ = [
     "SEARCH_LAYER",
@@ -156,7 +156,7 @@ def search_flow(
         )
         out = os.path.join(folder, f"{stem}.search")
         with run_folder(out, on_note=ask.message) as tmp:
-            written = write_search(run, tmp)
+            written = write_search_files(run, tmp)
         files = [os.path.join(out, p.name) for p in written]
         plot = os.path.join(out, "search.png")
         result = SearchFlowResult(

@@ -157,7 +157,7 @@ def assess(
             retrofit=rspec,
         )
     # With --json, stdout carries exactly one JSON document; the file notes go to stderr.
-    typer.echo(f"wrote {write_report(out, text)}", err=as_json)
+    typer.echo(f"wrote {write_report(text, out)}", err=as_json)
     if pdf:
         typer.echo(f"wrote {print_pdf(out, out.with_suffix('.pdf'))}", err=as_json)
     if as_json:

@@ -170,4 +170,4 @@ def report(
     if motion is not None:
         # the page lists them too; say so here as history does
         skipped_notes({"skipped": documents.time_domain_mechanisms(cf)[1]})
-    typer.echo(f"wrote {write_report(out, text)}")
+    typer.echo(f"wrote {write_report(text, out)}")

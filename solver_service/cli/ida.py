@@ -162,9 +162,9 @@ def ida(
         "--scales",
         help="Intensity levels: a list 0.25,0.5,1,2 or a log range start:stop:n (0.1:3:20).",
     ),
-    im: str = typer.Option(
+    measure: str = typer.Option(
         "scale",
-        "--im",
+        "--measure",
         metavar=choices(IM_MEASURES),
         help="Intensity measure: scale (factor on each record) or pga [g].",
     ),
@@ -254,7 +254,7 @@ def ida(
                     cf,
                     motions,
                     levels,
-                    im=im,
+                    measure=measure,
                     sf=scaling.sf,
                     building=scaling.building,
                     criterion=criterion,

@@ -61,7 +61,7 @@ def constants(
             cf, failures = inputs.constants_keep_going(scene, spec, units)
         else:
             cf = inputs.constants_from_files(scene, spec, units)
-    io.save_constants(output, cf)
+    io.write_constants(cf, output)
     if failures:
         typer.echo(
             f"error: {len(failures)} of {len(failures) + len(cf.mechanisms)} mechanisms failed "
@@ -109,7 +109,7 @@ def constants_table(
     if range_error is not None:
         # a constants file may hold it; the time-domain commands (and REST) refuse it
         note(f"warning: {range_error}; envelope, history, ida, report and assess refuse it")
-    io.save_constants(output, cf)
+    io.write_constants(cf, output)
     typer.echo(f"wrote {output}: {len(cf.mechanisms)} mechanism(s) from {table.name}")
 
 
@@ -151,7 +151,7 @@ def search(
 ) -> None:
     """Find a façade's collapse mechanisms and rank them by how they rock (issue #31)."""
     # the search's workflow is loaded by this command only
-    from ..workflows.search import search_from_files, write_search
+    from ..workflows.search import search_from_files, write_search_files
 
     check_folder_target(out)
     with status(f"search: {scene.name}"):
@@ -165,7 +165,7 @@ def search(
             limits=not limits.no_limits,
         )
         with run_folder(out, on_note=out_note, command="search") as tmp:
-            write_search(run, tmp, figure=figure)
+            write_search_files(run, tmp, figure=figure)
     doc = run.doc
     for warning in doc["warnings"]:
         note(f"warning: {warning}")

@@ -52,7 +52,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.atomic import write_atomic
-from shared_schema.errors import InputError
+from shared_schema.errors import InputError, wrong_type
 from shared_schema.version import __version__
 
 from . import _boundary_kernels as _bk
@@ -60,7 +60,7 @@ from .amplification import pulse_response_spectrum
 from .exact import kernels
 from .excitation import PULSE_SHAPES
 from .jit import first_use
-from .model import RockingModel, RockingSide, check_eta
+from .model import RockingModel, RockingSide, check_eta, require_model
 
 __all__ = [
     "A_MAX",
@@ -876,6 +876,7 @@ def mechanism_envelope(
     with the exact integrator, each impact with its direction's value and the pulse applied
     in both directions, and says so in ``notes`` (theory §6.6).
     """
+    model = require_model(model)
     f = np.atleast_1d(np.asarray(f_p, dtype=float))
     if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f) & (f > 0)):
         raise InputError("must be finite and > 0 (at least one value)", f"{model.name}.f_p")
@@ -919,6 +920,13 @@ def critical_bands(envelopes: Sequence[Envelope]) -> tuple[NDArray[np.int64], li
         ``{"mechanism", "f_min", "f_max"}`` [Hz] for each run of frequencies with the same
         governing mechanism (limits are the first and last frequency of the run).
     """
+    if isinstance(envelopes, (Envelope, str)) or not isinstance(envelopes, Sequence):
+        hint = "give a list of them: [envelope]" if isinstance(envelopes, Envelope) else ""
+        raise wrong_type(envelopes, "envelopes", "a sequence of Envelopes", hint)
+    for k, env in enumerate(envelopes):
+        if not isinstance(env, Envelope):
+            hint = "rockmech.mechanism_envelope(model, f_p) gives a mechanism's envelope"
+            raise wrong_type(env, f"envelopes[{k}]", "an Envelope", hint)
     if not envelopes:
         raise InputError("needs at least one mechanism", "mechanisms")
     f = envelopes[0].f_p

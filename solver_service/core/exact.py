@@ -46,16 +46,16 @@ from typing import Any, Optional
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from shared_schema.errors import InputError
+from shared_schema.errors import InputError, wrong_type
 from shared_schema.rules import G
 
 from . import _kernels as _k
 from ._compile import JIT, python_twins
-from .excitation import Pulse, SampledAccel
+from .excitation import Pulse, SampledAccel, accel_hint
 from .integrator import V_REST_REL, Excitation, Integrator
 from .jit import first_use
 from .linearisation import linearisation_warnings
-from .model import RockingModel, check_positive
+from .model import RockingModel, check_positive, require_model, require_models
 from .result import CRITERIA, STATUS_MESSAGES, RockingResult
 
 __all__ = [
@@ -290,9 +290,7 @@ def cells_for(excitation: Excitation, *, dense: bool = False, t_extra: float = 0
         return _pulse_cells(excitation, DENSE_PER_QUARTER if dense else 1, t_extra)
     if isinstance(excitation, SampledAccel):
         return _record_cells(excitation, t_extra)
-    raise InputError(
-        f"must be a Pulse or a SampledAccel, got {type(excitation).__name__}", "excitation"
-    )
+    raise wrong_type(excitation, "excitation", "a Pulse or a SampledAccel", accel_hint(excitation))
 
 
 def _criterion(criterion: Optional[str], excitation: Excitation) -> str:
@@ -390,6 +388,8 @@ def simulate(
     0.0
     """
     t_start = time.perf_counter()
+    if type(model) is not RockingModel:  # the common case costs nothing
+        model = require_model(model)
     params = _params(model)
     if not (type(scale) is float and 0.0 < scale < math.inf):  # the common case costs nothing
         scale = check_positive(scale, "scale")
@@ -630,6 +630,7 @@ def simulate_batch(
     BatchResult
     """
     t_start = time.perf_counter()
+    models = require_models(models)
     if len(models) == 0:
         raise InputError("needs at least one mechanism", "mechanisms")
     sc = np.atleast_1d(np.asarray(scales, dtype=float))

@@ -12,15 +12,16 @@ uplift threshold, and the pulse ends at phase 2π regardless of when uplift happ
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from shared_schema.errors import InputError
+from shared_schema.errors import InputError, wrong_type
 from shared_schema.rules import G
 
-__all__ = ["PULSE_SHAPES", "Pulse", "SampledAccel"]
+__all__ = ["PULSE_SHAPES", "Pulse", "SampledAccel", "accel_hint", "require_accel"]
 
 #: Pulse shapes and their phase offset: ``a_g(t) = a_p * sin(omega_p * t + offset)``.
 PULSE_SHAPES = {"sine": 0.0, "cosine": 0.5 * math.pi}
@@ -185,3 +186,19 @@ class SampledAccel:
         tt = np.asarray(t, dtype=float)
         inside = (tt >= self.t0) & (tt <= self.t0 + self.duration)
         return np.where(inside, np.interp(tt, self.time, self.acc), 0.0)
+
+
+def accel_hint(value: object) -> str:
+    """How to get a ``SampledAccel`` from ``value`` (a record, a path), for the messages."""
+    if isinstance(getattr(value, "accel", None), SampledAccel):  # a GroundMotion
+        return "a record's samples are its .accel (motion.accel)"
+    if isinstance(value, (str, os.PathLike)):
+        return "read the record first: rockmech.read_record(path).accel"
+    return ""
+
+
+def require_accel(value: object, field: str = "accel") -> SampledAccel:
+    """Return ``value`` if it is a ``SampledAccel``; else an ``InputError`` saying what to pass."""
+    if isinstance(value, SampledAccel):
+        return value
+    raise wrong_type(value, field, "a SampledAccel", accel_hint(value))

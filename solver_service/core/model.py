@@ -26,7 +26,7 @@ import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Optional
 
-from shared_schema.errors import InputError, per_side_error
+from shared_schema.errors import InputError, per_side_error, wrong_type
 from shared_schema.rules import (
     G,
     check_eta,
@@ -43,6 +43,8 @@ __all__ = [
     "check_non_negative",
     "check_number",
     "check_positive",
+    "require_model",
+    "require_models",
 ]
 
 
@@ -205,3 +207,41 @@ class RockingModel:
                 f"{self.name}.eta",
             )
         return self.eta
+
+
+def _model_hint(value: object) -> str:
+    """How to get a ``RockingModel`` from ``value``, for the message."""
+    if hasattr(value, "mechanisms"):  # a ConstantsFile
+        return "a constants file holds one per mechanism: rockmech.models_from_constants(cf)"
+    if hasattr(value, "positive") and hasattr(value, "id"):  # one mechanism of a file
+        return "rockmech.models_from_constants(cf) gives each mechanism's model"
+    if isinstance(value, str):
+        return (
+            "build one with RockingModel.symmetric(p_eq=..., lam=..., eta=...) or read a "
+            "constants file with rockmech.models_from_constants(path)"
+        )
+    return ""
+
+
+def require_model(value: object, field: str = "model") -> RockingModel:
+    """Return ``value`` if it is a ``RockingModel``; else an ``InputError`` saying what to pass.
+
+    Examples
+    --------
+    >>> require_model("W1")
+    Traceback (most recent call last):
+    ...
+    shared_schema.errors.InputError: model: must be a RockingModel, got str; build one with ...
+    """
+    if isinstance(value, RockingModel):
+        return value
+    raise wrong_type(value, field, "a RockingModel", _model_hint(value))
+
+
+def require_models(values: object, field: str = "models") -> list[RockingModel]:
+    """Return a sequence of ``RockingModel`` as a list; one model or another type is refused."""
+    if isinstance(values, RockingModel):
+        raise wrong_type(values, field, "a sequence of RockingModels", "give a list of it: [model]")
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+        raise wrong_type(values, field, "a sequence of RockingModels", _model_hint(values))
+    return [require_model(v, f"{field}[{k}]") for k, v in enumerate(values)]

@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 
 from shared_schema.errors import InputError
 
-from .excitation import SampledAccel
+from .excitation import SampledAccel, require_accel
 from .model import G
 
 __all__ = ["ExtractedPulse", "extract_pulses", "largest_pulse"]
@@ -147,8 +147,10 @@ def extract_pulses(
     ------
     InputError
         ``f_min``/``f_max`` not finite and > 0, or ``f_min > f_max`` (fields ``f_min``,
-        ``f_max``); ``n < 1`` (``n``).
+        ``f_max``); ``n < 1`` (``n``); an ``accel`` that is not a ``SampledAccel``
+        (``accel``, saying how to get one).
     """
+    accel = require_accel(accel)
     for name, value in (("f_min", f_min), ("f_max", f_max)):
         if value is not None and (
             isinstance(value, bool) or not (math.isfinite(float(value)) and value > 0)

@@ -27,7 +27,7 @@ import platform
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Optional, Union
 
 import numpy as np
 
@@ -402,10 +402,10 @@ def check_history_options(
 
 
 def build_report(
-    cf: Any,
+    constants: Union[ConstantsFile, PathLike],
     f_p: Any,
     *,
-    motion: Optional[Any] = None,
+    motion: Union[GroundMotion, PathLike, None] = None,
     scales: Sequence[float] = (1.0,),
     history: Optional[dict[str, Any]] = None,
     method: str = "exact",
@@ -418,7 +418,7 @@ def build_report(
 
     Parameters
     ----------
-    cf : ConstantsFile, str or os.PathLike
+    constants : ConstantsFile, str or os.PathLike
         The mechanisms, or a constants file or table to read (``read_constants``).
     f_p : (n,) float
         Pulse frequencies of the envelopes [Hz].
@@ -450,10 +450,10 @@ def build_report(
     ------
     InputError
         Invalid history options, or options given without a record
-        (``check_history_options``); a file that cannot be read, or a ``cf`` or ``motion``
-        of another type (naming it).
+        (``check_history_options``); a file that cannot be read, or a ``constants`` or
+        ``motion`` of another type (naming it).
     """
-    cf, motion = _report_inputs(cf, motion)
+    cf, motion = _report_inputs(constants, motion)
     check_history_options(scales, history, motion)
     env, envelopes = envelope_doc(cf, np.asarray(f_p, dtype=float), method=method, library=library)
     hist = None
@@ -511,34 +511,49 @@ def _report_inputs(cf: Any, motion: Any) -> tuple[ConstantsFile, Any]:
     from ..workflows.inputs import read_constants, read_record
 
     if not isinstance(cf, ConstantsFile):
-        cf = read_constants(as_path(cf, "cf", "a ConstantsFile or " + PATH_TYPES))
+        cf = read_constants(as_path(cf, "constants", "a ConstantsFile or " + PATH_TYPES))
     if motion is not None and not isinstance(motion, GroundMotion):
         motion = read_record(as_path(motion, "motion", "a GroundMotion or " + PATH_TYPES))
     return cf, motion
 
 
-def write_report(path: PathLike, text: str) -> Path:
+def write_report(page: str, path: PathLike) -> Path:
     """Write the report atomically and return its path.
 
     Parameters
     ----------
+    page : str
+        The page (``build_report``).
     path : str or os.PathLike
         The HTML file (its folder is created if missing); it is replaced atomically.
-    text : str
-        The page (``build_report``).
+
+    Returns
+    -------
+    Path
+        The file written.
 
     Raises
     ------
     InputError
-        ``path`` is not a ``str`` or ``os.PathLike``, is a folder, or cannot be written
-        (field ``path``, naming it).
+        ``page`` is not a ``str`` (field ``page``), ``path`` is not a ``str`` or
+        ``os.PathLike``, is a folder, or cannot be written (field ``path``, naming it).
+        The page comes first: a ``path`` that holds markup or a line break is refused as a
+        page given in its place, never written as a file of that name.
     """
+    if not isinstance(page, str):
+        raise InputError(f"must be the HTML page (a str), got {type(page).__name__}", "page")
+    if isinstance(path, str) and ("<" in path or "\n" in path):
+        raise InputError(
+            "looks like an HTML page, not a file name; the page comes first: "
+            "write_report(page, path)",
+            "path",
+        )
     target = as_path(path, "path")
     if target.is_dir():
         raise InputError(f"is a folder, not a file: {target}", "path")
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
-        write_atomic(target, text)
+        write_atomic(target, page)
     except OSError as exc:
         raise InputError(f"cannot write {target}: {exc.strerror or exc}", "path") from None
     return target

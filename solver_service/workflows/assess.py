@@ -19,7 +19,7 @@ import numpy as np
 from shared_schema.api import MAX_ASSESS_MULTIPLES, MULTIPLE_MAX
 from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError, RockmechError
-from shared_schema.paths import PathLike
+from shared_schema.paths import Source
 from shared_schema.rules import check_number
 from shared_schema.site import SiteFile
 
@@ -64,8 +64,11 @@ BAND_LOW, BAND_HIGH = 0.5, 1.5
 BAND_POINTS = 40
 
 
-def read_site(path: PathLike) -> SiteFile:
-    """Read and validate a site file (``inputs.read_site_file``); errors name ``site``."""
+def read_site(path: Source) -> SiteFile:
+    """Read and validate a site file, a path or an open file (``inputs.read_site_file``).
+
+    Errors name ``site``.
+    """
     return read_site_file(path)
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,8 +20,16 @@ from cad_maths.scenes import SCENE_FORMATS, read_scene
 from shared_schema.api import time_domain_problem
 from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.errors import InputError, RockmechError
-from shared_schema.io import load_constants
-from shared_schema.paths import PathLike, as_path
+from shared_schema.io import CONSTANTS_EXPECTED, load_constants, parse_constants
+from shared_schema.paths import (
+    SOURCE_TYPES,
+    PathLike,
+    Source,
+    as_path,
+    is_file_object,
+    read_source,
+    readable_file,
+)
 from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS, check_file, check_positive
 from shared_schema.site import SITE_EXPECTED, SiteFile, site_from_text
 from shared_schema.spec import parse_spec
@@ -273,13 +282,14 @@ def _wrong_file(path: Path, expected: str, where: str) -> Optional[InputError]:
     )
 
 
-def read_constants(path: PathLike, *, time_domain: bool = False) -> ConstantsFile:
+def read_constants(path: Source, *, time_domain: bool = False) -> ConstantsFile:
     """Read and validate a kinematic-constants file, or a constants table (``.csv``, ``.xlsx``).
 
     Parameters
     ----------
-    path : str or os.PathLike
-        The file.
+    path : str, os.PathLike or file object
+        The file; an open file is read as a JSON constants file (a table is read from its
+        path: its format is the path's suffix).
     time_domain : bool
         Also hold every mechanism to the ranges of a time-domain analysis (each side's
         ``p_eq`` and ``lam``, the amplification data; ``shared_schema.api.time_domain_problem``),
@@ -292,7 +302,13 @@ def read_constants(path: PathLike, *, time_domain: bool = False) -> ConstantsFil
         ``solver_service.workflows.tables``). A site file, spec or scene given instead is
         named as such (the arguments were swapped).
     """
-    path = check_file(path, "constants")
+    if is_file_object(path):
+        cf = _constants_from_stream(path)
+        problem = time_domain_problem(cf) if time_domain else None
+        if problem is not None:
+            raise InputError(f"{problem[0]}: {problem[1]}", "constants")
+        return cf
+    path = readable_file(path, "constants", SOURCE_TYPES)
     if is_table(path):
         return constants_from_table(path, time_domain=time_domain)
     try:
@@ -311,19 +327,38 @@ def read_constants(path: PathLike, *, time_domain: bool = False) -> ConstantsFil
     return cf
 
 
-def read_site_file(path: PathLike) -> SiteFile:
+def _constants_from_stream(stream: object) -> ConstantsFile:
+    """Read a JSON constants file given as an open file; errors name its ``.name``."""
+    raw, name = read_source(stream, "constants")
+    if is_table(name):
+        raise InputError(
+            f"{name}: a constants table is read from its path (the suffix says its format), "
+            "not from an open file; pass the path",
+            "constants",
+        )
+    text = decode_text(raw, name, "constants", CONSTANTS_EXPECTED)
+    try:
+        return parse_constants(text)
+    except InputError as exc:
+        raise InputError(str(exc), name) from None
+
+
+def read_site_file(path: Source) -> SiteFile:
     """Read and validate a site file (``shared_schema.site.read_site``); field ``site``.
 
-    A constants file or another of rockmech's inputs given instead is named as such (the
+    ``path`` is a path or an open file (``shared_schema.paths.read_source``). A constants
+    file or another of rockmech's inputs given instead (as a path) is named as such (the
     arguments of ``check`` or ``assess`` were swapped).
     """
-    path = check_file(path, "site")
-    text = decode_text(path.read_bytes(), path.name, "site", SITE_EXPECTED)
+    raw, name = read_source(path, "site")
+    text = decode_text(raw, name, "site", SITE_EXPECTED)
     try:
-        return site_from_text(text, path.name)
+        return site_from_text(text, name)
     except InputError:
+        if is_file_object(path):
+            raise
         wrong = _wrong_file(
-            path,
+            Path(os.fspath(path)),  # type: ignore[arg-type]
             "site",
             "the second argument is the site file (check and assess take the constants file first)",
         )

@@ -15,7 +15,7 @@ from pydantic import ValidationError
 
 from shared_schema.api import PulseRequest
 from shared_schema.constants import ConstantsFile, input_error_from_validation
-from shared_schema.errors import InputError
+from shared_schema.errors import InputError, wrong_type
 
 from ..core.exact import simulate
 from ..core.excitation import Pulse
@@ -76,6 +76,9 @@ def _pulse_request(request: Union[PulseRequest, Mapping[str, Any]]) -> PulseRequ
     """Validate a mapping as a ``PulseRequest``; an error names the field (as REST's 422)."""
     if isinstance(request, PulseRequest):
         return request
+    if not isinstance(request, Mapping):
+        example = 'e.g. {"p_eq": 2.2, "lam": 0.165, "eta": 0.96, "a_p_g": -0.3, "f_p": 1.0}'
+        raise wrong_type(request, "request", "a PulseRequest or a dict of its fields", example)
     try:
         return PulseRequest.model_validate(dict(request))
     except ValidationError as err:

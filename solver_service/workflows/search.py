@@ -16,9 +16,10 @@
    that overturns them) and the code check (``assess.check_doc``: α0 and the verdict);
 4. the document (``search.json``) says where the static (λ0) and the dynamic rankings differ.
 
-``write_search`` writes the outputs into a run folder: ``search.json``, ``search.spec.json``
-(the spec the existing commands and Rhino reopen), ``constants.json``, ``search.3dm`` (the
-search's scene with a crack layer) and ``search.png`` (the top mechanisms on the façade).
+``write_search_files`` writes the outputs into a staged folder (``write_search`` into a run
+folder, through ``rundir.run_folder``): ``search.json``, ``search.spec.json`` (the spec the
+existing commands and Rhino reopen), ``constants.json``, ``search.3dm`` (the search's scene
+with a crack layer) and ``search.png`` (the top mechanisms on the façade).
 """
 
 from __future__ import annotations
@@ -49,10 +50,18 @@ from cad_maths.search.prism import segment_intervals
 from cad_maths.search.specs import AGREEMENT_RTOL, build_candidates
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile, json_document
-from shared_schema.errors import InputError, RockmechError
+from shared_schema.errors import InputError, RockmechError, wrong_type
 from shared_schema.extras import require
-from shared_schema.io import save_constants, stamped
-from shared_schema.paths import PATH_TYPES, PathLike, as_path, is_path
+from shared_schema.io import stamped, write_constants
+from shared_schema.paths import (
+    PATH_TYPES,
+    PathLike,
+    Source,
+    as_path,
+    is_path,
+    read_source,
+    readable_folder,
+)
 from shared_schema.rules import check_file
 from shared_schema.search import SearchSpec, parse_search_spec
 from shared_schema.site import SiteFile
@@ -81,12 +90,12 @@ __all__ = [
     "crack_patches",
     "first_mode",
     "read_search_spec",
-    "save_search",
     "scales_to_overturn",
     "search_3dm",
     "search_from_files",
     "search_run",
     "write_search",
+    "write_search_files",
 ]
 
 #: Work limit of one search [evaluations of λ0]: the command line lifts it with
@@ -125,7 +134,7 @@ class SearchRun:
 SEARCH_SPEC_EXPECTED = 'a search spec (JSON, {"walls": [...], "levels": [...], ...})'
 
 
-def read_search_spec(path: PathLike) -> SearchSpec:
+def read_search_spec(path: Source) -> SearchSpec:
     """Read and validate a search spec file; errors name the spec and the field.
 
     An empty, binary (gzip, a workbook) or non-UTF-8 file is told as such, naming the file
@@ -134,18 +143,18 @@ def read_search_spec(path: PathLike) -> SearchSpec:
 
     Parameters
     ----------
-    path : str or os.PathLike
-        The search spec (JSON).
+    path : str, os.PathLike or file object
+        The search spec (JSON), as a path or an open file (``paths.read_source``). Its
+        ``ranking.site`` and ``ranking.records`` are relative to its folder: give that folder
+        to ``search`` as ``spec_dir``.
     """
-    path = check_file(path, "spec")
-    text = decode_text(path.read_bytes(), path.name, "spec", SEARCH_SPEC_EXPECTED)
+    raw, name = read_source(path, "spec")
+    text = decode_text(raw, name, "spec", SEARCH_SPEC_EXPECTED)
     try:
         json_document(text)  # malformed JSON: one line
     except InputError as exc:
-        raise InputError(
-            f"{path.name}: {exc.reason}; expected {SEARCH_SPEC_EXPECTED}", "spec"
-        ) from None
-    return parse_search_spec(text, path.name)
+        raise InputError(f"{name}: {exc.reason}; expected {SEARCH_SPEC_EXPECTED}", "spec") from None
+    return parse_search_spec(text, name)
 
 
 #: A site's building height this far (relative) from the scene's walls' gets a note.
@@ -773,8 +782,8 @@ def _scene_object(scene: Any) -> BaseScene:
     if isinstance(scene, BaseScene):
         return scene
     hint = (
-        "; read the file with rockmech.read_scene(path), or search files with "
-        "rockmech.search_from_files(scene, spec)"
+        "; read the file with rockmech.read_scene(path), or give rockmech.search(scene, spec) "
+        "the paths"
         if is_path(scene)
         else ""
     )
@@ -867,7 +876,7 @@ def search_run(
     t0 = time.perf_counter()
     scene = _scene_object(scene)
     spec = _search_spec(spec, spec_name)
-    folder = None if spec_dir is None else as_path(spec_dir, "spec_dir")
+    folder = None if spec_dir is None else readable_folder(spec_dir, "spec_dir")
     site = _site_object(site, "site")
     motions = _motion_objects(motions, "motions")
     rk = spec.ranking
@@ -1029,7 +1038,7 @@ def _encode(model: Any) -> bytes:
         return path.read_bytes()
 
 
-def write_search(run: SearchRun, out_dir: Path, *, figure: bool = True) -> list[Path]:
+def write_search_files(run: SearchRun, out_dir: Path, *, figure: bool = True) -> list[Path]:
     """Write a search's files into a folder (``run_folder`` stages it; each written whole).
 
     Returns
@@ -1051,7 +1060,7 @@ def write_search(run: SearchRun, out_dir: Path, *, figure: bool = True) -> list[
         out.append(path)
     if run.constants is not None:
         path = out_dir / "constants.json"
-        save_constants(path, stamped(run.constants))
+        write_constants(stamped(run.constants), path)
         out.append(path)
     path = out_dir / "search.3dm"
     write_atomic(path, search_3dm(run))
@@ -1063,7 +1072,7 @@ def write_search(run: SearchRun, out_dir: Path, *, figure: bool = True) -> list[
     return out
 
 
-def save_search(run: SearchRun, out: PathLike, *, figure: bool = True) -> list[Path]:
+def write_search(run: SearchRun, out: PathLike, *, figure: bool = True) -> list[Path]:
     """Write a search's files into the folder ``out`` as ``rockmech search --out`` does.
 
     Through ``rundir.run_folder``: only rockmech's own outputs in ``out`` are replaced, as
@@ -1072,7 +1081,7 @@ def save_search(run: SearchRun, out: PathLike, *, figure: bool = True) -> list[P
     Parameters
     ----------
     run : SearchRun
-        The search (``search_from_files``, ``search_run``).
+        The search (``rockmech.search``; ``search_from_files``, ``search_run``).
     out : str or os.PathLike
         The folder (created if missing).
     figure : bool
@@ -1081,12 +1090,14 @@ def save_search(run: SearchRun, out: PathLike, *, figure: bool = True) -> list[P
     Returns
     -------
     list of Path
-        The files written, in ``out`` (as ``write_search``).
+        The files written, in ``out`` (as ``write_search_files``).
     """
+    if not isinstance(run, SearchRun):
+        raise wrong_type(run, "run", "a SearchRun", "rockmech.search(scene, spec) gives one")
     out = as_path(out, "out")
     notes: list[str] = []
     with run_folder(out, on_note=notes.append, command="search") as tmp:
-        names = [p.name for p in write_search(run, tmp, figure=figure)]
+        names = [p.name for p in write_search_files(run, tmp, figure=figure)]
     for note in notes:
         warnings.warn(note, UserWarning, stacklevel=2)
     return [Path(out) / name for name in names]

@@ -884,7 +884,13 @@ def _cases() -> list[Case]:
             "limit|at most|<=",
             isolate=True,
         ),
-        Case("ida-im-bad", [*ida, "--scales", "1", "--im", "pgv"], "error", "im", "scale|pga"),
+        Case(
+            "ida-measure-bad",
+            [*ida, "--scales", "1", "--measure", "pgv"],
+            "error",
+            "measure",
+            "scale|pga",
+        ),
         Case(
             "ida-scheduler-bad-url",
             [*ida, "--scales", "1", "--scheduler", "not-a-url", "--timeout", "1"],

@@ -1,4 +1,4 @@
-"""``rockmech search`` and the Python API's ``rockmech.search_from_files`` (issue #31)."""
+"""``rockmech search`` and the Python API's ``rockmech.search`` (issue #31)."""
 
 from __future__ import annotations
 
@@ -115,7 +115,7 @@ def test_a_hinge_line_every_millimetre_is_refused_at_once_with_the_estimate(
     spec = write_spec(tmp_path / "mm.search.json", doc)
     t0 = time.perf_counter()
     with pytest.raises(InputError) as err:
-        rockmech.search_from_files(EXAMPLE_SCENE, spec)
+        rockmech.search(EXAMPLE_SCENE, spec)
     elapsed = time.perf_counter() - t0
     assert err.value.field == "work_limit"
     msg = str(err.value)
@@ -143,16 +143,16 @@ def test_the_work_estimate_is_a_lower_bound_of_the_search_s_work() -> None:
         enumerate_candidates(bld, Budget(est.evaluations - 1))
 
 
-def test_python_api_search_from_files(tmp_path: Path) -> None:
-    run = rockmech.search_from_files(EXAMPLE_SCENE, EXAMPLE_SPEC)
+def test_python_api_search(tmp_path: Path) -> None:
+    run = rockmech.search(EXAMPLE_SCENE, EXAMPLE_SPEC)
     assert isinstance(run, rockmech.SearchRun)
     (tmp_path / "constants.json").write_text("the user's own file\n")
     (tmp_path / "notes.txt").write_text("kept\n")
     # Written as --out writes: a file rockmech did not write is never replaced.
     with pytest.raises(InputError, match=r"constants\.json was not written by rockmech"):
-        rockmech.save_search(run, tmp_path, figure=True)
+        rockmech.write_search(run, tmp_path, figure=True)
     (tmp_path / "constants.json").unlink()
-    paths = rockmech.save_search(run, tmp_path, figure=True)
+    paths = rockmech.write_search(run, tmp_path, figure=True)
     assert (tmp_path / "notes.txt").read_text() == "kept\n"
     assert all(p.parent == tmp_path for p in paths)
     assert {p.name for p in paths} == {
@@ -180,7 +180,7 @@ def test_an_implausible_masonry_unit_gets_a_warning_naming_the_field(
 
     scene = wedge_facade(tmp_path)
     spec = write_spec(tmp_path / "s.json", wedge_spec("good", unit, families=["overturning"]))
-    run = rockmech.search_from_files(scene, spec)
+    run = rockmech.search(scene, spec)
     (note,) = [n for n in run.doc["warnings"] if field in n]
     assert note.startswith(f"{field} = {unit[0] if 'length' in field else unit[1]:g} m ")
     assert not [n for n in run.doc["notes"] if field in n]  # a warning, not among the notes
@@ -189,5 +189,5 @@ def test_an_implausible_masonry_unit_gets_a_warning_naming_the_field(
     spec = write_spec(
         tmp_path / "t.json", wedge_spec("good", (0.25, 0.06), families=["overturning"])
     )
-    quiet = rockmech.search_from_files(scene, spec).doc
+    quiet = rockmech.search(scene, spec).doc
     assert not [n for n in quiet["warnings"] + quiet["notes"] if "unit." in n]

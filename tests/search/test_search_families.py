@@ -21,7 +21,7 @@ from cad_maths.search.specs import build_candidates
 from shared_schema.errors import InputError
 from shared_schema.search import SearchSpec
 from solver_service.workflows.inputs import constants_from_files
-from solver_service.workflows.search import search_run, write_search
+from solver_service.workflows.search import search_run, write_search_files
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -117,7 +117,7 @@ def test_openings_drawn_as_solids_are_cut_and_the_spec_reopens_only_the_search_s
     assert any("(openings cut)" in n for n in run.doc["notes"])
     out = tmp_path / "out"
     out.mkdir()
-    write_search(run, out, figure=False)
+    write_search_files(run, out, figure=False)
     again = constants_from_files(out / "search.3dm", out / "search.spec.json")
     for m1, m2 in zip(run.constants.mechanisms, again.mechanisms):
         assert m2.positive.p_eq == pytest.approx(m1.positive.p_eq, rel=1e-12)

@@ -11,7 +11,7 @@ from pydantic_core import PydanticSerializationError
 import shared_schema.atomic as atomic
 from shared_schema.constants import ConstantsFile, Mechanism, parse_constants
 from shared_schema.errors import InputError
-from shared_schema.io import load_constants, save_constants, stamped, write_atomic
+from shared_schema.io import load_constants, stamped, write_atomic, write_constants
 from shared_schema.version import __version__
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "constants"
@@ -37,7 +37,7 @@ def leftovers(directory):
 def test_published_table_form_round_trips_and_omits_absent_sections(tmp_path):
     original = parse_constants({"mechanisms": [W1]})
     path = tmp_path / "walls.json"
-    save_constants(path, original)
+    write_constants(original, path)
     text = path.read_text(encoding="utf-8")
     assert text.endswith("}\n")
     assert "null" not in text
@@ -75,7 +75,7 @@ def test_physical_form_round_trips_exactly(tmp_path):
         ]
     )
     path = tmp_path / "loaded.json"
-    save_constants(path, original)
+    write_constants(original, path)
     loaded = load_constants(path)
     assert loaded == stamped(original)
     # Derived values are written next to the physical ones; nulls inside free-form data stay.
@@ -86,8 +86,8 @@ def test_physical_form_round_trips_exactly(tmp_path):
 
 def test_saving_twice_gives_identical_bytes(tmp_path):
     cf = parse_constants([W1])
-    save_constants(tmp_path / "a.json", cf)
-    save_constants(tmp_path / "b.json", load_constants(tmp_path / "a.json"))
+    write_constants(cf, tmp_path / "a.json")
+    write_constants(load_constants(tmp_path / "a.json"), tmp_path / "b.json")
     assert (tmp_path / "a.json").read_bytes() == (tmp_path / "b.json").read_bytes()
 
 
@@ -186,7 +186,7 @@ def test_failed_rename_leaves_previous_file_and_no_temporary_file(tmp_path, monk
 
 def test_failing_serialisation_leaves_previous_file_and_no_temporary_file(tmp_path):
     path = tmp_path / "walls.json"
-    save_constants(path, parse_constants([W1]))
+    write_constants(parse_constants([W1]), path)
     before = path.read_bytes()
     good = parse_constants([W1]).mechanisms[0]
     # model_construct skips validation, so an object JSON cannot hold gets through to dumping.
@@ -195,7 +195,7 @@ def test_failing_serialisation_leaves_previous_file_and_no_temporary_file(tmp_pa
         schema_version="1.0", units=parse_constants([W1]).units, mechanisms=[broken_mech]
     )
     with pytest.raises(PydanticSerializationError):
-        save_constants(path, broken)
+        write_constants(broken, path)
     assert path.read_bytes() == before
     assert leftovers(tmp_path) == ["walls.json"]
 
@@ -203,7 +203,7 @@ def test_failing_serialisation_leaves_previous_file_and_no_temporary_file(tmp_pa
 def test_save_into_missing_directory_is_an_input_error(tmp_path):
     path = tmp_path / "no" / "such" / "dir.json"
     with pytest.raises(InputError, match="cannot write constants file"):
-        save_constants(path, parse_constants([W1]))
+        write_constants(parse_constants([W1]), path)
 
 
 @pytest.mark.skipif(os.name != "posix", reason="POSIX permission bits")

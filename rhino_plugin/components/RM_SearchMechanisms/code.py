@@ -16,7 +16,7 @@ import Rhino.Geometry as rg
 from rhino_plugin.flows.search import search_lines, search_marks, search_prepared
 from rhino_plugin.rhino.gh import model_units, prepare_inputs
 from solver_service.workflows.rundir import run_folder
-from solver_service.workflows.search import write_search
+from solver_service.workflows.search import write_search_files
 
 
 class RM_SearchMechanisms(Grasshopper.Kernel.GH_ScriptInstance):
@@ -36,7 +36,7 @@ class RM_SearchMechanisms(Grasshopper.Kernel.GH_ScriptInstance):
         )
         if folder:
             with run_folder(str(folder)) as tmp:
-                write_search(run, tmp)
+                write_search_files(run, tmp)
         lines = [
             rg.Line(rg.Point3d(*m.points[0]), rg.Point3d(*m.points[1]))
             for m in search_marks(run.doc, scale)

@@ -60,9 +60,9 @@ def _collect(
     return {"kind": "local", "jobs": n_jobs, "tasks": len(tasks)}
 
 
-def _check_options(im: str, motions: Sequence[Any], jobs: Optional[int], task_s: Any) -> None:
-    if im not in IM_MEASURES:
-        raise InputError(f"must be one of {list(IM_MEASURES)}, got {im!r}", "im")
+def _check_options(measure: str, motions: Sequence[Any], jobs: Optional[int], task_s: Any) -> None:
+    if measure not in IM_MEASURES:
+        raise InputError(f"must be one of {list(IM_MEASURES)}, got {measure!r}", "measure")
     if len(motions) == 0:
         raise InputError("needs at least one record", "records")
     if jobs is not None and (isinstance(jobs, bool) or int(jobs) != jobs or jobs < 1):
@@ -76,7 +76,7 @@ def run_ida(
     motions: Sequence[Any],
     levels: Sequence[float],
     *,
-    im: str = "scale",
+    measure: str = "scale",
     sf: str = "none",
     building: Optional[Building] = None,
     criterion: Optional[str] = None,
@@ -96,9 +96,9 @@ def run_ida(
     motions : sequence of GroundMotion
         The records, at least one.
     levels : sequence of float
-        Intensity levels, each > 0 and distinct: scale factors [-] or PGAs [g] (``im``).
-    im : {"scale", "pga"}
-        Intensity measure.
+        Intensity levels, each > 0 and distinct: scale factors [-] or PGAs [g] (``measure``).
+    measure : {"scale", "pga"}
+        The intensity measure (the document's ``intensity.measure``).
     sf : {"none", "eq28", "ec8", "nzs"}
         Scale factor up the structure for mechanisms with amplification data (per record;
         see ``analysis.mechanism_scale_factor``).
@@ -146,13 +146,13 @@ def run_ida(
     Raises
     ------
     InputError
-        No records, a bad level, an unknown ``im``, a bad ``jobs`` or ``task_s``, or a
+        No records, a bad level, an unknown ``measure``, a bad ``jobs`` or ``task_s``, or a
         scheduler that is malformed, unreachable, without workers or with workers that run
         another rockmech (field ``scheduler``, with the address).
     MissingExtra
         ``scheduler`` without dask.distributed, ``peaks`` without pyarrow.
     """
-    _check_options(im, motions, jobs, task_s)
+    _check_options(measure, motions, jobs, task_s)
     lv = _levels(levels)
     building = building or Building()
     cf, skipped = time_domain_mechanisms(cf)
@@ -160,12 +160,12 @@ def run_ida(
         to_rocking_model(mech).require_eta()
     names = [str(m.name) for m in motions]
     ids = [m.id for m in cf.mechanisms]
-    writer = None if peaks is None else PeakWriter(Path(peaks), names, ids, lv, im)
+    writer = None if peaks is None else PeakWriter(Path(peaks), names, ids, lv, measure)
     ctx = {
         "token": uuid.uuid4().hex,
         "constants": cf.model_dump(mode="json", exclude_none=True),
         "levels": lv,
-        "im": im,
+        "im": measure,
         "options": {
             "sf": sf,
             "building": {
@@ -200,7 +200,7 @@ def run_ida(
     wall = time.perf_counter() - start
     if totals.runs_done != totals.n_runs:  # every run is in exactly one finished task
         raise RuntimeError(f"IDA ran {totals.runs_done} of {totals.n_runs} runs")
-    doc = ida_document(cf, motions, lv, im, totals)
+    doc = ida_document(cf, motions, lv, measure, totals)
     doc.update(runtime_s=wall, compute_s=totals.kernel_s)
     doc["backend"] = {**backend, **totals.task_stats()}
     if writer is not None:
