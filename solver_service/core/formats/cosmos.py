@@ -33,7 +33,10 @@ from ._text import (
     units_from_text,
 )
 
-__all__ = ["read", "sniff"]
+__all__ = ["DT_SOURCE", "read", "sniff"]
+
+#: Where the time step comes from, for the plausibility warning.
+DT_SOURCE = "real header 62 (in ms)"
 
 #: COSMOS physical-units codes of acceleration -> ``RECORD_UNITS`` keys.
 UNITS_CODES = {2: "g", 4: "cm/s2", 7: "in/s2", 10: "cm/s2", 11: "mg"}

@@ -31,7 +31,10 @@ from shared_schema.rules import DT_RANGE_S
 
 from ._text import Channel, check_count, check_peak, first_number, number
 
-__all__ = ["read", "sniff"]
+__all__ = ["DT_SOURCE", "read", "sniff"]
+
+#: Where the time step comes from, for the plausibility warning.
+DT_SOURCE = "1 / the header's Sampling Freq(Hz)"
 
 #: Header lines before the counts.
 HEADER_LINES = 17
