@@ -10,8 +10,11 @@ Floors, each importing only from its own floor or below (docs/architecture.md dr
    ``solver_service.core`` (the rocking solver), beside each other, import ``shared_schema``
    only; ``solver_service.codes`` (the building codes) imports ``shared_schema`` and
    ``solver_service.core``, and nothing of floor 1 imports it;
-2. workflows and documents: the rest of ``solver_service`` (``workflows``, ``report``, ``ida``,
-   ``demo``), the first floor that may import ``cad_maths``;
+2. workflows and documents: the rest of ``solver_service``, the first floor that may import
+   ``cad_maths``, in an order (``FLOOR_2_ORDER``): ``report`` (renders documents, runs no
+   analysis: of the solver it imports only constants, result types and the fitted curves it
+   draws), then ``workflows`` (the analyses and their documents, the IDA among them), then
+   ``demo``; each imports only those before it;
 3. front ends: ``solver_service.cli``, ``solver_service.api``, ``rhino_plugin`` (what runs
    inside Rhino: flows, commands, components) and the public ``rockmech`` package.
 """
@@ -47,6 +50,15 @@ MATHS: dict[str, tuple[str, ...]] = {
     "cad_maths": (),
     "solver_service.core": (),
     "solver_service.codes": ("solver_service.core",),
+}
+#: The packages of floor 2, each importing only those before it: the pages render what the
+#: workflows computed (``workflows.pages`` runs a page's analyses and calls ``report``).
+FLOOR_2_ORDER = ("solver_service.report", "solver_service.workflows", "solver_service.demo")
+#: What ``report`` may take from the solver: no analysis, only what it draws with.
+REPORT_TAKES_FROM_CORE = {
+    "solver_service.core.model": "G, to turn m/s² into g on an axis",
+    "solver_service.core.result": "RockingResult, the type of a run it draws",
+    "solver_service.core.fragility": "lognormal_cdf, the IDA's fitted curve drawn over its points",
 }
 #: ``solver_service``'s ``__init__`` holds no code of a floor; it may be imported from anywhere.
 PACKAGE_INITS = {"solver_service"}
@@ -144,6 +156,48 @@ def test_module_imports_only_its_floor_or_below(module: str) -> None:
                 f"{module} (floor {own}, {FLOOR_NAMES[own]}) imports {target} (floor {floor}, "
                 f"{FLOOR_NAMES[floor]}) at line {line}"
             )
+
+
+def _floor_2_rank(module: str) -> Optional[int]:
+    for rank, package in enumerate(FLOOR_2_ORDER):
+        if module == package or module.startswith(package + "."):
+            return rank
+    return None
+
+
+def test_every_floor_2_module_is_in_an_ordered_package() -> None:
+    for module in MODULES:
+        if floor_of(module) == 2:
+            assert _floor_2_rank(module) is not None, module
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if floor_of(m) == 2))
+def test_floor_2_packages_import_only_those_before_them(module: str) -> None:
+    """``workflows`` imports ``report``, never back; ``demo`` imports both."""
+    own = _floor_2_rank(module)
+    assert own is not None
+    for target, line, _ in imports(module):
+        rank = _floor_2_rank(target) if floor_of(target) == 2 else None
+        if rank is not None and rank > own:
+            pytest.fail(f"{module} imports {target} ({FLOOR_2_ORDER[rank]}) at line {line}")
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if _floor_2_rank(m) == 0))
+def test_report_runs_no_analysis(module: str) -> None:
+    """The pages render documents: of floor 1 they take only what they draw with."""
+    for target, line, _ in imports(module):
+        if floor_of(target) == 1 and target not in REPORT_TAKES_FROM_CORE:
+            pytest.fail(
+                f"{module} imports {target} at line {line}: an analysis belongs in workflows"
+            )
+
+
+def test_floor_2_order_check_catches_a_report_importing_a_workflow() -> None:
+    assert _floor_2_rank("solver_service.report.html") == 0
+    assert _floor_2_rank("solver_service.workflows.pages") == 1
+    assert _floor_2_rank("solver_service.workflows.ida.dask") == 1
+    assert _floor_2_rank("solver_service.demo") == 2
+    assert _floor_2_rank("solver_service.cli.app") is None
 
 
 def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:

@@ -1,14 +1,15 @@
 """The assessment report a client reads: code checks beside rocking dynamics, per mechanism.
 
-``render_assessment`` turns an assessment document (``workflows.assess.assessment_doc``) into
-one self-contained HTML page through a jinja2 template (autoescaped). Page one carries the
-project, site, engineer and date and the verdict table (code check linear and nonlinear,
-rocking dynamics on the records, pulse-envelope margin, governing mechanism); then one
-section per mechanism (constants to 4 significant figures, the check worked out, the
-capacity curve against the site spectrum, the envelope with the records' pulses, time
-histories at the design scale cropped to the motion); then provenance as tables. Print CSS
-keeps a mechanism's section on one page where it fits. ``print_pdf`` prints the page to PDF
-with headless Chromium.
+``render_assessment`` turns an assessment document (``workflows.assess.assessment_doc``),
+the site spectrum and the time histories run for it (``workflows.pages.assess_report``
+computes them; this module runs no analysis) into one self-contained HTML page through a
+jinja2 template (autoescaped). Page one carries the project, site, engineer and date and the
+verdict table (code check linear and nonlinear, rocking dynamics on the records, pulse-
+envelope margin, governing mechanism); then one section per mechanism (constants to 4
+significant figures, the check worked out, the capacity curve against the site spectrum, the
+envelope with the records' pulses, time histories at the design scale cropped to the
+motion); then provenance as tables. Print CSS keeps a mechanism's section on one page where
+it fits. ``print_pdf`` prints the page to PDF with headless Chromium.
 
 A folder given as ``template_dir`` overrides the packaged ``assess.html.j2`` (a firm's
 layout); it receives the same context.
@@ -25,7 +26,8 @@ import shlex
 import shutil
 import subprocess
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
@@ -36,17 +38,14 @@ from shared_schema.errors import InputError, RockmechError
 from shared_schema.site import SiteFile
 from shared_schema.version import __version__
 
-from ..core.exact import simulate
 from ..core.model import G
-from ..workflows.adapter import to_rocking_model
-from ..workflows.assess import assessment_doc, site_spectrum
-from ..workflows.scaling import mechanism_scale_factor
-from ..workflows.verdict import ratio_label, worst_pulse
+from .labels import ratio_label, worst_pulse
 from .plots import load_pyplot, plain, save_figure_atomic
 
 __all__ = [
     "TEMPLATE_NAME",
-    "assess_report",
+    "HistoryRun",
+    "check_template",
     "chromium",
     "print_pdf",
     "render_assessment",
@@ -63,6 +62,37 @@ CROP_BEFORE, CROP_AFTER = 1.0, 3.0
 MOTION_FRACTION = 1e-3
 #: Seconds allowed for Chromium to print a page.
 PDF_TIMEOUT_S = 120
+
+
+@dataclass(frozen=True)
+class HistoryRun:
+    """One time history of a mechanism on a record at its design scale, for its figure.
+
+    Attributes
+    ----------
+    caption : str
+        The figure's caption.
+    label : str
+        The mechanism's id (the trace's label).
+    motion : GroundMotion, optional
+        The record.
+    scale : float
+        The design scale factor on the record [-] (the ground trace drawn).
+    result : RockingResult, optional
+        The run with its time series (``dense``); None where it was not run.
+    note : str, optional
+        Why there is no figure (``not run: ...``, ``not drawn: ...``).
+    file : str
+        The figure's file name.
+    """
+
+    caption: str
+    label: str = ""
+    motion: Optional[Any] = None
+    scale: float = 1.0
+    result: Optional[Any] = None
+    note: Optional[str] = None
+    file: str = "history.png"
 
 
 def sig(value: Any, digits: int = 4) -> str:
@@ -402,52 +432,18 @@ def _plot_history(
         plt.close(fig)
 
 
-def _history_png(label: str, model: Any, motion: Any, design: float, up: float, path: Path) -> Path:
-    """Run one mechanism at ``design × up`` and plot its time history.
-
-    Both happen inside the figure's guard (``_embed``): a run that fails becomes the
-    figure's note, not a traceback.
-    """
-    res = simulate(model, motion.accel, scale=design * up, dense=True)
-    return _plot_history(label, res, motion, design, path)[0]
+def _history_png(run: HistoryRun, path: Path) -> Path:
+    return _plot_history(run.label, run.result, run.motion, run.scale, path)[0]
 
 
-def _history_figures(
-    mech: Any, row: dict[str, Any], motions: Sequence[Any], folder: Path
-) -> list[dict[str, str]]:
+def _history_figures(runs: Sequence[HistoryRun], folder: Path) -> list[dict[str, str]]:
+    """Return the time-history figures of one mechanism, or the notes saying why there are none."""
     out: list[dict[str, str]] = []
-    try:
-        model = to_rocking_model(mech)
-    except RockmechError as exc:
-        return [{"caption": "time histories", "note": f"not run: {exc}"}]
-    for k, (motion, dyn) in enumerate(zip(motions, row.get("dynamics", []))):
-        if "scale_factor" not in dyn:
-            continue
-        design = float(dyn["scale_factor"]["value"])
-        caption = f"{mech.id} on {motion.name} at the design scale {sig(design)}"
-        try:
-            height = mechanism_scale_factor(mech, motion, "eq28")
-        except (ValueError, ArithmeticError, RockmechError) as exc:
-            out.append({"caption": caption, "note": f"not run: {exc}"})
-            continue
-        up = 1.0 if height is None else float(height["value"])
-        caption += (
-            f" × {sig(up)} up the structure (Eq. 28)" if height is not None else ""
-        ) + "; time axis cropped to the motion"
-        out.append(
-            _embed(
-                functools.partial(
-                    _history_png,
-                    mech.id,
-                    model,
-                    motion,
-                    design,
-                    up,
-                    folder / f"{mech.id}_history_{k}.png",
-                ),
-                caption,
-            )
-        )
+    for run in runs:
+        if run.note is not None or run.result is None:
+            out.append({"caption": run.caption, "note": run.note or "not run"})
+        else:
+            out.append(_embed(functools.partial(_history_png, run, folder / run.file), run.caption))
     return out
 
 
@@ -822,7 +818,8 @@ def render_assessment(
     doc: dict[str, Any],
     cf: ConstantsFile,
     site: SiteFile,
-    motions: Sequence[Any],
+    spectrum: Any,
+    histories: Mapping[str, Sequence[HistoryRun]],
     *,
     sources: Sequence[dict[str, Any]] = (),
     options: Optional[dict[str, Any]] = None,
@@ -834,8 +831,14 @@ def render_assessment(
     ----------
     doc : dict
         ``workflows.assess.assessment_doc(cf, site, motions, ...)``.
-    cf, site, motions
-        The inputs of ``doc`` (for the figures).
+    cf, site
+        The inputs of ``doc`` (for the constants and the project).
+    spectrum : Spectrum
+        The site's elastic spectrum (``workflows.assess.site_spectrum(site)``), drawn with
+        the capacity curves.
+    histories : dict of str to sequence of HistoryRun
+        Per mechanism id, its time histories at the design scale
+        (``workflows.pages.assessment_histories``); a mechanism absent has none.
     sources : sequence of dict
         Inputs' provenance (``report.html.input_source``: role, name, bytes, SHA-256).
     options : dict, optional
@@ -848,8 +851,7 @@ def render_assessment(
     str
         The HTML page.
     """
-    _render(template_dir)  # a user template's syntax error before any figure is drawn
-    spectrum = site_spectrum(site)
+    check_template(template_dir)  # a user template's syntax error before any figure is drawn
     by_id = {m.id: m for m in cf.mechanisms}
     with tempfile.TemporaryDirectory(prefix="rockmech-assess-") as tmp:
         folder = Path(tmp)
@@ -889,7 +891,7 @@ def render_assessment(
                         "at design scale",
                     )
                 )
-            figs.extend(_history_figures(mech, row, motions, folder))
+            figs.extend(_history_figures(histories.get(row["id"], ()), folder))
             method = doc.get("method", {}).get("name", "circ2019")
             verdict = verdicts_by_id[row["id"]]
             cells = {
@@ -938,36 +940,16 @@ def render_assessment(
     return _render(template_dir, context)
 
 
-def assess_report(
-    cf: ConstantsFile,
-    site: SiteFile,
-    motions: Sequence[Any],
-    *,
-    multiples: Sequence[float] = (0.5, 1.0, 1.5, 2.0),
-    sources: Sequence[dict[str, Any]] = (),
-    options: Optional[dict[str, Any]] = None,
-    template_dir: Optional[Path] = None,
-) -> tuple[dict[str, Any], str]:
-    """Return the assessment document and its HTML page (for ``rockmech assess`` and REST).
+def check_template(template_dir: Optional[Path]) -> None:
+    """Refuse a user template that does not load or parse, before any work is done.
 
-    Parameters
-    ----------
-    cf, site, motions, multiples
-        As ``workflows.assess.assessment_doc``.
-    sources, options, template_dir
-        As ``render_assessment``.
-
-    Returns
-    -------
-    (dict, str)
-        The JSON-ready document and the HTML page.
+    Raises
+    ------
+    InputError
+        The folder has no readable ``assess.html.j2`` or it has a syntax error (naming the
+        file and line).
     """
-    _render(template_dir)  # a user template's syntax error before the analysis runs
-    doc = assessment_doc(cf, site, motions, multiples=multiples)
-    text = render_assessment(
-        doc, cf, site, motions, sources=sources, options=options, template_dir=template_dir
-    )
-    return doc, text
+    _render(template_dir)
 
 
 def chromium() -> Optional[str]:
