@@ -47,7 +47,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.errors import InputError
-from shared_schema.rules import G
+from shared_schema.rules import CRITERIA, G
 
 from . import _kernels as _k
 from ._compile import JIT, python_twins
@@ -56,7 +56,7 @@ from .integrator import V_REST_REL, Excitation, Integrator
 from .jit import first_use
 from .linearisation import linearisation_warnings
 from .model import RockingModel, check_positive
-from .result import CRITERIA, STATUS_MESSAGES, RockingResult
+from .result import STATUS_MESSAGES, RockingResult
 
 __all__ = [
     "BACKENDS",
