@@ -265,11 +265,9 @@ def _check_rows(check: dict[str, Any]) -> list[dict[str, str]]:
         return _rows_2009(check)
     rows: list[dict[str, str]] = []
 
-    def add(label: str, key: str, unit: str, source: Optional[dict[str, Any]] = None) -> None:
-        src = check if source is None else source
-        if src.get(key) is not None:
-            clauses = cl if source is None else src.get("clauses", {})
-            rows.append(_row(label, src[key], unit, clauses.get(key, "")))
+    def add(label: str, key: str, unit: str) -> None:
+        if check.get(key) is not None:
+            rows.append(_row(label, check[key], unit, cl.get(key, "")))
 
     nonlinear = "SLV" in check
     add("α0 of the capacity curve" if nonlinear else "α0", "alpha0", "-")
@@ -308,41 +306,57 @@ def _check_rows(check: dict[str, Any]) -> list[dict[str, str]]:
         add("a_g (SLV hazard)", "a_g", "g")
         add("a_g,SLV / a_g", "capacity_ratio", "-")
         return rows
-    ties = check.get("ties") or {}
-    if ties.get("present"):
-        rows.append(
-            {
-                "label": "ties",
-                "value": ties.get("treatment", ""),
-                "unit": "",
-                "clause": ties.get("rule", ""),
-            }
-        )
-        for label, key in (("φ0 with the ties", "phi0_with"), ("φ0 without", "phi0_without")):
-            rows.append(_row(label, ties[key], "rad", "theory §1.7 Eq. 6; C8.7.1.2.1.6"))
+    rows.extend(_ties_rows(check.get("ties") or {}))
     add("J/S (d per unit rotation)", "d_per_rad", "m/rad")
     add("φ0", "phi0", "rad")
     add("d0", "d0", "m")
     for name in ("SLV", "SLC"):
-        ls = check[name]
-        lcl = ls.get("clauses", {})
-        rows.append(_row(f"d_{name}", ls["d"], "m", f"{lcl.get('d', '')}: {ls['d_rule']}"))
-        add(f"a(d_{name})", "a", "m/s²", ls)
-        add(f"T_{name}", f"T_{name}", "s", ls)
-        add(f"ξ ({name})", "xi_percent", "%", ls)
-        rows.append(
-            _row(
-                f"demand {name} (code)",
-                ls["demand_code"],
-                "m",
-                f"{lcl.get('demand_code', '')}: {ls['demand_rule']}",
-            )
+        rows.extend(_limit_state_rows(name, check[name]))
+    return rows
+
+
+def _ties_rows(ties: dict[str, Any]) -> list[dict[str, str]]:
+    """Return the rows of a nonlinear check's ties: their treatment and φ0 with and without."""
+    if not ties.get("present"):
+        return []
+    rows = [
+        {
+            "label": "ties",
+            "value": ties.get("treatment", ""),
+            "unit": "",
+            "clause": ties.get("rule", ""),
+        }
+    ]
+    for label, key in (("φ0 with the ties", "phi0_with"), ("φ0 without", "phi0_without")):
+        rows.append(_row(label, ties[key], "rad", "theory §1.7 Eq. 6; C8.7.1.2.1.6"))
+    return rows
+
+
+def _limit_state_rows(name: str, ls: dict[str, Any]) -> list[dict[str, str]]:
+    """Return the rows of one limit state (SLV or SLC) of a nonlinear check."""
+    lcl = ls.get("clauses", {})
+    rows = [_row(f"d_{name}", ls["d"], "m", f"{lcl.get('d', '')}: {ls['d_rule']}")]
+
+    def add(label: str, key: str, unit: str) -> None:
+        if ls.get(key) is not None:
+            rows.append(_row(label, ls[key], unit, lcl.get(key, "")))
+
+    add(f"a(d_{name})", "a", "m/s²")
+    add(f"T_{name}", f"T_{name}", "s")
+    add(f"ξ ({name})", "xi_percent", "%")
+    rows.append(
+        _row(
+            f"demand {name} (code)",
+            ls["demand_code"],
+            "m",
+            f"{lcl.get('demand_code', '')}: {ls['demand_rule']}",
         )
-        add(f"demand {name} (records)", "demand_records", "m", ls)
-        add(f"a_g,{name} (capacity)", "a_g_capacity", "g", ls)
-        add("a_g,SLD (lower bound)", "a_g_SLD", "g", ls)
-        add(f"a_g ({name} hazard)", "a_g", "g", ls)
-        add(f"a_g,{name} / a_g", "capacity_ratio", "-", ls)
+    )
+    add(f"demand {name} (records)", "demand_records", "m")
+    add(f"a_g,{name} (capacity)", "a_g_capacity", "g")
+    add("a_g,SLD (lower bound)", "a_g_SLD", "g")
+    add(f"a_g ({name} hazard)", "a_g", "g")
+    add(f"a_g,{name} / a_g", "capacity_ratio", "-")
     return rows
 
 
@@ -814,6 +828,39 @@ def _render(template_dir: Optional[Path], context: Optional[dict[str, Any]] = No
         raise error from None
 
 
+def _mechanism_figures(
+    row: dict[str, Any], spectrum: Any, runs: Sequence[HistoryRun], folder: Path
+) -> list[dict[str, str]]:
+    """Return a mechanism's figures: its checks on the capacity curve, envelope, histories."""
+    non = row["nonlinear"]
+    figs = []
+    if non.get("status") == "ok" and non.get("curve"):
+        figs.append(
+            _embed(
+                functools.partial(
+                    _plot_capacity,
+                    row["linear"],
+                    non,
+                    spectrum,
+                    folder / f"{row['id']}_capacity.png",
+                ),
+                f"{row['id']}: the checks on the capacity curve (ADRS): capacity, "
+                "demand and verdict of each (Circ. 2019 C8.7.1.2.1.7-8)",
+            )
+        )
+    env_doc = row.get("envelope") or {}
+    if "a_p_min_g" in env_doc:
+        figs.append(
+            _embed(
+                functools.partial(_plot_envelope, env_doc, folder / f"{row['id']}_envelope.png"),
+                f"{row['id']}: overturning envelope and the records' largest pulses "
+                "at design scale",
+            )
+        )
+    figs.extend(_history_figures(runs, folder))
+    return figs
+
+
 def render_assessment(
     doc: dict[str, Any],
     cf: ConstantsFile,
@@ -853,6 +900,8 @@ def render_assessment(
     """
     check_template(template_dir)  # a user template's syntax error before any figure is drawn
     by_id = {m.id: m for m in cf.mechanisms}
+    method = doc.get("method", {}).get("name", "circ2019")
+    verdicts_by_id = {v["id"]: v for v in doc["conclusion"]["mechanisms"]}
     with tempfile.TemporaryDirectory(prefix="rockmech-assess-") as tmp:
         folder = Path(tmp)
         spectrum_fig = _embed(
@@ -861,38 +910,8 @@ def render_assessment(
         )
         sections = []
         verdicts = []
-        verdicts_by_id = {v["id"]: v for v in doc["conclusion"]["mechanisms"]}
         for row in doc["mechanisms"]:
-            mech = by_id[row["id"]]
-            non = row["nonlinear"]
-            figs = []
-            if non.get("status") == "ok" and non.get("curve"):
-                figs.append(
-                    _embed(
-                        functools.partial(
-                            _plot_capacity,
-                            row["linear"],
-                            non,
-                            spectrum,
-                            folder / f"{row['id']}_capacity.png",
-                        ),
-                        f"{row['id']}: the checks on the capacity curve (ADRS): capacity, "
-                        "demand and verdict of each (Circ. 2019 C8.7.1.2.1.7-8)",
-                    )
-                )
-            env_doc = row.get("envelope") or {}
-            if "a_p_min_g" in env_doc:
-                figs.append(
-                    _embed(
-                        functools.partial(
-                            _plot_envelope, env_doc, folder / f"{row['id']}_envelope.png"
-                        ),
-                        f"{row['id']}: overturning envelope and the records' largest pulses "
-                        "at design scale",
-                    )
-                )
-            figs.extend(_history_figures(histories.get(row["id"], ()), folder))
-            method = doc.get("method", {}).get("name", "circ2019")
+            figs = _mechanism_figures(row, spectrum, histories.get(row["id"], ()), folder)
             verdict = verdicts_by_id[row["id"]]
             cells = {
                 "verdict": _final_cell(verdict),
@@ -905,8 +924,8 @@ def render_assessment(
             sections.append(
                 {
                     "row": row,
-                    "mech": mech,
-                    "constants": _constants_rows(mech),
+                    "mech": by_id[row["id"]],
+                    "constants": _constants_rows(by_id[row["id"]]),
                     "figures": figs,
                     "cells": cells,
                     "linear_rows": _check_rows(row["linear"]),
@@ -921,8 +940,8 @@ def render_assessment(
         "site": doc["site"],
         "method": doc.get("method", {}),
         "hazard_table": hazard_table(doc["site"]),
-        "ratio_linear": ratio_label(doc.get("method", {}).get("name", "circ2019"), "linear"),
-        "ratio_nonlinear": ratio_label(doc.get("method", {}).get("name", "circ2019"), "nonlinear"),
+        "ratio_linear": ratio_label(method, "linear"),
+        "ratio_nonlinear": ratio_label(method, "nonlinear"),
         "conclusion": doc["conclusion"],
         "disagreements": [v for v in doc["conclusion"]["mechanisms"] if "pulse_margin" in v],
         "commands": reproduce_commands(sources, options),
