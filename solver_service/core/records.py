@@ -62,7 +62,6 @@ __all__ = [
     "ACCEL_MAX_G",
     "DT_PLAUSIBLE_S",
     "DT_RANGE_S",
-    "DT_RTOL",
     "FORMATS",
     "PGA_PLAUSIBLE_G",
     "UNITS",
@@ -77,8 +76,6 @@ UNITS = RECORD_UNITS
 PGA_PLAUSIBLE_G = (0.001, 5.0)
 #: Time step [s] outside which a record gets a plausibility warning.
 DT_PLAUSIBLE_S = (1e-4, 0.1)
-#: Relative tolerance on the spacing of time stamps read from a file.
-DT_RTOL = formats.DT_RTOL
 #: What a record file must be, for the messages on empty or binary files.
 RECORD_EXPECTED = (
     "a ground-motion record as text (AT2, two columns, one column, CSV, or the ASCII file of "
@@ -422,7 +419,7 @@ class GroundMotion:
         ------
         InputError
             Missing file, unparsable line, fewer than 2 samples, non-finite values, or time
-            that is not strictly increasing and uniform (within ``DT_RTOL``).
+            that is not strictly increasing and uniform (within ``formats.DT_RTOL``).
         """
         _unit_factor(units)  # unknown units are refused before the file is read
         p, text = _read_text(path)
