@@ -23,7 +23,8 @@ What is measured
 
 Records
 -------
-The real records of ``../shared/data/records`` when that folder exists, else the bundled
+The real records of the project's shared records folder (beside the repository, not part
+of a clone) when it exists, else the bundled
 El Centro 1940 N-S; ``N_RECORDS`` distinct motions are made from them by time-stretching
 (factors 0.6-1.6, which shifts their frequency content), negation and time reversal. They
 are real accelerograms transformed, not synthetic noise; their lengths are in the table.

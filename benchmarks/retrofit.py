@@ -17,9 +17,9 @@ The records' term (issue #39: the church with 5 records in ≤ 5 s on one core, 
 force from the records in ≤ 20 exact runs per record), in a second table:
 
 * the bundled church on El Centro 1940 N-S (bundled) and the four PEER records of the
-  project's shared folder (``--records DIR``, default ``../shared/data/records`` beside the
-  repository; the run stops, naming it, where they are absent: PEER's terms keep them out
-  of the repository);
+  project's shared folder (``--records DIR``; by default the records folder of the shared
+  data beside the repository, ``SHARED_RECORDS``; the run stops, naming it, where they are
+  absent: PEER's terms keep them out of the repository);
 * the free wall of ``tests/test_retrofit_records.py`` (b 0.5 m, h 6 m, L 4 m, 1800 kg/m³,
   one tie at 5 m) on a site of a_g = 0.45 g, where El Centro overturns it at its design
   scale, so the search on the tie force runs.

@@ -72,12 +72,12 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from solver_service.demo import copy_examples as copy_examples
     from solver_service.demo import examples_dir as examples_dir
     from solver_service.report.html import (
-        build_report as build_report,
-    )
-    from solver_service.report.html import (
         write_report as write_report,
     )
     from solver_service.workflows.documents import solve_pulse as solve_pulse
+    from solver_service.workflows.pages import (
+        build_report as build_report,
+    )
     from solver_service.workflows.search import SearchRun as SearchRun
     from solver_service.workflows.search import read_search_spec as read_search_spec
     from solver_service.workflows.search import write_search as write_search
@@ -196,7 +196,7 @@ _SOURCES = {
     "read_search_spec": "solver_service.workflows.search",
     "read_scene": "cad_maths.scenes",
     # Reports and the bundled examples.
-    "build_report": "solver_service.report.html",
+    "build_report": "solver_service.workflows.pages",
     "write_report": "solver_service.report.html",
     "examples_dir": "solver_service.demo",
     "copy_examples": "solver_service.demo",

@@ -24,13 +24,12 @@ from matplotlib.text import Text
 
 from shared_schema.constants import ConstantsFile
 from solver_service.demo import run_demo
-from solver_service.report.assess import assess_report
-from solver_service.report.html import build_report
 from solver_service.workflows.assess import read_site
 from solver_service.workflows.documents import frequency_grid, record_analysis, record_pulse_doc
 from solver_service.workflows.ida import run_ida
 from solver_service.workflows.inputs import read_record
 from solver_service.workflows.outputs import write_envelope, write_history, write_ida, write_record
+from solver_service.workflows.pages import assess_report, build_report
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "examples"

@@ -14,12 +14,11 @@ import pytest
 
 from shared_schema.errors import SolverError
 from solver_service.core.records import GroundMotion
-from solver_service.report import assess as assess_page
-from solver_service.report import html as report_page
-from solver_service.report.html import build_report
+from solver_service.workflows import pages
 from solver_service.workflows.assess import read_site
 from solver_service.workflows.documents import frequency_grid
 from solver_service.workflows.inputs import read_constants
+from solver_service.workflows.pages import build_report
 from solver_service.workflows.scaling import Building
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -39,7 +38,7 @@ def test_a_failing_history_figure_becomes_a_note(
     motion: GroundMotion, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     cf = read_constants(EXAMPLES / "constants" / "rect_walls.json")
-    monkeypatch.setattr(report_page, "dense_runs", _fail)
+    monkeypatch.setattr(pages, "dense_runs", _fail)
     page = build_report(
         cf,
         frequency_grid(0.5, 5.0, 5),
@@ -58,7 +57,7 @@ def test_a_failing_assessment_history_becomes_a_note(
     pytest.importorskip("jinja2", reason="the assess page needs the report extra (jinja2)")
     cf = read_constants(EXAMPLES / "constants" / "church_geometry.json")
     site = read_site(EXAMPLES / "sites" / "ntc_site.json")
-    monkeypatch.setattr(assess_page, "simulate", _fail)
-    doc, page = assess_page.assess_report(cf, site, [motion], multiples=[1.0])
+    monkeypatch.setattr(pages, "simulate", _fail)
+    doc, page = pages.assess_report(cf, site, [motion], multiples=[1.0])
     assert any(m.get("dynamics") for m in doc["mechanisms"])  # the tables' runs were made
     assert f"not drawn: {REASON}" in page

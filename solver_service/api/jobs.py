@@ -61,8 +61,8 @@ from ..core.excitation import Pulse, SampledAccel
 from ..core.model import G, RockingModel, check_positive
 from ..core.records import GroundMotion
 from ..core.spectra import STEPS_PER_PERIOD, response_spectrum
-from ..report.assess import assess_report, chromium, print_pdf
-from ..report.html import SPECTRUM_PERIODS, build_report, input_source
+from ..report.assess import chromium, print_pdf
+from ..report.html import SPECTRUM_PERIODS, input_source
 from ..workflows.assess import BAND_POINTS, assessment_doc, check_doc, matching_band
 from ..workflows.documents import (
     envelope_doc,
@@ -74,6 +74,7 @@ from ..workflows.documents import (
 )
 from ..workflows.inputs import SPEC_EXPECTED, read_record
 from ..workflows.outputs import finite_json
+from ..workflows.pages import assess_report, build_report
 from ..workflows.retrofit import retrofit_doc
 from ..workflows.retrofit_files import retrofit_json
 from ..workflows.scaling import Building

@@ -110,7 +110,7 @@ def assess(
 ) -> None:
     """Assessment report: code checks beside rocking dynamics for every mechanism."""
     # jinja2 (the report extra) is loaded only by this command.
-    from ..report.assess import assess_report, print_pdf
+    from ..report.assess import print_pdf
 
     # The report's inputs block and writer.
     from ..report.html import input_source, write_report
@@ -120,6 +120,9 @@ def assess(
 
     # The constants reader.
     from ..workflows import inputs, units
+
+    # The assessment and its page's figures, run when the command runs.
+    from ..workflows.pages import assess_report
 
     multiple = workflow.check_multiples(multiple)
     check_file_target(out)

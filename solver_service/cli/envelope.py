@@ -133,11 +133,14 @@ def report(
     limits: Limits = LIMITS,
 ) -> None:
     """One self-contained HTML report: constants, envelopes, and with --record its histories."""
-    # The report's renderer is loaded when the command runs (#38).
-    from ..report.html import build_report, input_source, write_report
+    # The report's inputs block and writer are loaded when the command runs (#38).
+    from ..report.html import input_source, write_report
 
     # The constants reader and the mechanisms the time histories run.
     from ..workflows import documents, inputs
+
+    # The report's analyses, run when the command runs.
+    from ..workflows.pages import build_report
 
     factors = scales(scale, ctx.args)
     method = envelope_method.name()

@@ -50,6 +50,50 @@ def _records_line(m: Any) -> str:
     )
 
 
+def _print_table(doc: Any) -> None:
+    """Print the retrofit's table, a sentence per mechanism and what governs next."""
+    # The table's rows (the document summarised) are loaded when the command prints.
+    from ..report.retrofit import retrofit_summary
+
+    summary = retrofit_summary(doc)
+    rows = []
+    for row in summary:
+        o = row.option
+        rows.append(
+            [
+                row.id,
+                row.status,
+                "-" if o is None else f"{o.height_m:.4g}",
+                _kn(None if o is None else o.T_star_N),
+                "-" if o is None or o.governing is None else o.governing,
+                row.bar_text,
+                f"{_ratio(row.before_ratio)} -> {_ratio(row.after_ratio)}",
+            ]
+        )
+    headers = [
+        "mechanism",
+        "status",
+        "h_t [m]",
+        "T* [kN]",
+        "governs",
+        "bars",
+        "least a_g ratio",
+    ]
+    for line in table_lines(headers, rows):
+        typer.echo(line)
+    for row in summary:
+        typer.echo(f"  {row.sentence}")
+    for m in doc.mechanisms:
+        if m.records_before:
+            typer.echo(_records_line(m))
+    nxt = doc.governs_next
+    if nxt is not None and nxt.after is not None and nxt.after_margin is not None:
+        typer.echo(
+            f"with the ties in, {nxt.after} governs: margin {nxt.after_margin:.3f} "
+            f"({nxt.after_criterion}); before, {nxt.before} at {nxt.before_margin:.3f}"
+        )
+
+
 @user_errors
 @grouped
 def retrofit(
@@ -79,9 +123,6 @@ def retrofit(
     """Tie-bars for every mechanism that fails the 2019 checks: least force, bar, checks after."""
     # The retrofit spec's reader is loaded when the command runs.
     from shared_schema.retrofit import read_retrofit_spec
-
-    # The table's rows (the document summarised) are loaded when the command prints.
-    from ..report.retrofit import retrofit_summary
 
     # The constants and site readers are loaded when the command runs.
     from ..workflows import assess, inputs
@@ -124,42 +165,6 @@ def retrofit(
         if out is not None:
             typer.echo(f"wrote {out / RETROFIT_FILE}", err=True)
         return
-    summary = retrofit_summary(doc)
-    rows = []
-    for row in summary:
-        o = row.option
-        rows.append(
-            [
-                row.id,
-                row.status,
-                "-" if o is None else f"{o.height_m:.4g}",
-                _kn(None if o is None else o.T_star_N),
-                "-" if o is None or o.governing is None else o.governing,
-                row.bar_text,
-                f"{_ratio(row.before_ratio)} -> {_ratio(row.after_ratio)}",
-            ]
-        )
-    headers = [
-        "mechanism",
-        "status",
-        "h_t [m]",
-        "T* [kN]",
-        "governs",
-        "bars",
-        "least a_g ratio",
-    ]
-    for line in table_lines(headers, rows):
-        typer.echo(line)
-    for row in summary:
-        typer.echo(f"  {row.sentence}")
-    for m in doc.mechanisms:
-        if m.records_before:
-            typer.echo(_records_line(m))
-    nxt = doc.governs_next
-    if nxt is not None and nxt.after is not None and nxt.after_margin is not None:
-        typer.echo(
-            f"with the ties in, {nxt.after} governs: margin {nxt.after_margin:.3f} "
-            f"({nxt.after_criterion}); before, {nxt.before} at {nxt.before_margin:.3f}"
-        )
+    _print_table(doc)
     if out is not None:
         typer.echo(f"wrote {out / RETROFIT_FILE}")

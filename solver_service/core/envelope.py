@@ -120,7 +120,7 @@ LIBRARY_VERSION = "1"
 JUMP = 0.04
 #: Factor on the library's interpolated ``A_min`` in the fast mode: next to the uplift
 #: threshold the interpolation sits up to ~1.7 % above the exact boundary (the scan step,
-#: benchmarks/library_bound.py); lowered by 2 % it errs on the safe side.
+#: tests/solver_core/test_library_bound.py); lowered by 2 % it errs on the safe side.
 LIBRARY_MARGIN = 0.98
 #: Documented bound of the fast mode: at most this fraction above the exact ground-level
 #: ``a_p,min`` (the tabulated pulse spectrum's interpolation; the curves never above).
@@ -810,7 +810,7 @@ def library_curve(
     Where the interpolation crossed a jump of the curve or left the grid
     (``OverturningLibrary.a_min_flagged``) the exact integrator gives the value; elsewhere
     the interpolated value times ``LIBRARY_MARGIN`` (the interpolation overshoots the exact
-    boundary by up to ~1.7 % near the uplift threshold, benchmarks/library_bound.py).
+    boundary by up to ~1.7 % near the uplift threshold, tests/solver_core/test_library_bound.py).
 
     Returns
     -------

@@ -47,7 +47,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from shared_schema.errors import InputError, wrong_type
-from shared_schema.rules import G
+from shared_schema.rules import CRITERIA, G
 
 from . import _kernels as _k
 from ._compile import JIT, python_twins
@@ -56,7 +56,7 @@ from .integrator import V_REST_REL, Excitation, Integrator
 from .jit import first_use
 from .linearisation import linearisation_warnings
 from .model import RockingModel, check_positive, require_model, require_models
-from .result import CRITERIA, STATUS_MESSAGES, RockingResult
+from .result import STATUS_MESSAGES, RockingResult
 
 __all__ = [
     "BACKENDS",
@@ -331,6 +331,33 @@ def _unresolved(err: float) -> str:
     )
 
 
+def _check_start(model: RockingModel, x0: float, t_extra: float, max_impacts: int) -> None:
+    """Refuse a start ``x0`` (phi/alpha), a ``t_extra`` [s] or an impact cap out of range."""
+    if isinstance(x0, bool) or not (math.isfinite(float(x0)) and abs(float(x0)) < 1.0):
+        raise InputError(f"must be finite with |x0| < 1, got {x0!r}", "x0")
+    if model.one_sided and x0 < 0.0:
+        raise InputError("must be >= 0 for one-sided rocking", "x0")
+    if not (math.isfinite(float(t_extra)) and t_extra >= 0.0):
+        raise InputError(f"must be finite and >= 0, got {t_extra!r}", "t_extra")
+    if int(max_impacts) < 1:
+        raise InputError(f"must be >= 1, got {max_impacts!r}", "max_impacts")
+
+
+def _buffers(
+    model: RockingModel, cells: Any, kern: Any, dense: bool, max_impacts: int, impact_log: bool
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return the kernel's time-series and impact-log buffers (empty where not asked for)."""
+    cap = 0
+    if dense:
+        p_max = max(model.positive.p_eq, model.neg.p_eq)
+        n_seg = np.ceil(p_max * cells.widths / kern.MAX_PH).clip(min=1).sum()
+        cap = int(n_seg) + 3 * min(max_impacts, 100_000) + 8
+    trace = np.empty((2, cap)) if cap else _NO_TRACE
+    n_log = min(max_impacts, IMPACT_LOG_CAP) + 2 if impact_log else 0
+    log = np.empty((4, n_log)) if n_log else _NO_LOG
+    return trace, log
+
+
 def simulate(
     model: RockingModel,
     excitation: Excitation,
@@ -394,14 +421,7 @@ def simulate(
     if not (type(scale) is float and 0.0 < scale < math.inf):  # the common case costs nothing
         scale = check_positive(scale, "scale")
     crit = _criterion(criterion, excitation)
-    if isinstance(x0, bool) or not (math.isfinite(float(x0)) and abs(float(x0)) < 1.0):
-        raise InputError(f"must be finite with |x0| < 1, got {x0!r}", "x0")
-    if model.one_sided and x0 < 0.0:
-        raise InputError("must be >= 0 for one-sided rocking", "x0")
-    if not (math.isfinite(float(t_extra)) and t_extra >= 0.0):
-        raise InputError(f"must be finite and >= 0, got {t_extra!r}", "t_extra")
-    if int(max_impacts) < 1:
-        raise InputError(f"must be >= 1, got {max_impacts!r}", "max_impacts")
+    _check_start(model, x0, t_extra, max_impacts)
     cells = _shared_cells(excitation, dense, t_extra)
     pos, neg = model.positive, model.neg
     check_range(
@@ -413,14 +433,7 @@ def simulate(
         "scale",
     )
     kern = kernels(backend)
-    cap = 0
-    if dense:
-        p_max = max(model.positive.p_eq, model.neg.p_eq)
-        n_seg = np.ceil(p_max * cells.widths / kern.MAX_PH).clip(min=1).sum()
-        cap = int(n_seg) + 3 * min(int(max_impacts), 100_000) + 8
-    trace = np.empty((2, cap)) if cap else _NO_TRACE
-    n_log = min(int(max_impacts), IMPACT_LOG_CAP) + 2 if impact_log else 0
-    log = np.empty((4, n_log)) if n_log else _NO_LOG
+    trace, log = _buffers(model, cells, kern, dense, int(max_impacts), impact_log)
     # One conversion of the output vector to Python floats (cheaper than one per field).
     compiled = first_use("simulate", backend)
     out = kern.simulate_cells_logged(

@@ -1,6 +1,9 @@
-"""Ground-motion records: reading, validation and metadata.
+"""Ground-motion records: reading a file, validation and metadata.
 
-Formats read here (``GroundMotion.from_file`` picks one by name or by the file):
+Every format's reader lives in ``solver_service.core.formats`` (one module per format); this
+module reads the file's text, hands it to the reader and turns the ``Channel`` it returns
+into an SI ``GroundMotion``, checked. ``GroundMotion.from_file`` picks the format by name or
+by the file:
 
 * ``"at2"``: PEER NGA ``.AT2``: four header lines (title; event, date, station, component;
   units; ``NPTS=..., DT=...``), then the samples in g, several per line
@@ -12,8 +15,8 @@ Formats read here (``GroundMotion.from_file`` picks one by name or by the file):
 * ``"csv"``: comma-separated with a header row; a time column or a given time step
   (``GroundMotion.from_csv``).
 
-The strong-motion databases' own formats, detected from their content and read by
-``solver_service.core.formats`` (``GroundMotion.from_strong_motion``):
+The strong-motion databases' own formats, detected from their content
+(``GroundMotion.from_strong_motion``):
 
 * ``"esm"``: ESM / ITACA ASCII (DYNA 1.2 header);
 * ``"knet"``: NIED K-NET and KiK-net ASCII (scale factor applied, mean removed as NIED does);
@@ -31,9 +34,6 @@ strong-motion readers also check the header's sample count and peak.
 
 from __future__ import annotations
 
-import csv
-import math
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Optional, Union
@@ -51,19 +51,17 @@ from shared_schema.rules import (
     accel_max,
     check_file,
 )
-from shared_schema.text import decimal_point, decode_text, delimiter_of
+from shared_schema.text import decode_text
 
-from .excitation import SampledAccel, check_finite_samples
-from .formats import READERS, Channel, channel_list, select_channel
-from .formats import detect as detect_strong_motion
-from .formats import truncated as truncated_strong_motion
-from .formats._text import units_or_none
+from . import formats
+from .excitation import SampledAccel
+from .formats import READERS, Channel, channel_list, check_samples, check_step, select_channel
+from .formats.csv import UNITS_HINT, Column
 
 __all__ = [
     "ACCEL_MAX_G",
     "DT_PLAUSIBLE_S",
     "DT_RANGE_S",
-    "DT_RTOL",
     "FORMATS",
     "PGA_PLAUSIBLE_G",
     "UNITS",
@@ -78,8 +76,6 @@ UNITS = RECORD_UNITS
 PGA_PLAUSIBLE_G = (0.001, 5.0)
 #: Time step [s] outside which a record gets a plausibility warning.
 DT_PLAUSIBLE_S = (1e-4, 0.1)
-#: Relative tolerance on the spacing of time stamps read from a file.
-DT_RTOL = 1e-6
 #: What a record file must be, for the messages on empty or binary files.
 RECORD_EXPECTED = (
     "a ground-motion record as text (AT2, two columns, one column, CSV, or the ASCII file of "
@@ -92,64 +88,14 @@ RECORD_BINARY_HINT = (
 )
 #: Record formats ``GroundMotion.from_file`` reads (``shared_schema.rules``).
 FORMATS = RECORD_FORMATS
-#: File extensions (lower case) that fix the format.
-_EXTENSIONS = {".at2": "at2", ".csv": "csv"}
-#: Units named on line 3 of an AT2 file, upper case without spaces -> our units.
-_AT2_UNITS = {
-    "G": "g",
-    "CM/S/S": "cm/s2",
-    "CM/SEC/SEC": "cm/s2",
-    "CM/S2": "cm/s2",
-    "CM/SEC2": "cm/s2",
-    "GAL": "cm/s2",
-    "M/S/S": "m/s2",
-    "M/SEC/SEC": "m/s2",
-    "M/S2": "m/s2",
-}
-_UNITS_HINT = "give units: " + ", ".join(list(RECORD_UNITS)[:-1]) + f" or {list(RECORD_UNITS)[-1]}"
-#: Units of a time column a CSV header may name; only seconds are read.
-_SECONDS = {"s", "sec", "secs", "second", "seconds"}
-_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?"
-_DATE = re.compile(r"\d{1,2}/\d{1,2}/\d{2,4}")
-
 PathLike = Union[str, Path]
-Column = Union[str, int, None]
 ChannelKey = Union[int, str, None]
-
-
-def _units_in_name(name: str) -> Optional[str]:
-    """Units a column name states: ``acc [g]``, ``a (m/s2)``, ``accel_cm/s2`` -> key, else None."""
-    bracket = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]\s*$", name)
-    if bracket:
-        return units_or_none(bracket.group(1))
-    for sep in ("_", " "):
-        if sep in name.strip():
-            return units_or_none(name.strip().rsplit(sep, 1)[1])
-    return None
-
-
-def _check_time_units(name: str, where: str) -> None:
-    """Refuse a time column that names units other than seconds (``t [ms]``)."""
-    bracket = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]\s*$", name)
-    if bracket and bracket.group(1).strip().lower() not in _SECONDS:
-        raise InputError(
-            f"{where}: time column {name!r} is in {bracket.group(1)!r}; give time in seconds",
-            "time_column",
-        )
 
 
 def _unit_factor(units: str) -> float:
     if units not in UNITS:
         raise InputError(f"must be one of {sorted(UNITS)}, got {units!r}", "units")
     return UNITS[units]
-
-
-def _check_dt(dt: Any) -> float:
-    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.floating, np.integer)):
-        raise InputError(f"must be a finite number > 0 [s], got {dt!r}", "dt")
-    if not (math.isfinite(float(dt)) and dt > 0):
-        raise InputError(f"must be finite and > 0 [s], got {dt!r}", "dt")
-    return float(dt)
 
 
 def _read_text(path: PathLike) -> tuple[Path, str]:
@@ -160,29 +106,6 @@ def _read_text(path: PathLike) -> tuple[Path, str]:
     except OSError as exc:
         raise InputError(f"cannot read record file {p}: {exc.strerror or exc}", "record") from exc
     return p, decode_text(raw, p.name, "record", RECORD_EXPECTED, RECORD_BINARY_HINT)
-
-
-def _data_lines(text: str) -> list[tuple[int, str, str]]:
-    """``(line number, raw line, line without comment)`` of every non-blank data line."""
-    out = []
-    for lineno, raw in enumerate(text.splitlines(), start=1):
-        line = raw.split("#", 1)[0].strip()
-        if line:
-            out.append((lineno, raw, line))
-    return out
-
-
-def _to_float(token: str, where: str, raw: str) -> float:
-    try:
-        return float(token)
-    except ValueError:
-        raise InputError(f"{where}: not a number: {raw.strip()!r}", "record") from None
-
-
-def _check_samples(a: NDArray[np.float64], name: str) -> None:
-    if a.size < 2:
-        raise InputError(f"{name}: needs at least 2 samples, got {a.size}", "record")
-    check_finite_samples(a, "record", name)
 
 
 def _sampled(a: NDArray[np.float64], units: str, dt: Any, name: str) -> SampledAccel:
@@ -196,7 +119,7 @@ def _sampled(a: NDArray[np.float64], units: str, dt: Any, name: str) -> SampledA
     """
     factor = _unit_factor(units)
     a = np.asarray(a, dtype=float)
-    _check_samples(a, name)
+    check_samples(a, name)
     # compared in the given units, so that a huge sample cannot overflow on the way to SI
     big = np.flatnonzero(np.abs(a) > accel_max(units))
     if big.size:
@@ -207,7 +130,7 @@ def _sampled(a: NDArray[np.float64], units: str, dt: Any, name: str) -> SampledA
             f"{PGA_PLAUSIBLE_G[1]:g} g); {big.size} such sample(s) in all: check the units",
             "record",
         )
-    step = _check_dt(dt)
+    step = check_step(dt)
     lo, hi = DT_RANGE_S
     if not lo <= step <= hi:
         raise InputError(
@@ -217,81 +140,6 @@ def _sampled(a: NDArray[np.float64], units: str, dt: Any, name: str) -> SampledA
             "dt",
         )
     return SampledAccel(a * factor, step)
-
-
-def _uniform_step(t: NDArray[np.float64], name: str) -> float:
-    """Time step [s] of strictly increasing, uniform (within ``DT_RTOL``) time stamps."""
-    bad = np.flatnonzero(~np.isfinite(t))
-    if bad.size:
-        raise InputError(f"{name}: time of sample {int(bad[0])} is not finite", "record")
-    steps = np.diff(t)
-    if np.any(steps <= 0.0):
-        k = int(np.flatnonzero(steps <= 0.0)[0])
-        raise InputError(
-            f"{name}: time is not strictly increasing at sample {k + 1} "
-            f"(t = {t[k]} then {t[k + 1]})",
-            "record",
-        )
-    dt = float((t[-1] - t[0]) / (t.size - 1))
-    worst = int(np.argmax(np.abs(steps - dt)))
-    if abs(steps[worst] - dt) > DT_RTOL * dt:
-        raise InputError(
-            f"{name}: time step is not uniform (step {worst + 1} is {steps[worst]:.6g} s, "
-            f"mean {dt:.6g} s); resample the record",
-            "record",
-        )
-    if not math.isfinite(dt) or dt <= 0.0:
-        raise InputError(f"{name}: invalid time step {dt!r}", "record")
-    return dt
-
-
-def _at2_station(line: str) -> dict[str, str]:
-    """Event, date, station and component from line 2 of an AT2 file, as far as they parse.
-
-    NGA-West2 writes ``event, m/d/yyyy, station, component``; older NGA files
-    ``EVENT m/d/yy hhmm, STATION, COMPONENT``.
-    """
-    parts = [s.strip() for s in line.split(",")]
-    meta = {"event": "", "date": "", "station": "", "component": ""}
-    if len(parts) >= 4 and _DATE.fullmatch(parts[1]):
-        meta.update(event=parts[0], date=parts[1], station=", ".join(parts[2:-1]))
-        meta["component"] = parts[-1]
-    elif len(parts) >= 3:
-        date = _DATE.search(parts[0])
-        meta["event"] = parts[0][: date.start()].strip() if date else parts[0]
-        meta["date"] = date.group(0) if date else ""
-        meta.update(station=", ".join(parts[1:-1]), component=parts[-1])
-    else:
-        meta["event"] = line.strip()
-    return meta
-
-
-def _at2_npts_dt(line: str, name: str) -> tuple[int, float]:
-    """``NPTS`` and ``DT`` [s] from line 4 of an AT2 file (both header styles)."""
-    npts = re.search(r"NPTS\s*=\s*(\d+)", line, re.IGNORECASE)
-    dt = re.search(rf"DT\s*=\s*({_NUMBER})", line, re.IGNORECASE)
-    if npts and dt:
-        return int(npts.group(1)), float(dt.group(1))
-    # Older NGA files: "  2048   .0066   NPTS, DT".
-    old = re.match(rf"\s*(\d+)\s+({_NUMBER})\s+NPTS\s*,\s*DT", line, re.IGNORECASE)
-    if old:
-        return int(old.group(1)), float(old.group(2))
-    raise InputError(f"{name} line 4: cannot find NPTS and DT in {line.strip()!r}", "record")
-
-
-def _resolve_column(col: Column, header: list[str], arg: str, name: str) -> int:
-    n = len(header)
-    if isinstance(col, int) and not isinstance(col, bool):
-        if not -n <= col < n:
-            raise InputError(f"{name} has {n} columns, got column index {col}", arg)
-        return col % n
-    if isinstance(col, str):
-        if col in header:
-            return header.index(col)
-        folded = [h.casefold() for h in header]
-        if col.strip().casefold() in folded:
-            return folded.index(col.strip().casefold())
-    raise InputError(f"{name} has no column {col!r}; columns are {header}", arg)
 
 
 def _check_stated_units(motion: GroundMotion, units: Optional[str], name: str) -> None:
@@ -446,7 +294,7 @@ class GroundMotion:
         elif fmt == "csv":
             motion = cls.from_csv(p, units, dt=dt)
         elif units is None:
-            raise InputError(f"{_UNITS_HINT} ({fmt} file {p.name} does not state them)", "units")
+            raise InputError(f"{UNITS_HINT} ({fmt} file {p.name} does not state them)", "units")
         elif fmt == "two_column":
             if dt is not None:
                 raise InputError(f"{p.name} has a time column; do not give dt", "dt")
@@ -492,7 +340,7 @@ class GroundMotion:
         ``"1: 90 DEG, 2: UP, ..."``), plus the fields each format adds.
         """
         p, text = _read_text(path)
-        fmt = format if format is not None else detect_strong_motion(text)
+        fmt = format if format is not None else formats.detect(text)
         if fmt is None or fmt not in READERS:
             raise InputError(
                 f"{p.name} is not one of the strong-motion formats {list(READERS)}", "format"
@@ -507,14 +355,30 @@ class GroundMotion:
             "channels": channel_list(channels),
         }
         name = p.stem if len(channels) == 1 else f"{p.stem}_{chosen.metadata['channel']}"
-        accel = _sampled(chosen.values, chosen.units, chosen.dt, p.name)
-        motion = cls(accel, name, meta)
-        meta["pga_g"] = motion.pga_g
+        return cls.from_channel(Channel(chosen.values, chosen.dt, chosen.units, meta), name)
+
+    @classmethod
+    def from_channel(cls, channel: Channel, name: str) -> GroundMotion:
+        """Build a record from one channel a format's reader returned (checked, then SI).
+
+        Parameters
+        ----------
+        channel : Channel
+            The samples in the units the file states or the caller gave, the time step
+            [s] and the metadata (``source`` names the file in messages).
+        name : str
+            The record's name (the file's stem).
+        """
+        meta = channel.metadata
+        source = str(meta.get("source", name))
+        motion = cls(_sampled(channel.values, channel.units, channel.dt, source), name, meta)
+        if meta.get("format") in ("at2", *READERS):
+            meta["pga_g"] = motion.pga_g
         return motion
 
     @classmethod
     def from_at2(cls, path: PathLike) -> GroundMotion:
-        """Read a PEER NGA ``.AT2`` acceleration record.
+        """Read a PEER NGA ``.AT2`` acceleration record (``formats.at2.read``).
 
         Parameters
         ----------
@@ -536,53 +400,11 @@ class GroundMotion:
         ``units``, ``source`` (file name), ``format`` and ``pga_g``.
         """
         p, text = _read_text(path)
-        lines = text.splitlines()
-        if len(lines) < 4:
-            raise InputError(
-                f"{p.name}: AT2 needs 4 header lines, got {len(lines)} line(s)", "record"
-            )
-        kind = lines[2].upper()
-        if "ACCELERATION" not in kind:
-            raise InputError(
-                f"{p.name} line 3: not an acceleration record: {lines[2].strip()!r}", "record"
-            )
-        unit_word = kind.rsplit("UNITS OF", 1)[-1].replace(" ", "") if "UNITS OF" in kind else ""
-        if unit_word not in _AT2_UNITS:
-            raise InputError(
-                f"{p.name} line 3: unknown units in {lines[2].strip()!r}; "
-                f"known: {sorted(_AT2_UNITS)}",
-                "record",
-            )
-        units = _AT2_UNITS[unit_word]
-        npts, dt = _at2_npts_dt(lines[3], p.name)
-        _check_dt(dt)
-        values: list[float] = []
-        for lineno, raw in enumerate(lines[4:], start=5):
-            where = f"{p.name} line {lineno}"
-            values.extend(_to_float(tok, where, raw) for tok in raw.split())
-        if len(values) != npts:
-            raise InputError(
-                f"{p.name}: header says NPTS={npts}, but the file has {len(values)} values",
-                "record",
-            )
-        a = np.array(values, dtype=float)
-        _check_samples(a, p.name)
-        meta: dict[str, Any] = {
-            **_at2_station(lines[1]),
-            "header": lines[1].strip(),
-            "source": p.name,
-            "format": "at2",
-            "units": units,
-            "dt": dt,
-            "npts": npts,
-        }
-        motion = cls(_sampled(a, units, dt, p.name), p.stem, meta)
-        meta["pga_g"] = motion.pga_g
-        return motion
+        return cls.from_channel(formats.at2.read(text, p.name)[0], p.stem)
 
     @classmethod
     def from_two_column(cls, path: PathLike, *, units: str = "g") -> GroundMotion:
-        """Read a two-column file: time [s] and acceleration in ``units``.
+        """Read a two-column file: time [s] and acceleration in ``units`` (``formats.two_column``).
 
         Parameters
         ----------
@@ -597,31 +419,15 @@ class GroundMotion:
         ------
         InputError
             Missing file, unparsable line, fewer than 2 samples, non-finite values, or time
-            that is not strictly increasing and uniform (within ``DT_RTOL``).
+            that is not strictly increasing and uniform (within ``formats.DT_RTOL``).
         """
         _unit_factor(units)  # unknown units are refused before the file is read
         p, text = _read_text(path)
-        rows: list[tuple[float, float]] = []
-        for lineno, raw, line in _data_lines(text):
-            parts = line.replace(",", " ").split()
-            where = f"{p.name} line {lineno}"
-            if len(parts) != 2:
-                raise InputError(
-                    f"{where}: expected 2 columns (time, acceleration), got {len(parts)}",
-                    "record",
-                )
-            rows.append((_to_float(parts[0], where, raw), _to_float(parts[1], where, raw)))
-        data = np.array(rows, dtype=float).reshape(-1, 2)
-        t, a = data[:, 0], data[:, 1]
-        _check_samples(a, p.name)
-        dt = _uniform_step(t, p.name)
-        meta = {"source": p.name, "format": "two_column", "units": units, "npts": int(t.size)}
-        meta.update(_time_origin(float(t[0]), p.name))
-        return cls(_sampled(a, units, dt, p.name), p.stem, meta)
+        return cls.from_channel(formats.two_column.read(text, p.name, units), p.stem)
 
     @classmethod
     def from_one_column(cls, path: PathLike, dt: float, units: str) -> GroundMotion:
-        """Read one acceleration per line, in ``units``, sampled every ``dt`` [s].
+        """Read one acceleration per line, in ``units``, every ``dt`` [s] (``formats.one_column``).
 
         Parameters
         ----------
@@ -638,20 +444,10 @@ class GroundMotion:
             Bad ``dt`` or ``units``, missing file, a line with other than one number,
             fewer than 2 samples or non-finite values.
         """
-        dt = _check_dt(dt)
+        dt = check_step(dt)
         _unit_factor(units)  # unknown units are refused before the file is read
         p, text = _read_text(path)
-        values: list[float] = []
-        for lineno, raw, line in _data_lines(text):
-            parts = line.replace(",", " ").split()
-            where = f"{p.name} line {lineno}"
-            if len(parts) != 1:
-                raise InputError(f"{where}: expected 1 column, got {len(parts)}", "record")
-            values.append(_to_float(parts[0], where, raw))
-        a = np.array(values, dtype=float)
-        _check_samples(a, p.name)
-        meta = {"source": p.name, "format": "one_column", "units": units, "npts": int(a.size)}
-        return cls(_sampled(a, units, dt, p.name), p.stem, meta)
+        return cls.from_channel(formats.one_column.read(text, p.name, dt, units), p.stem)
 
     @classmethod
     def from_csv(
@@ -662,7 +458,7 @@ class GroundMotion:
         accel_column: Column = None,
         dt: Optional[float] = None,
     ) -> GroundMotion:
-        """Read a comma-separated file with a header row.
+        """Read a comma-separated file with a header row (``formats.csv``).
 
         Parameters
         ----------
@@ -689,107 +485,12 @@ class GroundMotion:
         if units is not None:
             _unit_factor(units)
         if dt is not None:
-            dt = _check_dt(dt)
+            dt = check_step(dt)
             if time_column is not None:
                 raise InputError("give either a time column or dt, not both", "dt")
         p, text = _read_text(path)
-        lines = _data_lines(text)
-        if not lines:
-            raise InputError(f"{p.name}: needs at least 2 samples, got 0", "record")
-        # A CSV from a European spreadsheet separates cells with ';' and may write decimal
-        # commas (shared_schema.text.delimiter_of).
-        delimiter = delimiter_of(lines[0][2])
-        rows = [(n, raw, next(csv.reader([ln], delimiter=delimiter))) for n, raw, ln in lines]
-        if delimiter == ";":
-            rows = [(n, raw, [decimal_point(c) for c in cells]) for n, raw, cells in rows]
-        first = [c.strip() for c in rows[0][2]]
-        try:
-            [float(c) for c in first]
-            header = [str(i) for i in range(len(first))]
-            names = False
-        except ValueError:
-            header, rows, names = first, rows[1:], True
-        if dt is None:
-            if len(header) < 2:
-                raise InputError(f"{p.name} has no time column; give dt [s]", "dt")
-            it: Optional[int] = _resolve_column(
-                0 if time_column is None else time_column, header, "time_column", p.name
-            )
-            default_acc = 1 if it == 0 else 0
-        else:
-            it = None
-            if accel_column is None and len(header) != 1:
-                raise InputError(
-                    f"{p.name} has {len(header)} columns {header}; name the acceleration one",
-                    "accel_column",
-                )
-            default_acc = 0
-        ia = _resolve_column(
-            default_acc if accel_column is None else accel_column, header, "accel_column", p.name
-        )
-        if ia == it:
-            raise InputError(f"{p.name}: time and acceleration are the same column", "accel_column")
-        stated = _units_in_name(header[ia]) if names else None
-        if stated is None and units is None:
-            raise InputError(
-                f"{_UNITS_HINT} (column {header[ia]!r} of {p.name} does not state them)", "units"
-            )
-        if stated is not None and units is not None and stated != units:
-            raise InputError(
-                f"{p.name}: column {header[ia]!r} states units {stated!r}, got {units!r}", "units"
-            )
-        units = stated or units
-        assert units is not None
-        if it is not None and names:
-            _check_time_units(header[it], p.name)
-        need = max(ia, -1 if it is None else it) + 1
-        t_list: list[float] = []
-        a_list: list[float] = []
-        for lineno, raw, cells in rows:
-            where = f"{p.name} line {lineno}"
-            if len(cells) < need:
-                raise InputError(
-                    f"{where}: expected {len(header)} columns, got {len(cells)}", "record"
-                )
-            a_list.append(_to_float(cells[ia].strip(), where, raw))
-            if it is not None:
-                t_list.append(_to_float(cells[it].strip(), where, raw))
-        a = np.array(a_list, dtype=float)
-        _check_samples(a, p.name)
-        t0 = 0.0
-        if it is not None:
-            t = np.array(t_list, dtype=float)
-            dt, t0 = _uniform_step(t, p.name), float(t[0])
-        assert dt is not None
-        meta = {
-            "source": p.name,
-            "format": "csv",
-            "delimiter": delimiter,
-            "units": units,
-            "npts": int(a.size),
-            "time_column": header[it] if (it is not None and names) else it,
-            "accel_column": header[ia] if names else ia,
-            "units_from": "header" if stated is not None else "given",
-        }
-        meta.update(_time_origin(t0, p.name))
-        return cls(_sampled(a, units, dt, p.name), p.stem, meta)
-
-
-def _time_origin(t0: float, name: str) -> dict[str, Any]:
-    """Metadata for a time column that does not start at 0: the record is shifted to 0.
-
-    Every sample is used, from the first; the analyses take t = 0 at the first sample, so a
-    time column starting at ``t0`` is shifted by ``-t0`` and the shift is reported.
-    """
-    if t0 == 0.0:
-        return {}
-    return {
-        "time_shift_s": -t0,
-        "warnings": [
-            f"{name}: the time column starts at t = {t0:g} s; every sample is used and the "
-            f"time axis is shifted by {-t0:g} s so that the record starts at t = 0"
-        ],
-    }
+        channel = formats.csv.read(text, p.name, units, time_column, accel_column, dt)
+        return cls.from_channel(channel, p.stem)
 
 
 def plausibility_warnings(motion: GroundMotion) -> list[str]:
@@ -800,7 +501,7 @@ def plausibility_warnings(motion: GroundMotion) -> list[str]:
     """
     units = motion.metadata.get("units")
     read_in = f"read in {units}" if units else "units not stated"
-    dt_from = _dt_source(motion.metadata)
+    dt_from = formats.dt_source(motion.metadata)
     notes = []
     pga_g = motion.pga_g
     lo, hi = PGA_PLAUSIBLE_G
@@ -819,63 +520,14 @@ def plausibility_warnings(motion: GroundMotion) -> list[str]:
     return notes
 
 
-#: Where each format's time step comes from, for the plausibility warning.
-_DT_SOURCES = {
-    "at2": "the AT2 header's DT",
-    "two_column": "the time column",
-    "one_column": "the time step given (dt, --dt)",
-    "esm": "the header's SAMPLING_INTERVAL_S",
-    "knet": "1 / the header's Sampling Freq(Hz)",
-    "cosmos": "real header 62 (in ms)",
-    "dmg": "the 'POINTS OF ACCEL DATA EQUALLY SPACED AT' line",
-    "geonet": "the header's sampling interval (row 7, field 6)",
-    "samples": "dt",
-}
-
-
-def _dt_source(meta: dict[str, Any]) -> str:
-    """Where a record's time step was read from (a header field, a column, or given)."""
-    fmt = meta.get("format")
-    if fmt == "csv":
-        return (
-            "the time column" if meta.get("time_column") is not None else _DT_SOURCES["one_column"]
-        )
-    return _DT_SOURCES.get(str(fmt), "the time step given")
-
-
 def detect_format(p: Path) -> str:
-    """Return the format of a record file.
+    """Return the format of a record file (``formats.format_of``).
 
     From its extension (``.AT2``, ``.csv``), else its content: a PEER title, a strong-motion
     header (``solver_service.core.formats.detect``), else the count of numbers on the first
     data line (2: ``two_column``, 1: ``one_column``).
     """
-    fmt = _EXTENSIONS.get(p.suffix.lower())
-    if fmt is not None:
-        return fmt
+    if p.suffix.lower() in formats.EXTENSIONS:
+        return formats.EXTENSIONS[p.suffix.lower()]
     _, text = _read_text(p)
-    if text.lstrip().upper().startswith("PEER NGA"):
-        return "at2"
-    strong = detect_strong_motion(text)
-    if strong is not None:
-        return strong
-    cut = truncated_strong_motion(text, p.name)
-    if cut is not None:
-        raise InputError(cut, "record")
-    lines = _data_lines(text)
-    if not lines:
-        raise InputError(f"{p.name} is empty: no data lines to read", "record")
-    first = lines[0][2].replace(",", " ").split()
-    try:
-        [float(x) for x in first]
-    except ValueError:
-        first = []
-    if len(first) == 2:
-        return "two_column"
-    if len(first) == 1:
-        return "one_column"
-    raise InputError(
-        f"cannot tell the format of {p.name} (line {lines[0][0]}: {lines[0][1].strip()!r}); "
-        f"give format, one of {list(FORMATS)}",
-        "format",
-    )
+    return formats.format_of(text, p.name)

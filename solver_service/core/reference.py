@@ -53,6 +53,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from shared_schema.errors import InputError, SolverError
+from shared_schema.rules import CRITERIA
 from solver_service.core.excitation import Pulse, SampledAccel
 from solver_service.core.freemotion import free_rocking
 from solver_service.core.integrator import (
@@ -68,7 +69,7 @@ from solver_service.core.integrator import (
     motion_events,
 )
 from solver_service.core.model import G, RockingModel, check_positive
-from solver_service.core.result import CRITERIA, RockingResult
+from solver_service.core.result import RockingResult
 
 __all__ = [
     "IVP_METHODS",

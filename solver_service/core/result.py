@@ -21,10 +21,7 @@ from typing import Any, Optional
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["CRITERIA", "STATUS_MESSAGES", "RockingResult"]
-
-#: Overturning criteria a caller may choose.
-CRITERIA = ("ratio", "exact")
+__all__ = ["STATUS_MESSAGES", "RockingResult"]
 
 #: Status codes and their meaning.
 STATUS_MESSAGES = {

@@ -1,14 +1,15 @@
 """The assessment report a client reads: code checks beside rocking dynamics, per mechanism.
 
-``render_assessment`` turns an assessment document (``workflows.assess.assessment_doc``) into
-one self-contained HTML page through a jinja2 template (autoescaped). Page one carries the
-project, site, engineer and date and the verdict table (code check linear and nonlinear,
-rocking dynamics on the records, pulse-envelope margin, governing mechanism); then one
-section per mechanism (constants to 4 significant figures, the check worked out, the
-capacity curve against the site spectrum, the envelope with the records' pulses, time
-histories at the design scale cropped to the motion); then provenance as tables. Print CSS
-keeps a mechanism's section on one page where it fits. ``print_pdf`` prints the page to PDF
-with headless Chromium.
+``render_assessment`` turns an assessment document (``workflows.assess.assessment_doc``),
+the site spectrum and the time histories run for it (``workflows.pages.assess_report``
+computes them; this module runs no analysis) into one self-contained HTML page through a
+jinja2 template (autoescaped). Page one carries the project, site, engineer and date and the
+verdict table (code check linear and nonlinear, rocking dynamics on the records, pulse-
+envelope margin, governing mechanism); then one section per mechanism (constants to 4
+significant figures, the check worked out, the capacity curve against the site spectrum, the
+envelope with the records' pulses, time histories at the design scale cropped to the
+motion); then provenance as tables. Print CSS keeps a mechanism's section on one page where
+it fits. ``print_pdf`` prints the page to PDF with headless Chromium.
 
 With a retrofit (``rockmech assess --retrofit``: a retrofit spec, or the ``retrofit.json``
 ``rockmech retrofit`` wrote), page one ends with the retrofit table: per mechanism the tie
@@ -32,30 +33,28 @@ import shlex
 import shutil
 import subprocess
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Optional, Union
+from typing import Any, Optional
 
 import numpy as np
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError, RockmechError
-from shared_schema.retrofit import RetrofitDoc, RetrofitSpec
+from shared_schema.retrofit import RetrofitDoc
 from shared_schema.site import SiteFile
 from shared_schema.version import __version__
 
-from ..core.exact import simulate
 from ..core.model import G
-from ..workflows.adapter import to_rocking_model
-from ..workflows.assess import assessment_doc, site_spectrum
-from ..workflows.scaling import mechanism_scale_factor
-from ..workflows.verdict import ratio_label, worst_pulse
+from .labels import ratio_label, worst_pulse
 from .plots import load_pyplot, plain, save_figure_atomic
-from .retrofit import assessment_retrofit, records_notes, retrofit_summary
+from .retrofit import records_notes, retrofit_summary
 
 __all__ = [
     "TEMPLATE_NAME",
-    "assess_report",
+    "HistoryRun",
+    "check_template",
     "chromium",
     "print_pdf",
     "render_assessment",
@@ -72,6 +71,37 @@ CROP_BEFORE, CROP_AFTER = 1.0, 3.0
 MOTION_FRACTION = 1e-3
 #: Seconds allowed for Chromium to print a page.
 PDF_TIMEOUT_S = 120
+
+
+@dataclass(frozen=True)
+class HistoryRun:
+    """One time history of a mechanism on a record at its design scale, for its figure.
+
+    Attributes
+    ----------
+    caption : str
+        The figure's caption.
+    label : str
+        The mechanism's id (the trace's label).
+    motion : GroundMotion, optional
+        The record.
+    scale : float
+        The design scale factor on the record [-] (the ground trace drawn).
+    result : RockingResult, optional
+        The run with its time series (``dense``); None where it was not run.
+    note : str, optional
+        Why there is no figure (``not run: ...``, ``not drawn: ...``).
+    file : str
+        The figure's file name.
+    """
+
+    caption: str
+    label: str = ""
+    motion: Optional[Any] = None
+    scale: float = 1.0
+    result: Optional[Any] = None
+    note: Optional[str] = None
+    file: str = "history.png"
 
 
 def sig(value: Any, digits: int = 4) -> str:
@@ -244,11 +274,9 @@ def _check_rows(check: dict[str, Any]) -> list[dict[str, str]]:
         return _rows_2009(check)
     rows: list[dict[str, str]] = []
 
-    def add(label: str, key: str, unit: str, source: Optional[dict[str, Any]] = None) -> None:
-        src = check if source is None else source
-        if src.get(key) is not None:
-            clauses = cl if source is None else src.get("clauses", {})
-            rows.append(_row(label, src[key], unit, clauses.get(key, "")))
+    def add(label: str, key: str, unit: str) -> None:
+        if check.get(key) is not None:
+            rows.append(_row(label, check[key], unit, cl.get(key, "")))
 
     nonlinear = "SLV" in check
     add("α0 of the capacity curve" if nonlinear else "α0", "alpha0", "-")
@@ -287,41 +315,57 @@ def _check_rows(check: dict[str, Any]) -> list[dict[str, str]]:
         add("a_g (SLV hazard)", "a_g", "g")
         add("a_g,SLV / a_g", "capacity_ratio", "-")
         return rows
-    ties = check.get("ties") or {}
-    if ties.get("present"):
-        rows.append(
-            {
-                "label": "ties",
-                "value": ties.get("treatment", ""),
-                "unit": "",
-                "clause": ties.get("rule", ""),
-            }
-        )
-        for label, key in (("φ0 with the ties", "phi0_with"), ("φ0 without", "phi0_without")):
-            rows.append(_row(label, ties[key], "rad", "theory §1.7 Eq. 6; C8.7.1.2.1.6"))
+    rows.extend(_ties_rows(check.get("ties") or {}))
     add("J/S (d per unit rotation)", "d_per_rad", "m/rad")
     add("φ0", "phi0", "rad")
     add("d0", "d0", "m")
     for name in ("SLV", "SLC"):
-        ls = check[name]
-        lcl = ls.get("clauses", {})
-        rows.append(_row(f"d_{name}", ls["d"], "m", f"{lcl.get('d', '')}: {ls['d_rule']}"))
-        add(f"a(d_{name})", "a", "m/s²", ls)
-        add(f"T_{name}", f"T_{name}", "s", ls)
-        add(f"ξ ({name})", "xi_percent", "%", ls)
-        rows.append(
-            _row(
-                f"demand {name} (code)",
-                ls["demand_code"],
-                "m",
-                f"{lcl.get('demand_code', '')}: {ls['demand_rule']}",
-            )
+        rows.extend(_limit_state_rows(name, check[name]))
+    return rows
+
+
+def _ties_rows(ties: dict[str, Any]) -> list[dict[str, str]]:
+    """Return the rows of a nonlinear check's ties: their treatment and φ0 with and without."""
+    if not ties.get("present"):
+        return []
+    rows = [
+        {
+            "label": "ties",
+            "value": ties.get("treatment", ""),
+            "unit": "",
+            "clause": ties.get("rule", ""),
+        }
+    ]
+    for label, key in (("φ0 with the ties", "phi0_with"), ("φ0 without", "phi0_without")):
+        rows.append(_row(label, ties[key], "rad", "theory §1.7 Eq. 6; C8.7.1.2.1.6"))
+    return rows
+
+
+def _limit_state_rows(name: str, ls: dict[str, Any]) -> list[dict[str, str]]:
+    """Return the rows of one limit state (SLV or SLC) of a nonlinear check."""
+    lcl = ls.get("clauses", {})
+    rows = [_row(f"d_{name}", ls["d"], "m", f"{lcl.get('d', '')}: {ls['d_rule']}")]
+
+    def add(label: str, key: str, unit: str) -> None:
+        if ls.get(key) is not None:
+            rows.append(_row(label, ls[key], unit, lcl.get(key, "")))
+
+    add(f"a(d_{name})", "a", "m/s²")
+    add(f"T_{name}", f"T_{name}", "s")
+    add(f"ξ ({name})", "xi_percent", "%")
+    rows.append(
+        _row(
+            f"demand {name} (code)",
+            ls["demand_code"],
+            "m",
+            f"{lcl.get('demand_code', '')}: {ls['demand_rule']}",
         )
-        add(f"demand {name} (records)", "demand_records", "m", ls)
-        add(f"a_g,{name} (capacity)", "a_g_capacity", "g", ls)
-        add("a_g,SLD (lower bound)", "a_g_SLD", "g", ls)
-        add(f"a_g ({name} hazard)", "a_g", "g", ls)
-        add(f"a_g,{name} / a_g", "capacity_ratio", "-", ls)
+    )
+    add(f"demand {name} (records)", "demand_records", "m")
+    add(f"a_g,{name} (capacity)", "a_g_capacity", "g")
+    add("a_g,SLD (lower bound)", "a_g_SLD", "g")
+    add(f"a_g ({name} hazard)", "a_g", "g")
+    add(f"a_g,{name} / a_g", "capacity_ratio", "-")
     return rows
 
 
@@ -411,52 +455,18 @@ def _plot_history(
         plt.close(fig)
 
 
-def _history_png(label: str, model: Any, motion: Any, design: float, up: float, path: Path) -> Path:
-    """Run one mechanism at ``design × up`` and plot its time history.
-
-    Both happen inside the figure's guard (``_embed``): a run that fails becomes the
-    figure's note, not a traceback.
-    """
-    res = simulate(model, motion.accel, scale=design * up, dense=True)
-    return _plot_history(label, res, motion, design, path)[0]
+def _history_png(run: HistoryRun, path: Path) -> Path:
+    return _plot_history(run.label, run.result, run.motion, run.scale, path)[0]
 
 
-def _history_figures(
-    mech: Any, row: dict[str, Any], motions: Sequence[Any], folder: Path
-) -> list[dict[str, str]]:
+def _history_figures(runs: Sequence[HistoryRun], folder: Path) -> list[dict[str, str]]:
+    """Return the time-history figures of one mechanism, or the notes saying why there are none."""
     out: list[dict[str, str]] = []
-    try:
-        model = to_rocking_model(mech)
-    except RockmechError as exc:
-        return [{"caption": "time histories", "note": f"not run: {exc}"}]
-    for k, (motion, dyn) in enumerate(zip(motions, row.get("dynamics", []))):
-        if "scale_factor" not in dyn:
-            continue
-        design = float(dyn["scale_factor"]["value"])
-        caption = f"{mech.id} on {motion.name} at the design scale {sig(design)}"
-        try:
-            height = mechanism_scale_factor(mech, motion, "eq28")
-        except (ValueError, ArithmeticError, RockmechError) as exc:
-            out.append({"caption": caption, "note": f"not run: {exc}"})
-            continue
-        up = 1.0 if height is None else float(height["value"])
-        caption += (
-            f" × {sig(up)} up the structure (Eq. 28)" if height is not None else ""
-        ) + "; time axis cropped to the motion"
-        out.append(
-            _embed(
-                functools.partial(
-                    _history_png,
-                    mech.id,
-                    model,
-                    motion,
-                    design,
-                    up,
-                    folder / f"{mech.id}_history_{k}.png",
-                ),
-                caption,
-            )
-        )
+    for run in runs:
+        if run.note is not None or run.result is None:
+            out.append({"caption": run.caption, "note": run.note or "not run"})
+        else:
+            out.append(_embed(functools.partial(_history_png, run, folder / run.file), run.caption))
     return out
 
 
@@ -832,11 +842,45 @@ def _render(template_dir: Optional[Path], context: Optional[dict[str, Any]] = No
         raise error from None
 
 
+def _mechanism_figures(
+    row: dict[str, Any], spectrum: Any, runs: Sequence[HistoryRun], folder: Path
+) -> list[dict[str, str]]:
+    """Return a mechanism's figures: its checks on the capacity curve, envelope, histories."""
+    non = row["nonlinear"]
+    figs = []
+    if non.get("status") == "ok" and non.get("curve"):
+        figs.append(
+            _embed(
+                functools.partial(
+                    _plot_capacity,
+                    row["linear"],
+                    non,
+                    spectrum,
+                    folder / f"{row['id']}_capacity.png",
+                ),
+                f"{row['id']}: the checks on the capacity curve (ADRS): capacity, "
+                "demand and verdict of each (Circ. 2019 C8.7.1.2.1.7-8)",
+            )
+        )
+    env_doc = row.get("envelope") or {}
+    if "a_p_min_g" in env_doc:
+        figs.append(
+            _embed(
+                functools.partial(_plot_envelope, env_doc, folder / f"{row['id']}_envelope.png"),
+                f"{row['id']}: overturning envelope and the records' largest pulses "
+                "at design scale",
+            )
+        )
+    figs.extend(_history_figures(runs, folder))
+    return figs
+
+
 def render_assessment(
     doc: dict[str, Any],
     cf: ConstantsFile,
     site: SiteFile,
-    motions: Sequence[Any],
+    spectrum: Any,
+    histories: Mapping[str, Sequence[HistoryRun]],
     *,
     sources: Sequence[dict[str, Any]] = (),
     options: Optional[dict[str, Any]] = None,
@@ -848,8 +892,14 @@ def render_assessment(
     ----------
     doc : dict
         ``workflows.assess.assessment_doc(cf, site, motions, ...)``.
-    cf, site, motions
-        The inputs of ``doc`` (for the figures).
+    cf, site
+        The inputs of ``doc`` (for the constants and the project).
+    spectrum : Spectrum
+        The site's elastic spectrum (``workflows.assess.site_spectrum(site)``), drawn with
+        the capacity curves.
+    histories : dict of str to sequence of HistoryRun
+        Per mechanism id, its time histories at the design scale
+        (``workflows.pages.assessment_histories``); a mechanism absent has none.
     sources : sequence of dict
         Inputs' provenance (``report.html.input_source``: role, name, bytes, SHA-256).
     options : dict, optional
@@ -862,9 +912,10 @@ def render_assessment(
     str
         The HTML page.
     """
-    _render(template_dir)  # a user template's syntax error before any figure is drawn
-    spectrum = site_spectrum(site)
+    check_template(template_dir)  # a user template's syntax error before any figure is drawn
     by_id = {m.id: m for m in cf.mechanisms}
+    method = doc.get("method", {}).get("name", "circ2019")
+    verdicts_by_id = {v["id"]: v for v in doc["conclusion"]["mechanisms"]}
     with tempfile.TemporaryDirectory(prefix="rockmech-assess-") as tmp:
         folder = Path(tmp)
         spectrum_fig = _embed(
@@ -873,38 +924,8 @@ def render_assessment(
         )
         sections = []
         verdicts = []
-        verdicts_by_id = {v["id"]: v for v in doc["conclusion"]["mechanisms"]}
         for row in doc["mechanisms"]:
-            mech = by_id[row["id"]]
-            non = row["nonlinear"]
-            figs = []
-            if non.get("status") == "ok" and non.get("curve"):
-                figs.append(
-                    _embed(
-                        functools.partial(
-                            _plot_capacity,
-                            row["linear"],
-                            non,
-                            spectrum,
-                            folder / f"{row['id']}_capacity.png",
-                        ),
-                        f"{row['id']}: the checks on the capacity curve (ADRS): capacity, "
-                        "demand and verdict of each (Circ. 2019 C8.7.1.2.1.7-8)",
-                    )
-                )
-            env_doc = row.get("envelope") or {}
-            if "a_p_min_g" in env_doc:
-                figs.append(
-                    _embed(
-                        functools.partial(
-                            _plot_envelope, env_doc, folder / f"{row['id']}_envelope.png"
-                        ),
-                        f"{row['id']}: overturning envelope and the records' largest pulses "
-                        "at design scale",
-                    )
-                )
-            figs.extend(_history_figures(mech, row, motions, folder))
-            method = doc.get("method", {}).get("name", "circ2019")
+            figs = _mechanism_figures(row, spectrum, histories.get(row["id"], ()), folder)
             verdict = verdicts_by_id[row["id"]]
             cells = {
                 "verdict": _final_cell(verdict),
@@ -917,8 +938,8 @@ def render_assessment(
             sections.append(
                 {
                     "row": row,
-                    "mech": mech,
-                    "constants": _constants_rows(mech),
+                    "mech": by_id[row["id"]],
+                    "constants": _constants_rows(by_id[row["id"]]),
                     "figures": figs,
                     "cells": cells,
                     "linear_rows": _check_rows(row["linear"]),
@@ -934,8 +955,8 @@ def render_assessment(
         "site": doc["site"],
         "method": doc.get("method", {}),
         "hazard_table": hazard_table(doc["site"]),
-        "ratio_linear": ratio_label(doc.get("method", {}).get("name", "circ2019"), "linear"),
-        "ratio_nonlinear": ratio_label(doc.get("method", {}).get("name", "circ2019"), "nonlinear"),
+        "ratio_linear": ratio_label(method, "linear"),
+        "ratio_nonlinear": ratio_label(method, "nonlinear"),
         "conclusion": doc["conclusion"],
         "disagreements": [v for v in doc["conclusion"]["mechanisms"] if "pulse_margin" in v],
         "commands": reproduce_commands(sources, options),
@@ -1021,44 +1042,16 @@ def _retrofit_context(
     }
 
 
-def assess_report(
-    cf: ConstantsFile,
-    site: SiteFile,
-    motions: Sequence[Any],
-    *,
-    multiples: Sequence[float] = (0.5, 1.0, 1.5, 2.0),
-    sources: Sequence[dict[str, Any]] = (),
-    options: Optional[dict[str, Any]] = None,
-    template_dir: Optional[Path] = None,
-    retrofit: Union[RetrofitSpec, RetrofitDoc, None] = None,
-) -> tuple[dict[str, Any], str]:
-    """Return the assessment document and its HTML page (for ``rockmech assess`` and REST).
+def check_template(template_dir: Optional[Path]) -> None:
+    """Refuse a user template that does not load or parse, before any work is done.
 
-    Parameters
-    ----------
-    cf, site, motions, multiples
-        As ``workflows.assess.assessment_doc``.
-    sources, options, template_dir
-        As ``render_assessment``.
-    retrofit : RetrofitSpec or RetrofitDoc, optional
-        A retrofit spec (the retrofit is run on ``cf`` and ``site``) or a ``retrofit.json``
-        made from them (checked: ``report.retrofit.check_retrofit_matches``): the document
-        holds it under ``retrofit`` and page one shows its table.
-
-    Returns
-    -------
-    (dict, str)
-        The JSON-ready document and the HTML page.
+    Raises
+    ------
+    InputError
+        The folder has no readable ``assess.html.j2`` or it has a syntax error (naming the
+        file and line).
     """
-    _render(template_dir)  # a user template's syntax error before the analysis runs
-    doc = assessment_doc(cf, site, motions, multiples=multiples)
-    if retrofit is not None:
-        made = assessment_retrofit(cf, site, retrofit)
-        doc["retrofit"] = made.model_dump(mode="json")
-    text = render_assessment(
-        doc, cf, site, motions, sources=sources, options=options, template_dir=template_dir
-    )
-    return doc, text
+    _render(template_dir)
 
 
 def chromium() -> Optional[str]:

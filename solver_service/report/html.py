@@ -12,6 +12,9 @@ record with its elastic spectrum and the time histories of every mechanism at ev
 factor, with every mechanism they leave out and why; and the error estimates of every result.
 
 Units: SI; pulse amplitudes and accelerations in g where the heading says so.
+
+This module renders what ``solver_service.workflows.pages.build_report`` computed (the
+documents, the runs and the record's spectrum in a ``ReportContent``) and runs no analysis.
 """
 
 from __future__ import annotations
@@ -26,30 +29,80 @@ import math
 import platform
 import tempfile
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Optional, Union
+from typing import Any, Optional
 
 import numpy as np
 
 from shared_schema.atomic import write_atomic
-from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError, RockmechError
-from shared_schema.paths import PATH_TYPES, PathLike, as_path
-from shared_schema.rules import check_positive
+from shared_schema.paths import PathLike, as_path
 
 from ..core.model import G
-from ..core.records import GroundMotion
-from ..core.spectra import response_spectrum
-from ..workflows.documents import envelope_doc, history_doc
-from ..workflows.scaling import Building, dense_runs
 from .plots import plot_envelopes, plot_record, plot_time_histories
 
-__all__ = ["MAX_TRACES", "build_report", "input_source", "write_report"]
+__all__ = [
+    "MAX_TRACES",
+    "SPECTRUM_PERIODS",
+    "ReportContent",
+    "input_source",
+    "render_report",
+    "write_report",
+]
 
 #: Mechanisms drawn per time-history figure (more are split over several figures).
 MAX_TRACES = 6
-#: Periods of the report's response spectrum [s] (log-spaced).
+#: Periods of the report's response spectrum [s] (log-spaced: first, last, count).
 SPECTRUM_PERIODS = (0.02, 10.0, 150)
+
+
+@dataclass(frozen=True)
+class ReportContent:
+    """What the report shows, computed beforehand (``workflows.pages.build_report``).
+
+    Attributes
+    ----------
+    cf : ConstantsFile
+        The mechanisms.
+    env : dict
+        The envelope document (``envelope_doc``).
+    envelopes : list
+        The envelopes it was made from, for the figure.
+    motion : GroundMotion, optional
+        The record, if any.
+    hist : dict, optional
+        The time-history document (``history_doc``), with a record.
+    top : float
+        The largest scale factor [-]: the time histories drawn.
+    runs : list of (str, RockingResult)
+        The runs at ``top`` with their time series, labelled.
+    runs_error : str, optional
+        Why the runs could not be made again (then ``runs`` is empty).
+    spectrum : Spectrum, optional
+        The record's 5 % elastic response spectrum at ``SPECTRUM_PERIODS``.
+    pulses : list of ExtractedPulse
+        The record's largest sine pulse (or none).
+    record_error : Exception, optional
+        Why the record's spectrum or pulse could not be found (the figure says so).
+    spectral : list of (str, float, float)
+        Per mechanism with an amplification: its id, the structure's period T_n [s] and
+        the record's S_a(T_n) [g].
+    """
+
+    cf: Any
+    env: dict[str, Any]
+    envelopes: Sequence[Any]
+    motion: Optional[Any] = None
+    hist: Optional[dict[str, Any]] = None
+    top: float = 1.0
+    runs: Sequence[tuple[str, Any]] = ()
+    runs_error: Optional[str] = None
+    spectrum: Optional[Any] = None
+    pulses: Sequence[Any] = ()
+    record_error: Optional[Exception] = None
+    spectral: Sequence[tuple[str, float, float]] = field(default_factory=list)
+
 
 _CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;margin:2rem auto;
@@ -255,20 +308,14 @@ def _skipped_section(doc: dict[str, Any]) -> str:
     )
 
 
-def _history_figures(
-    cf: Any, motion: Any, doc: dict[str, Any], scales: Sequence[float], folder: Path
-) -> list[str]:
+def _history_figures(content: ReportContent, folder: Path) -> list[str]:
     """Figures of the time histories at the largest scale, or a note on why there are none."""
-    top = max(scales)
+    top, motion = content.top, content.motion
+    assert motion is not None
     caption = f"φ/φ_ov against time at scale {top:g}"
-    try:
-        # the runs are made again with their time series: a run can fail here alone
-        runs = [
-            (f"{mech_id} ×{scale:.3g}", res)
-            for mech_id, scale, res in dense_runs(cf, motion, doc, top)
-        ]
-    except (ValueError, ArithmeticError, RockmechError) as exc:
-        return [f"<p class='muted'>{_e(caption)}: not drawn ({_e(exc)})</p>"]
+    if content.runs_error is not None:
+        return [f"<p class='muted'>{_e(caption)}: not drawn ({_e(content.runs_error)})</p>"]
+    runs = list(content.runs)
     figures = []
     for k in range(0, len(runs), MAX_TRACES):
         part = runs[k : k + MAX_TRACES]
@@ -289,17 +336,27 @@ def _history_figures(
     return figures
 
 
-def _record_section(cf: Any, motion: Any, folder: Path) -> str:
+def _raise(exc: Exception) -> Path:
+    raise exc
 
-    periods = np.geomspace(*SPECTRUM_PERIODS[:2], int(SPECTRUM_PERIODS[2]))
-    draw = functools.partial(plot_record, motion, folder / "record.png", periods=periods)
-    rows = []
-    for m in cf.mechanisms:
-        if m.amplification is None:
-            continue
-        t_n = 1.0 / m.amplification.f_n
-        sa = float(response_spectrum(motion.accel.acc, motion.dt, [t_n]).psa[0]) / G
-        rows.append([_e(m.id), _num(t_n), _num(sa), _num(sa / motion.pga_g)])
+
+def _record_section(content: ReportContent, folder: Path) -> str:
+    motion = content.motion
+    assert motion is not None
+    if content.record_error is not None:
+        draw: Callable[[], Path] = functools.partial(_raise, content.record_error)
+    else:
+        draw = functools.partial(
+            plot_record,
+            motion,
+            folder / "record.png",
+            spectrum=content.spectrum,
+            pulses=content.pulses,
+        )
+    rows = [
+        [_e(mech_id), _num(t_n), _num(sa), _num(sa / motion.pga_g)]
+        for mech_id, t_n, sa in content.spectral
+    ]
     table = ""
     if rows:
         table = "<h3>Spectral acceleration at the supporting structure's period</h3>" + _table(
@@ -365,106 +422,38 @@ def _accuracy(hist: Optional[dict[str, Any]]) -> str:
     return "<h2>Error estimates</h2><ul>" + "".join(items) + "</ul>"
 
 
-def check_history_options(
-    scales: Sequence[float], history: Optional[dict[str, Any]], motion: Optional[Any]
-) -> None:
-    """Refuse history options that are invalid, or that have nothing to act on.
-
-    The scale factors must be > 0 with or without a record; without a record there are no
-    time histories, so scales, ``sf``, the building, ``criterion`` and ``at_height`` given
-    then would be silently ignored and are refused instead (issue #14).
-
-    Raises
-    ------
-    InputError
-        A scale not finite and > 0 (field ``scales[j]``), or an option given without a record
-        (field: its name).
-    """
-    for j, value in enumerate(scales):
-        check_positive(value, f"scales[{j}]")
-    if motion is not None:
-        return
-    opts = dict(history or {})
-    given = {
-        "scales": [float(v) for v in scales] != [1.0],
-        "sf": opts.get("sf", "none") != "none",
-        "building": opts.get("building", Building()) != Building(),
-        "criterion": opts.get("criterion") is not None,
-        "at_height": opts.get("at_height") is not None,
-    }
-    named = [name for name, is_given in given.items() if is_given]
-    if named:
-        raise InputError(
-            "acts on the time histories of a record, and no record is given; give a record "
-            f"or leave out {' and '.join(named)}",
-            named[0],
-        )
-
-
-def build_report(
-    constants: Union[ConstantsFile, PathLike],
-    f_p: Any,
+def render_report(
+    content: ReportContent,
     *,
-    motion: Union[GroundMotion, PathLike, None] = None,
-    scales: Sequence[float] = (1.0,),
-    history: Optional[dict[str, Any]] = None,
-    method: str = "exact",
     title: str = "",
     sources: Sequence[dict[str, Any]] = (),
     request: Optional[dict[str, Any]] = None,
-    library: Optional[Any] = None,
 ) -> str:
-    """Return the HTML report of a constants file and, optionally, a record.
+    """Return the HTML page of what a report shows.
 
     Parameters
     ----------
-    constants : ConstantsFile, str or os.PathLike
-        The mechanisms, or a constants file or table to read (``read_constants``).
-    f_p : (n,) float
-        Pulse frequencies of the envelopes [Hz].
-    motion : GroundMotion, str or os.PathLike, optional
-        A record, or a record file to read (``read_record``'s defaults): adds its spectrum
-        and the time histories.
-    scales : sequence of float
-        Scale factors on the record [-].
-    history : dict, optional
-        Options of the time histories, passed to ``history_doc`` (``sf``, ``building``,
-        ``criterion``, ``at_height``).
-    method : {"exact", "library"}
-        How the envelopes are computed (``envelope_doc``; exact by default).
+    content : ReportContent
+        The documents, runs and record spectrum (``workflows.pages.build_report``).
     title : str
         Report title.
     sources : sequence of dict
         Inputs (``input_source``) for the provenance table.
     request : dict, optional
         Analysis options, shown as given.
-    library : OverturningLibrary, optional
-        A loaded library for ``method="library"`` (else loaded here).
 
     Returns
     -------
     str
         The page.
-
-    Raises
-    ------
-    InputError
-        Invalid history options, or options given without a record
-        (``check_history_options``); a file that cannot be read, or a ``constants`` or
-        ``motion`` of another type (naming it).
     """
-    cf, motion = _report_inputs(constants, motion)
-    check_history_options(scales, history, motion)
-    env, envelopes = envelope_doc(cf, np.asarray(f_p, dtype=float), method=method, library=library)
-    hist = None
-    if motion is not None:
-        hist = history_doc(cf, motion, list(scales), **(history or {}))
+    cf, env, motion, hist = content.cf, content.env, content.motion, content.hist
     title = title or "rockmech report"
     with tempfile.TemporaryDirectory(prefix="rockmech-report-") as tmp:
         folder = Path(tmp)
         draw = functools.partial(
             plot_envelopes,
-            envelopes,
+            content.envelopes,
             env["critical"],
             folder / "envelope.png",
             labels={m.id: f"{m.id}: {m.name}" for m in cf.mechanisms},
@@ -477,21 +466,8 @@ def build_report(
             ),
         ]
         if motion is not None and hist is not None:
-            body.append(_record_section(cf, motion, folder))
-            figs = _history_figures(cf, motion, hist, scales, folder)
-            body.append(
-                "<h2>Time histories</h2>"
-                f"<p>criterion: {_e(hist['criterion'])}; method: {_e(hist['method'])}"
-                + (
-                    f"; scale factor up the structure: {_e(hist['scale_factor_method'])}"
-                    if "scale_factor_method" in hist
-                    else ""
-                )
-                + "</p>"
-                + _skipped_section(hist)
-                + "".join(figs)
-                + _history_table(hist)
-            )
+            body.append(_record_section(content, folder))
+            body.append(_history_section(hist, _history_figures(content, folder)))
         body.append(_accuracy(hist))
         body.append(_provenance(cf, motion, sources, dict(request or {}), env["method"]))
     when = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
@@ -505,16 +481,20 @@ def build_report(
     )
 
 
-def _report_inputs(cf: Any, motion: Any) -> tuple[ConstantsFile, Any]:
-    """Return the constants and the record of a report, read where given as paths."""
-    # read here, not at import: the readers pull in the scene readers (cad_maths)
-    from ..workflows.inputs import read_constants, read_record
-
-    if not isinstance(cf, ConstantsFile):
-        cf = read_constants(as_path(cf, "constants", "a ConstantsFile or " + PATH_TYPES))
-    if motion is not None and not isinstance(motion, GroundMotion):
-        motion = read_record(as_path(motion, "motion", "a GroundMotion or " + PATH_TYPES))
-    return cf, motion
+def _history_section(hist: dict[str, Any], figures: list[str]) -> str:
+    return (
+        "<h2>Time histories</h2>"
+        f"<p>criterion: {_e(hist['criterion'])}; method: {_e(hist['method'])}"
+        + (
+            f"; scale factor up the structure: {_e(hist['scale_factor_method'])}"
+            if "scale_factor_method" in hist
+            else ""
+        )
+        + "</p>"
+        + _skipped_section(hist)
+        + "".join(figures)
+        + _history_table(hist)
+    )
 
 
 def write_report(page: str, path: PathLike) -> Path:
@@ -526,11 +506,8 @@ def write_report(page: str, path: PathLike) -> Path:
         The page (``build_report``).
     path : str or os.PathLike
         The HTML file (its folder is created if missing); it is replaced atomically.
-
-    Returns
-    -------
-    Path
-        The file written.
+    text : str
+        The page (``render_report``, ``workflows.pages.build_report``).
 
     Raises
     ------

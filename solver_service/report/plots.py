@@ -17,9 +17,7 @@ from shared_schema.atomic import write_atomic
 
 from ..core.fragility import lognormal_cdf
 from ..core.model import G
-from ..core.pulses import extract_pulses
 from ..core.result import RockingResult
-from ..core.spectra import response_spectrum
 
 __all__ = [
     "plain",
@@ -189,13 +187,7 @@ def plot_ratio_histories(
 
 
 def plot_record(
-    motion: Any,
-    path: Union[str, Path],
-    *,
-    periods: Union[np.ndarray[Any, Any], None] = None,
-    zeta: float = 0.05,
-    spectrum: Any = None,
-    pulses: Union[Sequence[Any], None] = None,
+    motion: Any, path: Union[str, Path], *, spectrum: Any, pulses: Sequence[Any]
 ) -> Path:
     """Plot a record with its largest sine pulse, and its elastic response spectrum.
 
@@ -205,14 +197,10 @@ def plot_record(
         The record.
     path : str or Path
         Output file (.png or .svg); written atomically.
-    periods : (m,) float, optional
-        Natural periods of the spectrum [s]; default 100 log-spaced from 0.02 to 10 s.
-    zeta : float
-        Damping ratio of the spectrum [-].
-    spectrum : Spectrum, optional
-        The spectrum, when already computed (then ``periods`` and ``zeta`` are not used).
-    pulses : sequence of ExtractedPulse, optional
-        The record's pulses, largest first, when already found; the first is drawn.
+    spectrum : Spectrum
+        Its elastic response spectrum (``core.spectra.response_spectrum``).
+    pulses : sequence of ExtractedPulse
+        Its pulses, largest first (``core.pulses.extract_pulses``); the first is drawn.
 
     Returns
     -------
@@ -220,11 +208,6 @@ def plot_record(
         The written file.
     """
     plt = load_pyplot()
-    if spectrum is None:
-        t_n = np.geomspace(0.02, 10.0, 100) if periods is None else np.asarray(periods, float)
-        spectrum = response_spectrum(motion.accel.acc, motion.dt, t_n, zeta)
-    if pulses is None:
-        pulses = extract_pulses(motion.accel, n=1)
     fig, (ax_a, ax_s) = plt.subplots(
         1, 2, figsize=(11, 3.6), gridspec_kw={"width_ratios": [1.7, 1]}
     )

@@ -15,23 +15,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Optional, Union
+from typing import Any, Optional
 
-from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 from shared_schema.retrofit import (
     CheckFigures,
     MechanismRetrofit,
     RetrofitDoc,
-    RetrofitSpec,
     TieOption,
 )
-from shared_schema.site import SiteFile
 
 __all__ = [
     "RATIO_LABELS",
     "RetrofitRow",
-    "assessment_retrofit",
     "check_retrofit_ids",
     "check_retrofit_matches",
     "records_notes",
@@ -254,45 +250,6 @@ def check_retrofit_matches(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> None
                     "give the retrofit spec",
                     "retrofit",
                 )
-
-
-def assessment_retrofit(
-    cf: ConstantsFile, site: SiteFile, source: Union[RetrofitSpec, RetrofitDoc]
-) -> RetrofitDoc:
-    """Return the retrofit a report shows: computed from a spec, or a document checked.
-
-    Parameters
-    ----------
-    cf, site
-        The assessment's constants and site.
-    source : RetrofitSpec or RetrofitDoc
-        A retrofit spec (the retrofit is run on ``cf`` and ``site``, as ``rockmech retrofit``
-        runs it) or a ``retrofit.json``, checked against the code checks of ``cf`` on
-        ``site`` (``check_retrofit_matches``; the checks without the records' demand, as
-        the retrofit runs them).
-
-    Raises
-    ------
-    InputError
-        The spec's errors, their field under ``retrofit.`` (``retrofit.mechanisms.F9``);
-        a document made from other inputs (``retrofit``).
-    """
-    if isinstance(source, RetrofitDoc):
-        # The code checks (the retrofit's own, without records) to compare the document with.
-        from ..workflows.codecheck import check_doc
-
-        check_retrofit_matches(source, check_doc(cf, site)["mechanisms"])
-        return source
-    # The retrofit (its bisections on the code checks) is loaded only when a spec is given.
-    from ..workflows.retrofit import retrofit_doc
-
-    try:
-        return retrofit_doc(cf, site, source)
-    except InputError as exc:
-        head = (exc.field or "").split(".", 1)[0]
-        if head in ("mechanisms", "steel", "anchorage"):
-            raise InputError(exc.reason, f"retrofit.{exc.field}") from None
-        raise
 
 
 def records_notes(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> dict[str, str]:

@@ -591,6 +591,35 @@ class _Context:
         return out
 
 
+def _check_notes(
+    ctx: _Context, mech: Mechanism, floor: Any, floor_note: Optional[str]
+) -> list[str]:
+    """Return the notes both 2019 checks of a side carry: the floor, T1 against 1/f_n, no SLV."""
+    notes = [floor_note] if floor_note else []
+    amp = mech.amplification
+    if floor is not None and amp is not None and ctx.t1 is not None:
+        t_fn = 1.0 / amp.f_n
+        if abs(t_fn - ctx.t1) > T1_TOLERANCE * ctx.t1:
+            notes.append(
+                f"the constants' 1/f_n = {t_fn:.4g} s (the dynamics' Eq. 28) is not the check's "
+                f"T1 = {ctx.t1:.4g} s ({ctx.t1_source}); give building.T1 to use one period"
+            )
+    if not ctx.slv_given:
+        notes.append(
+            f"the site's hazard is for {ctx.main} and gives no SLV (hazard.limit_states.SLV): "
+            "the SLV checks use its spectrum's shape and are not evaluated"
+        )
+    return notes
+
+
+def _record_demands(records: Sequence[tuple[Any, float]], floor: Any) -> list[RecordDemand]:
+    """Return each (record, scale) as a demand of the nonlinear check (on the floor, if any)."""
+    return [
+        RecordDemand(np.asarray(m.accel.acc, dtype=float), float(m.dt), scale, m.name, floor)
+        for m, scale in records
+    ]
+
+
 def _side_checks_2019(
     ctx: _Context,
     mech: Mechanism,
@@ -613,22 +642,8 @@ def _side_checks_2019(
         floor, floor_note = _floor(site, z, ctx.t1)
     except RockmechError as exc:
         return _not_run(lin_m, str(exc)), _not_run(lin_m, str(exc))
-    if floor_note:
-        extra_notes.append(floor_note)
-    amp = mech.amplification
-    if floor is not None and amp is not None and ctx.t1 is not None:
-        t_fn = 1.0 / amp.f_n
-        if abs(t_fn - ctx.t1) > T1_TOLERANCE * ctx.t1:
-            extra_notes.append(
-                f"the constants' 1/f_n = {t_fn:.4g} s (the dynamics' Eq. 28) is not the check's "
-                f"T1 = {ctx.t1:.4g} s ({ctx.t1_source}); give building.T1 to use one period"
-            )
+    extra_notes += _check_notes(ctx, mech, floor, floor_note)
     complete = floor_note is None and ctx.slv_given
-    if not ctx.slv_given:
-        extra_notes.append(
-            f"the site's hazard is for {ctx.main} and gives no SLV (hazard.limit_states.SLV): "
-            "the SLV checks use its spectrum's shape and are not evaluated"
-        )
     slv = CodeDemand(ctx.slv, floor, "SLV spectrum")
     try:
         if vw.alpha0 <= 0.0:
@@ -653,12 +668,7 @@ def _side_checks_2019(
             non = _no_curve(ties["rule"])
         else:
             slc = None if ctx.slc is None else CodeDemand(ctx.slc, floor, "SLC spectrum")
-            recs = [
-                RecordDemand(
-                    np.asarray(m.accel.acc, dtype=float), float(m.dt), scale, m.name, floor
-                )
-                for m, scale in records
-            ]
+            recs = _record_demands(records, floor)
             non = nonlinear_check_2019(
                 vw,
                 curve,

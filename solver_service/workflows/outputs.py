@@ -14,10 +14,15 @@ import numpy as np
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile
 
+from ..core.pulses import extract_pulses
+from ..core.spectra import response_spectrum
 from ..report.plots import plot_envelopes, plot_fragility, plot_ratio_histories, plot_record
 from .documents import envelope_doc, history_doc
 from .ida.document import ida_csv
 from .units import finite_json, stamp
+
+#: Natural periods of a history run's record spectrum [s]: 100 log-spaced, 0.02 to 10 s.
+RECORD_PERIODS = np.geomspace(0.02, 10.0, 100)
 
 __all__ = [
     "envelope_csv",
@@ -103,7 +108,9 @@ def write_history(
     ids = list(dict.fromkeys(row["mechanism"] for row in doc["results"]))  # file order
     panels = [(scale, [(mech_id, runs[(mech_id, scale)]) for mech_id in ids]) for scale in picks]
     plot_ratio_histories(panels, out_dir / f"{stem}.png", title=title or motion.name)
-    plot_record(motion, out_dir / f"{stem}_record.png")
+    spectrum = response_spectrum(motion.accel.acc, motion.dt, RECORD_PERIODS, 0.05)
+    pulses = extract_pulses(motion.accel, n=1)
+    plot_record(motion, out_dir / f"{stem}_record.png", spectrum=spectrum, pulses=pulses)
     return doc
 
 

@@ -18,7 +18,9 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-__all__ = ["RULE", "check_label", "conclusion", "ratio_label", "worst_pulse"]
+from ..report.labels import ratio_label, worst_pulse
+
+__all__ = ["RULE", "check_label", "conclusion"]
 
 #: The rule that turns the analyses into one verdict, printed with it.
 RULE = (
@@ -28,19 +30,6 @@ RULE = (
     "(the record's largest pulse alone, as one sine; > 1: that pulse does not overturn it) is "
     "a screening and never governs."
 )
-
-
-def ratio_label(method: str, check: str) -> str:
-    """Return the capacity/demand ratio a check reports, as the report and the JSON name it.
-
-    Examples
-    --------
-    >>> ratio_label("circ2019", "nonlinear"), ratio_label("circ2009", "linear")
-    ('a_g,SLV/a_g', 'a0*/demand')
-    """
-    if method == "circ2019":
-        return "a_g,SLV/a_g"
-    return "a0*/demand" if check == "linear" else "du*/demand"
 
 
 def check_label(method: str, check: str) -> str:
@@ -80,13 +69,6 @@ def _code_part(row: dict[str, Any], method: str) -> dict[str, Any]:
     if notes:
         out["not_run"] = notes
     return out
-
-
-def worst_pulse(row: dict[str, Any]) -> Optional[dict[str, Any]]:
-    """Return the record pulse of a mechanism row with the smallest margin, or None."""
-    env = row.get("envelope") or {}
-    pulses = [p for p in env.get("pulses", []) if p.get("margin") is not None]
-    return min(pulses, key=lambda p: p["margin"]) if pulses else None
 
 
 def _margin_note(row: dict[str, Any], overturns: list[str]) -> Optional[str]:

@@ -283,7 +283,7 @@ _RENDER_MESH_WRITER = textwrap.dedent(
     ok = model.Write(sys.argv[1], 8)
     sys.stdout.write("ok" if ok else "failed")
     sys.stdout.flush()
-    # rhino3dm frees a mesh given to BrepFace.SetMesh twice at exit (ECOSYSTEM.md): skip it
+    # rhino3dm frees a mesh given to BrepFace.SetMesh twice at exit (its known bug): skip it
     os._exit(0)
     """
 )

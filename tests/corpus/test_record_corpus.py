@@ -3,8 +3,8 @@
 
 Every format the readers know gets every defect: AT2, two-column, one-column and CSV files are
 written into the case's tmp folder; the strong-motion formats (K-NET, ESM, COSMOS V2c, DMG V2,
-GeoNet V2A) are mutated copies of the shared real files (``../shared/data/records/formats``,
-read from the repository's parent; those cases skip where it is absent and the files are never
+GeoNet V2A) are mutated copies of the shared real files (the project's shared records folder,
+read from beside the repository; those cases skip where it is absent and the files are never
 copied into the repository). A bad record gets exit status 2 and ``error: <field>: ...``; a
 record the readers can read but should doubt (late start, implausible PGA) gets a warning and
 keeps every sample. Cases the code still answers wrongly are strict-xfail with their #14 class.

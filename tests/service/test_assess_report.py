@@ -20,7 +20,8 @@ from shared_schema.constants import parse_constants
 from shared_schema.site import parse_site
 from solver_service.cli import app
 from solver_service.core.records import GroundMotion
-from solver_service.workflows.assess import assessment_doc
+from solver_service.workflows.assess import assessment_doc, site_spectrum
+from solver_service.workflows.pages import assessment_histories
 
 pytest.importorskip("jinja2")
 
@@ -68,7 +69,9 @@ def test_short_form_church_gets_notes_in_every_row_not_an_abort() -> None:
     site = parse_site(NTC_SITE.read_bytes())
     motion = GroundMotion.from_two_column(RECORD)
     doc = assessment_doc(cf, site, [motion], multiples=(1.0,))
-    text = render_assessment(doc, cf, site, [motion])
+    text = render_assessment(
+        doc, cf, site, site_spectrum(site), assessment_histories(cf, doc, [motion])
+    )
     rows = re.findall(r'<tr data-mechanism="([^"]+)"', text)
     assert rows == [m.id for m in cf.mechanisms]
     assert text.count("no virtual_work in the constants") >= len(rows)
@@ -81,7 +84,7 @@ def test_each_number_of_the_worked_checks_names_its_clause() -> None:
     cf = parse_constants(CHURCH_GEOMETRY.read_bytes())
     site = parse_site(NTC_SITE.read_bytes())
     doc = assessment_doc(cf, site, [], multiples=(1.0,))
-    text = render_assessment(doc, cf, site, [])
+    text = render_assessment(doc, cf, site, site_spectrum(site), {})
     tables = re.findall(r'<table class="worked">(.*?)</table>', text, flags=re.S)
     assert len(tables) == 2 * len(cf.mechanisms)  # linear and nonlinear, per mechanism
     for table in tables:
@@ -111,14 +114,14 @@ def test_project_fields_are_escaped_and_a_user_template_wins(tmp_path: Path) -> 
     data["project"]["client"] = "<script>alert(1)</script>"
     site = parse_site(data)
     doc = assessment_doc(cf, site, [], multiples=(1.0,))
-    text = render_assessment(doc, cf, site, [])
+    text = render_assessment(doc, cf, site, site_spectrum(site), {})
     assert "<script>alert(1)</script>" not in text and "&lt;script&gt;" in text
     firm = tmp_path / "firm"
     firm.mkdir()
     (firm / "assess.html.j2").write_text(
         "<h1>ACME</h1>{% for v in verdicts %}<p>{{ v.row.id }}</p>{% endfor %}", encoding="utf-8"
     )
-    text = render_assessment(doc, cf, site, [], template_dir=firm)
+    text = render_assessment(doc, cf, site, site_spectrum(site), {}, template_dir=firm)
     assert text == "<h1>ACME</h1><p>F1</p><p>F2</p><p>A1</p><p>T1</p>"
 
 
@@ -200,7 +203,13 @@ def _page_and_doc(tmp_path: Path) -> tuple[str, dict]:
         input_source("record", RECORD.name, RECORD.read_bytes()),
     ]
     page = render_assessment(
-        doc, cf, site, [motion], sources=sources, options={"multiples": [1.0, 2.0]}
+        doc,
+        cf,
+        site,
+        site_spectrum(site),
+        assessment_histories(cf, doc, [motion]),
+        sources=sources,
+        options={"multiples": [1.0, 2.0]},
     )
     return page, doc
 

@@ -38,9 +38,9 @@ from solver_service.cli import app
 from solver_service.codes import scale_factors as codes
 from solver_service.core import exact
 from solver_service.core.records import GroundMotion
-from solver_service.report.html import check_history_options
 from solver_service.workflows import assess
 from solver_service.workflows.limits import DEFAULT_LIMITS, WORK_PER_SAMPLE
+from solver_service.workflows.pages import check_history_options
 
 runner = CliRunner()
 

@@ -185,3 +185,56 @@ def test_an_implausible_body_size_names_the_unit_read_and_the_one_that_fits(
     assert note.endswith(advice), note
     assert rules.body_size_note(0.01, 1.0, "meters", "W", scan) is None
     assert rules.body_size_note(200.0, 1.0, "meters", "W", scan) is None
+
+
+def _vocabularies() -> dict[str, frozenset[str]]:
+    out = {}
+    for name in dir(rules):
+        value = getattr(rules, name)
+        if name.isupper() and isinstance(value, tuple) and len(value) > 1:
+            if all(isinstance(v, str) for v in value):
+                out[name] = frozenset(value)
+    return out
+
+
+def copies_of_a_vocabulary(source: str) -> list[str]:
+    """Top-level names a module binds to a literal copy of a vocabulary of ``rules``."""
+    import ast
+
+    vocabularies = _vocabularies()
+    found = []
+    for node in ast.parse(source).body:
+        target, value = None, None
+        if isinstance(node, ast.Assign) and len(node.targets) == 1:
+            target, value = node.targets[0], node.value
+        elif isinstance(node, ast.AnnAssign):
+            target, value = node.target, node.value
+        if not isinstance(target, ast.Name) or not isinstance(value, (ast.Tuple, ast.List)):
+            continue
+        items = [e.value for e in value.elts if isinstance(e, ast.Constant)]
+        if len(items) != len(value.elts) or not all(isinstance(v, str) for v in items):
+            continue
+        for name, vocabulary in vocabularies.items():
+            if frozenset(items) == vocabulary:
+                found.append(f"{target.id} copies rules.{name}")
+    return found
+
+
+def test_each_vocabulary_is_defined_once() -> None:
+    """One home per vocabulary: no module outside rules.py spells one out again (#38)."""
+    from pathlib import Path
+
+    root = Path(rules.__file__).resolve().parents[1]
+    copies = {}
+    for package in ("shared_schema", "cad_maths", "solver_service", "rhino_plugin", "rockmech"):
+        for path in sorted((root / package).rglob("*.py")):
+            if path.name == "rules.py" and path.parent.name == "shared_schema":
+                continue
+            found = copies_of_a_vocabulary(path.read_text(encoding="utf-8"))
+            if found:
+                copies[path.relative_to(root).as_posix()] = found
+    assert copies == {}
+    # the check finds the copy the solver's result module held before #38
+    assert copies_of_a_vocabulary('CRITERIA = ("ratio", "exact")\n') == [
+        "CRITERIA copies rules.CRITERIA"
+    ]

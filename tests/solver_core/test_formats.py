@@ -1,12 +1,14 @@
-"""Strong-motion formats: each real file detected, read whole, and matching its own header.
+"""Record formats: each real file detected, read whole, and matching its own header.
 
-The files are the shared test records of ``../shared/data/records/formats`` (provenance in its
-README); the expected counts, steps and peaks below are copied from each file's header, and
+The files are the project's shared test records (``formats/`` of the shared records folder
+beside the repository, provenance in its README; absent on a clone, where these tests
+skip); the expected counts, steps and peaks below are copied from each file's header, and
 the samples are compared with an independent parse (plain whitespace splitting).
 """
 
 from __future__ import annotations
 
+import ast
 import shutil
 from pathlib import Path
 
@@ -14,7 +16,8 @@ import numpy as np
 import pytest
 
 from shared_schema.errors import InputError
-from shared_schema.rules import RECORD_UNITS
+from shared_schema.rules import RECORD_FORMATS, RECORD_UNITS
+from solver_service.core import formats, records
 from solver_service.core.formats._text import fixed_width_values
 from solver_service.core.records import GroundMotion, detect_format
 
@@ -277,3 +280,45 @@ def test_copy_with_another_name_is_still_detected(formats_dir: Path, tmp_path: P
         copy = tmp_path / f"record_{fmt}.txt"
         shutil.copy(formats_dir / fname, copy)
         assert detect_format(copy) == fmt
+
+
+def test_every_record_format_has_its_reader_in_formats() -> None:
+    """One home for the readers (#38): a module of ``formats`` per format, none in ``records``."""
+    for fmt in RECORD_FORMATS:
+        module = getattr(formats, fmt)
+        assert callable(module.read), fmt
+        if fmt != "csv":
+            assert formats.DT_SOURCES[fmt] == module.DT_SOURCE, fmt
+    for fmt in formats.READERS:
+        assert formats.READERS[fmt] == (getattr(formats, fmt).sniff, getattr(formats, fmt).read)
+    # records reads files and builds GroundMotion; it parses no format of its own
+    tree = ast.parse(Path(records.__file__).read_text(encoding="utf-8"))
+    imported = {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
+    assert not imported & {"re", "csv"}
+    calls = {
+        n.func.attr
+        for n in ast.walk(tree)
+        if isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute)
+    }
+    assert "splitlines" not in calls
+
+
+def test_column_readers_read_the_bundled_record_as_a_plain_split_does(elcentro_path: Path) -> None:
+    text = elcentro_path.read_text(encoding="utf-8")
+    rows = [ln.split("#")[0].split() for ln in text.splitlines()]
+    t, a = np.array([r for r in rows if r], dtype=float).T
+    two = formats.two_column.read(text, elcentro_path.name, "g")
+    np.testing.assert_array_equal(two.values, a)
+    assert two.dt == pytest.approx(0.02, rel=1e-9) and two.units == "g"
+    assert (two.metadata["format"], two.metadata["npts"]) == ("two_column", a.size)
+    one = formats.one_column.read("\n".join(map(repr, a.tolist())), "a.txt", 0.02, "g")
+    np.testing.assert_array_equal(one.values, a)
+    table = "t [s],acc [g]\n" + "\n".join(f"{x!r},{y!r}" for x, y in zip(t.tolist(), a.tolist()))
+    csv = formats.csv.read(table, "a.csv")
+    np.testing.assert_array_equal(csv.values, a)
+    assert (csv.units, csv.metadata["units_from"], csv.dt) == ("g", "header", pytest.approx(0.02))
+    assert formats.format_of(text, "x.dat") == "two_column"
+    assert formats.format_of(table, "x.txt", ".CSV") == "csv"
+    # the same record through GroundMotion, in SI
+    motion = GroundMotion.from_file(elcentro_path, units="g")
+    np.testing.assert_allclose(motion.accel.acc, a * 9.80665, rtol=1e-15)

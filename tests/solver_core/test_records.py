@@ -60,7 +60,7 @@ def test_missing_file_and_unknown_units(tmp_path: Path, elcentro_path: Path) -> 
 
 # --- PEER AT2 --------------------------------------------------------------------------
 
-#: README table of ../shared/data/records: file -> (NPTS, DT [s], PGA [g]).
+#: README table of the shared records folder: file -> (NPTS, DT [s], PGA [g]).
 AT2_TABLE = {
     "RSN126_GAZLI_GAZ000.AT2": (2048, 0.0066, 0.702),
     "RSN183_IMPVALL.H_H-E08140.AT2": (7554, 0.005, 0.610),

@@ -119,7 +119,7 @@ def test_elcentro_spectrum_matches_pyrotd(elcentro_path: Path) -> None:
         f"worst vs pyrotd: {100 * rel[long].max():.2f} % (T >= 0.3 s), "
         f"{100 * rel[~long].max():.1f} % (T < 0.3 s, not asserted)"
     )
-    # ECOSYSTEM.md: the programs agree within about 1 % for T >= 0.3 s.
+    # Published comparisons of spectrum programs agree within about 1 % for T >= 0.3 s.
     assert rel[long].max() < 0.01
 
 

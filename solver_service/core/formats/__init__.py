@@ -1,4 +1,6 @@
-"""Readers of the strong-motion formats of the record databases, each detected from its content.
+"""Readers of every ground-motion record format rockmech reads, one module per format.
+
+The strong-motion databases' formats, each detected from its content (``READERS``):
 
 =========  ==========================================================  =========================
 format     files                                                       channels
@@ -13,20 +15,49 @@ format     files                                                       channels
 Each module has ``sniff(head) -> bool`` (the first lines of a file) and
 ``read(text, name) -> list[Channel]`` (every acceleration channel, in the units its header
 states, checked against the header's sample count and peak). ``select_channel`` picks one by
-number or component name; ``solver_service.core.records`` turns it into a ``GroundMotion``.
+number or component name.
+
+The other formats: ``at2`` (PEER NGA, ``sniff`` and ``read(text, name)`` like the above, one
+channel), and the plain-text column files, which state no units or time step of their own,
+so their ``read`` takes them: ``two_column.read(text, name, units)``,
+``one_column.read(text, name, dt, units)`` and ``csv.read(text, name, units, time_column,
+accel_column, dt)``, each returning one ``Channel``. ``format_of`` tells a file's format from
+its extension and content, and ``dt_source`` where a record's time step came from.
+``solver_service.core.records`` reads the file and turns a ``Channel`` into an SI
+``GroundMotion``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Optional, Union
+from typing import Any, Optional, Union
 
 from shared_schema.errors import InputError
+from shared_schema.rules import RECORD_FORMATS
 
-from . import cosmos, dmg, esm, geonet, knet
+from . import at2, cosmos, csv, dmg, esm, geonet, knet, one_column, two_column
+from ._columns import DT_RTOL, check_samples, check_step, data_lines
 from ._text import Channel
 
-__all__ = ["READERS", "Channel", "channel_list", "detect", "select_channel", "truncated"]
+__all__ = [
+    "DT_RTOL",
+    "DT_SOURCES",
+    "EXTENSIONS",
+    "READERS",
+    "Channel",
+    "at2",
+    "channel_list",
+    "check_samples",
+    "check_step",
+    "csv",
+    "detect",
+    "dt_source",
+    "format_of",
+    "one_column",
+    "select_channel",
+    "truncated",
+    "two_column",
+]
 
 #: Format name -> (sniff, read), in the order detection tries them.
 READERS: dict[str, tuple[Callable[[str], bool], Callable[[str, str], list[Channel]]]] = {
@@ -38,6 +69,26 @@ READERS: dict[str, tuple[Callable[[str], bool], Callable[[str, str], list[Channe
 }
 #: Characters of a file's start that detection looks at.
 HEAD_CHARS = 4096
+#: File extensions (lower case) that fix the format.
+EXTENSIONS = {".at2": "at2", ".csv": "csv"}
+#: Where each format's time step comes from, for the plausibility warning (``samples``: a
+#: record built from samples in memory).
+DT_SOURCES: dict[str, str] = {
+    "at2": at2.DT_SOURCE,
+    "two_column": two_column.DT_SOURCE,
+    "one_column": one_column.DT_SOURCE,
+    **{
+        fmt: module.DT_SOURCE
+        for fmt, module in {
+            "esm": esm,
+            "knet": knet,
+            "cosmos": cosmos,
+            "dmg": dmg,
+            "geonet": geonet,
+        }.items()
+    },
+    "samples": "dt",
+}
 
 
 def detect(text: str) -> Optional[str]:
@@ -111,3 +162,67 @@ def select_channel(
             "channel",
         )
     return chosen[0]
+
+
+def format_of(text: str, name: str, suffix: str = "") -> str:
+    """Return the format of a record file from its extension, else its content.
+
+    Parameters
+    ----------
+    text : str
+        The file's text (not looked at for an extension in ``EXTENSIONS``).
+    name : str
+        File name, for messages.
+    suffix : str
+        The file's extension (``.AT2``, ``.csv``; any case).
+
+    Returns
+    -------
+    str
+        From the extension (``.AT2``, ``.csv``), else a PEER title (``at2``), a strong-motion
+        header (``detect``), else the count of numbers on the first data line (2:
+        ``two_column``, 1: ``one_column``).
+
+    Raises
+    ------
+    InputError
+        A strong-motion header cut short, an empty file (field ``record``), or a file whose
+        format cannot be told (``format``).
+    """
+    fmt = EXTENSIONS.get(suffix.lower())
+    if fmt is not None:
+        return fmt
+    if at2.sniff(text):
+        return "at2"
+    strong = detect(text)
+    if strong is not None:
+        return strong
+    cut = truncated(text, name)
+    if cut is not None:
+        raise InputError(cut, "record")
+    lines = data_lines(text)
+    if not lines:
+        raise InputError(f"{name} is empty: no data lines to read", "record")
+    first = lines[0][2].replace(",", " ").split()
+    try:
+        [float(x) for x in first]
+    except ValueError:
+        first = []
+    if len(first) == 2:
+        return "two_column"
+    if len(first) == 1:
+        return "one_column"
+    raise InputError(
+        f"cannot tell the format of {name} (line {lines[0][0]}: {lines[0][1].strip()!r}); "
+        f"give format, one of {list(RECORD_FORMATS)}",
+        "format",
+    )
+
+
+def dt_source(meta: dict[str, Any]) -> str:
+    """Where a record's time step was read from (a header field, a column, or given)."""
+    fmt = meta.get("format")
+    if fmt == "csv":
+        timed = meta.get("time_column") is not None
+        return DT_SOURCES["two_column"] if timed else DT_SOURCES["one_column"]
+    return DT_SOURCES.get(str(fmt), "the time step given")

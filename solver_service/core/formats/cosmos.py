@@ -33,7 +33,10 @@ from ._text import (
     units_from_text,
 )
 
-__all__ = ["read", "sniff"]
+__all__ = ["DT_SOURCE", "read", "sniff"]
+
+#: Where the time step comes from, for the plausibility warning.
+DT_SOURCE = "real header 62 (in ms)"
 
 #: COSMOS physical-units codes of acceleration -> ``RECORD_UNITS`` keys.
 UNITS_CODES = {2: "g", 4: "cm/s2", 7: "in/s2", 10: "cm/s2", 11: "mg"}
@@ -158,6 +161,47 @@ def _is_block(line: str, kind: str) -> bool:
     return match is not None and match.group(2).lower() == kind
 
 
+def _units(data: re.Match[str], where: str) -> str:
+    """Return the units of a channel's data line, its code and its text agreeing."""
+    code = int(data.group(4))
+    if code not in UNITS_CODES:
+        raise InputError(f"{where}: unknown COSMOS units code {code}", "record")
+    units = UNITS_CODES[code]
+    if data.group(3).strip() and units_from_text(data.group(3), where) != units:
+        raise InputError(
+            f"{where}: units {data.group(3).strip()!r} disagree with code {code}", "record"
+        )
+    return units
+
+
+def _step(reals: list[float], npts: int, digits: int, where: str) -> float:
+    """Return the time step [s] of real header 62 [ms], checked against the length (63)."""
+    if reals[61] == UNKNOWN:
+        raise InputError(f"{where}: real header 62 (sampling interval) is unknown", "record")
+    if reals[61] <= 0:
+        raise InputError(
+            f"{where}: real header 62 (sampling interval) must be > 0 ms, got "
+            f"{reals[61]:g}; the header was edited or the file is damaged",
+            "record",
+        )
+    dt = reals[61] / 1000.0
+    if reals[62] != UNKNOWN:
+        check_duration(f"{reals[62]:.{digits}f}", npts, dt, where, "real header 63 (length)")
+    return dt
+
+
+def _station(text_header: list[str], notes: list[str]) -> dict[str, str]:
+    """Return the event, station, component and SCNL a channel's text header and notes give."""
+    scnl = next((c.split(">", 1)[1].split()[0] for c in notes if "<SCNL>" in c), "")
+    found = re.search(r"Code:\s*(\S+)\s+(.*)$", text_header[4]) if len(text_header) > 4 else None
+    return {
+        "event": text_header[1].strip() if len(text_header) > 1 else "",
+        "station": f"{found.group(1)} {found.group(2).strip()}" if found else "",
+        "component": scnl.split(".")[1] if scnl.count(".") >= 1 else scnl,
+        "scnl": scnl,
+    }
+
+
 def read(text: str, name: str) -> list[Channel]:
     """Read every acceleration channel of a COSMOS V2 file (usually one).
 
@@ -209,41 +253,16 @@ def read(text: str, name: str) -> list[Channel]:
                 f"{where}: processing stage {int(ints[0])}, not corrected acceleration (V2)",
                 "record",
             )
-        code = int(data.group(4))
-        if code not in UNITS_CODES:
-            raise InputError(f"{where}: unknown COSMOS units code {code}", "record")
-        units = UNITS_CODES[code]
-        if data.group(3).strip() and units_from_text(data.group(3), where) != units:
-            raise InputError(
-                f"{where}: units {data.group(3).strip()!r} disagree with code {code}", "record"
-            )
-        if reals[61] == UNKNOWN:
-            raise InputError(f"{where}: real header 62 (sampling interval) is unknown", "record")
-        if reals[61] <= 0:
-            raise InputError(
-                f"{where}: real header 62 (sampling interval) must be > 0 ms, got "
-                f"{reals[61]:g}; the header was edited or the file is damaged",
-                "record",
-            )
-        dt = reals[61] / 1000.0
-        if reals[62] != UNKNOWN:
-            check_duration(f"{reals[62]:.{digits}f}", npts, dt, where, "real header 63 (length)")
+        units = _units(data, where)
+        dt = _step(reals, npts, digits, where)
         if approx is not None:
             _check_approx(approx.group(1), npts, dt, where)
         values = fixed_width_values(rows, width, npts, where)
         check_count(values, npts, where)
         stated = None if reals[63] == UNKNOWN else f"{reals[63]:.{digits}f}"
         peak = check_peak(values, stated, units, where)
-        scnl = next((c.split(">", 1)[1].split()[0] for c in notes if "<SCNL>" in c), "")
-        found = (
-            re.search(r"Code:\s*(\S+)\s+(.*)$", text_header[4]) if len(text_header) > 4 else None
-        )
-        station = f"{found.group(1)} {found.group(2).strip()}" if found else ""
         meta = {
-            "event": text_header[1].strip() if len(text_header) > 1 else "",
-            "station": station,
-            "component": scnl.split(".")[1] if scnl.count(".") >= 1 else scnl,
-            "scnl": scnl,
+            **_station(text_header, notes),
             "channel": number_in_file,
             "npts": npts,
             "dt": dt,

@@ -19,7 +19,10 @@ from shared_schema.errors import InputError
 
 from ._text import Channel, check_count, check_peak, fixed_width_values, number, units_from_text
 
-__all__ = ["read", "sniff"]
+__all__ = ["DT_SOURCE", "read", "sniff"]
+
+#: Where the time step comes from, for the plausibility warning.
+DT_SOURCE = "the 'POINTS OF ACCEL DATA EQUALLY SPACED AT' line"
 
 #: Characters per sample in the data blocks (Fortran 8F10.3).
 FIELD_WIDTH = 10

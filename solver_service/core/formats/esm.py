@@ -17,7 +17,10 @@ from shared_schema.rules import RECORD_UNITS
 
 from ._text import Channel, check_count, check_duration, check_peak, number, units_from_text
 
-__all__ = ["read", "sniff", "truncated_header"]
+__all__ = ["DT_SOURCE", "read", "sniff", "truncated_header"]
+
+#: Where the time step comes from, for the plausibility warning.
+DT_SOURCE = "the header's SAMPLING_INTERVAL_S"
 
 #: Keys that identify the format (all present in a DYNA 1.2 header).
 _KEYS = ("EVENT_ID:", "NDATA:", "SAMPLING_INTERVAL_S:", "UNITS:")

@@ -33,7 +33,10 @@ from ._text import (
     units_from_text,
 )
 
-__all__ = ["read", "sniff"]
+__all__ = ["DT_SOURCE", "read", "sniff"]
+
+#: Where the time step comes from, for the plausibility warning.
+DT_SOURCE = "the header's sampling interval (row 7, field 6)"
 
 #: Text lines of each component's header.
 TEXT_LINES = 16

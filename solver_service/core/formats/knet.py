@@ -31,7 +31,10 @@ from shared_schema.rules import DT_RANGE_S
 
 from ._text import Channel, check_count, check_peak, first_number, number
 
-__all__ = ["read", "sniff"]
+__all__ = ["DT_SOURCE", "read", "sniff"]
+
+#: Where the time step comes from, for the plausibility warning.
+DT_SOURCE = "1 / the header's Sampling Freq(Hz)"
 
 #: Header lines before the counts.
 HEADER_LINES = 17
@@ -69,6 +72,45 @@ def sniff(head: str) -> bool:
     )
 
 
+def _need(header: dict[str, str], label: str, name: str) -> str:
+    """Return a header value, refusing an empty or missing one."""
+    if not header.get(label):
+        raise InputError(f"{name}: K-NET header has no {label!r}", "record")
+    return header[label]
+
+
+def _rate_and_duration(header: dict[str, str], name: str) -> tuple[float, float]:
+    """Return the sampling frequency [Hz] and the duration [s], each in its range."""
+    rate = first_number(_need(header, "Sampling Freq(Hz)", name), f"{name} Sampling Freq(Hz)")
+    lo, hi = 1.0 / DT_RANGE_S[1], 1.0 / DT_RANGE_S[0]
+    if not lo <= rate <= hi:
+        raise InputError(
+            f"{name}: Sampling Freq(Hz) is {rate:g} Hz, outside [{lo:g}, {hi:g}] Hz "
+            "(K-NET records are sampled at 100 or 200 Hz)",
+            "record",
+        )
+    duration = first_number(_need(header, "Duration Time(s)", name), f"{name} Duration Time(s)")
+    if not 0.0 < duration <= DURATION_MAX_S:
+        raise InputError(
+            f"{name}: Duration Time(s) is {duration:g} s, outside (0, {DURATION_MAX_S:g}] s",
+            "record",
+        )
+    return rate, duration
+
+
+def _scale_factor(header: dict[str, str], name: str) -> tuple[float, float]:
+    """Return the Scale Factor's full scale [gal] and its counts, checked (``_check_scale``)."""
+    scale = _SCALE.match(_need(header, "Scale Factor", name))
+    if scale is None:
+        raise InputError(
+            f"{name}: Scale Factor {header['Scale Factor']!r} is not of the form 7845(gal)/8223790",
+            "record",
+        )
+    full_gal, full_counts = (number(scale.group(k), f"{name} Scale Factor") for k in (1, 2))
+    _check_scale(full_gal, full_counts, header["Scale Factor"], name)
+    return full_gal, full_counts
+
+
 def read(text: str, name: str) -> list[Channel]:
     """Read the one channel of a K-NET / KiK-net ASCII file, in gal, mean removed.
 
@@ -84,36 +126,10 @@ def read(text: str, name: str) -> list[Channel]:
     if len(lines) < HEADER_LINES:
         raise InputError(f"{name}: K-NET header needs {HEADER_LINES} lines", "record")
     header = {ln[:18].strip(): ln[18:].strip() for ln in lines[:HEADER_LINES]}
-
-    def need(label: str) -> str:
-        if not header.get(label):
-            raise InputError(f"{name}: K-NET header has no {label!r}", "record")
-        return header[label]
-
-    rate = first_number(need("Sampling Freq(Hz)"), f"{name} Sampling Freq(Hz)")
-    lo, hi = 1.0 / DT_RANGE_S[1], 1.0 / DT_RANGE_S[0]
-    if not lo <= rate <= hi:
-        raise InputError(
-            f"{name}: Sampling Freq(Hz) is {rate:g} Hz, outside [{lo:g}, {hi:g}] Hz "
-            "(K-NET records are sampled at 100 or 200 Hz)",
-            "record",
-        )
-    duration = first_number(need("Duration Time(s)"), f"{name} Duration Time(s)")
-    if not 0.0 < duration <= DURATION_MAX_S:
-        raise InputError(
-            f"{name}: Duration Time(s) is {duration:g} s, outside (0, {DURATION_MAX_S:g}] s",
-            "record",
-        )
-    scale = _SCALE.match(need("Scale Factor"))
-    if scale is None:
-        raise InputError(
-            f"{name}: Scale Factor {header['Scale Factor']!r} is not of the form 7845(gal)/8223790",
-            "record",
-        )
-    full_gal, full_counts = (number(scale.group(k), f"{name} Scale Factor") for k in (1, 2))
-    _check_scale(full_gal, full_counts, header["Scale Factor"], name)
+    rate, duration = _rate_and_duration(header, name)
+    full_gal, full_counts = _scale_factor(header, name)
     gal_per_count = full_gal / full_counts
-    direction = need("Dir.")
+    direction = _need(header, "Dir.", name)
     if direction not in _DIRECTIONS:
         raise InputError(f"{name}: unknown Dir. {direction!r}", "record")
     counts = [
