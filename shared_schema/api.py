@@ -90,9 +90,7 @@ __all__ = [
     "HistoryResponse",
     "HistoryRow",
     "NzsRequest",
-    "PulseInput",
     "PulseRequest",
-    "PulseResponse",
     "RecordFileOptions",
     "RecordInfo",
     "RecordSamples",
@@ -1043,52 +1041,6 @@ class HealthResponse(BaseModel):
     units: Dict[str, str] = Field(description="Units of the quantities.")
     compute_workers: int = Field(description="Compute processes ready or busy.")
     compute_timeout_s: float = Field(description="Compute time budget per request [s].")
-
-
-class PulseInput(BaseModel):
-    """The pulse problem as solved, with its dimensionless ratios."""
-
-    model_config = _RESPONSE
-
-    p_eq: Optional[float]
-    lam: Optional[float]
-    phi_ov: Optional[float]
-    eta: Optional[float]
-    rocking: Literal["two_sided", "one_sided"]
-    a_p_g: Optional[float]
-    f_p: Optional[float]
-    shape: str
-    omega_ratio: Optional[float] = Field(description="Omega = omega_p / p_eq [-].")
-    amplitude_ratio: Optional[float] = Field(description="A = |a_p| / (g lam) [-].")
-    pulse_convention: str
-
-
-class PulseResponse(BaseModel):
-    """Response of one mechanism to a pulse (``rockmech pulse --json``)."""
-
-    model_config = _RESPONSE
-
-    input: PulseInput
-    peak_ratio: Optional[float] = Field(description="Peak |phi|/phi_ov [-].")
-    t_peak: Optional[float] = Field(None, description="Time of the peak [s].")
-    overturned: bool
-    t_overturn: Optional[float] = Field(description="Time of overturning [s], or null.")
-    criterion: str
-    ratio_exceeded: bool
-    collapsed: bool
-    n_impacts: int
-    n_steps: int
-    error_estimate: Optional[float] = Field(
-        None, description="Estimated absolute error of peak_ratio [-]."
-    )
-    runtime_s: Optional[float]
-    status: int
-    message: str
-    method: str
-    warnings: List[str] = Field(
-        default_factory=list,
-        description="Where the linearised model may be off by > 10 %, or the peak is unresolved.",
-    )
 
 
 class Band(BaseModel):

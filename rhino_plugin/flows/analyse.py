@@ -292,7 +292,7 @@ def run_pulse(
     if client is not None:
         doc = client.post("pulse", payload)
     else:
-        doc = solve_pulse(payload)
+        doc = solve_pulse(payload).to_dict()
     verdict = "OVERTURNS" if doc.get("overturned") else "survives"
     line = f"  {mechanism}: sine pulse a_p = {a_p_g:g} g, f_p = {f_p:g} Hz: {verdict}"
     if "peak_ratio" in doc:

@@ -39,6 +39,7 @@ from shared_schema.api import (
     RecordSamples,
 )
 from shared_schema.constants import ConstantsFile, parse_constants
+from shared_schema.documents.pulse import PulseDocument
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import MissingExtra
 from shared_schema.io import CONSTANTS_EXPECTED, stamped
@@ -293,7 +294,7 @@ def motion_from_params(
 # --- jobs -------------------------------------------------------------------------------------
 
 
-def pulse_doc(job: PulseRequest, limits: Optional[dict[str, Any]] = None) -> dict[str, Any]:
+def pulse_doc(job: PulseRequest, limits: Optional[dict[str, Any]] = None) -> PulseDocument:
     """Response of one mechanism to a pulse, as ``rockmech pulse --json`` prints it.
 
     Parameters

@@ -11,6 +11,7 @@ from typing import Any, Optional
 import numpy as np
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.boundary import BoundaryDocument
 from shared_schema.errors import InputError
 from shared_schema.rules import ENVELOPE_METHODS, check_choice
 
@@ -330,7 +331,7 @@ def band_edges(
 
 def boundary_doc(
     omega: float, eta: Optional[float], *, one_sided: bool = False, shape: str = "sine"
-) -> dict[str, Any]:
+) -> BoundaryDocument:
     """Overturning intervals in ``A = a_p/(g lam)`` at one ``Omega = omega_p/p_eq``."""
 
     def pairs(curve: Any) -> list[list[Optional[float]]]:
@@ -363,7 +364,7 @@ def boundary_doc(
             "a_min": float(curve.a_min[0]) if math.isfinite(curve.a_min[0]) else None,
         }
     doc["search"] = {"a_max": curve.a_max, "scan_ratio": curve.scan_ratio, "rtol": curve.rtol}
-    return stamp(doc, "boundary")
+    return BoundaryDocument.model_validate(stamp(doc, "boundary"))
 
 
 def record_pulse_doc(

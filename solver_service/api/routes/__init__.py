@@ -6,15 +6,17 @@ from fastapi import APIRouter
 
 from . import assess, constants, envelope, meta, pulse, records, report, scale_factor, search
 
-__all__ = ["API_PREFIX", "api_router"]
+__all__ = ["API_PREFIX", "ROUTE_MODULES", "api_router"]
 
 #: Version prefix of every REST endpoint.
 API_PREFIX = "/api/v1"
+#: The modules of the routers, in the order the service includes them.
+ROUTE_MODULES = (meta, constants, search, pulse, envelope, scale_factor, records, report, assess)
 
 
 def api_router() -> APIRouter:
     """Return every REST route under ``API_PREFIX``."""
     router = APIRouter(prefix=API_PREFIX)
-    for module in (meta, constants, search, pulse, envelope, scale_factor, records, report, assess):
+    for module in ROUTE_MODULES:
         router.include_router(module.router)
     return router
