@@ -27,6 +27,10 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from cad_maths.scenes import read_scene as read_scene
     from shared_schema.api import PulseRequest as PulseRequest
     from shared_schema.constants import ConstantsFile as ConstantsFile
+    from shared_schema.documents.boundary import BoundaryDocument as BoundaryDocument
+    from shared_schema.documents.envelope import Band as Band
+    from shared_schema.documents.envelope import EnvelopeDocument as EnvelopeDocument
+    from shared_schema.documents.pulse import PulseDocument as PulseDocument
     from shared_schema.errors import (
         GeometryError as GeometryError,
     )
@@ -127,8 +131,6 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     )
     from .results import AssessmentResult as AssessmentResult
     from .results import CheckResult as CheckResult
-    from .results import CriticalBand as CriticalBand
-    from .results import EnvelopeResult as EnvelopeResult
     from .results import Fragility as Fragility
     from .results import HistoryResult as HistoryResult
     from .results import HistoryRun as HistoryRun
@@ -171,8 +173,8 @@ _SOURCES = {
     "BatchResult": "solver_service.core.exact",
     "HistoryResult": "rockmech.results",
     "HistoryRun": "rockmech.results",
-    "EnvelopeResult": "rockmech.results",
-    "CriticalBand": "rockmech.results",
+    "EnvelopeDocument": "shared_schema.documents.envelope",
+    "Band": "shared_schema.documents.envelope",
     "IDAResult": "rockmech.results",
     "Fragility": "rockmech.results",
     "CheckResult": "rockmech.results",
@@ -188,6 +190,8 @@ _SOURCES = {
     "simulate_batch": "solver_service.core.exact",
     # One pulse request, one function: the same verdict as the CLI, REST, Hops and Rhino.
     "PulseRequest": "shared_schema.api",
+    "PulseDocument": "shared_schema.documents.pulse",
+    "BoundaryDocument": "shared_schema.documents.boundary",
     "solve_pulse": "solver_service.workflows.documents",
     # Envelopes, pulses in records, spectra.
     "mechanism_envelope": "solver_service.core.envelope",

@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from typing import Any, Optional, Union
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.envelope import EnvelopeDocument
 from shared_schema.errors import InputError
 from shared_schema.paths import PATH_TYPES, PathLike, as_path, is_path
 from shared_schema.retrofit import RetrofitDoc, RetrofitSpec, read_retrofit_spec
@@ -35,7 +36,7 @@ from solver_service.workflows.retrofit import retrofit_doc
 from solver_service.workflows.scaling import Building
 from solver_service.workflows.units import stamp
 
-from .results import AssessmentResult, CheckResult, EnvelopeResult, HistoryResult, IDAResult
+from .results import AssessmentResult, CheckResult, HistoryResult, IDAResult
 
 __all__ = [
     "assess",
@@ -298,7 +299,7 @@ def envelope(
     f_max: float = 10.0,
     n: int = 200,
     fast: bool = False,
-) -> EnvelopeResult:
+) -> EnvelopeDocument:
     """Overturning envelopes of every mechanism and the critical bands.
 
     As ``rockmech envelope --json``: the smallest one-sine pulse amplitude at the ground that
@@ -319,12 +320,14 @@ def envelope(
 
     Returns
     -------
-    EnvelopeResult
-        ``f_p`` [Hz], ``a_p_min_g`` per mechanism [g], ``critical`` bands.
+    EnvelopeDocument
+        The document ``rockmech envelope --json`` prints (``to_dict()``): ``f_p`` [Hz],
+        per mechanism its ``a_p_min_g`` [g] (``find(id)``), the ``critical`` bands and
+        ``critical_at(f_p)``.
     """
     method = "library" if fast else "exact"
     doc, _ = envelope_doc(_constants(constants), frequency_grid(f_min, f_max, n), method=method)
-    return EnvelopeResult.from_doc(stamp(doc, "envelope"))
+    return doc
 
 
 def ida(

@@ -1,4 +1,4 @@
-"""Typed results of the analyses in ``rockmech.analysis`` (history, envelope, IDA, check, assess).
+"""Typed results of the analyses in ``rockmech.analysis`` (history, IDA, check, assess).
 
 Each result keeps the numbers a script reads as typed fields (units in brackets) and the
 whole JSON-ready document the command line writes (``doc``), so nothing the command line
@@ -18,8 +18,6 @@ from shared_schema.errors import InputError
 __all__ = [
     "AssessmentResult",
     "CheckResult",
-    "CriticalBand",
-    "EnvelopeResult",
     "Fragility",
     "HistoryResult",
     "HistoryRun",
@@ -117,77 +115,6 @@ class HistoryResult:
                 return r
         known = sorted({f"{r.mechanism} x{r.scale:g}" for r in self.runs})
         raise _unknown("run", f"{mechanism} x{scale:g}", known)
-
-
-@dataclass(frozen=True)
-class CriticalBand:
-    """A band of pulse frequencies over which one mechanism overturns first.
-
-    Attributes
-    ----------
-    mechanism : str
-        The mechanism's id.
-    f_min, f_max : float
-        The band's ends [Hz].
-    """
-
-    mechanism: str
-    f_min: float
-    f_max: float
-
-
-@dataclass(frozen=True)
-class EnvelopeResult:
-    """Overturning envelopes of every mechanism and the critical bands (``rockmech.envelope``).
-
-    Attributes
-    ----------
-    f_p : (n,) float array
-        Pulse frequencies [Hz].
-    a_p_min_g : dict of str to (n,) float array
-        Per mechanism id, the smallest sine-pulse amplitude at the ground that overturns
-        it [g] (amplified mechanisms corrected by Eq. 28; NaN where none does).
-    critical : tuple of CriticalBand
-        The mechanism that overturns first, band by band.
-    doc : dict
-        The whole document, as ``rockmech envelope --json`` prints it.
-    """
-
-    f_p: NDArray[np.float64]
-    a_p_min_g: dict[str, NDArray[np.float64]]
-    critical: tuple[CriticalBand, ...]
-    doc: dict[str, Any]
-
-    @classmethod
-    def from_doc(cls, doc: dict[str, Any]) -> EnvelopeResult:
-        """Read the typed fields of an envelope document."""
-
-        def arr(values: list[Optional[float]]) -> NDArray[np.float64]:
-            return np.array([np.nan if v is None else v for v in values], dtype=float)
-
-        return cls(
-            f_p=arr(doc["f_p"]),
-            a_p_min_g={str(m["id"]): arr(m["a_p_min_g"]) for m in doc["mechanisms"]},
-            critical=tuple(
-                CriticalBand(str(b["mechanism"]), float(b["f_min"]), float(b["f_max"]))
-                for b in doc["critical"]
-            ),
-            doc=doc,
-        )
-
-    def critical_at(self, f_p: float) -> str:
-        """Return the id of the mechanism that overturns first at the frequency ``f_p`` [Hz].
-
-        The nearest tabulated frequency decides.
-        """
-        i = int(np.argmin(np.abs(np.log(self.f_p) - np.log(f_p))))
-        f = float(self.f_p[i])
-        for band in self.critical:
-            if band.f_min <= f <= band.f_max:
-                return band.mechanism
-        raise _unknown(
-            "frequency", f"{f_p:g} Hz", [f"{b.f_min:g}-{b.f_max:g}" for b in self.critical]
-        )
 
 
 @dataclass(frozen=True)

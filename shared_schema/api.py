@@ -29,7 +29,7 @@ from typing import Annotated, Any, Dict, List, Literal, Optional, Tuple, Union
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
-from shared_schema.constants import Amplification, ConstantsFile, JsonInt, Mechanism
+from shared_schema.constants import ConstantsFile, JsonInt, Mechanism
 from shared_schema.errors import InputError
 from shared_schema.rules import (
     A_P_G_MAX,
@@ -71,16 +71,13 @@ __all__ = [
     "TIME_DOMAIN_RANGES",
     "AssessRequest",
     "AssessResponse",
-    "Band",
     "BuildingOptions",
     "CheckRequest",
     "CheckResponse",
     "ConstantsForm",
     "ConstantsResponse",
     "Ec8Request",
-    "EnvelopeMechanism",
     "EnvelopeRequest",
-    "EnvelopeResponse",
     "Eq28Request",
     "ErrorResponse",
     "HealthResponse",
@@ -1041,48 +1038,6 @@ class HealthResponse(BaseModel):
     units: Dict[str, str] = Field(description="Units of the quantities.")
     compute_workers: int = Field(description="Compute processes ready or busy.")
     compute_timeout_s: float = Field(description="Compute time budget per request [s].")
-
-
-class Band(BaseModel):
-    """A run of frequencies where one mechanism governs."""
-
-    mechanism: str
-    f_min: Optional[float] = Field(description="First frequency of the band [Hz].")
-    f_max: Optional[float] = Field(description="Last frequency of the band [Hz].")
-
-
-class EnvelopeMechanism(BaseModel):
-    """Envelope of one mechanism; amplification fields only for mechanisms above ground."""
-
-    model_config = _RESPONSE
-
-    id: str
-    name: Optional[str]
-    rocking: str
-    p_eq: Optional[float]
-    lam: Optional[float]
-    a_p_min_g: List[Optional[float]] = Field(
-        description="Minimum overturning ground pulse amplitude [g] per frequency; null: "
-        "none up to the search limit."
-    )
-    eta: Optional[float] = None
-    amplification: Optional[Amplification] = None
-    a_p_min_local_g: Optional[List[Optional[float]]] = None
-    scale_factor: Optional[List[Optional[float]]] = None
-    governing_side: Optional[List[int]] = None
-
-
-class EnvelopeResponse(BaseModel):
-    """Envelopes and the critical mechanism per frequency (``rockmech envelope --json``)."""
-
-    model_config = _RESPONSE
-
-    units: Dict[str, str]
-    f_p: List[Optional[float]] = Field(description="Pulse frequencies [Hz].")
-    mechanisms: List[EnvelopeMechanism]
-    critical: List[Band]
-    governing: List[Optional[str]]
-    method: Dict[str, Any]
 
 
 class RecordInfo(BaseModel):

@@ -225,7 +225,7 @@ def run_envelopes(
 
     doc = write_envelope(
         cf, frequency_grid(f_min, f_max, n), Path(out_dir), stem=stem, title="Overturning envelopes"
-    )
+    ).to_dict()
     plot = os.path.join(out_dir, f"{stem}.png")
     files = [json_path, os.path.join(out_dir, f"{stem}.csv"), plot]
     return AnalysisResult("Envelopes", doc, _band_lines(doc), plot, files)

@@ -10,11 +10,13 @@ Python 3.9-clean: no ``X | Y`` annotations.
 """
 
 import math
-from typing import Any, Dict
+from typing import Any, Dict, Sequence, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field
 
-__all__ = ["DOCUMENT_CONFIG", "Document", "Part", "finite"]
+from shared_schema.errors import InputError
+
+__all__ = ["DOCUMENT_CONFIG", "Document", "Part", "find_entry", "finite"]
 
 #: Documents state what rockmech computed: unknown keys are refused; a value that is not
 #: finite is kept in the model and written as ``null`` (``to_dict``).
@@ -50,3 +52,21 @@ class Document(Part):
     units: Dict[str, str] = Field(
         description="Unit of each quantity whose name does not state it (``-``: dimensionless)."
     )
+
+
+_E = TypeVar("_E")
+
+
+def find_entry(entries: Sequence[_E], mechanism_id: str) -> _E:
+    """Return the entry whose ``id`` is ``mechanism_id``: every document's ``find``.
+
+    Raises
+    ------
+    InputError
+        No such entry (field ``mechanism``; the message lists the ids the document has).
+    """
+    for entry in entries:
+        if getattr(entry, "id", None) == mechanism_id:
+            return entry
+    known = [getattr(e, "id", None) for e in entries]
+    raise InputError(f"no mechanism {mechanism_id!r}; the document has {known}", "mechanism")

@@ -455,7 +455,10 @@ def build_report(
     """
     cf, motion = _report_inputs(cf, motion)
     check_history_options(scales, history, motion)
-    env, envelopes = envelope_doc(cf, np.asarray(f_p, dtype=float), method=method, library=library)
+    env_doc, envelopes = envelope_doc(
+        cf, np.asarray(f_p, dtype=float), method=method, library=library
+    )
+    env = env_doc.to_dict()  # the report renders the documents' JSON form
     hist = None
     if motion is not None:
         hist = history_doc(cf, motion, list(scales), **(history or {}))

@@ -164,7 +164,7 @@ def _envelope_margin(
         env, _ = envelope_doc(ConstantsFile(mechanisms=[mech]), np.asarray(freq, dtype=float))
     except RockmechError as exc:
         return {"note": f"not run: {exc}"}
-    curve = np.array([np.nan if v is None else v for v in env["mechanisms"][0]["a_p_min_g"]])
+    curve = np.array([np.nan if v is None else v for v in env.mechanisms[0].a_p_min_g])
     out: dict[str, Any] = {"f_p": [float(v) for v in freq], "a_p_min_g": curve.tolist()}
     pulses = []
     for motion, design in zip(motions, designs):

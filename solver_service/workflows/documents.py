@@ -12,6 +12,7 @@ import numpy as np
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.documents.boundary import BoundaryDocument
+from shared_schema.documents.envelope import EnvelopeDocument, RecordPulse
 from shared_schema.errors import InputError
 from shared_schema.rules import ENVELOPE_METHODS, check_choice
 
@@ -176,7 +177,8 @@ def envelope_doc(
     *,
     method: Optional[str] = None,
     library: Optional[OverturningLibrary] = None,
-) -> tuple[dict[str, Any], list[Envelope]]:
+    record_pulse: Optional[RecordPulse] = None,
+) -> tuple[EnvelopeDocument, list[Envelope]]:
     """Ground-level envelopes of every mechanism and the critical bands.
 
     Mechanisms with ``amplification`` are corrected by ``SF(f_p)`` (theory §7); the others
@@ -196,11 +198,14 @@ def envelope_doc(
         band edges within ``LIBRARY_EDGE_RATIO`` (docs/envelopes.md).
     library : OverturningLibrary, optional
         The library of the fast mode (the shipped one by default).
+    record_pulse : RecordPulse, optional
+        A record's largest pulse against the envelopes (``record_pulse_doc``), kept in the
+        document.
 
     Returns
     -------
-    doc : dict
-        JSON-ready result (see ``rockmech envelope``): ``critical`` bands and
+    doc : EnvelopeDocument
+        The document ``rockmech envelope --json`` prints: ``critical`` bands and
         ``critical_edges``, the frequency interval [Hz] that holds each edge between two
         bands as the exact envelopes place it.
     envelopes : list of Envelope
@@ -258,7 +263,9 @@ def envelope_doc(
         "governing": [cf.mechanisms[i].id if i >= 0 else None for i in index],
         "method": _envelope_method(fast, envelopes),
     }
-    return stamp(doc, "envelope"), envelopes
+    if record_pulse is not None:
+        doc["record_pulse"] = record_pulse
+    return EnvelopeDocument.model_validate(stamp(doc, "envelope")), envelopes
 
 
 def _envelope_method(
@@ -375,7 +382,7 @@ def record_pulse_doc(
     f_min: Optional[float] = None,
     f_max: Optional[float] = None,
     method: str = "exact",
-) -> dict[str, Any]:
+) -> RecordPulse:
     """Compare a record's largest sine pulse, at several scale factors, with every envelope.
 
     Each point ``(f_p, s |a_p|)`` lists the mechanisms whose ground-level envelope lies at
@@ -400,7 +407,7 @@ def record_pulse_doc(
         check_positive(value, f"scales[{j}]")
     pulse = largest_pulse(motion.accel, f_min=f_min, f_max=f_max)
     at_fp, _ = envelope_doc(cf, np.array([pulse.f_p]), method=method)
-    a_min = {m["id"]: m["a_p_min_g"][0] for m in at_fp["mechanisms"]}
+    a_min = {m.id: m.a_p_min_g[0] for m in at_fp.mechanisms}
     points = []
     for scale in scales:
         a_p = scale * abs(pulse.a_p_g)
@@ -412,13 +419,15 @@ def record_pulse_doc(
                 "overturns": [k for k, v in a_min.items() if v is not None and a_p >= v],
             }
         )
-    return {
-        "record": motion.name,
-        "pulse": pulse.to_dict(),
-        "method": PULSE_METHOD,
-        "a_p_min_g_at_f_p": a_min,
-        "points": points,
-    }
+    return RecordPulse.model_validate(
+        {
+            "record": motion.name,
+            "pulse": pulse.to_dict(),
+            "method": PULSE_METHOD,
+            "a_p_min_g_at_f_p": a_min,
+            "points": points,
+        }
+    )
 
 
 def history_doc(

@@ -13,6 +13,7 @@ import numpy as np
 
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.envelope import EnvelopeDocument, RecordPulse
 
 from ..report.plots import plot_envelopes, plot_fragility, plot_ratio_histories, plot_record
 from .documents import envelope_doc, history_doc
@@ -29,14 +30,14 @@ __all__ = [
 ]
 
 
-def envelope_csv(doc: dict[str, Any]) -> str:
+def envelope_csv(doc: EnvelopeDocument) -> str:
     """Return an envelope document as CSV: f_p [Hz], a_p_min [g] per mechanism, governing."""
-    ids = [m["id"] for m in doc["mechanisms"]]
+    ids = [m.id for m in doc.mechanisms]
     lines = ["f_p_Hz," + ",".join(f"a_p_min_g_{i}" for i in ids) + ",governing"]
-    for k, f in enumerate(doc["f_p"]):
-        vals = [m["a_p_min_g"][k] for m in doc["mechanisms"]]
+    for k, f in enumerate(doc.f_p):
+        vals = [m.a_p_min_g[k] for m in doc.mechanisms]
         cells = ["" if v is None else f"{v:.6g}" for v in vals]
-        lines.append(f"{f:.6g}," + ",".join(cells) + f",{doc['governing'][k] or ''}")
+        lines.append(f"{f:.6g}," + ",".join(cells) + f",{doc.governing[k] or ''}")
     return "\n".join(lines) + "\n"
 
 
@@ -48,27 +49,26 @@ def write_envelope(
     stem: str = "envelope",
     title: str = "",
     method: str = "exact",
-    record_pulse: Optional[dict[str, Any]] = None,
-) -> dict[str, Any]:
+    record_pulse: Optional[RecordPulse] = None,
+) -> EnvelopeDocument:
     """Write ``<stem>.json``, ``<stem>.csv`` and ``<stem>.png`` (atomically); return the doc.
 
     ``method`` as ``envelope_doc``; ``record_pulse`` (from ``record_pulse_doc``) is added to
     the JSON and drawn on the plot. The plot draws where each band edge lies.
     """
-    doc, envs = envelope_doc(cf, f_p, method=method)
-    if record_pulse is not None:
-        doc["record_pulse"] = record_pulse
+    doc, envs = envelope_doc(cf, f_p, method=method, record_pulse=record_pulse)
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
+    data = doc.to_dict()
+    write_atomic(out_dir / f"{stem}.json", json.dumps(data, indent=2) + "\n")
     write_atomic(out_dir / f"{stem}.csv", envelope_csv(doc))
     plot_envelopes(
         envs,
-        doc["critical"],
+        data["critical"],
         out_dir / f"{stem}.png",
         labels={m.id: f"{m.id}: {m.name}" for m in cf.mechanisms},
         title=title,
-        pulse_points=None if record_pulse is None else record_pulse["points"],
-        edges=doc["critical_edges"],
+        pulse_points=None if record_pulse is None else data["record_pulse"]["points"],
+        edges=data["critical_edges"],
         fast=method == "library",
     )
     return doc
