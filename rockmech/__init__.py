@@ -30,7 +30,10 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from shared_schema.documents.boundary import BoundaryDocument as BoundaryDocument
     from shared_schema.documents.envelope import Band as Band
     from shared_schema.documents.envelope import EnvelopeDocument as EnvelopeDocument
+    from shared_schema.documents.history import HistoryDocument as HistoryDocument
+    from shared_schema.documents.history import HistoryRow as HistoryRow
     from shared_schema.documents.pulse import PulseDocument as PulseDocument
+    from shared_schema.documents.record import RecordDocument as RecordDocument
     from shared_schema.errors import (
         GeometryError as GeometryError,
     )
@@ -132,8 +135,6 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from .results import AssessmentResult as AssessmentResult
     from .results import CheckResult as CheckResult
     from .results import Fragility as Fragility
-    from .results import HistoryResult as HistoryResult
-    from .results import HistoryRun as HistoryRun
     from .results import IDAResult as IDAResult
     from .results import MechanismCheck as MechanismCheck
 
@@ -171,8 +172,9 @@ _SOURCES = {
     "read_retrofit_spec": "shared_schema.retrofit",
     "RockingResult": "solver_service.core.result",
     "BatchResult": "solver_service.core.exact",
-    "HistoryResult": "rockmech.results",
-    "HistoryRun": "rockmech.results",
+    "HistoryDocument": "shared_schema.documents.history",
+    "HistoryRow": "shared_schema.documents.history",
+    "RecordDocument": "shared_schema.documents.record",
     "EnvelopeDocument": "shared_schema.documents.envelope",
     "Band": "shared_schema.documents.envelope",
     "IDAResult": "rockmech.results",

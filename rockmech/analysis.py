@@ -17,6 +17,7 @@ from typing import Any, Optional, Union
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.documents.envelope import EnvelopeDocument
+from shared_schema.documents.history import HistoryDocument
 from shared_schema.errors import InputError
 from shared_schema.paths import PATH_TYPES, PathLike, as_path, is_path
 from shared_schema.retrofit import RetrofitDoc, RetrofitSpec, read_retrofit_spec
@@ -36,7 +37,7 @@ from solver_service.workflows.retrofit import retrofit_doc
 from solver_service.workflows.scaling import Building
 from solver_service.workflows.units import stamp
 
-from .results import AssessmentResult, CheckResult, HistoryResult, IDAResult
+from .results import AssessmentResult, CheckResult, IDAResult
 
 __all__ = [
     "assess",
@@ -252,7 +253,7 @@ def history(
     building_height: Optional[float] = None,
     criterion: Optional[str] = None,
     at_height: Optional[float] = None,
-) -> HistoryResult:
+) -> HistoryDocument:
     """Time histories of every mechanism at every scale factor of a record.
 
     As ``rockmech history --json``.
@@ -276,11 +277,13 @@ def history(
 
     Returns
     -------
-    HistoryResult
-        One ``HistoryRun`` per mechanism and scale (``peak_ratio`` [-], ``overturned``,
-        ``t_overturn`` [s], ``n_impacts``, ``error_estimate`` [-]).
+    HistoryDocument
+        The document ``rockmech history --json`` prints (``to_dict()``): in ``results``
+        one ``HistoryRow`` per mechanism and scale (``peak_ratio`` [-], ``overturned``,
+        ``t_overturn`` [s], ``n_impacts``, ``error_estimate`` [-]); ``find(id, scale)``
+        returns one; ``skipped`` the mechanisms left out.
     """
-    doc = history_doc(
+    return history_doc(
         _constants(constants),
         _record(record),
         [float(s) for s in scales],
@@ -289,7 +292,6 @@ def history(
         criterion=criterion,
         at_height=at_height,
     )
-    return HistoryResult.from_doc(stamp(doc, "history"))
 
 
 def envelope(

@@ -1,4 +1,4 @@
-"""Typed results of the analyses in ``rockmech.analysis`` (history, IDA, check, assess).
+"""Typed results of the analyses in ``rockmech.analysis`` (IDA, check, assess).
 
 Each result keeps the numbers a script reads as typed fields (units in brackets) and the
 whole JSON-ready document the command line writes (``doc``), so nothing the command line
@@ -19,8 +19,6 @@ __all__ = [
     "AssessmentResult",
     "CheckResult",
     "Fragility",
-    "HistoryResult",
-    "HistoryRun",
     "IDAResult",
     "MechanismCheck",
 ]
@@ -32,89 +30,6 @@ def _opt_float(value: Any) -> Optional[float]:
 
 def _unknown(kind: str, name: str, known: list[str]) -> InputError:
     return InputError(f"no {kind} {name!r}; the result has {known}", kind)
-
-
-@dataclass(frozen=True)
-class HistoryRun:
-    """One mechanism at one scale factor of a record (exact integration).
-
-    Attributes
-    ----------
-    mechanism : str
-        The mechanism's id.
-    scale : float
-        The user's scale factor on the record [-].
-    effective_scale : float
-        The scale applied to the mechanism [-]: ``scale`` times its factor up the structure
-        (``sf``), or ``scale`` at ground level.
-    peak_ratio : float
-        Peak ``|phi| / phi_ov`` over the motion, the free-rocking tail included [-].
-    overturned : bool
-        The verdict of the criterion (``ratio``: ``peak_ratio >= 1``; ``exact``: collapse).
-    t_overturn : float or None
-        Time of overturning [s] (None when it survives).
-    n_impacts : int
-        Impacts counted.
-    error_estimate : float
-        The solver's estimate of the error of ``peak_ratio`` [-].
-    """
-
-    mechanism: str
-    scale: float
-    effective_scale: float
-    peak_ratio: float
-    overturned: bool
-    t_overturn: Optional[float]
-    n_impacts: int
-    error_estimate: float
-
-
-@dataclass(frozen=True)
-class HistoryResult:
-    """Time histories of every mechanism at every scale factor (``rockmech.history``).
-
-    Attributes
-    ----------
-    runs : tuple of HistoryRun
-        One per mechanism and scale factor, mechanism by mechanism.
-    criterion : str
-        ``"ratio"`` or ``"exact"``.
-    skipped : tuple of dict
-        Mechanisms left out, each ``{"mechanism", "reason"}`` (e.g. no ``eta``).
-    doc : dict
-        The whole document, as ``rockmech history --json`` prints it.
-    """
-
-    runs: tuple[HistoryRun, ...]
-    criterion: str
-    skipped: tuple[dict[str, Any], ...]
-    doc: dict[str, Any]
-
-    @classmethod
-    def from_doc(cls, doc: dict[str, Any]) -> HistoryResult:
-        """Read the typed fields of a history document."""
-        runs = tuple(
-            HistoryRun(
-                mechanism=str(r["mechanism"]),
-                scale=float(r["scale"]),
-                effective_scale=float(r.get("effective_scale", r["scale"])),
-                peak_ratio=float(r["peak_ratio"]),
-                overturned=bool(r["overturned"]),
-                t_overturn=_opt_float(r.get("t_overturn")),
-                n_impacts=int(r["n_impacts"]),
-                error_estimate=float(r["error_estimate"]),
-            )
-            for r in doc["results"]
-        )
-        return cls(runs, str(doc["criterion"]), tuple(doc.get("skipped", [])), doc)
-
-    def run(self, mechanism: str, scale: float) -> HistoryRun:
-        """Return the run of ``mechanism`` at the user scale factor ``scale`` [-]."""
-        for r in self.runs:
-            if r.mechanism == mechanism and r.scale == scale:
-                return r
-        known = sorted({f"{r.mechanism} x{r.scale:g}" for r in self.runs})
-        raise _unknown("run", f"{mechanism} x{scale:g}", known)
 
 
 @dataclass(frozen=True)

@@ -84,12 +84,9 @@ __all__ = [
     "HistoryForm",
     "HistoryOptions",
     "HistoryRequest",
-    "HistoryResponse",
-    "HistoryRow",
     "NzsRequest",
     "PulseRequest",
     "RecordFileOptions",
-    "RecordInfo",
     "RecordSamples",
     "ReportForm",
     "ReportOptions",
@@ -98,11 +95,9 @@ __all__ = [
     "ScaleFactorResponse",
     "SearchForm",
     "SearchResponse",
-    "SpectrumCurve",
     "SpectrumForm",
     "SpectrumOptions",
     "SpectrumRequest",
-    "SpectrumResponse",
     "mechanism_problem",
     "time_domain_problem",
 ]
@@ -1038,79 +1033,6 @@ class HealthResponse(BaseModel):
     units: Dict[str, str] = Field(description="Units of the quantities.")
     compute_workers: int = Field(description="Compute processes ready or busy.")
     compute_timeout_s: float = Field(description="Compute time budget per request [s].")
-
-
-class RecordInfo(BaseModel):
-    """The record as read: name, step, PGA, duration and what the reader found."""
-
-    model_config = _RESPONSE
-
-    name: str
-    dt_s: Optional[float]
-    pga_g: Optional[float]
-    duration_s: Optional[float]
-
-
-class HistoryRow(BaseModel):
-    """One mechanism at one scale factor."""
-
-    model_config = _RESPONSE
-
-    mechanism: str
-    scale: Optional[float]
-    peak_ratio: Optional[float]
-    overturned: bool
-    t_overturn: Optional[float]
-    n_impacts: int
-    error_estimate: Optional[float]
-    status: int
-    message: str
-    effective_scale: Optional[float] = None
-    peak_displacement_m: Optional[float] = None
-    peak_displacement_is_bound: Optional[bool] = None
-    warnings: Optional[List[str]] = Field(None, description="Present when the peak is unresolved.")
-
-
-class HistoryResponse(BaseModel):
-    """Time histories (``rockmech history --json``)."""
-
-    model_config = _RESPONSE
-
-    record: RecordInfo
-    criterion: str
-    method: str
-    runtime_s: Optional[float]
-    results: List[HistoryRow]
-    scale_factor_method: Optional[str] = None
-    scale_factors: Optional[Dict[str, Dict[str, Any]]] = None
-    displacement: Optional[Dict[str, Any]] = None
-    warnings: Optional[Dict[str, List[str]]] = Field(
-        None, description="Per mechanism, where the linearised model may be off by > 10 %."
-    )
-
-
-class SpectrumCurve(BaseModel):
-    """An elastic response spectrum."""
-
-    model_config = _RESPONSE
-
-    damping: Optional[float] = Field(description="Damping ratio [-].")
-    periods_s: List[Optional[float]]
-    psa_g: List[Optional[float]] = Field(description="Pseudo-spectral acceleration [g].")
-    sd_m: List[Optional[float]] = Field(description="Spectral displacement [m].")
-    method: str
-    runtime_s: Optional[float]
-
-
-class SpectrumResponse(BaseModel):
-    """A record's spectrum and largest sine pulses (``rockmech record --json``)."""
-
-    model_config = _RESPONSE
-
-    record: RecordInfo
-    pulses: List[Dict[str, Any]] = Field(description="Largest one-cycle sine pulses.")
-    pulse_method: str
-    spectrum: SpectrumCurve
 
 
 class ScaleFactorResponse(BaseModel):

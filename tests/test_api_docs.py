@@ -97,8 +97,8 @@ def test_facade_analyses_give_the_command_lines_numbers(tmp_path: Path) -> None:
     record = EXAMPLES / "records" / "elcentro_NS.dat"
     cli = _cli_json(["history", str(walls), str(record), "--scale", "0.5", "1"])
     facade = rockmech.history(walls, record, scales=[0.5, 1.0])
-    assert _without_times(facade.doc) == _without_times(cli)
-    assert [(r.mechanism, r.scale, r.peak_ratio) for r in facade.runs] == [
+    assert _without_times(facade.to_dict()) == _without_times(cli)
+    assert [(r.mechanism, r.scale, r.peak_ratio) for r in facade.results] == [
         (r["mechanism"], r["scale"], r["peak_ratio"]) for r in cli["results"]
     ]
     church = EXAMPLES / "constants" / "church_geometry.json"
@@ -130,8 +130,8 @@ def test_a_run_or_mechanism_not_in_a_result_is_named_with_those_that_are() -> No
     walls = EXAMPLES / "constants" / "rect_walls.json"
     record = EXAMPLES / "records" / "elcentro_NS.dat"
     result = rockmech.history(walls, record, scales=[1.0])
-    with pytest.raises(InputError, match=r"no run 'W9 x1'; the result has \['F1 x1', 'W1 x1'"):
-        result.run("W9", 1.0)
+    with pytest.raises(InputError, match=r"no run 'W9 x1'; the document has \['F1 x1', 'W1 x1'"):
+        result.find("W9", 1.0)
     checks = rockmech.check(
         EXAMPLES / "constants" / "church_geometry.json", EXAMPLES / "sites" / "ntc_site.json"
     )

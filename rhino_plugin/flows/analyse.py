@@ -273,7 +273,9 @@ def run_history(
         write_atomic(json_path, json.dumps(doc, indent=2) + "\n")
         return AnalysisResult("History", doc, said + _history_lines(doc), None, [json_path])
 
-    doc = write_history(cf, motion, list(scales), Path(out_dir), stem=stem, title=motion.name)
+    doc = write_history(
+        cf, motion, list(scales), Path(out_dir), stem=stem, title=motion.name
+    ).to_dict()
     plot = os.path.join(out_dir, f"{stem}.png")
     files = [json_path, plot, os.path.join(out_dir, f"{stem}_record.png")]
     return AnalysisResult("History", doc, said + _history_lines(doc), plot, files)

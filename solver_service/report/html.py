@@ -461,7 +461,7 @@ def build_report(
     env = env_doc.to_dict()  # the report renders the documents' JSON form
     hist = None
     if motion is not None:
-        hist = history_doc(cf, motion, list(scales), **(history or {}))
+        hist = history_doc(cf, motion, list(scales), **(history or {})).to_dict()
     title = title or "rockmech report"
     with tempfile.TemporaryDirectory(prefix="rockmech-report-") as tmp:
         folder = Path(tmp)

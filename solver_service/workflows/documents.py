@@ -13,6 +13,8 @@ import numpy as np
 from shared_schema.constants import ConstantsFile
 from shared_schema.documents.boundary import BoundaryDocument
 from shared_schema.documents.envelope import EnvelopeDocument, RecordPulse
+from shared_schema.documents.history import HistoryDocument
+from shared_schema.documents.record import RecordDocument
 from shared_schema.errors import InputError
 from shared_schema.rules import ENVELOPE_METHODS, check_choice
 
@@ -87,7 +89,7 @@ def frequency_grid(f_min: float, f_max: float, n: int) -> np.ndarray[Any, Any]:
     return log_grid(f_min, f_max, n)
 
 
-def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> dict[str, Any]:
+def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> RecordDocument:
     """Describe a record: metadata, its largest sine pulses and its response spectrum.
 
     Parameters
@@ -119,7 +121,7 @@ def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> dict[str, Any]:
             "runtime_s": spectrum.runtime_s,
         },
     }
-    return stamp(doc, "record")
+    return RecordDocument.model_validate(stamp(doc, "record"))
 
 
 def record_analysis(
@@ -130,7 +132,7 @@ def record_analysis(
     n_pulses: int = 5,
     f_min: Optional[float] = None,
     f_max: Optional[float] = None,
-) -> tuple[dict[str, Any], Spectrum, list[Any]]:
+) -> tuple[RecordDocument, Spectrum, list[Any]]:
     """Compute the spectrum and largest sine pulses of a record once, with their document.
 
     Parameters
@@ -148,7 +150,7 @@ def record_analysis(
 
     Returns
     -------
-    doc : dict
+    doc : RecordDocument
         ``record_doc`` (``rockmech record --json``, ``POST /spectrum``).
     spectrum : Spectrum
         The spectrum, for plots.
@@ -440,8 +442,8 @@ def history_doc(
     criterion: Optional[str] = None,
     at_height: Optional[float] = None,
     runs: Optional[dict[tuple[str, float], Any]] = None,
-) -> dict[str, Any]:
-    """Time histories of every mechanism at every scale, as a JSON-ready document.
+) -> HistoryDocument:
+    """Time histories of every mechanism at every scale (``rockmech history --json``).
 
     With ``sf`` other than ``"none"`` a mechanism with ``amplification {f_n, h_e, h}``
     receives the record times its scale factor (``mechanism_scale_factor``) on top of each
@@ -507,7 +509,7 @@ def history_doc(
     notes = linearisation_notes(cf, models)
     if notes:
         doc["warnings"] = notes
-    return stamp(doc, "history")
+    return HistoryDocument.model_validate(stamp(doc, "history"))
 
 
 def time_domain_mechanisms(cf: ConstantsFile) -> tuple[ConstantsFile, list[dict[str, str]]]:

@@ -14,6 +14,8 @@ import numpy as np
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile
 from shared_schema.documents.envelope import EnvelopeDocument, RecordPulse
+from shared_schema.documents.history import HistoryDocument
+from shared_schema.documents.record import RecordDocument
 
 from ..report.plots import plot_envelopes, plot_fragility, plot_ratio_histories, plot_record
 from .documents import envelope_doc, history_doc
@@ -84,7 +86,7 @@ def write_history(
     title: str = "",
     max_panels: int = 6,
     **options: Any,
-) -> dict[str, Any]:
+) -> HistoryDocument:
     """Write ``<stem>.json``, ``<stem>.png`` and ``<stem>_record.png``; return the doc.
 
     ``<stem>.png`` shows ``phi/phi_ov`` of every mechanism against time, one panel per
@@ -95,12 +97,12 @@ def write_history(
     runs: dict[tuple[str, float], Any] = {}
     doc = history_doc(cf, motion, scales, runs=runs, **options)
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
+    write_atomic(out_dir / f"{stem}.json", json.dumps(doc.to_dict(), indent=2) + "\n")
     order = sorted(set(scales))
     picks = sorted(
         {order[round(k)] for k in np.linspace(0, len(order) - 1, min(max_panels, len(order)))}
     )
-    ids = list(dict.fromkeys(row["mechanism"] for row in doc["results"]))  # file order
+    ids = list(dict.fromkeys(row.mechanism for row in doc.results))  # file order
     panels = [(scale, [(mech_id, runs[(mech_id, scale)]) for mech_id in ids]) for scale in picks]
     plot_ratio_histories(panels, out_dir / f"{stem}.png", title=title or motion.name)
     plot_record(motion, out_dir / f"{stem}_record.png")
@@ -108,7 +110,7 @@ def write_history(
 
 
 def write_record(
-    motion: Any, doc: dict[str, Any], spectrum: Any, pulses: list[Any], out_dir: Path
+    motion: Any, doc: RecordDocument, spectrum: Any, pulses: list[Any], out_dir: Path
 ) -> None:
     """Write ``record.json`` and ``record.png`` (the record, its pulses and its spectrum).
 
@@ -122,7 +124,7 @@ def write_record(
         Output folder (created if missing).
     """
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / "record.json", json.dumps(doc, indent=2) + "\n")
+    write_atomic(out_dir / "record.json", json.dumps(doc.to_dict(), indent=2) + "\n")
     plot_record(motion, out_dir / "record.png", spectrum=spectrum, pulses=pulses)
 
 
