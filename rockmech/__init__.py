@@ -27,7 +27,10 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from cad_maths.scenes import read_scene as read_scene
     from shared_schema.api import PulseRequest as PulseRequest
     from shared_schema.constants import ConstantsFile as ConstantsFile
+    from shared_schema.documents.assess import AssessDocument as AssessDocument
     from shared_schema.documents.boundary import BoundaryDocument as BoundaryDocument
+    from shared_schema.documents.check import CheckDocument as CheckDocument
+    from shared_schema.documents.check import CheckMechanism as CheckMechanism
     from shared_schema.documents.envelope import Band as Band
     from shared_schema.documents.envelope import EnvelopeDocument as EnvelopeDocument
     from shared_schema.documents.history import HistoryDocument as HistoryDocument
@@ -132,11 +135,8 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from .analysis import (
         retrofit as retrofit,
     )
-    from .results import AssessmentResult as AssessmentResult
-    from .results import CheckResult as CheckResult
     from .results import Fragility as Fragility
     from .results import IDAResult as IDAResult
-    from .results import MechanismCheck as MechanismCheck
 
 #: Each public name and the module it comes from (imported on first access).
 _SOURCES = {
@@ -179,9 +179,9 @@ _SOURCES = {
     "Band": "shared_schema.documents.envelope",
     "IDAResult": "rockmech.results",
     "Fragility": "rockmech.results",
-    "CheckResult": "rockmech.results",
-    "MechanismCheck": "rockmech.results",
-    "AssessmentResult": "rockmech.results",
+    "CheckDocument": "shared_schema.documents.check",
+    "CheckMechanism": "shared_schema.documents.check",
+    "AssessDocument": "shared_schema.documents.assess",
     # Models, excitations and the exact solver.
     "G": "solver_service.core.model",
     "RockingModel": "solver_service.core.model",

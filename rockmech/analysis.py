@@ -16,6 +16,8 @@ from collections.abc import Sequence
 from typing import Any, Optional, Union
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.assess import AssessDocument
+from shared_schema.documents.check import CheckDocument
 from shared_schema.documents.envelope import EnvelopeDocument
 from shared_schema.documents.history import HistoryDocument
 from shared_schema.errors import InputError
@@ -37,7 +39,7 @@ from solver_service.workflows.retrofit import retrofit_doc
 from solver_service.workflows.scaling import Building
 from solver_service.workflows.units import stamp
 
-from .results import AssessmentResult, CheckResult, IDAResult
+from .results import IDAResult
 
 __all__ = [
     "assess",
@@ -386,7 +388,7 @@ def ida(
     return IDAResult.from_doc(stamp(doc, "ida"))
 
 
-def check(constants: Constants, site: Union[SiteFile, PathLike]) -> CheckResult:
+def check(constants: Constants, site: Union[SiteFile, PathLike]) -> CheckDocument:
     """NTC 2018 / Circolare 2019 §C8.7.1 kinematic checks of every mechanism on a site.
 
     As ``rockmech check --json``; mechanisms need ``virtual_work`` per side.
@@ -400,12 +402,13 @@ def check(constants: Constants, site: Union[SiteFile, PathLike]) -> CheckResult:
 
     Returns
     -------
-    CheckResult
-        Per mechanism ``passes`` and the linear and nonlinear capacity ratios [-];
+    CheckDocument
+        The document ``rockmech check --json`` prints (``to_dict()``): per mechanism
+        (``find(id)``) ``passes``, ``passes_SLC``, ``Z`` [m], the governing ``linear`` and
+        ``nonlinear`` checks and their ``linear_ratio``, ``nonlinear_ratio`` [-];
         ``governing``.
     """
-    doc = _assess.check_doc(_constants(constants), _site(site))
-    return CheckResult.from_doc(stamp(doc, "check"))
+    return _assess.check_document(_constants(constants), _site(site))
 
 
 def assess(
@@ -414,7 +417,7 @@ def assess(
     records: Sequence[Record] = (),
     *,
     multiples: Sequence[float] = (0.5, 1.0, 1.5, 2.0),
-) -> AssessmentResult:
+) -> AssessDocument:
     """Code checks beside rocking dynamics on records scaled to the site spectrum.
 
     As ``rockmech assess --json`` (the HTML page: ``rockmech assess -o report.html``).
@@ -432,18 +435,18 @@ def assess(
 
     Returns
     -------
-    AssessmentResult
-        The checks (as ``check``), and per mechanism ``survives_design`` and
-        ``first_overturning_multiple`` [-].
+    AssessDocument
+        The document ``rockmech assess --json`` prints: the checks (as ``check``), each
+        mechanism's ``dynamics`` and ``envelope``, and per mechanism id
+        ``survives_design`` and ``first_overturning_multiple`` [-].
     """
     motions: list[Any] = list(_records(records))
-    doc = _assess.assessment_doc(
+    return _assess.assessment_document(
         _constants(constants),
         _site(site),
         motions,
         multiples=_assess.check_multiples(list(multiples)),
     )
-    return AssessmentResult.from_doc(stamp(doc, "assess"))
 
 
 def retrofit(

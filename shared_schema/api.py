@@ -70,10 +70,8 @@ __all__ = [
     "SEARCH_MAX_EVALUATIONS",
     "TIME_DOMAIN_RANGES",
     "AssessRequest",
-    "AssessResponse",
     "BuildingOptions",
     "CheckRequest",
-    "CheckResponse",
     "ConstantsForm",
     "ConstantsResponse",
     "Ec8Request",
@@ -1044,30 +1042,6 @@ class ScaleFactorResponse(BaseModel):
     method: str
     formula: str
     inputs: Dict[str, Optional[float]]
-
-
-class CheckResponse(BaseModel):
-    """Code checks (``rockmech check --json``); fields named as the Circolare names them."""
-
-    model_config = _RESPONSE
-
-    site: Dict[str, Any] = Field(description="Code, spectrum parameters, corner periods, FC, q.")
-    spectrum: Dict[str, Any] = Field(description="T [s], Se_g [g], SDe_m [m] for plotting.")
-    mechanisms: List[Dict[str, Any]] = Field(
-        description="Per mechanism: Z, per side and governing linear and nonlinear checks "
-        "(status ok, or not_run with a note), passes."
-    )
-    governing: Optional[str] = Field(description="Mechanism with the lowest capacity ratio.")
-
-
-class AssessResponse(CheckResponse):
-    """The assessment document (``rockmech assess --json``)."""
-
-    records: List[Dict[str, Any]] = Field(
-        description="The records: name, pga_g, dt, duration, and warnings (an implausible PGA "
-        "or time step, naming the units read) where there are any."
-    )
-    multiples: List[Optional[float]] = Field(description="Multiples of the design scale run.")
 
 
 #: The constants endpoint answers with a kinematic-constants file.

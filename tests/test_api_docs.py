@@ -105,11 +105,11 @@ def test_facade_analyses_give_the_command_lines_numbers(tmp_path: Path) -> None:
     site = EXAMPLES / "sites" / "ntc_site.json"
     cli = _cli_json(["check", str(church), str(site)])
     checks = rockmech.check(church, site)
-    assert checks.doc == cli and checks.governing == cli["governing"]
+    assert checks.to_dict() == cli and checks.governing == cli["governing"]
     for row, typed in zip(cli["mechanisms"], checks.mechanisms):
         assert typed.linear_ratio == row["linear"]["capacity_ratio"]
         assert typed.passes is row["passes"]
-        assert typed.passes_slc is row["nonlinear"]["SLC"]["passes"] is row["passes_SLC"]
+        assert typed.passes_SLC is row["nonlinear"]["SLC"]["passes"] is row["passes_SLC"]
     cli = _cli_json(
         [
             "envelope",
@@ -135,5 +135,5 @@ def test_a_run_or_mechanism_not_in_a_result_is_named_with_those_that_are() -> No
     checks = rockmech.check(
         EXAMPLES / "constants" / "church_geometry.json", EXAMPLES / "sites" / "ntc_site.json"
     )
-    with pytest.raises(InputError, match=r"no mechanism 'X'; the result has \['F1', 'F2'"):
-        checks.mechanism("X")
+    with pytest.raises(InputError, match=r"no mechanism 'X'; the document has \['F1', 'F2'"):
+        checks.find("X")
