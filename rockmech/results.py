@@ -13,8 +13,6 @@ from typing import Any, Optional
 import numpy as np
 from numpy.typing import NDArray
 
-from shared_schema.errors import InputError
-
 __all__ = [
     "Fragility",
     "IDAResult",
@@ -23,10 +21,6 @@ __all__ = [
 
 def _opt_float(value: Any) -> Optional[float]:
     return None if value is None else float(value)
-
-
-def _unknown(kind: str, name: str, known: list[str]) -> InputError:
-    return InputError(f"no {kind} {name!r}; the result has {known}", kind)
 
 
 @dataclass(frozen=True)

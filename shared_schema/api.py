@@ -5,9 +5,11 @@ are refused, and unknown keys are errors. Range checks that the command line als
 (``p_eq > 0``, ``eta`` in [-1, 1], ...) are left to the solver, so that the service gives the
 same message as ``rockmech``; their limits are still stated in the published schema.
 
-Responses mirror the JSON documents that ``rockmech ... --json`` prints. Optional sections
-that do not apply are absent, not ``null``; a number is ``null`` only where its value is not
-finite (an overflow on extreme inputs, or "none up to the search limit").
+The analyses answer with their documents, the models of ``shared_schema.documents`` (what
+``rockmech ... --json`` prints; the routes declare them as ``response_model``). Optional
+sections that do not apply are absent, not ``null``; a number is ``null`` only where its
+value is not finite (an overflow on extreme inputs, or "none up to the search limit").
+The responses left here: errors, health, the scale factor and the search.
 
 The published schema states every rule JSON Schema can state, so that clients learn them
 from the contract: the ranges of ``shared_schema.rules``, the options' bounds, and the rules
