@@ -41,19 +41,22 @@ class CheckMethod(Part):
 
 
 class CheckSite(Part):
-    """The site: its code, the spectrum's parameters and each limit state's hazard."""
+    """The site: its code, the spectrum's parameters and each limit state's hazard.
+
+    A number is null only where it is not finite (inputs at the edge of double precision).
+    """
 
     code: Literal["NTC2018", "EC8"] = Field(description="The hazard's code.")
     params: Dict[str, Any] = Field(description="The hazard as given, with derived factors.")
-    S: float = Field(description="Soil and topography factor [-].")
-    eta: float = Field(description="Damping correction of the plotted spectrum [-].")
-    F: float = Field(description="Spectral amplification F0 [-].")
-    T_B: float = Field(description="Corner period T_B [s].")
-    T_C: float = Field(description="Corner period T_C [s].")
-    T_D: float = Field(description="Corner period T_D [s].")
-    pga_g: float = Field(description="Peak ground acceleration a_g S [g].")
-    FC: float = Field(description="Confidence factor [-].")
-    q: float = Field(description="Behaviour factor [-].")
+    S: Optional[float] = Field(description="Soil and topography factor [-].")
+    eta: Optional[float] = Field(description="Damping correction of the plotted spectrum [-].")
+    F: Optional[float] = Field(description="Spectral amplification F0 [-].")
+    T_B: Optional[float] = Field(description="Corner period T_B [s].")
+    T_C: Optional[float] = Field(description="Corner period T_C [s].")
+    T_D: Optional[float] = Field(description="Corner period T_D [s].")
+    pga_g: Optional[float] = Field(description="Peak ground acceleration a_g S [g].")
+    FC: Optional[float] = Field(description="Confidence factor [-].")
+    q: Optional[float] = Field(description="Behaviour factor [-].")
     limit_state: str = Field(description="The limit state of the checks (SLV).")
     limit_states: Dict[str, Optional[Dict[str, Any]]] = Field(
         description="Per limit state its hazard: a_g [g], S, F, T_B, T_C, T_D [s], pga_g [g] "
@@ -69,9 +72,13 @@ class CheckSite(Part):
 class CheckSpectrum(Part):
     """The site's elastic spectrum, for plotting."""
 
-    T: List[float] = Field(description="Periods [s].")
-    Se_g: List[float] = Field(description="Elastic spectral acceleration [g].")
-    SDe_m: List[float] = Field(description="Elastic spectral displacement [m].")
+    T: List[Optional[float]] = Field(description="Periods [s].")
+    Se_g: List[Optional[float]] = Field(
+        description="Elastic spectral acceleration [g] (null where not finite: extreme inputs)."
+    )
+    SDe_m: List[Optional[float]] = Field(
+        description="Elastic spectral displacement [m] (null where not finite)."
+    )
 
 
 class FreeStanding(Part):
