@@ -130,7 +130,7 @@ def run(quick: bool) -> list[dict[str, Any]]:
             "fast_s": t_fast,
             "cli_exact_s": cli_time(path, False),
             "cli_fast_s": cli_time(path, True),
-            **compare(exact, fast),
+            **compare(exact.to_dict(), fast.to_dict()),
         }
         rows.append(row)
         print(

@@ -174,9 +174,9 @@ def main(argv: list[str] | None = None) -> int:
     def rank() -> list[str]:
         env, _ = envelope_doc(cf, f_p, library=library)
         scores = {}
-        for entry in env["mechanisms"]:
-            vals = [v for v in entry["a_p_min_g"] if v is not None]
-            scores[entry["id"]] = float(np.exp(np.mean(np.log(vals)))) if vals else math.inf
+        for entry in env.mechanisms:
+            vals = [v for v in entry.a_p_min_g if v is not None]
+            scores[entry.id] = float(np.exp(np.mean(np.log(vals)))) if vals else math.inf
         return sorted(scores, key=lambda k: scores[k])
 
     cold_r, rank_s, rank_w, order = best_of(rank)

@@ -27,6 +27,16 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from cad_maths.scenes import read_scene as read_scene
     from shared_schema.api import PulseRequest as PulseRequest
     from shared_schema.constants import ConstantsFile as ConstantsFile
+    from shared_schema.documents.assess import AssessDocument as AssessDocument
+    from shared_schema.documents.boundary import BoundaryDocument as BoundaryDocument
+    from shared_schema.documents.check import CheckDocument as CheckDocument
+    from shared_schema.documents.check import CheckMechanism as CheckMechanism
+    from shared_schema.documents.envelope import Band as Band
+    from shared_schema.documents.envelope import EnvelopeDocument as EnvelopeDocument
+    from shared_schema.documents.history import HistoryDocument as HistoryDocument
+    from shared_schema.documents.history import HistoryRow as HistoryRow
+    from shared_schema.documents.pulse import PulseDocument as PulseDocument
+    from shared_schema.documents.record import RecordDocument as RecordDocument
     from shared_schema.errors import (
         GeometryError as GeometryError,
     )
@@ -121,15 +131,8 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from .analysis import (
         search as search,
     )
-    from .results import AssessmentResult as AssessmentResult
-    from .results import CheckResult as CheckResult
-    from .results import CriticalBand as CriticalBand
-    from .results import EnvelopeResult as EnvelopeResult
     from .results import Fragility as Fragility
-    from .results import HistoryResult as HistoryResult
-    from .results import HistoryRun as HistoryRun
     from .results import IDAResult as IDAResult
-    from .results import MechanismCheck as MechanismCheck
 
 #: Each public name and the module it comes from (imported on first access).
 _SOURCES = {
@@ -163,15 +166,16 @@ _SOURCES = {
     "read_retrofit_spec": "shared_schema.retrofit",
     "RockingResult": "solver_service.core.result",
     "BatchResult": "solver_service.core.exact",
-    "HistoryResult": "rockmech.results",
-    "HistoryRun": "rockmech.results",
-    "EnvelopeResult": "rockmech.results",
-    "CriticalBand": "rockmech.results",
+    "HistoryDocument": "shared_schema.documents.history",
+    "HistoryRow": "shared_schema.documents.history",
+    "RecordDocument": "shared_schema.documents.record",
+    "EnvelopeDocument": "shared_schema.documents.envelope",
+    "Band": "shared_schema.documents.envelope",
     "IDAResult": "rockmech.results",
     "Fragility": "rockmech.results",
-    "CheckResult": "rockmech.results",
-    "MechanismCheck": "rockmech.results",
-    "AssessmentResult": "rockmech.results",
+    "CheckDocument": "shared_schema.documents.check",
+    "CheckMechanism": "shared_schema.documents.check",
+    "AssessDocument": "shared_schema.documents.assess",
     # Models, excitations and the exact solver.
     "G": "solver_service.core.model",
     "RockingModel": "solver_service.core.model",
@@ -182,6 +186,8 @@ _SOURCES = {
     "simulate_batch": "solver_service.core.exact",
     # One pulse request, one function: the same verdict as the CLI, REST, Hops and Rhino.
     "PulseRequest": "shared_schema.api",
+    "PulseDocument": "shared_schema.documents.pulse",
+    "BoundaryDocument": "shared_schema.documents.boundary",
     "solve_pulse": "solver_service.workflows.documents",
     # Envelopes, pulses in records, spectra.
     "mechanism_envelope": "solver_service.core.envelope",

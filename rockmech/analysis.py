@@ -21,6 +21,10 @@ from typing import TYPE_CHECKING, Any, Optional, Union
 import numpy as np
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.assess import AssessDocument
+from shared_schema.documents.check import CheckDocument
+from shared_schema.documents.envelope import EnvelopeDocument
+from shared_schema.documents.history import HistoryDocument
 from shared_schema.errors import InputError, wrong_type
 from shared_schema.paths import (
     PATH_TYPES,
@@ -49,7 +53,7 @@ from solver_service.workflows.retrofit_records import read_retrofit_records
 from solver_service.workflows.scaling import Building
 from solver_service.workflows.units import stamp
 
-from .results import AssessmentResult, CheckResult, EnvelopeResult, HistoryResult, IDAResult
+from .results import IDAResult
 
 if TYPE_CHECKING:  # the search's types; its workflow is imported when a search runs
     from cad_maths.scene_base import BaseScene
@@ -278,7 +282,7 @@ def history(
     building_height: Optional[float] = None,
     criterion: Optional[str] = None,
     at_height: Optional[float] = None,
-) -> HistoryResult:
+) -> HistoryDocument:
     """Time histories of every mechanism at every scale factor of a record.
 
     As ``rockmech history --json``.
@@ -302,11 +306,13 @@ def history(
 
     Returns
     -------
-    HistoryResult
-        One ``HistoryRun`` per mechanism and scale (``peak_ratio`` [-], ``overturned``,
-        ``t_overturn`` [s], ``n_impacts``, ``error_estimate`` [-]).
+    HistoryDocument
+        The document ``rockmech history --json`` prints (``to_dict()``): in ``results``
+        one ``HistoryRow`` per mechanism and scale (``peak_ratio`` [-], ``overturned``,
+        ``t_overturn`` [s], ``n_impacts``, ``error_estimate`` [-]); ``find(id, scale)``
+        returns one; ``skipped`` the mechanisms left out.
     """
-    doc = history_doc(
+    return history_doc(
         _constants(constants),
         _record(record),
         _numbers(scales, "scales"),
@@ -315,7 +321,6 @@ def history(
         criterion=criterion,
         at_height=at_height,
     )
-    return HistoryResult.from_doc(stamp(doc, "history"))
 
 
 def envelope(
@@ -325,7 +330,7 @@ def envelope(
     f_max: float = 10.0,
     n: int = 200,
     fast: bool = False,
-) -> EnvelopeResult:
+) -> EnvelopeDocument:
     """Overturning envelopes of every mechanism and the critical bands.
 
     As ``rockmech envelope --json``: the smallest one-sine pulse amplitude at the ground that
@@ -346,12 +351,14 @@ def envelope(
 
     Returns
     -------
-    EnvelopeResult
-        ``f_p`` [Hz], ``a_p_min_g`` per mechanism [g], ``critical`` bands.
+    EnvelopeDocument
+        The document ``rockmech envelope --json`` prints (``to_dict()``): ``f_p`` [Hz],
+        per mechanism its ``a_p_min_g`` [g] (``find(id)``), the ``critical`` bands and
+        ``critical_at(f_p)``.
     """
     method = "library" if fast else "exact"
     doc, _ = envelope_doc(_constants(constants), frequency_grid(f_min, f_max, n), method=method)
-    return EnvelopeResult.from_doc(stamp(doc, "envelope"))
+    return doc
 
 
 def ida(
@@ -408,7 +415,7 @@ def ida(
     return IDAResult.from_doc(stamp(doc, "ida"))
 
 
-def check(constants: Constants, site: Site) -> CheckResult:
+def check(constants: Constants, site: Site) -> CheckDocument:
     """NTC 2018 / Circolare 2019 §C8.7.1 kinematic checks of every mechanism on a site.
 
     As ``rockmech check --json``; mechanisms need ``virtual_work`` per side.
@@ -422,12 +429,13 @@ def check(constants: Constants, site: Site) -> CheckResult:
 
     Returns
     -------
-    CheckResult
-        Per mechanism ``passes`` and the linear and nonlinear capacity ratios [-];
+    CheckDocument
+        The document ``rockmech check --json`` prints (``to_dict()``): per mechanism
+        (``find(id)``) ``passes``, ``passes_SLC``, ``Z`` [m], the governing ``linear`` and
+        ``nonlinear`` checks and their ``linear_ratio``, ``nonlinear_ratio`` [-];
         ``governing``.
     """
-    doc = _assess.check_doc(_constants(constants), _site(site))
-    return CheckResult.from_doc(stamp(doc, "check"))
+    return _assess.check_document(_constants(constants), _site(site))
 
 
 def assess(
@@ -436,7 +444,7 @@ def assess(
     records: Sequence[Record] = (),
     *,
     multiples: Sequence[float] = (0.5, 1.0, 1.5, 2.0),
-) -> AssessmentResult:
+) -> AssessDocument:
     """Code checks beside rocking dynamics on records scaled to the site spectrum.
 
     As ``rockmech assess --json`` (the HTML page: ``rockmech assess -o report.html``).
@@ -454,18 +462,18 @@ def assess(
 
     Returns
     -------
-    AssessmentResult
-        The checks (as ``check``), and per mechanism ``survives_design`` and
-        ``first_overturning_multiple`` [-].
+    AssessDocument
+        The document ``rockmech assess --json`` prints: the checks (as ``check``), each
+        mechanism's ``dynamics`` and ``envelope``, and per mechanism id
+        ``survives_design`` and ``first_overturning_multiple`` [-].
     """
     motions: list[Any] = list(_records(records))
-    doc = _assess.assessment_doc(
+    return _assess.assessment_document(
         _constants(constants),
         _site(site),
         motions,
         multiples=_assess.check_multiples(_numbers(multiples, "multiples")),
     )
-    return AssessmentResult.from_doc(stamp(doc, "assess"))
 
 
 def retrofit(

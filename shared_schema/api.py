@@ -5,9 +5,11 @@ are refused, and unknown keys are errors. Range checks that the command line als
 (``p_eq > 0``, ``eta`` in [-1, 1], ...) are left to the solver, so that the service gives the
 same message as ``rockmech``; their limits are still stated in the published schema.
 
-Responses mirror the JSON documents that ``rockmech ... --json`` prints. Optional sections
-that do not apply are absent, not ``null``; a number is ``null`` only where its value is not
-finite (an overflow on extreme inputs, or "none up to the search limit").
+The analyses answer with their documents, the models of ``shared_schema.documents`` (what
+``rockmech ... --json`` prints; the routes declare them as ``response_model``). Optional
+sections that do not apply are absent, not ``null``; a number is ``null`` only where its
+value is not finite (an overflow on extreme inputs, or "none up to the search limit").
+The responses left here: errors, health, the scale factor and the search.
 
 The published schema states every rule JSON Schema can state, so that clients learn them
 from the contract: the ranges of ``shared_schema.rules``, the options' bounds, and the rules
@@ -29,7 +31,7 @@ from typing import Annotated, Any, Dict, List, Literal, Optional, Tuple, Union
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
-from shared_schema.constants import Amplification, ConstantsFile, JsonInt, Mechanism
+from shared_schema.constants import ConstantsFile, JsonInt, Mechanism
 from shared_schema.errors import InputError
 from shared_schema.retrofit import RetrofitDoc, RetrofitSpec
 from shared_schema.rules import (
@@ -71,31 +73,21 @@ __all__ = [
     "SEARCH_MAX_EVALUATIONS",
     "TIME_DOMAIN_RANGES",
     "AssessRequest",
-    "AssessResponse",
-    "Band",
     "BuildingOptions",
     "CheckRequest",
-    "CheckResponse",
     "ConstantsForm",
     "ConstantsResponse",
     "Ec8Request",
-    "EnvelopeMechanism",
     "EnvelopeRequest",
-    "EnvelopeResponse",
     "Eq28Request",
     "ErrorResponse",
     "HealthResponse",
     "HistoryForm",
     "HistoryOptions",
     "HistoryRequest",
-    "HistoryResponse",
-    "HistoryRow",
     "NzsRequest",
-    "PulseInput",
     "PulseRequest",
-    "PulseResponse",
     "RecordFileOptions",
-    "RecordInfo",
     "RecordSamples",
     "ReportForm",
     "ReportOptions",
@@ -106,11 +98,9 @@ __all__ = [
     "ScaleFactorResponse",
     "SearchForm",
     "SearchResponse",
-    "SpectrumCurve",
     "SpectrumForm",
     "SpectrumOptions",
     "SpectrumRequest",
-    "SpectrumResponse",
     "mechanism_problem",
     "time_domain_problem",
 ]
@@ -1065,167 +1055,6 @@ class HealthResponse(BaseModel):
     compute_timeout_s: float = Field(description="Compute time budget per request [s].")
 
 
-class PulseInput(BaseModel):
-    """The pulse problem as solved, with its dimensionless ratios."""
-
-    model_config = _RESPONSE
-
-    p_eq: Optional[float]
-    lam: Optional[float]
-    phi_ov: Optional[float]
-    eta: Optional[float]
-    rocking: Literal["two_sided", "one_sided"]
-    a_p_g: Optional[float]
-    f_p: Optional[float]
-    shape: str
-    omega_ratio: Optional[float] = Field(description="Omega = omega_p / p_eq [-].")
-    amplitude_ratio: Optional[float] = Field(description="A = |a_p| / (g lam) [-].")
-    pulse_convention: str
-
-
-class PulseResponse(BaseModel):
-    """Response of one mechanism to a pulse (``rockmech pulse --json``)."""
-
-    model_config = _RESPONSE
-
-    input: PulseInput
-    peak_ratio: Optional[float] = Field(description="Peak |phi|/phi_ov [-].")
-    t_peak: Optional[float] = Field(None, description="Time of the peak [s].")
-    overturned: bool
-    t_overturn: Optional[float] = Field(description="Time of overturning [s], or null.")
-    criterion: str
-    ratio_exceeded: bool
-    collapsed: bool
-    n_impacts: int
-    n_steps: int
-    error_estimate: Optional[float] = Field(
-        None, description="Estimated absolute error of peak_ratio [-]."
-    )
-    runtime_s: Optional[float]
-    status: int
-    message: str
-    method: str
-    warnings: List[str] = Field(
-        default_factory=list,
-        description="Where the linearised model may be off by > 10 %, or the peak is unresolved.",
-    )
-
-
-class Band(BaseModel):
-    """A run of frequencies where one mechanism governs."""
-
-    mechanism: str
-    f_min: Optional[float] = Field(description="First frequency of the band [Hz].")
-    f_max: Optional[float] = Field(description="Last frequency of the band [Hz].")
-
-
-class EnvelopeMechanism(BaseModel):
-    """Envelope of one mechanism; amplification fields only for mechanisms above ground."""
-
-    model_config = _RESPONSE
-
-    id: str
-    name: Optional[str]
-    rocking: str
-    p_eq: Optional[float]
-    lam: Optional[float]
-    a_p_min_g: List[Optional[float]] = Field(
-        description="Minimum overturning ground pulse amplitude [g] per frequency; null: "
-        "none up to the search limit."
-    )
-    eta: Optional[float] = None
-    amplification: Optional[Amplification] = None
-    a_p_min_local_g: Optional[List[Optional[float]]] = None
-    scale_factor: Optional[List[Optional[float]]] = None
-    governing_side: Optional[List[int]] = None
-
-
-class EnvelopeResponse(BaseModel):
-    """Envelopes and the critical mechanism per frequency (``rockmech envelope --json``)."""
-
-    model_config = _RESPONSE
-
-    units: Dict[str, str]
-    f_p: List[Optional[float]] = Field(description="Pulse frequencies [Hz].")
-    mechanisms: List[EnvelopeMechanism]
-    critical: List[Band]
-    governing: List[Optional[str]]
-    method: Dict[str, Any]
-
-
-class RecordInfo(BaseModel):
-    """The record as read: name, step, PGA, duration and what the reader found."""
-
-    model_config = _RESPONSE
-
-    name: str
-    dt_s: Optional[float]
-    pga_g: Optional[float]
-    duration_s: Optional[float]
-
-
-class HistoryRow(BaseModel):
-    """One mechanism at one scale factor."""
-
-    model_config = _RESPONSE
-
-    mechanism: str
-    scale: Optional[float]
-    peak_ratio: Optional[float]
-    overturned: bool
-    t_overturn: Optional[float]
-    n_impacts: int
-    error_estimate: Optional[float]
-    status: int
-    message: str
-    effective_scale: Optional[float] = None
-    peak_displacement_m: Optional[float] = None
-    peak_displacement_is_bound: Optional[bool] = None
-    warnings: Optional[List[str]] = Field(None, description="Present when the peak is unresolved.")
-
-
-class HistoryResponse(BaseModel):
-    """Time histories (``rockmech history --json``)."""
-
-    model_config = _RESPONSE
-
-    record: RecordInfo
-    criterion: str
-    method: str
-    runtime_s: Optional[float]
-    results: List[HistoryRow]
-    scale_factor_method: Optional[str] = None
-    scale_factors: Optional[Dict[str, Dict[str, Any]]] = None
-    displacement: Optional[Dict[str, Any]] = None
-    warnings: Optional[Dict[str, List[str]]] = Field(
-        None, description="Per mechanism, where the linearised model may be off by > 10 %."
-    )
-
-
-class SpectrumCurve(BaseModel):
-    """An elastic response spectrum."""
-
-    model_config = _RESPONSE
-
-    damping: Optional[float] = Field(description="Damping ratio [-].")
-    periods_s: List[Optional[float]]
-    psa_g: List[Optional[float]] = Field(description="Pseudo-spectral acceleration [g].")
-    sd_m: List[Optional[float]] = Field(description="Spectral displacement [m].")
-    method: str
-    runtime_s: Optional[float]
-
-
-class SpectrumResponse(BaseModel):
-    """A record's spectrum and largest sine pulses (``rockmech record --json``)."""
-
-    model_config = _RESPONSE
-
-    record: RecordInfo
-    pulses: List[Dict[str, Any]] = Field(description="Largest one-cycle sine pulses.")
-    pulse_method: str
-    spectrum: SpectrumCurve
-
-
 class ScaleFactorResponse(BaseModel):
     """A scale factor with its method, formula and inputs."""
 
@@ -1235,30 +1064,6 @@ class ScaleFactorResponse(BaseModel):
     method: str
     formula: str
     inputs: Dict[str, Optional[float]]
-
-
-class CheckResponse(BaseModel):
-    """Code checks (``rockmech check --json``); fields named as the Circolare names them."""
-
-    model_config = _RESPONSE
-
-    site: Dict[str, Any] = Field(description="Code, spectrum parameters, corner periods, FC, q.")
-    spectrum: Dict[str, Any] = Field(description="T [s], Se_g [g], SDe_m [m] for plotting.")
-    mechanisms: List[Dict[str, Any]] = Field(
-        description="Per mechanism: Z, per side and governing linear and nonlinear checks "
-        "(status ok, or not_run with a note), passes."
-    )
-    governing: Optional[str] = Field(description="Mechanism with the lowest capacity ratio.")
-
-
-class AssessResponse(CheckResponse):
-    """The assessment document (``rockmech assess --json``)."""
-
-    records: List[Dict[str, Any]] = Field(
-        description="The records: name, pga_g, dt, duration, and warnings (an implausible PGA "
-        "or time step, naming the units read) where there are any."
-    )
-    multiples: List[Optional[float]] = Field(description="Multiples of the design scale run.")
 
 
 #: The retrofit endpoint answers with the retrofit document (``retrofit.json``).

@@ -120,19 +120,19 @@ def test_facade_analyses_give_the_command_lines_numbers(tmp_path: Path) -> None:
     record = EXAMPLES / "records" / "elcentro_NS.dat"
     cli = _cli_json(["history", str(walls), str(record), "--scale", "0.5", "1"])
     facade = rockmech.history(walls, record, scales=[0.5, 1.0])
-    assert _without_times(facade.doc) == _without_times(cli)
-    assert [(r.mechanism, r.scale, r.peak_ratio) for r in facade.runs] == [
+    assert _without_times(facade.to_dict()) == _without_times(cli)
+    assert [(r.mechanism, r.scale, r.peak_ratio) for r in facade.results] == [
         (r["mechanism"], r["scale"], r["peak_ratio"]) for r in cli["results"]
     ]
     church = EXAMPLES / "constants" / "church_geometry.json"
     site = EXAMPLES / "sites" / "ntc_site.json"
     cli = _cli_json(["check", str(church), str(site)])
     checks = rockmech.check(church, site)
-    assert checks.doc == cli and checks.governing == cli["governing"]
+    assert checks.to_dict() == cli and checks.governing == cli["governing"]
     for row, typed in zip(cli["mechanisms"], checks.mechanisms):
         assert typed.linear_ratio == row["linear"]["capacity_ratio"]
         assert typed.passes is row["passes"]
-        assert typed.passes_slc is row["nonlinear"]["SLC"]["passes"] is row["passes_SLC"]
+        assert typed.passes_SLC is row["nonlinear"]["SLC"]["passes"] is row["passes_SLC"]
     cli = _cli_json(
         [
             "envelope",
@@ -144,18 +144,19 @@ def test_facade_analyses_give_the_command_lines_numbers(tmp_path: Path) -> None:
         ]
     )
     env = rockmech.envelope(EXAMPLES / "constants" / "church.json", n=7)
-    assert _without_times(env.doc) == _without_times(cli)
-    assert env.f_p.tolist() == cli["f_p"]
+    assert _without_times(env.to_dict()) == _without_times(cli)
+    assert env.f_p == cli["f_p"]
+    assert env.find("F1").a_p_min_g == cli["mechanisms"][0]["a_p_min_g"]
 
 
 def test_a_run_or_mechanism_not_in_a_result_is_named_with_those_that_are() -> None:
     walls = EXAMPLES / "constants" / "rect_walls.json"
     record = EXAMPLES / "records" / "elcentro_NS.dat"
     result = rockmech.history(walls, record, scales=[1.0])
-    with pytest.raises(InputError, match=r"no run 'W9 x1'; the result has \['F1 x1', 'W1 x1'"):
-        result.run("W9", 1.0)
+    with pytest.raises(InputError, match=r"no run 'W9 x1'; the document has \['F1 x1', 'W1 x1'"):
+        result.find("W9", 1.0)
     checks = rockmech.check(
         EXAMPLES / "constants" / "church_geometry.json", EXAMPLES / "sites" / "ntc_site.json"
     )
-    with pytest.raises(InputError, match=r"no mechanism 'X'; the result has \['F1', 'F2'"):
-        checks.mechanism("X")
+    with pytest.raises(InputError, match=r"no mechanism 'X'; the document has \['F1', 'F2'"):
+        checks.find("X")

@@ -30,6 +30,7 @@ from typing import Any, Optional
 import pytest
 
 import rockmech
+from shared_schema.documents.base import Document
 
 EX = rockmech.examples_dir()
 WALLS = EX / "constants" / "rect_walls.json"
@@ -234,9 +235,11 @@ def canonical(value: Any) -> Any:
         return re.sub(r"generated [^<]*? UTC", "generated", value)
     if isinstance(value, rockmech.GroundMotion):
         return (value.name, value.dt, value.accel.acc.tolist(), value.warnings, value.metadata)
+    if isinstance(value, Document):  # the analyses' documents: their JSON, clocks aside
+        return json.dumps(_untimed(value.to_dict()), sort_keys=True)
     if hasattr(value, "model_dump"):  # ConstantsFile, SiteFile, SearchSpec
         return json.dumps(value.model_dump(mode="json"), sort_keys=True)
-    if hasattr(value, "doc"):  # the analyses' results and SearchRun
+    if hasattr(value, "doc"):  # the IDA's result and SearchRun
         return json.dumps(_untimed(value.doc), sort_keys=True)
     if hasattr(value, "objects"):  # a scene
         return (value.units, value.unit_scale, value.tolerance, value.objects)

@@ -24,7 +24,7 @@ def test_envelope_plot_of_degenerate_constants(tmp_path: Path) -> None:
         warnings.simplefilter("ignore", RuntimeWarning)  # omega_p/p_eq overflows to inf
         doc, envs = envelope_doc(cf, np.geomspace(0.1, 10.0, 12))
     assert not any(np.isfinite(v) and v > 0 for v in envs[0].a_p_min_g)
-    out = plot_envelopes(envs, doc["critical"], tmp_path / "e.png")
+    out = plot_envelopes(envs, [b.to_dict() for b in doc.critical], tmp_path / "e.png")
     assert out.read_bytes()[:8] == PNG
 
 
@@ -58,7 +58,9 @@ def test_envelope_plot_draws_where_each_band_edge_lies(
     cf = load_constants(Path(__file__).resolve().parents[1] / "examples/constants/church.json")
     for method, label in (("exact", "between two grid frequencies"), ("library", "×1.05")):
         seen.clear()
-        doc = write_envelope(cf, frequency_grid(0.1, 10.0, 60), tmp_path / method, method=method)
+        doc = write_envelope(
+            cf, frequency_grid(0.1, 10.0, 60), tmp_path / method, method=method
+        ).to_dict()
         assert len(doc["critical_edges"]) == len(doc["critical"]) - 1 >= 2
         (fig,) = seen
         ax = fig.axes[0]

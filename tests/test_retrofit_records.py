@@ -127,7 +127,7 @@ def test_the_wall_overturns_as_it_stands_and_the_design_scale_is_the_assessments
     assert before["survives_design"] is False and before["multiple"] < 1.0
     # The design scale is rockmech assess's, on the same record and site.
     assessed = rockmech.assess(wall["constants"], wall["site"], [ELCENTRO], multiples=[1.0])
-    dyn = assessed.doc["mechanisms"][0]["dynamics"][0]
+    dyn = (assessed.mechanisms[0].dynamics or [])[0]
     assert before["design_scale"] == pytest.approx(dyn["scale_factor"]["value"], rel=1e-12)
     assert dyn["survives_design"] is False
     assert wall_doc["records"][0]["name"] == "elcentro_NS"

@@ -225,7 +225,7 @@ def run_envelopes(
 
     doc = write_envelope(
         cf, frequency_grid(f_min, f_max, n), Path(out_dir), stem=stem, title="Overturning envelopes"
-    )
+    ).to_dict()
     plot = os.path.join(out_dir, f"{stem}.png")
     files = [json_path, os.path.join(out_dir, f"{stem}.csv"), plot]
     return AnalysisResult("Envelopes", doc, _band_lines(doc), plot, files)
@@ -273,7 +273,9 @@ def run_history(
         write_atomic(json_path, json.dumps(doc, indent=2) + "\n")
         return AnalysisResult("History", doc, said + _history_lines(doc), None, [json_path])
 
-    doc = write_history(cf, motion, list(scales), Path(out_dir), stem=stem, title=motion.name)
+    doc = write_history(
+        cf, motion, list(scales), Path(out_dir), stem=stem, title=motion.name
+    ).to_dict()
     plot = os.path.join(out_dir, f"{stem}.png")
     files = [json_path, plot, os.path.join(out_dir, f"{stem}_record.png")]
     return AnalysisResult("History", doc, said + _history_lines(doc), plot, files)
@@ -292,7 +294,7 @@ def run_pulse(
     if client is not None:
         doc = client.post("pulse", payload)
     else:
-        doc = solve_pulse(payload)
+        doc = solve_pulse(payload).to_dict()
     verdict = "OVERTURNS" if doc.get("overturned") else "survives"
     line = f"  {mechanism}: sine pulse a_p = {a_p_g:g} g, f_p = {f_p:g} Hz: {verdict}"
     if "peak_ratio" in doc:

@@ -1,6 +1,6 @@
 """RM_CodeCheck: the code's kinematic checks of every mechanism on a site (theory §11).
 
-Runs ``solver_service.workflows.assess.check_doc`` through the Python API or, with a service
+Runs ``solver_service.workflows.assess.check_document`` through the Python API or, with a service
 URL, ``POST <url>/api/v1/check`` with ``{"constants": ..., "site": ...}`` (the same JSON as
 the files). The summary has one line per mechanism: its linear and nonlinear verdicts (the
 Circolare 2019's SLV checks, and the SLC where the site gives its hazard) with their
@@ -15,8 +15,7 @@ from typing import Any, Dict, List, Optional
 from rhino_plugin.flows.analyse import AnalysisResult, ServiceClient
 from shared_schema.errors import InputError
 from shared_schema.site import parse_site
-from solver_service.workflows.assess import check_doc
-from solver_service.workflows.units import stamp
+from solver_service.workflows.assess import check_document
 
 __all__ = ["check_lines", "parse_site_text", "run_check"]
 
@@ -62,5 +61,5 @@ def run_check(cf: Any, site: Any, *, client: Optional[ServiceClient] = None) -> 
         }
         doc = client.post("check", payload)
     else:
-        doc = stamp(check_doc(cf, site), "check")
+        doc = check_document(cf, site).to_dict()
     return AnalysisResult("Check", doc, check_lines(doc))

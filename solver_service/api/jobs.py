@@ -39,6 +39,7 @@ from shared_schema.api import (
     RecordSamples,
 )
 from shared_schema.constants import ConstantsFile, parse_constants
+from shared_schema.documents.pulse import PulseDocument
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import MissingExtra
 from shared_schema.io import CONSTANTS_EXPECTED, stamped
@@ -63,7 +64,13 @@ from ..core.records import GroundMotion
 from ..core.spectra import STEPS_PER_PERIOD, response_spectrum
 from ..report.assess import chromium, print_pdf
 from ..report.html import SPECTRUM_PERIODS, input_source
-from ..workflows.assess import BAND_POINTS, assessment_doc, check_doc, matching_band
+from ..workflows.assess import (
+    BAND_POINTS,
+    assessment_document,
+    check_doc,
+    check_document,
+    matching_band,
+)
 from ..workflows.documents import (
     envelope_doc,
     frequency_grid,
@@ -297,7 +304,7 @@ def motion_from_params(
 # --- jobs -------------------------------------------------------------------------------------
 
 
-def pulse_doc(job: PulseRequest, limits: Optional[dict[str, Any]] = None) -> dict[str, Any]:
+def pulse_doc(job: PulseRequest, limits: Optional[dict[str, Any]] = None) -> PulseDocument:
     """Response of one mechanism to a pulse, as ``rockmech pulse --json`` prints it.
 
     Parameters
@@ -544,7 +551,7 @@ def run_report(job: ReportJob, blobs: list[bytes], limits: dict[str, Any]) -> by
 def run_check(job: CheckJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     """Answer ``rockmech check --json``'s document."""
     cf = _constants(job.constants.model_dump(exclude_none=True), "constants", limits)
-    return dumps(stamp(check_doc(cf, job.site), "check"))
+    return dumps(check_document(cf, job.site))
 
 
 #: The sections of a retrofit request that a retrofit's own errors name without the
@@ -639,8 +646,7 @@ def check_spectra_work(
 def run_assess(job: AssessJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     """Answer ``rockmech assess --json``'s document."""
     cf, motions = _assess_inputs(job, limits)
-    doc = assessment_doc(cf, job.site, motions, multiples=list(job.multiples))
-    return dumps(stamp(doc, "assess"))
+    return dumps(assessment_document(cf, job.site, motions, multiples=list(job.multiples)))
 
 
 def run_assess_pdf(job: AssessPdfJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:

@@ -39,24 +39,24 @@ def check(
 ) -> None:
     """Code checks of every mechanism (Circolare 2019 §C8.7.1: linear SLV, nonlinear SLV/SLC)."""
     # The code checks and their readers are loaded when the command runs (#38).
-    from ..workflows import assess, inputs, units
+    from ..workflows import assess, inputs
 
-    doc = assess.check_doc(inputs.read_constants(constants), assess.read_site(site))
+    doc = assess.check_document(inputs.read_constants(constants), assess.read_site(site))
     if as_json:
-        print_json(units.stamp(doc, "check"))
+        print_json(doc)
         return
-    s = doc["site"]
-    typer.echo(f"method: {doc['method']['name']}: {doc['method']['standard']}")
-    typer.echo(f"{s['code']}: a_g S = {s['pga_g']:.4f} g, FC = {s['FC']:g}, q = {s['q']:g}")
-    if s.get("T1") is not None:
-        typer.echo(f"T1 = {s['T1']:.4g} s ({s['T1_source']})")
-    period = "T_SLV s" if doc["method"]["name"] == "circ2019" else "Ts s"
+    s = doc.site
+    typer.echo(f"method: {doc.method.name}: {doc.method.standard}")
+    typer.echo(f"{s.code}: a_g S = {s.pga_g:.4f} g, FC = {s.FC:g}, q = {s.q:g}")
+    if s.T1 is not None:
+        typer.echo(f"T1 = {s.T1:.4g} s ({s.T1_source})")
+    period = "T_SLV s" if doc.method.name == "circ2019" else "Ts s"
     typer.echo(
         f"{'mechanism':<10}{'alpha0':>9}{'e*':>8}{'a0* m/s2':>10}{'demand':>9}{'linear':>8}"
         f"{'d m':>9}{'demand':>9}{period:>8}{'nonlinear':>11}"
     )
-    for row in doc["mechanisms"]:
-        lin, non = row["linear"], row["nonlinear"]
+    for row in doc.mechanisms:
+        lin, non = row.linear, row.nonlinear
         if lin.get("status") == "ok":
             left = (
                 f"{lin['alpha0']:>9.4g}{lin['e_star']:>8.4g}{lin['a0_star']:>10.4g}"
@@ -70,18 +70,19 @@ def check(
             right = f"{_num(d, 9)}{_num(non.get('demand'), 9)}{_num(t, 8, 3)}{_verdict(non):>11}"
         else:
             right = f"{'-':>9}{'-':>9}{'-':>8}{_verdict(non):>11}"
-        typer.echo(f"{row['id']:<10}" + left + right)
+        typer.echo(f"{row.id:<10}" + left + right)
         slc = non.get("SLC") if non.get("status") == "ok" else None
         if slc is not None:
             state = {True: "pass", False: "FAIL", None: "not evaluated"}[slc["passes"]]
             typer.echo(
-                f"  {row['id']}: SLC d = {slc['d']:.4g} m, demand = {slc['demand']:.4g} m, "
+                f"  {row.id}: SLC d = {slc['d']:.4g} m, demand = {slc['demand']:.4g} m, "
                 f"T_SLC = {slc['T_SLC']:.3g} s, a_g,SLC = {slc['a_g_capacity']:.4g} g: {state}"
             )
-        for text in sorted({lin.get("note"), non.get("note")} - {None, ""}):
-            typer.echo(f"  note: {row['id']}: {text}")
-    if doc["governing"] is not None:
-        typer.echo(f"governing mechanism: {doc['governing']}")
+        notes: set[str] = {str(c["note"]) for c in (lin, non) if c.get("note")}
+        for text in sorted(notes):
+            typer.echo(f"  note: {row.id}: {text}")
+    if doc.governing is not None:
+        typer.echo(f"governing mechanism: {doc.governing}")
 
 
 # assess reads records without --channel and --component
@@ -119,7 +120,7 @@ def assess(
     from ..workflows import assess as workflow
 
     # The constants reader.
-    from ..workflows import inputs, units
+    from ..workflows import inputs
 
     # The assessment and its page's figures, run when the command runs.
     from ..workflows.pages import assess_report
@@ -164,4 +165,4 @@ def assess(
     if pdf:
         typer.echo(f"wrote {print_pdf(out, out.with_suffix('.pdf'))}", err=as_json)
     if as_json:
-        print_json(units.stamp(doc, "assess"))
+        print_json(workflow.typed_assessment(doc))

@@ -87,7 +87,7 @@ def envelope(
             title=f"Overturning envelopes: {constants.name}",
             record_pulse=pulse,
         )
-    library_file = doc["method"].get("library_file", "shipped with rockmech")
+    library_file = getattr(doc.method, "library_file", "shipped with rockmech")
     if library_file != "shipped with rockmech":
         note(f"note: envelopes interpolated in the library {library_file}")
     if as_json:
@@ -95,18 +95,18 @@ def envelope(
         return
     typer.echo(f"wrote {out / 'envelope.json'}, envelope.csv, envelope.png")
     typer.echo("critical mechanism by pulse frequency:")
-    rows = [[str(b["mechanism"]), g4(b["f_min"]), g4(b["f_max"])] for b in doc["critical"]]
+    rows = [[b.mechanism, g4(b.f_min), g4(b.f_max)] for b in doc.critical]
     for line in table(["mechanism", "f_min [Hz]", "f_max [Hz]"], rows):
         typer.echo(line)
     if pulse is not None:
-        p = pulse["pulse"]
+        p = pulse.pulse
         typer.echo(
-            f"largest pulse of {pulse['record']}: {abs(p['a_p_g']):.4f} g at "
-            f"{p['f_p_hz']:.3f} Hz (t = {p['t_start_s']:.2f} s)"
+            f"largest pulse of {pulse.record}: {abs(p.a_p_g):.4f} g at "
+            f"{p.f_p_hz:.3f} Hz (t = {p.t_start_s:.2f} s)"
         )
-        for point in pulse["points"]:
-            names = ", ".join(point["overturns"]) or "none"
-            typer.echo(f"  x{point['scale']:g}: {point['a_p_g']:.4f} g overturns {names}")
+        for point in pulse.points:
+            names = ", ".join(point.overturns) or "none"
+            typer.echo(f"  x{point.scale:g}: {point.a_p_g:.4f} g overturns {names}")
 
 
 @user_errors

@@ -113,31 +113,31 @@ def history(
         return
     typer.echo(
         f"{motion.name}: PGA {motion.pga_g:.3f} g, dt {motion.dt:g} s, "
-        f"{motion.duration:.2f} s; criterion: {doc['criterion']}"
+        f"{motion.duration:.2f} s; criterion: {doc.criterion}"
     )
-    for mech_id, info in doc.get("scale_factors", {}).items():
-        typer.echo(f"  SF {mech_id}: {info['value']:.4f} = {info['formula']}")
+    for mech_id, info in (doc.scale_factors or {}).items():
+        typer.echo(f"  SF {mech_id}: {info.value:.4f} = {info.formula}")
     disp = at_height is not None
     headers = ["mechanism", "scale", "peak |phi|/phi_ov", "overturned", "t_ov [s]", "impacts"]
     headers += ["error"] + (["u_peak [m]"] if disp else [])
     rows = []
-    for row in doc["results"]:
+    for row in doc.results:
         cells = [
-            str(row["mechanism"]),
-            g4(row["scale"]),
-            g4(row["peak_ratio"]),
-            "yes" if row["overturned"] else "no",
-            g4(row["t_overturn"]),
-            str(row["n_impacts"]),
-            f"{row['error_estimate']:.1e}",
+            row.mechanism,
+            g4(row.scale),
+            g4(row.peak_ratio),
+            "yes" if row.overturned else "no",
+            g4(row.t_overturn),
+            str(row.n_impacts),
+            f"{row.error_estimate:.1e}",
         ]
-        rows.append(cells + ([g4(row["peak_displacement_m"])] if disp else []))
+        rows.append(cells + ([g4(row.peak_displacement_m)] if disp else []))
     for line in table(headers, rows):
         typer.echo(line)
-    for mech_id, notes in doc.get("warnings", {}).items():
+    for mech_id, notes in (doc.warnings or {}).items():
         for text in notes:
             mechanism_warning(mech_id, text)
-    for text in doc.get("option_warnings", []):
+    for text in doc.option_warnings or []:
         note(f"warning: {text}")
     skipped_notes(doc)
     if out is not None:
@@ -196,14 +196,15 @@ def record_info(
         )
     )
     typer.echo("largest one-cycle sine pulses (a_p signed: > 0 first accelerates positively):")
-    rows = [[f"{p['a_p_g']:+.4g}", g4(p["f_p_hz"]), g4(p["t_start_s"])] for p in doc["pulses"]]
+    rows = [[f"{p.a_p_g:+.4g}", g4(p.f_p_hz), g4(p.t_start_s)] for p in doc.pulses]
     for line in table(["a_p [g]", "f_p [Hz]", "t_start [s]"], rows):
         typer.echo(line)
-    spec = doc["spectrum"]
-    k = max(range(len(spec["psa_g"])), key=lambda i: spec["psa_g"][i])
+    spec = doc.spectrum
+    psa = [-1.0 if v is None else v for v in spec.psa_g]
+    k = max(range(len(psa)), key=lambda i: psa[i])
     typer.echo(
-        f"spectrum ({100 * zeta:g} %): peak PSA {spec['psa_g'][k]:.4f} g at "
-        f"T = {spec['periods_s'][k]:.3f} s (computed in {spec['runtime_s'] * 1e3:.1f} ms)"
+        f"spectrum ({100 * zeta:g} %): peak PSA {spec.psa_g[k]:.4f} g at "
+        f"T = {spec.periods_s[k]:.3f} s (computed in {(spec.runtime_s or 0.0) * 1e3:.1f} ms)"
     )
     if out is not None:
         typer.echo(f"wrote {out / 'record.json'}, record.png")

@@ -39,10 +39,22 @@ def out_note(message: str) -> None:
     note(f"note: {message}")
 
 
-def skipped_notes(doc: dict[str, Any]) -> None:
-    """Print a warning for each mechanism an analysis left out (``doc["skipped"]``)."""
-    for skip in doc.get("skipped", []):
-        note(f"warning: {skip['mechanism']} skipped: {skip['reason']}")
+def skipped_notes(doc: Any) -> None:
+    """Print a warning for each mechanism an analysis left out (its ``skipped``).
+
+    ``doc`` is a document's JSON form or a typed document (``shared_schema.documents``).
+    """
+    skipped = doc.get("skipped", []) if isinstance(doc, dict) else doc.skipped or []
+    for skip in skipped:
+        mech, reason = (
+            (skip["mechanism"], skip["reason"])
+            if isinstance(skip, dict)
+            else (
+                skip.mechanism,
+                skip.reason,
+            )
+        )
+        note(f"warning: {mech} skipped: {reason}")
 
 
 def mechanism_warning(mech_id: str, text: str) -> None:

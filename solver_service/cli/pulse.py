@@ -75,19 +75,20 @@ def pulse(
     if as_json:
         print_json(doc)
         return
-    verdict = "OVERTURNS" if doc["overturned"] else "survives"
-    name = f"{doc['input']['mechanism']}: " if "mechanism" in doc["input"] else ""
+    verdict = "OVERTURNS" if doc.overturned else "survives"
+    problem = doc.input
+    name = f"{problem.mechanism}: " if problem.mechanism is not None else ""
     typer.echo(
         f"{name}Pulse {shape} a_p = {a_p_g:g} g, f_p = {f_p:g} Hz "
-        f"(Omega = {doc['input']['omega_ratio']:.4g}, A = {doc['input']['amplitude_ratio']:.4g}):"
-        f" {verdict} [{doc['criterion']} criterion]"
+        f"(Omega = {problem.omega_ratio:.4g}, A = {problem.amplitude_ratio:.4g}):"
+        f" {verdict} [{doc.criterion} criterion]"
     )
     typer.echo(
-        f"  peak |phi|/phi_ov = {doc['peak_ratio']:.6f} at {doc['t_peak']:.4f} s "
-        f"(error estimate {doc['error_estimate']:.1e}); impacts: {doc['n_impacts']}; "
-        f"t_overturn: {fmt_time(doc['t_overturn'])}"
+        f"  peak |phi|/phi_ov = {doc.peak_ratio:.6f} at {doc.t_peak:.4f} s "
+        f"(error estimate {doc.error_estimate:.1e}); impacts: {doc.n_impacts}; "
+        f"t_overturn: {fmt_time(doc.t_overturn)}"
     )
-    for warning in doc["warnings"]:
+    for warning in doc.warnings:
         note(f"warning: {warning}")
 
 
@@ -111,12 +112,10 @@ def boundary(
         return
     spans = ", ".join(
         f"[{lo:.5g}, {'A_max' if hi is None else f'{hi:.5g}'}]"
-        for lo, hi in doc["overturning_intervals"]
+        for lo, hi in doc.overturning_intervals
     )
     typer.echo(
-        f"Omega = {omega:g}, eta = {doc['eta']:g} ({doc['rocking']}): "
+        f"Omega = {omega:g}, eta = {doc.eta:g} ({doc.rocking}): "
         f"overturns for A in {spans or 'none'}"
     )
-    typer.echo(
-        f"  scan ratio {doc['search']['scan_ratio']:.4f}, bisection to {doc['search']['rtol']:g}"
-    )
+    typer.echo(f"  scan ratio {doc.search.scan_ratio:.4f}, bisection to {doc.search.rtol:g}")

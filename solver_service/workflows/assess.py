@@ -18,6 +18,8 @@ import numpy as np
 
 from shared_schema.api import MAX_ASSESS_MULTIPLES, MULTIPLE_MAX
 from shared_schema.constants import ConstantsFile, Mechanism
+from shared_schema.documents.assess import AssessDocument
+from shared_schema.documents.check import CheckDocument
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.paths import Source
 from shared_schema.rules import check_number
@@ -39,6 +41,7 @@ from .documents import envelope_doc, log_grid
 from .inputs import read_site_file
 from .limits import ASSESS_ENVELOPE
 from .scaling import mechanism_scale_factor
+from .units import stamp
 from .verdict import conclusion
 
 __all__ = [
@@ -47,12 +50,16 @@ __all__ = [
     "NO_VIRTUAL_WORK",
     "T1_COEFFICIENT",
     "assessment_doc",
+    "assessment_document",
     "check_doc",
+    "check_document",
     "check_multiples",
     "matching_band",
     "read_site",
     "record_scale_factor",
     "site_spectrum",
+    "typed_assessment",
+    "typed_check",
 ]
 
 #: Period band [s] for matching a record to the site spectrum when a mechanism has no T_SLV
@@ -167,7 +174,7 @@ def _envelope_margin(
         env, _ = envelope_doc(ConstantsFile(mechanisms=[mech]), np.asarray(freq, dtype=float))
     except RockmechError as exc:
         return {"note": f"not run: {exc}"}
-    curve = np.array([np.nan if v is None else v for v in env["mechanisms"][0]["a_p_min_g"]])
+    curve = np.array([np.nan if v is None else v for v in env.mechanisms[0].a_p_min_g])
     out: dict[str, Any] = {"f_p": [float(v) for v in freq], "a_p_min_g": curve.tolist()}
     pulses = []
     for motion, design in zip(motions, designs):
@@ -318,3 +325,32 @@ def assessment_doc(
     doc["multiples"] = list(multiples)
     doc["conclusion"] = conclusion(doc, site.project.building)
     return doc
+
+
+def typed_check(doc: dict[str, Any]) -> CheckDocument:
+    """Return a ``check_doc`` as the typed document, stamped (units, version) and validated."""
+    return CheckDocument.model_validate(stamp(doc, "check"))
+
+
+def typed_assessment(doc: dict[str, Any]) -> AssessDocument:
+    """Return an ``assessment_doc`` as the typed document, stamped and validated."""
+    return AssessDocument.model_validate(stamp(doc, "assess"))
+
+
+def check_document(cf: ConstantsFile, site: SiteFile) -> CheckDocument:
+    """Code checks of every mechanism on a site: the document ``rockmech check --json`` prints.
+
+    ``check_doc`` (the working form the retrofit and the search read) as a ``CheckDocument``.
+    """
+    return typed_check(check_doc(cf, site))
+
+
+def assessment_document(
+    cf: ConstantsFile,
+    site: SiteFile,
+    motions: Sequence[Any],
+    *,
+    multiples: Sequence[float] = (0.5, 1.0, 1.5, 2.0),
+) -> AssessDocument:
+    """Return the assessment as the document ``rockmech assess --json`` prints."""
+    return typed_assessment(assessment_doc(cf, site, motions, multiples=multiples))

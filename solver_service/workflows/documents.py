@@ -11,6 +11,10 @@ from typing import Any, Optional
 import numpy as np
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.boundary import BoundaryDocument
+from shared_schema.documents.envelope import EnvelopeDocument, RecordPulse
+from shared_schema.documents.history import HistoryDocument
+from shared_schema.documents.record import RecordDocument
 from shared_schema.errors import InputError
 from shared_schema.rules import ENVELOPE_METHODS, check_choice
 
@@ -85,7 +89,7 @@ def frequency_grid(f_min: float, f_max: float, n: int) -> np.ndarray[Any, Any]:
     return log_grid(f_min, f_max, n)
 
 
-def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> dict[str, Any]:
+def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> RecordDocument:
     """Describe a record: metadata, its largest sine pulses and its response spectrum.
 
     Parameters
@@ -117,7 +121,7 @@ def record_doc(motion: Any, spectrum: Any, pulses: list[Any]) -> dict[str, Any]:
             "runtime_s": spectrum.runtime_s,
         },
     }
-    return stamp(doc, "record")
+    return RecordDocument.model_validate(stamp(doc, "record"))
 
 
 def record_analysis(
@@ -128,7 +132,7 @@ def record_analysis(
     n_pulses: int = 5,
     f_min: Optional[float] = None,
     f_max: Optional[float] = None,
-) -> tuple[dict[str, Any], Spectrum, list[Any]]:
+) -> tuple[RecordDocument, Spectrum, list[Any]]:
     """Compute the spectrum and largest sine pulses of a record once, with their document.
 
     Parameters
@@ -146,7 +150,7 @@ def record_analysis(
 
     Returns
     -------
-    doc : dict
+    doc : RecordDocument
         ``record_doc`` (``rockmech record --json``, ``POST /spectrum``).
     spectrum : Spectrum
         The spectrum, for plots.
@@ -175,7 +179,8 @@ def envelope_doc(
     *,
     method: Optional[str] = None,
     library: Optional[OverturningLibrary] = None,
-) -> tuple[dict[str, Any], list[Envelope]]:
+    record_pulse: Optional[RecordPulse] = None,
+) -> tuple[EnvelopeDocument, list[Envelope]]:
     """Ground-level envelopes of every mechanism and the critical bands.
 
     Mechanisms with ``amplification`` are corrected by ``SF(f_p)`` (theory §7); the others
@@ -195,11 +200,14 @@ def envelope_doc(
         band edges within ``LIBRARY_EDGE_RATIO`` (docs/envelopes.md).
     library : OverturningLibrary, optional
         The library of the fast mode (the shipped one by default).
+    record_pulse : RecordPulse, optional
+        A record's largest pulse against the envelopes (``record_pulse_doc``), kept in the
+        document.
 
     Returns
     -------
-    doc : dict
-        JSON-ready result (see ``rockmech envelope``): ``critical`` bands and
+    doc : EnvelopeDocument
+        The document ``rockmech envelope --json`` prints: ``critical`` bands and
         ``critical_edges``, the frequency interval [Hz] that holds each edge between two
         bands as the exact envelopes place it.
     envelopes : list of Envelope
@@ -257,7 +265,9 @@ def envelope_doc(
         "governing": [cf.mechanisms[i].id if i >= 0 else None for i in index],
         "method": _envelope_method(fast, envelopes),
     }
-    return stamp(doc, "envelope"), envelopes
+    if record_pulse is not None:
+        doc["record_pulse"] = record_pulse
+    return EnvelopeDocument.model_validate(stamp(doc, "envelope")), envelopes
 
 
 def _envelope_method(
@@ -330,7 +340,7 @@ def band_edges(
 
 def boundary_doc(
     omega: float, eta: Optional[float], *, one_sided: bool = False, shape: str = "sine"
-) -> dict[str, Any]:
+) -> BoundaryDocument:
     """Overturning intervals in ``A = a_p/(g lam)`` at one ``Omega = omega_p/p_eq``."""
 
     def pairs(curve: Any) -> list[list[Optional[float]]]:
@@ -363,7 +373,7 @@ def boundary_doc(
             "a_min": float(curve.a_min[0]) if math.isfinite(curve.a_min[0]) else None,
         }
     doc["search"] = {"a_max": curve.a_max, "scan_ratio": curve.scan_ratio, "rtol": curve.rtol}
-    return stamp(doc, "boundary")
+    return BoundaryDocument.model_validate(stamp(doc, "boundary"))
 
 
 def record_pulse_doc(
@@ -374,7 +384,7 @@ def record_pulse_doc(
     f_min: Optional[float] = None,
     f_max: Optional[float] = None,
     method: str = "exact",
-) -> dict[str, Any]:
+) -> RecordPulse:
     """Compare a record's largest sine pulse, at several scale factors, with every envelope.
 
     Each point ``(f_p, s |a_p|)`` lists the mechanisms whose ground-level envelope lies at
@@ -399,7 +409,7 @@ def record_pulse_doc(
         check_positive(value, f"scales[{j}]")
     pulse = largest_pulse(motion.accel, f_min=f_min, f_max=f_max)
     at_fp, _ = envelope_doc(cf, np.array([pulse.f_p]), method=method)
-    a_min = {m["id"]: m["a_p_min_g"][0] for m in at_fp["mechanisms"]}
+    a_min = {m.id: m.a_p_min_g[0] for m in at_fp.mechanisms}
     points = []
     for scale in scales:
         a_p = scale * abs(pulse.a_p_g)
@@ -411,13 +421,15 @@ def record_pulse_doc(
                 "overturns": [k for k, v in a_min.items() if v is not None and a_p >= v],
             }
         )
-    return {
-        "record": motion.name,
-        "pulse": pulse.to_dict(),
-        "method": PULSE_METHOD,
-        "a_p_min_g_at_f_p": a_min,
-        "points": points,
-    }
+    return RecordPulse.model_validate(
+        {
+            "record": motion.name,
+            "pulse": pulse.to_dict(),
+            "method": PULSE_METHOD,
+            "a_p_min_g_at_f_p": a_min,
+            "points": points,
+        }
+    )
 
 
 def history_doc(
@@ -430,8 +442,8 @@ def history_doc(
     criterion: Optional[str] = None,
     at_height: Optional[float] = None,
     runs: Optional[dict[tuple[str, float], Any]] = None,
-) -> dict[str, Any]:
-    """Time histories of every mechanism at every scale, as a JSON-ready document.
+) -> HistoryDocument:
+    """Time histories of every mechanism at every scale (``rockmech history --json``).
 
     With ``sf`` other than ``"none"`` a mechanism with ``amplification {f_n, h_e, h}``
     receives the record times its scale factor (``mechanism_scale_factor``) on top of each
@@ -497,7 +509,7 @@ def history_doc(
     notes = linearisation_notes(cf, models)
     if notes:
         doc["warnings"] = notes
-    return stamp(doc, "history")
+    return HistoryDocument.model_validate(stamp(doc, "history"))
 
 
 def time_domain_mechanisms(cf: ConstantsFile) -> tuple[ConstantsFile, list[dict[str, str]]]:

@@ -13,6 +13,9 @@ import numpy as np
 
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.envelope import EnvelopeDocument, RecordPulse
+from shared_schema.documents.history import HistoryDocument
+from shared_schema.documents.record import RecordDocument
 
 from ..core.pulses import extract_pulses
 from ..core.spectra import response_spectrum
@@ -34,14 +37,14 @@ __all__ = [
 ]
 
 
-def envelope_csv(doc: dict[str, Any]) -> str:
+def envelope_csv(doc: EnvelopeDocument) -> str:
     """Return an envelope document as CSV: f_p [Hz], a_p_min [g] per mechanism, governing."""
-    ids = [m["id"] for m in doc["mechanisms"]]
+    ids = [m.id for m in doc.mechanisms]
     lines = ["f_p_Hz," + ",".join(f"a_p_min_g_{i}" for i in ids) + ",governing"]
-    for k, f in enumerate(doc["f_p"]):
-        vals = [m["a_p_min_g"][k] for m in doc["mechanisms"]]
+    for k, f in enumerate(doc.f_p):
+        vals = [m.a_p_min_g[k] for m in doc.mechanisms]
         cells = ["" if v is None else f"{v:.6g}" for v in vals]
-        lines.append(f"{f:.6g}," + ",".join(cells) + f",{doc['governing'][k] or ''}")
+        lines.append(f"{f:.6g}," + ",".join(cells) + f",{doc.governing[k] or ''}")
     return "\n".join(lines) + "\n"
 
 
@@ -53,27 +56,26 @@ def write_envelope(
     stem: str = "envelope",
     title: str = "",
     method: str = "exact",
-    record_pulse: Optional[dict[str, Any]] = None,
-) -> dict[str, Any]:
+    record_pulse: Optional[RecordPulse] = None,
+) -> EnvelopeDocument:
     """Write ``<stem>.json``, ``<stem>.csv`` and ``<stem>.png`` (atomically); return the doc.
 
     ``method`` as ``envelope_doc``; ``record_pulse`` (from ``record_pulse_doc``) is added to
     the JSON and drawn on the plot. The plot draws where each band edge lies.
     """
-    doc, envs = envelope_doc(cf, f_p, method=method)
-    if record_pulse is not None:
-        doc["record_pulse"] = record_pulse
+    doc, envs = envelope_doc(cf, f_p, method=method, record_pulse=record_pulse)
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
+    data = doc.to_dict()
+    write_atomic(out_dir / f"{stem}.json", json.dumps(data, indent=2) + "\n")
     write_atomic(out_dir / f"{stem}.csv", envelope_csv(doc))
     plot_envelopes(
         envs,
-        doc["critical"],
+        data["critical"],
         out_dir / f"{stem}.png",
         labels={m.id: f"{m.id}: {m.name}" for m in cf.mechanisms},
         title=title,
-        pulse_points=None if record_pulse is None else record_pulse["points"],
-        edges=doc["critical_edges"],
+        pulse_points=None if record_pulse is None else data["record_pulse"]["points"],
+        edges=data["critical_edges"],
         fast=method == "library",
     )
     return doc
@@ -89,7 +91,7 @@ def write_history(
     title: str = "",
     max_panels: int = 6,
     **options: Any,
-) -> dict[str, Any]:
+) -> HistoryDocument:
     """Write ``<stem>.json``, ``<stem>.png`` and ``<stem>_record.png``; return the doc.
 
     ``<stem>.png`` shows ``phi/phi_ov`` of every mechanism against time, one panel per
@@ -100,12 +102,12 @@ def write_history(
     runs: dict[tuple[str, float], Any] = {}
     doc = history_doc(cf, motion, scales, runs=runs, **options)
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / f"{stem}.json", json.dumps(doc, indent=2) + "\n")
+    write_atomic(out_dir / f"{stem}.json", json.dumps(doc.to_dict(), indent=2) + "\n")
     order = sorted(set(scales))
     picks = sorted(
         {order[round(k)] for k in np.linspace(0, len(order) - 1, min(max_panels, len(order)))}
     )
-    ids = list(dict.fromkeys(row["mechanism"] for row in doc["results"]))  # file order
+    ids = list(dict.fromkeys(row.mechanism for row in doc.results))  # file order
     panels = [(scale, [(mech_id, runs[(mech_id, scale)]) for mech_id in ids]) for scale in picks]
     plot_ratio_histories(panels, out_dir / f"{stem}.png", title=title or motion.name)
     spectrum = response_spectrum(motion.accel.acc, motion.dt, RECORD_PERIODS, 0.05)
@@ -115,7 +117,7 @@ def write_history(
 
 
 def write_record(
-    motion: Any, doc: dict[str, Any], spectrum: Any, pulses: list[Any], out_dir: Path
+    motion: Any, doc: RecordDocument, spectrum: Any, pulses: list[Any], out_dir: Path
 ) -> None:
     """Write ``record.json`` and ``record.png`` (the record, its pulses and its spectrum).
 
@@ -129,7 +131,7 @@ def write_record(
         Output folder (created if missing).
     """
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / "record.json", json.dumps(doc, indent=2) + "\n")
+    write_atomic(out_dir / "record.json", json.dumps(doc.to_dict(), indent=2) + "\n")
     plot_record(motion, out_dir / "record.png", spectrum=spectrum, pulses=pulses)
 
 

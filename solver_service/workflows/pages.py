@@ -177,10 +177,13 @@ def build_report(
     """
     cf, record = _report_inputs(constants, motion)
     check_history_options(scales, history, record)
-    env, envelopes = envelope_doc(cf, np.asarray(f_p, dtype=float), method=method, library=library)
+    env_doc, envelopes = envelope_doc(
+        cf, np.asarray(f_p, dtype=float), method=method, library=library
+    )
+    env = env_doc.to_dict()  # the report renders the documents' JSON form
     extra: dict[str, Any] = {}
     if record is not None:
-        hist = history_doc(cf, record, list(scales), **(history or {}))
+        hist = history_doc(cf, record, list(scales), **(history or {})).to_dict()
         top = max(scales)
         extra = {"hist": hist, "top": top, **_record_content(cf, record)}
         extra.update(_history_runs(cf, record, hist, top))

@@ -15,6 +15,7 @@ from pydantic import ValidationError
 
 from shared_schema.api import PulseRequest
 from shared_schema.constants import ConstantsFile, input_error_from_validation
+from shared_schema.documents.pulse import PulseDocument
 from shared_schema.errors import InputError, wrong_type
 
 from ..core.exact import simulate
@@ -85,7 +86,7 @@ def _pulse_request(request: Union[PulseRequest, Mapping[str, Any]]) -> PulseRequ
         raise input_error_from_validation(err) from None
 
 
-def solve_pulse(request: Union[PulseRequest, Mapping[str, Any]]) -> dict[str, Any]:
+def solve_pulse(request: Union[PulseRequest, Mapping[str, Any]]) -> PulseDocument:
     """Response of one mechanism to a one-cycle pulse: the one function of every front end.
 
     ``rockmech pulse``, REST ``/pulse``, the Hops pulse component, RM_Analyse and RM_RunPulse
@@ -100,16 +101,16 @@ def solve_pulse(request: Union[PulseRequest, Mapping[str, Any]]) -> dict[str, An
 
     Returns
     -------
-    dict
-        The document ``rockmech pulse --json`` prints: ``input`` (the problem as solved,
-        both sides when they differ), the verdict under ``criterion`` (``exact`` by
-        default), ``t_overturn`` [s] (the time of the collapse the verdict refers to),
+    PulseDocument
+        The document ``rockmech pulse --json`` prints (``to_dict()``): ``input`` (the
+        problem as solved, both sides when they differ), the verdict under ``criterion``
+        (``exact`` by default), ``t_overturn`` [s] (the time of the collapse the verdict refers to),
         ``peak_ratio`` with its ``error_estimate``, work counters, ``units`` and ``version``.
 
     Examples
     --------
     >>> doc = solve_pulse({"p_eq": 2.0, "lam": 0.2, "eta": 0.95, "a_p_g": 0.282, "f_p": 0.32})
-    >>> doc["overturned"], round(doc["t_overturn"], 3)
+    >>> doc.overturned, round(doc.t_overturn, 3)
     (True, 3.649)
     """
     request = _pulse_request(request)
@@ -145,4 +146,4 @@ def solve_pulse(request: Union[PulseRequest, Mapping[str, Any]]) -> dict[str, An
         },
         **res.summary(),
     }
-    return stamp(doc, "pulse")
+    return PulseDocument.model_validate(stamp(doc, "pulse"))

@@ -50,6 +50,7 @@ from cad_maths.search.prism import segment_intervals
 from cad_maths.search.specs import AGREEMENT_RTOL, build_candidates
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile, json_document
+from shared_schema.documents.envelope import EnvelopeDocument
 from shared_schema.errors import InputError, RockmechError, wrong_type
 from shared_schema.extras import require
 from shared_schema.io import stamped, write_constants
@@ -512,7 +513,7 @@ class _Ranked:
     constants: Optional[ConstantsFile] = None
     failures: list[MechanismFailure] = field(default_factory=list)
     spec_file: Optional[SpecFile] = None
-    envelopes: Optional[dict[str, Any]] = None
+    envelopes: Optional[EnvelopeDocument] = None
     dynamic: list[str] = field(default_factory=list)
 
 
@@ -551,9 +552,9 @@ def _build_and_rank(
     out.constants = cf
     method = "exact" if exact else "library"
     out.envelopes, _ = envelope_doc(cf, f_p, method=method, library=library)
-    for entry, mech in zip(out.envelopes["mechanisms"], cf.mechanisms):
+    for entry, mech in zip(out.envelopes.mechanisms, cf.mechanisms):
         d = docs[mech.id]
-        values = entry["a_p_min_g"]
+        values = entry.a_p_min_g
         finite = [v for v in values if v is not None]
         d["overturning"] = {
             "a_p_min_g": values,
@@ -561,12 +562,12 @@ def _build_and_rank(
             "min_g": min(finite) if finite else None,
             "f_at_min_hz": float(f_p[values.index(min(finite))]) if finite else None,
         }
-        if "scale_factor" in entry:
+        if entry.amplification is not None and entry.a_p_min_local_g is not None:
             # above ground: the local envelope and Eq. 28's SF(f_p) it was divided by
-            d["amplification"] = entry["amplification"]
-            d["overturning"]["a_p_min_local_g"] = entry["a_p_min_local_g"]
-            d["overturning"]["scale_factor"] = entry["scale_factor"]
-            d["overturning"]["band_score_local_g"] = _band_score(entry["a_p_min_local_g"])
+            d["amplification"] = entry.amplification.model_dump()
+            d["overturning"]["a_p_min_local_g"] = entry.a_p_min_local_g
+            d["overturning"]["scale_factor"] = entry.scale_factor
+            d["overturning"]["band_score_local_g"] = _band_score(entry.a_p_min_local_g)
             d["overturning"]["sf_formula"] = (
                 "SF(f_p) = sqrt(1 + (R(f_p/f_n) h/h_e)^2), R the 5 % pulse response spectrum "
                 "(theory §7.1, Eq. 28)"
@@ -929,9 +930,9 @@ def search_run(
             "static": [d["id"] for d in docs],
             "dynamic": ranked.dynamic,
             **compare,
-            "governing": env["governing"] if env else [],
-            "critical": env["critical"] if env else [],
-            "envelope_method": env["method"] if env else None,
+            "governing": env.governing if env else [],
+            "critical": [b.to_dict() for b in env.critical] if env else [],
+            "envelope_method": env.method.to_dict() if env else None,
             "band_score": "geometric mean of a_p,min over the band [g]",
         },
         "lp": [_lp_doc(ch) for ch in result.checks],

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from shared_schema.documents.base import Part
 from shared_schema.retrofit import RETROFIT_UNITS
 from shared_schema.version import __version__
 
@@ -136,8 +137,11 @@ def finite_json(value: Any) -> Any:
     """Replace non-finite floats by None and numpy scalars by Python numbers, recursively.
 
     ``json.dumps`` never calls ``default`` for floats, so NaN and infinity must be cleaned
-    before serialising (``allow_nan=False`` then guards the result).
+    before serialising (``allow_nan=False`` then guards the result). A typed document
+    (``shared_schema.documents``) gives its JSON form, ``to_dict()``.
     """
+    if isinstance(value, Part):
+        return value.to_dict()
     if isinstance(value, dict):
         return {str(k): finite_json(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):

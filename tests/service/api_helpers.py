@@ -13,6 +13,7 @@ from typing import Any
 
 from typer.testing import CliRunner
 
+from shared_schema.documents.base import Part
 from solver_service.cli import app
 
 REPO = Path(__file__).resolve().parents[2]
@@ -39,7 +40,12 @@ def cli_error(*args: str, cwd: Path | None = None) -> str:
 
 
 def without_runtime(doc: Any) -> Any:
-    """Drop wall-clock fields (``runtime_s``), which differ between two runs."""
+    """Drop wall-clock fields (``runtime_s``), which differ between two runs.
+
+    A typed document (``shared_schema.documents``) is compared in its JSON form.
+    """
+    if isinstance(doc, Part):
+        doc = doc.to_dict()
     if isinstance(doc, dict):
         return {k: without_runtime(v) for k, v in doc.items() if k != "runtime_s"}
     if isinstance(doc, list):

@@ -22,6 +22,7 @@ from api_helpers import EXAMPLES, runner
 from servers import Server
 from test_hops import hops_payload, outputs
 
+from shared_schema.documents.base import Document
 from shared_schema.version import __version__
 from solver_service.cli import app
 
@@ -112,6 +113,21 @@ def _json_operations(client: httpx.Client) -> set[tuple[str, str]]:
     return found
 
 
+def _response_models() -> dict[tuple[str, str], Any]:
+    """The typed document each route declares (``response_model``), by (method, path)."""
+    from fastapi.routing import APIRoute
+
+    from solver_service.api import routes
+
+    return {
+        (method, routes.API_PREFIX + route.path): route.response_model
+        for module in routes.ROUTE_MODULES
+        for route in module.router.routes
+        if isinstance(route, APIRoute) and route.response_model is not None
+        for method in route.methods
+    }
+
+
 def test_every_endpoint_and_hops_component_names_units_and_version(
     server: Server, client: httpx.Client, tmp_path: Path
 ) -> None:
@@ -160,10 +176,21 @@ def test_every_endpoint_and_hops_component_names_units_and_version(
         },
     }
     assert set(calls) == _json_operations(client)
+    models = _response_models()
+    validated = 0
     for (method, path), kwargs in calls.items():
         res = client.request(method, path, **kwargs)
         assert res.status_code == 200, (path, res.text[:300])
         _stamped(res.json(), f"{method} {path}")
+        model = models.get((method, path))
+        if isinstance(model, type) and issubclass(model, Document):
+            # The declared document (extra="forbid") takes the answer, and gives it back
+            # byte for byte (key order, ints, absent sections).
+            doc = model.model_validate(res.json())
+            assert doc.to_dict() == res.json(), path
+            assert json.dumps(doc.to_dict()) == json.dumps(res.json()), path
+            validated += 1
+    assert validated >= 1
     hops = {
         "pulse": hops_payload(p_eq=2.0, lam=0.2, a_p_g=0.3, f_p=1.0, eta=0.9, one_sided=False,
                               shape="sine"),

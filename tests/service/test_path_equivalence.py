@@ -261,7 +261,7 @@ def test_every_history_path_gives_the_same_answer(
     ):
         text = path.read_text()
         cf = load_constants(path)
-        want = _answer_rows(history_doc(cf, motion, scales))
+        want = _answer_rows(history_doc(cf, motion, scales).to_dict())
         assert sum(r["overturned"] for r in want["results"]) >= 1  # something to disagree on
         got = {
             "cli": _cli_doc("history", str(path), str(RECORD), "--scale", *map(str, scales)),

@@ -31,15 +31,15 @@ def test_runs_with_time_series_give_the_batch_document_exactly(church_and_record
     batch = history_doc(cf, motion, scales, sf="eq28")
     runs: dict[tuple[str, float], Any] = {}
     dense = history_doc(cf, motion, scales, sf="eq28", runs=runs)
-    assert dense["results"] == batch["results"]
-    ran = {r["mechanism"] for r in batch["results"]}
+    assert dense.results == batch.results
+    ran = {r.mechanism for r in batch.results}
     assert set(runs) == {(m, s) for m in ran for s in scales}
     for (mech_id, scale), res in runs.items():
         assert res.t is not None and res.ratio is not None
-        row = next(r for r in batch["results"] if r["mechanism"] == mech_id and r["scale"] == scale)
-        assert row["peak_ratio"] == res.peak_ratio
+        row = batch.find(mech_id, scale)
+        assert row.peak_ratio == res.peak_ratio
         if not res.collapsed:  # the trace of a survivor peaks at the reported ratio
-            assert row["peak_ratio"] == pytest.approx(float(np.max(np.abs(res.ratio))), abs=1e-9)
+            assert row.peak_ratio == pytest.approx(float(np.max(np.abs(res.ratio))), abs=1e-9)
 
 
 def test_write_history_simulates_each_run_once(
@@ -60,6 +60,6 @@ def test_write_history_simulates_each_run_once(
     monkeypatch.setattr(scaling, "simulate", counted_simulate)
     monkeypatch.setattr(scaling, "simulate_batch", counted_batch)
     doc = write_history(cf, motion, [0.5, 1.0], tmp_path, sf="eq28")
-    assert calls == {"simulate": len(doc["results"]), "batch": 0}
-    assert json.loads((tmp_path / "history.json").read_text()) == json.loads(json.dumps(doc))
+    assert calls == {"simulate": len(doc.results), "batch": 0}
+    assert (tmp_path / "history.json").read_text() == json.dumps(doc.to_dict(), indent=2) + "\n"
     assert (tmp_path / "history.png").stat().st_size > 0

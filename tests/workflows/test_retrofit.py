@@ -118,10 +118,10 @@ def test_free_wall_linear_t_star_is_the_closed_form_and_flips_the_check(
     assert opt.T_nonlinear_SLV_N is not None and opt.T_nonlinear_SLV_N < t_hand
     assert opt.after is not None and opt.after.passes
     # The product's check on the builder's tie: fails 0.5 % below T*, passes 0.5 % above.
-    below = rockmech.check(_tied(tmp_path, t_hand * 0.995), parse_site(SITE)).doc
-    above = rockmech.check(_tied(tmp_path, t_hand * 1.005), parse_site(SITE)).doc
-    assert below["mechanisms"][0]["linear"]["passes"] is False
-    assert above["mechanisms"][0]["linear"]["passes"] is True
+    below = rockmech.check(_tied(tmp_path, t_hand * 0.995), parse_site(SITE))
+    above = rockmech.check(_tied(tmp_path, t_hand * 1.005), parse_site(SITE))
+    assert below.mechanisms[0].linear["passes"] is False
+    assert above.mechanisms[0].linear["passes"] is True
 
 
 def test_nonlinear_t_is_bracketed_to_half_a_percent(wall: ConstantsFile, tmp_path: Path) -> None:
@@ -129,8 +129,8 @@ def test_nonlinear_t_is_bracketed_to_half_a_percent(wall: ConstantsFile, tmp_pat
     t_nl = doc.mechanism("W").options[0].T_nonlinear_SLV_N
     assert t_nl is not None
     site = _site(ties="verified")  # a designed tie whose bar and anchorage carry it
-    lo = rockmech.check(_tied(tmp_path, t_nl * 0.995), site).doc["mechanisms"][0]["nonlinear"]
-    hi = rockmech.check(_tied(tmp_path, t_nl), site).doc["mechanisms"][0]["nonlinear"]
+    lo = rockmech.check(_tied(tmp_path, t_nl * 0.995), site).mechanisms[0].nonlinear
+    hi = rockmech.check(_tied(tmp_path, t_nl), site).mechanisms[0].nonlinear
     assert lo["passes"] is False and hi["passes"] is True
 
 
@@ -156,11 +156,11 @@ def test_more_tie_force_never_lowers_the_capacity_ratio(tmp_path: Path) -> None:
     site = _site(ties="verified")
     last = (0.0, 0.0, 0.0)
     for force in (1.0, 4000.0, 8000.0, 16000.0, 32000.0):
-        row = rockmech.check(_tied(tmp_path, force), site).doc["mechanisms"][0]
+        row = rockmech.check(_tied(tmp_path, force), site).mechanisms[0]
         now = (
-            row["linear"]["capacity_ratio"],
-            row["nonlinear"]["SLV"]["capacity_ratio"],
-            row["nonlinear"]["SLC"]["capacity_ratio"],
+            row.linear["capacity_ratio"],
+            row.nonlinear["SLV"]["capacity_ratio"],
+            row.nonlinear["SLC"]["capacity_ratio"],
         )
         assert all(n >= p for n, p in zip(now, last)), (force, now, last)
         last = now

@@ -12,7 +12,9 @@ from typing import Annotated, Any, Union
 
 from fastapi import APIRouter, Response
 
-from shared_schema.api import AssessRequest, AssessResponse, CheckRequest, CheckResponse
+from shared_schema.api import AssessRequest, CheckRequest
+from shared_schema.documents.assess import AssessDocument
+from shared_schema.documents.check import CheckDocument
 
 from ..bodies import json_body
 from ..compute import compute
@@ -42,8 +44,8 @@ def _json_or_html(model: Any) -> dict[Any, Any]:
 @router.post(
     "/check",
     summary="Code checks (Circolare 2019 §C8.7.1, NTC 2018) of every mechanism on a site",
-    response_model=None,
-    responses=responses(CheckResponse),
+    response_model=CheckDocument,
+    responses=responses(CheckDocument),
     openapi_extra=body_doc(CheckRequest, None),
 )
 async def check(
@@ -56,8 +58,8 @@ async def check(
 @router.post(
     "/assess",
     summary="Assessment: code checks beside rocking dynamics on records scaled to the site",
-    response_model=None,
-    responses=_json_or_html(AssessResponse),
+    response_model=AssessDocument,
+    responses=_json_or_html(AssessDocument),
     openapi_extra=body_doc(AssessRequest, None),
 )
 async def assess(

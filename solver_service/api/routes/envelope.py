@@ -6,7 +6,8 @@ from typing import Annotated
 
 from fastapi import APIRouter, Response
 
-from shared_schema.api import EnvelopeRequest, EnvelopeResponse
+from shared_schema.api import EnvelopeRequest
+from shared_schema.documents.envelope import EnvelopeDocument
 
 from ..bodies import json_body
 from ..compute import compute
@@ -22,8 +23,8 @@ router = APIRouter(tags=["solver"])
 @router.post(
     "/envelope",
     summary="Overturning envelopes and the critical mechanism per frequency",
-    response_model=None,
-    responses=responses(EnvelopeResponse),
+    response_model=EnvelopeDocument,
+    responses=responses(EnvelopeDocument),
     openapi_extra=body_doc(EnvelopeRequest, None),
     dependencies=[accepts(JSON)],
 )

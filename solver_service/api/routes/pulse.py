@@ -6,7 +6,8 @@ from typing import Annotated
 
 from fastapi import APIRouter, Response
 
-from shared_schema.api import PulseRequest, PulseResponse
+from shared_schema.api import PulseRequest
+from shared_schema.documents.pulse import PulseDocument
 
 from ..bodies import json_body
 from ..compute import compute
@@ -22,8 +23,8 @@ router = APIRouter(tags=["solver"])
 @router.post(
     "/pulse",
     summary="One mechanism under a one-cycle sine or cosine pulse",
-    response_model=None,
-    responses=responses(PulseResponse),
+    response_model=PulseDocument,
+    responses=responses(PulseDocument),
     openapi_extra=body_doc(PulseRequest, None),
     dependencies=[accepts(JSON)],
 )

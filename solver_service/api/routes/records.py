@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Request, Response
 
-from shared_schema.api import HistoryRequest, HistoryResponse, SpectrumRequest, SpectrumResponse
+from shared_schema.api import HistoryRequest, SpectrumRequest
+from shared_schema.documents.history import HistoryDocument
+from shared_schema.documents.record import RecordDocument
 
 from ..deps import JSON, MULTIPART, PoolDep, accepts
 from ..jobspec import HistoryJob, SpectrumJob
@@ -19,8 +21,8 @@ router = APIRouter(tags=["records"], dependencies=[accepts(JSON, MULTIPART)])
 @router.post(
     "/history",
     summary="Time histories of every mechanism at every scale factor",
-    response_model=None,
-    responses=responses(HistoryResponse),
+    response_model=HistoryDocument,
+    responses=responses(HistoryDocument),
     openapi_extra=body_doc(HistoryRequest, "history"),
 )
 async def history(request: Request, pool: PoolDep) -> Response:
@@ -31,8 +33,8 @@ async def history(request: Request, pool: PoolDep) -> Response:
 @router.post(
     "/spectrum",
     summary="Exact elastic response spectrum of a record",
-    response_model=None,
-    responses=responses(SpectrumResponse),
+    response_model=RecordDocument,
+    responses=responses(RecordDocument),
     openapi_extra=body_doc(SpectrumRequest, "spectrum"),
 )
 async def spectrum(request: Request, pool: PoolDep) -> Response:
