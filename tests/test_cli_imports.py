@@ -19,6 +19,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 #: Packages the light commands must not load (a module or any of its submodules).
 HEAVY = ("scipy.optimize", "cad_maths", "matplotlib")
+#: What ``--help`` and ``--version`` do not load either: numba (and its LLVM), the solver.
+NOT_FOR_VERSION = ("numba", "llvmlite", "solver_service.core.exact")
 #: One two-sided pulse (eta given: a two-sided pulse without one is refused).
 PULSE = ["pulse", "--p-eq", "2", "--lam", "0.2", "--a-p-g", "0.3", "--f-p", "1", "--eta", "0.9"]
 
@@ -37,15 +39,32 @@ print(json.dumps({"code": code, "heavy": heavy}), file=sys.stderr)
 """
 
 
-def _loaded(argv: list[str], cwd: Path = ROOT) -> tuple[int, list[str], str]:
-    """Run ``rockmech argv`` in a fresh interpreter: exit code, heavy modules, stdout."""
-    code = f"HEAVY = {HEAVY!r}\n" + PROBE
+def _loaded(
+    argv: list[str], cwd: Path = ROOT, heavy: tuple[str, ...] = HEAVY
+) -> tuple[int, list[str], str]:
+    """Run ``rockmech argv`` in a fresh interpreter: exit code, ``heavy`` modules, stdout."""
+    code = f"HEAVY = {heavy!r}\n" + PROBE
     res = subprocess.run(
         [sys.executable, "-c", code, *argv], capture_output=True, text=True, cwd=cwd
     )
     last = res.stderr.strip().splitlines()[-1]
     found = json.loads(last)
     return found["code"], found["heavy"], res.stdout
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["--version"]], ids=["help", "version"])
+def test_help_and_version_load_no_numba_and_no_solver(argv: list[str]) -> None:
+    code, heavy, stdout = _loaded(argv, heavy=HEAVY + NOT_FOR_VERSION)
+    assert code == 0, stdout
+    assert stdout.strip(), "the command printed nothing"
+    assert heavy == []
+
+
+def test_the_probe_sees_numba_where_a_command_loads_it() -> None:
+    # rockmech kernels loads numba to check the kernels (the CPU included).
+    code, heavy, stdout = _loaded(["kernels"], heavy=NOT_FOR_VERSION)
+    assert code == 0, stdout
+    assert "numba" in heavy and "llvmlite" in heavy
 
 
 @pytest.mark.parametrize(

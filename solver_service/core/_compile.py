@@ -27,6 +27,8 @@ import threading
 import types
 from typing import Any, Callable, Dict, Optional, Tuple
 
+from .kernel_cache import KERNEL_SOURCES
+
 __all__ = [
     "JIT",
     "JIT_REASON",
@@ -48,15 +50,8 @@ TWIN_REASON = "compilation switched off"
 
 Fn = Callable[..., Any]
 
-#: The kernel sources beside this module, compiled together (module docstring).
-KERNEL_SOURCES = (
-    "_compile.py",
-    "_kernels.py",
-    "_closed_form.py",
-    "_stepping.py",
-    "_batch_kernels.py",
-    "_boundary_kernels.py",
-)
+# KERNEL_SOURCES: the kernel sources beside this module, compiled together (module
+# docstring); listed in kernel_cache, which reads numba's cache without loading numba.
 
 #: Why the kernels run as plain Python (None when numba compiles them).
 JIT_REASON: Optional[str] = None
