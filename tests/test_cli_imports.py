@@ -54,7 +54,7 @@ def _loaded(
 
 @pytest.mark.parametrize("argv", [["--help"], ["--version"]], ids=["help", "version"])
 def test_help_and_version_load_no_numba_and_no_solver(argv: list[str]) -> None:
-    code, heavy, stdout = _loaded(argv, heavy=HEAVY + NOT_FOR_VERSION)
+    code, heavy, stdout = _loaded(argv, heavy=(*HEAVY, *NOT_FOR_VERSION))
     assert code == 0, stdout
     assert stdout.strip(), "the command printed nothing"
     assert heavy == []
@@ -84,11 +84,24 @@ def test_the_pulse_command_still_answers() -> None:
     assert "Omega = 3.142, A = 1.5" in stdout
 
 
-def test_the_probe_sees_a_command_that_loads_the_envelopes() -> None:
-    # rockmech boundary needs the envelopes' boundary (scipy.optimize's root finders).
-    code, heavy, stdout = _loaded(["boundary", "--omega", "5", "--eta", "0.9"])
+def test_the_boundary_loads_the_exact_kernels_but_no_optimiser() -> None:
+    # rockmech boundary runs the exact kernels (numba); the envelopes no longer load the
+    # pulse spectrum's root finder (scipy.optimize) with the module.
+    code, heavy, stdout = _loaded(
+        ["boundary", "--omega", "5", "--eta", "0.9"], heavy=(*HEAVY, "numba")
+    )
     assert code == 0, stdout
-    assert "scipy.optimize" in heavy
+    assert "numba" in heavy
+    assert [m for m in heavy if m.split(".")[0] != "numba"] == []
+
+
+def test_the_probe_sees_a_command_that_loads_the_optimiser(tmp_path: Path) -> None:
+    # rockmech envelope on the bundled church: its mechanisms above ground need the pulse
+    # spectrum's extrema (scipy.optimize's root finder), and it draws the envelopes.
+    church = ROOT / "examples" / "constants" / "church.json"
+    code, heavy, stdout = _loaded(["envelope", str(church), "--out", "out"], cwd=tmp_path)
+    assert code == 0, stdout
+    assert "scipy.optimize" in heavy and "matplotlib" in heavy
 
 
 def test_the_probe_sees_a_command_that_loads_the_cad_readers(tmp_path: Path) -> None:
@@ -99,3 +112,22 @@ def test_the_probe_sees_a_command_that_loads_the_cad_readers(tmp_path: Path) -> 
     assert code == 2
     assert any(m == "cad_maths" or m.startswith("cad_maths.") for m in heavy)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_search_without_records_or_site_loads_no_solver_kernels_no_code_check_no_pyplot(
+    tmp_path: Path,
+) -> None:
+    # The bundled façade's search, its ranking on the library's envelopes only: the exact
+    # kernels (numba), the code check (workflows.assess) and pyplot stay unloaded; the figure
+    # is drawn all the same (a Figure on an Agg canvas).
+    spec = json.loads((ROOT / "examples/specs/search_facade.search.json").read_text())
+    spec["ranking"] = {k: v for k, v in spec["ranking"].items() if k not in ("site", "records")}
+    (tmp_path / "spec.json").write_text(json.dumps(spec))
+    scene = str(ROOT / "examples/scenes/search_facade.3dm")
+    heavy = ("numba", "solver_service.workflows.assess", "matplotlib.pyplot")
+    code, found, stdout = _loaded(
+        ["search", scene, "spec.json", "--out", "out"], cwd=tmp_path, heavy=heavy
+    )
+    assert code == 0, stdout
+    assert found == []
+    assert (tmp_path / "out" / "search.png").stat().st_size > 10_000

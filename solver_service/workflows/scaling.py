@@ -15,7 +15,6 @@ from shared_schema.errors import InputError
 from shared_schema.rules import SF_METHODS, G, check_choice, check_non_negative, check_positive
 
 from ..codes.scale_factors import check_height, sf_ec8, sf_eq28, sf_nzs
-from ..core.exact import BatchResult, simulate, simulate_batch
 from ..core.spectra import response_spectrum
 from .adapter import to_rocking_model
 
@@ -167,6 +166,9 @@ def run_scaled(
         Which mechanisms (indices into ``cf.mechanisms``) each batch ran; the batch's
         ``scales`` are the effective ones (user scale times factor).
     """
+    # the exact solver (numba), when runs are made: the scale factors alone need none (#38)
+    from ..core.exact import BatchResult, simulate, simulate_batch
+
     factors, groups = factor_groups(cf, motion, sf, building)
     batches = []
     for factor, members in groups.items():
@@ -202,6 +204,9 @@ def dense_runs(
     list of (mechanism id, effective scale, RockingResult)
         The results carry ``t`` and ``ratio`` (``dense=True``).
     """
+    # the exact solver (numba), when runs are made (#38)
+    from ..core.exact import simulate
+
     factors = {k: v["value"] for k, v in doc.get("scale_factors", {}).items()}
     skipped = {s["mechanism"] for s in doc.get("skipped", [])}
     runs = []
