@@ -15,7 +15,13 @@ from shared_schema.version import __version__
 
 from .errors import Commands, note
 
-__all__ = ["app"]
+__all__ = ["CONSOLE", "app"]
+
+#: ``process`` is set by ``solver_service.cli.main`` (the ``rockmech`` console script): the
+#: process runs one command and ends, so a command may choose for the whole process
+#: (``pulse`` runs the pure-Python kernels without loading numba). Not set where the app is
+#: called in a longer-lived process (tests, a notebook).
+CONSOLE = {"process": False}
 
 app = typer.Typer(
     cls=Commands,

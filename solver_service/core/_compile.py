@@ -27,7 +27,7 @@ import threading
 import types
 from typing import Any, Callable, Dict, Optional, Tuple
 
-from .kernel_cache import KERNEL_SOURCES
+from .kernel_cache import KERNEL_SOURCES, PLAIN_REASON, numba_declined
 
 __all__ = [
     "JIT",
@@ -55,18 +55,22 @@ Fn = Callable[..., Any]
 
 #: Why the kernels run as plain Python (None when numba compiles them).
 JIT_REASON: Optional[str] = None
-try:  # numba is optional: without it the same code runs as plain Python.
-    import numba as _numba
-
-    JIT = True
-except ImportError as _exc:  # pragma: no cover - exercised where numba is missing
-    # numba absent (no wheel for this platform), or present but unusable (its message).
+if numba_declined():  # a command making one short run (kernel_cache.without_numba)
     JIT = False
-    JIT_REASON = (
-        "numba is not installed"
-        if getattr(_exc, "name", None) == "numba"
-        else f"numba cannot be used: {_exc}"
-    )
+    JIT_REASON = PLAIN_REASON
+else:
+    try:  # numba is optional: without it the same code runs as plain Python.
+        import numba as _numba
+
+        JIT = True
+    except ImportError as _exc:  # pragma: no cover - exercised where numba is missing
+        # numba absent (no wheel for this platform), or present but unusable (its message).
+        JIT = False
+        JIT_REASON = (
+            "numba is not installed"
+            if getattr(_exc, "name", None) == "numba"
+            else f"numba cannot be used: {_exc}"
+        )
 
 
 def sources_stamp(folder: str, names: Tuple[str, ...]) -> Optional[str]:

@@ -30,7 +30,7 @@ from shared_schema.atomic import write_atomic
 
 from ._compile import JIT, JIT_REASON
 from ._kernels import simulate_cells_logged
-from .kernel_cache import PATHS, SOURCES, STAMP, stamp_key
+from .kernel_cache import PATHS, SOURCES, STAMP, numba_declined, stamp_key
 
 __all__ = [
     "PATHS",
@@ -189,7 +189,8 @@ def first_use(path: str, backend: str = "auto") -> Optional[Callable[[], None]]:
     with _LOCK:
         todo = path not in _CHECKED
         _CHECKED.add(path)
-        say_python = not JIT and not _STATE["said_python"]
+        # a process that declined numba for one short run is not slowed down by it
+        say_python = not JIT and not _STATE["said_python"] and not numba_declined()
         if say_python:
             _STATE["said_python"] = True
     if not JIT:

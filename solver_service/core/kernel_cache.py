@@ -15,7 +15,6 @@ Python 3.9-clean: Rhino 8 imports the solver through its flows (without numba).
 """
 
 import hashlib
-import importlib.metadata
 import importlib.util
 import json
 import os
@@ -28,12 +27,16 @@ from shared_schema.version import __version__
 __all__ = [
     "KERNEL_SOURCES",
     "PATHS",
+    "PLAIN_ETA_MAX",
+    "PLAIN_REASON",
     "SOURCES",
     "STAMP",
     "cache_dir_guess",
+    "numba_declined",
     "numba_version",
     "stamp_key",
     "version_line",
+    "without_numba",
 ]
 
 #: The kernel sources, compiled together (``_compile``'s docstring).
@@ -60,7 +63,40 @@ STAMP = "rockmech-kernels-{path}.json"
 #: The kernel module whose cache folder holds the stamps (``jit._cache_dir``).
 STAMPED_SOURCE = "_kernels.py"
 
+#: Why the kernels run as plain Python in a process that declined numba (``without_numba``).
+PLAIN_REASON = "numba not loaded (one short run costs less as plain Python than numba's start)"
+#: Largest |eta| for which one pulse runs as plain Python (``rockmech pulse``). Rocking that
+#: settles takes about ln(V_REST_REL) / ln|eta| impacts (1e-9: 404 at 0.95, 2060 at 0.99,
+#: 20700 at 0.999), each some 80 us as Python: below 0.95 a pulse costs well under 0.2 s
+#: there, less than loading numba and its cached kernels (about 1 s); above it numba runs.
+PLAIN_ETA_MAX = 0.95
+
 _HERE = Path(__file__).resolve().parent
+#: Whether this process declined numba before its kernels were imported (``without_numba``).
+_DECLINED = {"numba": False}
+
+
+def without_numba() -> bool:
+    """Run this process's solver kernels as plain Python, without loading numba.
+
+    For a command that makes one short run (``rockmech pulse``): its results are those of the
+    compiled kernels (the same code, uncompiled; ``exact.kernels``), its ``method`` says
+    ``exact:python``, and it starts without numba's import and its cached kernels' load.
+
+    Returns
+    -------
+    bool
+        True when declined; False (nothing changes) when the kernels are already imported.
+    """
+    if "solver_service.core._compile" in sys.modules:
+        return False
+    _DECLINED["numba"] = True
+    return True
+
+
+def numba_declined() -> bool:
+    """Return True when this process asked for plain-Python kernels (``without_numba``)."""
+    return _DECLINED["numba"]
 
 
 def numba_version() -> Optional[str]:
@@ -70,9 +106,12 @@ def numba_version() -> Optional[str]:
             return None
     except (ImportError, ValueError):  # a broken or blocked entry in sys.modules
         return None
+    # importlib.metadata here: rockmech --help imports this module, and needs none of it
+    from importlib.metadata import PackageNotFoundError, version
+
     try:
-        return importlib.metadata.version("numba")
-    except importlib.metadata.PackageNotFoundError:  # a numba without metadata (a source tree)
+        return version("numba")
+    except PackageNotFoundError:  # a numba without metadata (a source tree)
         return None
 
 

@@ -107,7 +107,8 @@ def test_without_numba_the_pure_python_kernels_run_and_say_so_once() -> None:
         "from typer.testing import CliRunner\n"
         "from solver_service.cli import app\n"
         "r = CliRunner()\n"
-        "args = ['pulse', '--p-eq', '2', '--lam', '0.2', '--eta', '0.9', '--a-p-g', '-0.61',"
+        # eta 0.99: a pulse the command would run compiled (kernel_cache.PLAIN_ETA_MAX)
+        "args = ['pulse', '--p-eq', '2', '--lam', '0.2', '--eta', '0.99', '--a-p-g', '-0.61',"
         " '--f-p', '1.59', '--json']\n"
         "one, two = r.invoke(app, args), r.invoke(app, args)\n"
         "print(repr(one.stderr), repr(two.stderr), sep='\\n')\n"

@@ -70,3 +70,22 @@ def test_without_numba_the_line_says_so() -> None:
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert res.returncode == 0, res.stderr
     assert res.stdout.startswith("compiled kernels: not active (numba is not installed)")
+
+
+def test_numba_can_be_declined_only_before_the_kernels_are_imported() -> None:
+    # This process has imported them (compiled): declining now changes nothing.
+    from solver_service.core import exact
+
+    assert exact.JIT
+    assert kernel_cache.without_numba() is False
+    assert kernel_cache.numba_declined() is False
+    code = (
+        "from solver_service.core import kernel_cache\n"
+        "assert kernel_cache.without_numba()\n"
+        "import sys\n"
+        "from solver_service.core import exact, jit\n"
+        "print(exact.JIT, 'numba' in sys.modules, jit.kernel_status().describe())\n"
+    )
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.startswith("False False compiled kernels: not active (numba not loaded")
