@@ -20,14 +20,14 @@ from .output import fmt_time, print_json
 __all__ = ["boundary", "pulse"]
 
 
-def _settles_fast(eta: Optional[float], one_sided: bool) -> bool:
+def _settles_fast(eta: Optional[float]) -> bool:
     """Whether a short-form pulse's rocking settles in few impacts (``PLAIN_ETA_MAX``).
 
-    An ``eta`` outside [-1, 1] counts as slow: the solver's own check refuses it.
+    Without ``eta`` the request is refused (a pulse needs one, ``one_sided`` or not), which
+    needs no kernel; the bound is on ``|eta|``, one-sided (``eta <= 0``) or two-sided; an
+    ``eta`` outside [-1, 1] counts as slow (the solver refuses it).
     """
-    if eta is None:
-        return one_sided  # refused by the solver unless one-sided (eta 0)
-    return bool(abs(eta) <= PLAIN_ETA_MAX)
+    return eta is None or bool(abs(eta) <= PLAIN_ETA_MAX)
 
 
 @user_errors
@@ -68,7 +68,7 @@ def pulse(
     as_json: bool = JSON_OPT,
 ) -> None:
     """Response of one mechanism to a one-cycle sine or cosine acceleration pulse."""
-    if CONSOLE["process"] and constants is None and _settles_fast(eta, one_sided):
+    if CONSOLE["process"] and constants is None and _settles_fast(eta):
         # One pulse that settles in a few hundred impacts: the pure-Python kernels give the
         # compiled kernels' numbers in less time than numba takes to load (#38).
         without_numba()
