@@ -6,9 +6,10 @@ Wall-clock time of whole processes, each the best of ``REPEATS`` runs after one 
 (which also compiles any solver kernel the command needs, so no run waits for numba):
 
 1. ``python -c "import numpy"``: the yardstick, measured in the same run;
-2. ``rockmech --help`` and ``rockmech --version`` (this one loads numba to say whether the
-   compiled kernels are active);
-3. a one-pulse ``rockmech pulse --p-eq 2 --lam 0.2 --a-p-g 0.3 --f-p 1 --eta 0.9``;
+2. ``rockmech --help`` and ``rockmech --version`` (this one reads numba's version and the
+   kernels' build stamps from files, without loading numba);
+3. a one-pulse ``rockmech pulse --p-eq 2 --lam 0.2 --a-p-g 0.3 --f-p 1 --eta 0.9`` (the
+   pure-Python kernels, without numba: ``kernel_cache.PLAIN_ETA_MAX``);
 4. ``rockmech search examples/scenes/search_facade.3dm
    examples/specs/search_facade.search.json --out <dir>``, the figure included, beside the
    search's own ``total_s`` (``search.json``'s ``timings``: reading the scene, the search,
@@ -187,9 +188,15 @@ def report(
         "`--help` loads typer and the command line's own modules only; every command imports "
         "its workflow when it runs (tests/test_cli_imports.py checks that `--help`, "
         "`--version` and `pulse` load neither scipy.optimize, nor `cad_maths`, nor "
-        "matplotlib). `--version` also loads numba, to say whether the compiled kernels "
-        "are active and which are built; `pulse` loads numba, the exact solver's kernels "
-        "from numba's cache, and pydantic's request model.",
+        "matplotlib). `--help` and `--version` load no numba either: "
+        "`--version` reads numba's version from its package metadata and the kernels' "
+        "build stamps from numba's cache folder. The one-pulse `pulse` runs the solver's "
+        "pure-Python kernels (the same numbers as the compiled ones, bit for bit) instead "
+        "of loading numba and its cached kernels; what it still loads beyond `--help` is "
+        "numpy, the solver's modules and pydantic's request model (`shared_schema.api`, "
+        "with the constants file's models it holds). The search loads neither numba nor "
+        "the code check when its spec has no records and no site (not the case of the "
+        "bundled façade, which has both), and draws its figure without pyplot.",
     ]
     return "\n".join(out)
 

@@ -445,7 +445,7 @@ def test_wheel_holds_the_packages_examples_licence_and_metadata(dists: dict[str,
         scripts = whl.read(f"rockmech-{version}.dist-info/entry_points.txt").decode()
     assert meta["License-Expression"] == "MIT" and meta["Version"] == version
     assert f"rockmech-{version}.dist-info/licenses/LICENSE" in names
-    assert "rockmech = solver_service.cli:app" in scripts
+    assert "rockmech = solver_service.cli:main" in scripts
     base = {_dist(r) for r in meta.get_all("Requires-Dist") if "extra ==" not in r}
     assert {"typer", "rich", "scipy", "matplotlib", "numpy", "pydantic"} <= base
     examples = ROOT / "examples"

@@ -18,7 +18,7 @@ matplotlib (tests/test_cli_imports.py; docs/benchmarks.md times them).
 from __future__ import annotations
 
 from . import check, envelope, history, ida, pulse, retrofit, search, tools
-from .app import app
+from .app import CONSOLE, app
 from .options import MORE_SCALES
 
 __all__ = ["app", "main"]
@@ -45,6 +45,7 @@ app.command()(retrofit.retrofit)
 app.command()(search.search)
 
 
-def main() -> None:  # pragma: no cover - console entry point
-    """Entry point of the ``rockmech`` console script."""
+def main() -> None:
+    """Entry point of the ``rockmech`` console script (one command, then the process ends)."""
+    CONSOLE["process"] = True
     app()

@@ -15,7 +15,13 @@ from shared_schema.version import __version__
 
 from .errors import Commands, note
 
-__all__ = ["app"]
+__all__ = ["CONSOLE", "app"]
+
+#: ``process`` is set by ``solver_service.cli.main`` (the ``rockmech`` console script): the
+#: process runs one command and ends, so a command may choose for the whole process
+#: (``pulse`` runs the pure-Python kernels without loading numba). Not set where the app is
+#: called in a longer-lived process (tests, a notebook).
+CONSOLE = {"process": False}
 
 app = typer.Typer(
     cls=Commands,
@@ -52,11 +58,12 @@ def _origin(name: str) -> object:
 
 def _print_version(value: bool) -> None:
     if value:
-        # numba is loaded to say whether the compiled kernels are active.
-        from ..core.jit import kernel_status
+        # What is known of the compiled kernels without loading numba (#38): rockmech
+        # kernels loads it and checks everything.
+        from ..core.kernel_cache import version_line
 
         typer.echo(f"rockmech {__version__}")
-        typer.echo(kernel_status().describe())
+        typer.echo(version_line())
         for line in _foreign_packages():
             note(line)
         raise typer.Exit()
@@ -69,7 +76,8 @@ def _main(
         "--version",
         callback=_print_version,
         is_eager=True,
-        help="Print the version, whether the compiled kernels are active, and exit.",
+        help="Print the version, what is known of the compiled kernels (without loading "
+        "numba), and exit.",
     ),
 ) -> None:
     """Rocking collapse mechanisms of masonry: exact rocking solver and tools (SI units)."""

@@ -11,11 +11,23 @@ from typing import Any, Optional
 
 import typer
 
+from ..core.kernel_cache import PLAIN_ETA_MAX, without_numba
+from .app import CONSOLE
 from .errors import fail, note, user_errors
 from .options import JSON_OPT, SHAPES, criterion_opt
 from .output import fmt_time, print_json
 
 __all__ = ["boundary", "pulse"]
+
+
+def _settles_fast(eta: Optional[float]) -> bool:
+    """Whether a short-form pulse's rocking settles in few impacts (``PLAIN_ETA_MAX``).
+
+    Without ``eta`` the request is refused (a pulse needs one, ``one_sided`` or not), which
+    needs no kernel; the bound is on ``|eta|``, one-sided (``eta <= 0``) or two-sided; an
+    ``eta`` outside [-1, 1] counts as slow (the solver refuses it).
+    """
+    return eta is None or bool(abs(eta) <= PLAIN_ETA_MAX)
 
 
 @user_errors
@@ -56,6 +68,10 @@ def pulse(
     as_json: bool = JSON_OPT,
 ) -> None:
     """Response of one mechanism to a one-cycle sine or cosine acceleration pulse."""
+    if CONSOLE["process"] and constants is None and _settles_fast(eta):
+        # One pulse that settles in a few hundred impacts: the pure-Python kernels give the
+        # compiled kernels' numbers in less time than numba takes to load (#38).
+        without_numba()
     # The pulse workflow (the exact solver) is loaded when the command runs (#38).
     from ..workflows import pulse as workflow
 

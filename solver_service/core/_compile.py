@@ -27,6 +27,8 @@ import threading
 import types
 from typing import Any, Callable, Dict, Optional, Tuple
 
+from .kernel_cache import KERNEL_SOURCES, PLAIN_REASON, numba_declined
+
 __all__ = [
     "JIT",
     "JIT_REASON",
@@ -48,30 +50,27 @@ TWIN_REASON = "compilation switched off"
 
 Fn = Callable[..., Any]
 
-#: The kernel sources beside this module, compiled together (module docstring).
-KERNEL_SOURCES = (
-    "_compile.py",
-    "_kernels.py",
-    "_closed_form.py",
-    "_stepping.py",
-    "_batch_kernels.py",
-    "_boundary_kernels.py",
-)
+# KERNEL_SOURCES: the kernel sources beside this module, compiled together (module
+# docstring); listed in kernel_cache, which reads numba's cache without loading numba.
 
 #: Why the kernels run as plain Python (None when numba compiles them).
 JIT_REASON: Optional[str] = None
-try:  # numba is optional: without it the same code runs as plain Python.
-    import numba as _numba
-
-    JIT = True
-except ImportError as _exc:  # pragma: no cover - exercised where numba is missing
-    # numba absent (no wheel for this platform), or present but unusable (its message).
+if numba_declined():  # a command making one short run (kernel_cache.without_numba)
     JIT = False
-    JIT_REASON = (
-        "numba is not installed"
-        if getattr(_exc, "name", None) == "numba"
-        else f"numba cannot be used: {_exc}"
-    )
+    JIT_REASON = PLAIN_REASON
+else:
+    try:  # numba is optional: without it the same code runs as plain Python.
+        import numba as _numba
+
+        JIT = True
+    except ImportError as _exc:  # pragma: no cover - exercised where numba is missing
+        # numba absent (no wheel for this platform), or present but unusable (its message).
+        JIT = False
+        JIT_REASON = (
+            "numba is not installed"
+            if getattr(_exc, "name", None) == "numba"
+            else f"numba cannot be used: {_exc}"
+        )
 
 
 def sources_stamp(folder: str, names: Tuple[str, ...]) -> Optional[str]:

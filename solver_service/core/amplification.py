@@ -36,7 +36,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import brentq
 
 from shared_schema.errors import InputError
 
@@ -202,6 +201,9 @@ class _Oscillator:
             elif dq[i + 1] == 0.0:
                 t_star = hi
             else:
+                # scipy.optimize is loaded where a peak needs it, not with the module (#38)
+                from scipy.optimize import brentq
+
                 t_star = float(brentq(dq_scalar, lo, hi, xtol=XTOL, rtol=4 * np.finfo(float).eps))
             best = max(best, abs(self.quantity(t_star, kind)[0]))
         return best

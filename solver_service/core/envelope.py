@@ -55,12 +55,12 @@ from shared_schema.atomic import write_atomic
 from shared_schema.errors import InputError, wrong_type
 from shared_schema.version import __version__
 
-from . import _boundary_kernels as _bk
-from .amplification import pulse_response_spectrum
-from .exact import kernels
 from .excitation import PULSE_SHAPES
-from .jit import first_use
 from .model import RockingModel, RockingSide, check_eta, require_model
+
+# The exact kernels (numba), the pulse spectrum (scipy.optimize) and the kernels' first-use
+# notes are imported by the functions that run them, so that reading the library and
+# interpolating it (the search's ranking) loads none of them (#37, #38).
 
 __all__ = [
     "A_MAX",
@@ -284,6 +284,12 @@ def boundary_curve(
         raise InputError(f"must be >= 2, got {n_scan!r}", "n_scan")
     if int(n_scan_near) < 0:
         raise InputError(f"must be >= 0, got {n_scan_near!r}", "n_scan_near")
+    # the exact kernels (numba) and their first-use note, loaded when a boundary is searched
+    from .exact import kernels
+
+    # (the note of the kernels' first use: numba's cache stamps)
+    from .jit import first_use
+
     scan = _scan(a_max, int(n_scan), int(n_scan_near))
     kern = kernels(backend)
     compiled = first_use("boundary", backend)
@@ -589,6 +595,12 @@ def _library_curves(
     ``eta`` (the other two-sided curves skip them), then the rest in ``LIBRARY_GROUPS``
     parallel calls over (curve, Omega), with ``progress(done, total)`` after each.
     """
+    # the library's kernels (numba), loaded when the library is built
+    from . import _boundary_kernels as _bk
+
+    # (the note of the kernels' first use: numba's cache stamps)
+    from .jit import first_use
+
     scan = _scan(A_MAX, N_SCAN, 0)
     scan_ratio = float(np.max(scan[1:] / scan[:-1]))
     phase = PULSE_SHAPES[shape]
@@ -667,6 +679,9 @@ def build_library(
     (curve, Omega), while the pulse response spectrum (Python, holding the GIL) is computed
     on a second thread beside the compiled search, which releases it.
     """
+    # the pulse spectrum (scipy.optimize), loaded when the library is built
+    from .amplification import pulse_response_spectrum
+
     t0 = time.perf_counter()
     om = (
         np.geomspace(LIBRARY_OMEGA[0], LIBRARY_OMEGA[1], LIBRARY_OMEGA[2])

@@ -20,7 +20,6 @@ Python 3.9-clean: Rhino 8 imports the solver through its flows (without numba).
 
 import contextlib
 import json
-import os
 import sys
 import threading
 from dataclasses import dataclass, field
@@ -28,13 +27,15 @@ from pathlib import Path
 from typing import Callable, Dict, List, Optional, Set, Tuple
 
 from shared_schema.atomic import write_atomic
-from shared_schema.version import __version__
 
-from ._compile import JIT, JIT_REASON, KERNEL_SOURCES
+from ._compile import JIT, JIT_REASON
 from ._kernels import simulate_cells_logged
+from .kernel_cache import PATHS, SOURCES, STAMP, numba_declined, stamp_key
 
 __all__ = [
     "PATHS",
+    "SOURCES",
+    "STAMP",
     "KernelStatus",
     "first_use",
     "kernel_status",
@@ -42,18 +43,9 @@ __all__ = [
     "set_notifier",
 ]
 
-#: The solver paths compiled apart, each with what runs it.
-PATHS: Dict[str, str] = {
-    "simulate": "one run (simulate: pulses, records, time series)",
-    "batch": "batches of runs (simulate_batch: histories, IDA)",
-    "boundary": "overturning boundaries (boundary_curve: envelope --exact)",
-    "library": "the overturning library (build_library: library build)",
-    "spectrum": "response spectra (response_spectrum)",
-}
-#: Sources whose compiled code numba caches (their size and time stamp key its cache).
-SOURCES = (*KERNEL_SOURCES, "spectra.py")
-#: Name of a path's stamp, written beside numba's cache once the path is compiled.
-STAMP = "rockmech-kernels-{path}.json"
+# PATHS (the solver paths compiled apart), SOURCES (those numba caches) and STAMP (a path's
+# stamp beside numba's cache) live in kernel_cache, which rockmech --version reads without
+# loading numba.
 
 _LOCK = threading.Lock()
 #: Paths checked in this process (a stamp is read once per process and path).
@@ -143,18 +135,7 @@ def _key() -> Dict[str, object]:
         import llvmlite.binding as llvm
 
         cpu = llvm.get_host_cpu_name()
-    here = Path(__file__).resolve().parent
-    sources = {}
-    for name in SOURCES:
-        st = os.stat(here / name)
-        sources[name] = [st.st_mtime, st.st_size]
-    return {
-        "rockmech": __version__,
-        "numba": numba.__version__,
-        "python": list(sys.version_info[:2]),
-        "cpu": cpu,
-        "sources": sources,
-    }
+    return stamp_key(numba.__version__, str(cpu))
 
 
 def _stamp(path: str) -> Optional[Path]:
@@ -208,7 +189,8 @@ def first_use(path: str, backend: str = "auto") -> Optional[Callable[[], None]]:
     with _LOCK:
         todo = path not in _CHECKED
         _CHECKED.add(path)
-        say_python = not JIT and not _STATE["said_python"]
+        # a process that declined numba for one short run is not slowed down by it
+        say_python = not JIT and not _STATE["said_python"] and not numba_declined()
         if say_python:
             _STATE["said_python"] = True
     if not JIT:

@@ -30,7 +30,6 @@ from numpy.typing import ArrayLike, NDArray
 from shared_schema.errors import InputError
 
 from .excitation import check_finite_samples
-from .jit import first_use
 from .model import G
 
 __all__ = ["BACKENDS", "Spectrum", "response_spectrum"]
@@ -325,6 +324,9 @@ def _psa(
         backend = "numba" if _numba_available() else "numpy"
     if backend == "numpy":
         return _peaks_numpy(acc, dt, omega, zeta)
+    # the note of the kernel's first use (jit loads numba), with the compiled kernel (#38)
+    from .jit import first_use
+
     kernel = _compiled()
     n_sub = np.maximum(1, np.ceil(dt * omega * STEPS_PER_PERIOD / (2.0 * np.pi))).astype(np.int64)
     eta = omega * dt / n_sub

@@ -6,7 +6,7 @@ Units: frequencies in Hz, pulse amplitudes and PGA in g (names end in ``_g``), S
 from __future__ import annotations
 
 import math
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
@@ -39,7 +39,6 @@ from ..core.pulses import extract_pulses, largest_pulse
 from ..core.records import GroundMotion
 from ..core.spectra import Spectrum, response_spectrum
 from .adapter import to_rocking_model
-from .pulse import pick_mechanism, pulse_model, solve_pulse
 from .scaling import Building, option_notes, run_scaled
 from .units import stamp
 
@@ -60,6 +59,23 @@ __all__ = [
     "solve_pulse",
     "time_domain_mechanisms",
 ]
+
+if TYPE_CHECKING:
+    from .pulse import pick_mechanism, pulse_model, solve_pulse
+
+#: The pulse analysis's names, re-exported from ``workflows.pulse`` on first use (``__getattr__``).
+_PULSE_NAMES = ("pick_mechanism", "pulse_model", "solve_pulse")
+
+
+def __getattr__(name: str) -> Any:
+    # workflows.pulse loads the exact solver (numba); the envelopes' importers (the search's
+    # ranking) need none of it, so it is imported when one of its names is asked for (#38).
+    if name in _PULSE_NAMES:
+        # the pulse analysis (the exact solver, numba), on first use of one of its names
+        from . import pulse
+
+        return getattr(pulse, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def _finite_or_none(values: np.ndarray[Any, Any]) -> list[Optional[float]]:

@@ -17,7 +17,6 @@ from shared_schema.errors import InputError
 from shared_schema.rules import SF_METHODS, G, check_choice, check_non_negative, check_positive
 
 from ..codes.scale_factors import check_height, sf_ec8, sf_eq28, sf_nzs
-from ..core.exact import BatchResult, simulate, simulate_batch
 from ..core.spectra import response_spectrum
 from .adapter import to_rocking_model
 
@@ -177,6 +176,9 @@ def run_scaled(
         Which mechanisms (indices into ``cf.mechanisms``) each batch ran; the batch's
         ``scales`` are the effective ones (user scale times factor).
     """
+    # the exact solver (numba), when runs are made: the scale factors alone need none (#38)
+    from ..core.exact import BatchResult, simulate, simulate_batch
+
     factors, groups = factor_groups(cf, motion, sf, building)
     batches = []
     for factor, members in groups.items():
@@ -212,6 +214,9 @@ def dense_runs(
     list of (mechanism id, effective scale, RockingResult)
         The results carry ``t`` and ``ratio`` (``dense=True``).
     """
+    # the exact solver (numba), when runs are made (#38)
+    from ..core.exact import simulate
+
     factors = {k: v["value"] for k, v in doc.get("scale_factors", {}).items()}
     skipped = {s["mechanism"] for s in doc.get("skipped", [])}
     runs = []
@@ -271,6 +276,9 @@ def least_overturning_scales(
     the scale reported is the first on the grid that overturns, refined between it and the
     grid point below, which did not. Every scale below it on the grid survives.
     """
+    # the exact solver (numba), when runs are made (#38)
+    from ..core.exact import simulate_batch
+
     ups = [1.0] * len(models) if factors is None else [float(f) for f in factors]
     stretches = [1.0] * len(models) if stretch is None else [float(c) for c in stretch]
     base = np.geomspace(grid[0], grid[1], int(grid[2]))
@@ -290,6 +298,9 @@ def _refine(
     model: Any, motion: Any, up: float, scales: Any, overturned: Any, criterion: str
 ) -> dict[str, Any]:
     """Bisect between the first grid scale that overturns and the one below it."""
+    # the exact solver (numba), when runs are made (#38)
+    from ..core.exact import simulate
+
     runs = len(scales)
     hit = np.flatnonzero(overturned)
     if hit.size == 0:

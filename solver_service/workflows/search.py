@@ -31,7 +31,7 @@ import time
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Optional, Sequence, Union
 
 import numpy as np
 
@@ -71,21 +71,20 @@ from shared_schema.text import decode_text
 from shared_schema.version import __version__
 
 from ..codes.floor_spectra import participation_first_mode
-from ..core.envelope import OverturningLibrary
-from ..core.records import GroundMotion
-from ..report.search_figure import plot_search
 from .adapter import to_rocking_model
-from .assess import check_doc, read_site
 from .codecheck import T1_TOLERANCE, building_period
 from .documents import envelope_doc, log_grid
-from .inputs import read_record
-from .outputs import finite_json
 from .rundir import run_folder
-from .scaling import SCALE_GRID, least_overturning_scales, mechanism_scale_factor
-from .units import stamp
+from .units import finite_json, stamp
+
+if TYPE_CHECKING:
+    from ..core.envelope import OverturningLibrary
+
+# Loaded by the steps that need them, not with the module (#37, #38): the exact solver
+# (numba) for the records, the code check (workflows.assess) for a site, the record readers
+# for records, matplotlib for the figure. A search without records or site loads none.
 
 __all__ = [
-    "SCALE_GRID",
     "SearchRun",
     "check_first_mode",
     "crack_patches",
@@ -278,7 +277,7 @@ def _ids(n: int) -> list[str]:
 
 
 def scales_to_overturn(
-    cf: ConstantsFile, motion: Any, grid: tuple[float, float, int] = SCALE_GRID
+    cf: ConstantsFile, motion: Any, grid: Optional[tuple[float, float, int]] = None
 ) -> list[dict[str, Any]]:
     """Find the smallest scale factor of a record that overturns each mechanism (exact solver).
 
@@ -288,8 +287,9 @@ def scales_to_overturn(
         The mechanisms (each needs ``eta``).
     motion : GroundMotion
         The record.
-    grid : (float, float, int)
-        Scale factors tried: log-spaced from the first to the second, that many.
+    grid : (float, float, int), optional
+        Scale factors tried: log-spaced from the first to the second, that many (default
+        ``scaling.SCALE_GRID``).
 
     Returns
     -------
@@ -304,8 +304,11 @@ def scales_to_overturn(
     the scale reported is the first on the grid that overturns, refined between it and the
     grid point below, which did not.
     """
+    # the records' scale search and the exact solver (numba), for the records only (#38)
+    from .scaling import SCALE_GRID, least_overturning_scales
+
     models = [to_rocking_model(m) for m in cf.mechanisms]
-    found = least_overturning_scales(models, motion, grid=grid)
+    found = least_overturning_scales(models, motion, grid=SCALE_GRID if grid is None else grid)
     return [{k: v for k, v in f.items() if k != "runs"} for f in found]
 
 
@@ -620,6 +623,9 @@ def _run_records(
     ground scale that overturns it is the local one over SF (``scale``; the local one is
     ``scale_local``). Mechanisms at ground level take the record as it is.
     """
+    # Eq. 28's scale factor of a record (its spectrum), for the records only
+    from .scaling import mechanism_scale_factor
+
     out: list[dict[str, Any]] = []
     sub = ConstantsFile(mechanisms=[m for m in cf.mechanisms if m.id in top])
     for motion in motions:
@@ -661,6 +667,9 @@ def _run_check(
         for mid in top
         if docs[mid]["Z_m"] > 0.0 and "amplification" not in docs[mid]
     }
+    # the code check, for a search with a site only (#37)
+    from .assess import check_doc
+
     sub = ConstantsFile(mechanisms=[m for m in cf.mechanisms if m.id in top])
     check = check_doc(sub, site, heights)
     for row in check["mechanisms"]:
@@ -793,17 +802,36 @@ def _scene_object(scene: Any) -> BaseScene:
     )
 
 
+def _read_site(path: Path) -> SiteFile:
+    """Read a site file (``assess.read_site``, loaded here: only a search with a site needs it)."""
+    # the site reader lives with the code check (workflows.assess)
+    from .assess import read_site
+
+    return read_site(path)
+
+
+def _read_record(path: Path) -> Any:
+    """Read a record (``inputs.read_record``, loaded here: only a search with records needs it)."""
+    # the record readers (and the CAD inputs beside them), for records only
+    from .inputs import read_record
+
+    return read_record(path)
+
+
 def _site_object(site: Any, field_name: str) -> Any:
     """Return a site given as a ``SiteFile``, or read it from a site file's path."""
     if site is None or isinstance(site, SiteFile):
         return site
-    return read_site(as_path(site, field_name, "a SiteFile or " + PATH_TYPES))
+    return _read_site(as_path(site, field_name, "a SiteFile or " + PATH_TYPES))
 
 
 def _motion_objects(motions: Any, field_name: str) -> Optional[list[Any]]:
     """Return records given as ``GroundMotion`` objects, or read them from their paths."""
     if motions is None:
         return None
+    # the record type, for a search given records only
+    from ..core.records import GroundMotion
+
     if is_path(motions) or isinstance(motions, GroundMotion):
         raise InputError(
             "must be a sequence of records (GroundMotion objects or paths), got one record; "
@@ -816,7 +844,7 @@ def _motion_objects(motions: Any, field_name: str) -> Optional[list[Any]]:
         out.append(
             m
             if isinstance(m, GroundMotion)
-            else read_record(as_path(m, where, "a GroundMotion or " + PATH_TYPES))
+            else _read_record(as_path(m, where, "a GroundMotion or " + PATH_TYPES))
         )
     return out
 
@@ -882,10 +910,10 @@ def search_run(
     motions = _motion_objects(motions, "motions")
     rk = spec.ranking
     if site is None and rk.site is not None:
-        site = read_site(_resolve(rk.site, folder, "ranking.site"))
+        site = _read_site(_resolve(rk.site, folder, "ranking.site"))
     if motions is None:
         motions = [
-            read_record(_resolve(r, folder, f"ranking.records[{k}]"))
+            _read_record(_resolve(r, folder, f"ranking.records[{k}]"))
             for k, r in enumerate(rk.records)
         ]
     check_first_mode(spec, site)  # before the search: a contradiction costs nothing
@@ -1067,6 +1095,9 @@ def write_search_files(run: SearchRun, out_dir: Path, *, figure: bool = True) ->
     write_atomic(path, search_3dm(run))
     out.append(path)
     if figure:
+        # matplotlib, for the figure only (#37)
+        from ..report.search_figure import plot_search
+
         png = plot_search(run, out_dir / "search.png")
         if png is not None:
             out.append(png)
@@ -1138,7 +1169,7 @@ def search_from_files(
     spec_path = as_path(spec, "spec")
     search_spec = read_search_spec(spec_path)
     scene_obj = read_scene(scene_path, units=units)
-    site_obj = None if site is None else read_site(as_path(site, "site"))
+    site_obj = None if site is None else _read_site(as_path(site, "site"))
     motions = _motion_objects(records, "records")
     return search_run(
         scene_obj,
