@@ -419,8 +419,12 @@ def _outside_sum(p: float, f_min: float, f_max: float, n: int) -> float:
 
     Examples
     --------
-    >>> _outside_sum(1.0, 0.1, 10.0, 3)  # Omega 0.63, 6.3, 63: the last is outside
+    >>> _outside_sum(0.1, 0.1, 10.0, 3)  # Omega 6.3, 63, 628: the last is above 500
     1.0
+    >>> _outside_sum(20.0, 0.1, 10.0, 3)  # Omega 0.031, 0.31, 3.1: the first is below 0.05
+    200.0
+    >>> _outside_sum(1.0, 0.1, 10.0, 3)  # Omega 0.63, 6.3, 63: all inside
+    0.0
     """
     if n < 2 or not _positive(f_min, f_max, p) or f_max <= f_min:
         return 0.0
