@@ -29,6 +29,7 @@ import rockmech
 from solver_service.cli import app
 from solver_service.core.model import RockingModel, RockingSide
 from solver_service.core.reference import simulate_ivp
+from solver_service.workflows.retrofit import with_tie
 
 runner = CliRunner()
 REPO = Path(__file__).resolve().parents[1]
@@ -363,3 +364,46 @@ def test_the_table_gives_the_records_margin_before_and_after(
         f"{after:.3f} (elcentro_NS)"
     )
     assert line in res.stdout.splitlines()
+
+
+def test_with_records_the_nonlinear_check_after_the_tie_is_the_assessments(
+    tmp_path: Path,
+) -> None:
+    """With El Centro, each designed tie's nonlinear ratios are ``rockmech assess``'s.
+
+    The assessment takes the nonlinear demand as the larger of the spectrum's and the
+    records' (Circ. 2019 C8.7.1.2.1.8); the retrofit sizes the tie on the same demand, so
+    the church's F1 and F2 with their ties at T* pass the assessment with the record.
+    """
+    doc = rockmech.retrofit(CHURCH, CHURCH_SITE, CHURCH_SPEC, records=[ELCENTRO])
+    assert any("C8.7.1.2.1.8" in d for d in doc.decisions)
+    cf = rockmech.read_constants(CHURCH)
+    before = rockmech.assess(CHURCH, CHURCH_SITE, [ELCENTRO], multiples=[1.0]).doc
+    designed = [m for m in doc.mechanisms if m.status == "designed"]
+    assert {m.id for m in designed} == {"F1", "F2"}
+    for i, m in enumerate(doc.mechanisms):
+        # The "before" of every mechanism is the assessment's, records' demand included.
+        row = before["mechanisms"][i]
+        assert row["id"] == m.id
+        if row["nonlinear"].get("status") == "ok":
+            assert m.before.SLV_ratio == pytest.approx(row["nonlinear"]["capacity_ratio"], rel=1e-9)
+    for m in designed:
+        assert m.chosen is not None
+        o = m.options[m.chosen]
+        assert o.T_star_N is not None and o.after is not None and o.verified
+        mechs = [
+            with_tie(x, o.T_star_N, o.height_m, listed=False) if x.id == m.id else x
+            for x in cf.mechanisms
+        ]
+        tied = tmp_path / f"tied_{m.id}.json"
+        tied.write_text(cf.model_copy(update={"mechanisms": mechs}).model_dump_json())
+        after = rockmech.assess(tied, CHURCH_SITE, [ELCENTRO], multiples=[1.0]).doc
+        (row,) = [r for r in after["mechanisms"] if r["id"] == m.id]
+        non = row["nonlinear"]
+        assert o.after.SLV_ratio == pytest.approx(non["capacity_ratio"], rel=1e-9, abs=0)
+        assert o.after.SLC_ratio == pytest.approx(non["SLC"]["capacity_ratio"], rel=1e-9)
+        assert non["capacity_ratio"] >= 1.0 and non["SLC"]["capacity_ratio"] >= 1.0
+        # The records raise the demand: the spectrum alone would give a higher ratio.
+        alone = rockmech.retrofit(CHURCH, CHURCH_SITE, CHURCH_SPEC).mechanism(m.id)
+        assert alone.before.SLV_ratio is not None and m.before.SLV_ratio is not None
+        assert m.before.SLV_ratio <= alone.before.SLV_ratio

@@ -1053,7 +1053,7 @@ def assess_report(
     _render(template_dir)  # a user template's syntax error before the analysis runs
     doc = assessment_doc(cf, site, motions, multiples=multiples)
     if retrofit is not None:
-        made = assessment_retrofit(cf, site, retrofit)
+        made = assessment_retrofit(cf, site, retrofit, motions)
         doc["retrofit"] = made.model_dump(mode="json")
     text = render_assessment(
         doc, cf, site, motions, sources=sources, options=options, template_dir=template_dir

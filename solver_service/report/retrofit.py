@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Optional, Union
+from typing import Any, Optional, Sequence, Union
 
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
@@ -225,8 +225,8 @@ def check_retrofit_matches(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> None
     doc : RetrofitDoc
         A ``retrofit.json`` read back.
     rows : list of dict
-        The mechanism rows of the code checks (``codecheck.check_doc(cf, site)``), without
-        the records' demand: the checks the retrofit ran.
+        The mechanism rows of the code checks as the retrofit ran them
+        (``assess.check_doc_with_records``: with the records' demand where it had records).
 
     Raises
     ------
@@ -257,7 +257,10 @@ def check_retrofit_matches(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> None
 
 
 def assessment_retrofit(
-    cf: ConstantsFile, site: SiteFile, source: Union[RetrofitSpec, RetrofitDoc]
+    cf: ConstantsFile,
+    site: SiteFile,
+    source: Union[RetrofitSpec, RetrofitDoc],
+    motions: Sequence[Any] = (),
 ) -> RetrofitDoc:
     """Return the retrofit a report shows: computed from a spec, or a document checked.
 
@@ -266,10 +269,12 @@ def assessment_retrofit(
     cf, site
         The assessment's constants and site.
     source : RetrofitSpec or RetrofitDoc
-        A retrofit spec (the retrofit is run on ``cf`` and ``site``, as ``rockmech retrofit``
-        runs it) or a ``retrofit.json``, checked against the code checks of ``cf`` on
-        ``site`` (``check_retrofit_matches``; the checks without the records' demand, as
-        the retrofit runs them).
+        A retrofit spec (the retrofit is run on ``cf``, ``site`` and the assessment's
+        records, as ``rockmech retrofit --record`` runs it) or a ``retrofit.json``, checked
+        against the code checks of ``cf`` on ``site`` (``check_retrofit_matches``), with the
+        records' demand where the document was made with records, as it then ran them.
+    motions : sequence of GroundMotion
+        The assessment's records.
 
     Raises
     ------
@@ -278,16 +283,17 @@ def assessment_retrofit(
         a document made from other inputs (``retrofit``).
     """
     if isinstance(source, RetrofitDoc):
-        # The code checks (the retrofit's own, without records) to compare the document with.
-        from ..workflows.codecheck import check_doc
+        # The code checks as the retrofit ran them: with the records' demand if it had any.
+        from ..workflows.assess import check_doc_with_records
 
-        check_retrofit_matches(source, check_doc(cf, site)["mechanisms"])
+        doc, _ = check_doc_with_records(cf, site, motions if source.records else ())
+        check_retrofit_matches(source, doc["mechanisms"])
         return source
     # The retrofit (its bisections on the code checks) is loaded only when a spec is given.
     from ..workflows.retrofit import retrofit_doc
 
     try:
-        return retrofit_doc(cf, site, source)
+        return retrofit_doc(cf, site, source, motions)
     except InputError as exc:
         head = (exc.field or "").split(".", 1)[0]
         if head in ("mechanisms", "steel", "anchorage"):
@@ -298,9 +304,11 @@ def assessment_retrofit(
 def records_notes(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> dict[str, str]:
     """Say where the assessment's records raise a demand the retrofit did not size for.
 
-    The retrofit runs the code checks on the site spectrum; with records, an assessment's
-    nonlinear check also takes their largest spectral displacement (Circ. 2019 C8.7.1.2.1.8),
-    so its ratio may be lower than the retrofit's "before".
+    A retrofit run with the assessment's records takes their demand as the assessment does
+    (Circ. 2019 C8.7.1.2.1.8, ``assess.check_doc_with_records``), and this finds nothing. A
+    ``retrofit.json`` made without records ran the code checks on the site spectrum alone;
+    with records, the assessment's nonlinear check also takes their largest spectral
+    displacement, so its ratio may be lower than that document's "before".
 
     Parameters
     ----------
