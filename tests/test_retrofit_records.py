@@ -26,6 +26,7 @@ from search.search_scenes import BUILD
 from typer.testing import CliRunner
 
 import rockmech
+from shared_schema.errors import InputError
 from solver_service.cli import app
 from solver_service.core.model import RockingModel, RockingSide
 from solver_service.core.reference import simulate_ivp
@@ -257,6 +258,33 @@ def test_records_past_the_budget_are_refused_up_front(wall: dict[str, Path]) -> 
     with pytest.raises(InputError) as err:
         check_retrofit_work(cf, site, spec, 1e-5, "more time")
     assert "exact runs" not in str(err.value)
+
+
+def test_the_estimate_counts_the_spectra_of_each_check_with_records(
+    wall: dict[str, Path],
+) -> None:
+    """Each code check with records matches every record and takes its demand (40 + 40)."""
+    from shared_schema.retrofit import read_retrofit_spec
+    from solver_service.codes.circ2019 import RECORD_POINTS
+    from solver_service.workflows.assess import BAND_POINTS
+    from solver_service.workflows.limits import (
+        RETROFIT_RECORD_PERIODS,
+        check_retrofit_work,
+        retrofit_checks,
+        shortest_time,
+    )
+
+    assert RETROFIT_RECORD_PERIODS == BAND_POINTS + RECORD_POINTS
+    cf = rockmech.read_constants(wall["constants"])
+    site = rockmech.read_site(wall["site"])
+    spec = read_retrofit_spec(wall["spec"])
+    motion = rockmech.read_record(ELCENTRO)
+    n = retrofit_checks(cf, site, spec)
+    least = shortest_time(spectrum_steps=n * RETROFIT_RECORD_PERIODS * (motion.accel.n - 1))
+    # A budget just under the spectra alone is refused; it names them.
+    with pytest.raises(InputError) as err:
+        check_retrofit_work(cf, site, spec, 0.99 * least, "more time", [motion])
+    assert "sub-steps of response spectra" in str(err.value)
 
 
 def test_tying_one_wall_moves_the_governing_mechanism_to_the_other(tmp_path: Path) -> None:

@@ -262,7 +262,12 @@ def _unlist_ties(mech: Mechanism) -> Mechanism:
 
 
 class _Checker:
-    """Runs the code check of one mechanism with a tie, as ``check_doc`` does."""
+    """Runs the code check of one mechanism with a tie, as ``rockmech assess`` does.
+
+    With records (``motions``), the nonlinear demand is also theirs (C8.7.1.2.1.8), by
+    ``assess.check_doc_with_records``: each record matched over the band of the mechanism
+    with the tie at that force.
+    """
 
     def __init__(
         self, cf: ConstantsFile, site: SiteFile, mech: Mechanism, motions: Sequence[Any] = ()
@@ -739,7 +744,9 @@ def retrofit_doc(
         Steel, bars on offer, anchorage resistance, candidate tie heights per mechanism.
     motions : sequence of GroundMotion
         Records (``spec.records`` as the front ends read them): each tied mechanism must
-        survive every one at its design scale (``workflows.retrofit_records``).
+        survive every one at its design scale (``workflows.retrofit_records``), and the
+        nonlinear checks take their demand as ``rockmech assess`` does (C8.7.1.2.1.8,
+        ``assess.check_doc_with_records``), before the tie, in the bisections and after.
 
     Returns
     -------
