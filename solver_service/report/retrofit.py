@@ -247,11 +247,13 @@ def check_retrofit_matches(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> None
                 and math.isclose(theirs, ours, rel_tol=MATCH_RTOL, abs_tol=0.0)
             )
             if not same:
+                names = ", ".join(str(r.get("name", "?")) for r in doc.records)
+                records = f" or other records than its {names}" if names else ""
                 raise InputError(
                     f"the retrofit document's {m.id} has {label} {_ratio(theirs)} before the "
                     f"tie where these inputs give {_ratio(ours)}: it was made from other "
-                    "constants or another site; run rockmech retrofit again on these files, or "
-                    "give the retrofit spec",
+                    f"constants or another site{records}; run rockmech retrofit again on "
+                    "these files, or give the retrofit spec",
                     "retrofit",
                 )
 

@@ -214,6 +214,24 @@ def test_a_retrofit_json_of_another_site_is_refused(tmp_path: Path) -> None:
     assert not (tmp_path / "r.html").exists()
 
 
+def test_a_retrofit_json_made_with_records_needs_them(tmp_path: Path) -> None:
+    """Made with El Centro, shown beside an assessment without it: F2's "before" differs."""
+    res = runner.invoke(
+        app,
+        ["retrofit", str(CHURCH), "--site", str(SITE), "--spec", str(SPEC), "--record",
+         str(RECORD), "-o", str(tmp_path)],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    args = ["assess", str(CHURCH), str(SITE), "-o", str(tmp_path / "r.html"),
+            "--retrofit", str(tmp_path / "retrofit.json")]  # fmt: skip
+    res = runner.invoke(app, args)
+    assert res.exit_code == 2, res.output
+    (line,) = res.stderr.strip().splitlines()
+    assert line.startswith("error: retrofit: the retrofit document's F2 has "), line
+    assert "or other records than its elcentro_NS;" in line
+    assert not (tmp_path / "r.html").exists()
+
+
 @pytest.mark.parametrize(
     ("change", "words"),
     [
