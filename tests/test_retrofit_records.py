@@ -26,9 +26,11 @@ from search.search_scenes import BUILD
 from typer.testing import CliRunner
 
 import rockmech
+from shared_schema.errors import InputError
 from solver_service.cli import app
 from solver_service.core.model import RockingModel, RockingSide
 from solver_service.core.reference import simulate_ivp
+from solver_service.workflows.retrofit import with_tie
 
 runner = CliRunner()
 REPO = Path(__file__).resolve().parents[1]
@@ -258,6 +260,33 @@ def test_records_past_the_budget_are_refused_up_front(wall: dict[str, Path]) -> 
     assert "exact runs" not in str(err.value)
 
 
+def test_the_estimate_counts_the_spectra_of_each_check_with_records(
+    wall: dict[str, Path],
+) -> None:
+    """Each code check with records matches every record and takes its demand (40 + 40)."""
+    from shared_schema.retrofit import read_retrofit_spec
+    from solver_service.codes.circ2019 import RECORD_POINTS
+    from solver_service.workflows.assess import BAND_POINTS
+    from solver_service.workflows.limits import (
+        RETROFIT_RECORD_PERIODS,
+        check_retrofit_work,
+        retrofit_checks,
+        shortest_time,
+    )
+
+    assert RETROFIT_RECORD_PERIODS == BAND_POINTS + RECORD_POINTS
+    cf = rockmech.read_constants(wall["constants"])
+    site = rockmech.read_site(wall["site"])
+    spec = read_retrofit_spec(wall["spec"])
+    motion = rockmech.read_record(ELCENTRO)
+    n = retrofit_checks(cf, site, spec)
+    least = shortest_time(spectrum_steps=n * RETROFIT_RECORD_PERIODS * (motion.accel.n - 1))
+    # A budget just under the spectra alone is refused; it names them.
+    with pytest.raises(InputError) as err:
+        check_retrofit_work(cf, site, spec, 0.99 * least, "more time", [motion])
+    assert "sub-steps of response spectra" in str(err.value)
+
+
 def test_tying_one_wall_moves_the_governing_mechanism_to_the_other(tmp_path: Path) -> None:
     """W (b/h = 1/12) governs; V (b/h = 1/5) cannot take its tie (above its top)."""
     constants = _constants(tmp_path, [("W", 0.0, B, H), ("V", 20.0, 0.8, 4.0)])
@@ -363,3 +392,46 @@ def test_the_table_gives_the_records_margin_before_and_after(
         f"{after:.3f} (elcentro_NS)"
     )
     assert line in res.stdout.splitlines()
+
+
+def test_with_records_the_nonlinear_check_after_the_tie_is_the_assessments(
+    tmp_path: Path,
+) -> None:
+    """With El Centro, each designed tie's nonlinear ratios are ``rockmech assess``'s.
+
+    The assessment takes the nonlinear demand as the larger of the spectrum's and the
+    records' (Circ. 2019 C8.7.1.2.1.8); the retrofit sizes the tie on the same demand, so
+    the church's F1 and F2 with their ties at T* pass the assessment with the record.
+    """
+    doc = rockmech.retrofit(CHURCH, CHURCH_SITE, CHURCH_SPEC, records=[ELCENTRO])
+    assert any("C8.7.1.2.1.8" in d for d in doc.decisions)
+    cf = rockmech.read_constants(CHURCH)
+    before = rockmech.assess(CHURCH, CHURCH_SITE, [ELCENTRO], multiples=[1.0]).to_dict()
+    designed = [m for m in doc.mechanisms if m.status == "designed"]
+    assert {m.id for m in designed} == {"F1", "F2"}
+    for i, m in enumerate(doc.mechanisms):
+        # The "before" of every mechanism is the assessment's, records' demand included.
+        row = before["mechanisms"][i]
+        assert row["id"] == m.id
+        if row["nonlinear"].get("status") == "ok":
+            assert m.before.SLV_ratio == pytest.approx(row["nonlinear"]["capacity_ratio"], rel=1e-9)
+    for m in designed:
+        assert m.chosen is not None
+        o = m.options[m.chosen]
+        assert o.T_star_N is not None and o.after is not None and o.verified
+        mechs = [
+            with_tie(x, o.T_star_N, o.height_m, listed=False) if x.id == m.id else x
+            for x in cf.mechanisms
+        ]
+        tied = tmp_path / f"tied_{m.id}.json"
+        tied.write_text(cf.model_copy(update={"mechanisms": mechs}).model_dump_json())
+        after = rockmech.assess(tied, CHURCH_SITE, [ELCENTRO], multiples=[1.0]).to_dict()
+        (row,) = [r for r in after["mechanisms"] if r["id"] == m.id]
+        non = row["nonlinear"]
+        assert o.after.SLV_ratio == pytest.approx(non["capacity_ratio"], rel=1e-9, abs=0)
+        assert o.after.SLC_ratio == pytest.approx(non["SLC"]["capacity_ratio"], rel=1e-9)
+        assert non["capacity_ratio"] >= 1.0 and non["SLC"]["capacity_ratio"] >= 1.0
+        # The records raise the demand: the spectrum alone would give a higher ratio.
+        alone = rockmech.retrofit(CHURCH, CHURCH_SITE, CHURCH_SPEC).mechanism(m.id)
+        assert alone.before.SLV_ratio is not None and m.before.SLV_ratio is not None
+        assert m.before.SLV_ratio <= alone.before.SLV_ratio

@@ -221,8 +221,8 @@ def check_retrofit_matches(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> None
     doc : RetrofitDoc
         A ``retrofit.json`` read back.
     rows : list of dict
-        The mechanism rows of the code checks (``codecheck.check_doc(cf, site)``), without
-        the records' demand: the checks the retrofit ran.
+        The mechanism rows of the code checks as the retrofit ran them
+        (``assess.check_doc_with_records``: with the records' demand where it had records).
 
     Raises
     ------
@@ -243,11 +243,13 @@ def check_retrofit_matches(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> None
                 and math.isclose(theirs, ours, rel_tol=MATCH_RTOL, abs_tol=0.0)
             )
             if not same:
+                names = ", ".join(str(r.get("name", "?")) for r in doc.records)
+                records = f" or other records than its {names}" if names else ""
                 raise InputError(
                     f"the retrofit document's {m.id} has {label} {_ratio(theirs)} before the "
                     f"tie where these inputs give {_ratio(ours)}: it was made from other "
-                    "constants or another site; run rockmech retrofit again on these files, or "
-                    "give the retrofit spec",
+                    f"constants or another site{records}; run rockmech retrofit again on "
+                    "these files, or give the retrofit spec",
                     "retrofit",
                 )
 
@@ -255,9 +257,11 @@ def check_retrofit_matches(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> None
 def records_notes(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> dict[str, str]:
     """Say where the assessment's records raise a demand the retrofit did not size for.
 
-    The retrofit runs the code checks on the site spectrum; with records, an assessment's
-    nonlinear check also takes their largest spectral displacement (Circ. 2019 C8.7.1.2.1.8),
-    so its ratio may be lower than the retrofit's "before".
+    A retrofit run with the assessment's records takes their demand as the assessment does
+    (Circ. 2019 C8.7.1.2.1.8, ``assess.check_doc_with_records``), and this finds nothing. A
+    ``retrofit.json`` made without records ran the code checks on the site spectrum alone;
+    with records, the assessment's nonlinear check also takes their largest spectral
+    displacement, so its ratio may be lower than that document's "before".
 
     Parameters
     ----------

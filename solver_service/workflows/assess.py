@@ -52,6 +52,7 @@ __all__ = [
     "assessment_doc",
     "assessment_document",
     "check_doc",
+    "check_doc_with_records",
     "check_document",
     "check_multiples",
     "matching_band",
@@ -231,6 +232,59 @@ def check_multiples(multiples: Sequence[float]) -> list[float]:
     return out
 
 
+def check_doc_with_records(
+    cf: ConstantsFile, site: SiteFile, motions: Sequence[Any]
+) -> tuple[dict[str, Any], list[list[Any]]]:
+    """Return the code checks with the records' demand of §C8.7.1.2.1.8, as assess runs them.
+
+    The one home of the rule (``rockmech assess`` and ``rockmech retrofit`` both call it):
+    each record is matched to the site spectrum over the band of each mechanism's own
+    nonlinear check (``matching_band``, ``record_scale_factor``), and at that design scale
+    the nonlinear check's demand becomes the larger of the spectrum's and the records'
+    (``codecheck.recheck_with_records``).
+
+    Parameters
+    ----------
+    cf, site
+        As ``check_doc``.
+    motions : sequence of GroundMotion
+        Records (none: ``check_doc`` alone).
+
+    Returns
+    -------
+    doc : dict
+        ``check_doc(cf, site)`` with the records' demand in its nonlinear checks.
+    matched : list of list
+        Per mechanism and record, the design scale (``record_scale_factor``'s dict) or the
+        ``RockmechError`` that kept the record from being matched.
+    """
+    doc = check_doc(cf, site)
+    spectrum = site_spectrum(site)
+    # The design scale of each record per mechanism (its band comes from the code check).
+    matched: list[list[Any]] = []
+    for row in doc["mechanisms"]:
+        band = matching_band(row)
+        per_record: list[Any] = []
+        for motion in motions:
+            try:
+                per_record.append(record_scale_factor(motion, spectrum, band))
+            except RockmechError as exc:
+                per_record.append(exc)
+        matched.append(per_record)
+    if motions:
+        # C8.7.1.2.1.8: with records, the demand is also their largest S_De over [T0, T_SLV].
+        recheck_with_records(
+            doc,
+            cf,
+            site,
+            [
+                [(m, d["value"]) for m, d in zip(motions, per) if isinstance(d, dict)]
+                for per in matched
+            ],
+        )
+    return doc, matched
+
+
 def assessment_doc(
     cf: ConstantsFile,
     site: SiteFile,
@@ -267,27 +321,8 @@ def assessment_doc(
         ``a_p,min / a_p``); a part that cannot run carries a ``note`` instead.
     """
     multiples = check_multiples(multiples)
-    doc = check_doc(cf, site)
-    spectrum = site_spectrum(site)
+    doc, matched = check_doc_with_records(cf, site, motions)
     freq = np.asarray(f_p if f_p is not None else log_grid(*ASSESS_ENVELOPE), dtype=float)
-    # The design scale of each record per mechanism (its band comes from the code check).
-    matched: list[list[Any]] = []
-    for row in doc["mechanisms"]:
-        band = matching_band(row)
-        per_record: list[Any] = []
-        for motion in motions:
-            try:
-                per_record.append(record_scale_factor(motion, spectrum, band))
-            except RockmechError as exc:
-                per_record.append(exc)
-        matched.append(per_record)
-    # C8.7.1.2.1.8: with records, the demand is also their largest S_De over [T0, T_SLV].
-    recheck_with_records(
-        doc,
-        cf,
-        site,
-        [[(m, d["value"]) for m, d in zip(motions, per) if isinstance(d, dict)] for per in matched],
-    )
     for row, mech, per_record in zip(doc["mechanisms"], cf.mechanisms, matched):
         try:
             model = to_rocking_model(mech)

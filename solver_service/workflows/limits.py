@@ -69,6 +69,7 @@ __all__ = [
     "RATE_MARGIN",
     "RETROFIT_BISECTION_STEPS",
     "RETROFIT_CHECKS_PER_S",
+    "RETROFIT_RECORD_PERIODS",
     "RETROFIT_RECORD_RUNS",
     "RETROFIT_SCALE_RUNS",
     "SPECTRUM_GRID_PER_PERIOD",
@@ -128,6 +129,12 @@ RETROFIT_CHECKS_PER_S = 1.2e3
 #: Exact runs at the design scale one record's search on the tie force plans (the
 #: benchmark's target, ``benchmarks/retrofit.py``).
 RETROFIT_RECORD_RUNS = 20
+#: Periods of each record's response spectrum one code check of a retrofit with records
+#: computes: the match to the site spectrum over the mechanism's band
+#: (``assess.BAND_POINTS``) and the records' demand of C8.7.1.2.1.8
+#: (``codes.circ2019.RECORD_POINTS``); a test checks the sum. Each period takes at least one
+#: sub-step per sample.
+RETROFIT_RECORD_PERIODS = 80
 #: Exact runs one least overturning scale takes: the log grid of scales and the bisection
 #: to ``scaling.SCALE_RTOL`` (about 12 halvings from the grid's ratio 1.124), and the run
 #: at the design scale.
@@ -419,8 +426,12 @@ def _outside_sum(p: float, f_min: float, f_max: float, n: int) -> float:
 
     Examples
     --------
-    >>> _outside_sum(1.0, 0.1, 10.0, 3)  # Omega 0.63, 6.3, 63: the last is outside
+    >>> _outside_sum(0.1, 0.1, 10.0, 3)  # Omega 6.3, 63, 628: the last is above 500
     1.0
+    >>> _outside_sum(20.0, 0.1, 10.0, 3)  # Omega 0.031, 0.31, 3.1: the first is below 0.05
+    200.0
+    >>> _outside_sum(1.0, 0.1, 10.0, 3)  # Omega 0.63, 6.3, 63: all inside
+    0.0
     """
     if n < 2 or not _positive(f_min, f_max, p) or f_max <= f_min:
         return 0.0
@@ -679,7 +690,8 @@ def check_retrofit_work(
     cf, site, spec
         The retrofit's inputs (``retrofit_checks`` counts the plan).
     motions : sequence of GroundMotion
-        The records: each adds ``retrofit_record_runs`` runs of its longest mechanism.
+        The records: each adds ``retrofit_record_runs`` runs of its longest mechanism and,
+        per code check, ``RETROFIT_RECORD_PERIODS`` periods of its response spectrum.
     budget_s : float
         The time budget [s]: the service's compute timeout, the command's time limit.
     how : str
@@ -693,11 +705,14 @@ def check_retrofit_work(
     n = retrofit_checks(cf, site, spec)
     runs = retrofit_record_runs(cf, spec) if motions else 0
     steps = sum(history_steps(cf, m.accel.n, m.dt, 1, worst=True) * runs for m in motions)
-    seconds = shortest_time(retrofit_checks=n, history_steps=steps)
+    # With records, every code check matches each record and takes its demand (C8.7.1.2.1.8).
+    spectra = float(n * sum(RETROFIT_RECORD_PERIODS * max(m.accel.n - 1, 0) for m in motions))
+    seconds = shortest_time(retrofit_checks=n, history_steps=steps, spectrum_steps=spectra)
     if seconds > budget_s and steps > 0:
         raise InputError(
             f"the retrofit plans {n} code checks and {runs} exact runs of each of "
-            f"{len(motions)} records ({work_words(retrofit_checks=n, history_steps=steps)}): "
+            f"{len(motions)} records "
+            f"({work_words(retrofit_checks=n, history_steps=steps, spectrum_steps=spectra)}): "
             f"at least {seconds:.3g} s even at {RATE_MARGIN:g} times the rates measured, past "
             f"the budget of {budget_s:g} s; give fewer tie heights, mechanisms or records, "
             f"or {how}",

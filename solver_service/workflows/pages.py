@@ -30,7 +30,7 @@ from ..report.assess import HistoryRun, check_template, render_assessment, sig
 from ..report.html import SPECTRUM_PERIODS, ReportContent, render_report
 from ..report.retrofit import check_retrofit_matches
 from .adapter import to_rocking_model
-from .assess import assessment_doc, site_spectrum
+from .assess import assessment_doc, check_doc_with_records, site_spectrum
 from .documents import envelope_doc, history_doc
 from .scaling import Building, dense_runs, mechanism_scale_factor
 
@@ -250,7 +250,10 @@ def assessment_histories(
 
 
 def assessment_retrofit(
-    cf: ConstantsFile, site: SiteFile, source: Union[RetrofitSpec, RetrofitDoc]
+    cf: ConstantsFile,
+    site: SiteFile,
+    source: Union[RetrofitSpec, RetrofitDoc],
+    motions: Sequence[Any] = (),
 ) -> RetrofitDoc:
     """Return the retrofit a report shows: computed from a spec, or a document checked.
 
@@ -259,10 +262,13 @@ def assessment_retrofit(
     cf, site
         The assessment's constants and site.
     source : RetrofitSpec or RetrofitDoc
-        A retrofit spec (the retrofit is run on ``cf`` and ``site``, as ``rockmech retrofit``
-        runs it) or a ``retrofit.json``, checked against the code checks of ``cf`` on
-        ``site`` (``report.retrofit.check_retrofit_matches``; the checks without the
-        records' demand, as the retrofit runs them).
+        A retrofit spec (the retrofit is run on ``cf``, ``site`` and the assessment's
+        records, as ``rockmech retrofit --record`` runs it) or a ``retrofit.json``, checked
+        against the code checks of ``cf`` on ``site`` (``report.retrofit.check_retrofit_matches``),
+        with the records' demand where the document was made with records, as it then ran
+        them.
+    motions : sequence of GroundMotion
+        The assessment's records.
 
     Raises
     ------
@@ -271,16 +277,15 @@ def assessment_retrofit(
         a document made from other inputs (``retrofit``).
     """
     if isinstance(source, RetrofitDoc):
-        # The code checks (the retrofit's own, without records) to compare the document with.
-        from .codecheck import check_doc
-
-        check_retrofit_matches(source, check_doc(cf, site)["mechanisms"])
+        # The code checks as the retrofit ran them: with the records' demand if it had any.
+        doc, _ = check_doc_with_records(cf, site, motions if source.records else ())
+        check_retrofit_matches(source, doc["mechanisms"])
         return source
     # The retrofit (its bisections on the code checks) is loaded only when a spec is given.
     from .retrofit import retrofit_doc
 
     try:
-        return retrofit_doc(cf, site, source)
+        return retrofit_doc(cf, site, source, motions)
     except InputError as exc:
         head = (exc.field or "").split(".", 1)[0]
         if head in ("mechanisms", "steel", "anchorage"):
@@ -320,7 +325,8 @@ def assess_report(
     check_template(template_dir)  # a user template's syntax error before the analysis runs
     doc = assessment_doc(cf, site, motions, multiples=multiples)
     if retrofit is not None:
-        doc["retrofit"] = assessment_retrofit(cf, site, retrofit).model_dump(mode="json")
+        made = assessment_retrofit(cf, site, retrofit, motions)
+        doc["retrofit"] = made.model_dump(mode="json")
     text = render_assessment(
         doc,
         cf,

@@ -55,11 +55,12 @@ from shared_schema.site import MechanismOptions, SiteFile
 
 from ..codes.circ2019 import CIRC2019
 from ..core.model import G
-from .codecheck import check_doc
+from .assess import check_doc_with_records
 from .retrofit_records import RECORD_DECISIONS, MechanismRecords, tie_slope
 
 __all__ = [
     "ALPHA0_MAX",
+    "RECORDS_DEMAND_DECISION",
     "RETROFIT_DECISIONS",
     "SINGLE_BLOCK_TYPOLOGIES",
     "T_REL_TOL",
@@ -106,6 +107,15 @@ RETROFIT_DECISIONS = [
     "Bars at one height share T* equally; the steel mass is per metre unless the spec "
     "gives the bar length (the constants do not carry where the bar is anchored).",
 ]
+
+#: With records, the decision on the nonlinear check's demand (listed in the document).
+RECORDS_DEMAND_DECISION = (
+    "With records, the nonlinear checks before and after the tie, and the bisection of their "
+    "T*, take the demand as rockmech assess does (Circ. 2019 C8.7.1.2.1.8; one function, "
+    "assess.check_doc_with_records): the larger of the site spectrum's and the records' "
+    "largest S_De over [T0, T_SLV], each record matched to the site spectrum over the band "
+    "of the mechanism with the tie at that force (its own T_SLV)."
+)
 
 _CL = {
     "linear_ratio": "Circ. 2019 C8.7.1.2.1.7: a_g,SLV/a_g (linear kinematic analysis)",
@@ -252,12 +262,20 @@ def _unlist_ties(mech: Mechanism) -> Mechanism:
 
 
 class _Checker:
-    """Runs the code check of one mechanism with a tie, as ``check_doc`` does."""
+    """Runs the code check of one mechanism with a tie, as ``rockmech assess`` does.
 
-    def __init__(self, cf: ConstantsFile, site: SiteFile, mech: Mechanism) -> None:
+    With records (``motions``), the nonlinear demand is also theirs (C8.7.1.2.1.8), by
+    ``assess.check_doc_with_records``: each record matched over the band of the mechanism
+    with the tie at that force.
+    """
+
+    def __init__(
+        self, cf: ConstantsFile, site: SiteFile, mech: Mechanism, motions: Sequence[Any] = ()
+    ) -> None:
         self.cf = cf
         self.site = site
         self.mech = mech
+        self.motions = motions
         lm = site.local_mechanisms
         self.options = lm.mechanisms.get(mech.id) or MechanismOptions()
         self.runs = 0
@@ -286,7 +304,8 @@ class _Checker:
                     opts = opts.model_copy(update={"ties": "not_verified"})
                 mech = with_tie(mech, force, height, listed=True)
         cf = self.cf.model_copy(update={"mechanisms": [mech]})
-        doc = check_doc(cf, self._site(opts))
+        # With records, the nonlinear demand is assess's (C8.7.1.2.1.8): the same function.
+        doc, _ = check_doc_with_records(cf, self._site(opts), self.motions)
         row: dict[str, Any] = doc["mechanisms"][0]
         return row
 
@@ -683,7 +702,7 @@ def _mechanism(
             f"mechanism {mech.id}: {top_source}; give the tie heights",
             f"mechanisms.{mech.id}.heights_m",
         )
-    checker = _Checker(cf, site, mech)
+    checker = _Checker(cf, site, mech, motions)
     options = [
         _option(checker, spec, ties, row, h, src, top, recs, records_before) for h, src in heights
     ]
@@ -725,7 +744,9 @@ def retrofit_doc(
         Steel, bars on offer, anchorage resistance, candidate tie heights per mechanism.
     motions : sequence of GroundMotion
         Records (``spec.records`` as the front ends read them): each tied mechanism must
-        survive every one at its design scale (``workflows.retrofit_records``).
+        survive every one at its design scale (``workflows.retrofit_records``), and the
+        nonlinear checks take their demand as ``rockmech assess`` does (C8.7.1.2.1.8,
+        ``assess.check_doc_with_records``), before the tie, in the bisections and after.
 
     Returns
     -------
@@ -756,7 +777,7 @@ def retrofit_doc(
             "circ2019",
             "local_mechanisms.method",
         )
-    doc = check_doc(cf, site)
+    doc, _ = check_doc_with_records(cf, site, motions)
     rows = doc["mechanisms"]
     out = []
     for mech, row in zip(cf.mechanisms, rows):
@@ -790,7 +811,8 @@ def retrofit_doc(
     return RetrofitDoc(
         standard=CIRC2019 + "; NTC 2018 §4.2.4.1.2.1 (tie-bars)",
         steel=steel,
-        decisions=RETROFIT_DECISIONS + (RECORD_DECISIONS if motions else []),
+        decisions=RETROFIT_DECISIONS
+        + ([RECORDS_DEMAND_DECISION, *RECORD_DECISIONS] if motions else []),
         records=[
             {
                 "name": m.name,

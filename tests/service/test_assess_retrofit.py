@@ -7,8 +7,11 @@ at h_t above the hinge adding T h_t/(g S) (S = Σ P_k δ_PQx,k/g per unit rotati
 constants' ``virtual_work.S``), and the linear demand does not depend on T, so the ratio
 a_g,SLV/a_g is proportional to α0 and reaches 1 at T = (α0/ratio − α0) g S/h_t. The bar is
 NTC 2018 [4.2.6]: N_pl,Rd = A f_yk/γ_M0, f_yk = 275 N/mm² (S275, Tab. 4.2.I), γ_M0 = 1.05
-(Tab. 4.2.VII). The page is opened in a real headless Chromium and printed to PDF where the
-machine has them (the test skips, saying why, where it does not).
+(Tab. 4.2.VII). With El Centro the retrofit takes the records' demand in its nonlinear
+check as the assessment does (Circ. 2019 C8.7.1.2.1.8), so the linear force by hand is F1's
+linear criterion and a lower bound of its T*. The page is opened in a real headless Chromium
+and printed to PDF where the machine has them (the test skips, saying why, where it does
+not).
 """
 
 from __future__ import annotations
@@ -99,20 +102,24 @@ def test_page_one_carries_the_tie_that_makes_f1_pass(with_spec: tuple[str, dict]
     rdoc = doc["retrofit"]
     m = next(x for x in rdoc["mechanisms"] if x["id"] == "F1")
     tie = m["options"][m["chosen"]]
-    assert tie["governing"] == "linear SLV" and tie["height_m"] == max(heights)
-    assert tie["T_star_N"] == pytest.approx(t_hand, rel=1e-6)
-    # Two bars share it: 15.06 kN each; Ø16 S275 carries π 16²/4 · 275/1.05 = 52.7 kN.
-    per_bar = t_hand / 2
+    assert tie["height_m"] == max(heights)
+    assert tie["T_linear_N"] == pytest.approx(t_hand, rel=1e-6)
+    # With El Centro's demand (C8.7.1.2.1.8), the nonlinear SLV check needs more than the
+    # linear one: it governs, and the tie carries its force.
+    assert tie["governing"] == "nonlinear SLV"
+    assert tie["T_star_N"] == tie["T_nonlinear_SLV_N"] > t_hand
+    # Two bars share it; Ø16 S275 carries π 16²/4 · 275/1.05 = 52.7 kN.
+    per_bar = tie["T_star_N"] / 2
     assert tie["bar"]["diameter_mm"] == 16.0
     assert tie["bar"]["N_pl_Rd_N"] == pytest.approx(math.pi * 64.0 * 275.0 / 1.05, rel=1e-12)
     assert per_bar <= tie["bar"]["N_pl_Rd_N"]
     mech, status, bars, force, governs, ratios = table["F1"]
     assert (mech, status, bars, governs) == ("F1", "tie designed", "2 Ø16 S275 at 8 m",
-                                             "linear SLV")  # fmt: skip
+                                             "nonlinear SLV")  # fmt: skip
     found = re.fullmatch(r"([0-9.]+) \(([0-9.]+)\)", force)
     assert found is not None, force
     total, each = found.groups()
-    assert float(total) == float(f"{t_hand / 1e3:.3g}")  # 3 significant figures
+    assert float(total) == float(f"{tie['T_star_N'] / 1e3:.3g}")  # 3 significant figures
     assert float(each) == float(f"{per_bar / 1e3:.3g}")
     before, after = re.findall(r"[0-9.]+", ratios)[:2]
     least_before = min(
@@ -126,7 +133,51 @@ def test_page_one_carries_the_tie_that_makes_f1_pass(with_spec: tuple[str, dict]
     assert table["A1"][1] == "not retrofitted by a tie" and table["A1"][2] == "–"
     assert "A1: not retrofitted by a tie: typology multi_block" in detail
     # With El Centro the nonlinear demand of F2 and A1 is also the record's (C8.7.1.2.1.8):
-    # their assessment ratios are below the retrofit's, sized on the site spectrum; said.
+    # the retrofit run from the spec takes it too, so its "before" is the assessment's and
+    # nothing is flagged.
+    for r in doc["mechanisms"]:
+        b = next(x for x in rdoc["mechanisms"] if x["id"] == r["id"])["before"]
+        assert b["SLV_ratio"] == pytest.approx(r["nonlinear"]["capacity_ratio"], rel=1e-9)
+    assert "†" not in html.unescape(one)
+    # The anchorage resistance is the user's, shown with its source.
+    assert "60.0 kN per tie (illustrative: plate punching" in detail
+
+
+def test_the_documents_retrofit_is_rockmech_retrofits(with_spec: tuple[str, dict]) -> None:
+    _, doc = with_spec
+    res = runner.invoke(
+        app,
+        ["retrofit", str(CHURCH), "--site", str(SITE), "--spec", str(SPEC), "--record",
+         str(RECORD), "--json"],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert doc["retrofit"] == json.loads(res.stdout)
+
+
+def test_a_retrofit_json_gives_the_same_table(with_spec: tuple[str, dict], tmp_path: Path) -> None:
+    res = runner.invoke(
+        app,
+        ["retrofit", str(CHURCH), "--site", str(SITE), "--spec", str(SPEC), "--record",
+         str(RECORD), "-o", str(tmp_path)],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    page, doc = _assess(tmp_path / "r.html", "--retrofit", str(tmp_path / "retrofit.json"))
+    assert _table(page) == _table(with_spec[0])
+    assert doc["retrofit"] == with_spec[1]["retrofit"]
+
+
+def test_a_retrofit_json_made_without_the_records_is_flagged(tmp_path: Path) -> None:
+    """A retrofit.json sized on the site spectrum alone, beside an assessment with records."""
+    res = runner.invoke(
+        app,
+        ["retrofit", str(CHURCH), "--site", str(SITE), "--spec", str(SPEC), "-o", str(tmp_path)],
+    )
+    assert res.exit_code == 0, res.output
+    page, doc = _assess(tmp_path / "r.html", "--retrofit", str(tmp_path / "retrofit.json"))
+    rdoc, one, table = doc["retrofit"], _page_one(page), _table(page)
+    assert rdoc["records"] == []
+    # With El Centro the nonlinear demand of F2 and A1 is also the record's (C8.7.1.2.1.8):
+    # their assessment ratios are below the document's, sized on the site spectrum; said.
     sentences = html.unescape(page.split('id="retrofit-sentences"', 1)[1].split("</ul>", 1)[0])
     for mid in ("F2", "A1"):
         r = next(x for x in doc["mechanisms"] if x["id"] == mid)
@@ -140,28 +191,6 @@ def test_page_one_carries_the_tie_that_makes_f1_pass(with_spec: tuple[str, dict]
     assert "F1: with the records" not in sentences  # F1's record demand is the spectrum's
     assert "† F2, A1: with the records' demand" in html.unescape(one)  # flagged on page one
     assert [r for r in table if table[r][-1].endswith("†") or "† " in table[r][-1]] == ["F2", "A1"]
-    # The anchorage resistance is the user's, shown with its source.
-    assert "60.0 kN per tie (illustrative: plate punching" in detail
-
-
-def test_the_documents_retrofit_is_rockmech_retrofits(with_spec: tuple[str, dict]) -> None:
-    _, doc = with_spec
-    res = runner.invoke(
-        app, ["retrofit", str(CHURCH), "--site", str(SITE), "--spec", str(SPEC), "--json"]
-    )
-    assert res.exit_code == 0, res.output
-    assert doc["retrofit"] == json.loads(res.stdout)
-
-
-def test_a_retrofit_json_gives_the_same_table(with_spec: tuple[str, dict], tmp_path: Path) -> None:
-    res = runner.invoke(
-        app,
-        ["retrofit", str(CHURCH), "--site", str(SITE), "--spec", str(SPEC), "-o", str(tmp_path)],
-    )
-    assert res.exit_code == 0, res.output
-    page, doc = _assess(tmp_path / "r.html", "--retrofit", str(tmp_path / "retrofit.json"))
-    assert _table(page) == _table(with_spec[0])
-    assert doc["retrofit"] == with_spec[1]["retrofit"]
 
 
 def test_a_retrofit_json_of_another_site_is_refused(tmp_path: Path) -> None:
@@ -182,6 +211,24 @@ def test_a_retrofit_json_of_another_site_is_refused(tmp_path: Path) -> None:
     (line,) = res.stderr.strip().splitlines()
     assert line.startswith("error: retrofit: the retrofit document's F1 has ")
     assert "made from other constants or another site" in line
+    assert not (tmp_path / "r.html").exists()
+
+
+def test_a_retrofit_json_made_with_records_needs_them(tmp_path: Path) -> None:
+    """Made with El Centro, shown beside an assessment without it: F2's "before" differs."""
+    res = runner.invoke(
+        app,
+        ["retrofit", str(CHURCH), "--site", str(SITE), "--spec", str(SPEC), "--record",
+         str(RECORD), "-o", str(tmp_path)],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    args = ["assess", str(CHURCH), str(SITE), "-o", str(tmp_path / "r.html"),
+            "--retrofit", str(tmp_path / "retrofit.json")]  # fmt: skip
+    res = runner.invoke(app, args)
+    assert res.exit_code == 2, res.output
+    (line,) = res.stderr.strip().splitlines()
+    assert line.startswith("error: retrofit: the retrofit document's F2 has "), line
+    assert "or other records than its elcentro_NS;" in line
     assert not (tmp_path / "r.html").exists()
 
 
@@ -261,7 +308,10 @@ def test_the_table_in_chromium_and_on_the_pdfs_first_page(tmp_path: Path) -> Non
     # Page one of the print ends with the retrofit table, each row on a line of its own.
     assert "Retrofit: tie-bars for the mechanisms that fail" in words
     lines = {ln.split()[0]: " ".join(ln.split()) for ln in first.splitlines() if ln.split()}
-    assert lines["F1"].startswith("F1 tie designed 2 Ø16 S275 at 8 m 30.1 (15.1) linear SLV")
+    # F1's tie is sized on the nonlinear SLV check with El Centro's demand (C8.7.1.2.1.8).
+    assert lines["F1"].startswith(
+        "F1 tie designed 2 Ø16 S275 at 8 m 34.6 (17.3) nonlinear SLV 0.313 → 1.00"
+    )
     assert lines["F2"].startswith("F2 tie designed 1 Ø16 S275 at 6.33 m 19.9 linear SLV")
     assert lines["A1"].startswith("A1 not retrofitted by a tie")
     second = subprocess.run(
@@ -270,4 +320,4 @@ def test_the_table_in_chromium_and_on_the_pdfs_first_page(tmp_path: Path) -> Non
         capture_output=True,
         timeout=60,
     ).stdout.decode("utf-8")
-    assert "2 Ø16 S275 ties at 8 m, 15.1 kN each, make F1 pass" in " ".join(second.split())
+    assert "2 Ø16 S275 ties at 8 m, 17.3 kN each, make F1 pass" in " ".join(second.split())
