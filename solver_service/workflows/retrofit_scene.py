@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import uuid
 from dataclasses import dataclass
-from typing import Any, Optional, Sequence
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
@@ -471,6 +471,7 @@ def retrofit_search(
     spec_name: str = "search spec",
     max_evaluations: Optional[int] = None,
     max_lp_blocks: Optional[int] = None,
+    check_work: Optional[Callable[[ConstantsFile, RetrofitSpec], None]] = None,
 ) -> RetrofitSearch:
     """Design the ties of a searched scene's mechanisms, then search the tied scene again.
 
@@ -490,6 +491,9 @@ def retrofit_search(
         For the searches' provenance.
     max_evaluations, max_lp_blocks : int, optional
         The searches' work limits (``search_run``).
+    check_work : callable, optional
+        Called with the first search's constants and the retrofit spec (its tie heights
+        filled in from the scene) before the retrofit runs: a front end's work limit.
 
     Returns
     -------
@@ -512,6 +516,8 @@ def retrofit_search(
     if before.constants is None:
         raise InputError("the search built no mechanism: nothing to retrofit", "scene")
     rspec, sources = scene_heights(before, rspec)
+    if check_work is not None:
+        check_work(before.constants, rspec)
     doc = _with_sources(retrofit_doc(before.constants, site, rspec, motions), sources)
     placed, lines, bars = place_ties(before, doc)
     if not lines:

@@ -14,15 +14,19 @@ the scene as tie-bar lines at the top of F, and the search runs again. The refer
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 from search.search_scenes import EXAMPLE_SCENE, EXAMPLE_SPEC
+from typer.testing import CliRunner
 
 from cad_maths.scenes import read_scene
 from shared_schema.retrofit import parse_retrofit_spec
+from solver_service.cli import app
 from solver_service.workflows.assess import read_site
 from solver_service.workflows.retrofit import with_tie
 from solver_service.workflows.retrofit_files import retrofit_json
@@ -36,12 +40,16 @@ RSPEC = {
 }
 
 
+def _lighter() -> Any:
+    """The example's search spec, lighter: the ranking's band does not enter the retrofit."""
+    spec = read_search_spec(EXAMPLE_SPEC)
+    lighter = spec.ranking.model_copy(update={"n_frequencies": 40})
+    return spec.model_copy(update={"lp": False, "ranking": lighter})
+
+
 @pytest.fixture(scope="module")
 def run() -> Any:
-    spec = read_search_spec(EXAMPLE_SPEC)
-    # fewer frequencies and no global check: the ranking's band does not enter the retrofit
-    lighter = spec.ranking.model_copy(update={"n_frequencies": 40})
-    spec = spec.model_copy(update={"lp": False, "ranking": lighter})
+    spec = _lighter()
     return retrofit_search(
         read_scene(EXAMPLE_SCENE),
         spec,
@@ -125,3 +133,30 @@ def test_document_carries_search_after_and_a_plain_retrofit_does_not(run: Any) -
     assert '"search_after": {' in text
     plain = run.doc.model_copy(update={"search_after": None})
     assert "search_after" not in retrofit_json(plain)
+
+
+def test_cli_retrofit_from_a_scene_writes_the_same_document(run: Any, tmp_path: Path) -> None:
+    spec = tmp_path / "light.search.json"
+    spec.write_text(_lighter().model_dump_json(exclude_none=True), encoding="utf-8")
+    rspec = tmp_path / "ties.retrofit.json"
+    rspec.write_text(json.dumps(RSPEC), encoding="utf-8")
+    args = ["--site", str(SITE), "--spec", str(rspec)]
+    scene = ["--scene", str(EXAMPLE_SCENE), "--search-spec", str(spec)]
+    res = CliRunner().invoke(app, ["retrofit", *scene, *args, "--json"])
+    assert res.exit_code == 0, res.output
+    got = json.loads(res.stdout)
+    want = json.loads(retrofit_json(run.doc))
+    assert got["search_after"] == want["search_after"]
+    assert got["mechanisms"] == want["mechanisms"]
+    # refusals: one line naming the field, exit 2, no traceback
+    for extra, field in (
+        (["--scene", str(EXAMPLE_SCENE)], "search_spec"),
+        (
+            [str(EXAMPLE_SCENE.parent.parent / "constants" / "church_geometry.json"), *scene],
+            "constants",
+        ),
+        ([], "constants"),
+    ):
+        res = CliRunner().invoke(app, ["retrofit", *extra, *args])
+        assert res.exit_code == 2 and "Traceback" not in res.output, res.output
+        assert f"error: {field}:" in res.output
