@@ -60,8 +60,8 @@ def retrofit(
     scene: Optional[Path] = typer.Option(
         None,
         "--scene",
-        help="Scene (.3dm) to search, with --search-spec: the ties designed for its "
-        "mechanisms go in as tie-bars and the search runs again (search_after).",
+        help="Scene (.3dm), or a `rockmech search --out` folder, to search with "
+        "--search-spec: the designed ties go in as tie-bars and the search runs again.",
     ),
     search_spec: Optional[Path] = typer.Option(
         None, "--search-spec", help="The search spec (JSON) of --scene."

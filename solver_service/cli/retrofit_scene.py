@@ -1,5 +1,8 @@
 """``rockmech retrofit --scene SCENE --search-spec SPEC``: the retrofit of a searched scene.
 
+``--scene`` may be the run folder of ``rockmech search --out``: its ``search.3dm`` is searched
+and must give the folder's ``constants.json`` again.
+
 The search runs, the retrofit designs the ties of its failing mechanisms, the ties go into the
 scene as tie-bars and the search runs again (``workflows.retrofit_scene``). The workflow (the
 search, scipy, the geometry) is imported when the command runs.
@@ -100,6 +103,20 @@ def scene_retrofit(
     # The search spec's reader and the search's work limits, with the search.
     from ..workflows.search import MAX_EVALUATIONS, MAX_LP_BLOCKS, read_search_spec
 
+    expected = None
+    if scene.is_dir():
+        # A search's run folder: its own scene, and the constants the search must rebuild.
+        from ..workflows.inputs import read_constants
+
+        folder, scene = scene, scene / "search.3dm"
+        if not scene.is_file():
+            raise InputError(
+                f"{folder.name} is a folder without search.3dm: give a scene, or the run "
+                "folder of `rockmech search --out`",
+                "scene",
+            )
+        if (folder / "constants.json").is_file():
+            expected = read_constants(folder / "constants.json")
     spec = read_search_spec(search_spec)
     scene_obj = read_scene(check_file(scene, "scene"))
     with status("retrofit: search, tie forces, search again with the ties"):
@@ -114,6 +131,7 @@ def scene_retrofit(
             max_evaluations=None if limits.no_limits else MAX_EVALUATIONS,
             max_lp_blocks=None if limits.no_limits else MAX_LP_BLOCKS,
             check_work=check_work,
+            expected=expected,
         )
     return run.doc
 

@@ -249,6 +249,33 @@ def place_ties(
     return placed, lines, bars
 
 
+#: The first search's α0 and a run folder's agree to this (relative) when they are one run.
+SAME_RUN_RTOL = 1e-9
+
+
+def _alpha0(mech: Mechanism) -> Optional[float]:
+    vw = mech.positive.virtual_work
+    return None if vw is None else float(vw.alpha0)
+
+
+def _same_run(got: ConstantsFile, want: ConstantsFile) -> None:
+    """Refuse a search whose mechanisms are not a run folder's ``constants.json``."""
+    a = [(m.id, m.name) for m in got.mechanisms]
+    b = [(m.id, m.name) for m in want.mechanisms]
+    same = a == b
+    for m, n in zip(got.mechanisms, want.mechanisms):
+        x, y = _alpha0(m), _alpha0(n)
+        if same and x is not None and y is not None:
+            same = abs(x - y) <= SAME_RUN_RTOL * max(abs(y), 1e-12)
+    if not same:
+        raise InputError(
+            "the search of the run folder's search.3dm with this search spec does not build "
+            "the run's constants.json (other mechanisms or multipliers): give the search spec "
+            "that made the run",
+            "search_spec",
+        )
+
+
 def scene_heights(run: SearchRun, rspec: RetrofitSpec) -> tuple[RetrofitSpec, dict[str, str]]:
     """Give each built mechanism without ``heights_m`` the tie height the scene gives.
 
@@ -472,6 +499,7 @@ def retrofit_search(
     max_evaluations: Optional[int] = None,
     max_lp_blocks: Optional[int] = None,
     check_work: Optional[Callable[[ConstantsFile, RetrofitSpec], None]] = None,
+    expected: Optional[ConstantsFile] = None,
 ) -> RetrofitSearch:
     """Design the ties of a searched scene's mechanisms, then search the tied scene again.
 
@@ -494,6 +522,10 @@ def retrofit_search(
     check_work : callable, optional
         Called with the first search's constants and the retrofit spec (its tie heights
         filled in from the scene) before the retrofit runs: a front end's work limit.
+    expected : ConstantsFile, optional
+        The constants a search run folder holds (``constants.json``): the first search must
+        build the same mechanisms (ids, names, α0 to ``SAME_RUN_RTOL``), else the search spec
+        is not the one that made the run.
 
     Returns
     -------
@@ -504,7 +536,8 @@ def retrofit_search(
     Raises
     ------
     InputError
-        The first search builds no mechanism; any input error of the search or retrofit.
+        The first search builds no mechanism, or not the ``expected`` ones (field
+        ``search_spec``); any input error of the search or retrofit.
     """
     common: dict[str, Any] = {
         "site": site,
@@ -515,6 +548,8 @@ def retrofit_search(
     before = search_run(scene, spec, scene_name=scene_name, spec_name=spec_name, **common)
     if before.constants is None:
         raise InputError("the search built no mechanism: nothing to retrofit", "scene")
+    if expected is not None:
+        _same_run(before.constants, expected)
     rspec, sources = scene_heights(before, rspec)
     if check_work is not None:
         check_work(before.constants, rspec)

@@ -160,3 +160,30 @@ def test_cli_retrofit_from_a_scene_writes_the_same_document(run: Any, tmp_path: 
         res = CliRunner().invoke(app, ["retrofit", *extra, *args])
         assert res.exit_code == 2 and "Traceback" not in res.output, res.output
         assert f"error: {field}:" in res.output
+
+
+def test_cli_retrofit_from_a_search_run_folder(run: Any, tmp_path: Path) -> None:
+    spec = tmp_path / "light.search.json"
+    doc = json.loads(_lighter().model_dump_json(exclude_none=True))
+    doc["ranking"].update(site=str(SITE), records=[])  # the search's own ranking, from here
+    spec.write_text(json.dumps(doc), encoding="utf-8")
+    rspec = tmp_path / "ties.retrofit.json"
+    rspec.write_text(json.dumps(RSPEC), encoding="utf-8")
+    folder = tmp_path / "run"
+    res = CliRunner().invoke(app, ["search", str(EXAMPLE_SCENE), str(spec), "--out", str(folder)])
+    assert res.exit_code == 0, res.output
+    args = ["--site", str(SITE), "--spec", str(rspec), "--json"]
+    res = CliRunner().invoke(
+        app, ["retrofit", "--scene", str(folder), "--search-spec", str(spec), *args]
+    )
+    assert res.exit_code == 0, res.output
+    got = json.loads(res.stdout)
+    assert got["search_after"] == json.loads(retrofit_json(run.doc))["search_after"]
+    # another search spec (a denser façade) does not rebuild the run: refused, naming it
+    other = json.loads(spec.read_text(encoding="utf-8"))
+    other["walls"][0]["density"] = 1900.0
+    spec.write_text(json.dumps(other), encoding="utf-8")
+    res = CliRunner().invoke(
+        app, ["retrofit", "--scene", str(folder), "--search-spec", str(spec), *args]
+    )
+    assert res.exit_code == 2 and "error: search_spec:" in res.output, res.output
