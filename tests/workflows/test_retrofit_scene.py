@@ -187,3 +187,22 @@ def test_cli_retrofit_from_a_search_run_folder(run: Any, tmp_path: Path) -> None
         app, ["retrofit", "--scene", str(folder), "--search-spec", str(spec), *args]
     )
     assert res.exit_code == 2 and "error: search_spec:" in res.output, res.output
+
+
+def test_a_tie_above_the_wall_is_not_placed_and_its_mechanism_still_governs() -> None:
+    # S10 (hinge at z = 7 m): the constants' rectangle puts its top 3.81 m above the hinge,
+    # the scene's wall ends 3.5 m above it: a tie designed at 3.7 m has no wall to meet
+    high = {**RSPEC, "mechanisms": {"S10": {"heights_m": [3.7]}}}
+    got = retrofit_search(
+        read_scene(EXAMPLE_SCENE), _lighter(), read_site(SITE), parse_retrofit_spec(high)
+    )
+    assert got.doc.mechanism("S10").status == "designed"
+    sa = got.doc.search_after
+    by = {t.mechanism: t for t in sa.ties}
+    assert by["S10"].status == "not_placed" and "off the wall F" in (by["S10"].note or "")
+    assert by["S11"].status == "placed" and by["S13"].status == "placed"
+    # the rerun: S10 carries only the others' top tie, less than it needs, and governs, failing
+    s10 = got.doc.mechanism("S10").name
+    row = next(r for r in sa.rows if r.name == s10)
+    assert row.ties and row.margin is not None and row.margin < 1.0
+    assert sa.after_name == s10 and sa.after_margin == row.margin and not sa.moved
