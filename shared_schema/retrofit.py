@@ -25,7 +25,7 @@ The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` 
 
 from typing import Any, Dict, List, Literal, Mapping, Optional, Tuple, Union
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_serializer
 
 from shared_schema.constants import validate_document
 from shared_schema.errors import InputError
@@ -46,10 +46,13 @@ __all__ = [
     "GoverningRow",
     "MechanismRetrofit",
     "MechanismTies",
+    "PlacedTie",
     "RecordScale",
     "RecordTie",
     "RetrofitDoc",
     "RetrofitSpec",
+    "SearchAfter",
+    "SearchAfterRow",
     "Steel",
     "TieOption",
     "bar_strengths",
@@ -472,6 +475,12 @@ RETROFIT_UNITS: Dict[str, str] = {
     "e_star": "-",
     "before_margin": "-",
     "after_margin": "-",
+    "lam0": "-",
+    "after_lam0": "-",
+    "least_lam0_value": "-",
+    "margin": "-",
+    "at_m": "m",
+    "end_m": "m",
 }
 
 
@@ -509,6 +518,76 @@ class GoverningNext(BaseModel):
     basis: List[str] = Field(default_factory=list)
 
 
+class PlacedTie(BaseModel):
+    """A designed tie put into the scene as a tie-bar for the search's rerun."""
+
+    model_config = _DOC
+
+    mechanism: str = Field(description="The mechanism the tie is designed for.")
+    status: Literal["placed", "not_placed"]
+    object: Optional[str] = Field(None, description="Name of the tie-bar line in the scene.")
+    wall: Optional[str] = Field(None, description="The search's wall the tie meets.")
+    force_N: Optional[float] = Field(None, description="The tie-bar's constant force [N].")
+    height_m: Optional[float] = Field(None, description="Height above the hinge [m].")
+    at_m: Optional[List[float]] = Field(
+        None, description="Where the line meets the wall's outer face [m]."
+    )
+    end_m: Optional[List[float]] = Field(
+        None, description="The line's other end, on the wall's inner face [m]."
+    )
+    note: Optional[str] = None
+
+
+class SearchAfterRow(BaseModel):
+    """One mechanism of the search rerun with the ties in."""
+
+    model_config = _DOC
+
+    id: str
+    name: str
+    family: str
+    facade: str
+    direction: str
+    lam0: float = Field(description="Exact static multiplier of the rerun [-].")
+    margin: Optional[float] = Field(None, description="Least a_g,X/a_g of its checks [-].")
+    criterion: Optional[str] = None
+    ties: List[str] = Field(
+        default_factory=list, description="The designed tie-bars its moving part carries."
+    )
+
+
+class SearchAfter(BaseModel):
+    """The search rerun on the scene with the designed ties: what governs after.
+
+    The margin is the least capacity/demand of the Circolare 2019 checks (``a_g,X/a_g``) of
+    the mechanisms the search builds; ``moved`` compares the governing mechanism's family,
+    façade and direction before and after (the rerun numbers its mechanisms anew).
+    """
+
+    model_config = _DOC
+
+    ties: List[PlacedTie] = Field(default_factory=list)
+    before: Optional[str] = Field(None, description="Governing mechanism of the first search.")
+    before_name: Optional[str] = None
+    before_facade: Optional[str] = Field(None, description="The wall it turns.")
+    before_family: Optional[str] = None
+    before_margin: Optional[float] = None
+    before_criterion: Optional[str] = None
+    after: Optional[str] = Field(None, description="Governing mechanism of the rerun.")
+    after_name: Optional[str] = None
+    after_facade: Optional[str] = Field(None, description="The wall it turns.")
+    after_family: Optional[str] = None
+    after_margin: Optional[float] = None
+    after_criterion: Optional[str] = None
+    after_lam0: Optional[float] = Field(None, description="Its static multiplier [-].")
+    least_lam0: Optional[str] = Field(None, description="The rerun's mechanism of least λ0.")
+    least_lam0_value: Optional[float] = Field(None, description="That λ0 [-].")
+    moved: bool = Field(description="Another mechanism governs after the intervention.")
+    rows: List[SearchAfterRow] = Field(default_factory=list)
+    basis: List[str] = Field(default_factory=list)
+    notes: List[str] = Field(default_factory=list)
+
+
 class RetrofitDoc(BaseModel):
     """The retrofit document: per mechanism the least tie force and what it takes.
 
@@ -537,6 +616,17 @@ class RetrofitDoc(BaseModel):
     governs_next: Optional[GoverningNext] = Field(
         None, description="What governs before and after the intervention."
     )
+    search_after: Optional[SearchAfter] = Field(
+        None, description="From a scene: the search rerun with the designed ties."
+    )
+
+    @model_serializer(mode="wrap")
+    def _without_search_after(self, handler: Any) -> Any:
+        # A retrofit from a constants file keeps the bytes it had before the key existed.
+        data = handler(self)
+        if isinstance(data, dict) and data.get("search_after", 0) is None:
+            del data["search_after"]
+        return data
 
     def mechanism(self, mechanism_id: str) -> MechanismRetrofit:
         """Return the mechanism with this id."""

@@ -12,9 +12,10 @@ import typer
 
 from ..workflows.rundir import check_folder_target, run_folder
 from .errors import user_errors
-from .options import CONSTANTS_ARG, LIMITS, Limits, grouped
-from .output import out_note, record_warning, status
+from .options import LIMITS, Limits, grouped
+from .output import out_note, record_warning
 from .output import table as table_lines
+from .retrofit_scene import retrofit_document, search_after_lines
 
 __all__ = ["retrofit"]
 
@@ -92,12 +93,26 @@ def _print_table(doc: Any) -> None:
             f"with the ties in, {nxt.after} governs: margin {nxt.after_margin:.3f} "
             f"({nxt.after_criterion}); before, {nxt.before} at {nxt.before_margin:.3f}"
         )
+    if doc.search_after is not None:
+        for line in search_after_lines(doc.search_after):
+            typer.echo(line)
 
 
 @user_errors
 @grouped
 def retrofit(
-    constants: Path = CONSTANTS_ARG,
+    constants: Optional[Path] = typer.Argument(
+        None, help="Kinematic-constants JSON file (or --scene with --search-spec)."
+    ),
+    scene: Optional[Path] = typer.Option(
+        None,
+        "--scene",
+        help="Scene (.3dm), or a `rockmech search --out` folder, to search with "
+        "--search-spec: the designed ties go in as tie-bars and the search runs again.",
+    ),
+    search_spec: Optional[Path] = typer.Option(
+        None, "--search-spec", help="The search spec (JSON) of --scene."
+    ),
     site: Path = typer.Option(..., "--site", help="Site file (SITE.json): hazard, FC, q."),
     spec: Path = typer.Option(
         ...,
@@ -124,14 +139,8 @@ def retrofit(
     # The retrofit spec's reader is loaded when the command runs.
     from shared_schema.retrofit import read_retrofit_spec
 
-    # The constants and site readers are loaded when the command runs.
-    from ..workflows import assess, inputs
-
-    # The up-front work estimate.
-    from ..workflows.limits import NO_LIMITS, TIME_LIMIT, check_retrofit_work
-
-    # The retrofit (the code checks, scipy) is loaded when the command runs.
-    from ..workflows.retrofit import retrofit_doc
+    # The site reader is loaded when the command runs.
+    from ..workflows import assess
 
     # The document's file.
     from ..workflows.retrofit_files import RETROFIT_FILE, retrofit_json, write_retrofit
@@ -141,21 +150,10 @@ def retrofit(
 
     if out is not None:
         check_folder_target(out)
-    cf = inputs.read_constants(constants)
     site_file = assess.read_site(site)
     rspec = read_retrofit_spec(spec)
     motions = read_retrofit_records(rspec, spec.parent, record, on_warning=record_warning)
-    if not limits.no_limits:
-        check_retrofit_work(
-            cf,
-            site_file,
-            rspec,
-            limits.time_limit,
-            f"give {TIME_LIMIT} with more seconds, or {NO_LIMITS}",
-            motions,
-        )
-    with status("retrofit: code checks and tie forces"):
-        doc = retrofit_doc(cf, site_file, rspec, motions)
+    doc = retrofit_document(constants, scene, search_spec, site_file, rspec, motions, limits)
     if out is not None:
         # Only retrofit.json is replaced: the other outputs in the folder stay.
         with run_folder(out, on_note=out_note, command="retrofit") as tmp:

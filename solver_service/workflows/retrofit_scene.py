@@ -1,0 +1,594 @@
+"""The retrofit from a scene: design the ties, put them in the scene, search again.
+
+``retrofit_search`` takes a scene and a search spec (``rockmech search``'s inputs), a site
+and a retrofit spec:
+
+1. the search runs (``workflows.search.search_run``) and builds its mechanisms' constants;
+2. the retrofit designs the ties of every failing mechanism on those constants
+   (``workflows.retrofit.retrofit_doc``: the least force, the bar, the checks after);
+3. each designed tie (a chosen option whose bar and anchorage carry it) goes into the scene
+   as a tie-bar line, and into the search spec's ``tie_bars`` with its force;
+4. the search runs again on the tied scene, its mechanisms are checked (``check_doc``) and
+   the document's ``search_after`` names the mechanism that governs after the intervention,
+   its margin and λ0, and whether the collapse moved to another wall or family.
+
+How a designed tie is idealised in the scene (``TIE_IDEALISATION``): one straight tie-bar
+line, horizontal, along the wall's inward normal from its outer face to its inner face, at
+the designed height above the mechanism's hinge and at the middle of its hinge axis,
+carrying the whole designed force ``T*`` of the option (its bars together) as a constant
+force: the search's and the builder's tie model (theory §2.2), which pulls the wall inward
+and counts only on a motion that stretches the bar.
+"""
+
+from __future__ import annotations
+
+import uuid
+from dataclasses import dataclass
+from typing import Any, Callable, Optional, Sequence
+
+import numpy as np
+
+from cad_maths.scene_base import BaseScene, SceneObject
+from shared_schema.constants import ConstantsFile, Mechanism
+from shared_schema.errors import InputError
+from shared_schema.retrofit import (
+    CheckFigures,
+    MechanismTies,
+    PlacedTie,
+    RetrofitDoc,
+    RetrofitSpec,
+    SearchAfter,
+    SearchAfterRow,
+)
+from shared_schema.search import SearchSpec
+from shared_schema.site import SiteFile
+
+from .codecheck import check_doc
+from .retrofit import retrofit_doc
+from .search import SearchRun, search_run
+
+__all__ = [
+    "SEARCH_AFTER_BASIS",
+    "TIE_IDEALISATION",
+    "TIE_LAYER",
+    "RetrofitSearch",
+    "TiedScene",
+    "place_ties",
+    "retrofit_search",
+    "scene_heights",
+    "search_after",
+]
+
+#: The layer of the designed tie-bars in the tied scene.
+TIE_LAYER = "rockmech retrofit::ties"
+
+#: Designed ties whose points are this close (relative to the building's size) are one line.
+SAME_POINT_RTOL = 1e-9
+
+#: How a designed tie enters the rerun, stated in the document.
+TIE_IDEALISATION = [
+    "Each designed tie (a chosen option whose bar and anchorage carry T*) is one tie-bar "
+    "line of the scene: horizontal, along the wall's inward normal from its outer face to "
+    "its inner face, at the designed height above the mechanism's hinge, at the middle of "
+    "the hinge axis.",
+    "Ties of several mechanisms at one point are one line carrying the largest of their "
+    "forces (each of those mechanisms then has at least its own T* there).",
+    "It carries the option's whole T* (its bars together) as a constant force, the "
+    "search's and the builder's tie model (theory §2.2): it pulls the wall inward at that "
+    "point and counts only on a motion that stretches it; a mechanism of the rerun whose "
+    "moving part does not hold that point does not feel it.",
+    "A designed tie is verified up to collapse (C8.7.1.2.1.6): the rerun's checks count it "
+    "in d0; ties already in the scene keep the site's treatment.",
+    "Only a mechanism that turns outward is tied: a tie is slack on an inward motion.",
+]
+
+SEARCH_AFTER_BASIS = [
+    "A mechanism's margin is its least a_g,X/a_g of the Circolare 2019 checks (linear, "
+    "nonlinear SLV and SLC where evaluated), before and after alike; records are not run "
+    "on the rerun's mechanisms.",
+    "The governing mechanism has the least margin; the collapse moved when it is another "
+    "mechanism than the first search's governing one (another name: family, façade, "
+    "direction, hinge height or crack angles); its façade and family say where it went.",
+    "The rerun numbers its mechanisms anew (by λ0): a site's per-mechanism options keyed by "
+    "the first search's ids apply to the rerun's mechanisms of the same id.",
+]
+
+
+class TiedScene(BaseScene):
+    """A scene with tie-bar lines added (points in metres), the rest read from the base.
+
+    Parameters
+    ----------
+    base : BaseScene
+        The scene the search read.
+    lines : list of (SceneObject, (start, end))
+        The tie-bars to add: the object and its end points [m].
+    """
+
+    def __init__(self, base: BaseScene, lines: Sequence[tuple[SceneObject, Any]]) -> None:
+        super().__init__(
+            list(base.objects) + [o for o, _ in lines],
+            unit_scale=base.unit_scale,
+            units=base.units,
+            path=base.path,
+            tolerance=base.tolerance,
+        )
+        self._ratio = base._ratio
+        self._layer_paths = list(base._layer_paths)
+        self.base = base
+        self.lines = {o.id: (np.asarray(a, float), np.asarray(b, float)) for o, (a, b) in lines}
+
+    def mesh(self, obj: SceneObject, require_closed: bool = True) -> Any:
+        """Return the base scene's mesh of ``obj`` [m]."""
+        return self.base.mesh(obj, require_closed)
+
+    def extent(self, obj: SceneObject) -> tuple[np.ndarray, np.ndarray]:
+        """Return the object's bounding box [m]."""
+        if obj.id in self.lines:
+            a, b = self.lines[obj.id]
+            return np.minimum(a, b), np.maximum(a, b)
+        return self.base.extent(obj)
+
+    def line(self, obj: SceneObject) -> tuple[np.ndarray, np.ndarray]:
+        """Return a line's end points [m] (an added tie-bar's, or the base scene's)."""
+        if obj.id in self.lines:
+            a, b = self.lines[obj.id]
+            return a.copy(), b.copy()
+        return self.base.line(obj)
+
+    def plane(self, obj: SceneObject) -> tuple[np.ndarray, np.ndarray]:
+        """Return the base scene's plane of ``obj``."""
+        return self.base.plane(obj)
+
+
+def _not_placed(mech_id: str, note: str) -> PlacedTie:
+    return PlacedTie(mechanism=mech_id, status="not_placed", note=note)
+
+
+def _group_lines(
+    groups: list[dict[str, Any]],
+) -> tuple[list[PlacedTie], list[tuple[SceneObject, Any]], list[dict[str, Any]]]:
+    """Return one tie-bar line per group of ties at one point, with its placed ties."""
+    placed: list[PlacedTie] = []
+    lines: list[tuple[SceneObject, Any]] = []
+    bars: list[dict[str, Any]] = []
+    for group in groups:
+        members = group["members"]
+        name = "retrofit tie " + "+".join(mid for mid, _, _ in members)
+        force = max(t for _, t, _ in members)
+        obj = SceneObject(str(uuid.uuid5(uuid.NAMESPACE_URL, name)), name, TIE_LAYER, "line")
+        lines.append((obj, (group["at"], group["end"])))
+        bars.append({"object": {"id": obj.id}, "force": force})
+        for mid, t, h in members:
+            note = None
+            if len(members) > 1:
+                note = (
+                    f"one line with {', '.join(x for x, _, _ in members if x != mid)} (the "
+                    f"same point): it carries the largest of their forces, {force:.6g} N, "
+                    f"this mechanism's {t:.6g} N or more"
+                )
+            placed.append(
+                PlacedTie(
+                    mechanism=mid,
+                    status="placed",
+                    object=name,
+                    wall=group["wall"],
+                    force_N=force,
+                    height_m=h,
+                    at_m=[float(v) for v in group["at"]],
+                    end_m=[float(v) for v in group["end"]],
+                    note=note,
+                )
+            )
+    return placed, lines, bars
+
+
+def place_ties(
+    run: SearchRun, doc: RetrofitDoc
+) -> tuple[list[PlacedTie], list[tuple[SceneObject, Any]], list[dict[str, Any]]]:
+    """Return the designed ties as tie-bar lines of the search's scene.
+
+    Parameters
+    ----------
+    run : SearchRun
+        The first search (its building, candidates and constants).
+    doc : RetrofitDoc
+        The retrofit of its constants.
+
+    Returns
+    -------
+    placed : list of PlacedTie
+        One per designed mechanism: where the line is, or why it is not placed.
+    lines : list of (SceneObject, (start, end))
+        The lines to add to the scene (``TiedScene``) [m].
+    tie_bars : list of dict
+        The search spec's ``tie_bars`` entries of the lines (``object`` by id, ``force``).
+    """
+    bld = run.result.building
+    by_id = {mid: run.result.candidates[k] for k, mid in run.ids.items()}
+    mechs = {} if run.constants is None else {m.id: m for m in run.constants.mechanisms}
+    placed: list[PlacedTie] = []
+    groups: list[dict[str, Any]] = []
+    for m in doc.mechanisms:
+        if m.chosen is None:
+            continue
+        o = m.options[m.chosen]
+        cand, mech = by_id.get(m.id), mechs.get(m.id)
+        if cand is None or mech is None or o.T_star_N is None:
+            placed.append(_not_placed(m.id, "the search has no candidate of this id"))
+            continue
+        if cand.direction != "outward":
+            placed.append(
+                _not_placed(m.id, f"the mechanism turns {cand.direction}: a tie is slack there")
+            )
+            continue
+        wall = bld.walls[cand.facade]
+        f = wall.frame
+        geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
+        hinge_z = float(geo["positive"]["axis_point_m"][2])
+        mid = 0.5 * (np.asarray(cand.axis[0], float) + np.asarray(cand.axis[1], float))
+        s = float(f.to_frame(mid)[0])
+        z = hinge_z + o.height_m
+        if not (wall.z_lo - 1e-9 <= z <= wall.z_hi + 1e-9):
+            placed.append(
+                _not_placed(
+                    m.id,
+                    f"the tie at {o.height_m:g} m above the hinge (z = {z:.4g} m) is off "
+                    f"the wall {wall.id} (z {wall.z_lo:.4g} to {wall.z_hi:.4g} m)",
+                )
+            )
+            continue
+        start = f.to_world(s, 0.0, z)
+        end = f.to_world(s, f.thickness, z)
+        tol = SAME_POINT_RTOL * max(bld.size, 1.0)
+        for group in groups:
+            if group["wall"] == wall.id and float(np.linalg.norm(group["at"] - start)) <= tol:
+                group["members"].append((m.id, float(o.T_star_N), o.height_m))
+                break
+        else:
+            groups.append(
+                {
+                    "wall": wall.id,
+                    "at": start,
+                    "end": end,
+                    "members": [(m.id, o.T_star_N, o.height_m)],
+                }
+            )
+    made, lines, bars = _group_lines(groups)
+    return placed + made, lines, bars
+
+
+#: The first search's α0 and a run folder's agree to this (relative) when they are one run.
+SAME_RUN_RTOL = 1e-9
+
+
+def _alpha0(mech: Mechanism) -> Optional[float]:
+    vw = mech.positive.virtual_work
+    return None if vw is None else float(vw.alpha0)
+
+
+def _same_run(got: ConstantsFile, want: ConstantsFile) -> None:
+    """Refuse a search whose mechanisms are not a run folder's ``constants.json``."""
+    a = [(m.id, m.name) for m in got.mechanisms]
+    b = [(m.id, m.name) for m in want.mechanisms]
+    same = a == b
+    for m, n in zip(got.mechanisms, want.mechanisms):
+        x, y = _alpha0(m), _alpha0(n)
+        if same and x is not None and y is not None:
+            same = abs(x - y) <= SAME_RUN_RTOL * max(abs(y), 1e-12)
+    if not same:
+        raise InputError(
+            "the search of the run folder's search.3dm with this search spec does not build "
+            "the run's constants.json (other mechanisms or multipliers): give the search spec "
+            "that made the run",
+            "search_spec",
+        )
+
+
+def scene_heights(run: SearchRun, rspec: RetrofitSpec) -> tuple[RetrofitSpec, dict[str, str]]:
+    """Give each built mechanism without ``heights_m`` the tie height the scene gives.
+
+    From a scene the moving part's top on its façade is known: the wall's top above the
+    mechanism's hinge (``z_hi − z_hinge``), where the constants alone give only the
+    rectangle of the block's ``R`` and ``α``. Mechanisms that turn inward are left to the
+    retrofit's default (a tie is slack on that motion).
+
+    Returns
+    -------
+    spec : RetrofitSpec
+        The spec with those heights [m].
+    sources : dict of str to str
+        Per mechanism id whose height was filled in: where it comes from.
+    """
+    if run.constants is None:
+        return rspec, {}
+    bld = run.result.building
+    by_id = {mid: run.result.candidates[k] for k, mid in run.ids.items()}
+    ties = dict(rspec.mechanisms)
+    sources: dict[str, str] = {}
+    for mech in run.constants.mechanisms:
+        cand = by_id.get(mech.id)
+        given = ties.get(mech.id)
+        if cand is None or cand.direction != "outward" or (given and given.heights_m):
+            continue
+        geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
+        pos = geo.get("positive")
+        if not isinstance(pos, dict) or "axis_point_m" not in pos:
+            continue
+        wall = bld.walls[cand.facade]
+        h = wall.z_hi - float(pos["axis_point_m"][2])
+        if not h > 0.0:
+            continue
+        base = given if given is not None else MechanismTies()
+        ties[mech.id] = base.model_copy(update={"heights_m": [h]})
+        sources[mech.id] = (
+            f"default from the scene: the top of wall {wall.id} (z = {wall.z_hi:.4g} m) above "
+            "the hinge"
+        )
+    return rspec.model_copy(update={"mechanisms": ties}), sources
+
+
+def _with_sources(doc: RetrofitDoc, sources: dict[str, str]) -> RetrofitDoc:
+    """Name the scene as the source of the tie heights it gave."""
+    out = []
+    for m in doc.mechanisms:
+        if m.id in sources:
+            opts = [o.model_copy(update={"height_source": sources[m.id]}) for o in m.options]
+            m = m.model_copy(update={"options": opts})
+        out.append(m)
+    return doc.model_copy(update={"mechanisms": out})
+
+
+def _margin(fig: Optional[CheckFigures]) -> tuple[Optional[float], Optional[str]]:
+    """Return the least a_g,X/a_g of a mechanism's checks and its criterion (None: none)."""
+    if fig is None:
+        return None, None
+    found = [
+        (value, name)
+        for value, name in (
+            (fig.linear_ratio, "linear SLV"),
+            (fig.SLV_ratio, "nonlinear SLV"),
+            (fig.SLC_ratio, "nonlinear SLC"),
+        )
+        if value is not None
+    ]
+    if not found:
+        return None, None
+    value, name = min(found, key=lambda p: p[0])
+    return value, name
+
+
+def _row_margin(row: dict[str, Any]) -> tuple[Optional[float], Optional[str]]:
+    """Return the least a_g,X/a_g of a ``check_doc`` row and its criterion."""
+    lin, non = row.get("linear") or {}, row.get("nonlinear") or {}
+    fig = CheckFigures()
+    if lin.get("status") == "ok":
+        fig.linear_ratio = float(lin["capacity_ratio"])
+    if non.get("status") == "ok":
+        fig.SLV_ratio = float(non["capacity_ratio"])
+        slc = non.get("SLC")
+        if isinstance(slc, dict) and slc.get("capacity_ratio") is not None:
+            fig.SLC_ratio = float(slc["capacity_ratio"])
+    return _margin(fig)
+
+
+def _bake_designed(cf: ConstantsFile, ids: set[str]) -> tuple[ConstantsFile, dict[str, list[str]]]:
+    """Unlist the designed tie-bars (verified: counted in d0); name those each carries."""
+    out: list[Mechanism] = []
+    carried: dict[str, list[str]] = {}
+    for mech in cf.mechanisms:
+        geo: dict[str, Any] = dict(mech.geometry) if isinstance(mech.geometry, dict) else {}
+        loaded = geo.get("loaded")
+        elements = loaded.get("elements") if isinstance(loaded, dict) else None
+        if not isinstance(loaded, dict) or not isinstance(elements, list):
+            out.append(mech)
+            continue
+        mine = [
+            e
+            for e in elements
+            if isinstance(e, dict)
+            and e.get("kind") == "tie_bar"
+            and any(i in ids for i in e.get("objects") or [])
+        ]
+        carried[mech.id] = [i for e in mine for i in e["objects"] if i in ids]
+        loaded = {**loaded, "elements": [e for e in elements if e not in mine]}
+        geo["loaded"] = loaded
+        out.append(mech.model_copy(update={"geometry": geo}))
+    return cf.model_copy(update={"mechanisms": out}), carried
+
+
+def search_after(
+    before: SearchRun,
+    after: SearchRun,
+    doc: RetrofitDoc,
+    site: SiteFile,
+    placed: list[PlacedTie],
+    names: dict[str, str],
+) -> SearchAfter:
+    """Compare the first search's governing mechanism with the rerun's (``SearchAfter``).
+
+    Parameters
+    ----------
+    before, after : SearchRun
+        The first search and the rerun on the tied scene.
+    doc : RetrofitDoc
+        The retrofit of the first search's constants (its ``before`` checks).
+    site : SiteFile
+        The site of the checks.
+    placed : list of PlacedTie
+        The ties put into the scene.
+    names : dict of str to str
+        Object id of each designed tie-bar line -> its name.
+    """
+    notes: list[str] = []
+    cands = {d["id"]: d for d in before.doc["candidates"]}
+    first: list[tuple[float, str, Optional[str]]] = []
+    for m in doc.mechanisms:
+        margin, crit = _margin(m.before)
+        if margin is not None:
+            first.append((margin, m.id, crit))
+    b = min(first, key=lambda p: p[0]) if first else None
+    rows: list[SearchAfterRow] = []
+    if after.constants is None:
+        notes.append("the rerun built no mechanism")
+    else:
+        cf, carried = _bake_designed(after.constants, set(names))
+        checked = check_doc(cf, site)["mechanisms"]
+        docs = {d["id"]: d for d in after.doc["candidates"]}
+        for mech, row in zip(cf.mechanisms, checked):
+            d = docs[mech.id]
+            margin, crit = _row_margin(row)
+            rows.append(
+                SearchAfterRow(
+                    id=mech.id,
+                    name=mech.name,
+                    family=d["family"],
+                    facade=d["facade"],
+                    direction=d["direction"],
+                    lam0=float(d["lam0"]),
+                    margin=margin,
+                    criterion=crit,
+                    ties=[names[i] for i in carried.get(mech.id, [])],
+                )
+            )
+    got = [r for r in rows if r.margin is not None]
+    a = min(got, key=lambda r: r.margin or 0.0) if got else None
+    least = min(rows, key=lambda r: r.lam0) if rows else None
+    cb = None if b is None else cands[b[1]]
+    return SearchAfter(
+        ties=placed,
+        before=None if b is None else b[1],
+        before_name=None if b is None else doc.mechanism(b[1]).name,
+        before_facade=None if cb is None else cb["facade"],
+        before_family=None if cb is None else cb["family"],
+        before_margin=None if b is None else b[0],
+        before_criterion=None if b is None else b[2],
+        after=None if a is None else a.id,
+        after_name=None if a is None else a.name,
+        after_facade=None if a is None else a.facade,
+        after_family=None if a is None else a.family,
+        after_margin=None if a is None else a.margin,
+        after_criterion=None if a is None else a.criterion,
+        after_lam0=None if a is None else a.lam0,
+        least_lam0=None if least is None else least.id,
+        least_lam0_value=None if least is None else least.lam0,
+        moved=b is not None and a is not None and a.name != doc.mechanism(b[1]).name,
+        rows=rows,
+        basis=TIE_IDEALISATION + SEARCH_AFTER_BASIS,
+        notes=notes,
+    )
+
+
+@dataclass
+class RetrofitSearch:
+    """A retrofit from a scene.
+
+    Attributes
+    ----------
+    doc : RetrofitDoc
+        The retrofit document, with ``search_after``.
+    before, after : SearchRun
+        The first search and the rerun on the tied scene (None: no tie was placed).
+    """
+
+    doc: RetrofitDoc
+    before: SearchRun
+    after: Optional[SearchRun]
+
+
+def retrofit_search(
+    scene: BaseScene,
+    spec: SearchSpec,
+    site: SiteFile,
+    rspec: RetrofitSpec,
+    motions: Sequence[Any] = (),
+    *,
+    scene_name: str = "scene",
+    spec_name: str = "search spec",
+    max_evaluations: Optional[int] = None,
+    max_lp_blocks: Optional[int] = None,
+    check_work: Optional[Callable[[ConstantsFile, RetrofitSpec], None]] = None,
+    expected: Optional[ConstantsFile] = None,
+) -> RetrofitSearch:
+    """Design the ties of a searched scene's mechanisms, then search the tied scene again.
+
+    Parameters
+    ----------
+    scene : BaseScene
+        The scene (``cad_maths.scenes.read_scene``).
+    spec : SearchSpec
+        The search spec; its ranking's records are not run (the retrofit takes ``motions``).
+    site : SiteFile
+        The site: hazard, FC, q (the search's code check and the retrofit's).
+    rspec : RetrofitSpec
+        Steel, bars, anchorage, candidate tie heights per mechanism id of the first search.
+    motions : sequence of GroundMotion
+        Records each tied mechanism must survive (``retrofit_doc``).
+    scene_name, spec_name : str
+        For the searches' provenance.
+    max_evaluations, max_lp_blocks : int, optional
+        The searches' work limits (``search_run``).
+    check_work : callable, optional
+        Called with the first search's constants and the retrofit spec (its tie heights
+        filled in from the scene) before the retrofit runs: a front end's work limit.
+    expected : ConstantsFile, optional
+        The constants a search run folder holds (``constants.json``): the first search must
+        build the same mechanisms (ids, names, α0 to ``SAME_RUN_RTOL``), else the search spec
+        is not the one that made the run.
+
+    Returns
+    -------
+    RetrofitSearch
+        The document (``search_after``: the governing mechanism after, its margin [-] and
+        λ0 [-], whether it moved) and both searches.
+
+    Raises
+    ------
+    InputError
+        The first search builds no mechanism, or not the ``expected`` ones (field
+        ``search_spec``); any input error of the search or retrofit.
+    """
+    common: dict[str, Any] = {
+        "site": site,
+        "motions": [],
+        "max_evaluations": max_evaluations,
+        "max_lp_blocks": max_lp_blocks,
+    }
+    before = search_run(scene, spec, scene_name=scene_name, spec_name=spec_name, **common)
+    if before.constants is None:
+        raise InputError("the search built no mechanism: nothing to retrofit", "scene")
+    if expected is not None:
+        _same_run(before.constants, expected)
+    rspec, sources = scene_heights(before, rspec)
+    if check_work is not None:
+        check_work(before.constants, rspec)
+    doc = _with_sources(retrofit_doc(before.constants, site, rspec, motions), sources)
+    placed, lines, bars = place_ties(before, doc)
+    if not lines:
+        block = SearchAfter(
+            ties=placed,
+            moved=False,
+            basis=TIE_IDEALISATION + SEARCH_AFTER_BASIS,
+            notes=["no designed tie was placed in the scene: the search is not rerun"],
+        )
+        return RetrofitSearch(doc.model_copy(update={"search_after": block}), before, None)
+    tied_scene = TiedScene(scene, lines)
+    tied_spec = SearchSpec.model_validate(
+        {
+            **spec.model_dump(exclude_none=True),
+            "tie_bars": [
+                *[t.model_dump() for t in spec.tie_bars],
+                *bars,
+            ],
+        }
+    )
+    after = search_run(
+        tied_scene,
+        tied_spec,
+        scene_name=f"{scene_name} with the designed ties",
+        spec_name=spec_name,
+        **common,
+    )
+    names = {o.id: o.name for o, _ in lines}
+    block = search_after(before, after, doc, site, placed, names)
+    return RetrofitSearch(doc.model_copy(update={"search_after": block}), before, after)
