@@ -85,9 +85,11 @@ class Scene(BaseScene):
 
     Examples
     --------
-    >>> scene = Scene.from_3dm("examples/scenes/rect_wall.3dm")  # doctest: +SKIP
-    >>> wall = scene.find("wall")[0]  # doctest: +SKIP
-    >>> mesh = scene.mesh(wall)  # doctest: +SKIP
+    >>> scene = Scene.from_3dm("examples/scenes/rect_wall.3dm")
+    >>> wall = scene.find("wall")[0]
+    >>> mesh = scene.mesh(wall)
+    >>> wall.kind, mesh.n_triangles
+    ('brep', 12)
     """
 
     #: The File3dm the geometry belongs to, kept alive with the scene (set when read).

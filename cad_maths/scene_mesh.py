@@ -92,8 +92,10 @@ class MeshScene(BaseScene):
 
     Examples
     --------
-    >>> scene = MeshScene.from_file("wall.ply", units="mm")  # doctest: +SKIP
-    >>> mesh = scene.mesh(scene.find("wall")[0])  # doctest: +SKIP
+    >>> scene = MeshScene.from_file("examples/scenes/scan_wall.ply", units="mm")
+    >>> mesh = scene.mesh(scene.find("scan_wall")[0])
+    >>> mesh.vertices.max(axis=0).round(3).tolist()  # x, y, z [m]
+    [0.614, 4.0, 5.0]
     """
 
     scan = True

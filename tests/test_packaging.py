@@ -468,13 +468,6 @@ def test_sdist_holds_every_tracked_file(dists: dict[str, Path]) -> None:
     assert not missing, missing
 
 
-def test_rockmech_docstring_example_runs() -> None:
-    import doctest
-
-    result = doctest.testmod(rockmech, verbose=False)
-    assert result.attempted >= 3 and result.failed == 0
-
-
 def test_version_warns_when_a_top_level_package_comes_from_elsewhere(tmp_path: Path) -> None:
     # Another distribution (or a folder on the path) named rhino_plugin, first on sys.path:
     # --version names it and where it comes from (docs/install.md, "Package names").

@@ -7,7 +7,6 @@ finite differences, theory §2.4's closed forms in angle notation, and Housner's
 
 from __future__ import annotations
 
-import doctest
 import math
 import re
 from typing import Any, Callable, NamedTuple, Sequence
@@ -621,9 +620,3 @@ def test_bad_arguments_are_named():
         with pytest.raises(InputError) as err:
             call()
         assert err.value.field == field
-
-
-def test_module_examples():
-    result = doctest.testmod(multi_block, optionflags=doctest.ELLIPSIS)
-    assert result.failed == 0
-    assert result.attempted > 0

@@ -10,7 +10,6 @@ finite difference.
 from __future__ import annotations
 
 import cmath
-import doctest
 import math
 from dataclasses import dataclass
 from typing import Callable, Sequence
@@ -499,9 +498,3 @@ def test_mechanism_unstable_at_rest_has_no_critical_rotation():
     upper = PlanarBody(500.0, (0.15, 3.0), 60.0)
     with pytest.raises(GeometryError, match="no critical rotation"):
         two_block_constants(lower, upper, (0.3, 0.0), (0.0, 2.0), (0.3, 4.0))
-
-
-def test_module_examples():
-    result = doctest.testmod(tb, optionflags=doctest.ELLIPSIS)
-    assert result.failed == 0
-    assert result.attempted > 0

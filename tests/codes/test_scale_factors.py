@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-import doctest
-
 import pytest
 
 from shared_schema.errors import InputError
-from solver_service.codes import scale_factors as codes
 from solver_service.codes.scale_factors import sf_ec8, sf_eq28, sf_nzs
 
 
@@ -86,10 +83,6 @@ def test_invalid_inputs_name_the_field(call: object, field: str) -> None:
     with pytest.raises(InputError) as info:
         call()  # type: ignore[operator]
     assert info.value.field == field
-
-
-def test_doctests() -> None:
-    assert doctest.testmod(codes).failed == 0
 
 
 def test_booleans_are_not_numbers() -> None:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import doctest
 import math
 from typing import Any
 
@@ -214,10 +213,6 @@ def test_effective_height_of_uniform_cantilever_and_tip_mass() -> None:
     z = (np.arange(n) + 0.5) / n * 6.0
     assert effective_height(np.ones(n), z) == pytest.approx(4.0, rel=1e-6)
     assert effective_height([1e-9, 1.0], [2.0, 4.6]) == pytest.approx(4.6, rel=1e-9)
-
-
-def test_docstring_examples() -> None:
-    assert doctest.testmod(amplification).failed == 0
 
 
 # --- validation ------------------------------------------------------------------------------

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import doctest
 import math
 
 import numpy as np
@@ -11,10 +10,6 @@ import pytest
 from shared_schema.errors import InputError
 from solver_service.core import fragility
 from solver_service.core.fragility import BETA_BOUNDS, fit_lognormal, lognormal_cdf
-
-
-def test_doctests() -> None:
-    assert doctest.testmod(fragility).failed == 0
 
 
 @pytest.mark.parametrize(("median", "beta"), [(0.35, 0.3), (1.2, 0.6), (0.05, 1.1)])

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import doctest
 from pathlib import Path
 
 import numpy as np
@@ -168,10 +167,6 @@ def test_invalid_inputs_name_the_field(kwargs: dict[str, object], field: str) ->
     assert info.value.field == field
     if field == "periods" and kwargs["periods"]:
         assert "T_n must be > 0" in str(info.value)
-
-
-def test_doctests() -> None:
-    assert doctest.testmod(spectra).failed == 0
 
 
 def test_a_non_finite_sample_is_named_alike_everywhere() -> None:
