@@ -34,13 +34,7 @@ NOT_IMPORTABLE = {
 }
 #: Examples that fail today, by docstring, and why: each must still fail (an example that
 #: passes again is taken off), and no other example of its module may.
-KNOWN_STALE = {
-    "solver_service.workflows.limits._outside_sum": "expects 1.0, gets 0.0: fixed on its own"
-    " branch",
-    "solver_service.report.assess.sig": "the code, not the example, looks wrong: 12345.678"
-    " formats as '12346' (5 figures, the threshold is exp >= 5), the docstring and"
-    " docs/assess.md promise 4 ('1.235e+04', as the CLI's g4 prints)",
-}
+KNOWN_STALE: dict[str, str] = {}
 PROMPT = re.compile(r"^\s*>>>", re.MULTILINE)
 
 

@@ -228,7 +228,7 @@ def require_model(value: object, field: str = "model") -> RockingModel:
 
     Examples
     --------
-    >>> require_model("W1")
+    >>> require_model("W1")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     shared_schema.errors.InputError: model: must be a RockingModel, got str; build one with ...

@@ -107,10 +107,13 @@ class HistoryRun:
 def sig(value: Any, digits: int = 4) -> str:
     """Format a number to ``digits`` significant figures ("–" for None or non-finite).
 
+    A number below 1e5 keeps all its integer digits (a mass of 72 522 kg reads so, not as
+    7.252e+04); from 1e5 up, and below 1e-3, it is written with an exponent.
+
     Examples
     --------
-    >>> sig(2.0), sig(0.123456), sig(12345.678), sig(None)
-    ('2.000', '0.1235', '1.235e+04', '–')
+    >>> sig(2.0), sig(0.123456), sig(12345.678), sig(123456.7), sig(None)
+    ('2.000', '0.1235', '12346', '1.235e+05', '–')
     """
     if value is None or isinstance(value, str):
         return "–" if value is None else value
