@@ -338,6 +338,20 @@ NO_PATH = {
     "kernel_status": "nothing",
 }
 IDS = [slot.id for slot in READERS]
+#: Functions whose whole run (a search of the façade: seconds each) the str-and-Path and
+#: open-file comparisons mark slow: the quick loop keeps their refusals and
+#: test_search_takes_objects_as_it_takes_files; the whole suite (CI) runs them all.
+HEAVY = frozenset({"search"})
+
+
+def _runs(slots: list[Slot]) -> list[Any]:
+    """The slots as parameters, those of HEAVY functions marked slow."""
+    return [
+        pytest.param(s, id=s.id, marks=[pytest.mark.slow] if s.function in HEAVY else [])
+        for s in slots
+    ]
+
+
 TARGET_IDS = [target.id for target in TARGETS]
 
 
@@ -380,7 +394,7 @@ def test_every_reader_of_the_api_page_is_listed() -> None:
     assert shown <= {slot.function for slot in READERS}, shown - {s.function for s in READERS}
 
 
-@pytest.mark.parametrize("slot", READERS, ids=IDS)
+@pytest.mark.parametrize("slot", _runs(READERS))
 def test_a_str_path_reads_as_a_path_object_does(slot: Slot) -> None:
     assert slot.example.is_file()
     from_path = slot.call(slot.example)
@@ -463,7 +477,7 @@ def test_the_open_file_readers_are_the_json_documents() -> None:
 
 
 @pytest.mark.parametrize("mode", ["rb", "r", "bytesio"])
-@pytest.mark.parametrize("slot", OPEN_FILE_READERS, ids=[s.id for s in OPEN_FILE_READERS])
+@pytest.mark.parametrize("slot", _runs(OPEN_FILE_READERS))
 def test_an_open_file_reads_as_its_path_does(slot: Slot, mode: str) -> None:
     if slot.function == "search" and slot.argument == "spec":
         pytest.skip("an open spec has no folder: test_search_reads_an_open_spec_with_its_folder")

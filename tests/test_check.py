@@ -208,6 +208,7 @@ def test_cli_assess_json_prints_one_document(tmp_path: Path) -> None:
     assert out.is_file() and "wrote" in res.stderr
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_cli_assess_reads_one_channel_of_a_multi_channel_record(
     tmp_path: Path, shared_records: Path
 ) -> None:

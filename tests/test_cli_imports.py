@@ -97,6 +97,7 @@ def test_the_boundary_loads_the_exact_kernels_but_no_optimiser() -> None:
     assert [m for m in heavy if m.split(".")[0] != "numba"] == []
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_the_probe_sees_a_command_that_loads_the_optimiser(tmp_path: Path) -> None:
     # rockmech envelope on the bundled church: its mechanisms above ground need the pulse
     # spectrum's extrema (scipy.optimize's root finder), and it draws the envelopes.

@@ -140,6 +140,7 @@ def test_a_malformed_address_is_one_line_and_no_traceback() -> None:
     ]
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_the_cluster_gives_the_local_numbers_as_docs_check_them(
     scheduler: str, tmp_path: Path, elcentro_path: Path
 ) -> None:

@@ -366,6 +366,7 @@ def test_cli_names_the_extra_of_a_stray_missing_module(monkeypatch: pytest.Monke
     assert line.endswith("pip install 'rockmech[geometry]'") and "trimesh" in line
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_demo_without_the_geometry_extra_runs_and_says_what_it_skipped(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path
 ) -> None:

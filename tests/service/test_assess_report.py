@@ -108,6 +108,7 @@ def test_each_number_of_the_worked_checks_names_its_clause() -> None:
     assert "ties not verified" in text
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_project_fields_are_escaped_and_a_user_template_wins(tmp_path: Path) -> None:
     cf = parse_constants(CHURCH_GEOMETRY.read_bytes())
     data = json.loads(NTC_SITE.read_text(encoding="utf-8"))
@@ -140,6 +141,7 @@ def test_report_loads_every_plot_in_chromium(tmp_path: Path) -> None:
     assert re.findall(r'<tr data-mechanism="([^"]+)"', dom) == ["F1", "F2", "A1", "T1"]
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_pdf_first_page_shows_the_verdict_table(tmp_path: Path) -> None:
     _tool("chromium", "chromium-browser", "google-chrome")
     pdftotext = _tool("pdftotext")
@@ -176,6 +178,7 @@ def test_pdf_first_page_shows_the_verdict_table(tmp_path: Path) -> None:
     assert words.endswith(" ".join(sentence.split())), words[-400:]
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_short_form_church_pdf_first_page_has_every_row(tmp_path: Path) -> None:
     _tool("chromium", "chromium-browser", "google-chrome")
     pdftotext = _tool("pdftotext")
@@ -232,6 +235,7 @@ def test_hazard_table_has_one_row_per_quantity_with_its_unit_and_source(tmp_path
         assert f">{raw}<" not in page
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_the_printed_command_gives_every_number_of_the_page_again(tmp_path: Path) -> None:
     page, doc = _page_and_doc(tmp_path)
     commands = re.findall(r"<code>(rockmech assess .*?)</code>", page)

@@ -154,6 +154,7 @@ def test_the_documents_retrofit_is_rockmech_retrofits(with_spec: tuple[str, dict
     assert doc["retrofit"] == json.loads(res.stdout)
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_a_retrofit_json_gives_the_same_table(with_spec: tuple[str, dict], tmp_path: Path) -> None:
     res = runner.invoke(
         app,
@@ -264,6 +265,7 @@ def test_without_retrofit_the_page_and_document_have_none(tmp_path: Path) -> Non
     assert "retrofit" not in doc and 'id="retrofit-table"' not in page
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_the_printed_command_gives_the_retrofit_again(
     with_spec: tuple[str, dict], tmp_path: Path
 ) -> None:
@@ -279,6 +281,7 @@ def test_the_printed_command_gives_the_retrofit_again(
     assert json.loads(res.stdout)["retrofit"] == doc["retrofit"]
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_the_table_in_chromium_and_on_the_pdfs_first_page(tmp_path: Path) -> None:
     exe = _tool("chromium", "chromium-browser", "google-chrome")
     pdftotext = _tool("pdftotext")

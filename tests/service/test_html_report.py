@@ -65,6 +65,7 @@ def _check_screenshot(shot: Path) -> None:
     assert len(np.unique((pixels[..., :3] * 255).astype(np.uint8).reshape(-1, 3), axis=0)) > 100
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_report_from_the_endpoint_loads_all_its_plots_in_chromium(
     client: httpx.Client, tmp_path: Path
 ) -> None:
@@ -83,6 +84,7 @@ def test_report_from_the_endpoint_loads_all_its_plots_in_chromium(
     _check_screenshot(tmp_path / "report.png")
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_cli_report_without_a_record_renders(tmp_path: Path) -> None:
     out = tmp_path / "walls.html"
     res = runner.invoke(app, ["report", str(WALLS), "-o", str(out), "--n", "50"])

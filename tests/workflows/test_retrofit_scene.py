@@ -162,6 +162,7 @@ def test_cli_retrofit_from_a_scene_writes_the_same_document(run: Any, tmp_path: 
         assert f"error: {field}:" in res.output
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
 def test_cli_retrofit_from_a_search_run_folder(run: Any, tmp_path: Path) -> None:
     spec = tmp_path / "light.search.json"
     doc = json.loads(_lighter().model_dump_json(exclude_none=True))
