@@ -65,6 +65,7 @@ __all__ = [
     "SINGLE_BLOCK_TYPOLOGIES",
     "T_REL_TOL",
     "governs_next",
+    "least_margin",
     "retrofit_doc",
     "with_tie",
 ]
@@ -839,10 +840,14 @@ GOVERNS_BASIS = [
 ]
 
 
-def _margin(
-    fig: Optional[CheckFigures], scales: Sequence[RecordScale]
+def least_margin(
+    fig: Optional[CheckFigures], scales: Sequence[RecordScale] = ()
 ) -> tuple[Optional[float], Optional[str]]:
-    """Return the least margin and its criterion (None: nothing evaluated)."""
+    """Return the least margin and its criterion (None: nothing evaluated).
+
+    The margins are the code checks' a_g,X/a_g (linear SLV, nonlinear SLV and SLC) and,
+    with records, each record's least overturning scale over its design scale [-].
+    """
     found: list[tuple[float, str]] = []
     if fig is not None:
         for value, name in (
@@ -877,12 +882,12 @@ def governs_next(mechanisms: Sequence[MechanismRetrofit]) -> GoverningNext:
     """
     rows = []
     for m in mechanisms:
-        b, b_name = _margin(m.before, m.records_before)
+        b, b_name = least_margin(m.before, m.records_before)
         tied = m.chosen is not None
         if tied:
             assert m.chosen is not None
             o = m.options[m.chosen]
-            a, a_name = _margin(o.after, o.records_after if m.records_before else [])
+            a, a_name = least_margin(o.after, o.records_after if m.records_before else [])
         else:
             a, a_name = b, b_name
         rows.append(

@@ -44,7 +44,7 @@ from shared_schema.search import SearchSpec
 from shared_schema.site import SiteFile
 
 from .codecheck import check_doc
-from .retrofit import retrofit_doc
+from .retrofit import least_margin, retrofit_doc
 from .search import SearchRun, search_run
 
 __all__ = [
@@ -339,25 +339,6 @@ def _with_sources(doc: RetrofitDoc, sources: dict[str, str]) -> RetrofitDoc:
     return doc.model_copy(update={"mechanisms": out})
 
 
-def _margin(fig: Optional[CheckFigures]) -> tuple[Optional[float], Optional[str]]:
-    """Return the least a_g,X/a_g of a mechanism's checks and its criterion (None: none)."""
-    if fig is None:
-        return None, None
-    found = [
-        (value, name)
-        for value, name in (
-            (fig.linear_ratio, "linear SLV"),
-            (fig.SLV_ratio, "nonlinear SLV"),
-            (fig.SLC_ratio, "nonlinear SLC"),
-        )
-        if value is not None
-    ]
-    if not found:
-        return None, None
-    value, name = min(found, key=lambda p: p[0])
-    return value, name
-
-
 def _row_margin(row: dict[str, Any]) -> tuple[Optional[float], Optional[str]]:
     """Return the least a_g,X/a_g of a ``check_doc`` row and its criterion."""
     lin, non = row.get("linear") or {}, row.get("nonlinear") or {}
@@ -369,7 +350,7 @@ def _row_margin(row: dict[str, Any]) -> tuple[Optional[float], Optional[str]]:
         slc = non.get("SLC")
         if isinstance(slc, dict) and slc.get("capacity_ratio") is not None:
             fig.SLC_ratio = float(slc["capacity_ratio"])
-    return _margin(fig)
+    return least_margin(fig)
 
 
 def _bake_designed(cf: ConstantsFile, ids: set[str]) -> tuple[ConstantsFile, dict[str, list[str]]]:
@@ -424,7 +405,7 @@ def search_after(
     cands = {d["id"]: d for d in before.doc["candidates"]}
     first: list[tuple[float, str, Optional[str]]] = []
     for m in doc.mechanisms:
-        margin, crit = _margin(m.before)
+        margin, crit = least_margin(m.before)
         if margin is not None:
             first.append((margin, m.id, crit))
     b = min(first, key=lambda p: p[0]) if first else None

@@ -27,7 +27,7 @@ router = APIRouter(tags=["assessment"], dependencies=[accepts(JSON)])
 @router.post(
     "/retrofit",
     summary="Tie-bars: the least tie force that makes each failing mechanism pass",
-    response_model=None,
+    response_model=RetrofitResponse,
     responses=responses(RetrofitResponse),
     openapi_extra=body_doc(RetrofitRequest, None),
 )
