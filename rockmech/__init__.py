@@ -37,6 +37,8 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from shared_schema.documents.history import HistoryRow as HistoryRow
     from shared_schema.documents.pulse import PulseDocument as PulseDocument
     from shared_schema.documents.record import RecordDocument as RecordDocument
+    from shared_schema.documents.search import SearchCandidate as SearchCandidate
+    from shared_schema.documents.search import SearchDocument as SearchDocument
     from shared_schema.errors import (
         GeometryError as GeometryError,
     )
@@ -198,6 +200,8 @@ _SOURCES = {
     # The automatic search of a façade's mechanisms (issue #31).
     "search": "rockmech.analysis",
     "SearchRun": "solver_service.workflows.search",
+    "SearchDocument": "shared_schema.documents.search",
+    "SearchCandidate": "shared_schema.documents.search",
     "write_search": "solver_service.workflows.search",
     "read_search_spec": "solver_service.workflows.search",
     "read_scene": "cad_maths.scenes",

@@ -568,9 +568,11 @@ def search(
     Returns
     -------
     SearchRun
-        ``doc`` (``search.json``: ``candidates`` with λ0 [-], ``rankings`` ``static`` and
-        ``dynamic``, ``records``, ``code_check``, ``timings`` [s]), ``constants`` of the
-        mechanisms built (``ConstantsFile``), ``spec_file``; ``write_search`` writes them.
+        ``doc``, the typed ``SearchDocument`` (its ``to_dict()`` is ``search.json``):
+        ``candidates`` (``SearchCandidate``, with ``lam0`` [-]; ``doc.find(id)``),
+        ``rankings.static`` and ``.dynamic``, ``ranked`` (best first), ``records``,
+        ``code_check``, ``timings`` [s]; ``constants`` of the mechanisms built
+        (``ConstantsFile``), ``spec_file``; ``write_search`` writes them.
     """
     # The search needs the geometry extra (cad_maths, rhino3dm, trimesh): loaded when one
     # runs, so that the other analyses load without it.

@@ -9,7 +9,8 @@ The analyses answer with their documents, the models of ``shared_schema.document
 ``rockmech ... --json`` prints; the routes declare them as ``response_model``). Optional
 sections that do not apply are absent, not ``null``; a number is ``null`` only where its
 value is not finite (an overflow on extreme inputs, or "none up to the search limit").
-The responses left here: errors, health, the scale factor and the search.
+The responses left here: errors, health and the scale factor (the search's document is
+``shared_schema.documents.search.SearchDocument``).
 
 The published schema states every rule JSON Schema can state, so that clients learn them
 from the contract: the ranges of ``shared_schema.rules``, the options' bounds, and the rules
@@ -97,7 +98,6 @@ __all__ = [
     "ScaleFactorRequest",
     "ScaleFactorResponse",
     "SearchForm",
-    "SearchResponse",
     "SpectrumForm",
     "SpectrumOptions",
     "SpectrumRequest",
@@ -1071,31 +1071,3 @@ RetrofitResponse = RetrofitDoc
 
 #: The constants endpoint answers with a kinematic-constants file.
 ConstantsResponse = ConstantsFile
-
-
-class SearchResponse(BaseModel):
-    """The search document (``search.json``, ``rockmech search --json``)."""
-
-    model_config = _RESPONSE
-
-    kind: Literal["search"]
-    candidates: List[Dict[str, Any]] = Field(
-        description="Every refined mechanism, least λ0 first: family, façade, direction, "
-        "parameters, cracks, hinge axis, λ0, the builder's constants and linearised λ, the "
-        "overturning acceleration over the band, records and the code check (the top ones)."
-    )
-    rankings: Dict[str, Any] = Field(
-        description="Static (λ0) and dynamic (overturning acceleration) rankings and where "
-        "they differ; the governing mechanism per frequency."
-    )
-    lp: List[Dict[str, Any]] = Field(
-        description="The global check per façade and direction: multiplier, gap, whether the "
-        "catalogue missed a mechanism (and that mechanism), the sliding check."
-    )
-    counts: Dict[str, Any] = Field(description="Work counters.")
-    timings: Dict[str, Any] = Field(description="Wall-clock seconds per stage.")
-    warnings: List[str] = Field(
-        description="The spec's admissible but implausible values (a density or a tie-bar "
-        "force outside its plausible range, as for a mechanism spec), each with what it most "
-        "likely means."
-    )

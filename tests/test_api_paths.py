@@ -239,8 +239,9 @@ def canonical(value: Any) -> Any:
         return json.dumps(_untimed(value.to_dict()), sort_keys=True)
     if hasattr(value, "model_dump"):  # ConstantsFile, SiteFile, SearchSpec
         return json.dumps(value.model_dump(mode="json"), sort_keys=True)
-    if hasattr(value, "doc"):  # the IDA's result and SearchRun
-        return json.dumps(_untimed(value.doc), sort_keys=True)
+    if hasattr(value, "doc"):  # the IDA's result and SearchRun (its SearchDocument)
+        doc = value.doc.to_dict() if isinstance(value.doc, Document) else value.doc
+        return json.dumps(_untimed(doc), sort_keys=True)
     if hasattr(value, "objects"):  # a scene
         return (value.units, value.unit_scale, value.tolerance, value.objects)
     return value  # RockingModel: a dataclass of numbers
@@ -625,7 +626,7 @@ def test_a_spec_folder_is_a_folder(kind: type, search_inputs: Any, tmp_path: Pat
 
 
 def _provenance_aside(run: Any) -> Any:
-    doc = dict(run.doc)
+    doc = run.doc.to_dict()
     doc.pop("input")  # the names of the scene and the spec, as given
     return json.dumps(_untimed(doc), sort_keys=True)
 
@@ -637,7 +638,7 @@ def test_search_takes_objects_as_it_takes_files(search_inputs: Any) -> None:
     from_dict = rockmech.search(scene, raw, spec_dir=str(SEARCH_SPEC.parent))
     assert canonical(from_dict) == canonical(from_spec)
     assert _provenance_aside(from_files) == _provenance_aside(from_spec)
-    assert from_files.doc["input"]["scene"] != from_spec.doc["input"]["scene"]  # its name
+    assert from_files.doc.input.scene != from_spec.doc.input.scene  # its name
 
 
 def test_search_says_what_it_takes(search_inputs: Any) -> None:

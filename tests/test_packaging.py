@@ -92,6 +92,8 @@ PUBLIC = [
     "response_spectrum",
     "search",
     "SearchRun",
+    "SearchDocument",
+    "SearchCandidate",
     "write_search",
     "read_search_spec",
     "read_scene",

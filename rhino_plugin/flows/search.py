@@ -14,12 +14,13 @@ Python 3.9-clean: imported by Rhino 8.
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, List, Optional, Sequence, Tuple
 
 from rhino_plugin.flows.analyse import ServiceClient
 from rhino_plugin.flows.marks import Mark
 from rhino_plugin.flows.prepared import PreparedScene
 from rhino_plugin.flows.prompter import Prompter
+from shared_schema.documents.search import SearchDocument
 from shared_schema.errors import InputError
 from shared_schema.search import parse_search_spec
 from shared_schema.site import parse_site
@@ -47,8 +48,9 @@ class SearchFlowResult:
 
     Attributes
     ----------
-    doc : dict
-        ``search.json``.
+    doc : SearchDocument
+        The search's document (``search.json`` is its ``to_dict()``; the service's answer
+        is validated into it).
     summary : list of str
         Lines for the command line.
     marks : list of Mark
@@ -59,7 +61,7 @@ class SearchFlowResult:
         Files written.
     """
 
-    doc: Dict[str, Any]
+    doc: SearchDocument
     summary: List[str] = field(default_factory=list)
     marks: List[Mark] = field(default_factory=list)
     plot: Optional[str] = None
@@ -67,45 +69,37 @@ class SearchFlowResult:
     kind: str = "Search"
 
 
-def _order(doc: Dict[str, Any]) -> List[str]:
-    return list(doc["rankings"]["dynamic"] or doc["rankings"]["static"])
-
-
-def search_lines(doc: Dict[str, Any]) -> List[str]:
+def search_lines(doc: SearchDocument) -> List[str]:
     """One line per shown mechanism (best ranked first), the checks' verdicts, the summary."""
-    by_id = {d["id"]: d for d in doc["candidates"]}
     lines = []
-    for mid in _order(doc)[:N_SHOWN]:
-        d = by_id[mid]
-        score = (d.get("overturning") or {}).get("band_score_g")
+    for d in doc.ranked[:N_SHOWN]:
+        score = None if d.overturning is None else d.overturning.band_score_g
         a_p = "" if score is None else f", a_p,min {score:.3g} g"
         lines.append(
             "{}: {} of {} ({}), lam0 {:.4g}{}".format(
-                mid, d["family"].replace("_", " "), d["facade"], d["direction"], d["lam0"], a_p
+                d.id, d.family.replace("_", " "), d.facade, d.direction, d.lam0, a_p
             )
         )
-    for check in doc.get("lp") or []:
-        lines.append("{} {}: {}".format(check["facade"], check["direction"], check["message"]))
-    lines.extend(doc["rankings"].get("summary") or [])
+    for check in doc.lp:
+        lines.append(f"{check.facade} {check.direction}: {check.message}")
+    lines.extend(doc.rankings.summary)
     return lines
 
 
-def search_marks(doc: Dict[str, Any], unit_scale: float) -> List[Mark]:
+def search_marks(doc: SearchDocument, unit_scale: float) -> List[Mark]:
     """Hinge axes and cracks (their outer-face edge) of the shown mechanisms [model units]."""
-    by_id = {d["id"]: d for d in doc["candidates"]}
     s = float(unit_scale)
 
     def pt(p: Sequence[float]) -> Tuple[float, float, float]:
         return (p[0] / s, p[1] / s, p[2] / s)
 
     marks: List[Mark] = []
-    for mid in _order(doc)[:N_SHOWN]:
-        d = by_id[mid]
-        a, b = d["hinge_axis"]
-        marks.append(Mark(f"{mid} hinge", (pt(a), pt(b))))
-        for k, crack in enumerate(d["cracks"]):
-            c = crack["corners"]
-            marks.append(Mark(f"{mid} crack {k + 1}", (pt(c[0]), pt(c[1]))))
+    for d in doc.ranked[:N_SHOWN]:
+        a, b = d.hinge_axis
+        marks.append(Mark(f"{d.id} hinge", (pt(a), pt(b))))
+        for k, crack in enumerate(d.cracks):
+            c = crack.corners
+            marks.append(Mark(f"{d.id} crack {k + 1}", (pt(c[0]), pt(c[1]))))
     return marks
 
 
@@ -141,12 +135,14 @@ def search_flow(
         if not scene_path:
             raise InputError("save the model first: the service searches the saved file", "scene")
         client = ServiceClient(service_url)
-        doc = client.post_files(
-            "search",
-            {
-                "scene": (scene_name, Path(scene_path).read_bytes()),
-                "spec": (spec_path.name, spec_path.read_bytes()),
-            },
+        doc = SearchDocument.model_validate(
+            client.post_files(
+                "search",
+                {
+                    "scene": (scene_name, Path(scene_path).read_bytes()),
+                    "spec": (spec_path.name, spec_path.read_bytes()),
+                },
+            )
         )
         result = SearchFlowResult(doc, search_lines(doc), search_marks(doc, scene.unit_scale))
     else:

@@ -485,7 +485,7 @@ def run_search(job: SearchJob, blobs: list[bytes], limits: dict[str, Any]) -> by
         max_lp_blocks=MAX_LP_BLOCKS,
         max_built=limits["max_mechanisms"],
     )
-    return dumps(run.doc)
+    return dumps(run.doc.to_dict())
 
 
 #: Request fields a report lists under "Inputs and provenance", in this order.

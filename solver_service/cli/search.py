@@ -167,33 +167,30 @@ def search(
         with run_folder(out, on_note=out_note, command="search") as tmp:
             write_search_files(run, tmp, figure=figure)
     doc = run.doc
-    for warning in doc["warnings"]:
+    for warning in doc.warnings:
         note(f"warning: {warning}")
-    for text in doc["notes"]:
+    for text in doc.notes:
         note(f"note: {text}")
-    for fail in doc["failures"]:
-        note(f"warning: {fail['error']}")
+    for fail in doc.failures:
+        note(f"warning: {fail.error}")
     if as_json:
         print_json(doc)
         return
-    by_id = {d["id"]: d for d in doc["candidates"]}
-    order = doc["rankings"]["dynamic"] or doc["rankings"]["static"]
     rows = []
-    for mid in order[:15]:
-        d = by_id[mid]
-        score = (d.get("overturning") or {}).get("band_score_g")
+    for d in doc.ranked[:15]:
+        score = None if d.overturning is None else d.overturning.band_score_g
         rows.append(
             [
-                mid,
-                d["family"],
-                f"{d['facade']} {d['direction']}",
-                g4(d["lam0"]),
-                g4(d.get("lam_linearised")),
+                d.id,
+                d.family,
+                f"{d.facade} {d.direction}",
+                g4(d.lam0),
+                g4(d.lam_linearised),
                 g4(score),
-                str(d["rank_static"]),
+                str(d.rank_static),
             ]
         )
-    band = doc["band"]["band_hz"]
+    band = doc.band.band_hz
     headers = [
         "mechanism",
         "family",
@@ -205,11 +202,11 @@ def search(
     ]
     for line in table_lines(headers, rows):
         typer.echo(line)
-    for check in doc["lp"]:
-        typer.echo(f"{check['facade']} {check['direction']}: {check['message']}")
-    c = doc["counts"]
+    for check in doc.lp:
+        typer.echo(f"{check.facade} {check.direction}: {check.message}")
+    c = doc.counts
     typer.echo(
-        f"{c['candidates']} mechanisms ({c['evaluations']} evaluations of lam0), {c['built']} "
+        f"{c.candidates} mechanisms ({c.evaluations} evaluations of lam0), {c.built} "
         f"built; wrote {out / 'search.json'}, search.spec.json, constants.json, search.3dm"
         + (", search.png" if figure else "")
     )

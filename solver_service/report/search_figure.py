@@ -80,9 +80,8 @@ def plot_search(
     Path or None
         The image, or None when there is no candidate to draw.
     """
-    doc = run.doc
-    order = doc["rankings"]["dynamic"] or doc["rankings"]["static"]
-    order = order[:top]
+    ranked = run.doc.ranked[:top]
+    order = [d.id for d in ranked]
     if not order:
         return None
     index = {mid: k for k, mid in run.ids.items()}
@@ -96,10 +95,10 @@ def plot_search(
     fig = Figure(figsize=(5.0 * cols, 4.2 * rows))
     FigureCanvasAgg(fig)
     axes = fig.subplots(rows, cols, squeeze=False)
-    by_id = {d["id"]: d for d in doc["candidates"]}
     for ax in axes.ravel()[n:]:
         ax.axis("off")
-    for ax, mid in zip(axes.ravel(), order):
+    for ax, d in zip(axes.ravel(), ranked):
+        mid = d.id
         cand = run.result.candidates[index[mid]]
         facade = bld.walls[cand.facade]
         returns = bld.returns.get(facade.id, [])
@@ -114,11 +113,11 @@ def plot_search(
             if fmap is None:
                 continue
             _draw_rings(ax, piece.rings(), fmap, facecolor="tab:red", alpha=0.45, lw=0)
-        for crack in by_id[mid]["cracks"]:
-            w = bld.walls[crack["wall"]]
+        for crack in d.cracks:
+            w = bld.walls[crack.wall]
             fmap = _unfold(facade, w, returns)
             if fmap is not None:
-                seg = fmap(np.asarray(crack["segment"], dtype=float))
+                seg = fmap(np.asarray(crack.segment, dtype=float))
                 ax.plot(seg[:, 0], seg[:, 1], color="tab:red", lw=1.8)
         if cand.typology == "two_block":
             z = facade.z_lo + cand.params["h1_m"]
@@ -126,8 +125,7 @@ def plot_search(
         elif cand.family != "corner":
             z = cand.hinge_z
             ax.plot([0.0, facade.length], [z, z], color="tab:blue", lw=2.2)
-        d = by_id[mid]
-        score = (d.get("overturning") or {}).get("band_score_g")
+        score = None if d.overturning is None else d.overturning.band_score_g
         head = f"{mid} {cand.family.replace('_', ' ')} ({cand.facade}, {cand.direction})"
         sub = f"λ0 = {cand.lam0:.3g}" + ("" if score is None else f", a_p,min ≈ {score:.3g} g")
         ax.set_title(head + "\n" + sub, fontsize=9)

@@ -402,7 +402,6 @@ def search_after(
         Object id of each designed tie-bar line -> its name.
     """
     notes: list[str] = []
-    cands = {d["id"]: d for d in before.doc["candidates"]}
     first: list[tuple[float, str, Optional[str]]] = []
     for m in doc.mechanisms:
         margin, crit = least_margin(m.before)
@@ -415,18 +414,17 @@ def search_after(
     else:
         cf, carried = _bake_designed(after.constants, set(names))
         checked = check_doc(cf, site)["mechanisms"]
-        docs = {d["id"]: d for d in after.doc["candidates"]}
         for mech, row in zip(cf.mechanisms, checked):
-            d = docs[mech.id]
+            d = after.doc.find(mech.id)
             margin, crit = _row_margin(row)
             rows.append(
                 SearchAfterRow(
                     id=mech.id,
                     name=mech.name,
-                    family=d["family"],
-                    facade=d["facade"],
-                    direction=d["direction"],
-                    lam0=float(d["lam0"]),
+                    family=d.family,
+                    facade=d.facade,
+                    direction=d.direction,
+                    lam0=d.lam0,
                     margin=margin,
                     criterion=crit,
                     ties=[names[i] for i in carried.get(mech.id, [])],
@@ -435,13 +433,13 @@ def search_after(
     got = [r for r in rows if r.margin is not None]
     a = min(got, key=lambda r: r.margin or 0.0) if got else None
     least = min(rows, key=lambda r: r.lam0) if rows else None
-    cb = None if b is None else cands[b[1]]
+    cb = None if b is None else before.doc.find(b[1])
     return SearchAfter(
         ties=placed,
         before=None if b is None else b[1],
         before_name=None if b is None else doc.mechanism(b[1]).name,
-        before_facade=None if cb is None else cb["facade"],
-        before_family=None if cb is None else cb["family"],
+        before_facade=None if cb is None else cb.facade,
+        before_family=None if cb is None else cb.family,
         before_margin=None if b is None else b[0],
         before_criterion=None if b is None else b[2],
         after=None if a is None else a.id,

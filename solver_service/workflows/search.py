@@ -51,6 +51,7 @@ from cad_maths.search.specs import AGREEMENT_RTOL, build_candidates
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.documents.envelope import EnvelopeDocument
+from shared_schema.documents.search import SearchDocument
 from shared_schema.errors import InputError, RockmechError, wrong_type
 from shared_schema.extras import require
 from shared_schema.io import stamped, write_constants
@@ -75,7 +76,7 @@ from .adapter import to_rocking_model
 from .codecheck import T1_TOLERANCE, building_period
 from .documents import envelope_doc, log_grid
 from .rundir import run_folder
-from .units import finite_json, stamp
+from .units import stamp
 
 if TYPE_CHECKING:
     from ..core.envelope import OverturningLibrary
@@ -111,8 +112,9 @@ class SearchRun:
 
     Attributes
     ----------
-    doc : dict
-        ``search.json`` (JSON-ready).
+    doc : SearchDocument
+        The document (``search.json`` is its ``to_dict()``): candidates, rankings, the
+        global checks, records and code check, read as attributes (``doc.find(id).lam0``).
     spec_file : SpecFile or None
         The mechanism spec of the built candidates (``search.spec.json``).
     constants : ConstantsFile or None
@@ -123,7 +125,7 @@ class SearchRun:
         Mechanism id of each candidate (by its index in ``result.candidates``).
     """
 
-    doc: dict[str, Any]
+    doc: SearchDocument
     spec_file: Optional[SpecFile]
     constants: Optional[ConstantsFile]
     result: SearchResult
@@ -982,7 +984,8 @@ def search_run(
         "warnings": spec.plausibility_notes(),
         "notes": notes + mode_info["notes"] + compare["summary"],
     }
-    return SearchRun(stamp(doc, "search"), ranked.spec_file, cf, result, dict(enumerate(ids)))
+    typed = SearchDocument.model_validate(stamp(doc, "search"))
+    return SearchRun(typed, ranked.spec_file, cf, result, dict(enumerate(ids)))
 
 
 def _layer(model: Any, r3: Any, path: str, cache: dict[str, int]) -> int:
@@ -1038,13 +1041,12 @@ def search_3dm(run: SearchRun) -> bytes:
         if mid not in built:
             continue
         index = _layer(model, r3, f"rockmech search::{mid}", layers)
-        doc = next(d for d in run.doc["candidates"] if d["id"] == mid)
-        for j, crack in enumerate(doc["cracks"]):
+        for j, crack in enumerate(run.doc.find(mid).cracks):
             attrs = r3.ObjectAttributes()
-            attrs.Name = f"{mid} crack {j + 1} ({crack['wall']})"
+            attrs.Name = f"{mid} crack {j + 1} ({crack.wall})"
             attrs.LayerIndex = index
             mesh = r3.Mesh()
-            for x, y, z in crack["corners"]:
+            for x, y, z in crack.corners:
                 mesh.Vertices.AddPoint3d(x, y, z)
             mesh.Faces.AddFace(0, 1, 2, 3)
             model.Objects.AddMesh(mesh, attrs)
@@ -1077,9 +1079,8 @@ def write_search_files(run: SearchRun, out_dir: Path, *, figure: bool = True) ->
         ``search.3dm`` and ``search.png``.
     """
     out = []
-    doc = finite_json(run.doc)
     path = out_dir / "search.json"
-    write_atomic(path, json.dumps(doc, indent=1, allow_nan=False) + "\n")
+    write_atomic(path, json.dumps(run.doc.to_dict(), indent=1, allow_nan=False) + "\n")
     out.append(path)
     if run.spec_file is not None:
         path = out_dir / "search.spec.json"

@@ -52,9 +52,9 @@ def test_command_flow_writes_the_search_folder_and_draws_the_best_mechanisms(
     assert result.plot == str(out / "search.png")
     reference = _reference().doc
     assert _without_timings(json.loads((out / "search.json").read_text())) == json.loads(
-        json.dumps(_without_timings(_finite(reference)))
+        json.dumps(_without_timings(reference.to_dict()))
     )
-    first = result.doc["rankings"]["dynamic"][0]
+    first = result.doc.rankings.dynamic[0]
     assert result.summary[0].startswith(f"{first}: ")
     labels = [m.label for m in result.marks]
     assert f"{first} hinge" in labels and any(lb.startswith(f"{first} crack") for lb in labels)
@@ -72,12 +72,6 @@ def _reference(spec: Any = None) -> Any:
     )
 
 
-def _finite(doc: Any) -> Any:
-    from solver_service.workflows.outputs import finite_json
-
-    return finite_json(doc)
-
-
 def test_component_searches_named_geometry_like_the_command_line(scenes: Any) -> None:
     scene = scenes["search_facade"]
     prepared = prepared_from(scene)
@@ -87,10 +81,8 @@ def test_component_searches_named_geometry_like_the_command_line(scenes: Any) ->
     del spec["ranking"]
     run = search_prepared(records, json.dumps(spec))
     reference = _reference(SearchSpec.model_validate(spec))
-    assert [c["lam0"] for c in run.doc["candidates"]] == [
-        c["lam0"] for c in reference.doc["candidates"]
-    ]
-    assert run.doc["rankings"]["dynamic"] == reference.doc["rankings"]["dynamic"]
+    assert [c.lam0 for c in run.doc.candidates] == [c.lam0 for c in reference.doc.candidates]
+    assert run.doc.rankings.dynamic == reference.doc.rankings.dynamic
 
 
 def test_component_refuses_file_paths_in_the_ranking() -> None:
@@ -131,7 +123,7 @@ def service() -> Iterator[str]:
 
 def test_service_path_posts_the_saved_model_and_the_spec(service: str, tmp_path: Path) -> None:
     scene = read_scene(SCENE)
-    answer = _finite(_reference().doc)
+    answer = _reference().doc.to_dict()
     _Recorder.received, _Recorder.answer = [], answer
     ask = ScriptedPrompter(scene, [("get_file", str(SPEC))])
     result = search_flow(
@@ -142,7 +134,8 @@ def test_service_path_posts_the_saved_model_and_the_spec(service: str, tmp_path:
         scene_path=str(SCENE),
         service_url=service,
     )
-    assert result is not None and result.doc == answer
+    # the answer is validated into the typed document and read back byte for byte
+    assert result is not None and json.dumps(result.doc.to_dict()) == json.dumps(answer)
     ((path, ctype, body),) = _Recorder.received
     assert path == "/api/v1/search" and ctype.startswith("multipart/form-data; boundary=")
     assert SCENE.read_bytes() in body and SPEC.read_bytes() in body

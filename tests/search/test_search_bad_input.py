@@ -108,7 +108,7 @@ def test_a_lifted_scene_reads_its_lowest_base_as_the_ground(tmp_path: Path, plac
     """All walls from z = 100 m: the same λ0 (t / h) as on z = 0, and every Z 0."""
     lifted = {"A": (100.0, 100.0 + H), "B": (100.0, 100.0 + H)}
     scene = _scene(tmp_path, _l_walls(), place, heights=lifted)
-    doc = rockmech.search(scene, _spec(tmp_path, ["A", "B"])).doc
+    doc = rockmech.search(scene, _spec(tmp_path, ["A", "B"])).doc.to_dict()
     for wall in ("A", "B"):
         c = _whole(doc, wall)
         assert c["lam0"] == pytest.approx(T / H, rel=1e-9), wall
@@ -120,7 +120,7 @@ def test_a_lifted_scene_reads_its_lowest_base_as_the_ground(tmp_path: Path, plac
 def test_a_base_a_little_above_the_ground_stands_on_it_with_a_note(tmp_path: Path) -> None:
     """B drawn 20 mm up (within a tenth of its 0.5 m thickness) stands on the ground."""
     scene = _scene(tmp_path, _l_walls(), PLACES[1], heights={"B": (0.02, H)})
-    doc = rockmech.search(scene, _spec(tmp_path, ["A", "B"])).doc
+    doc = rockmech.search(scene, _spec(tmp_path, ["A", "B"])).doc.to_dict()
     (note,) = [n for n in doc["notes"] if n.startswith("B: its base is")]
     assert "20 mm above the ground" in note and "read as standing on the ground" in note
     assert _whole(doc, "B")["lam0"] == pytest.approx(T / (H - 0.02), rel=1e-9)
@@ -136,10 +136,10 @@ def test_a_wall_on_a_level_stands_on_it_and_the_level_does_not_load_it(
     walls = [("A", (0.0, 0.0), (5.0, 0.0), T), ("C", (0.0, 0.0), (5.0, 0.0), T)]
     scene = _scene(tmp_path, walls, place, heights={"C": (H + 0.2, 2 * H)}, slabs=[slab])
     run = rockmech.search(scene, _spec(tmp_path, ["A", "C"], levels=["S"]))
-    c = _whole(run.doc, "C")
+    c = _whole(run.doc.to_dict(), "C")
     assert c["lam0"] == pytest.approx(T / (H - 0.2), rel=1e-9)
     assert c["Z_m"] == pytest.approx(H + 0.2, rel=1e-9)
-    (note,) = [n for n in run.doc["notes"] if n.startswith("C: stands on")]
+    (note,) = [n for n in run.doc.to_dict()["notes"] if n.startswith("C: stands on")]
     assert note.startswith("C: stands on the level S over 100 % of its footprint; its base at ")
     assert "4.200 m above the ground" in note and "the level is no load on it" in note
     assert "the walls under the level do not carry C's weight" in note
@@ -193,7 +193,7 @@ def test_a_level_touching_no_wall_is_refused_with_the_gap(
 def test_walls_that_nearly_meet_get_a_note_with_the_gap(tmp_path: Path, place: Place) -> None:
     """B stops 80 mm short of A (the joining gap is 50 mm, a tenth of 0.5 m): read apart."""
     scene = _scene(tmp_path, _l_walls(gap=0.08), place)
-    doc = rockmech.search(scene, _spec(tmp_path, ["A", "B"])).doc
+    doc = rockmech.search(scene, _spec(tmp_path, ["A", "B"])).doc.to_dict()
     (note,) = [n for n in doc["notes"] if "short of" in n]
     assert re.match(
         r"B's end \(s = [0-9.]+ m\) stops 80 mm short of A, beyond the joining gap ", note
@@ -210,12 +210,16 @@ def test_walls_within_the_joining_gap_meet_and_walls_far_apart_get_no_note(
 ) -> None:
     near = tmp_path / "near"
     near.mkdir()
-    doc = rockmech.search(_scene(near, _l_walls(gap=0.03), place), _spec(near, ["A", "B"])).doc
+    doc = rockmech.search(
+        _scene(near, _l_walls(gap=0.03), place), _spec(near, ["A", "B"])
+    ).doc.to_dict()
     assert any(n.startswith("B and A are drawn 30 mm apart: read as meeting") for n in doc["notes"])
     assert not any("short of" in n for n in doc["notes"])
     far = tmp_path / "far"
     far.mkdir()
-    doc = rockmech.search(_scene(far, _l_walls(gap=0.6), place), _spec(far, ["A", "B"])).doc
+    doc = rockmech.search(
+        _scene(far, _l_walls(gap=0.6), place), _spec(far, ["A", "B"])
+    ).doc.to_dict()
     assert not any("short of" in n or "apart" in n for n in doc["notes"])
 
 

@@ -181,13 +181,15 @@ def test_an_implausible_masonry_unit_gets_a_warning_naming_the_field(
     scene = wedge_facade(tmp_path)
     spec = write_spec(tmp_path / "s.json", wedge_spec("good", unit, families=["overturning"]))
     run = rockmech.search(scene, spec)
-    (note,) = [n for n in run.doc["warnings"] if field in n]
+    (note,) = [n for n in run.doc.to_dict()["warnings"] if field in n]
     assert note.startswith(f"{field} = {unit[0] if 'length' in field else unit[1]:g} m ")
-    assert not [n for n in run.doc["notes"] if field in n]  # a warning, not among the notes
+    assert not [
+        n for n in run.doc.to_dict()["notes"] if field in n
+    ]  # a warning, not among the notes
     assert f"{math.degrees(math.atan(unit[0] / (2 * unit[1]))):.1f} deg" in note
     # a plausible unit says nothing
     spec = write_spec(
         tmp_path / "t.json", wedge_spec("good", (0.25, 0.06), families=["overturning"])
     )
-    quiet = rockmech.search(scene, spec).doc
+    quiet = rockmech.search(scene, spec).doc.to_dict()
     assert not [n for n in quiet["warnings"] + quiet["notes"] if "unit." in n]

@@ -69,7 +69,7 @@ def _flexure(path: Path, overburden: Optional[dict[str, Any]]) -> dict[str, dict
         }
     )
     run = search_run(read_scene(path), spec)
-    return {d["direction"]: d for d in run.doc["candidates"]}
+    return {d["direction"]: d for d in run.doc.to_dict()["candidates"]}
 
 
 @pytest.mark.parametrize("ratio", [0.25, 1.0, 4.0])

@@ -114,7 +114,7 @@ def test_openings_drawn_as_solids_are_cut_and_the_spec_reopens_only_the_search_s
     assert [c.lam0 for c in run.result.candidates] == pytest.approx(
         [c.lam0 for c in voids.result.candidates], rel=1e-12
     )
-    assert any("(openings cut)" in n for n in run.doc["notes"])
+    assert any("(openings cut)" in n for n in run.doc.to_dict()["notes"])
     out = tmp_path / "out"
     out.mkdir()
     write_search_files(run, out, figure=False)
@@ -161,12 +161,12 @@ def test_sliding_is_flagged_where_friction_cannot_hold_the_rocking_multiplier(
     path = b.write(tmp_path / "squat.3dm")
     spec = {"walls": [{"id": "W", "object": "wall", "density": 2600.0}], "friction": 0.6}
     run = search_run(read_scene(path), SearchSpec.model_validate(spec))
-    cand = run.doc["candidates"][0]
+    cand = run.doc.to_dict()["candidates"][0]
     # 2 m long and 1 m thick: it rocks across its thickness, λ0 = 1/1.5 > μ
     assert cand["lam0"] == pytest.approx(1.0 / 1.5, rel=1e-12)
     assert cand["sliding"]["required"] == pytest.approx(1.0 / 1.5, rel=1e-12)
     assert any("sliding governs" in n for n in cand["notes"])
-    (check,) = run.doc["lp"]
+    (check,) = run.doc.to_dict()["lp"]
     assert check["sliding_governs"] and check["lam_friction"] < 0.6 * 1.01
     assert "sliding governs this façade" in check["sliding_note"]
-    json.dumps(run.doc["lp"])  # JSON-ready
+    json.dumps(run.doc.to_dict()["lp"])  # JSON-ready

@@ -93,14 +93,14 @@ def test_the_top_storey_is_ranked_on_the_amplified_envelope_of_eq28(scene: Path)
     )
     spec = three_storey_spec(ranking=BAND, first_mode={"f_n": F_N, "h_e": H_E})
     run = search_run(read_scene(scene), SearchSpec.model_validate(spec))
-    assert ground.doc["building"]["given"] is False
-    assert "no building data" in ground.doc["assumptions"][-1]
-    info = run.doc["building"]
+    assert ground.doc.to_dict()["building"]["given"] is False
+    assert "no building data" in ground.doc.to_dict()["assumptions"][-1]
+    info = run.doc.to_dict()["building"]
     assert info["given"] and info["f_n_hz"] == F_N and info["h_e_m"] == H_E
     assert info["T1_source"].startswith("search spec first_mode.f_n")
     assert info["h_e_source"] == "search spec first_mode.h_e"
-    f_p = np.asarray(run.doc["band"]["f_p"])
-    before, after = _by_place(ground.doc), _by_place(run.doc)
+    f_p = np.asarray(run.doc.to_dict()["band"]["f_p"])
+    before, after = _by_place(ground.doc.to_dict()), _by_place(run.doc.to_dict())
     top = after[("partial_overturning", 7.0)]
     assert top["amplification"] == {"f_n": F_N, "h_e": H_E, "h": 7.0}
     sf = np.array([math.hypot(1.0, pulse_spectrum(f / F_N) * 7.0 / H_E) for f in f_p])
@@ -135,7 +135,7 @@ def test_at_ag_015_the_top_storey_passes_on_the_ground_and_fails_at_its_height(
         SearchSpec.model_validate(three_storey_spec(ranking=BAND)),
         site=read_site(site),
     )
-    info = run.doc["building"]
+    info = run.doc.to_dict()["building"]
     t1 = 0.05 * H_BLD**0.75  # Circ. 2019 [C7.3.2]
     assert info["T1_s"] == pytest.approx(t1, rel=1e-12)
     assert info["h_e_m"] == pytest.approx(H_BLD * (2 * STOREYS + 1) / (3 * STOREYS), rel=1e-12)
@@ -148,7 +148,7 @@ def test_at_ag_015_the_top_storey_passes_on_the_ground_and_fails_at_its_height(
     on_ground = {r["id"]: r for r in check_doc(bare, read_site(site))["mechanisms"]}
     failed = []
     for z in (7.0, 7.2):
-        d = _by_place(run.doc)[("partial_overturning", z)]
+        d = _by_place(run.doc.to_dict())[("partial_overturning", z)]
         lin = d["code_check"]["linear"]
         a_z = A_G * F0 * gamma * (z / H_BLD) * math.sqrt(1.0 + 0.0004 * 5.0**2)  # [C7.2.7]
         assert lin["capacity_ratio"] == pytest.approx(
@@ -171,13 +171,13 @@ def test_without_building_data_a_mechanism_above_ground_is_incomplete(
         SearchSpec.model_validate(three_storey_spec(ranking=BAND)),
         site=read_site(site),
     )
-    assert not run.doc["building"]["given"]
-    assert any("no building data" in n for n in run.doc["notes"])
-    top = _by_place(run.doc)[("partial_overturning", 7.0)]
+    assert not run.doc.to_dict()["building"]["given"]
+    assert any("no building data" in n for n in run.doc.to_dict()["notes"])
+    top = _by_place(run.doc.to_dict())[("partial_overturning", 7.0)]
     check = top["code_check"]
     assert check["Z"] == 7.0 and check["passes"] is None
     assert "gives no building" in check["linear"]["note"]
-    base = _by_place(run.doc)[("overturning", 0.0)]["code_check"]
+    base = _by_place(run.doc.to_dict())[("overturning", 0.0)]["code_check"]
     assert base["Z"] == 0.0 and base["passes"] is not None
 
 
@@ -205,7 +205,7 @@ def test_records_are_scaled_up_to_the_mechanisms_height(scene: Path, tmp_path: P
     )
     run = search_run(read_scene(scene), SearchSpec.model_validate(spec))
     seen = 0
-    for d in run.doc["candidates"]:
+    for d in run.doc.to_dict()["candidates"]:
         for rec in d.get("records", []):
             if d["Z_m"] == 0.0:
                 assert "scale_factor" not in rec
@@ -242,7 +242,7 @@ def test_a_tie_at_the_top_storey_raises_every_mechanism_it_crosses(
     assert f3dm.Write(str(tied), 7)
     force, z_t = 30000.0, 9.0
     spec = three_storey_spec(tie_bars=[{"object": "tie", "force": force}], lp=True)
-    doc = search_from_files(tied, write_spec(tmp_path / "tied.json", spec)).doc
+    doc = search_from_files(tied, write_spec(tmp_path / "tied.json", spec)).doc.to_dict()
     t, length, h = 0.5, 8.0, 10.5
     m_f = 0.5 * 2400.0 * 6.0 * (8.0 - 2 * 0.45 - 0.02) * 0.2
     floors = (3.6, 7.1, 10.4)  # the 0.2 m floors abutting from 3.5, 7.0 and 10.3 m

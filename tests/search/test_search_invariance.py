@@ -100,7 +100,7 @@ def spec_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def drawn(spec_path: Path) -> dict[str, Any]:
-    return rockmech.search(EXAMPLE_SCENE, spec_path).doc
+    return rockmech.search(EXAMPLE_SCENE, spec_path).doc.to_dict()
 
 
 def _key(c: dict[str, Any]) -> tuple[Any, ...]:
@@ -145,7 +145,7 @@ def test_the_whole_output_is_the_same_wherever_the_scene_is_drawn(
 ) -> None:
     angle, shift, mirror, scale, units = PLACES[name]
     scene = _write_placed(tmp_path / f"{name}.3dm", angle, shift, mirror, scale, units)
-    doc = rockmech.search(scene, spec_path).doc
+    doc = rockmech.search(scene, spec_path).doc.to_dict()
     size = 15.0  # the building's diagonal [m], the scale of its coordinates' tolerance
 
     ref = {_key(c): c for c in drawn["candidates"]}
@@ -197,7 +197,7 @@ def test_a_scene_twice_the_size_keeps_lam0_and_scales_p_eq(
     spec["tie_bars"][0]["force"] *= 8.0
     path = tmp_path / "twice.json"
     path.write_text(json.dumps(spec), encoding="utf-8")
-    doc = rockmech.search(scene, path).doc
+    doc = rockmech.search(scene, path).doc.to_dict()
 
     def by_key(d: dict[str, Any]) -> dict[tuple[Any, ...], dict[str, Any]]:
         out = {}

@@ -37,7 +37,7 @@ def _search(tmp_path: Path) -> dict[str, Any]:
     # the reading is the point here: two families, no global check, few mechanisms built
     spec.update(families=["overturning", "wedge_overturning"], lp=False, candidates={"keep": 2})
     spec["ranking"] = {"n_frequencies": 2, "keep": 1}
-    return rockmech.search(scene, write_spec(tmp_path / "palazzo.json", spec)).doc
+    return rockmech.search(scene, write_spec(tmp_path / "palazzo.json", spec)).doc.to_dict()
 
 
 def test_the_palazzo_is_read_as_drawn(tmp_path: Path) -> None:

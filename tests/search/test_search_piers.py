@@ -103,7 +103,7 @@ def test_a_square_pier_overturns_about_a_base_edge(
     """1 m x 1 m x 4 m: λ0 = b / h = 0.25 wherever it is drawn, never read at 45 degrees."""
     b = 1.0
     scene = _scene(tmp_path, {"P": _prism(_rect(0.0, 0.0, b, b), [], H)}, place)
-    doc = rockmech.search(scene, _spec(tmp_path, ["P"])).doc
+    doc = rockmech.search(scene, _spec(tmp_path, ["P"])).doc.to_dict()
     (c,) = doc["candidates"]
     assert c["lam0"] == pytest.approx(b / H, rel=1e-9, abs=0.0)
     # the motion is across one of the pier's sides, as placed
@@ -124,7 +124,7 @@ def test_a_near_square_pier_is_read_across_its_shorter_side(
     """0.8 m x 1.0 m (a ratio 1.25, below 1.5): λ0 = 0.8 / h, the motion along the 0.8 m side."""
     bx, by = 1.0, 0.8
     scene = _scene(tmp_path, {"P": _prism(_rect(2.0, -1.0, bx, by), [], H)}, place)
-    doc = rockmech.search(scene, _spec(tmp_path, ["P"])).doc
+    doc = rockmech.search(scene, _spec(tmp_path, ["P"])).doc.to_dict()
     (c,) = doc["candidates"]
     assert c["lam0"] == pytest.approx(by / H, rel=1e-9, abs=0.0)
     across = _placement(place[0], place[2]) @ np.array([0.0, 1.0, 0.0])
@@ -140,7 +140,7 @@ def test_a_row_of_piers_each_overturns_across_its_thickness(
     """Three 0.6 m x 1.2 m x 4 m piers 3 m apart, no junctions: each λ0 = 0.6 / 4 = 0.15."""
     b, d, gap = 0.6, 1.2, 3.0
     solids = {f"P{k}": _prism(_rect(k * (b + gap), 0.0, b, d), [], H) for k in range(3)}
-    doc = rockmech.search(_scene(tmp_path, solids, place), _spec(tmp_path, solids)).doc
+    doc = rockmech.search(_scene(tmp_path, solids, place), _spec(tmp_path, solids)).doc.to_dict()
     whole = _whole(doc)
     across = _placement(place[0], place[2]) @ np.array([1.0, 0.0, 0.0])
     for wid in solids:
@@ -207,7 +207,7 @@ def test_a_wall_out_of_plumb_is_idealised_plumb_with_a_note(
     delta = H_W * abs(tan)
     solid = _prism(_rect(0.0, 0.0, T_W, L_W), [], H_W, lean=tan)
     scene = _scene(tmp_path, {"W": solid}, place)
-    doc = rockmech.search(scene, _spec(tmp_path, ["W"])).doc
+    doc = rockmech.search(scene, _spec(tmp_path, ["W"])).doc.to_dict()
     c = _whole(doc)["W"]
     assert c["lam0"] == pytest.approx((T_W - delta) / H_W, rel=1e-8, abs=0.0)
     assert c["mass_kg"] == pytest.approx(1800.0 * T_W * L_W * H_W, rel=1e-9)
@@ -280,7 +280,7 @@ def test_the_doc_json_of_a_pier_is_the_same_when_turned(tmp_path: Path) -> None:
         out = tmp_path / str(k)
         out.mkdir()
         scene = _scene(out, {"P": _prism(_rect(0.0, 0.0, 1.0, 1.0), [], H)}, place)
-        docs.append(rockmech.search(scene, _spec(out, ["P"])).doc)
+        docs.append(rockmech.search(scene, _spec(out, ["P"])).doc.to_dict())
     first = docs[0]["candidates"][0]
     for d in docs[1:]:
         (c,) = d["candidates"]
@@ -313,7 +313,7 @@ def test_a_square_pier_carrying_a_level_moves_away_from_it(
         "directions": ["outward"],
         "ranking": {"n_frequencies": 20, "records": []},
     }
-    out = rockmech.search(scene, write_spec(tmp_path / "s.json", doc)).doc
+    out = rockmech.search(scene, write_spec(tmp_path / "s.json", doc)).doc.to_dict()
     c = _whole(out)["P"]
     assert np.allclose(c["direction_vector"], m @ np.array([-1.0, 0.0, 0.0]), atol=1e-9)
     assert c["builder"]["agrees"], c["builder"]

@@ -76,7 +76,7 @@ def _search(tmp_path: Path, name: str, walls: Any, place: Any, **spec: Any) -> d
         tmp_path, walls, spec.pop("h", H), rotate_deg=angle, shift=shift, mirror=mirror, name=tag
     )
     doc = plan_spec([w[0] for w in walls], **spec)
-    return rockmech.search(scene, write_spec(tmp_path / f"{tag}.json", doc)).doc
+    return rockmech.search(scene, write_spec(tmp_path / f"{tag}.json", doc)).doc.to_dict()
 
 
 @pytest.mark.parametrize("place", PLACES, ids=["drawn", "37deg_far", "-123deg_far", "mirrored"])
@@ -175,7 +175,7 @@ def test_a_courtyard_block_faces_its_courtyard(tmp_path: Path) -> None:
         )
         spec = plan_spec([w[0] for w in walls], levels=["floor"])
         spec["levels"][0]["tributary"] = 0.01
-        doc = rockmech.search(scene, write_spec(tmp_path / f"{tag}.json", spec)).doc
+        doc = rockmech.search(scene, write_spec(tmp_path / f"{tag}.json", spec)).doc.to_dict()
         notes = doc["notes"]
         by_wall = {c["facade"]: c for c in doc["candidates"]}
         for k, (wid, a, b, _) in enumerate(walls):
@@ -218,7 +218,7 @@ def _wedge_doc(tmp_path: Path, scene: Path, **spec: Any) -> dict[str, Any]:
     from search_scenes import wedge_spec
 
     doc = wedge_spec("good", families=["overturning", "wedge_overturning"], **spec)
-    return rockmech.search(scene, write_spec(tmp_path / "s.json", doc)).doc
+    return rockmech.search(scene, write_spec(tmp_path / "s.json", doc)).doc.to_dict()
 
 
 def test_walls_drawn_a_little_apart_or_into_each_other_meet_and_the_notes_say_so(
@@ -323,7 +323,9 @@ def test_a_trapezoid_plan_with_a_100_degree_corner_and_three_thicknesses(
         tmp_path, [], h, rotate_deg=angle, shift=shift, mirror=mirror, name=tag,
         footprints=sorted(quads.items()),
     )  # fmt: skip
-    doc = rockmech.search(scene, write_spec(tmp_path / f"{tag}.json", plan_spec(sorted(quads)))).doc
+    doc = rockmech.search(
+        scene, write_spec(tmp_path / f"{tag}.json", plan_spec(sorted(quads)))
+    ).doc.to_dict()
     by_wall = {c["facade"]: c for c in doc["candidates"] if c["family"] == "overturning"}
     assert sorted(by_wall) == sorted(quads)
     for wid, (normal, point) in outward.items():
@@ -377,7 +379,7 @@ def test_mitred_corners_are_said_to_form_no_junction(tmp_path: Path) -> None:
     scene = plan_scene(tmp_path, [], 6.0, footprints=sorted(quads.items()), name="mitred")
     doc = rockmech.search(
         scene, write_spec(tmp_path / "mitred.json", plan_spec(sorted(quads), connection="good"))
-    ).doc
+    ).doc.to_dict()
     assert doc["input"]["junctions"] == []
     for i in range(4):
         a, b = sorted([f"M{i}", f"M{(i + 1) % 4}"])
@@ -413,7 +415,7 @@ def test_a_level_drawn_as_several_slabs_loads_each_wall_with_the_slabs_on_it(
             {"id": "floor", "kind": "floor", "objects": ["slab1", "slab2"], "density": 600.0,
              "tributary": 0.5}
         ]  # fmt: skip
-        doc = rockmech.search(scene, write_spec(tmp_path / f"{tag}.json", spec)).doc
+        doc = rockmech.search(scene, write_spec(tmp_path / f"{tag}.json", spec)).doc.to_dict()
         by_wall = {c["facade"]: c for c in doc["candidates"] if c["family"] == "overturning"}
         share = 0.5 * 600.0 * 0.2 * 6.0 * 6.0  # half of one room's slab [kg]
         for wid in ("R0W1", "R0W3"):  # the east and west walls: one room's slab each

@@ -109,7 +109,7 @@ def test_v4_same_input_gives_bit_identical_output(example: Any) -> None:
     again = search_run(read_scene(EXAMPLE_SCENE), spec, spec_dir=EXAMPLE_SPEC.parent)
     docs = []
     for run in (example, again):
-        doc = dict(run.doc)
+        doc = run.doc.to_dict()
         doc.pop("timings")
         docs.append(json.dumps(finite_json(doc), sort_keys=True))
     assert docs[0] == docs[1]
@@ -130,7 +130,7 @@ def test_v5_denser_seed_grid_keeps_the_governing_mechanism_at_every_frequency(
         index = {mid: k for k, mid in run.ids.items()}
         return [
             None if g is None else _key(run.result.candidates[index[g]])
-            for g in run.doc["rankings"]["governing"]
+            for g in run.doc.to_dict()["rankings"]["governing"]
         ]
 
     assert governing(runs[0]) == governing(runs[1])
@@ -141,7 +141,7 @@ def test_v5_denser_seed_grid_keeps_the_governing_mechanism_at_every_frequency(
 
 def test_v5_static_and_dynamic_first_differ_and_the_exact_solver_agrees(example: Any) -> None:
     run = example
-    doc = run.doc
+    doc = run.doc.to_dict()
     static_first = doc["rankings"]["static"][0]
     dynamic_first = doc["rankings"]["dynamic"][0]
     assert static_first != dynamic_first
@@ -176,8 +176,8 @@ def test_v5_static_and_dynamic_first_differ_and_the_exact_solver_agrees(example:
 def test_records_and_code_check_rank_the_top_mechanisms(example: Any) -> None:
     spec = parse_search_spec(EXAMPLE_SPEC.read_text())
     run = example
-    top = run.doc["rankings"]["dynamic"][: spec.ranking.keep]
-    by_doc = {d["id"]: d for d in run.doc["candidates"]}
+    top = run.doc.to_dict()["rankings"]["dynamic"][: spec.ranking.keep]
+    by_doc = {d["id"]: d for d in run.doc.to_dict()["candidates"]}
     by_id = {m.id: m for m in run.constants.mechanisms}
     from solver_service.workflows.inputs import read_record
 

@@ -11,6 +11,8 @@ import httpx
 import pytest
 from api_helpers import cli_json
 
+from shared_schema.documents.search import SearchDocument
+
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
 # The search tests' scene helpers (tests/search is not a package).
@@ -61,14 +63,26 @@ def test_search_with_an_uploaded_site_and_record(client: httpx.Client, tmp_path:
         data={"record_units": "g", "max_evaluations": "50000"},
     )
     assert res.status_code == 200, res.text
-    out = res.json()
-    top = out["rankings"]["dynamic"][:3]
-    by_id = {d["id"]: d for d in out["candidates"]}
-    for mid in top:
-        assert by_id[mid]["records"][0]["record"] == "elcentro_NS"
-        assert by_id[mid]["code_check"]["alpha0"] == pytest.approx(by_id[mid]["lam0"], rel=1e-9)
+    # the route's declared document (extra="forbid") takes the answer and gives it back
+    # byte for byte
+    out = SearchDocument.model_validate(res.json())
+    assert json.dumps(out.to_dict()) == json.dumps(res.json())
+    for mid in out.rankings.dynamic[:3]:
+        cand = out.find(mid)
+        assert cand.records is not None and cand.records[0].record == "elcentro_NS"
+        assert cand.code_check is not None
+        assert cand.code_check.alpha0 == pytest.approx(cand.lam0, rel=1e-9)
     # the service's max_mechanisms (20 on the test server) cuts the built list, and says so
-    assert len(out["rankings"]["dynamic"]) <= 20
+    assert len(out.rankings.dynamic) <= 20
+
+
+def test_search_declares_its_document_as_the_response_model() -> None:
+    from fastapi.routing import APIRoute
+
+    from solver_service.api.routes import search
+
+    (route,) = [r for r in search.router.routes if isinstance(r, APIRoute)]
+    assert route.response_model is SearchDocument
 
 
 @pytest.mark.parametrize(

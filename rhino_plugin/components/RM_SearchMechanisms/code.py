@@ -41,4 +41,4 @@ class RM_SearchMechanisms(Grasshopper.Kernel.GH_ScriptInstance):
             rg.Line(rg.Point3d(*m.points[0]), rg.Point3d(*m.points[1]))
             for m in search_marks(run.doc, scale)
         ]
-        return json.dumps(run.doc, indent=1), search_lines(run.doc), lines
+        return json.dumps(run.doc.to_dict(), indent=1), search_lines(run.doc), lines

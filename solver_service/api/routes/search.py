@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Request, Response
 
-from shared_schema.api import SearchResponse
+from shared_schema.documents.search import SearchDocument
 
 from ..compute import compute
 from ..deps import MULTIPART, PoolDep, accepts
@@ -20,8 +20,8 @@ router = APIRouter(tags=["geometry"])
 @router.post(
     "/search",
     summary="Find a façade's collapse mechanisms in a scene and rank them by how they rock",
-    response_model=None,
-    responses=responses(SearchResponse, extra=(501,)),
+    response_model=SearchDocument,
+    responses=responses(SearchDocument, extra=(501,)),
     openapi_extra=body_doc(None, "search"),
     dependencies=[accepts(MULTIPART)],
 )
