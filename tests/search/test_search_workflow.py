@@ -176,25 +176,25 @@ def test_v5_static_and_dynamic_first_differ_and_the_exact_solver_agrees(example:
 def test_records_and_code_check_rank_the_top_mechanisms(example: Any) -> None:
     spec = parse_search_spec(EXAMPLE_SPEC.read_text())
     run = example
-    top = run.doc.to_dict()["rankings"]["dynamic"][: spec.ranking.keep]
-    by_doc = {d["id"]: d for d in run.doc.to_dict()["candidates"]}
+    top = run.doc.rankings.dynamic[: spec.ranking.keep]
     by_id = {m.id: m for m in run.constants.mechanisms}
     from solver_service.workflows.inputs import read_record
 
     motion = read_record(EXAMPLE_SPEC.parent / spec.ranking.records[0])
     for mid in top:
-        d = by_doc[mid]
-        (rec,) = d["records"]
-        check = d["code_check"]
-        assert check["alpha0"] == pytest.approx(d["lam0"], rel=1e-9)
-        assert check["passes"] in (True, False)
-        if rec["scale"] is None:
+        d = run.doc.find(mid)
+        assert d.records is not None and d.code_check is not None
+        (rec,) = d.records
+        assert d.code_check.alpha0 == pytest.approx(d.lam0, rel=1e-9)
+        assert d.code_check.passes in (True, False)
+        if rec.scale is None:
             continue
-        lo, hi = rec["bracket"]
+        assert rec.bracket is not None
+        lo, hi = rec.bracket
         model = to_rocking_model(by_id[mid])
         # above ground the record arrives times Eq. 28's SF (ground scale x SF = local)
-        sf = rec["scale_factor"]["value"] if "scale_factor" in rec else 1.0
+        sf = 1.0 if rec.scale_factor is None else rec.scale_factor.value
         assert simulate(model, motion.accel, scale=hi * sf).overturned
         assert lo == 0.0 or not simulate(model, motion.accel, scale=lo * sf).overturned
         assert (hi - lo) <= 1e-3 * hi
-        assert rec["pga_g"] == pytest.approx(hi * motion.pga_g, rel=1e-12)
+        assert rec.pga_g == pytest.approx(hi * motion.pga_g, rel=1e-12)
