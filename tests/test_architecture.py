@@ -329,8 +329,6 @@ SIZE_EXCEPTIONS: dict[str, str] = {
     "step one clause; the check's inputs are its parameters",
     # The mechanisms' constants: one derivation of docs/theory.md each, whose steps share a
     # dozen intermediate quantities (tested end to end against the closed forms).
-    "cad_maths.mechanisms.multi_block_cad:multi_block_sides": "theory §3's multi-block chain, "
-    "step by step",
     # A figure: one artist a line.
     "solver_service.report.assess:_plot_capacity": "one matplotlib figure, one artist a line",
     # Modules other work of #37 and #39 is changing now; split there.
