@@ -327,10 +327,6 @@ SIZE_EXCEPTIONS: dict[str, str] = {
     "solver_service.codes.circ2019:_limit_state": "one limit state's check: the clause's inputs",
     "solver_service.codes.circ2019:nonlinear_check_2019": "C8.7.1.2.1.8 step by step, each "
     "step one clause; the check's inputs are its parameters",
-    # The mechanisms' constants: one derivation of docs/theory.md each, whose steps share a
-    # dozen intermediate quantities (tested end to end against the closed forms).
-    # A figure: one artist a line.
-    "solver_service.report.assess:_plot_capacity": "one matplotlib figure, one artist a line",
     # Modules other work of #37 and #39 is changing now; split there.
     "cad_maths.search.lp:_wall_interfaces": "the search's LP (#37)",
     "cad_maths.search.lp:_programme": "the search's LP (#37)",
