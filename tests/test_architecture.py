@@ -301,11 +301,16 @@ MAX_PARAMETERS = 10
 #: is back within the rule (or gone) fails ``test_every_size_exception_is_still_needed``.
 SIZE_EXCEPTIONS: dict[str, str] = {
     # The command line: a typer command takes each of its options as a parameter (the options
-    # several commands share are already grouped, solver_service/cli/options.py).
-    "solver_service.cli.envelope:report": "a typer command: one parameter per option",
-    "solver_service.cli.history:history": "a typer command: one parameter per option",
-    "solver_service.cli.history:record_info": "a typer command: one parameter per option",
-    "solver_service.cli.pulse:pulse": "a typer command: one parameter per option",
+    # several commands share are already grouped, solver_service/cli/options.py). These four
+    # are past the rule by their parameters only: their bodies are within 80 code lines.
+    "solver_service.cli.envelope:report": "a typer command: one parameter per option (the "
+    "typer idiom); parameters only",
+    "solver_service.cli.history:history": "a typer command: one parameter per option (the "
+    "typer idiom); parameters only",
+    "solver_service.cli.history:record_info": "a typer command: one parameter per option (the "
+    "typer idiom); parameters only",
+    "solver_service.cli.pulse:pulse": "a typer command: one parameter per option (the typer "
+    "idiom); parameters only",
     "solver_service.cli.ida:ida": "a typer command: one parameter per option; its progress "
     "bar and summary table are the CLI's package's to split (#38)",
     "solver_service.cli.search:search": "a typer command; its figure and table are the CLI "
@@ -317,8 +322,10 @@ SIZE_EXCEPTIONS: dict[str, str] = {
     # The solver's public entry points: keyword options, each documented (docs/api.md).
     "solver_service.core.nonlinear:simulate_nonlinear": "public keyword options of the solver",
     "solver_service.core.reference:simulate_ivp": "public keyword options of the solver",
-    "solver_service.core.reference:integrate_events": "the reference integrator: one event "
-    "loop over uplift, flight, impact and rest whose state the steps share",
+    "solver_service.core.reference:integrate_events": "the reference integrator's keyword "
+    "options (simulate_ivp's and simulate_nonlinear's, passed on) and its one event loop over "
+    "uplift, flight, impact and rest, whose state (side, phase, stalls, dense log) every "
+    "branch shares; kept whole to be read beside the exact kernel",
     "solver_service.core.envelope:boundary_curve": "public keyword options of the envelopes",
     "solver_service.workflows.ida.run:run_ida": "public keyword options of the IDA (docs/api.md)",
     "solver_service.workflows.search:search_run": "public keyword options of the search; its "
