@@ -301,11 +301,16 @@ MAX_PARAMETERS = 10
 #: is back within the rule (or gone) fails ``test_every_size_exception_is_still_needed``.
 SIZE_EXCEPTIONS: dict[str, str] = {
     # The command line: a typer command takes each of its options as a parameter (the options
-    # several commands share are already grouped, solver_service/cli/options.py).
-    "solver_service.cli.envelope:report": "a typer command: one parameter per option",
-    "solver_service.cli.history:history": "a typer command: one parameter per option",
-    "solver_service.cli.history:record_info": "a typer command: one parameter per option",
-    "solver_service.cli.pulse:pulse": "a typer command: one parameter per option",
+    # several commands share are already grouped, solver_service/cli/options.py). These four
+    # are past the rule by their parameters only: their bodies are within 80 code lines.
+    "solver_service.cli.envelope:report": "a typer command: one parameter per option (the "
+    "typer idiom); parameters only",
+    "solver_service.cli.history:history": "a typer command: one parameter per option (the "
+    "typer idiom); parameters only",
+    "solver_service.cli.history:record_info": "a typer command: one parameter per option (the "
+    "typer idiom); parameters only",
+    "solver_service.cli.pulse:pulse": "a typer command: one parameter per option (the typer "
+    "idiom); parameters only",
     "solver_service.cli.ida:ida": "a typer command: one parameter per option; its progress "
     "bar and summary table are the CLI's package's to split (#38)",
     "solver_service.cli.search:search": "a typer command; its figure and table are the CLI "
@@ -317,25 +322,18 @@ SIZE_EXCEPTIONS: dict[str, str] = {
     # The solver's public entry points: keyword options, each documented (docs/api.md).
     "solver_service.core.nonlinear:simulate_nonlinear": "public keyword options of the solver",
     "solver_service.core.reference:simulate_ivp": "public keyword options of the solver",
-    "solver_service.core.reference:integrate_events": "the reference integrator: one event "
-    "loop over uplift, flight, impact and rest whose state the steps share",
+    "solver_service.core.reference:integrate_events": "the reference integrator's keyword "
+    "options (simulate_ivp's and simulate_nonlinear's, passed on) and its one event loop over "
+    "uplift, flight, impact and rest, whose state (side, phase, stalls, dense log) every "
+    "branch shares; kept whole to be read beside the exact kernel",
     "solver_service.core.envelope:boundary_curve": "public keyword options of the envelopes",
     "solver_service.workflows.ida.run:run_ida": "public keyword options of the IDA (docs/api.md)",
     "solver_service.workflows.search:search_run": "public keyword options of the search; its "
     "run is the search work of #37",
-    # The code checks, in the Circolare's clause order: the inputs of a clause are parameters.
-    "solver_service.codes.circ2019:_limit_state": "one limit state's check: the clause's inputs",
-    "solver_service.codes.circ2019:nonlinear_check_2019": "C8.7.1.2.1.8 step by step, each "
-    "step one clause; the check's inputs are its parameters",
-    # The mechanisms' constants: one derivation of docs/theory.md each, whose steps share a
-    # dozen intermediate quantities (tested end to end against the closed forms).
-    "cad_maths.mechanisms.loaded:loaded_side": "theory §1.3's loaded wall, step by step",
-    "cad_maths.mechanisms.two_block_cad:two_block_sides": "theory §2's two-block wall, step by "
-    "step",
-    "cad_maths.mechanisms.multi_block_cad:multi_block_sides": "theory §3's multi-block chain, "
-    "step by step",
-    # A figure: one artist a line.
-    "solver_service.report.assess:_plot_capacity": "one matplotlib figure, one artist a line",
+    # A code check's public entry point: the clauses' inputs are its keyword options.
+    "solver_service.codes.circ2019:nonlinear_check_2019": "public keyword options of the "
+    "check (the SLC's hazard, a free-standing element, records, damping); its steps, one "
+    "clause each, are split out",
     # Modules other work of #37 and #39 is changing now; split there.
     "cad_maths.search.lp:_wall_interfaces": "the search's LP (#37)",
     "cad_maths.search.lp:_programme": "the search's LP (#37)",

@@ -27,6 +27,7 @@ The summary also reports the exact static multiplier at rest for comparison (§2
 """
 
 import math
+from dataclasses import dataclass, field
 from typing import Any, Dict, List, Tuple
 
 import numpy as np
@@ -158,42 +159,49 @@ def _default_share(label: str, share: float, mass: float) -> str:
     )
 
 
-def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Result:
-    """Constants of a loaded wall about one axis, its summary and warnings.
+@dataclass
+class _Loading:
+    """What the added elements put on the wall, gathered element by element."""
+
+    #: Load-bearing masses: (mass [kg], point, label).
+    bearing: Loads = field(default_factory=list)
+    #: Masses whose horizontal inertia alone acts on the wall: (mass [kg], point, label).
+    nonbearing: Loads = field(default_factory=list)
+    #: Static forces, outward positive: (force [N], point, label).
+    forces: Loads = field(default_factory=list)
+    #: The summary's record of each element.
+    elements: List[Dict[str, Any]] = field(default_factory=list)
+    #: Warnings (repairs, defaults used).
+    notes: List[str] = field(default_factory=list)
+
+
+def _add_floors(loading: _Loading, spec: Any, scene: Any, wall: List[Any], tol: float) -> None:
+    """Add the floors: load-bearing or not from how they meet the wall (module docstring).
 
     Parameters
     ----------
+    loading : _Loading
+        What the elements put on the wall so far; extended in place.
     spec : MechanismSpec
-        With ``floors``, ``roof``, ``vaults`` and ``tie_bars`` as declared.
+        With ``floors`` as declared.
     scene : Scene
         The scene.
-    body : single.Body
-        The wall (and adjacent walls) after cracks.
-    side : single.RockingSide
-        The rocking side.
-    table : thrust.ThrustTable
-        Vault thrust table.
+    wall : list of Mesh
+        The wall's solids (after cracks).
+    tol : float
+        Contact tolerance [m].
     """
-    where = spec.id
-    bearing: Loads = []  # (mass [kg], point, label)
-    nonbearing: Loads = []
-    forces: Loads = []  # (outward force [N], point, label)
-    elements: List[Dict[str, Any]] = []
-    notes: List[str] = []
-    wall = body.meshes
-    tol = contact_tolerance(scene)
-
     for k, floor in enumerate(spec.floors or []):
-        label = f"{where}.floors[{k}]"
+        label = f"{spec.id}.floors[{k}]"
         meshes, ids, warn = element_solids(scene, floor.objects, label)
-        notes.extend(warn)
+        loading.notes.extend(warn)
         mass = floor.tributary * sum(mass_properties(m, floor.density).mass for m in meshes)
         if "tributary" not in floor.model_fields_set:
-            notes.append(_default_share(label, floor.tributary, mass))
+            loading.notes.append(_default_share(label, floor.tributary, mass))
         area, point, normal = largest_contact(meshes, wall, label, tol)
         is_bearing = abs(float(normal[2])) >= math.cos(BEARING_ANGLE)
-        (bearing if is_bearing else nonbearing).append((mass, point, label))
-        elements.append(
+        (loading.bearing if is_bearing else loading.nonbearing).append((mass, point, label))
+        loading.elements.append(
             {
                 "element": label,
                 "objects": ids,
@@ -205,48 +213,93 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
             }
         )
 
-    if spec.roof is not None:
-        label = f"{where}.roof"
-        roof = spec.roof
-        meshes, ids, warn = element_solids(scene, roof.objects, label)
-        notes.extend(warn)
-        weight = G * sum(mass_properties(m, roof.density).mass for m in meshes)
-        area, point, _ = largest_contact(meshes, wall, label, tol)
-        span, _, rise = _box(meshes, side)
-        thrust = roof_thrust(weight, span, rise, roof.tied)
-        bearing.append((roof.tributary * weight / G, point, label))
-        if "tributary" not in roof.model_fields_set:
-            notes.append(_default_share(label, roof.tributary, roof.tributary * weight / G))
-        if thrust > 0.0:
-            forces.append((thrust, point, label))
-        elements.append(
-            {
-                "element": label,
-                "objects": ids,
-                "kind": "roof",
-                "weight_N": weight,
-                "bearing_mass_kg": roof.tributary * weight / G,
-                "span_m": span,
-                "rise_m": rise,
-                "thrust_N": thrust,
-                "tied": roof.tied,
-                "at_m": [float(v) for v in point],
-            }
-        )
 
+def _add_roof(
+    loading: _Loading, spec: Any, scene: Any, wall: List[Any], tol: float, side: Any
+) -> None:
+    """Add the roof: its share of weight as a bearing mass, its thrust ``W_r L/(8 f)`` outward.
+
+    Parameters
+    ----------
+    loading : _Loading
+        What the elements put on the wall so far; extended in place.
+    spec : MechanismSpec
+        With ``roof`` as declared (nothing is added without one).
+    scene : Scene
+        The scene.
+    wall : list of Mesh
+        The wall's solids (after cracks).
+    tol : float
+        Contact tolerance [m].
+    side : single.RockingSide
+        The rocking side (the frame of the roof's span and rise).
+    """
+    if spec.roof is None:
+        return
+    label = f"{spec.id}.roof"
+    roof = spec.roof
+    meshes, ids, warn = element_solids(scene, roof.objects, label)
+    loading.notes.extend(warn)
+    weight = G * sum(mass_properties(m, roof.density).mass for m in meshes)
+    _, point, _ = largest_contact(meshes, wall, label, tol)
+    span, _, rise = _box(meshes, side)
+    thrust = roof_thrust(weight, span, rise, roof.tied)
+    loading.bearing.append((roof.tributary * weight / G, point, label))
+    if "tributary" not in roof.model_fields_set:
+        loading.notes.append(_default_share(label, roof.tributary, roof.tributary * weight / G))
+    if thrust > 0.0:
+        loading.forces.append((thrust, point, label))
+    loading.elements.append(
+        {
+            "element": label,
+            "objects": ids,
+            "kind": "roof",
+            "weight_N": weight,
+            "bearing_mass_kg": roof.tributary * weight / G,
+            "span_m": span,
+            "rise_m": rise,
+            "thrust_N": thrust,
+            "tied": roof.tied,
+            "at_m": [float(v) for v in point],
+        }
+    )
+
+
+def _add_vaults(
+    loading: _Loading, spec: Any, scene: Any, wall: List[Any], tol: float, side: Any, table: Any
+) -> None:
+    """Add the vaults: ``V/g`` a bearing mass and ``H`` an outward force at the springing.
+
+    Parameters
+    ----------
+    loading : _Loading
+        What the elements put on the wall so far; extended in place.
+    spec : MechanismSpec
+        With ``vaults`` as declared.
+    scene : Scene
+        The scene.
+    wall : list of Mesh
+        The wall's solids (after cracks).
+    tol : float
+        Contact tolerance [m].
+    side : single.RockingSide
+        The rocking side (the frame of the vault's span, length and rise).
+    table : thrust.ThrustTable
+        Vault thrust table: ``V`` and ``H`` per plan area [N/m²].
+    """
     for k, vault in enumerate(spec.vaults or []):
-        label = f"{where}.vaults[{k}]"
+        label = f"{spec.id}.vaults[{k}]"
         meshes, ids, warn = element_solids(scene, vault.objects, label)
-        notes.extend(warn)
+        loading.notes.extend(warn)
         span_n, span_p, rise = _box(meshes, side)
         if span_n <= 0.0 or span_p <= 0.0 or rise <= 0.0:
             raise GeometryError(f"{label}: degenerate bounding box (span or rise is zero)")
         v_area, h_area = table.per_area(vault.construction_class, rise / span_n, label)
         plan = span_n * span_p
-        area, point, _ = largest_contact(meshes, wall, label, tol)
-        bearing.append((v_area * plan / G, point, label))
-        forces.append((h_area * plan, point, label))
-        elements.append(
+        _, point, _ = largest_contact(meshes, wall, label, tol)
+        loading.bearing.append((v_area * plan / G, point, label))
+        loading.forces.append((h_area * plan, point, label))
+        loading.elements.append(
             {
                 "element": label,
                 "objects": ids,
@@ -263,14 +316,31 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
             }
         )
 
+
+def _add_tie_bars(loading: _Loading, spec: Any, scene: Any, body: Any, side: Any) -> None:
+    """Add the tie-bars: a restraining (inward) force where each meets the façade's outer face.
+
+    Parameters
+    ----------
+    loading : _Loading
+        What the elements put on the wall so far; extended in place.
+    spec : MechanismSpec
+        With ``tie_bars`` as declared.
+    scene : Scene
+        The scene.
+    body : single.Body
+        The wall (its size sets the tolerance of the crossing).
+    side : single.RockingSide
+        The rocking side (its outer face).
+    """
     for k, tie in enumerate(spec.tie_bars or []):
-        label = f"{where}.tie_bars[{k}]"
+        label = f"{spec.id}.tie_bars[{k}]"
 
         obj = find_objects(scene, [tie.object], label)[0]
         start, end = scene.line(obj)
         point = _face_point(start, end, side, body.size, label)
-        forces.append((-tie.force, point, label))
-        elements.append(
+        loading.forces.append((-tie.force, point, label))
+        loading.elements.append(
             {
                 "element": label,
                 "objects": [obj.id],
@@ -280,7 +350,42 @@ def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Resu
             }
         )
 
-    return _constants(body, side, bearing, nonbearing, forces, elements, notes)
+
+def loaded_side(spec: Any, scene: Any, body: Any, side: Any, table: Any) -> Result:
+    """Constants of a loaded wall about one axis, its summary and warnings.
+
+    The elements are added in the spec's order of kinds (floors, roof, vaults, tie-bars),
+    then the constants follow from the gathered masses and forces (``_constants``).
+
+    Parameters
+    ----------
+    spec : MechanismSpec
+        With ``floors``, ``roof``, ``vaults`` and ``tie_bars`` as declared.
+    scene : Scene
+        The scene.
+    body : single.Body
+        The wall (and adjacent walls) after cracks.
+    side : single.RockingSide
+        The rocking side.
+    table : thrust.ThrustTable
+        Vault thrust table.
+    """
+    loading = _Loading()
+    wall = body.meshes
+    tol = contact_tolerance(scene)
+    _add_floors(loading, spec, scene, wall, tol)
+    _add_roof(loading, spec, scene, wall, tol, side)
+    _add_vaults(loading, spec, scene, wall, tol, side, table)
+    _add_tie_bars(loading, spec, scene, body, side)
+    return _constants(
+        body,
+        side,
+        loading.bearing,
+        loading.nonbearing,
+        loading.forces,
+        loading.elements,
+        loading.notes,
+    )
 
 
 def _face_point(

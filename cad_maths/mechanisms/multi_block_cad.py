@@ -185,6 +185,75 @@ def _solve(blocks: Any, pts: List[Any], where: str) -> Any:
     raise GeometryError(f"{where}: {last}")
 
 
+#: The hinges' names, in order along the linkage.
+_NAMES = ("A", "B", "C", "D")
+
+
+def _hinge_sets(
+    spec: Any, scene: Any, where: str
+) -> Tuple[Dict[str, np.ndarray], Dict[str, np.ndarray]]:
+    """Return the points [m] and line directions of the spec's hinge sets, by ``set.name``.
+
+    The positive set (``hinges``) always; the negative one (``hinges_negative``) when the
+    mechanism is two-sided and gives it. Only the hinges that are line objects have a
+    direction.
+    """
+    points: Dict[str, np.ndarray] = {}
+    lines: Dict[str, np.ndarray] = {}
+    sets = [("hinges", spec.hinges)]
+    if spec.rocking == "two_sided" and spec.hinges_negative is not None:
+        sets.append(("hinges_negative", spec.hinges_negative))
+    for key, hinges in sets:
+        for n in _NAMES:
+            point, line = _hinge(scene, getattr(hinges, n), f"{where}.{key}.{n}")
+            points[f"{key}.{n}"] = point
+            if line is not None:
+                lines[f"{key}.{n}"] = line
+    return points, lines
+
+
+def _derived_negative(
+    hinges_pos: List[Tuple[float, float]],
+    verts: List[np.ndarray],
+    origin: np.ndarray,
+    ex: np.ndarray,
+    where: str,
+) -> Tuple[List[Any], str]:
+    """Derive the negative hinge set when the spec gives none, and the warning that says so.
+
+    Parameters
+    ----------
+    hinges_pos : list of (x, z)
+        The positive hinges in the mechanism's plane [m].
+    verts : list of ndarray
+        Each block's vertices [m]; the first and the last blocks are the columns.
+    origin : ndarray
+        Hinge A, the plane's origin [m].
+    ex : ndarray
+        The plane's horizontal unit axis, from A towards D.
+    where : str
+        The mechanism's id (for the warning).
+
+    Returns
+    -------
+    hinges_neg : list of (x, z)
+        Each hinge reflected across its column at its height (``_mirrored``) [m].
+    note : str
+        The warning, with the derived points in the scene's frame [m].
+    """
+    cols = [np.column_stack([(verts[k] - origin) @ ex, verts[k][:, 2] - origin[2]]) for k in (0, 2)]
+    hinges_neg = _mirrored(hinges_pos, cols)
+    derived = ", ".join(
+        f"{n}' = {[round(float(v), 6) for v in origin + x * ex + np.array([0, 0, z])]}"
+        for n, (x, z) in zip(_NAMES, hinges_neg)
+    )
+    note = (
+        f"{where}: hinges_negative not given; derived by reflecting each hinge across "
+        f"its column at its height: {derived} [m]. Give hinges_negative to set them"
+    )
+    return hinges_neg, note
+
+
 def multi_block_sides(
     spec: Any, scene: Any
 ) -> Tuple[
@@ -193,19 +262,8 @@ def multi_block_sides(
     """Constants of both hinge sets, eta (or None), a summary and object ids."""
     where = spec.id
     props, verts, ids, notes = _blocks(scene, spec)
-    names = ("A", "B", "C", "D")
-    points: Dict[str, np.ndarray] = {}
-    lines: Dict[str, np.ndarray] = {}
-    sets = [("hinges", spec.hinges)]
-    if spec.rocking == "two_sided" and spec.hinges_negative is not None:
-        sets.append(("hinges_negative", spec.hinges_negative))
-    for key, hinges in sets:
-        for n in names:
-            point, line = _hinge(scene, getattr(hinges, n), f"{where}.{key}.{n}")
-            points[f"{key}.{n}"] = point
-            if line is not None:
-                lines[f"{key}.{n}"] = line
-    pos3 = [points[f"hinges.{n}"] for n in names]
+    points, lines = _hinge_sets(spec, scene, where)
+    pos3 = [points[f"hinges.{n}"] for n in _NAMES]
     origin = pos3[0]
     ex, normal, plane = _plane(points, lines, float(getattr(scene, "tolerance", 0.0)), where)
 
@@ -240,22 +298,11 @@ def multi_block_sides(
     }
     if spec.rocking == "two_sided":
         if spec.hinges_negative is not None:
-            hinges_neg = [planar(points[f"hinges_negative.{n}"]) for n in names]
+            hinges_neg = [planar(points[f"hinges_negative.{n}"]) for n in _NAMES]
         else:
-            cols = [
-                np.column_stack([(verts[k] - origin) @ ex, verts[k][:, 2] - origin[2]])
-                for k in (0, 2)
-            ]
-            hinges_neg = _mirrored(hinges_pos, cols)
+            hinges_neg, note = _derived_negative(hinges_pos, verts, origin, ex, where)
             summary["hinges_negative_derived"] = [list(h) for h in hinges_neg]
-            derived = ", ".join(
-                f"{n}' = {[round(float(v), 6) for v in origin + x * ex + np.array([0, 0, z])]}"
-                for n, (x, z) in zip(names, hinges_neg)
-            )
-            notes.append(
-                f"{where}: hinges_negative not given; derived by reflecting each hinge across "
-                f"its column at its height: {derived} [m]. Give hinges_negative to set them"
-            )
+            notes.append(note)
         res_n, dir_n = _solve(blocks, hinges_neg, f"{where}.hinges_negative")
         if dir_n == direction:
             raise InputError(

@@ -72,14 +72,8 @@ def _split(body: Any, plane_point: np.ndarray) -> Tuple[List[Any], List[Any]]:
     return lower, upper
 
 
-def two_block_sides(
-    spec: Any, scene: Any, body: Any, pos: Any
-) -> Tuple[Dict[str, float], Optional[Dict[str, float]], Optional[float], Dict[str, Any]]:
-    """Constants of both sides of a two-block wall, eta (or None) and a summary.
-
-    The summary's ``warnings`` (popped by the builder) state the defaults that were used.
-    """
-    where = spec.id
+def _wall_extent(body: Any, pos: Any, where: str) -> Tuple[float, float, float]:
+    """Return the wall's thickness ``b`` behind its axis, height ``h`` and length [m]."""
     o, out, ax = pos.point, pos.outward, pos.direction
     rel = body.vertices - o
     xs, zs, ys = rel @ out, rel[:, 2], rel @ ax
@@ -88,7 +82,43 @@ def two_block_sides(
     length = float(ys.max() - ys.min())
     if b <= 0.0 or h <= 0.0:
         raise GeometryError(f"{where}: the wall has no thickness or height behind its axis")
-    weight = float(body.props.mass) * G
+    return b, h, length
+
+
+def _overburden(
+    spec: Any, scene: Any, body: Any, pos: Any, b: float
+) -> Tuple[float, float, List[str], List[str]]:
+    """Return the overburden N and where it acts on the wall top (theory §2.3).
+
+    Parameters
+    ----------
+    spec : MechanismSpec
+        With ``overburden`` (a force, or objects with a density and a tributary share) or
+        none.
+    scene : Scene
+        The scene.
+    body : single.Body
+        The wall.
+    pos : single.RockingSide
+        The positive side (axis point O, outward direction).
+    b : float
+        The wall's thickness [m].
+
+    Returns
+    -------
+    n : float
+        The overburden [N] (0 without one).
+    x_p : float
+        Its point on the wall top, along the outward direction from H [m]: ``xi b`` from H
+        when ``xi`` is given, else the centroid of the objects' contact with the wall, else
+        the wall's centre line.
+    ids : list of str
+        The overburden's objects.
+    notes : list of str
+        Repairs of its solids and the default share used.
+    """
+    where = spec.id
+    o, out = pos.point, pos.outward
     ob = spec.overburden
     n = 0.0
     x_p = -(0.5 if ob is None or ob.xi is None else float(ob.xi)) * b  # xi b from H, §2.3
@@ -110,7 +140,20 @@ def two_block_sides(
             meshes, body.meshes, f"{where}.overburden", contact_tolerance(scene)
         )
         x_p = float((point - o) @ out) if ob.xi is None else x_p  # else xi b from H
-    f_mt = float(spec.f_mt or 0.0)
+    return n, x_p, overburden_ids, notes
+
+
+def _hinge_at(
+    spec: Any, h: float, weight: float, n: float, f_mt: float, area: float
+) -> Tuple[float, bool]:
+    """Return the intermediate hinge's height ``h_c`` [m] and whether the spec gave it.
+
+    Eq. 17 (``two_block.hinge_height``) from the wall's height ``h`` [m], weight [N], the
+    overburden ``n`` [N], the mortar's tensile strength ``f_mt`` [Pa] over the bed joint's
+    ``area`` [m²], unless the spec gives ``hinge_height``; a hinge at the top is no
+    two-block mechanism (an error).
+    """
+    where = spec.id
     given = getattr(spec, "hinge_height", None)
     if given is not None:
         h_c = float(given)
@@ -120,12 +163,95 @@ def two_block_sides(
                 "its base"
             )
     else:
-        h_c = hinge_height(h, weight, n, f_mt, length * b)
+        h_c = hinge_height(h, weight, n, f_mt, area)
     if h_c >= h * (1.0 - 1e-9):
         raise GeometryError(
             f"{where}: with no overburden and no mortar tensile strength the hinge forms at the "
             "top (Eq. 17), so there is no two-block mechanism; give 'overburden' or 'f_mt'"
         )
+    return h_c, given is not None
+
+
+_Hinges = Tuple[Tuple[float, float], Tuple[float, float], Tuple[float, float]]
+
+
+def _negative_side(
+    b1: Any,
+    b2: Any,
+    hinges: _Hinges,
+    mirrored: _Hinges,
+    b: float,
+    overburden: Tuple[float, float, float],
+    ecc: str,
+) -> Tuple[Dict[str, float], Dict[str, float], Optional[Dict[str, float]], float, Dict[str, Any]]:
+    """Return the negative side of a two-sided wall: its linkage and the restitution.
+
+    Parameters
+    ----------
+    b1, b2 : PlanarBody
+        The lower and upper blocks (positive side's frame).
+    hinges, mirrored : tuple of (x, z)
+        The hinges O, C, H of the positive side and their mirror images [m].
+    b : float
+        The wall's thickness [m] (the mirror is about its mid-plane).
+    overburden : tuple of float
+        The overburden N [N] and its point ``(x_p, h)`` on the positive side [m].
+    ecc : str
+        The overburden's eccentricity rule.
+
+    Returns
+    -------
+    negative : dict
+        The negative side's constants (M_F signed in the positive sense).
+    details : dict
+        The mirrored wall's details (in the mirrored wall's frame, x inward).
+    virtual_work : dict or None
+        Its virtual-work check (``base.virtual_work_of``).
+    eta : float
+        Restitution from the positive to the negative mode (theory §3.4).
+    restitution : dict
+        Both impact directions' values and the rule.
+    """
+    n, x_p, h = overburden
+    neg = two_block_constants(
+        _mirror(b1, b),
+        _mirror(b2, b),
+        *hinges,
+        overburden=n,
+        overburden_point=(-b - x_p, h),
+        eccentricity=ecc,
+    )
+    # neg is the mirrored wall: its M_F drives the inward collapse, which the file
+    # writes with a negative sign (shared_schema.constants: M_F per side is signed in
+    # the positive sense).
+    negative = neg.constants("negative")
+    details = {k: float(v) for k, v in neg.details.items()}
+    vw = virtual_work_of(neg.details, "lam_static_exact")
+    eta = two_block_restitution(b1, b2, *hinges, *mirrored)
+    # Both impact directions (theory §3.4); they differ for an asymmetric wall.
+    restitution = {
+        "rule": "momentum projection (theory §3.4); eta is the positive-to-negative value",
+        "eta_pos_to_neg": eta,
+        "eta_neg_to_pos": two_block_restitution(b1, b2, *mirrored, *hinges),
+    }
+    return negative, details, vw, eta, restitution
+
+
+def two_block_sides(
+    spec: Any, scene: Any, body: Any, pos: Any
+) -> Tuple[Dict[str, float], Optional[Dict[str, float]], Optional[float], Dict[str, Any]]:
+    """Constants of both sides of a two-block wall, eta (or None) and a summary.
+
+    The summary's ``warnings`` (popped by the builder) state the defaults that were used.
+    """
+    where = spec.id
+    o, out, ax = pos.point, pos.outward, pos.direction
+    b, h, length = _wall_extent(body, pos, where)
+    weight = float(body.props.mass) * G
+    n, x_p, overburden_ids, notes = _overburden(spec, scene, body, pos, b)
+    ob = spec.overburden
+    f_mt = float(spec.f_mt or 0.0)
+    h_c, given = _hinge_at(spec, h, weight, n, f_mt, length * b)
     lower, upper = _split(body, o + np.array([0.0, 0.0, h_c]))
     if not lower or not upper:
         raise GeometryError(f"{where}: the split plane at h_c = {h_c:.3f} m misses the wall")
@@ -147,29 +273,11 @@ def two_block_sides(
     if vw is not None:
         virtual_work["positive"] = vw
     if spec.rocking == "two_sided":
-        neg = two_block_constants(
-            _mirror(b1, b),
-            _mirror(b2, b),
-            *hinges,
-            overburden=n,
-            overburden_point=(-b - x_p, h),
-            eccentricity=ecc,
+        negative, neg_details, vw, eta, summary_eta = _negative_side(
+            b1, b2, hinges, mirrored, b, (n, x_p, h), ecc
         )
-        # neg is the mirrored wall: its M_F drives the inward collapse, which the file
-        # writes with a negative sign (shared_schema.constants: M_F per side is signed in
-        # the positive sense).
-        negative = neg.constants("negative")
-        neg_details = {k: float(v) for k, v in neg.details.items()}
-        vw = virtual_work_of(neg.details, "lam_static_exact")
         if vw is not None:
             virtual_work["negative"] = vw
-        eta = two_block_restitution(b1, b2, *hinges, *mirrored)
-        # Both impact directions (theory §3.4); they differ for an asymmetric wall.
-        summary_eta = {
-            "rule": "momentum projection (theory §3.4); eta is the positive-to-negative value",
-            "eta_pos_to_neg": eta,
-            "eta_neg_to_pos": two_block_restitution(b1, b2, *mirrored, *hinges),
-        }
     summary: Dict[str, Any] = {
         "thickness_m": b,
         "height_m": h,
@@ -179,7 +287,7 @@ def two_block_sides(
         "overburden_x_m": x_p,
         "f_mt_Pa": f_mt,
         "h_c_m": h_c,
-        "h_c_source": "hinge_height (given)" if given is not None else "Eq. 17",
+        "h_c_source": "hinge_height (given)" if given else "Eq. 17",
         "eccentricity": ecc,
         "lower_mass_kg": b1.mass,
         "upper_mass_kg": b2.mass,

@@ -749,6 +749,67 @@ def _record_demand(
     return largest, rows
 
 
+def _limit_period(
+    name: str, curve: CapacityCurve, d_limit: float, at_break: bool
+) -> tuple[float, float]:
+    """Return ``a(d)`` at a limit state's displacement [m/s²] and the state's period [s].
+
+    [C8.7.1.10] ``T_SLV = 1.68 π sqrt(d_SLV / a(d_SLV))``, [C8.7.1.11] ``T_SLC = 1.56 π
+    sqrt(d_SLC / a(d_SLC))``; ``a(d)`` on the capacity curve by [C8.7.1.3]. A vanishing
+    ``a(d)`` is an error (no period).
+    """
+    factor = T_SLV_FACTOR if name == "SLV" else T_SLC_FACTOR
+    a_d = float(curve.a([d_limit], held_at_break=at_break)[0])
+    if not a_d > 0.0:
+        raise InputError(
+            f"the capacity vanishes at d_{name} = {d_limit:.4g} m: no period for {name}",
+            f"d_{name}",
+        )
+    return a_d, factor * math.pi * math.sqrt(d_limit / a_d)
+
+
+def _displacement_demand(
+    demand: _Demand,
+    records: Sequence[RecordDemand],
+    t0: float,
+    period: float,
+    xi_percent: float,
+) -> dict[str, Any]:
+    """Return the displacement demand of a limit state (§C8.7.1.2.1.8), its terms by key.
+
+    The code spectrum's largest ``S_De`` over ``[T0, T]`` (the mechanism's damping, at its
+    height) and the records' largest over the same periods; the larger governs
+    (``demand``). Keys: ``demand_code``, ``demand_code_at_T``, ``demand_rule``,
+    ``demand_records`` (None without records), ``records``, ``demand`` [m, s].
+    """
+    code_v, code_at, code_rule = demand.largest_displacement(t0, period, xi_percent)
+    rec_v, rec_rows = _record_demand(records, t0, period, xi_percent)
+    governing = code_v if rec_v is None else max(code_v, rec_v)
+    return {
+        "demand_code": code_v,
+        "demand_code_at_T": code_at,
+        "demand_rule": code_rule,
+        "demand_records": rec_v,
+        "records": rec_rows,
+        "demand": governing,
+    }
+
+
+def _adrs(demand: _Demand, period: float, xi_percent: float) -> dict[str, list[float]]:
+    """Return the demand spectrum in ADRS form (for the report's plot): ``d(T)``, ``a``.
+
+    ``a = d (2π/T)²`` [m/s²] over ``ADRS_POINTS`` periods from ``ADRS_T_MIN`` to the larger
+    of ``ADRS_T_MAX`` and 1.5 times the limit state's period [s].
+    """
+    t = np.geomspace(ADRS_T_MIN, max(ADRS_T_MAX, 1.5 * period), ADRS_POINTS)
+    d_spec, _ = demand.displacement(t, xi_percent)
+    return {
+        "T": t.tolist(),
+        "d": d_spec.tolist(),
+        "a": (d_spec * (2.0 * math.pi / t) ** 2).tolist(),
+    }
+
+
 def _limit_state(
     name: str,
     curve: CapacityCurve,
@@ -758,45 +819,58 @@ def _limit_state(
     a_g: float,
     xi_percent: float,
     records: Sequence[RecordDemand],
-    t0: float,
     ratio_sld: Optional[float],
     evaluated: bool,
-    at_break: bool = False,
 ) -> dict[str, Any]:
     """One limit state of the displacement check (§C8.7.1.2.1.8).
 
-    ``at_break``: ``d_limit`` is where the ties break; ``a(d)`` of [C8.7.1.10] is then
-    taken as the mechanism reaches that displacement ("raggiungimento dello SLV"), with the
-    ties still holding.
+    When ``d_rule`` says the ties break (``BREAK_RULE``), ``d_limit`` is where they do;
+    ``a(d)`` of [C8.7.1.10] is then taken as the mechanism reaches that displacement
+    ("raggiungimento dello SLV"), with the ties still holding. The demand is over
+    ``[T0, T]``, ``T0`` the curve's (0 for a rigid mechanism).
+
+    Parameters
+    ----------
+    name : str
+        ``"SLV"`` or ``"SLC"``.
+    curve : CapacityCurve
+        The capacity curve.
+    d_limit : float
+        The limit displacement [m] (§C8.7.1.2.1.6).
+    d_rule : str
+        What gives it.
+    demand : _Demand
+        The limit state's spectrum.
+    a_g : float
+        Its ground acceleration on type A ground [g].
+    xi_percent : float
+        The mechanism's damping [%].
+    records : sequence of RecordDemand
+        Records at their design scale (their demand over ``[T0, T]`` also counts).
+    ratio_sld : float or None
+        ``a_g,SLD / a_g`` of the activation, the lower bound of ``a_g,SLV``; None for the SLC.
+    evaluated : bool
+        False when the hazard is not the site's (the verdict is then None).
     """
-    factor = T_SLV_FACTOR if name == "SLV" else T_SLC_FACTOR
-    a_d = float(curve.a([d_limit], held_at_break=at_break)[0])
-    if not a_d > 0.0:
-        raise InputError(
-            f"the capacity vanishes at d_{name} = {d_limit:.4g} m: no period for {name}",
-            f"d_{name}",
-        )
-    period = factor * math.pi * math.sqrt(d_limit / a_d)
-    code_v, code_at, code_rule = demand.largest_displacement(t0, period, xi_percent)
-    rec_v, rec_rows = _record_demand(records, t0, period, xi_percent)
-    governing = code_v if rec_v is None else max(code_v, rec_v)
-    ratio_d = d_limit / governing
+    at_break = d_rule.startswith(BREAK_RULE)
+    t0 = curve.T0 or 0.0
+    # [C8.7.1.10] / [C8.7.1.11]: the period at the limit displacement.
+    a_d, period = _limit_period(name, curve, d_limit, at_break)
+    # C8.7.1.2.1.8: the demand over [T0, T], and d/demand = a_g,X/a_g.
+    terms = _displacement_demand(demand, records, t0, period, xi_percent)
+    ratio_d = d_limit / terms["demand"]
     out: dict[str, Any] = {
         "d": d_limit,
         "d_rule": d_rule,
         "a": a_d,
         f"T_{name}": period,
         "xi_percent": xi_percent,
-        "demand_code": code_v,
-        "demand_code_at_T": code_at,
-        "demand_rule": code_rule,
-        "demand_records": rec_v,
-        "records": rec_rows,
-        "demand": governing,
+        **terms,
         "ratio_displacement": ratio_d,
         "a_g": a_g,
         "a_g_capacity": ratio_d * a_g,
     }
+    # C8.7.1.2.1.8: a_g,SLV not below a_g,SLD of the activation (C8.7.1.2.1.5).
     ratio = ratio_d
     if ratio_sld is not None:
         out["a_g_SLD"] = ratio_sld * a_g
@@ -806,17 +880,10 @@ def _limit_state(
             out["a_g_capacity"] = ratio_sld * a_g
     out["capacity_ratio"] = ratio
     out["passes"] = bool(ratio >= 1.0) if evaluated else None
-    # The demand spectrum in ADRS form (for the report's plot): d(T) and a = d (2π/T)².
-    t = np.geomspace(ADRS_T_MIN, max(ADRS_T_MAX, 1.5 * period), ADRS_POINTS)
-    d_spec, _ = demand.displacement(t, xi_percent)
-    out["adrs"] = {
-        "T": t.tolist(),
-        "d": d_spec.tolist(),
-        "a": (d_spec * (2.0 * math.pi / t) ** 2).tolist(),
-    }
+    out["adrs"] = _adrs(demand, period, xi_percent)
     out["clauses"] = {k: CL_LS[k] for k in out if k in CL_LS}
     out["clauses"]["a_g_SLD"] = CL_LS["a_g_SLD"]
-    if rec_v is None:
+    if terms["demand_records"] is None:
         out["clauses"].pop("demand_records", None)
     return out
 
@@ -914,13 +981,13 @@ def nonlinear_check_2019(
     _, e_star = participating_mass(vw)
     a_g_slv = check_positive(a_g_slv, "a_g")
     d0 = curve.d0
+    # C8.7.1.2.1.6: the limit displacements.
     (d_slv, rule_slv), (d_slc, rule_slc), notes = _thresholds(curve, instability_rotation)
-    at_break = rule_slv.startswith(BREAK_RULE)
-    t0 = curve.T0 or 0.0
-    # a_g,SLD on the SLV spectrum (for the lower bound of C8.7.1.2.1.8).
+    # C8.7.1.2.1.5: a_g,SLD on the SLV spectrum (for the lower bound of C8.7.1.2.1.8).
     dem_act, act_rule, _ = _activation_demand(demand_slv, free)
     a0_star = vw.alpha0 * G / (e_star * curve.FC)
     ratio_sld = a0_star / dem_act
+    # C8.7.1.2.1.8: the SLV and the SLC.
     slv = _limit_state(
         "SLV",
         curve,
@@ -930,31 +997,10 @@ def nonlinear_check_2019(
         a_g_slv,
         xi_slv,
         records,
-        t0,
         ratio_sld,
         evaluated_slv,
-        at_break,
     )
-    slc_demand = demand_slc if demand_slc is not None else demand_slv
-    slc_ag = a_g_slc if (demand_slc is not None and a_g_slc is not None) else a_g_slv
-    slc = _limit_state(
-        "SLC",
-        curve,
-        d_slc,
-        rule_slc,
-        slc_demand,
-        slc_ag,
-        xi_slc,
-        records,
-        t0,
-        None,
-        demand_slc is not None,
-    )
-    if demand_slc is None:
-        slc["note"] = (
-            "no SLC hazard in the site file (hazard.limit_states.SLC): a_g_capacity is on the "
-            "SLV spectrum's shape and a_g is the SLV one; the SLC verdict is not evaluated"
-        )
+    slc = _slc(curve, d_slc, rule_slc, demand_slv, demand_slc, a_g_slv, a_g_slc, xi_slc, records)
     d_max = 1.15 * max(d0, d_slc, slv["demand"], slc["demand"])
     out: dict[str, Any] = {
         "method": "circ2019",
@@ -980,6 +1026,57 @@ def nonlinear_check_2019(
         "curve": curve.points(d_max),
         "notes": notes,
     }
+    clauses = _nonlinear_clauses()
+    if free is not None:
+        _free_standing(out, clauses, curve, free)
+    clauses["curve"] = CL_LS["a"] + " with d = φ J/S; [C8.7.1.6] for a free-standing element"
+    _ties_and_floor(out, clauses, curve, demand_slv)
+    out["clauses"] = clauses
+    out["note"] = "; ".join(notes)
+    return out
+
+
+def _slc(
+    curve: CapacityCurve,
+    d_slc: float,
+    rule_slc: str,
+    demand_slv: _Demand,
+    demand_slc: Optional[_Demand],
+    a_g_slv: float,
+    a_g_slc: Optional[float],
+    xi_slc: float,
+    records: Sequence[RecordDemand],
+) -> dict[str, Any]:
+    """Return the SLC's displacement check (§C8.7.1.2.1.8, [C8.7.1.11]).
+
+    On the SLC spectrum and its ``a_g`` where the site gives them; without them on the SLV
+    spectrum's shape and ``a_g`` (a note says so), and the verdict is not evaluated.
+    ``nonlinear_check_2019`` gives the parameters.
+    """
+    slc_demand = demand_slc if demand_slc is not None else demand_slv
+    slc_ag = a_g_slc if (demand_slc is not None and a_g_slc is not None) else a_g_slv
+    slc = _limit_state(
+        "SLC",
+        curve,
+        d_slc,
+        rule_slc,
+        slc_demand,
+        slc_ag,
+        xi_slc,
+        records,
+        None,
+        demand_slc is not None,
+    )
+    if demand_slc is None:
+        slc["note"] = (
+            "no SLC hazard in the site file (hazard.limit_states.SLC): a_g_capacity is on the "
+            "SLV spectrum's shape and a_g is the SLV one; the SLC verdict is not evaluated"
+        )
+    return slc
+
+
+def _nonlinear_clauses() -> dict[str, str]:
+    """Return the clauses of the nonlinear check's own numbers (its limit states' apart)."""
     clauses = {k: CL[k] for k in ("alpha0", "e_star", "FC", "a0_star", "d_per_rad", "phi0", "d0")}
     clauses["alpha0"] = (
         _C + "C8.7.1.2.1.1 [C8.7.1.1] of the actions kept in the curve (C8.7.1.2.1.6)"
@@ -994,18 +1091,19 @@ def nonlinear_check_2019(
             "capacity_ratio": CL_LS["capacity_ratio"],
         }
     )
-    if free is not None:
-        out.update(_free_terms(free))
-        clauses.update({k: CL[k] for k in ("T0", "kappa", "lambda", "L", "t", "W", "E")})
-        yp = curve.yield_point()
-        if yp is not None:
-            out["d_y"], out["a_y"] = yp
-            clauses.update({"d_y": CL["d_y"], "a_y": CL["a_y"]})
-    clauses["curve"] = CL_LS["a"] + " with d = φ J/S; [C8.7.1.6] for a free-standing element"
-    _ties_and_floor(out, clauses, curve, demand_slv)
-    out["clauses"] = clauses
-    out["note"] = "; ".join(notes)
-    return out
+    return clauses
+
+
+def _free_standing(
+    out: dict[str, Any], clauses: dict[str, str], curve: CapacityCurve, free: FreeStanding
+) -> None:
+    """Add a free-standing element's terms: [C8.7.1.7] ``T0`` and [C8.7.1.6] the yield point."""
+    out.update(_free_terms(free))
+    clauses.update({k: CL[k] for k in ("T0", "kappa", "lambda", "L", "t", "W", "E")})
+    yp = curve.yield_point()
+    if yp is not None:
+        out["d_y"], out["a_y"] = yp
+        clauses.update({"d_y": CL["d_y"], "a_y": CL["a_y"]})
 
 
 def _ties_and_floor(

@@ -162,6 +162,97 @@ def _plot_spectrum(spectrum: Any, path: Path) -> Path:
         plt.close(fig)
 
 
+def _plot_limit_state(ax: Any, name: str, color: str, ls: dict[str, Any]) -> float:
+    """Draw one limit state of the 2019 check on the ADRS axes; return its demand's ``a``.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+        The capacity curve's axes (d [m], a [m/s²]).
+    name : str
+        ``"SLV"`` or ``"SLC"``.
+    color : str
+        The limit state's colour.
+    ls : dict
+        The check's record of the limit state (``adrs``, ``T_<name>``, ``demand_code``,
+        ``demand_records``, ``d``, ``a``, ``capacity_ratio``, ``passes``...).
+
+    Returns
+    -------
+    float
+        The code demand's acceleration ``d (2π/T)²`` [m/s²] (for the axes' top).
+    """
+    adrs = ls["adrs"]
+    word = _word(ls["passes"])
+    ax.plot(
+        adrs["d"],
+        adrs["a"],
+        color=color,
+        lw=0.9,
+        alpha=0.7,
+        label=f"{name} demand spectrum (ξ = {ls['xi_percent']:g} %)",
+    )
+    t = ls[f"T_{name}"]
+    a_dem: float = ls["demand_code"] * (2.0 * math.pi / t) ** 2
+    ax.plot(
+        [ls["demand_code"]],
+        [a_dem],
+        "o",
+        color=color,
+        label=f"{name} code demand {ls['demand_code']:.3g} m at T = {t:.3g} s",
+    )
+    if ls.get("demand_records") is not None:
+        ax.plot(
+            [ls["demand_records"]],
+            [a_dem],
+            "x",
+            color=color,
+            label=f"{name} records' demand {ls['demand_records']:.3g} m",
+        )
+    bound = " (a_g,SLD bound)" if ls.get("lower_bound_applied") else ""
+    ax.axvline(
+        ls["d"],
+        color=color,
+        ls="--",
+        lw=1.0,
+        label=f"d_{name} = {ls['d']:.3g} m: {word}, ratio {ls['capacity_ratio']:.3g}{bound}",
+    )
+    ax.plot([ls["d"]], [ls["a"]], "s", color=color, ms=5)
+    return a_dem
+
+
+def _plot_linear(ax: Any, lin: dict[str, Any]) -> list[float]:
+    """Draw the linear check's capacity ``a0*`` and its demand; return both (or none) [m/s²]."""
+    if lin.get("status") != "ok":
+        return []
+    ax.axhline(
+        lin["a0_star"],
+        color="tab:blue",
+        lw=0.9,
+        label=f"linear: a0* = {lin['a0_star']:.3g} m/s²",
+    )
+    ax.axhline(
+        lin["demand"],
+        color="tab:blue",
+        ls=":",
+        lw=1.0,
+        label=f"linear demand/q = {lin['demand']:.3g}: {_word(lin['passes'])}",
+    )
+    return [lin["a0_star"], lin["demand"]]
+
+
+def _plot_2009(ax: Any, non: dict[str, Any], spectrum: Any) -> None:
+    """Draw the 2009 check's forms: the 5 % site spectrum, ``d_u*`` and the demand."""
+    t = np.linspace(0.02, 6.0, 600)
+    ax.plot(spectrum.SDe(t), spectrum.Se(t) * G, color="0.5", lw=1.0, label="site spectrum (5 %)")
+    ax.axvline(non["du_star"], color="tab:blue", ls="--", lw=1, label="d_u* = 0.4 d_0* (2009)")
+    ax.axvline(
+        non["demand"], color="crimson", ls="--", lw=1, label=f"demand: {_word(non['passes'])}"
+    )
+    ax.set_xlim(0.0, 1.15 * max(non["d0_star"], non["demand"]))
+    ax.set_ylim(0.0, 1.2 * non["a0_star"])
+
+
 def _plot_capacity(lin: dict[str, Any], non: dict[str, Any], spectrum: Any, path: Path) -> Path:
     """Plot the checks on the capacity curve in ADRS form: capacity, demand, verdict of each.
 
@@ -179,76 +270,14 @@ def _plot_capacity(lin: dict[str, Any], non: dict[str, Any], spectrum: Any, path
     if non.get("method") == "circ2019" and "SLV" in non:
         tops = [max(a_cur)]
         for name, color in (("SLV", "crimson"), ("SLC", "tab:purple")):
-            ls = non[name]
-            adrs = ls["adrs"]
-            word = _word(ls["passes"])
-            ax.plot(
-                adrs["d"],
-                adrs["a"],
-                color=color,
-                lw=0.9,
-                alpha=0.7,
-                label=f"{name} demand spectrum (ξ = {ls['xi_percent']:g} %)",
-            )
-            t = ls[f"T_{name}"]
-            a_dem = ls["demand_code"] * (2.0 * math.pi / t) ** 2
-            ax.plot(
-                [ls["demand_code"]],
-                [a_dem],
-                "o",
-                color=color,
-                label=f"{name} code demand {ls['demand_code']:.3g} m at T = {t:.3g} s",
-            )
-            if ls.get("demand_records") is not None:
-                ax.plot(
-                    [ls["demand_records"]],
-                    [a_dem],
-                    "x",
-                    color=color,
-                    label=f"{name} records' demand {ls['demand_records']:.3g} m",
-                )
-            bound = " (a_g,SLD bound)" if ls.get("lower_bound_applied") else ""
-            ax.axvline(
-                ls["d"],
-                color=color,
-                ls="--",
-                lw=1.0,
-                label=(
-                    f"d_{name} = {ls['d']:.3g} m: {word}, ratio {ls['capacity_ratio']:.3g}{bound}"
-                ),
-            )
-            ax.plot([ls["d"]], [ls["a"]], "s", color=color, ms=5)
-            tops.append(a_dem)
-        if lin.get("status") == "ok":
-            ax.axhline(
-                lin["a0_star"],
-                color="tab:blue",
-                lw=0.9,
-                label=f"linear: a0* = {lin['a0_star']:.3g} m/s²",
-            )
-            ax.axhline(
-                lin["demand"],
-                color="tab:blue",
-                ls=":",
-                lw=1.0,
-                label=f"linear demand/q = {lin['demand']:.3g}: {_word(lin['passes'])}",
-            )
-            tops += [lin["a0_star"], lin["demand"]]
+            tops.append(_plot_limit_state(ax, name, color, non[name]))
+        tops += _plot_linear(ax, lin)
         d_top = max(non["d0"], non["SLV"]["demand"], non["SLC"]["demand"], non["SLC"]["d"])
         d_top = min(d_top, 3.0 * max(non["d0"], non["SLC"]["d"]))
         ax.set_xlim(0.0, 1.2 * d_top)
         ax.set_ylim(0.0, 1.25 * max(tops))
     else:
-        t = np.linspace(0.02, 6.0, 600)
-        ax.plot(
-            spectrum.SDe(t), spectrum.Se(t) * G, color="0.5", lw=1.0, label="site spectrum (5 %)"
-        )
-        ax.axvline(non["du_star"], color="tab:blue", ls="--", lw=1, label="d_u* = 0.4 d_0* (2009)")
-        ax.axvline(
-            non["demand"], color="crimson", ls="--", lw=1, label=f"demand: {_word(non['passes'])}"
-        )
-        ax.set_xlim(0.0, 1.15 * max(non["d0_star"], non["demand"]))
-        ax.set_ylim(0.0, 1.2 * non["a0_star"])
+        _plot_2009(ax, non, spectrum)
     ax.set_xlabel("d [m]")
     ax.set_ylabel("a [m/s²]")
     ax.grid(alpha=0.3)
