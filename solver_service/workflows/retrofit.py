@@ -759,10 +759,17 @@ def retrofit_doc(
     Raises
     ------
     InputError
-        The spec names a mechanism the constants do not have; the site contradicts the
-        constants (``codecheck.check_site_inputs``); a default tie height with no height of
-        the moving part in the constants.
+        The spec gives connection upgrades (field ``upgrades``: they need the scene,
+        ``retrofit_scene.retrofit_search``); it names a mechanism the constants do not have;
+        the site contradicts the constants (``codecheck.check_site_inputs``); a default tie
+        height with no height of the moving part in the constants.
     """
+    if spec.upgrades:
+        raise InputError(
+            "connection upgrades are compared by searching the scene again with each, which "
+            "a constants file cannot do: retrofit from the scene with --scene and --search-spec",
+            "upgrades",
+        )
     ids = [m.id for m in cf.mechanisms]
     for key in spec.mechanisms:
         if key not in ids:
