@@ -260,3 +260,23 @@ def test_a_retrofit_from_constants_refuses_upgrades(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="--scene") as err:
         rockmech.retrofit(CHURCH, SITE, spec)
     assert err.value.field == "upgrades"
+
+
+def test_the_work_estimate_counts_a_search_again_per_upgrade() -> None:
+    from solver_service.workflows.limits import (
+        check_retrofit_work,
+        retrofit_checks,
+        retrofit_reruns,
+        shortest_time,
+    )
+
+    cf, site = rockmech.read_constants(CHURCH), read_site(SITE)
+    spec = parse_retrofit_spec({**STEEL, "upgrades": UPGRADES})
+    # the ties' search, one per upgrade, one with them all
+    assert retrofit_reruns(spec) == 1 + 2 + 1
+    alone = retrofit_checks(cf, site, spec)
+    budget = shortest_time(retrofit_checks=alone)
+    check_retrofit_work(cf, site, spec, budget, "more time")
+    with pytest.raises(InputError, match="4 searches again") as err:
+        check_retrofit_work(cf, site, spec, budget, "more time", reruns=retrofit_reruns(spec))
+    assert f"plans {alone + 4 * len(cf.mechanisms)} code checks" in str(err.value)
