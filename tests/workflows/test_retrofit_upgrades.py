@@ -19,7 +19,9 @@ tied; ``rockmech retrofit --scene`` searches again with each. The references:
 
 from __future__ import annotations
 
+import html
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -148,9 +150,7 @@ def test_a_level_tied_removes_the_mechanisms_that_cross_it(
     _same_as_by_hand(up, run, checked)
     # every moving part of the rerun starts at or above floor_2, which now holds the walls
     bld = run.result.building
-    z_floor = min(
-        c.point[2] for cs in bld.contacts.values() for c in cs if c.level.id == "floor_2"
-    )
+    z_floor = min(c.point[2] for cs in bld.contacts.values() for c in cs if c.level.id == "floor_2")
     assert len(up["rows"]) < len(doc["mechanisms"])
     for mech in run.constants.mechanisms:
         assert mech.geometry["positive"]["axis_point_m"][2] >= z_floor - 1e-9, mech.name
@@ -280,3 +280,35 @@ def test_the_work_estimate_counts_a_search_again_per_upgrade() -> None:
     with pytest.raises(InputError, match="4 searches again") as err:
         check_retrofit_work(cf, site, spec, budget, "more time", reruns=retrofit_reruns(spec))
     assert f"plans {alone + 4 * len(cf.mechanisms)} code checks" in str(err.value)
+
+
+def test_page_one_of_the_report_has_a_row_per_upgrade(tmp_path: Path) -> None:
+    pytest.importorskip("jinja2")
+    args = _files(tmp_path, UPGRADES)
+    folder = tmp_path / "run"
+    res = runner.invoke(app, ["search", str(EXAMPLE_SCENE), args[3], "--out", str(folder)])
+    assert res.exit_code == 0, res.output
+    res = runner.invoke(app, ["retrofit", "--scene", str(folder), *args[2:], "--out", str(folder)])
+    assert res.exit_code == 0, res.output
+    rdoc = json.loads((folder / "retrofit.json").read_text(encoding="utf-8"))
+    report = tmp_path / "report.html"
+    res = runner.invoke(
+        app,
+        ["assess", str(folder / "constants.json"), str(SITE), "-o", str(report),
+         "--retrofit", str(folder / "retrofit.json")],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    page = report.read_text(encoding="utf-8")
+    one = page[page.index('id="summary">') :]
+    body = one.split('<table id="retrofit-table">', 1)[1].split("</table>", 1)[0]
+    rows = dict(re.findall(r'<tr data-upgrade="([^"]+)"[^>]*>(.*?)</tr>', body, re.S))
+    assert list(rows) == ["0", "1", "together"]
+    sa = rdoc["search_after"]
+    for key, u in [("0", sa["upgrades"][0]), ("1", sa["upgrades"][1])]:
+        text = html.unescape(re.sub(r"<[^>]+>", " ", rows[key]))
+        assert u["upgrades"][0].replace("->", "→") in text
+        assert f"{u['after']} governs (λ0 {u['after_lam0']:.3g})" in text
+        assert f"→ {u['after_margin']:.3g}" in text
+    assert "no mechanism is left" in html.unescape(rows["together"])
+    # after the mechanisms' rows, which stay one per mechanism
+    assert body.index('data-upgrade="0"') > body.rindex("data-mechanism=")
