@@ -11,7 +11,10 @@ The spec says where ties may go and what they are made of:
   one tie at the top of the moving part), the number of bars at that height sharing the
   force, and the bar length for the steel mass [m];
 * ``records``: ground-motion record files (relative to the spec's folder; formats detected)
-  that each mechanism, once tied, must survive at its design scale by the exact solver.
+  that each mechanism, once tied, must survive at its design scale by the exact solver;
+* ``upgrades``: connection upgrades to compare with the ties, from a scene only (a junction
+  of the search spec made ``good`` or ``tied``, a level ``tied``): the search runs again
+  with each.
 
 The document holds, per mechanism, the least tie force that makes the Circolare 2019 checks
 pass, the criterion that governs it, the bar, the anchorage check, the steel mass, and the
@@ -25,11 +28,19 @@ The models run on CPython 3.9 inside Rhino 8, so annotations use the ``typing`` 
 
 from typing import Any, Dict, List, Literal, Mapping, Optional, Tuple, Union
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_serializer
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    field_validator,
+    model_serializer,
+    model_validator,
+)
 
 from shared_schema.constants import validate_document
 from shared_schema.errors import InputError
 from shared_schema.paths import Source, read_source
+from shared_schema.search import Unit
 from shared_schema.version import __version__
 
 __all__ = [
@@ -42,6 +53,7 @@ __all__ = [
     "AnchorageCheck",
     "BarChoice",
     "CheckFigures",
+    "ConnectionUpgrade",
     "GoverningNext",
     "GoverningRow",
     "MechanismRetrofit",
@@ -55,6 +67,7 @@ __all__ = [
     "SearchAfterRow",
     "Steel",
     "TieOption",
+    "UpgradeAfter",
     "bar_strengths",
     "parse_retrofit_spec",
     "read_retrofit_spec",
@@ -80,6 +93,8 @@ ANCHORAGE_MAX_N = 5.0e6
 HEIGHT_MAX_M, LENGTH_MAX_M = 200.0, 300.0
 #: Bars at one height sharing the force: at most this many.
 BARS_MAX = 20
+#: Connection upgrades in one spec: at most this many (each is one more search).
+UPGRADES_MAX = 20
 
 _MODEL = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
 
@@ -219,6 +234,75 @@ class MechanismTies(BaseModel):
         return v
 
 
+class ConnectionUpgrade(BaseModel):
+    """One connection upgrade, compared with the ties by searching the scene again with it.
+
+    Either a junction of the search spec (``walls``, as the search spec names them, and
+    ``to``: ``"good"``, which needs the masonry ``unit`` as the search spec's junction does,
+    or ``"tied"``) or a level of the search spec (``level``, its id, and ``tied: true``).
+    Whether the junction or level is there, and whether the upgrade changes it, is checked
+    against the search spec when the retrofit runs from a scene (a retrofit from constants
+    cannot apply it: the search must run again).
+
+    Attributes
+    ----------
+    walls : [str, str], optional
+        The junction's two wall ids.
+    to : {"good", "tied"}, optional
+        The junction's connection after the upgrade.
+    unit : Unit, optional
+        The masonry unit of a junction made good (length, height [m]).
+    level : str, optional
+        The level's id.
+    tied : bool, optional
+        ``true`` for a level tied into the walls.
+    """
+
+    model_config = ConfigDict(
+        **_MODEL, json_schema_extra={"description": "A junction or level connection upgrade."}
+    )
+
+    walls: Optional[List[str]] = Field(
+        None, min_length=2, max_length=2, description="A junction's two wall ids."
+    )
+    to: Optional[Literal["good", "tied"]] = Field(
+        None, description="The junction's connection after the upgrade."
+    )
+    unit: Optional[Unit] = Field(
+        None, description="Masonry unit of a junction made good (length, height [m])."
+    )
+    level: Optional[str] = Field(None, min_length=1, description="A level's id.")
+    tied: Optional[bool] = Field(None, description="A level upgrade: true (tied into the walls).")
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> "ConnectionUpgrade":
+        if (self.walls is None) == (self.level is None):
+            raise ValueError(
+                "an upgrade is either a junction ('walls' and 'to') or a level ('level' and "
+                "'tied': true)"
+            )
+        if self.walls is not None:
+            if self.tied is not None:
+                raise ValueError("'tied' is a level's; a junction takes 'to': \"tied\"")
+            if self.to is None:
+                raise ValueError('a junction upgrade needs \'to\': "good" or "tied"')
+            if self.walls[0] == self.walls[1]:
+                raise ValueError(f"a junction joins two different walls, got {self.walls}")
+            if self.to == "good" and self.unit is None:
+                raise ValueError(
+                    "a junction made good needs the masonry 'unit' (length, height [m]): the "
+                    "bond bounds the crack angle"
+                )
+            if self.to == "tied" and self.unit is not None:
+                raise ValueError("'unit' is for a junction made good; a tied one takes none")
+        else:
+            if self.to is not None or self.unit is not None:
+                raise ValueError("'to' and 'unit' are a junction's; a level takes 'tied': true")
+            if self.tied is not True:
+                raise ValueError("a level upgrade is 'tied': true (the level tied into the walls)")
+        return self
+
+
 class RetrofitSpec(BaseModel):
     """A retrofit spec: the steel, the anchorage and the candidate ties per mechanism.
 
@@ -248,6 +332,12 @@ class RetrofitSpec(BaseModel):
         max_length=50,
         description="Record files each tied mechanism must survive at its design scale "
         "(relative to the spec's folder).",
+    )
+    upgrades: List[ConnectionUpgrade] = Field(
+        default_factory=list,
+        max_length=UPGRADES_MAX,
+        description="Connection upgrades to compare with the ties (from a scene only): each "
+        "is one more search.",
     )
 
 
@@ -549,11 +639,50 @@ class SearchAfterRow(BaseModel):
     facade: str
     direction: str
     lam0: float = Field(description="Exact static multiplier of the rerun [-].")
-    margin: Optional[float] = Field(None, description="Least a_g,X/a_g of its checks [-].")
+    margin: Optional[float] = Field(
+        None,
+        description="Least margin: its checks' a_g,X/a_g and, with records, each record's "
+        "overturning_scale/design_scale [-].",
+    )
     criterion: Optional[str] = None
     ties: List[str] = Field(
         default_factory=list, description="The designed tie-bars its moving part carries."
     )
+    records: List[RecordScale] = Field(
+        default_factory=list,
+        description="The retrofit spec's records on this mechanism: design scale, least "
+        "overturning scale (exact solver).",
+    )
+
+
+class UpgradeAfter(BaseModel):
+    """The search rerun with connection upgrades: what governs after them.
+
+    One per upgrade on its own (the scene and the search spec as given, with that upgrade),
+    and one with every upgrade and the designed ties together. The margin is the rerun's,
+    by the same rule as ``SearchAfter``; ``moved`` compares with the first search's
+    governing mechanism.
+    """
+
+    model_config = _DOC
+
+    upgrades: List[str] = Field(
+        description="The upgrades applied, in words ('junction F-L: poor -> tied')."
+    )
+    indices: List[int] = Field(description="Their indices in the retrofit spec's upgrades.")
+    with_ties: bool = Field(description="The designed ties are in the scene too.")
+    after: Optional[str] = Field(None, description="Governing mechanism of the rerun.")
+    after_name: Optional[str] = None
+    after_facade: Optional[str] = Field(None, description="The wall it turns.")
+    after_family: Optional[str] = None
+    after_margin: Optional[float] = Field(None, description="Its least margin [-].")
+    after_criterion: Optional[str] = None
+    after_lam0: Optional[float] = Field(None, description="Its static multiplier [-].")
+    least_lam0: Optional[str] = Field(None, description="The rerun's mechanism of least λ0.")
+    least_lam0_value: Optional[float] = Field(None, description="That λ0 [-].")
+    moved: bool = Field(description="Another mechanism governs than before the intervention.")
+    rows: List[SearchAfterRow] = Field(default_factory=list)
+    notes: List[str] = Field(default_factory=list)
 
 
 class SearchAfter(BaseModel):
@@ -584,6 +713,13 @@ class SearchAfter(BaseModel):
     least_lam0_value: Optional[float] = Field(None, description="That λ0 [-].")
     moved: bool = Field(description="Another mechanism governs after the intervention.")
     rows: List[SearchAfterRow] = Field(default_factory=list)
+    upgrades: List[UpgradeAfter] = Field(
+        default_factory=list,
+        description="Per connection upgrade of the retrofit spec: the search rerun with it.",
+    )
+    together: Optional[UpgradeAfter] = Field(
+        None, description="The search rerun with every upgrade and the designed ties."
+    )
     basis: List[str] = Field(default_factory=list)
     notes: List[str] = Field(default_factory=list)
 
@@ -628,7 +764,7 @@ class RetrofitDoc(BaseModel):
             del data["search_after"]
         return data
 
-    def mechanism(self, mechanism_id: str) -> MechanismRetrofit:
+    def find(self, mechanism_id: str) -> MechanismRetrofit:
         """Return the mechanism with this id."""
         for m in self.mechanisms:
             if m.id == mechanism_id:

@@ -340,11 +340,8 @@ SIZE_EXCEPTIONS: dict[str, str] = {
     "cad_maths.search.model:_orient": "the search's building model (#37)",
     "cad_maths.search.model:_level_contacts": "the search's building model (#37)",
     "cad_maths.search.model:building_from_scene": "the search's building model (#37)",
-    "solver_service.workflows.retrofit:_option": "the retrofit's inversion (#39)",
     "solver_service.workflows.retrofit_scene:retrofit_search": "a workflow entry: the search's "
     "keyword options (names, work limits, the work check, the expected run) beside the retrofit's",
-    "solver_service.workflows.retrofit:_mechanism": "the retrofit's per-mechanism steps, "
-    "records included (#39, being extended)",
 }
 
 

@@ -179,7 +179,7 @@ def test_the_church_is_retrofitted_from_the_bundled_files(tmp_path: Path) -> Non
     status = {m.id: m.status for m in doc.mechanisms}
     assert status == {"F1": "designed", "F2": "designed", "A1": "not_applicable",
                       "T1": "not_applicable"}  # fmt: skip
-    f1 = doc.mechanism("F1")
+    f1 = doc.find("F1")
     tie = f1.options[f1.chosen or 0]
     # Two bars share T* equally; each one's force is checked against the bar and anchorage.
     assert tie.bars == 2 and tie.bar is not None and tie.T_star_N is not None

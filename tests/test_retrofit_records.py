@@ -301,7 +301,7 @@ def test_tying_one_wall_moves_the_governing_mechanism_to_the_other(tmp_path: Pat
     nxt = doc.governs_next
     assert nxt is not None
     assert (nxt.before, nxt.after, nxt.moved) == ("W", "V", True)
-    v = doc.mechanism("V")
+    v = doc.find("V")
     assert v.options[0].status == "above_moving_part" and v.chosen is None
     # V's linear ratio by hand: α0 = b/h over α0,req = e* FC a_g S/q (soil C, e* = 1).
     s_s = min(max(1.70 - 0.60 * 2.4 * 0.30, 1.0), 1.5)
@@ -432,6 +432,6 @@ def test_with_records_the_nonlinear_check_after_the_tie_is_the_assessments(
         assert o.after.SLC_ratio == pytest.approx(non["SLC"]["capacity_ratio"], rel=1e-9)
         assert non["capacity_ratio"] >= 1.0 and non["SLC"]["capacity_ratio"] >= 1.0
         # The records raise the demand: the spectrum alone would give a higher ratio.
-        alone = rockmech.retrofit(CHURCH, CHURCH_SITE, CHURCH_SPEC).mechanism(m.id)
+        alone = rockmech.retrofit(CHURCH, CHURCH_SITE, CHURCH_SPEC).find(m.id)
         assert alone.before.SLV_ratio is not None and m.before.SLV_ratio is not None
         assert m.before.SLV_ratio <= alone.before.SLV_ratio

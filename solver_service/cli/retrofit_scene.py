@@ -18,7 +18,7 @@ from shared_schema.rules import check_file
 
 from .output import status
 
-__all__ = ["retrofit_document", "scene_retrofit", "search_after_lines"]
+__all__ = ["retrofit_document", "scene_retrofit", "search_after_lines", "upgrade_lines"]
 
 
 def retrofit_document(
@@ -39,18 +39,22 @@ def retrofit_document(
     from ..workflows import inputs
 
     # The up-front work estimate.
-    from ..workflows.limits import NO_LIMITS, TIME_LIMIT, check_retrofit_work
+    from ..workflows.limits import NO_LIMITS, TIME_LIMIT, check_retrofit_work, retrofit_reruns
 
     # The retrofit (the code checks, scipy) is loaded when the command runs.
     from ..workflows.retrofit import retrofit_doc
 
     how = f"give {TIME_LIMIT} with more seconds, or {NO_LIMITS}"
 
-    def check_work(cf: Any, rs: Any) -> None:
-        if not limits.no_limits:
-            check_retrofit_work(cf, site, rs, limits.time_limit, how, motions)
+    from_scene = scene is not None or search_spec is not None
 
-    if scene is not None or search_spec is not None:
+    def check_work(cf: Any, rs: Any) -> None:
+        # From a scene the search runs again (the ties, each upgrade): those checks count.
+        reruns = retrofit_reruns(rs) if from_scene else 0
+        if not limits.no_limits:
+            check_retrofit_work(cf, site, rs, limits.time_limit, how, motions, reruns)
+
+    if from_scene:
         return scene_retrofit(
             constants, scene, search_spec, site, rspec, motions, limits, check_work
         )
@@ -153,7 +157,7 @@ def search_after_lines(sa: Any) -> list[str]:
             out.append(f"  {t.mechanism}: not put in the scene: {t.note}")
     if sa.after is None:
         out.extend(f"  {n}" for n in sa.notes)
-        return out
+        return out + upgrade_lines(sa)
     where = "another mechanism" if sa.moved else "the same mechanism"
     if sa.moved and sa.after_facade != sa.before_facade:
         where = f"another wall ({sa.before_facade} -> {sa.after_facade})"
@@ -168,4 +172,21 @@ def search_after_lines(sa: Any) -> list[str]:
         else f"  before: {sa.before} at {_g(sa.before_margin)} ({sa.before_criterion}); "
         f"{where} governs"
     )
+    return out + upgrade_lines(sa)
+
+
+def upgrade_lines(sa: Any) -> list[str]:
+    """Return the lines the command prints about the searches with connection upgrades."""
+    out = []
+    for u in [*sa.upgrades, *([sa.together] if sa.together is not None else [])]:
+        what = " + ".join(u.upgrades) + (" + the designed ties" if u.with_ties else "")
+        if u.after is None:
+            out.append(f"search again with {what}: {'; '.join(u.notes) or 'no margin'}")
+            continue
+        out.append(
+            f"search again with {what}: {u.after} governs, margin {_g(u.after_margin)} "
+            f"({u.after_criterion}), lambda0 {u.after_lam0:.4g}"
+            + ("; the collapse moves" if u.moved else "")
+            + f": {u.after_name}"
+        )
     return out

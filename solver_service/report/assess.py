@@ -1014,6 +1014,41 @@ def _kn(value: Optional[float]) -> str:
     return "–" if value is None else sig(value / 1e3, 3)
 
 
+def _upgrade_rows(rdoc: RetrofitDoc) -> list[dict[str, Any]]:
+    """Return page one's rows of the connection upgrades (from a scene): one per upgrade.
+
+    Each: the upgrade in words, the mechanism that governs the search again with it, its
+    λ0 and the least margin before (the first search's) → after; then the row of every
+    upgrade with the designed ties.
+    """
+    sa = rdoc.search_after
+    if sa is None or not sa.upgrades:
+        return []
+    rows = []
+    for key, u in [*((str(k), u) for k, u in enumerate(sa.upgrades)), ("together", sa.together)]:
+        if u is None:
+            continue
+        words = " + ".join(w.replace("->", "→") for w in u.upgrades)
+        governs = "no mechanism is left"
+        if u.after is not None:
+            lam0 = "–" if u.after_lam0 is None else sig(u.after_lam0, 3)
+            governs = f"{u.after} governs (λ0 {lam0})"
+        ok = u.after is None or (u.after_margin is not None and u.after_margin >= 1.0)
+        rows.append(
+            {
+                "key": key,
+                "words": words + (" + the designed ties" if u.with_ties else ""),
+                "governs": governs,
+                "before": "–" if sa.before_margin is None else sig(sa.before_margin, 3),
+                "after": "–" if u.after_margin is None else sig(u.after_margin, 3),
+                "label": u.after_criterion or "",
+                "cls": "ok" if ok else "ko",
+                "moved": u.moved,
+            }
+        )
+    return rows
+
+
 def _retrofit_context(
     data: Optional[dict[str, Any]], mechanisms: list[dict[str, Any]]
 ) -> Optional[dict[str, Any]]:
@@ -1066,6 +1101,7 @@ def _retrofit_context(
     )
     return {
         "rows": rows,
+        "upgrades": _upgrade_rows(rdoc),
         "records_ids": [r["id"] for r in rows if r["records_note"]],
         "grade": rdoc.steel.get("grade", ""),
         "gamma_M0": rdoc.steel.get("gamma_M0"),

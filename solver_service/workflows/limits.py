@@ -90,6 +90,7 @@ __all__ = [
     "mechanism_sides",
     "retrofit_checks",
     "retrofit_record_runs",
+    "retrofit_reruns",
     "scale_factor_points",
     "shortest_time",
     "spectrum_steps",
@@ -675,6 +676,25 @@ def retrofit_record_runs(cf: ConstantsFile, spec: RetrofitSpec) -> int:
     return total
 
 
+def retrofit_reruns(spec: RetrofitSpec) -> int:
+    """Return the searches a retrofit from a scene runs after the first one.
+
+    One with the designed ties and, with connection upgrades, one per upgrade and one with
+    them all and the ties.
+
+    Examples
+    --------
+    >>> from shared_schema.retrofit import parse_retrofit_spec
+    >>> spec = parse_retrofit_spec('{"steel": {"grade": "S275", "diameters_mm": [16]},'
+    ...     ' "anchorage": {"capacity_N": 6e4, "source": "test R-1"},'
+    ...     ' "upgrades": [{"level": "roof", "tied": true}, {"walls": ["F", "L"], "to": "tied"}]}')
+    >>> retrofit_reruns(spec)  # the ties, 2 upgrades, all together
+    4
+    """
+    n = len(spec.upgrades)
+    return 1 + n + (1 if n else 0)
+
+
 def check_retrofit_work(
     cf: ConstantsFile,
     site: SiteFile,
@@ -682,6 +702,7 @@ def check_retrofit_work(
     budget_s: float,
     how: str,
     motions: Sequence[Any] = (),
+    reruns: int = 0,
 ) -> None:
     """Refuse a retrofit whose planned code checks cannot finish within ``budget_s`` [s].
 
@@ -692,6 +713,11 @@ def check_retrofit_work(
     motions : sequence of GroundMotion
         The records: each adds ``retrofit_record_runs`` runs of its longest mechanism and,
         per code check, ``RETROFIT_RECORD_PERIODS`` periods of its response spectrum.
+    reruns : int
+        Searches run again after the first (from a scene: ``retrofit_reruns``), each
+        counted with as many mechanisms as ``cf`` has: per mechanism one code check and,
+        per record, the ``RETROFIT_SCALE_RUNS`` of its least overturning scale. The
+        searches' own work is bounded by their evaluation limits.
     budget_s : float
         The time budget [s]: the service's compute timeout, the command's time limit.
     how : str
@@ -702,28 +728,30 @@ def check_retrofit_work(
     InputError
         Naming ``spec`` (the tie heights set the work), the count and the budget.
     """
-    n = retrofit_checks(cf, site, spec)
-    runs = retrofit_record_runs(cf, spec) if motions else 0
+    again = reruns * len(cf.mechanisms)
+    n = retrofit_checks(cf, site, spec) + again
+    runs = retrofit_record_runs(cf, spec) + again * RETROFIT_SCALE_RUNS if motions else 0
     steps = sum(history_steps(cf, m.accel.n, m.dt, 1, worst=True) * runs for m in motions)
     # With records, every code check matches each record and takes its demand (C8.7.1.2.1.8).
     spectra = float(n * sum(RETROFIT_RECORD_PERIODS * max(m.accel.n - 1, 0) for m in motions))
     seconds = shortest_time(retrofit_checks=n, history_steps=steps, spectrum_steps=spectra)
+    again_words = f", {reruns} searches again" if reruns else ""
     if seconds > budget_s and steps > 0:
         raise InputError(
             f"the retrofit plans {n} code checks and {runs} exact runs of each of "
-            f"{len(motions)} records "
+            f"{len(motions)} records{again_words} "
             f"({work_words(retrofit_checks=n, history_steps=steps, spectrum_steps=spectra)}): "
             f"at least {seconds:.3g} s even at {RATE_MARGIN:g} times the rates measured, past "
-            f"the budget of {budget_s:g} s; give fewer tie heights, mechanisms or records, "
-            f"or {how}",
+            f"the budget of {budget_s:g} s; give fewer tie heights, mechanisms, records or "
+            f"upgrades, or {how}",
             "spec",
         )
     if seconds > budget_s:
         raise InputError(
             f"the retrofit plans {n} code checks ({len(cf.mechanisms)} mechanisms counted as "
             f"failing, their tie heights, {RETROFIT_BISECTION_STEPS} bisection steps per limit "
-            f"state): at least {seconds:.3g} s even at {RATE_MARGIN:g} times the "
+            f"state{again_words}): at least {seconds:.3g} s even at {RATE_MARGIN:g} times the "
             f"{RETROFIT_CHECKS_PER_S:g} checks/s measured, past the budget of {budget_s:g} s; "
-            f"give fewer tie heights or mechanisms, or {how}",
+            f"give fewer tie heights, mechanisms or upgrades, or {how}",
             "spec",
         )

@@ -500,6 +500,108 @@ def _together(
     return governing, t_star, recs.scales(tied(t_star))
 
 
+def _above_moving_part(
+    height: float, height_source: str, top: Optional[float], bars: int
+) -> Optional[TieOption]:
+    """Return the option of a tie above the moving part's top (None: it is not above)."""
+    if top is None or height <= top * (1.0 + 1e-9):
+        return None
+    return TieOption(
+        height_m=height,
+        height_source=height_source,
+        status="above_moving_part",
+        bars=bars,
+        verified=False,
+        decisions=[
+            f"the tie at {height:g} m is above the moving part (its top is {top:.4g} m "
+            "above the hinge): it meets no block that moves, so it restrains nothing and "
+            "changes no check; put it at or below the top"
+        ],
+    )
+
+
+def _option_criteria(
+    checker: _Checker,
+    before: dict[str, Any],
+    height: float,
+    t_max: float,
+    recs: Optional[MechanismRecords],
+    records_before: Sequence[RecordScale],
+) -> tuple[dict[str, Optional[float]], list[RecordTie]]:
+    """Return the least force [N] per criterion, the records' included, and each record's."""
+    criteria = _criteria(checker, before, height, t_max)
+    record_ties: list[RecordTie] = []
+    if recs is not None and recs.records:
+        tied = functools.partial(with_tie, checker.mech, height=height, listed=False)
+        slope = tie_slope(checker.mech, height)
+        criteria["records"], record_ties = recs.tie_forces(tied, slope, records_before, t_max)
+    return criteria, record_ties
+
+
+def _option_notes(
+    before: dict[str, Any], e_star: Optional[float], governing: str, t_star: float
+) -> list[str]:
+    """Return the decisions of a designed option: its e* and an inward side a tie cannot help."""
+    notes = []
+    if e_star is not None:
+        notes.append(
+            f"T* = {t_star:.6g} N, governed by the {governing} check, with e* = {e_star:.4g} "
+            "([C8.7.1.5] as the code check sums it)"
+        )
+    neg = before["sides"].get("negative")
+    if neg is not None and _figures(neg).passes is False:
+        notes.append(
+            "the negative (inward) side fails and a tie, slack on that swing (theory "
+            "§1.8), does not help it: the mechanism still fails there"
+        )
+    return notes
+
+
+def _steel_mass(
+    bar: Optional[BarChoice], ties: MechanismTies, decisions: list[str]
+) -> tuple[Optional[float], Optional[float]]:
+    """Return the bars' steel mass [kg] and per metre [kg/m] (None: no bar, no length)."""
+    if bar is None:
+        return None, None
+    per_m = ties.bars * bar.area_mm2 * 1e-6 * STEEL_DENSITY
+    if ties.length_m is None:
+        decisions.append("steel mass per metre: the spec gives no bar length (length_m)")
+        return None, per_m
+    return per_m * ties.length_m, per_m
+
+
+def _designed(
+    checker: _Checker,
+    spec: RetrofitSpec,
+    ties: MechanismTies,
+    before: dict[str, Any],
+    common: dict[str, Any],
+    governing: str,
+    t_star: float,
+    records_after: list[RecordScale],
+) -> TieOption:
+    """Return the option with its force: the bar, the anchorage, the checks after, the steel."""
+    decisions: list[str] = []
+    bar, anchorage, verified = _carried(spec, ties, t_star / ties.bars, decisions)
+    after = _row_figures(checker.row(t_star, common["height_m"], verified=verified))
+    decisions += _option_notes(before, common["e_star"], governing, t_star)
+    mass, per_m = _steel_mass(bar, ties, decisions)
+    return TieOption(
+        **common,
+        status="designed" if verified and after.passes else "not_carried",
+        T_star_N=t_star,
+        governing=governing,
+        bar=bar,
+        anchorage=anchorage,
+        verified=verified,
+        steel_mass_kg=mass,
+        steel_mass_per_m_kg=per_m,
+        after=after,
+        records_after=records_after,
+        decisions=decisions,
+    )
+
+
 def _option(
     checker: _Checker,
     spec: RetrofitSpec,
@@ -511,43 +613,22 @@ def _option(
     recs: Optional[MechanismRecords] = None,
     records_before: Sequence[RecordScale] = (),
 ) -> TieOption:
-    mech = checker.mech
-    n = ties.bars
-    decisions: list[str] = []
-    if top is not None and height > top * (1.0 + 1e-9):
-        return TieOption(
-            height_m=height,
-            height_source=height_source,
-            status="above_moving_part",
-            bars=n,
-            verified=False,
-            decisions=[
-                f"the tie at {height:g} m is above the moving part (its top is {top:.4g} m "
-                "above the hinge): it meets no block that moves, so it restrains nothing and "
-                "changes no check; put it at or below the top"
-            ],
-        )
-    vw = mech.positive.virtual_work
+    above = _above_moving_part(height, height_source, top, ties.bars)
+    if above is not None:
+        return above
+    vw = checker.mech.positive.virtual_work
     assert vw is not None
     t_max = (ALPHA0_MAX - vw.alpha0) * G * vw.S / height
     lin = before["sides"]["positive"]["linear"]
-    e_star = float(lin["e_star"]) if lin.get("status") == "ok" else None
-    criteria = _criteria(checker, before, height, t_max)
-    record_ties: list[RecordTie] = []
-    if recs is not None and recs.records:
-        tied = functools.partial(with_tie, mech, height=height, listed=False)
-        slope = tie_slope(mech, height)
-        criteria["records"], record_ties = recs.tie_forces(tied, slope, records_before, t_max)
-    t_lin_v = criteria.get("linear SLV")
-    t_slv, t_slc = criteria.get("nonlinear SLV"), criteria.get("nonlinear SLC")
+    criteria, record_ties = _option_criteria(checker, before, height, t_max, recs, records_before)
     common = {
         "height_m": height,
         "height_source": height_source,
-        "T_linear_N": t_lin_v,
-        "T_nonlinear_SLV_N": t_slv,
-        "T_nonlinear_SLC_N": t_slc,
-        "e_star": e_star,
-        "bars": n,
+        "T_linear_N": criteria.get("linear SLV"),
+        "T_nonlinear_SLV_N": criteria.get("nonlinear SLV"),
+        "T_nonlinear_SLC_N": criteria.get("nonlinear SLC"),
+        "e_star": float(lin["e_star"]) if lin.get("status") == "ok" else None,
+        "bars": ties.bars,
         "T_records_N": criteria.get("records"),
         "records": record_ties,
     }
@@ -567,8 +648,7 @@ def _option(
     )
     records_after: list[RecordScale] = []
     if recs is not None and recs.records:
-        together = _together(recs, mech, height, governing, t_star, t_max, record_ties)
-        common["records"] = record_ties
+        together = _together(recs, checker.mech, height, governing, t_star, t_max, record_ties)
         if together is None:
             return TieOption(
                 **common,
@@ -581,43 +661,7 @@ def _option(
                 ],
             )
         governing, t_star, records_after = together
-    bar, anchorage, verified = _carried(spec, ties, t_star / n, decisions)
-    after_row = checker.row(t_star, height, verified=verified)
-    after = _row_figures(after_row)
-    if e_star is not None:
-        decisions.append(
-            f"T* = {t_star:.6g} N, governed by the {governing} check, with e* = {e_star:.4g} "
-            "([C8.7.1.5] as the code check sums it)"
-        )
-    neg = before["sides"].get("negative")
-    if neg is not None:
-        nf = _figures(neg)
-        if nf.passes is False:
-            decisions.append(
-                "the negative (inward) side fails and a tie, slack on that swing (theory "
-                "§1.8), does not help it: the mechanism still fails there"
-            )
-    area = 0.0 if bar is None else bar.area_mm2 * 1e-6
-    per_m = n * area * STEEL_DENSITY if bar is not None else None
-    mass = None
-    if per_m is not None and ties.length_m is not None:
-        mass = per_m * ties.length_m
-    elif per_m is not None:
-        decisions.append("steel mass per metre: the spec gives no bar length (length_m)")
-    return TieOption(
-        **common,
-        status="designed" if verified and after.passes else "not_carried",
-        T_star_N=t_star,
-        governing=governing,
-        bar=bar,
-        anchorage=anchorage,
-        verified=verified,
-        steel_mass_kg=mass,
-        steel_mass_per_m_kg=per_m,
-        after=after,
-        records_after=records_after,
-        decisions=decisions,
-    )
+    return _designed(checker, spec, ties, before, common, governing, t_star, records_after)
 
 
 def _failing(fig: CheckFigures) -> bool:
@@ -641,30 +685,21 @@ def _records_fail(scales: Sequence[RecordScale]) -> bool:
     return any(sc.survives_design is False for sc in scales)
 
 
-def _mechanism(
-    cf: ConstantsFile,
-    site: SiteFile,
-    spec: RetrofitSpec,
+def _standing(
+    head: dict[str, Any],
     mech: Mechanism,
     row: dict[str, Any],
-    motions: Sequence[Any] = (),
-) -> MechanismRetrofit:
-    before = _row_figures(row)
-    recs, records_before, record_notes = _records(mech, row, site, motions)
-    head = {
-        "id": mech.id,
-        "name": mech.name,
-        "typology": mech.typology,
-        "before": before,
-        "records_before": records_before,
-    }
+    records_fail: bool,
+    record_notes: list[str],
+) -> Optional[MechanismRetrofit]:
+    """Return a mechanism that takes no tie option (why, as it stands), or None."""
+    before: CheckFigures = head["before"]
     if before.linear_ratio is None and before.SLV_ratio is None:
         return MechanismRetrofit(
             **head,
             status="not_checked",
             decisions=["the code check did not run", *before.notes, *record_notes],
         )
-    records_fail = _records_fail(records_before)
     if not _failing(before) and not records_fail:
         if before.SLV_passes is None and before.linear_passes is None:
             return MechanismRetrofit(
@@ -673,7 +708,7 @@ def _mechanism(
                 decisions=["the site's checks are not evaluated (see the notes)"],
             )
         said = "passes every check evaluated"
-        if records_before:
+        if head["records_before"]:
             said += " and survives every record at its design scale"
         return MechanismRetrofit(
             **head, status="passes", decisions=[f"{said}: needs no tie", *record_notes]
@@ -692,7 +727,13 @@ def _mechanism(
         return MechanismRetrofit(
             **head, status="not_applicable", decisions=[problem, *record_notes]
         )
-    ties = spec.mechanisms.get(mech.id) or MechanismTies()
+    return None
+
+
+def _heights(
+    mech: Mechanism, ties: MechanismTies
+) -> tuple[list[tuple[float, str]], Optional[float]]:
+    """Return the candidate tie heights [m] with their sources, and the moving part's top."""
     top, top_source = _top_height(mech)
     if ties.heights_m is not None:
         heights = [(h, f"retrofit spec mechanisms.{mech.id}.heights_m") for h in ties.heights_m]
@@ -703,30 +744,57 @@ def _mechanism(
             f"mechanism {mech.id}: {top_source}; give the tie heights",
             f"mechanisms.{mech.id}.heights_m",
         )
+    return heights, top
+
+
+def _choice(options: list[TieOption]) -> tuple[Optional[int], list[str]]:
+    """Return the designed option of least force (None: none) and the decision it makes."""
+    done = [i for i, o in enumerate(options) if o.status == "designed"]
+    chosen = min(done, key=lambda i: (options[i].T_star_N or 0.0, i)) if done else None
+    if chosen is None:
+        return None, ["no tie option makes every check pass (see each option's decisions)"]
+    o = options[chosen]
+    assert o.bar is not None and o.T_star_N is not None
+    return chosen, [
+        f"{o.bars} Ø{o.bar.diameter_mm:g} {o.bar.grade} tie(s) at {o.height_m:g} m, "
+        f"{o.T_star_N:.4g} N in all ({o.governing} governs): the least force of the "
+        "options that make every check pass"
+    ]
+
+
+def _mechanism(
+    cf: ConstantsFile,
+    site: SiteFile,
+    spec: RetrofitSpec,
+    mech: Mechanism,
+    row: dict[str, Any],
+    motions: Sequence[Any] = (),
+) -> MechanismRetrofit:
+    before = _row_figures(row)
+    recs, records_before, record_notes = _records(mech, row, site, motions)
+    head = {
+        "id": mech.id,
+        "name": mech.name,
+        "typology": mech.typology,
+        "before": before,
+        "records_before": records_before,
+    }
+    standing = _standing(head, mech, row, _records_fail(records_before), record_notes)
+    if standing is not None:
+        return standing
+    ties = spec.mechanisms.get(mech.id) or MechanismTies()
+    heights, top = _heights(mech, ties)
     checker = _Checker(cf, site, mech, motions)
     options = [
         _option(checker, spec, ties, row, h, src, top, recs, records_before) for h, src in heights
     ]
-    done = [i for i, o in enumerate(options) if o.status == "designed"]
-    chosen = min(done, key=lambda i: (options[i].T_star_N or 0.0, i)) if done else None
-    decisions = []
-    if chosen is not None:
-        o = options[chosen]
-        assert o.bar is not None and o.T_star_N is not None
-        decisions.append(
-            f"{o.bars} Ø{o.bar.diameter_mm:g} {o.bar.grade} tie(s) at {o.height_m:g} m, "
-            f"{o.T_star_N:.4g} N in all ({o.governing} governs): the least force of the "
-            "options that make every check pass"
-        )
-    else:
-        decisions.append("no tie option makes every check pass (see each option's decisions)")
-    decisions += record_notes
+    chosen, decisions = _choice(options)
     return MechanismRetrofit(
         **head,
         status="designed" if chosen is not None else "not_achievable",
         options=options,
         chosen=chosen,
-        decisions=decisions,
+        decisions=decisions + record_notes,
     )
 
 
@@ -759,10 +827,17 @@ def retrofit_doc(
     Raises
     ------
     InputError
-        The spec names a mechanism the constants do not have; the site contradicts the
-        constants (``codecheck.check_site_inputs``); a default tie height with no height of
-        the moving part in the constants.
+        The spec gives connection upgrades (field ``upgrades``: they need the scene,
+        ``retrofit_scene.retrofit_search``); it names a mechanism the constants do not have;
+        the site contradicts the constants (``codecheck.check_site_inputs``); a default tie
+        height with no height of the moving part in the constants.
     """
+    if spec.upgrades:
+        raise InputError(
+            "connection upgrades are compared by searching the scene again with each, which "
+            "a constants file cannot do: retrofit from the scene with --scene and --search-spec",
+            "upgrades",
+        )
     ids = [m.id for m in cf.mechanisms]
     for key in spec.mechanisms:
         if key not in ids:

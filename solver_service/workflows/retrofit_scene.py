@@ -8,9 +8,14 @@ and a retrofit spec:
    (``workflows.retrofit.retrofit_doc``: the least force, the bar, the checks after);
 3. each designed tie (a chosen option whose bar and anchorage carry it) goes into the scene
    as a tie-bar line, and into the search spec's ``tie_bars`` with its force;
-4. the search runs again on the tied scene, its mechanisms are checked (``check_doc``) and
-   the document's ``search_after`` names the mechanism that governs after the intervention,
-   its margin and λ0, and whether the collapse moved to another wall or family.
+4. the search runs again on the tied scene, its mechanisms are checked
+   (``assess.check_doc_with_records``) and, with records, each is run on them
+   (``retrofit_records.MechanismRecords``: the least overturning scale over the design
+   one); the document's ``search_after`` names the mechanism that governs after the
+   intervention, its margin and λ0, and whether the collapse moved to another wall or family;
+5. with connection upgrades in the retrofit spec (``retrofit_upgrades``), the search runs
+   again once per upgrade on its own and once with every upgrade and the designed ties,
+   each compared the same way (``search_after.upgrades``, ``search_after.together``).
 
 How a designed tie is idealised in the scene (``TIE_IDEALISATION``): one straight tie-bar
 line, horizontal, along the wall's inward normal from its outer face to its inner face, at
@@ -23,28 +28,33 @@ and counts only on a motion that stretches the bar.
 from __future__ import annotations
 
 import uuid
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
 from cad_maths.scene_base import BaseScene, SceneObject
 from shared_schema.constants import ConstantsFile, Mechanism
-from shared_schema.errors import InputError
+from shared_schema.errors import InputError, RockmechError
 from shared_schema.retrofit import (
     CheckFigures,
+    ConnectionUpgrade,
     MechanismTies,
     PlacedTie,
+    RecordScale,
     RetrofitDoc,
     RetrofitSpec,
     SearchAfter,
     SearchAfterRow,
+    UpgradeAfter,
 )
 from shared_schema.search import SearchSpec
 from shared_schema.site import SiteFile
 
-from .codecheck import check_doc
+from .assess import check_doc_with_records
 from .retrofit import least_margin, retrofit_doc
+from .retrofit_records import MechanismRecords
+from .retrofit_upgrades import apply_upgrades, check_upgrades, check_upgrades_meet
 from .search import SearchRun, search_run
 
 __all__ = [
@@ -83,14 +93,19 @@ TIE_IDEALISATION = [
 ]
 
 SEARCH_AFTER_BASIS = [
-    "A mechanism's margin is its least a_g,X/a_g of the Circolare 2019 checks (linear, "
-    "nonlinear SLV and SLC where evaluated), before and after alike; records are not run "
-    "on the rerun's mechanisms.",
+    "A mechanism's margin is its least capacity/demand, before and after alike: the "
+    "Circolare 2019 checks' a_g,X/a_g (linear, nonlinear SLV and SLC where evaluated) and, "
+    "where the retrofit has records, each record's least overturning scale over its design "
+    "scale, run by the exact solver on every mechanism of the rerun as on the first "
+    "search's (the records' demand enters the nonlinear checks, C8.7.1.2.1.8).",
     "The governing mechanism has the least margin; the collapse moved when it is another "
     "mechanism than the first search's governing one (another name: family, façade, "
     "direction, hinge height or crack angles); its façade and family say where it went.",
     "The rerun numbers its mechanisms anew (by λ0): a site's per-mechanism options keyed by "
     "the first search's ids apply to the rerun's mechanisms of the same id.",
+    "A connection upgrade (a junction made good or tied, a level tied) is compared the same "
+    "way: the search runs again on the scene as given with the search spec so changed, once "
+    "per upgrade, and once with every upgrade and the designed ties together.",
 ]
 
 
@@ -339,8 +354,10 @@ def _with_sources(doc: RetrofitDoc, sources: dict[str, str]) -> RetrofitDoc:
     return doc.model_copy(update={"mechanisms": out})
 
 
-def _row_margin(row: dict[str, Any]) -> tuple[Optional[float], Optional[str]]:
-    """Return the least a_g,X/a_g of a ``check_doc`` row and its criterion."""
+def _row_margin(
+    row: dict[str, Any], scales: Sequence[RecordScale] = ()
+) -> tuple[Optional[float], Optional[str]]:
+    """Return the least margin of a ``check_doc`` row and its records, and its criterion."""
     lin, non = row.get("linear") or {}, row.get("nonlinear") or {}
     fig = CheckFigures()
     if lin.get("status") == "ok":
@@ -350,7 +367,7 @@ def _row_margin(row: dict[str, Any]) -> tuple[Optional[float], Optional[str]]:
         slc = non.get("SLC")
         if isinstance(slc, dict) and slc.get("capacity_ratio") is not None:
             fig.SLC_ratio = float(slc["capacity_ratio"])
-    return least_margin(fig)
+    return least_margin(fig, scales)
 
 
 def _bake_designed(cf: ConstantsFile, ids: set[str]) -> tuple[ConstantsFile, dict[str, list[str]]]:
@@ -378,6 +395,98 @@ def _bake_designed(cf: ConstantsFile, ids: set[str]) -> tuple[ConstantsFile, dic
     return cf.model_copy(update={"mechanisms": out}), carried
 
 
+def _rerun_records(
+    mech: Mechanism, row: dict[str, Any], site: SiteFile, motions: Sequence[Any]
+) -> tuple[list[RecordScale], Optional[str]]:
+    """Return the records' scales on one mechanism of a rerun, or why they do not run."""
+    if not motions:
+        return [], None
+    try:
+        return MechanismRecords(mech, row, motions, site).scales(mech), None
+    except RockmechError as exc:
+        return [], f"{mech.id}: the records are not run on this mechanism: {exc}"
+
+
+def _rerun_rows(
+    after: SearchRun, site: SiteFile, motions: Sequence[Any], names: dict[str, str]
+) -> tuple[list[SearchAfterRow], list[str]]:
+    """Return the rows of a rerun (checks, records, margins) and its notes."""
+    if after.constants is None:
+        return [], ["the rerun built no mechanism"]
+    notes: list[str] = []
+    cf, carried = _bake_designed(after.constants, set(names))
+    # The records' demand enters the nonlinear checks as in the first run (C8.7.1.2.1.8).
+    checked = check_doc_with_records(cf, site, motions)[0]["mechanisms"]
+    rows: list[SearchAfterRow] = []
+    for mech, row in zip(cf.mechanisms, checked):
+        d = after.doc.find(mech.id)
+        scales, note = _rerun_records(mech, row, site, motions)
+        if note is not None:
+            notes.append(note)
+        margin, crit = _row_margin(row, scales)
+        rows.append(
+            SearchAfterRow(
+                id=mech.id,
+                name=mech.name,
+                family=d.family,
+                facade=d.facade,
+                direction=d.direction,
+                lam0=d.lam0,
+                margin=margin,
+                criterion=crit,
+                ties=[names[i] for i in carried.get(mech.id, [])],
+                records=scales,
+            )
+        )
+    return rows, notes
+
+
+def _after_fields(rows: Sequence[SearchAfterRow], before_name: Optional[str]) -> dict[str, Any]:
+    """Return the governing mechanism of a rerun's rows (least margin), as document fields."""
+    got = [r for r in rows if r.margin is not None]
+    a = min(got, key=lambda r: r.margin or 0.0) if got else None
+    least = min(rows, key=lambda r: r.lam0) if rows else None
+    return {
+        "after": None if a is None else a.id,
+        "after_name": None if a is None else a.name,
+        "after_facade": None if a is None else a.facade,
+        "after_family": None if a is None else a.family,
+        "after_margin": None if a is None else a.margin,
+        "after_criterion": None if a is None else a.criterion,
+        "after_lam0": None if a is None else a.lam0,
+        "least_lam0": None if least is None else least.id,
+        "least_lam0_value": None if least is None else least.lam0,
+        "moved": before_name is not None and a is not None and a.name != before_name,
+        "rows": list(rows),
+    }
+
+
+def _first_governing(doc: RetrofitDoc) -> Optional[tuple[float, str, Optional[str]]]:
+    """Return the first search's least margin, its mechanism and criterion (None: none)."""
+    first: list[tuple[float, str, Optional[str]]] = []
+    for m in doc.mechanisms:
+        margin, crit = least_margin(m.before, m.records_before)
+        if margin is not None:
+            first.append((margin, m.id, crit))
+    return min(first, key=lambda p: p[0]) if first else None
+
+
+def _before_fields(before: SearchRun, doc: RetrofitDoc) -> dict[str, Any]:
+    """Return the first search's governing mechanism (least margin), as document fields."""
+    b = _first_governing(doc)
+    if b is None:
+        return {"before_name": None}
+    cand = before.doc.find(b[1])
+    return {
+        "before": b[1],
+        "before_name": doc.find(b[1]).name,
+        "before_facade": cand.facade,
+        "before_family": cand.family,
+        "before_margin": b[0],
+        "before_criterion": b[2],
+    }
+
+
 def search_after(
     before: SearchRun,
     after: SearchRun,
@@ -385,6 +494,7 @@ def search_after(
     site: SiteFile,
     placed: list[PlacedTie],
     names: dict[str, str],
+    motions: Sequence[Any] = (),
 ) -> SearchAfter:
     """Compare the first search's governing mechanism with the rerun's (``SearchAfter``).
 
@@ -393,66 +503,24 @@ def search_after(
     before, after : SearchRun
         The first search and the rerun on the tied scene.
     doc : RetrofitDoc
-        The retrofit of the first search's constants (its ``before`` checks).
+        The retrofit of the first search's constants (its ``before`` checks and records).
     site : SiteFile
         The site of the checks.
     placed : list of PlacedTie
         The ties put into the scene.
     names : dict of str to str
         Object id of each designed tie-bar line -> its name.
+    motions : sequence of GroundMotion
+        The retrofit's records: run on every mechanism of the rerun at its design scale by
+        the exact solver (``retrofit_records.MechanismRecords``); each row's margin counts
+        them as ``least_margin`` does.
     """
-    notes: list[str] = []
-    first: list[tuple[float, str, Optional[str]]] = []
-    for m in doc.mechanisms:
-        margin, crit = least_margin(m.before)
-        if margin is not None:
-            first.append((margin, m.id, crit))
-    b = min(first, key=lambda p: p[0]) if first else None
-    rows: list[SearchAfterRow] = []
-    if after.constants is None:
-        notes.append("the rerun built no mechanism")
-    else:
-        cf, carried = _bake_designed(after.constants, set(names))
-        checked = check_doc(cf, site)["mechanisms"]
-        for mech, row in zip(cf.mechanisms, checked):
-            d = after.doc.find(mech.id)
-            margin, crit = _row_margin(row)
-            rows.append(
-                SearchAfterRow(
-                    id=mech.id,
-                    name=mech.name,
-                    family=d.family,
-                    facade=d.facade,
-                    direction=d.direction,
-                    lam0=d.lam0,
-                    margin=margin,
-                    criterion=crit,
-                    ties=[names[i] for i in carried.get(mech.id, [])],
-                )
-            )
-    got = [r for r in rows if r.margin is not None]
-    a = min(got, key=lambda r: r.margin or 0.0) if got else None
-    least = min(rows, key=lambda r: r.lam0) if rows else None
-    cb = None if b is None else before.doc.find(b[1])
+    rows, notes = _rerun_rows(after, site, motions, names)
+    first = _before_fields(before, doc)
     return SearchAfter(
         ties=placed,
-        before=None if b is None else b[1],
-        before_name=None if b is None else doc.mechanism(b[1]).name,
-        before_facade=None if cb is None else cb.facade,
-        before_family=None if cb is None else cb.family,
-        before_margin=None if b is None else b[0],
-        before_criterion=None if b is None else b[2],
-        after=None if a is None else a.id,
-        after_name=None if a is None else a.name,
-        after_facade=None if a is None else a.facade,
-        after_family=None if a is None else a.family,
-        after_margin=None if a is None else a.margin,
-        after_criterion=None if a is None else a.criterion,
-        after_lam0=None if a is None else a.lam0,
-        least_lam0=None if least is None else least.id,
-        least_lam0_value=None if least is None else least.lam0,
-        moved=b is not None and a is not None and a.name != doc.mechanism(b[1]).name,
-        rows=rows,
+        **first,
+        **_after_fields(rows, first["before_name"]),
         basis=TIE_IDEALISATION + SEARCH_AFTER_BASIS,
         notes=notes,
     )
@@ -468,11 +536,92 @@ class RetrofitSearch:
         The retrofit document, with ``search_after``.
     before, after : SearchRun
         The first search and the rerun on the tied scene (None: no tie was placed).
+    upgrades : list of SearchRun
+        The reruns with each connection upgrade, in the spec's order.
+    together : SearchRun, optional
+        The rerun with every upgrade and the designed ties (None: no upgrade given).
     """
 
     doc: RetrofitDoc
     before: SearchRun
     after: Optional[SearchRun]
+    upgrades: list[SearchRun] = field(default_factory=list)
+    together: Optional[SearchRun] = None
+
+
+@dataclass
+class _Reruns:
+    """What every search of a retrofit from a scene shares."""
+
+    site: SiteFile
+    motions: Sequence[Any]
+    common: dict[str, Any]
+    scene_name: str
+    spec_name: str
+
+    def search(self, scene: BaseScene, spec: SearchSpec, what: str = "") -> SearchRun:
+        """Run the search (``search_run``) on ``scene`` with ``spec``; ``what`` names it."""
+        name = f"{self.scene_name} {what}".strip()
+        return search_run(scene, spec, scene_name=name, spec_name=self.spec_name, **self.common)
+
+
+def _tied_spec(spec: SearchSpec, bars: list[dict[str, Any]]) -> SearchSpec:
+    """Return the search spec with the designed tie-bars added to its own."""
+    return SearchSpec.model_validate(
+        {
+            **spec.model_dump(exclude_none=True),
+            "tie_bars": [*[t.model_dump() for t in spec.tie_bars], *bars],
+        }
+    )
+
+
+def _upgrade_after(
+    reruns: _Reruns,
+    run: SearchRun,
+    words: Sequence[str],
+    indices: list[int],
+    names: dict[str, str],
+    before_name: Optional[str],
+) -> UpgradeAfter:
+    """Return the governing mechanism of a rerun with upgrades (``UpgradeAfter``)."""
+    rows, notes = _rerun_rows(run, reruns.site, reruns.motions, names)
+    return UpgradeAfter(
+        upgrades=[words[i] for i in indices],
+        indices=indices,
+        with_ties=bool(names),
+        **_after_fields(rows, before_name),
+        notes=notes,
+    )
+
+
+def _upgrades_after(
+    reruns: _Reruns,
+    block: SearchAfter,
+    scene: BaseScene,
+    spec: SearchSpec,
+    upgrades: Sequence[ConnectionUpgrade],
+    tied: tuple[list[tuple[SceneObject, Any]], list[dict[str, Any]]],
+) -> tuple[SearchAfter, list[SearchRun], Optional[SearchRun]]:
+    """Search again with each upgrade, then with every upgrade and the designed ties."""
+    if not upgrades:
+        return block, [], None
+    words = check_upgrades(spec, upgrades)
+    lines, bars = tied
+    runs = []
+    rows = []
+    for k, up in enumerate(upgrades):
+        run = reruns.search(scene, apply_upgrades(spec, [up]), f"with {words[k]}")
+        runs.append(run)
+        rows.append(_upgrade_after(reruns, run, words, [k], {}, block.before_name))
+    both = apply_upgrades(_tied_spec(spec, bars), upgrades)
+    where = TiedScene(scene, lines) if lines else scene
+    together = reruns.search(where, both, "with the upgrades and the designed ties")
+    names = {o.id: o.name for o, _ in lines}
+    every = list(range(len(upgrades)))
+    last = _upgrade_after(reruns, together, words, every, names, block.before_name)
+    if not lines:
+        last.notes.insert(0, "no designed tie was placed in the scene: the upgrades alone")
+    return block.model_copy(update={"upgrades": rows, "together": last}), runs, together
 
 
 def retrofit_search(
@@ -491,6 +640,11 @@ def retrofit_search(
 ) -> RetrofitSearch:
     """Design the ties of a searched scene's mechanisms, then search the tied scene again.
 
+    With connection upgrades in the retrofit spec (``upgrades``), the search also runs once
+    with each upgrade on its own and once with every upgrade and the designed ties: one
+    more search per upgrade, and one for them all (``search_after.upgrades``,
+    ``search_after.together``).
+
     Parameters
     ----------
     scene : BaseScene
@@ -500,13 +654,15 @@ def retrofit_search(
     site : SiteFile
         The site: hazard, FC, q (the search's code check and the retrofit's).
     rspec : RetrofitSpec
-        Steel, bars, anchorage, candidate tie heights per mechanism id of the first search.
+        Steel, bars, anchorage, candidate tie heights per mechanism id of the first search,
+        connection upgrades (junctions and levels of ``spec``).
     motions : sequence of GroundMotion
-        Records each tied mechanism must survive (``retrofit_doc``).
+        Records each tied mechanism must survive (``retrofit_doc``), run too on every
+        mechanism of the reruns.
     scene_name, spec_name : str
         For the searches' provenance.
     max_evaluations, max_lp_blocks : int, optional
-        The searches' work limits (``search_run``).
+        The searches' work limits (``search_run``), each search's.
     check_work : callable, optional
         Called with the first search's constants and the retrofit spec (its tie heights
         filled in from the scene) before the retrofit runs: a front end's work limit.
@@ -519,55 +675,59 @@ def retrofit_search(
     -------
     RetrofitSearch
         The document (``search_after``: the governing mechanism after, its margin [-] and
-        λ0 [-], whether it moved) and both searches.
+        λ0 [-], whether it moved; per upgrade the same) and the searches.
 
     Raises
     ------
     InputError
         The first search builds no mechanism, or not the ``expected`` ones (field
-        ``search_spec``); any input error of the search or retrofit.
+        ``search_spec``); an upgrade the search spec or the scene does not admit (field
+        ``upgrades[k]...``, ``retrofit_upgrades.check_upgrades``); any input error of the
+        search or retrofit.
     """
-    common: dict[str, Any] = {
-        "site": site,
-        "motions": [],
-        "max_evaluations": max_evaluations,
-        "max_lp_blocks": max_lp_blocks,
-    }
-    before = search_run(scene, spec, scene_name=scene_name, spec_name=spec_name, **common)
+    check_upgrades(spec, rspec.upgrades)
+    reruns = _Reruns(
+        site,
+        motions,
+        {
+            "site": site,
+            "motions": [],
+            "max_evaluations": max_evaluations,
+            "max_lp_blocks": max_lp_blocks,
+        },
+        scene_name,
+        spec_name,
+    )
+    before = reruns.search(scene, spec)
     if before.constants is None:
         raise InputError("the search built no mechanism: nothing to retrofit", "scene")
     if expected is not None:
         _same_run(before.constants, expected)
+    check_upgrades_meet(before.result.building, rspec.upgrades)
     rspec, sources = scene_heights(before, rspec)
     if check_work is not None:
         check_work(before.constants, rspec)
-    doc = _with_sources(retrofit_doc(before.constants, site, rspec, motions), sources)
+    designed = retrofit_doc(
+        before.constants, site, rspec.model_copy(update={"upgrades": []}), motions
+    )
+    doc = _with_sources(designed, sources)
     placed, lines, bars = place_ties(before, doc)
-    if not lines:
+    after = None
+    if lines:
+        where = TiedScene(scene, lines)
+        after = reruns.search(where, _tied_spec(spec, bars), "with the designed ties")
+        names = {o.id: o.name for o, _ in lines}
+        block = search_after(before, after, doc, site, placed, names, motions)
+    else:
         block = SearchAfter(
             ties=placed,
+            **_before_fields(before, doc),
             moved=False,
             basis=TIE_IDEALISATION + SEARCH_AFTER_BASIS,
             notes=["no designed tie was placed in the scene: the search is not rerun"],
         )
-        return RetrofitSearch(doc.model_copy(update={"search_after": block}), before, None)
-    tied_scene = TiedScene(scene, lines)
-    tied_spec = SearchSpec.model_validate(
-        {
-            **spec.model_dump(exclude_none=True),
-            "tie_bars": [
-                *[t.model_dump() for t in spec.tie_bars],
-                *bars,
-            ],
-        }
+    block, runs, together = _upgrades_after(
+        reruns, block, scene, spec, rspec.upgrades, (lines, bars)
     )
-    after = search_run(
-        tied_scene,
-        tied_spec,
-        scene_name=f"{scene_name} with the designed ties",
-        spec_name=spec_name,
-        **common,
-    )
-    names = {o.id: o.name for o, _ in lines}
-    block = search_after(before, after, doc, site, placed, names)
-    return RetrofitSearch(doc.model_copy(update={"search_after": block}), before, after)
+    final = doc.model_copy(update={"search_after": block})
+    return RetrofitSearch(final, before, after, runs, together)

@@ -45,7 +45,7 @@ def test_the_flow_writes_rockmech_retrofits_file_and_places_the_bars(tmp_path: P
     assert ask.messages[0] == f"RM_Retrofit: 4 mechanism(s) via the Python API; wrote {out}"
     assert ask.messages[1:] == retrofit_lines(result.doc) == result.summary
     assert result.summary[0].startswith("2 Ø16 S275 ties at 8 m, 15.1 kN each, make F1 pass")
-    f1 = result.doc.mechanism("F1")
+    f1 = result.doc.find("F1")
     t_bar = f1.options[f1.chosen or 0].T_star_N / 2 / 1e3  # type: ignore[operator]
     f1_marks = [m for m in result.marks if m.label.startswith("F1 ")]
     assert [m.label for m in f1_marks] == [
@@ -61,7 +61,7 @@ def test_the_flow_writes_rockmech_retrofits_file_and_places_the_bars(tmp_path: P
     # F2: one bar at the default height (the top of the moving part), centred on its G.
     (f2,) = [m for m in result.marks if m.label.startswith("F2 ")]
     geo = json.loads(CHURCH.read_text())["mechanisms"][1]["geometry"]
-    h2 = result.doc.mechanism("F2").options[0].height_m
+    h2 = result.doc.find("F2").options[0].height_m
     assert f2.points[0] == pytest.approx((0.0, geo["com_m"][1] * 1e3, h2 * 1e3), abs=1e-6)
     assert f2.points[1][0] == pytest.approx(6200.0)
     # A1 and T1 get no tie: nothing drawn for them.

@@ -108,7 +108,7 @@ def test_free_wall_linear_t_star_is_the_closed_form_and_flips_the_check(
     t_hand = _hand_t_star()
     assert t_hand == pytest.approx(15645.0, abs=1.0)  # the worked example's figure
     doc = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(SPEC))
-    m = doc.mechanism("W")
+    m = doc.find("W")
     assert m.status == "designed" and m.before.linear_passes is False
     opt = m.options[m.chosen or 0]
     assert opt.e_star == pytest.approx(1.0, rel=1e-12)
@@ -126,7 +126,7 @@ def test_free_wall_linear_t_star_is_the_closed_form_and_flips_the_check(
 
 def test_nonlinear_t_is_bracketed_to_half_a_percent(wall: ConstantsFile, tmp_path: Path) -> None:
     doc = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(SPEC))
-    t_nl = doc.mechanism("W").options[0].T_nonlinear_SLV_N
+    t_nl = doc.find("W").options[0].T_nonlinear_SLV_N
     assert t_nl is not None
     site = _site(ties="verified")  # a designed tie whose bar and anchorage carry it
     lo = rockmech.check(_tied(tmp_path, t_nl * 0.995), site).mechanisms[0].nonlinear
@@ -136,7 +136,7 @@ def test_nonlinear_t_is_bracketed_to_half_a_percent(wall: ConstantsFile, tmp_pat
 
 def test_the_smallest_bar_that_carries_t_star_and_its_steel(wall: ConstantsFile) -> None:
     doc = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(SPEC))
-    opt = doc.mechanism("W").options[0]
+    opt = doc.find("W").options[0]
     t = _hand_t_star()
 
     # NTC 2018 [4.2.6] N_pl,Rd = A f_yk/γ_M0, S275 f_yk = 275 N/mm² (Tab. 4.2.I, t ≤ 40 mm),
@@ -169,7 +169,7 @@ def test_more_tie_force_never_lowers_the_capacity_ratio(tmp_path: Path) -> None:
 def test_a_tie_above_the_moving_part_changes_nothing_and_says_why(wall: ConstantsFile) -> None:
     spec = json.loads(json.dumps(SPEC))
     spec["mechanisms"]["W"]["heights_m"] = [6.5]
-    m = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(spec)).mechanism("W")
+    m = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(spec)).find("W")
     (opt,) = m.options
     assert opt.status == "above_moving_part" and opt.T_star_N is None and opt.after is None
     assert "above the moving part" in opt.decisions[0] and "6 m" in opt.decisions[0]
@@ -178,7 +178,7 @@ def test_a_tie_above_the_moving_part_changes_nothing_and_says_why(wall: Constant
 
 def test_default_tie_is_at_the_top_of_the_moving_part(wall: ConstantsFile) -> None:
     spec = {k: v for k, v in SPEC.items() if k != "mechanisms"}
-    m = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(spec)).mechanism("W")
+    m = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(spec)).find("W")
     opt = m.options[0]
     assert opt.height_m == pytest.approx(H, rel=1e-9)
     t_top = RHO * G * B * H * L * (1.0 * FC * A_G * 1.34 / Q * H - B) / (2.0 * H)
@@ -188,14 +188,14 @@ def test_default_tie_is_at_the_top_of_the_moving_part(wall: ConstantsFile) -> No
 def test_a_passing_mechanism_needs_no_tie(wall: ConstantsFile) -> None:
     site = json.loads(json.dumps(SITE))
     site["hazard"]["a_g"] = 0.02
-    m = rockmech.retrofit(wall, parse_site(site), parse_retrofit_spec(SPEC)).mechanism("W")
+    m = rockmech.retrofit(wall, parse_site(site), parse_retrofit_spec(SPEC)).find("W")
     assert m.status == "passes" and m.options == [] and "needs no tie" in m.decisions[0]
 
 
 def test_a_weak_anchorage_leaves_the_tie_unverified(wall: ConstantsFile) -> None:
     spec = json.loads(json.dumps(SPEC))
     spec["anchorage"]["capacity_N"] = 5000.0
-    m = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(spec)).mechanism("W")
+    m = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(spec)).find("W")
     opt = m.options[0]
     assert not opt.verified and opt.anchorage is not None and not opt.anchorage.passes
     assert opt.status == "not_carried" and m.status == "not_achievable"
@@ -208,7 +208,7 @@ def test_a_weak_anchorage_leaves_the_tie_unverified(wall: ConstantsFile) -> None
 def test_no_bar_on_offer_is_said(wall: ConstantsFile) -> None:
     spec = json.loads(json.dumps(SPEC))
     spec["steel"]["diameters_mm"] = [6]
-    opt = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(spec)).mechanism("W")
+    opt = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(spec)).find("W")
     assert opt.options[0].bar is None
     assert any("no bar on offer" in d for d in opt.options[0].decisions)
 
@@ -221,7 +221,7 @@ def test_invariant_to_the_order_of_mechanisms(tmp_path: Path) -> None:
     db = rockmech.retrofit(b, parse_site(SITE), parse_retrofit_spec(spec))
     assert [m.id for m in da.mechanisms] == ["W", "V"]
     for ident in ("W", "V"):
-        assert da.mechanism(ident).model_dump() == db.mechanism(ident).model_dump()
+        assert da.find(ident).model_dump() == db.find(ident).model_dump()
 
 
 def test_paths_work_as_objects(wall: ConstantsFile, tmp_path: Path) -> None:
@@ -231,7 +231,7 @@ def test_paths_work_as_objects(wall: ConstantsFile, tmp_path: Path) -> None:
     doc = rockmech.retrofit(
         str(tmp_path / "c.json"), tmp_path / "site.json", tmp_path / "retrofit.json"
     )
-    assert doc.mechanism("W").options[0].T_star_N == pytest.approx(_hand_t_star(), rel=1e-6)
+    assert doc.find("W").options[0].T_star_N == pytest.approx(_hand_t_star(), rel=1e-6)
 
 
 @pytest.mark.parametrize(

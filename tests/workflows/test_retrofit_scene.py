@@ -77,7 +77,7 @@ def test_designed_ties_go_to_the_top_of_the_facade_as_one_line(run: Any) -> None
         assert f.to_frame(np.asarray(tie.end_m))[1] == pytest.approx(f.thickness, abs=1e-9)
         # one point: one line carrying the largest designed force
         assert tie.force_N == pytest.approx(max(forces), rel=1e-12)
-        m = doc.mechanism(tie.mechanism)
+        m = doc.find(tie.mechanism)
         assert m.options[m.chosen].height_source.startswith("default from the scene")
     assert len({t.object for t in sa.ties}) == 1
 
@@ -197,13 +197,13 @@ def test_a_tie_above_the_wall_is_not_placed_and_its_mechanism_still_governs() ->
     got = retrofit_search(
         read_scene(EXAMPLE_SCENE), _lighter(), read_site(SITE), parse_retrofit_spec(high)
     )
-    assert got.doc.mechanism("S10").status == "designed"
+    assert got.doc.find("S10").status == "designed"
     sa = got.doc.search_after
     by = {t.mechanism: t for t in sa.ties}
     assert by["S10"].status == "not_placed" and "off the wall F" in (by["S10"].note or "")
     assert by["S11"].status == "placed" and by["S13"].status == "placed"
     # the rerun: S10 carries only the others' top tie, less than it needs, and governs, failing
-    s10 = got.doc.mechanism("S10").name
+    s10 = got.doc.find("S10").name
     row = next(r for r in sa.rows if r.name == s10)
     assert row.ties and row.margin is not None and row.margin < 1.0
     assert sa.after_name == s10 and sa.after_margin == row.margin and not sa.moved
