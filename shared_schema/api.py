@@ -924,6 +924,13 @@ class AssessRequest(BaseModel):
         description="Answer with the assessment document (json), its HTML page (html), or the "
         "page printed to PDF (pdf; needs a headless Chromium in the deployment, else 501).",
     )
+    retrofit: Optional[RetrofitSpec] = Field(
+        None,
+        description="A retrofit spec, as rockmech assess --retrofit takes it: the retrofit is "
+        "run on the constants, the site and the records (as rockmech retrofit --record), the "
+        "document holds it under retrofit and page one shows its table; its errors name "
+        "retrofit.<field> (schema: shared_schema/jsonschema/retrofit.schema.json).",
+    )
 
     _plausible = field_validator("constants")(classmethod(_time_domain_constants))
 

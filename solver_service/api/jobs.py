@@ -69,10 +69,11 @@ from ..report.assess import chromium, print_pdf
 from ..report.html import SPECTRUM_PERIODS, input_source
 from ..workflows.assess import (
     BAND_POINTS,
-    assessment_document,
+    assessment_doc,
     check_doc,
     check_document,
     matching_band,
+    typed_assessment,
 )
 from ..workflows.documents import (
     envelope_doc,
@@ -85,7 +86,7 @@ from ..workflows.documents import (
 from ..workflows.inputs import SPEC_EXPECTED, read_record
 from ..workflows.limits import check_retrofit_work
 from ..workflows.outputs import finite_json
-from ..workflows.pages import assess_report, build_report
+from ..workflows.pages import assess_report, assessment_retrofit, build_report
 from ..workflows.retrofit import retrofit_doc
 from ..workflows.retrofit_files import retrofit_json
 from ..workflows.retrofit_scene import retrofit_search
@@ -712,6 +713,12 @@ def _assess_inputs(
             part = {None: "", "record": ".accel"}.get(exc.field, f".{exc.field}")
             raise InputError(exc.reason, f"records[{i}]{part}") from None
     check_spectra_work(cf, check_doc(cf, job.site)["mechanisms"], motions, limits)
+    budget = limits.get("budget_s")
+    if job.retrofit is not None and budget is not None:
+        try:  # as rockmech retrofit --record counts it, before the retrofit runs
+            check_retrofit_work(cf, job.site, job.retrofit, budget, _RETROFIT_HOW, motions)
+        except InputError as exc:
+            raise InputError(exc.reason, "retrofit") from None
     return cf, motions
 
 
@@ -757,7 +764,12 @@ def check_spectra_work(
 def run_assess(job: AssessJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     """Answer ``rockmech assess --json``'s document."""
     cf, motions = _assess_inputs(job, limits)
-    return dumps(assessment_document(cf, job.site, motions, multiples=list(job.multiples)))
+    doc = assessment_doc(cf, job.site, motions, multiples=list(job.multiples))
+    if job.retrofit is not None:
+        # as rockmech assess --retrofit: the retrofit on the constants, site and records
+        made = assessment_retrofit(cf, job.site, job.retrofit, motions)
+        doc["retrofit"] = made.model_dump(mode="json")
+    return dumps(typed_assessment(doc))
 
 
 def run_assess_pdf(job: AssessPdfJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
@@ -793,10 +805,19 @@ def run_assess_html(
         input_source("constants", "constants", dumps(job.constants.model_dump(exclude_none=True))),
         input_source("site", "site", dumps(job.site.model_dump())),
     ] + [input_source("record", r.name, dumps(r.model_dump())) for r in job.records]
+    if job.retrofit is not None:
+        spec = dumps(job.retrofit.model_dump(exclude_none=True))
+        sources.append(input_source("retrofit", "retrofit", spec))
     multiples = list(job.multiples)
     options = {"multiples": multiples}
     _, page = assess_report(
-        cf, job.site, motions, multiples=multiples, sources=sources, options=options
+        cf,
+        job.site,
+        motions,
+        multiples=multiples,
+        sources=sources,
+        options=options,
+        retrofit=job.retrofit,
     )
     return page.encode("utf-8")
 
