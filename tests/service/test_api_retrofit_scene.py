@@ -79,6 +79,28 @@ def test_a_scene_upload_answers_the_clis_retrofit_json_byte_for_byte(
     assert sa["after_margin"] == min(margins) and sa["after_margin"] >= 1.0 - 1e-9
 
 
+@pytest.mark.slow  # the quick loop's budget: the whole suite (CI) runs it
+def test_with_a_record_it_is_the_clis_retrofit_record(client: httpx.Client, tmp_path: Path) -> None:
+    # The first 8 s of El Centro NS (two columns, t [s] and a [g]): each tied mechanism must
+    # survive it at the design scale, as rockmech retrofit --record runs it.
+    lines = (EXAMPLES / "records" / "elcentro_NS.dat").read_text().splitlines()[:400]
+    record = tmp_path / "elcentro_8s.dat"
+    record.write_text("\n".join(lines) + "\n")
+    rspec = tmp_path / "ties.retrofit.json"
+    rspec.write_text(json.dumps(RSPEC), encoding="utf-8")
+    args = ["retrofit", "--scene", str(SCENE), "--search-spec", str(SEARCH), "--site",
+            str(SITE), "--spec", str(rspec), "--record", str(record),
+            "-o", str(tmp_path)]  # fmt: skip
+    cli = runner.invoke(app, args)
+    assert cli.exit_code == 0, cli.output
+    files = {**_files(RSPEC), "record": (record.name, record.read_bytes())}
+    res = client.post(URL, files=files, data={"record_units": "g"})
+    assert res.status_code == 200, res.text
+    assert res.content == (tmp_path / "retrofit.json").read_bytes()
+    doc = res.json()
+    assert [r["name"] for r in doc["records"]] == ["elcentro_8s"]
+
+
 def _refusal(client: httpx.Client, url: str, files: Any, limit: int) -> str | None:
     """The up-front work refusal's message at ``limit``, or None (the work was started)."""
     res = client.post(url, files=files, data={"max_evaluations": str(limit)})
