@@ -204,13 +204,14 @@ def placed_marks(doc: RetrofitDoc, unit_scale: float) -> List[Mark]:
     marks: List[Mark] = []
     seen = set()
     for t in sa.ties:
-        if t.status != "placed" or t.object in seen or t.at_m is None or t.end_m is None:
+        if t.status != "placed" or t.object in seen or t.force_N is None:
+            continue
+        if t.at_m is None or t.end_m is None:
             continue
         seen.add(t.object)
         a = (t.at_m[0] / s, t.at_m[1] / s, t.at_m[2] / s)
         b = (t.end_m[0] / s, t.end_m[1] / s, t.end_m[2] / s)
-        force = (t.force_N or 0.0) / 1e3
-        marks.append(Mark(f"{t.object}: {force:.3g} kN on {t.wall}", (a, b)))
+        marks.append(Mark(f"{t.object}: {t.force_N / 1e3:.3g} kN on {t.wall}", (a, b)))
     return marks
 
 
