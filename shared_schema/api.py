@@ -93,6 +93,7 @@ __all__ = [
     "ReportForm",
     "ReportOptions",
     "ReportRequest",
+    "RetrofitForm",
     "RetrofitRequest",
     "RetrofitResponse",
     "ScaleFactorRequest",
@@ -923,6 +924,13 @@ class AssessRequest(BaseModel):
         description="Answer with the assessment document (json), its HTML page (html), or the "
         "page printed to PDF (pdf; needs a headless Chromium in the deployment, else 501).",
     )
+    retrofit: Optional[RetrofitSpec] = Field(
+        None,
+        description="A retrofit spec, as rockmech assess --retrofit takes it: the retrofit is "
+        "run on the constants, the site and the records (as rockmech retrofit --record), the "
+        "document holds it under retrofit and page one shows its table; its errors name "
+        "retrofit.<field> (schema: shared_schema/jsonschema/retrofit.schema.json).",
+    )
 
     _plausible = field_validator("constants")(classmethod(_time_domain_constants))
 
@@ -1014,6 +1022,44 @@ class SearchForm(ConstantsForm):
         "before it runs them.",
     )
     exact: bool = Field(False, description="Envelopes by the exact solver (not the library).")
+    record_format: Optional[str] = Field(
+        None,
+        description=f"Format of the record: {', '.join(RECORD_FORMATS)} (default: detected).",
+        json_schema_extra={"enum": list(RECORD_FORMATS)},
+    )
+    record_units: Optional[str] = Field(
+        None,
+        description=f"Acceleration units of the record: {', '.join(RECORD_UNITS)}.",
+        json_schema_extra={"enum": list(RECORD_UNITS)},
+    )
+    record_dt: Optional[float] = Field(
+        None,
+        description="Time step [s] of a record without a time column.",
+        json_schema_extra={"exclusiveMinimum": 0},
+    )
+
+
+class RetrofitForm(ConstantsForm):
+    """Multipart form of ``retrofit`` from a scene: the scene, its search spec and these fields.
+
+    Files ``scene``, ``search_spec``, ``site``, ``spec`` (the retrofit spec) and an optional
+    ``record``. As ``rockmech retrofit --scene SCENE --search-spec SPEC``: the scene is searched,
+    the ties of its failing mechanisms designed, put in the scene, and the scene searched again.
+    The search spec's ``ranking.site`` and ``ranking.records`` are not read (the uploaded
+    site and record are the retrofit's, as on the command line).
+    """
+
+    # ``units`` (a scan mesh's length unit) and its check are ConstantsForm's.
+    max_evaluations: Optional[int] = Field(
+        None,
+        ge=1,
+        le=SEARCH_MAX_EVALUATIONS,
+        description="Work limit of the two searches together (the scene, then the scene with "
+        "the designed ties): most evaluations of the static multiplier λ0 (default and "
+        f"largest {SEARCH_MAX_EVALUATIONS}); the search's work estimate counts twice, and a "
+        "retrofit past the limit is refused before either search runs; each search may use "
+        "half of it.",
+    )
     record_format: Optional[str] = Field(
         None,
         description=f"Format of the record: {', '.join(RECORD_FORMATS)} (default: detected).",

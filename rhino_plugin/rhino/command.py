@@ -128,6 +128,9 @@ def run_retrofit() -> Optional[RetrofitFlowResult]:
             stem=os.path.splitext(os.path.basename(path))[0],
             unit_scale=Rhino.RhinoMath.UnitScale(doc.ModelUnitSystem, Rhino.UnitSystem.Meters),
             service_url=doc.Strings.GetValue(SERVICE_URL_KEY) or None,
+            scene=DocScene.from_doc(doc),
+            scene_name=os.path.basename(path),
+            scene_path=path,
         )
     except Cancelled:
         Rhino.RhinoApp.WriteLine("RM_Retrofit: cancelled.")

@@ -15,7 +15,14 @@ from pydantic import BaseModel, ValidationError
 from starlette.datastructures import FormData, UploadFile
 
 from cad_maths.archive_3dm import check_3dm
-from shared_schema.api import ConstantsForm, HistoryForm, ReportForm, SearchForm, SpectrumForm
+from shared_schema.api import (
+    ConstantsForm,
+    HistoryForm,
+    ReportForm,
+    RetrofitForm,
+    SearchForm,
+    SpectrumForm,
+)
 from shared_schema.errors import InputError
 
 from .problems import Problem, validation_message
@@ -33,8 +40,9 @@ __all__ = [
     "read_upload",
 ]
 
-#: Most files and fields a multipart request may carry.
-MAX_FORM_FILES = 4
+#: Most files and fields a multipart request may carry (a retrofit from a scene: the scene,
+#: the search spec, the site, the retrofit spec and a record).
+MAX_FORM_FILES = 5
 MAX_FORM_FIELDS = 200
 
 
@@ -95,6 +103,24 @@ FORMS = {
             "spec": (True, "Search spec (JSON): walls, levels, junctions, families, ranking."),
             "site": (False, "Site file (SITE.json) for the code check of the top mechanisms."),
             "record": (False, _RECORD),
+        },
+    ),
+    "retrofit": FormSpec(
+        RetrofitForm,
+        {
+            "scene": (True, "Rhino .3dm file, or a scan mesh (.ply, .obj, .stl, .off) with units."),
+            "search_spec": (
+                True,
+                "Search spec (JSON), as rockmech retrofit --search-spec: walls, levels, "
+                "junctions, tie-bars; its ranking's site and records are not read.",
+            ),
+            "site": (True, "Site file (SITE.json): hazard, FC, q, building."),
+            "spec": (
+                True,
+                "Retrofit spec (JSON): steel, anchorage, candidate tie heights per mechanism "
+                "id of the first search.",
+            ),
+            "record": (False, _RECORD + " Each tied mechanism must survive it."),
         },
     ),
 }

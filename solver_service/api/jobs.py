@@ -29,6 +29,8 @@ import numpy as np
 
 from cad_maths.mechanisms.build import constants_from_spec
 from cad_maths.scenes import read_scene
+from cad_maths.search.families import work_estimate
+from cad_maths.search.model import building_from_scene
 from shared_schema.api import (
     SEARCH_MAX_EVALUATIONS,
     Ec8Request,
@@ -43,8 +45,9 @@ from shared_schema.documents.pulse import PulseDocument
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.extras import MissingExtra
 from shared_schema.io import CONSTANTS_EXPECTED, stamped
+from shared_schema.retrofit import parse_retrofit_spec
 from shared_schema.rules import CRITERIA, F_N_RANGE, SF_METHODS, check_choice
-from shared_schema.search import parse_search_spec
+from shared_schema.search import SearchSpec, parse_search_spec
 from shared_schema.site import read_site
 from shared_schema.spec import parse_spec
 from shared_schema.text import decode_text
@@ -66,10 +69,11 @@ from ..report.assess import chromium, print_pdf
 from ..report.html import SPECTRUM_PERIODS, input_source
 from ..workflows.assess import (
     BAND_POINTS,
-    assessment_document,
+    assessment_doc,
     check_doc,
     check_document,
     matching_band,
+    typed_assessment,
 )
 from ..workflows.documents import (
     envelope_doc,
@@ -80,10 +84,12 @@ from ..workflows.documents import (
     solve_pulse,
 )
 from ..workflows.inputs import SPEC_EXPECTED, read_record
+from ..workflows.limits import check_retrofit_work
 from ..workflows.outputs import finite_json
-from ..workflows.pages import assess_report, build_report
+from ..workflows.pages import assess_report, assessment_retrofit, build_report
 from ..workflows.retrofit import retrofit_doc
 from ..workflows.retrofit_files import retrofit_json
+from ..workflows.retrofit_scene import retrofit_search
 from ..workflows.scaling import Building
 from ..workflows.search import MAX_LP_BLOCKS, search_run
 from ..workflows.units import stamp
@@ -108,6 +114,7 @@ from .jobspec import (
     RecordUpload,
     ReportJob,
     RetrofitJob,
+    RetrofitSceneJob,
     ScaleFactorJob,
     SceneJob,
     SearchJob,
@@ -139,6 +146,7 @@ __all__ = [
     "run_job",
     "run_pulse",
     "run_report",
+    "run_retrofit_scene",
     "run_scale_factor",
     "run_search",
     "run_spectrum",
@@ -566,6 +574,14 @@ _RETROFIT_SECTIONS = {
 }
 
 
+def _retrofit_field(exc: InputError) -> InputError:
+    """Return the error with its field as the request holds it (``spec.mechanisms.F9``)."""
+    head = (exc.field or "").split(".", 1)[0]
+    if head not in _RETROFIT_SECTIONS:
+        return exc
+    return InputError(exc.reason, f"{_RETROFIT_SECTIONS[head]}.{exc.field}")
+
+
 def run_retrofit(job: RetrofitJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     """Answer ``rockmech retrofit --json``'s document: the bytes of its ``retrofit.json``.
 
@@ -576,11 +592,125 @@ def run_retrofit(job: RetrofitJob, blobs: list[bytes], limits: dict[str, Any]) -
     try:
         doc = retrofit_doc(cf, job.site, job.spec)
     except InputError as exc:
-        head = (exc.field or "").split(".", 1)[0]
-        if head not in _RETROFIT_SECTIONS:
-            raise
-        raise InputError(exc.reason, f"{_RETROFIT_SECTIONS[head]}.{exc.field}") from None
+        raise _retrofit_field(exc) from None
     return retrofit_json(doc).encode("utf-8")
+
+
+#: How a client lifts the budget of a retrofit, ending its refusal.
+_RETROFIT_HOW = (
+    "run rockmech retrofit with the command line (ROCKMECH_COMPUTE_TIMEOUT_S is the "
+    "service's budget per request)"
+)
+
+
+def retrofit_searches(rspec: Any) -> int:
+    """Return how many searches a retrofit from a scene runs (``retrofit_search``).
+
+    The scene as given, then with the designed ties; with connection upgrades, one more per
+    upgrade and one with them all and the ties.
+    """
+    n = len(getattr(rspec, "upgrades", None) or [])
+    return 2 + n + (1 if n else 0)
+
+
+def check_scene_searches(scene: Any, spec: SearchSpec, searches: int, limit: int) -> None:
+    """Refuse a retrofit from a scene whose searches need more than ``limit`` λ0 evaluations.
+
+    The search's work estimate (``cad_maths.search.families.work_estimate``, the least
+    evaluations of its refinements' seed grids) counts once per search the retrofit runs
+    (``retrofit_searches``: the scene as given, with the designed ties, and once per
+    connection upgrade and for them all). Counted before any search runs.
+
+    Raises
+    ------
+    InputError
+        On ``work_limit``, with the counts and the limit.
+    """
+    est = work_estimate(building_from_scene(scene, spec), limit)
+    if searches * est.evaluations > limit:
+        least = "" if est.complete else "at least "
+        what = (
+            "twice (as given, then with the designed ties)"
+            if searches == 2
+            else f"{searches} times (as given, with the designed ties, once per connection "
+            "upgrade and once with them all)"
+        )
+        raise InputError(
+            f"the retrofit searches the scene {what}, each search needing {est.describe()}: "
+            f"{least}{searches * est.evaluations} in all, more than the work limit's {limit} "
+            "(max_evaluations); ask for fewer families or directions, a coarser "
+            "candidates.grid or a wider candidates.spacing in the search spec, fewer "
+            "upgrades, or raise the work limit (counted before any search ran)",
+            "work_limit",
+        )
+
+
+def _scene_retrofit_work(
+    site: Any, motions: list[Any], limits: dict[str, Any]
+) -> Callable[[ConstantsFile, Any], None]:
+    """Return the check of a scene retrofit's work, run once the first search has built."""
+
+    def check(cf: ConstantsFile, rspec: Any) -> None:
+        check_limit(
+            len(cf.mechanisms),
+            limits["max_mechanisms"],
+            "mechanisms built by the search",
+            "search_spec.candidates.keep",
+            "max_mechanisms",
+        )
+        budget = limits.get("budget_s")
+        if budget is not None:
+            check_retrofit_work(cf, site, rspec, budget, _RETROFIT_HOW, motions)
+
+    return check
+
+
+def run_retrofit_scene(job: RetrofitSceneJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
+    """Answer ``rockmech retrofit --scene --search-spec --json``'s document (its bytes).
+
+    Blobs: scene, search spec, site, retrofit spec and the record when given. The
+    searches stay within ``max_evaluations`` together (``check_scene_searches``; each may use
+    its share); the built mechanisms within ``max_mechanisms`` and the retrofit's checks
+    within the budget, checked before the retrofit runs.
+    """
+    scene_bytes, search_bytes, site_bytes, spec_bytes, *rest = blobs
+    scene_name = safe_filename(job.scene_name, "scene.3dm")
+    search_name = safe_filename(job.search_spec_name, "search.json")
+    spec = parse_search_spec(search_bytes, search_name)
+    site = read_site(site_bytes, safe_filename(job.site_name, "site.json"))
+    try:
+        rspec = parse_retrofit_spec(spec_bytes)
+    except InputError as exc:
+        raise InputError(exc.reason, "spec" if not exc.field else f"spec.{exc.field}") from None
+    motions = []
+    if job.record is not None:
+        motions.append(motion_from_params(None, job.record, rest[0], limits))
+    try:
+        scene = read_scene(scene_bytes, name=scene_name, units=job.units)
+    except ImportError as exc:
+        raise ServiceUnavailable(
+            "the retrofit of a scene needs the geometry extra (pip install "
+            f"'rockmech[geometry]'), which this deployment lacks ({exc.name} is missing)"
+        ) from None
+    limit = min(job.max_evaluations or SEARCH_MAX_EVALUATIONS, SEARCH_MAX_EVALUATIONS)
+    searches = retrofit_searches(rspec)
+    check_scene_searches(scene, spec, searches, limit)
+    try:
+        run = retrofit_search(
+            scene,
+            spec,
+            site,
+            rspec,
+            motions,
+            scene_name=scene_name,
+            spec_name=search_name,
+            max_evaluations=limit // searches,
+            max_lp_blocks=MAX_LP_BLOCKS,
+            check_work=_scene_retrofit_work(site, motions, limits),
+        )
+    except InputError as exc:
+        raise _retrofit_field(exc) from None
+    return retrofit_json(run.doc).encode("utf-8")
 
 
 def _assess_inputs(
@@ -601,6 +731,12 @@ def _assess_inputs(
             part = {None: "", "record": ".accel"}.get(exc.field, f".{exc.field}")
             raise InputError(exc.reason, f"records[{i}]{part}") from None
     check_spectra_work(cf, check_doc(cf, job.site)["mechanisms"], motions, limits)
+    budget = limits.get("budget_s")
+    if job.retrofit is not None and budget is not None:
+        try:  # as rockmech retrofit --record counts it, before the retrofit runs
+            check_retrofit_work(cf, job.site, job.retrofit, budget, _RETROFIT_HOW, motions)
+        except InputError as exc:
+            raise InputError(exc.reason, "retrofit") from None
     return cf, motions
 
 
@@ -646,7 +782,12 @@ def check_spectra_work(
 def run_assess(job: AssessJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     """Answer ``rockmech assess --json``'s document."""
     cf, motions = _assess_inputs(job, limits)
-    return dumps(assessment_document(cf, job.site, motions, multiples=list(job.multiples)))
+    doc = assessment_doc(cf, job.site, motions, multiples=list(job.multiples))
+    if job.retrofit is not None:
+        # as rockmech assess --retrofit: the retrofit on the constants, site and records
+        made = assessment_retrofit(cf, job.site, job.retrofit, motions)
+        doc["retrofit"] = made.model_dump(mode="json")
+    return dumps(typed_assessment(doc))
 
 
 def run_assess_pdf(job: AssessPdfJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
@@ -682,10 +823,19 @@ def run_assess_html(
         input_source("constants", "constants", dumps(job.constants.model_dump(exclude_none=True))),
         input_source("site", "site", dumps(job.site.model_dump())),
     ] + [input_source("record", r.name, dumps(r.model_dump())) for r in job.records]
+    if job.retrofit is not None:
+        spec = dumps(job.retrofit.model_dump(exclude_none=True))
+        sources.append(input_source("retrofit", "retrofit", spec))
     multiples = list(job.multiples)
     options = {"multiples": multiples}
     _, page = assess_report(
-        cf, job.site, motions, multiples=multiples, sources=sources, options=options
+        cf,
+        job.site,
+        motions,
+        multiples=multiples,
+        sources=sources,
+        options=options,
+        retrofit=job.retrofit,
     )
     return page.encode("utf-8")
 

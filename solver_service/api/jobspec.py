@@ -66,6 +66,7 @@ __all__ = [
     "RecordUpload",
     "ReportJob",
     "RetrofitJob",
+    "RetrofitSceneJob",
     "ScaleFactorJob",
     "SceneJob",
     "SearchJob",
@@ -216,6 +217,26 @@ class RetrofitJob(RetrofitRequest, Job):
     kind: Literal["retrofit"] = "retrofit"
 
 
+class RetrofitSceneJob(Job):
+    """``rockmech retrofit --scene --search-spec --json``: the retrofit of a searched scene.
+
+    Blobs: the scene, the search spec, the site, the retrofit spec, and the record when
+    ``record`` is given. ``max_evaluations`` bounds the two searches together (the search's
+    work estimate counted twice), checked in the compute process before either runs.
+    """
+
+    model_config = _JOB
+
+    kind: Literal["retrofit_scene"] = "retrofit_scene"
+    scene_name: str = ""
+    search_spec_name: str = ""
+    site_name: str = ""
+    spec_name: str = ""
+    units: Optional[str] = None
+    max_evaluations: Optional[int] = None
+    record: Optional[RecordUpload] = None
+
+
 class WarmupJob(Job):
     """Load every kernel once, before a compute process takes work."""
 
@@ -282,6 +303,7 @@ JOB_KINDS = _by_kind(
     JobKind(AssessPdfJob, "run_assess_pdf", estimate_assess_page, media_type="application/pdf"),
     JobKind(SearchJob, "run_search"),
     JobKind(RetrofitJob, "run_retrofit", estimate_retrofit),
+    JobKind(RetrofitSceneJob, "run_retrofit_scene"),
     JobKind(WarmupJob, "run_warmup"),
 )
 

@@ -11,6 +11,7 @@ two heights, which needs the less force).
 
 import json
 from pathlib import Path
+from typing import Any, Dict, List, Tuple
 
 import pytest
 from typer.testing import CliRunner
@@ -20,6 +21,7 @@ from shared_schema.errors import InputError
 from solver_service.cli import app
 
 from .conftest import ScriptedPrompter
+from .test_prepared import prepared_from
 
 ROOT = Path(__file__).resolve().parents[2]
 CHURCH = ROOT / "examples" / "constants" / "church_geometry.json"
@@ -94,3 +96,113 @@ def test_a_bad_spec_names_the_field_and_writes_nothing(tmp_path: Path) -> None:
         retrofit_flow(ask, str(tmp_path), stem="church")
     assert info.value.field == "steel.grade"
     assert not (tmp_path / "church.retrofit").exists()
+
+
+# --- the scene route: the document's objects searched with a search spec (#39) -------------
+
+SCENE = ROOT / "examples" / "scenes" / "search_facade.3dm"
+SEARCH = ROOT / "examples" / "specs" / "search_facade.search.json"
+TIES = {
+    "steel": {"grade": "S275", "diameters_mm": [16, 20, 24]},
+    "anchorage": {"capacity_N": 60000.0, "source": "plate punching, designer's calculation"},
+}
+
+
+@pytest.fixture(scope="module")
+def scene_files(tmp_path_factory: pytest.TempPathFactory) -> Dict[str, Path]:
+    """The retrofit spec, and ``rockmech retrofit --scene``'s retrofit.json on the example."""
+    folder = tmp_path_factory.mktemp("scene_route")
+    spec = folder / "ties.retrofit.json"
+    spec.write_text(json.dumps(TIES), encoding="utf-8")
+    cli = CliRunner().invoke(
+        app,
+        ["retrofit", "--scene", str(SCENE), "--search-spec", str(SEARCH), "--site", str(SITE),
+         "--spec", str(spec), "-o", str(folder / "cli")],
+    )  # fmt: skip
+    assert cli.exit_code == 0, cli.output
+    return {"spec": spec, "cli": folder / "cli" / "retrofit.json"}
+
+
+def _scene_steps(spec: Path) -> List[Tuple[str, Any]]:
+    return [("get_option", "SceneSearch"), ("get_file", str(SEARCH)), ("get_file", str(SITE)),
+            ("get_file", str(spec))]  # fmt: skip
+
+
+def test_the_scene_route_is_rockmech_retrofit_scene_and_draws_the_tie_lines(
+    scenes: Any, scene_files: Dict[str, Path], tmp_path: Path
+) -> None:
+    # The document's objects as DocScene gives them in Rhino (prepared records).
+    scene = prepared_from(scenes["search_facade"])
+    ask = ScriptedPrompter(scene, _scene_steps(scene_files["spec"]))
+    result = retrofit_flow(
+        ask, str(tmp_path), stem="search_facade", scene=scene, scene_name=SCENE.name
+    )
+    assert ask.done() and ask.asked[0] == ("get_option", "Mechanisms from")
+    out = tmp_path / "search_facade.retrofit" / "retrofit.json"
+    assert result.files == [str(out)]
+    assert out.read_bytes() == scene_files["cli"].read_bytes()
+    assert ask.messages[0] == (
+        f"RM_Retrofit: {len(result.doc.mechanisms)} mechanism(s) via the Python API; wrote {out}"
+    )
+    sa = result.doc.search_after
+    assert sa is not None and sa.after is not None
+    assert ask.messages[1:] == result.summary
+    assert result.summary[-1].startswith(f"Searched again with the ties: {sa.after} governs")
+    # By hand (examples/scenes/build_scenes.py): the façade F has its outer face at x = 0, its
+    # inner face at x = 0.5 m, runs along y over 8 m and rises 10.5 m; the designed ties meet
+    # at its top, at the middle of the hinge axis: one line (0, 4, 10.5) -> (0.5, 4, 10.5) m
+    # carrying the largest designed force.
+    designed = [m for m in result.doc.mechanisms if m.status == "designed"]
+    force = max(m.options[m.chosen or 0].T_star_N or 0.0 for m in designed)
+    (mark,) = result.marks
+    assert mark.points[0] == pytest.approx((0.0, 4.0, 10.5), abs=1e-9)
+    assert mark.points[1] == pytest.approx((0.5, 4.0, 10.5), abs=1e-9)
+    name = "retrofit tie " + "+".join(m.id for m in designed)
+    assert mark.label == f"{name}: {force / 1e3:.3g} kN on F"
+
+
+def test_the_scene_route_on_the_service_gives_the_same_answer(
+    server: object, scenes: Any, scene_files: Dict[str, Path], tmp_path: Path
+) -> None:
+    scene = prepared_from(scenes["search_facade"])
+    ask = ScriptedPrompter(scene, _scene_steps(scene_files["spec"]))
+    remote = retrofit_flow(
+        ask,
+        str(tmp_path),
+        stem="search_facade",
+        unit_scale=0.001,
+        service_url=server.url,  # type: ignore[attr-defined]
+        scene=scene,
+        scene_name=SCENE.name,
+        scene_path=str(SCENE),
+    )
+    assert "via the service" in ask.messages[0]
+    out = tmp_path / "search_facade.retrofit" / "retrofit.json"
+    assert out.read_bytes() == scene_files["cli"].read_bytes()
+    # in millimetres: the same line, a thousand times the metres
+    (mark,) = remote.marks
+    assert mark.points[0] == pytest.approx((0.0, 4000.0, 10500.0), abs=1e-6)
+    assert mark.points[1] == pytest.approx((500.0, 4000.0, 10500.0), abs=1e-6)
+
+
+def test_the_scene_route_on_the_service_needs_a_saved_model(
+    scenes: Any, scene_files: Dict[str, Path], tmp_path: Path
+) -> None:
+    scene = prepared_from(scenes["search_facade"])
+    ask = ScriptedPrompter(scene, _scene_steps(scene_files["spec"]))
+    with pytest.raises(InputError) as info:
+        retrofit_flow(ask, str(tmp_path), stem="m", service_url="http://127.0.0.1:9", scene=scene)
+    assert info.value.field == "scene" and "save the model" in info.value.reason
+    assert not (tmp_path / "m.retrofit").exists()
+
+
+def test_in_a_document_the_constants_route_asks_its_three_files(
+    scenes: Any, tmp_path: Path
+) -> None:
+    scene = prepared_from(scenes["search_facade"])
+    ask = ScriptedPrompter(scene, [("get_option", "Constants"), *FILES])
+    result = retrofit_flow(ask, str(tmp_path), stem="church", scene=scene)
+    assert ask.done()
+    alone = retrofit_flow(ScriptedPrompter(None, FILES), str(tmp_path / "b"), stem="church")
+    assert result.doc == alone.doc and result.marks == alone.marks
+    assert result.doc.search_after is None

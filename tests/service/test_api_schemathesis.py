@@ -11,8 +11,9 @@ excepted: ``/constants``, ``/search`` and the multipart forms of ``/history``, `
 ``/report`` (a ``.3dm`` must be a Rhino model, a spec must name objects of the scene, a
 record file must be one of the formats); the hooks run the check on JSON bodies only. So is
 ``/retrofit``, whose spec must name mechanisms of its constants and whose candidate ties must
-be for mechanisms in physical form with their geometry (a rule across two documents); every
-other check, ``not_a_server_error`` among them, still runs on it.
+be for mechanisms in physical form with their geometry (a rule across two documents), and,
+for that reason, the positive ``/assess`` cases that carry a ``retrofit`` spec; every other
+check, ``not_a_server_error`` among them, still runs on them.
 
 The schema states every rule JSON Schema can state (design 1):
 
