@@ -23,6 +23,7 @@ from shared_schema.documents.boundary import BoundaryDocument
 from shared_schema.documents.check import CheckDocument
 from shared_schema.documents.envelope import EnvelopeDocument
 from shared_schema.documents.history import HistoryDocument
+from shared_schema.documents.ida import IdaDocument
 from shared_schema.documents.pulse import PulseDocument
 from shared_schema.documents.record import RecordDocument
 from shared_schema.errors import InputError
@@ -47,6 +48,10 @@ CASES = {
     "history_sf": (HistoryDocument, ["history", str(C / "church.json"), RECORD, "--scale", "1",
                                      "--sf", "eq28", "--at-height", "2.5"]),
     "record": (RecordDocument, ["record", RECORD, "--pulses", "2", "--n", "20"]),
+    "ida": (IdaDocument, ["ida", str(C / "rect_walls.json"), RECORD, "--scales", "0.5,1,2",
+                          "--jobs", "1"]),
+    "ida_sf_skipped": (IdaDocument, ["ida", str(C / "church.json"), RECORD, "--scales", "1,2",
+                                     "--sf", "eq28", "--jobs", "1", "--no-progress"]),
     "check_ec8": (CheckDocument, ["check", str(C / "church.json"), EC8]),
     "assess": (AssessDocument, ["assess", str(C / "church_geometry.json"), SITE, "--record",
                                 RECORD, "--multiple", "1", "-o", "{tmp}/a.html"]),
@@ -105,3 +110,27 @@ def test_the_reader_metadata_of_a_record_block_is_kept_in_order(tmp_path: Path) 
     keys = list(json.loads(text)["record"])
     assert keys[:5] == ["name", "n_samples", "dt_s", "pga_g", "duration_s"]
     assert list(doc.record.to_dict()) == keys and len(keys) > 5
+
+
+def test_the_ida_document_reads_as_the_printed_numbers(tmp_path: Path) -> None:
+    text = _cli(CASES["ida_sf_skipped"][1], tmp_path)
+    raw = json.loads(text)
+    doc = IdaDocument.model_validate_json(text)
+    assert doc.measure == raw["intensity"]["measure"] == "scale"
+    assert doc.levels == raw["intensity"]["levels"] == [1.0, 2.0]
+    for entry in raw["mechanisms"]:
+        mech = doc.find(entry["id"])
+        assert mech.fraction == entry["fraction"]
+        assert mech.n_overturned == entry["n_overturned"]
+        # The fraction is the count over the records, read from the text independently.
+        assert mech.fraction == [n / len(raw["records"]) for n in entry["n_overturned"]]
+        assert mech.fragility.median == entry["fragility"].get("median")
+        assert mech.fragility.note == entry["fragility"].get("note", "")
+        assert mech.scale_factors == entry.get("scale_factors")
+    above = [m for m in raw["mechanisms"] if "scale_factors" in m]
+    assert above and all(f > 1.0 for m in above for f in m["scale_factors"] if f is not None)
+    assert doc.scale_factor_method == "eq28" and doc.backend.kind == "local"
+    assert doc.skipped is not None and [s.mechanism for s in doc.skipped] == ["F1"]
+    with pytest.raises(InputError, match=r"no mechanism 'F1'") as err:
+        doc.find("F1")
+    assert err.value.field == "mechanism"
