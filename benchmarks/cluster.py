@@ -122,7 +122,7 @@ def _worker_cpu() -> float:
 
 
 def best_run(
-    run: Callable[[Optional[Callable[[int, int], None]]], dict[str, Any]],
+    run: Callable[[Optional[Callable[[int, int], None]]], Any],
     client: Any = None,
     trace: bool = False,
     repeats: int = REPEATS,
@@ -145,6 +145,7 @@ def best_run(
         doc = run(note if trace else None)
         wall = time.perf_counter() - t0
         cpu = cpu_seconds(client) - c0
+        doc = doc.to_dict()  # the IDA document's JSON form, as ida.json holds it
         if not best or wall < best["wall"]:
             best = {"doc": doc, "wall": wall, "cpu": cpu, "load": f"{before} / {load_average()}"}
             best["calls"] = calls

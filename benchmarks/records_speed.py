@@ -159,6 +159,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     warm = time.perf_counter() - t0
     one, t_one, cpu_one, load_one = timed(lambda: run_ida(cf, records, levels, jobs=1))
     local, t_local, cpu_local, load_two = timed(lambda: run_ida(cf, records, levels, jobs=2))
+    one, local = one.to_dict(), local.to_dict()  # the documents' JSON form, as ida.json
     same_jobs = all(one[k] == local[k] for k in ("mechanisms", "records", "max_error_estimate"))
     efficiency = t_one / (2.0 * t_local)
     print(
@@ -177,6 +178,7 @@ def main(argv: Optional[list[str]] = None) -> int:
         t0 = time.perf_counter()
         remote = run_ida(cf, records, levels, scheduler=cluster.scheduler_address)
         t_dask = time.perf_counter() - t0
+    remote = remote.to_dict()
     same = all(remote[k] == local[k] for k in ("mechanisms", "records", "max_error_estimate"))
 
     base = records[0]

@@ -35,6 +35,8 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from shared_schema.documents.envelope import EnvelopeDocument as EnvelopeDocument
     from shared_schema.documents.history import HistoryDocument as HistoryDocument
     from shared_schema.documents.history import HistoryRow as HistoryRow
+    from shared_schema.documents.ida import IdaDocument as IdaDocument
+    from shared_schema.documents.ida import IdaMechanism as IdaMechanism
     from shared_schema.documents.pulse import PulseDocument as PulseDocument
     from shared_schema.documents.record import RecordDocument as RecordDocument
     from shared_schema.documents.search import SearchCandidate as SearchCandidate
@@ -133,8 +135,6 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     from .analysis import (
         search as search,
     )
-    from .results import Fragility as Fragility
-    from .results import IDAResult as IDAResult
 
 #: Each public name and the module it comes from (imported on first access).
 _SOURCES = {
@@ -173,8 +173,8 @@ _SOURCES = {
     "RecordDocument": "shared_schema.documents.record",
     "EnvelopeDocument": "shared_schema.documents.envelope",
     "Band": "shared_schema.documents.envelope",
-    "IDAResult": "rockmech.results",
-    "Fragility": "rockmech.results",
+    "IdaDocument": "shared_schema.documents.ida",
+    "IdaMechanism": "shared_schema.documents.ida",
     "CheckDocument": "shared_schema.documents.check",
     "CheckMechanism": "shared_schema.documents.check",
     "AssessDocument": "shared_schema.documents.assess",

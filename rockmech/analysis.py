@@ -1,8 +1,8 @@
 """The analyses a script runs, one function each, as the ``rockmech`` command runs them.
 
 Every function calls the workflow the command line and the REST service call, so a script,
-the command line and the service give the same numbers; each returns a typed result
-(``rockmech.results``) that keeps the command's whole JSON document in ``doc``. Inputs may
+the command line and the service give the same numbers; each returns the command's typed document
+(``shared_schema.documents``; ``to_dict()`` is the JSON the command prints). Inputs may
 be given as objects (``ConstantsFile``, ``GroundMotion``, ``SiteFile``) or as file paths,
 each a ``str`` or an ``os.PathLike`` (``pathlib.Path``); a JSON document (constants, a site,
 a retrofit or search spec) also as an open file (``shared_schema.paths.read_source``). A
@@ -25,6 +25,7 @@ from shared_schema.documents.assess import AssessDocument
 from shared_schema.documents.check import CheckDocument
 from shared_schema.documents.envelope import EnvelopeDocument
 from shared_schema.documents.history import HistoryDocument
+from shared_schema.documents.ida import IdaDocument
 from shared_schema.errors import InputError, wrong_type
 from shared_schema.paths import (
     PATH_TYPES,
@@ -51,9 +52,6 @@ from solver_service.workflows.ida import run_ida
 from solver_service.workflows.retrofit import retrofit_doc
 from solver_service.workflows.retrofit_records import read_retrofit_records
 from solver_service.workflows.scaling import Building
-from solver_service.workflows.units import stamp
-
-from .results import IDAResult
 
 if TYPE_CHECKING:  # the search's types; its workflow is imported when a search runs
     from cad_maths.scene_base import BaseScene
@@ -372,7 +370,7 @@ def ida(
     criterion: Optional[str] = None,
     scheduler: Optional[str] = None,
     jobs: Optional[int] = None,
-) -> IDAResult:
+) -> IdaDocument:
     """Incremental dynamic analysis: overturned fraction per level and a fragility fit.
 
     As ``rockmech ida``.
@@ -387,7 +385,7 @@ def ida(
         Intensity levels, each > 0: scale factors [-] (``measure="scale"``) or PGAs [g]
         (``measure="pga"``).
     measure : {"scale", "pga"}
-        The intensity measure (``IDAResult.measure``, ``rockmech ida --measure``).
+        The intensity measure (``IdaDocument.measure``, ``rockmech ida --measure``).
     sf, building_height, criterion
         As ``history``.
     scheduler : str, optional
@@ -397,11 +395,13 @@ def ida(
 
     Returns
     -------
-    IDAResult
-        ``measure``, ``levels``, ``fraction`` overturned per mechanism [-], ``fragility``
-        (median in the measure's units, ``beta`` [-]).
+    IdaDocument
+        The document ``rockmech ida --json`` prints (``to_dict()``): its ``measure`` and
+        ``levels``, and per mechanism (``find(id)``) the ``fraction`` of the records that
+        overturn it at each level [-] and its ``fragility`` (``median`` in the measure's
+        units, ``beta`` [-], ``note``).
     """
-    doc = run_ida(
+    return run_ida(
         _constants(constants),
         _records(records),
         _numbers(levels, "levels"),
@@ -412,7 +412,6 @@ def ida(
         scheduler=scheduler,
         jobs=jobs,
     )
-    return IDAResult.from_doc(stamp(doc, "ida"))
 
 
 def check(constants: Constants, site: Site) -> CheckDocument:

@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from shared_schema.documents.ida import IdaDocument
 from shared_schema.errors import InputError
 from shared_schema.io import load_constants
 from solver_service.cli import app
@@ -84,9 +85,9 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
-def _results(doc: dict[str, Any]) -> dict[str, Any]:
-    """The document without its timing and backend: what must not depend on the path."""
-    return {k: v for k, v in doc.items() if k not in TIMING}
+def _results(doc: IdaDocument, *drop: str) -> dict[str, Any]:
+    """The document's JSON without its timing and backend: what must not depend on the path."""
+    return {k: v for k, v in doc.to_dict().items() if k not in TIMING and k not in drop}
 
 
 def _peak_rows(path: Path) -> list[tuple[Any, ...]]:
@@ -106,21 +107,23 @@ def test_local_ida_counts_equal_direct_simulations(motions: list[GroundMotion]) 
     n_runs = len(motions) * len(LEVELS) * len(cf.mechanisms)
     assert seen[0] == (0, n_runs) and seen[-1] == (n_runs, n_runs)
     assert [d for d, _ in seen] == sorted(d for d, _ in seen)
-    assert doc["intensity"] == {"measure": "scale", "units": "-", "levels": LEVELS}
-    assert doc["runs"] == n_runs
-    for model, mech in zip(models_from_file(cf), doc["mechanisms"]):
+    assert doc.intensity.to_dict() == {"measure": "scale", "units": "-", "levels": LEVELS}
+    assert doc.measure == "scale" and doc.levels == LEVELS
+    assert doc.runs == n_runs
+    for model, mech in zip(models_from_file(cf), doc.mechanisms):
         verdicts = np.array(
             [[simulate(model, m.accel, scale=s).overturned for s in LEVELS] for m in motions]
         )
-        assert mech["n_overturned"] == verdicts.sum(axis=0).tolist()
-        assert mech["fraction"] == pytest.approx(verdicts.mean(axis=0).tolist())
-        for row, first in zip(verdicts, mech["first_overturning_level"]):
+        assert doc.find(mech.id) is mech
+        assert mech.n_overturned == verdicts.sum(axis=0).tolist()
+        assert mech.fraction == pytest.approx(verdicts.mean(axis=0).tolist())
+        for row, first in zip(verdicts, mech.first_overturning_level):
             assert first == (LEVELS[int(np.argmax(row))] if row.any() else None)
-    backend = doc["backend"]
-    assert backend["kind"] == "local" and backend["jobs"] == available_cores()
-    assert backend["tasks"] >= 1 and 0 < backend["task_s"] and backend["overhead_per_task_s"] >= 0
+    backend = doc.backend
+    assert backend.kind == "local" and backend.jobs == available_cores()
+    assert backend.tasks >= 1 and 0 < backend.task_s and backend.overhead_per_task_s >= 0
     assert 1 <= available_cores() <= (os.cpu_count() or 1)
-    assert "scale_factors" not in doc["mechanisms"][0]
+    assert "scale_factors" not in doc.to_dict()["mechanisms"][0]
 
 
 def test_plan_covers_every_run_once_in_tasks_of_the_aimed_size() -> None:
@@ -194,11 +197,11 @@ def test_results_are_identical_on_every_cutting_and_number_of_threads(
     if task_s is None:  # interleaved blocks of levels beside a pack of short records
         task_s = _interleaving_task_s(cf, mixed)
     reference = run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9)  # one task, one thread
-    assert reference["backend"]["tasks"] == 1
+    assert reference.backend.tasks == 1
     doc = run_ida(cf, mixed, LEVELS, jobs=jobs, task_s=task_s)
     if task_s < 1e-6:  # every record cut into single levels
-        assert doc["backend"]["tasks"] == len(mixed) * len(LEVELS)
-    assert [r["name"] for r in doc["records"]] == [m.name for m in mixed]
+        assert doc.backend.tasks == len(mixed) * len(LEVELS)
+    assert [r.name for r in doc.records] == [m.name for m in mixed]
     assert _results(doc) == _results(reference)  # counts bit for bit; fits hence identical
 
 
@@ -206,13 +209,13 @@ def test_pga_intensity_scales_each_record_to_the_level(motions: list[GroundMotio
     cf = load_constants(CONSTANTS)
     levels = [0.1, 0.3, 0.6]
     doc = run_ida(cf, motions, levels, measure="pga")
-    assert doc["intensity"]["units"] == "g"
+    assert doc.intensity.units == "g" and doc.measure == "pga"
     model = models_from_file(cf)[0]
     expected = [
         sum(simulate(model, m.accel, scale=lv / m.pga_g).overturned for m in motions)
         for lv in levels
     ]
-    assert doc["mechanisms"][0]["n_overturned"] == expected
+    assert doc.mechanisms[0].n_overturned == expected
 
 
 def test_peaks_file_holds_every_run_as_a_direct_simulation_gives_it(
@@ -224,7 +227,7 @@ def test_peaks_file_holds_every_run_as_a_direct_simulation_gives_it(
     doc = run_ida(cf, mixed, LEVELS, jobs=2, task_s=1e-9, peaks=path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["peaks.parquet"]  # no temp left
     n_runs = len(mixed) * len(cf.mechanisms) * len(LEVELS)
-    assert doc["peaks"] == {"file": "peaks.parquet", "rows": n_runs}
+    assert doc.to_dict()["peaks"] == {"file": "peaks.parquet", "rows": n_runs}
     table = pq.read_table(path)
     assert table.num_rows == n_runs and table.schema.metadata[b"intensity_measure"] == b"scale"
     rows = _peak_rows(path)
@@ -235,11 +238,11 @@ def test_peaks_file_holds_every_run_as_a_direct_simulation_gives_it(
         direct = simulate(models[ids.index(mech)], mixed[record].accel, scale=level)
         assert peak == pytest.approx(direct.peak_ratio, rel=1e-12, abs=1e-15)
         assert over == direct.overturned and status == direct.status
-        assert 0 <= err <= doc["max_error_estimate"]
-    for j, mech in enumerate(doc["mechanisms"]):
+        assert 0 <= err <= doc.max_error_estimate
+    for j, mech in enumerate(doc.mechanisms):
         for k, level in enumerate(LEVELS):
             hits = [r for r in rows if r[2] == ids[j] and r[3] == level and r[5]]
-            assert len(hits) == mech["n_overturned"][k]
+            assert len(hits) == mech.n_overturned[k]
     # Other cuttings (one task; interleaved blocks of levels), the same rows (in another order).
     again = tmp_path / "again.parquet"
     run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9, peaks=again)
@@ -286,10 +289,10 @@ def test_dask_local_cluster_gives_the_local_numbers_on_every_cutting(
                 *("--scales", "1,2", "--scheduler", address, "--no-progress"),
             ],
         )
-    assert remote["backend"]["kind"] == "dask"
-    assert remote["backend"]["n_workers"] == 2 and remote["backend"]["threads"] == 2
+    assert remote.backend.kind == "dask"
+    assert remote.backend.n_workers == 2 and remote.backend.threads == 2
     # Dask's own defaults: the document names each setting that differs from rockmech's.
-    assert remote["backend"]["settings_differ"] == [
+    assert remote.backend.settings_differ == [
         "distributed.admin.tick.interval: 20ms on 2 of 2 workers (rockmech: 1s)",
         "distributed.worker.profile.enabled: True on 2 of 2 workers (rockmech: False)",
     ]
@@ -297,9 +300,10 @@ def test_dask_local_cluster_gives_the_local_numbers_on_every_cutting(
     [note] = [line for line in res.stderr.splitlines() if "rockmech's settings" in line]
     assert note.startswith("note: the Dask workers run without rockmech's settings")
     assert "tick.interval: 20ms on 2 of 2 workers" in note and "docs/cluster.md" in note
-    assert cut["backend"]["tasks"] == len(mixed) * len(LEVELS)
-    assert remote.pop("peaks") == {"file": "dask.parquet", "rows": local.pop("peaks")["rows"]}
-    assert _results(remote) == _results(local) == _results(cut)
+    assert cut.backend.tasks == len(mixed) * len(LEVELS)
+    assert remote.peaks is not None and local.peaks is not None
+    assert remote.peaks.to_dict() == {"file": "dask.parquet", "rows": local.peaks.rows}
+    assert _results(remote, "peaks") == _results(local, "peaks") == _results(cut)
     assert _peak_rows(tmp_path / "dask.parquet") == _peak_rows(tmp_path / "local.parquet")
 
 
@@ -420,15 +424,13 @@ def test_a_mechanism_without_eta_is_skipped_with_a_note_not_fatal(
     assert no_eta == ["F1"]
     levels = [0.5, 1.0, 2.0]
     doc = run_ida(church, motions[:1], levels, jobs=1)
-    assert [s["mechanism"] for s in doc["skipped"]] == ["F1"]
-    assert "eta" in doc["skipped"][0]["reason"]
+    assert doc.skipped is not None and [s.mechanism for s in doc.skipped] == ["F1"]
+    assert "eta" in doc.skipped[0].reason
     kept = church.model_copy(update={"mechanisms": church.mechanisms[1:]})
     alone = run_ida(kept, motions[:1], levels, jobs=1)
-    assert [m["id"] for m in doc["mechanisms"]] == [m["id"] for m in alone["mechanisms"]]
-    assert [m["n_overturned"] for m in doc["mechanisms"]] == [
-        m["n_overturned"] for m in alone["mechanisms"]
-    ]
-    assert "skipped" not in alone
+    assert [m.id for m in doc.mechanisms] == [m.id for m in alone.mechanisms]
+    assert [m.n_overturned for m in doc.mechanisms] == [m.n_overturned for m in alone.mechanisms]
+    assert "skipped" not in alone.to_dict()
     rec = tmp_path / "r.dat"
     rec.write_text("".join(f"{0.02 * i:.2f} {0.1 * np.sin(i / 3):.5f}\n" for i in range(200)))
     res = CliRunner().invoke(
@@ -467,7 +469,7 @@ def test_a_worker_lost_during_the_run_costs_its_tasks_not_the_run(
         )
     assert killed
     assert _results(remote) == _results(local)
-    assert "settings_differ" not in remote["backend"]
+    assert "settings_differ" not in remote.to_dict()["backend"]
 
 
 def test_a_half_built_dask_future_says_nothing_when_collected(

@@ -48,7 +48,7 @@ class AssessDocument(CheckDocument):
         out: Dict[str, Optional[bool]] = {}
         for m in self.mechanisms:
             runs = m.dynamics or []
-            verdicts = [r.get("survives_design") for r in runs]
+            verdicts = [r.survives_design for r in runs]
             out[m.id] = None if not runs or None in verdicts else all(verdicts)
         return out
 
@@ -61,9 +61,9 @@ class AssessDocument(CheckDocument):
         out: Dict[str, Optional[float]] = {}
         for m in self.mechanisms:
             found = [
-                float(r["first_overturning_multiple"])
+                float(r.first_overturning_multiple)
                 for r in m.dynamics or []
-                if r.get("first_overturning_multiple") is not None
+                if r.first_overturning_multiple is not None
             ]
             out[m.id] = min(found) if found else None
         return out

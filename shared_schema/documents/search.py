@@ -17,7 +17,7 @@ from shared_schema.constants import SideConstants
 from shared_schema.spec import Amplification
 
 from .base import Document, Part, find_entry
-from .check import Check, CheckSite
+from .check import CheckSite, LinearCheck, NonlinearCheck
 from .envelope import Band, ExactMethod, LibraryMethod
 
 __all__ = [
@@ -235,8 +235,8 @@ class CandidateCheck(Part):
 
     alpha0: Optional[float] = Field(description="Activation multiplier α0 [-].")
     passes: Optional[bool] = Field(description="Both checks pass at SLV (null: not run).")
-    linear: Check = Field(description="The governing linear check.")
-    nonlinear: Check = Field(description="The governing nonlinear check.")
+    linear: LinearCheck = Field(description="The governing linear check.")
+    nonlinear: NonlinearCheck = Field(description="The governing nonlinear check.")
     Z: float = Field(description="Height of its base above the ground [m].")
     Z_source: str = Field(description="Where Z comes from.")
     T1: Optional[float] = Field(description="The building's first period [s].")

@@ -18,10 +18,11 @@ from .output import print_json, status
 __all__ = ["assess", "check"]
 
 
-def _verdict(check: dict[str, Any]) -> str:
-    if check.get("status") != "ok":
+def _verdict(check: Any) -> str:
+    """Return a check's verdict in one word (``n/a``: it did not run)."""
+    if check.status != "ok":
         return "n/a"
-    return {True: "pass", False: "FAIL", None: "incomplete"}[check["passes"]]
+    return {True: "pass", False: "FAIL", None: "incomplete"}[check.passes]
 
 
 def _num(value: Any, width: int, digits: int = 4) -> str:
@@ -38,6 +39,15 @@ def check(
     as_json: bool = JSON_OPT,
 ) -> None:
     """Code checks of every mechanism (Circolare 2019 §C8.7.1: linear SLV, nonlinear SLV/SLC)."""
+    # The check document's variants, for the summary table: loaded with the checks.
+    from shared_schema.documents.check import (
+        Linear2009,
+        Linear2019,
+        NoCurve2019,
+        Nonlinear2009,
+        Nonlinear2019,
+    )
+
     # The code checks and their readers are loaded when the command runs (#38).
     from ..workflows import assess, inputs
 
@@ -57,28 +67,30 @@ def check(
     )
     for row in doc.mechanisms:
         lin, non = row.linear, row.nonlinear
-        if lin.get("status") == "ok":
+        if isinstance(lin, (Linear2019, Linear2009)):
             left = (
-                f"{lin['alpha0']:>9.4g}{lin['e_star']:>8.4g}{lin['a0_star']:>10.4g}"
-                f"{lin['demand']:>9.4g}{_verdict(lin):>8}"
+                f"{_num(lin.alpha0, 9)}{_num(lin.e_star, 8)}{_num(lin.a0_star, 10)}"
+                f"{_num(lin.demand, 9)}{_verdict(lin):>8}"
             )
         else:
             left = f"{'-':>9}{'-':>8}{'-':>10}{'-':>9}{_verdict(lin):>8}"
-        if non.get("status") == "ok":
-            d = non.get("d_SLV", non.get("du_star"))
-            t = non.get("T_SLV", non.get("Ts"))
-            right = f"{_num(d, 9)}{_num(non.get('demand'), 9)}{_num(t, 8, 3)}{_verdict(non):>11}"
+        if isinstance(non, Nonlinear2009):
+            d, t = non.du_star, non.Ts
+        elif isinstance(non, (Nonlinear2019, NoCurve2019)):
+            d, t = non.d_SLV, non.T_SLV
+        if isinstance(non, (Nonlinear2019, NoCurve2019, Nonlinear2009)):
+            right = f"{_num(d, 9)}{_num(non.demand, 9)}{_num(t, 8, 3)}{_verdict(non):>11}"
         else:
             right = f"{'-':>9}{'-':>9}{'-':>8}{_verdict(non):>11}"
         typer.echo(f"{row.id:<10}" + left + right)
-        slc = non.get("SLC") if non.get("status") == "ok" else None
-        if slc is not None:
-            state = {True: "pass", False: "FAIL", None: "not evaluated"}[slc["passes"]]
+        if isinstance(non, Nonlinear2019):
+            slc = non.SLC
+            state = {True: "pass", False: "FAIL", None: "not evaluated"}[slc.passes]
             typer.echo(
-                f"  {row.id}: SLC d = {slc['d']:.4g} m, demand = {slc['demand']:.4g} m, "
-                f"T_SLC = {slc['T_SLC']:.3g} s, a_g,SLC = {slc['a_g_capacity']:.4g} g: {state}"
+                f"  {row.id}: SLC d = {slc.d:.4g} m, demand = {slc.demand:.4g} m, "
+                f"T_SLC = {slc.T_SLC:.3g} s, a_g,SLC = {slc.a_g_capacity:.4g} g: {state}"
             )
-        notes: set[str] = {str(c["note"]) for c in (lin, non) if c.get("note")}
+        notes: set[str] = {c.note for c in (lin, non) if c.note}
         for text in sorted(notes):
             typer.echo(f"  note: {row.id}: {text}")
     if doc.governing is not None:

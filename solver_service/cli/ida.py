@@ -205,7 +205,7 @@ def ida(
     from ..core.model import check_positive
 
     # The readers and the writer of the IDA's files.
-    from ..workflows import inputs, outputs, units
+    from ..workflows import inputs, outputs
 
     # The IDA, its inputs and its writer are loaded when the command runs (#38).
     from ..workflows.ida import run as workflow
@@ -274,33 +274,33 @@ def ida(
         raise typer.Exit(code=130) from None
     skipped_notes(doc)
     if as_json:
-        print_json(units.stamp(doc, "ida"))
+        print_json(doc.to_dict())
         return
-    backend = doc["backend"]
+    backend, err = doc.backend, doc.max_error_estimate
     where = (
-        f"locally on {backend['jobs']} threads"
-        if backend["kind"] == "local"
-        else f"on Dask at {backend['scheduler']} ({backend['threads']} worker threads)"
+        f"locally on {backend.jobs} threads"
+        if backend.kind == "local"
+        else f"on Dask at {backend.scheduler} ({backend.threads} worker threads)"
     )
     typer.echo(
-        f"{doc['runs']} runs ({len(motions)} records x {len(levels)} levels x "
-        f"{len(doc['mechanisms'])} mechanisms) {where} in {doc['runtime_s']:.2f} s "
-        f"({backend['tasks']} tasks, overhead {100 * backend['overhead_fraction']:.1f} % of "
-        f"task time); largest error estimate {doc['max_error_estimate']:.1e}"
+        f"{doc.runs} runs ({len(motions)} records x {len(levels)} levels x "
+        f"{len(doc.mechanisms)} mechanisms) {where} in {doc.runtime_s:.2f} s "
+        f"({backend.tasks} tasks, overhead {100 * backend.overhead_fraction:.1f} % of "
+        f"task time); largest error estimate {'n/a' if err is None else f'{err:.1e}'}"
     )
-    if backend.get("settings_differ"):
+    if backend.settings_differ:
         note(
             "note: the Dask workers run without rockmech's settings, which keep Dask's own "
-            f"background work off the cores ({'; '.join(backend['settings_differ'])}); "
+            f"background work off the cores ({'; '.join(backend.settings_differ)}); "
             'see docs/cluster.md, "Dask\'s settings"'
         )
-    unit = doc["intensity"]["units"]
+    unit = doc.intensity.units
     rows, notes = [], []
-    for mech in doc["mechanisms"]:
-        fit = mech["fragility"]
-        rows.append([str(mech["id"]), g4(fit.get("median")), g4(fit.get("beta"))])
-        if "note" in fit:
-            notes.append(f"  {mech['id']}: {fit['note']}")
+    for mech in doc.mechanisms:
+        fit = mech.fragility
+        rows.append([mech.id, g4(fit.median), g4(fit.beta)])
+        if fit.note:
+            notes.append(f"  {mech.id}: {fit.note}")
     for line in table(["mechanism", f"median [{unit}]", "beta [-]"], rows) + notes:
         typer.echo(line)
     if out is not None:

@@ -14,6 +14,7 @@ from typing import Any, Union
 import numpy as np
 
 from shared_schema.atomic import write_atomic
+from shared_schema.documents.ida import IdaDocument
 
 from ..core.fragility import lognormal_cdf
 from ..core.model import G
@@ -338,12 +339,12 @@ def plot_envelopes(
         plt.close(fig)
 
 
-def plot_fragility(doc: dict[str, Any], path: Union[str, Path], *, title: str = "") -> Path:
+def plot_fragility(doc: IdaDocument, path: Union[str, Path], *, title: str = "") -> Path:
     """Plot IDA results: overturned fraction per level and the fitted lognormal curves.
 
     Parameters
     ----------
-    doc : dict
+    doc : IdaDocument
         The document of ``solver_service.workflows.ida.run_ida``.
     path : str or Path
         Output file (.png or .svg); written atomically.
@@ -356,24 +357,24 @@ def plot_fragility(doc: dict[str, Any], path: Union[str, Path], *, title: str = 
         The written file.
     """
     plt = load_pyplot()
-    levels = np.asarray(doc["intensity"]["levels"], dtype=float)
+    levels = np.asarray(doc.levels, dtype=float)
     fig, ax = plt.subplots(figsize=(8, 5))
     cmap = plt.get_cmap("tab10")
     x = np.geomspace(levels.min() / 1.5, levels.max() * 1.5, 300)
-    for k, mech in enumerate(doc["mechanisms"]):
+    for k, mech in enumerate(doc.mechanisms):
         colour = cmap(k % 10)
-        fit = mech["fragility"]
-        label = plain(mech["id"])
-        if "median" in fit:
-            ax.plot(x, lognormal_cdf(x, fit["median"], fit["beta"]), color=colour, lw=1.3)
-            label += f": median {fit['median']:.3g}, β {fit['beta']:.2f}"
-        ax.plot(levels, mech["fraction"], "o", color=colour, ms=4, label=label)
+        fit = mech.fragility
+        label = plain(mech.id)
+        if fit.median is not None and fit.beta is not None:
+            ax.plot(x, lognormal_cdf(x, fit.median, fit.beta), color=colour, lw=1.3)
+            label += f": median {fit.median:.3g}, β {fit.beta:.2f}"
+        ax.plot(levels, mech.fraction, "o", color=colour, ms=4, label=label)
     ax.set_xscale("log")
     ax.set_ylim(-0.03, 1.03)
-    unit = doc["intensity"]["units"]
-    name = "scale factor [-]" if doc["intensity"]["measure"] == "scale" else f"PGA [{unit}]"
+    unit = doc.intensity.units
+    name = "scale factor [-]" if doc.measure == "scale" else f"PGA [{unit}]"
     ax.set_xlabel(name)
-    ax.set_ylabel(f"fraction of {len(doc['records'])} records that overturn")
+    ax.set_ylabel(f"fraction of {len(doc.records)} records that overturn")
     ax.grid(which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="upper left")
     ax.set_title(plain(title) or "Fragility from incremental dynamic analysis (lognormal MLE)")

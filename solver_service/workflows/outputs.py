@@ -15,6 +15,7 @@ from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile
 from shared_schema.documents.envelope import EnvelopeDocument, RecordPulse
 from shared_schema.documents.history import HistoryDocument
+from shared_schema.documents.ida import IdaDocument
 from shared_schema.documents.record import RecordDocument
 
 from ..core.pulses import extract_pulses
@@ -22,7 +23,7 @@ from ..core.spectra import response_spectrum
 from ..report.plots import plot_envelopes, plot_fragility, plot_ratio_histories, plot_record
 from .documents import envelope_doc, history_doc
 from .ida.document import ida_csv
-from .units import finite_json, stamp
+from .units import finite_json
 
 #: Natural periods of a history run's record spectrum [s]: 100 log-spaced, 0.02 to 10 s.
 RECORD_PERIODS = np.geomspace(0.02, 10.0, 100)
@@ -135,9 +136,9 @@ def write_record(
     plot_record(motion, out_dir / "record.png", spectrum=spectrum, pulses=pulses)
 
 
-def write_ida(doc: dict[str, Any], out_dir: Path, *, title: str = "") -> None:
+def write_ida(doc: IdaDocument, out_dir: Path, *, title: str = "") -> None:
     """Write ``ida.json``, ``ida.csv`` and ``ida.png`` (fragility curves) of an IDA document."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / "ida.json", json.dumps(stamp(doc, "ida"), indent=2) + "\n")
+    write_atomic(out_dir / "ida.json", json.dumps(doc.to_dict(), indent=2) + "\n")
     write_atomic(out_dir / "ida.csv", ida_csv(doc))
     plot_fragility(doc, out_dir / "ida.png", title=title)

@@ -20,9 +20,10 @@ from typer.testing import CliRunner
 from shared_schema.documents.assess import AssessDocument
 from shared_schema.documents.base import Document
 from shared_schema.documents.boundary import BoundaryDocument
-from shared_schema.documents.check import CheckDocument
+from shared_schema.documents.check import CheckDocument, Nonlinear2009, Nonlinear2019, NotRun
 from shared_schema.documents.envelope import EnvelopeDocument
 from shared_schema.documents.history import HistoryDocument
+from shared_schema.documents.ida import IdaDocument
 from shared_schema.documents.pulse import PulseDocument
 from shared_schema.documents.record import RecordDocument
 from shared_schema.errors import InputError
@@ -47,6 +48,10 @@ CASES = {
     "history_sf": (HistoryDocument, ["history", str(C / "church.json"), RECORD, "--scale", "1",
                                      "--sf", "eq28", "--at-height", "2.5"]),
     "record": (RecordDocument, ["record", RECORD, "--pulses", "2", "--n", "20"]),
+    "ida": (IdaDocument, ["ida", str(C / "rect_walls.json"), RECORD, "--scales", "0.5,1,2",
+                          "--jobs", "1"]),
+    "ida_sf_skipped": (IdaDocument, ["ida", str(C / "church.json"), RECORD, "--scales", "1,2",
+                                     "--sf", "eq28", "--jobs", "1", "--no-progress"]),
     "check_ec8": (CheckDocument, ["check", str(C / "church.json"), EC8]),
     "assess": (AssessDocument, ["assess", str(C / "church_geometry.json"), SITE, "--record",
                                 RECORD, "--multiple", "1", "-o", "{tmp}/a.html"]),
@@ -105,3 +110,78 @@ def test_the_reader_metadata_of_a_record_block_is_kept_in_order(tmp_path: Path) 
     keys = list(json.loads(text)["record"])
     assert keys[:5] == ["name", "n_samples", "dt_s", "pga_g", "duration_s"]
     assert list(doc.record.to_dict()) == keys and len(keys) > 5
+
+
+def test_the_ida_document_reads_as_the_printed_numbers(tmp_path: Path) -> None:
+    text = _cli(CASES["ida_sf_skipped"][1], tmp_path)
+    raw = json.loads(text)
+    doc = IdaDocument.model_validate_json(text)
+    assert doc.measure == raw["intensity"]["measure"] == "scale"
+    assert doc.levels == raw["intensity"]["levels"] == [1.0, 2.0]
+    for entry in raw["mechanisms"]:
+        mech = doc.find(entry["id"])
+        assert mech.fraction == entry["fraction"]
+        assert mech.n_overturned == entry["n_overturned"]
+        # The fraction is the count over the records, read from the text independently.
+        assert mech.fraction == [n / len(raw["records"]) for n in entry["n_overturned"]]
+        assert mech.fragility.median == entry["fragility"].get("median")
+        assert mech.fragility.note == entry["fragility"].get("note", "")
+        assert mech.scale_factors == entry.get("scale_factors")
+    above = [m for m in raw["mechanisms"] if "scale_factors" in m]
+    assert above and all(f > 1.0 for m in above for f in m["scale_factors"] if f is not None)
+    assert doc.scale_factor_method == "eq28" and doc.backend.kind == "local"
+    assert doc.skipped is not None and [s.mechanism for s in doc.skipped] == ["F1"]
+    with pytest.raises(InputError, match=r"no mechanism 'F1'") as err:
+        doc.find("F1")
+    assert err.value.field == "mechanism"
+
+
+def _check_text(constants: Path, site: dict[str, Any], tmp: Path) -> str:
+    path = tmp / "site.json"
+    path.write_text(json.dumps(site), encoding="utf-8")
+    return _cli(["check", str(constants), str(path)], tmp)
+
+
+def test_every_variant_of_a_check_reads_back_typed_and_prints_byte_for_byte(
+    tmp_path: Path,
+) -> None:
+    site = json.loads(Path(SITE).read_text(encoding="utf-8"))
+    seen: set[str] = set()
+    for constants, method in [
+        (C / "church_geometry.json", "circ2019"),
+        (C / "church_geometry.json", "circ2009"),
+        (C / "church.json", "circ2019"),  # short form: no virtual_work, no check runs
+    ]:
+        text = _check_text(constants, dict(site, local_mechanisms={"method": method}), tmp_path)
+        raw = json.loads(text)
+        doc = CheckDocument.model_validate_json(text)
+        assert json.dumps(doc.to_dict(), indent=2) + "\n" == text
+        assert doc.site.params.to_dict() == raw["site"]["params"]
+        assert doc.conclusion.verdict == raw["conclusion"]["verdict"]
+        for row, mech in zip(raw["mechanisms"], doc.mechanisms):
+            for name, typed in (("linear", mech.linear), ("nonlinear", mech.nonlinear)):
+                block = row[name]
+                seen.add(type(typed).__name__)
+                assert typed.status == block["status"] and typed.passes == block.get("passes")
+                if block["status"] == "not_run":
+                    assert isinstance(typed, NotRun) and "virtual_work" in typed.note
+                    continue
+                assert typed.method == method
+                assert typed.capacity_ratio == block["capacity_ratio"]
+            non = mech.nonlinear
+            if isinstance(non, Nonlinear2019):  # the limit states as printed
+                assert non.SLV.T_SLV == row["nonlinear"]["SLV"]["T_SLV"]
+                assert non.SLC.capacity_ratio == row["nonlinear"]["SLC"]["capacity_ratio"]
+                assert mech.nonlinear_ratio == row["nonlinear"]["capacity_ratio"]
+                above = row["nonlinear"].get("floor")
+                assert (non.floor is None) == (above is None)
+            if isinstance(non, Nonlinear2009):
+                assert non.Ts == row["nonlinear"]["Ts"] and len(non.curve.d_star) > 2
+    assert seen == {
+        "Linear2019", "Nonlinear2019", "Linear2009", "Nonlinear2009", "NotRun"
+    }  # fmt: skip
+    # A block of one variant with a key of another is refused, naming it.
+    data = json.loads(_check_text(C / "church_geometry.json", site, tmp_path))
+    data["mechanisms"][0]["linear"]["du_star"] = 0.1
+    with pytest.raises(ValidationError, match="du_star"):
+        CheckDocument.model_validate(data)

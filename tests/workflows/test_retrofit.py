@@ -29,6 +29,7 @@ from typer.testing import CliRunner
 
 import rockmech
 from shared_schema.constants import ConstantsFile, parse_constants
+from shared_schema.documents.check import Nonlinear2019
 from shared_schema.errors import InputError
 from shared_schema.retrofit import parse_retrofit_spec
 from shared_schema.site import parse_site
@@ -120,8 +121,8 @@ def test_free_wall_linear_t_star_is_the_closed_form_and_flips_the_check(
     # The product's check on the builder's tie: fails 0.5 % below T*, passes 0.5 % above.
     below = rockmech.check(_tied(tmp_path, t_hand * 0.995), parse_site(SITE))
     above = rockmech.check(_tied(tmp_path, t_hand * 1.005), parse_site(SITE))
-    assert below.mechanisms[0].linear["passes"] is False
-    assert above.mechanisms[0].linear["passes"] is True
+    assert below.mechanisms[0].linear.passes is False
+    assert above.mechanisms[0].linear.passes is True
 
 
 def test_nonlinear_t_is_bracketed_to_half_a_percent(wall: ConstantsFile, tmp_path: Path) -> None:
@@ -131,7 +132,7 @@ def test_nonlinear_t_is_bracketed_to_half_a_percent(wall: ConstantsFile, tmp_pat
     site = _site(ties="verified")  # a designed tie whose bar and anchorage carry it
     lo = rockmech.check(_tied(tmp_path, t_nl * 0.995), site).mechanisms[0].nonlinear
     hi = rockmech.check(_tied(tmp_path, t_nl), site).mechanisms[0].nonlinear
-    assert lo["passes"] is False and hi["passes"] is True
+    assert lo.passes is False and hi.passes is True
 
 
 def test_the_smallest_bar_that_carries_t_star_and_its_steel(wall: ConstantsFile) -> None:
@@ -157,11 +158,9 @@ def test_more_tie_force_never_lowers_the_capacity_ratio(tmp_path: Path) -> None:
     last = (0.0, 0.0, 0.0)
     for force in (1.0, 4000.0, 8000.0, 16000.0, 32000.0):
         row = rockmech.check(_tied(tmp_path, force), site).mechanisms[0]
-        now = (
-            row.linear["capacity_ratio"],
-            row.nonlinear["SLV"]["capacity_ratio"],
-            row.nonlinear["SLC"]["capacity_ratio"],
-        )
+        non = row.nonlinear
+        assert isinstance(non, Nonlinear2019)  # the 2019 check with its capacity curve
+        now = (row.linear_ratio, non.SLV.capacity_ratio, non.SLC.capacity_ratio)
         assert all(n >= p for n, p in zip(now, last)), (force, now, last)
         last = now
 

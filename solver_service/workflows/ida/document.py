@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.ida import IdaDocument
 from shared_schema.rules import IM_MEASURES
 
 from ...core.fragility import fit_lognormal
@@ -74,9 +75,12 @@ class Totals:
 
 
 def ida_document(
-    cf: ConstantsFile, motions: Sequence[Any], lv: list[float], im: str, totals: Totals
+    cf: ConstantsFile, motions: Sequence[Any], lv: list[float], measure: str, totals: Totals
 ) -> dict[str, Any]:
-    """Build the IDA document from the reduced runs (counts, first levels, fits)."""
+    """Build the IDA document's results from the reduced runs (counts, first levels, fits).
+
+    ``run_ida`` adds the timing, the backend and the optional sections, and types it.
+    """
     n_rec = len(motions)
     mechanisms = []
     for i, mech in enumerate(cf.mechanisms):
@@ -95,7 +99,7 @@ def ida_document(
             entry["scale_factors"] = factors
         mechanisms.append(entry)
     return {
-        "intensity": {"measure": im, "units": IM_MEASURES[im], "levels": lv},
+        "intensity": {"measure": measure, "units": IM_MEASURES[measure], "levels": lv},
         "records": [
             {
                 "name": m.name,
@@ -113,11 +117,11 @@ def ida_document(
     }
 
 
-def ida_csv(doc: dict[str, Any]) -> str:
+def ida_csv(doc: IdaDocument) -> str:
     """Return the overturned fractions as CSV: level, then one column per mechanism."""
-    head = f"{doc['intensity']['measure']}_{doc['intensity']['units']}"
-    lines = [head + "," + ",".join(f"fraction_{m['id']}" for m in doc["mechanisms"])]
-    for j, level in enumerate(doc["intensity"]["levels"]):
-        cells = [f"{m['fraction'][j]:.6g}" for m in doc["mechanisms"]]
+    head = f"{doc.intensity.measure}_{doc.intensity.units}"
+    lines = [head + "," + ",".join(f"fraction_{m.id}" for m in doc.mechanisms)]
+    for j, level in enumerate(doc.intensity.levels):
+        cells = [f"{m.fraction[j]:.6g}" for m in doc.mechanisms]
         lines.append(f"{level:.6g}," + ",".join(cells))
     return "\n".join(lines) + "\n"

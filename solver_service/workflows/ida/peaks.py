@@ -28,7 +28,12 @@ class PeakWriter:
     """
 
     def __init__(
-        self, path: Path, records: list[str], mechanisms: list[str], levels: list[float], im: str
+        self,
+        path: Path,
+        records: list[str],
+        mechanisms: list[str],
+        levels: list[float],
+        measure: str,
     ) -> None:
         self.pa = require("pyarrow", "parquet", "for the per-run peaks of ida")
         self.pq = require("pyarrow.parquet", "parquet", "for the per-run peaks of ida")
@@ -50,7 +55,11 @@ class PeakWriter:
                 ("error_estimate", pa.float64()),
                 ("status", pa.int8()),
             ],
-            metadata={"intensity_measure": im, "units": IM_MEASURES[im], "rockmech": __version__},
+            metadata={
+                "intensity_measure": measure,
+                "units": IM_MEASURES[measure],
+                "rockmech": __version__,
+            },
         )
         self.writer = self.pq.ParquetWriter(str(self.tmp), self.schema, compression="zstd")
         self.buffer: list[Any] = []

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any, Optional
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.ida import IdaDocument
 from shared_schema.errors import InputError
 from shared_schema.rules import IM_MEASURES
 
@@ -21,6 +22,7 @@ from ...core.model import check_positive
 from ..adapter import to_rocking_model
 from ..documents import time_domain_mechanisms
 from ..scaling import Building
+from ..units import stamp
 from .dask import CONNECT_TIMEOUT_S, run_on_cluster
 from .document import Totals, ida_document
 from .local import run_local
@@ -86,8 +88,8 @@ def run_ida(
     jobs: Optional[int] = None,
     peaks: Optional[Path] = None,
     task_s: Optional[float] = None,
-) -> dict[str, Any]:
-    """Incremental dynamic analysis with lognormal fragility fits, as a JSON-ready document.
+) -> IdaDocument:
+    """Incremental dynamic analysis with lognormal fragility fits: the IDA document.
 
     Parameters
     ----------
@@ -129,19 +131,20 @@ def run_ida(
 
     Returns
     -------
-    dict
-        ``intensity``, ``records``, per mechanism ``n_overturned``, ``fraction``,
-        ``first_overturning_level`` (per record) and ``fragility`` (median, beta), plus
-        ``runs``, ``runtime_s``, ``compute_s`` (inside the kernels, all tasks),
-        ``max_error_estimate`` and ``backend``: ``kind``, ``jobs`` or the Dask ``scheduler``,
-        ``n_workers`` and ``threads``, the number of ``tasks`` and worker threads that ran
-        them (``lanes``), the mean ``task_s``, the mean ``overhead_per_task_s`` (time in a
-        task outside the kernels, plus the gap before the next task on the same worker
-        thread) and its ``overhead_fraction`` of the task time, the gap alone
-        (``gap_per_task_s``) and ``span_s``, from the first task's start to the last one's
-        end (on the workers' clocks); on Dask, ``settings_differ`` where the workers run other
-        values of ``DASK_SETTINGS`` (one line each). With ``peaks``, ``peaks`` (``file``,
-        ``rows``).
+    IdaDocument
+        As ``rockmech ida --json`` prints it (``to_dict()``; the fields are described in
+        ``shared_schema.documents.ida``): ``intensity``, ``records``, per mechanism
+        (``find(id)``) ``n_overturned``, ``fraction``, ``first_overturning_level`` (per
+        record) and ``fragility`` (median, beta), plus ``runs``, ``runtime_s``,
+        ``compute_s`` (inside the kernels, all tasks), ``max_error_estimate`` and
+        ``backend``: ``kind``, ``jobs`` or the Dask ``scheduler``, ``n_workers`` and
+        ``threads``, the number of ``tasks`` and worker threads that ran them (``lanes``),
+        the mean ``task_s``, the mean ``overhead_per_task_s`` (time in a task outside the
+        kernels, plus the gap before the next task on the same worker thread) and its
+        ``overhead_fraction`` of the task time, the gap alone (``gap_per_task_s``) and
+        ``span_s``, from the first task's start to the last one's end (on the workers'
+        clocks); on Dask, ``settings_differ`` where the workers run other values of
+        ``DASK_SETTINGS`` (one line each). With ``peaks``, ``peaks`` (``file``, ``rows``).
 
     Raises
     ------
@@ -165,7 +168,7 @@ def run_ida(
         "token": uuid.uuid4().hex,
         "constants": cf.model_dump(mode="json", exclude_none=True),
         "levels": lv,
-        "im": measure,
+        "measure": measure,
         "options": {
             "sf": sf,
             "building": {
@@ -211,4 +214,4 @@ def run_ida(
         doc["incomplete_runs"] = totals.incomplete
     if skipped:
         doc["skipped"] = skipped
-    return doc
+    return IdaDocument.model_validate(stamp(doc, "ida"))

@@ -39,7 +39,7 @@ class _Setup:
     cf: ConstantsFile
     models: list[RockingModel]
     levels: list[float]
-    im: str
+    measure: str
     sf: str
     building: Building
     criterion: Optional[str]
@@ -50,7 +50,7 @@ class _Setup:
         cls,
         constants: dict[str, Any],
         levels: Sequence[float],
-        im: str,
+        measure: str,
         options: Optional[dict[str, Any]],
         peaks: bool = False,
     ) -> _Setup:
@@ -60,7 +60,7 @@ class _Setup:
             cf=cf,
             models=[to_rocking_model(m) for m in cf.mechanisms],
             levels=[float(v) for v in levels],
-            im=im,
+            measure=measure,
             sf=opts.get("sf", "none"),
             building=Building(**opts.get("building", {})),
             criterion=opts.get("criterion"),
@@ -78,7 +78,7 @@ def _setup(ctx: dict[str, Any]) -> _Setup:
         found = _SETUPS.get(ctx["token"])
         if found is None:
             found = _Setup.build(
-                ctx["constants"], ctx["levels"], ctx["im"], ctx["options"], ctx["peaks"]
+                ctx["constants"], ctx["levels"], ctx["measure"], ctx["options"], ctx["peaks"]
             )
             _SETUPS[ctx["token"]] = found
             while len(_SETUPS) > SETUPS_KEPT:
@@ -91,7 +91,7 @@ def _run_one(
 ) -> dict[str, Any]:
     """One record against every mechanism at ``levels`` (see ``run_record``)."""
     motion = GroundMotion.from_samples(acc, dt, name=name)
-    if setup.im == "pga":
+    if setup.measure == "pga":
         scales = [level / motion.pga_g for level in levels]
     else:
         scales = list(levels)
@@ -127,7 +127,7 @@ def run_record(
     dt: float,
     name: str,
     levels: list[float],
-    im: str = "scale",
+    measure: str = "scale",
     options: Optional[dict[str, Any]] = None,
 ) -> dict[str, Any]:
     """Run one record against every mechanism at every intensity level.
@@ -143,8 +143,8 @@ def run_record(
     name : str
         Record name.
     levels : list of float
-        Intensity levels, ascending (units of ``im``).
-    im : {"scale", "pga"}
+        Intensity levels, ascending (units of ``measure``).
+    measure : {"scale", "pga"}
         Intensity measure.
     options : dict, optional
         ``sf``, ``building`` (dict of ``analysis.Building``) and ``criterion``.
@@ -156,7 +156,7 @@ def run_record(
         (mechanisms × levels), ``scale_factors`` per mechanism id, ``pga_g`` and
         ``runtime_s``.
     """
-    return _run_one(_Setup.build(constants, levels, im, options), acc, dt, name, levels)
+    return _run_one(_Setup.build(constants, levels, measure, options), acc, dt, name, levels)
 
 
 def run_task(
@@ -175,7 +175,7 @@ def run_task(
     ----------
     ctx : dict
         The run's shared data: ``token``, ``constants`` (JSON data), ``levels`` (all of
-        them, ascending), ``im``, ``options`` and ``peaks`` (bool).
+        them, ascending), ``measure``, ``options`` and ``peaks`` (bool).
     pack : sequence of (int, ndarray, float, str)
         ``(record index, acceleration [m/s²], dt [s], name)`` of each record.
     lo, hi : int
