@@ -177,7 +177,13 @@ class Steel(BaseModel):
 
     grade: Literal["S235", "S275", "S355"] = Field(description="Steel grade, NTC 2018 Tab. 4.2.I.")
     diameters_mm: List[float] = Field(
-        min_length=1, max_length=50, description="Bar diameters on offer [mm], each in (0, 80]."
+        min_length=1,
+        max_length=50,
+        description="Bar diameters on offer [mm], each in (0, 80].",
+        # the schema states the validator's bound (its message cites the table)
+        json_schema_extra={
+            "items": {"type": "number", "exclusiveMinimum": 0, "maximum": THICKNESS_MAX_MM}
+        },
     )
 
     @field_validator("diameters_mm")
