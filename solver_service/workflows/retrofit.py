@@ -67,11 +67,12 @@ __all__ = [
     "RETROFIT_DECISIONS",
     "SINGLE_BLOCK_TYPOLOGIES",
     "T_REL_TOL",
+    "default_heights",
     "governs_next",
     "least_margin",
-    "retrofit_doc",
-    "default_heights",
     "level_height",
+    "retrofit_doc",
+    "top_height",
     "with_tie",
 ]
 
@@ -166,7 +167,7 @@ def _single_block_problem(mech: Mechanism) -> Optional[str]:
     return None
 
 
-def _top_height(mech: Mechanism) -> tuple[Optional[float], str]:
+def top_height(mech: Mechanism) -> tuple[Optional[float], str]:
     """Height of the moving part's top above the hinge [m], and where it comes from."""
     geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
     h = geo.get("h_m")
@@ -784,9 +785,13 @@ def _level_points(mech: Mechanism) -> list[tuple[float, str]]:
 
 
 def default_heights(
-    mech: Mechanism, top: float, top_source: str
+    mech: Mechanism, top: float, top_words: str, label: str = "default"
 ) -> tuple[list[tuple[float, str]], list[str]]:
     """Return the default candidate heights [m] with their sources, and notes.
+
+    ``top`` is the moving part's top above the hinge [m], ``top_words`` where it comes from
+    (``"the top of the moving part (the geometry's h_m)"``) and ``label`` the sources' first
+    words (``"default"``).
 
     One tie at the top of the moving part and one at each level (``LEVEL_KINDS`` of the
     constants' ``geometry.loaded.elements``) strictly between the hinge and the top, in
@@ -811,9 +816,9 @@ def default_heights(
         else:
             groups.append((h, [name]))
     heights = [
-        (h, f"default: {' and '.join(names)} at {h:.4g} m above the hinge") for h, names in groups
+        (h, f"{label}: {' and '.join(names)} at {h:.4g} m above the hinge") for h, names in groups
     ]
-    src = f"default: the top of the moving part ({top_source})"
+    src = f"{label}: {top_words}"
     if top_names:
         src += ", with the " + " and the ".join(top_names)
     return [*heights, (top, src)], notes
@@ -823,7 +828,7 @@ def _heights(
     mech: Mechanism, ties: MechanismTies
 ) -> tuple[list[tuple[float, str]], Optional[float], list[str]]:
     """Return the candidate tie heights [m] with their sources, the moving part's top, notes."""
-    top, top_source = _top_height(mech)
+    top, top_source = top_height(mech)
     if ties.heights_m is not None:
         heights = [(h, f"retrofit spec mechanisms.{mech.id}.heights_m") for h in ties.heights_m]
         return heights, top, []
@@ -832,7 +837,7 @@ def _heights(
             f"mechanism {mech.id}: {top_source}; give the tie heights",
             f"mechanisms.{mech.id}.heights_m",
         )
-    heights, notes = default_heights(mech, top, top_source)
+    heights, notes = default_heights(mech, top, f"the top of the moving part ({top_source})")
     return heights, top, notes
 
 
@@ -916,16 +921,23 @@ def retrofit_doc(
     Raises
     ------
     InputError
-        The spec gives connection upgrades (field ``upgrades``: they need the scene,
-        ``retrofit_scene.retrofit_search``); it names a mechanism the constants do not have;
-        the site contradicts the constants (``codecheck.check_site_inputs``); a default tie
-        height with no height of the moving part in the constants.
+        The spec gives connection upgrades (field ``upgrades``) or tie lines (field
+        ``tie_lines``): they need the scene (``retrofit_scene.retrofit_search``); it names a
+        mechanism the constants do not have; the site contradicts the constants
+        (``codecheck.check_site_inputs``); a default tie height with no height of the moving
+        part in the constants.
     """
     if spec.upgrades:
         raise InputError(
             "connection upgrades are compared by searching the scene again with each, which "
             "a constants file cannot do: retrofit from the scene with --scene and --search-spec",
             "upgrades",
+        )
+    if spec.tie_lines is not None:
+        raise InputError(
+            "tie lines are line objects of a scene, which a constants file does not have: "
+            "retrofit from the scene with --scene and --search-spec",
+            "tie_lines",
         )
     ids = [m.id for m in cf.mechanisms]
     for key in spec.mechanisms:
