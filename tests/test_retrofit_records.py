@@ -316,7 +316,10 @@ def test_tying_one_wall_moves_the_governing_mechanism_to_the_other(tmp_path: Pat
         and rows["W"].after_margin >= 1.0 - 1e-9
     )
     assert rows["V"].after_margin == rows["V"].before_margin == nxt.after_margin
-    assert f"with the ties in, of these mechanisms V governs: margin {nxt.after_margin:.3f}" in res.stdout
+    assert (
+        f"with the ties in, of these mechanisms V governs: margin {nxt.after_margin:.3f}"
+        in res.stdout
+    )
     # The order of the mechanisms changes nothing.
     cf = rockmech.read_constants(constants)
     flipped = cf.model_copy(update={"mechanisms": cf.mechanisms[::-1]})
