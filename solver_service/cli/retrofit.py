@@ -91,7 +91,8 @@ def _print_table(doc: Any) -> None:
     if nxt is not None and nxt.after is not None and nxt.after_margin is not None:
         typer.echo(
             f"with the ties in, of these mechanisms {nxt.after} governs: margin "
-            f"{nxt.after_margin:.3f} ({nxt.after_criterion}); before, {nxt.before} at {nxt.before_margin:.3f}"
+            f"{nxt.after_margin:.3f} ({nxt.after_criterion}); before, {nxt.before} at "
+            f"{nxt.before_margin:.3f}"
         )
     if doc.search_after is not None:
         for line in search_after_lines(doc.search_after):

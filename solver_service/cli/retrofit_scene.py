@@ -163,7 +163,8 @@ def search_after_lines(sa: Any) -> list[str]:
         where = f"another wall ({sa.before_facade} -> {sa.after_facade})"
     out.append(
         f"search again with the ties (its own mechanisms): {sa.after} governs, margin "
-        f"{_g(sa.after_margin)} ({sa.after_criterion}), lambda0 {sa.after_lam0:.4g}: {sa.after_name}"
+        f"{_g(sa.after_margin)} ({sa.after_criterion}), lambda0 {sa.after_lam0:.4g}: "
+        f"{sa.after_name}"
     )
     out.append(
         f"  before: {sa.before} at {_g(sa.before_margin)} ({sa.before_criterion}); the "
