@@ -235,6 +235,24 @@ def test_default_ties_are_the_top_and_each_level_the_moving_part_crosses() -> No
     assert f2.height_m == pytest.approx(2.0 * g2["R_m"] * math.cos(g2["alpha_rad"]), abs=1e-12)
 
 
+def test_the_work_plan_counts_every_default_candidate() -> None:
+    # The plan (--time-limit) counts per candidate 1 check after the tie and 7 bisection steps
+    # per limit state; it must count at least the options the retrofit then tries.
+    from solver_service.workflows.limits import retrofit_checks
+
+    data, doc = _church_default()
+    cf = parse_constants(json.dumps(data))
+    site = parse_site((CHURCH / "sites" / "ntc_site.json").read_text())
+    states = 1 + int("SLC" in (site.hazard.limit_states or {}))
+    spec = json.loads((CHURCH / "specs" / "church.retrofit.json").read_text())
+    spec["mechanisms"] = {}
+    planned = retrofit_checks(cf, site, parse_retrofit_spec(spec))
+    tried = sum(max(len(m.options), 1) for m in doc.mechanisms)
+    assert len(doc.find("F1").options) == 3
+    assert planned >= tried * (1 + 7 * states)
+    assert planned == (4 + 1 + 1 + 1) * (1 + 7 * states)  # F1: top, 2 floors, roof; F2, A1, T1
+
+
 def test_default_ties_do_not_depend_on_the_order_of_the_elements() -> None:
     _, a = _church_default(1)
     _, b = _church_default(-1)
