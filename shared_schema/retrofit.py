@@ -8,8 +8,12 @@ The spec says where ties may go and what they are made of:
   from (plate punching, pull-out: rockmech has no masonry formula of its own and invents
   none); a mechanism may give its own;
 * ``mechanisms``: per mechanism id, the candidate tie heights above its hinge [m] (default:
-  one tie at the top of the moving part), the number of bars at that height sharing the
-  force, and the bar length for the steel mass [m];
+  one tie at the top of the moving part and one at each level it carries), the number of
+  bars at that height sharing the force, and the bar length for the steel mass [m];
+* ``tie_lines``: from a scene only, line objects of the scene drawn where ties may go
+  (selectors as the search spec's: a name, or ``{"name"|"layer"|"id": ...}``; a layer
+  selects every line on it): each line is a candidate tie of the mechanisms whose moving
+  part it crosses, in place of the default heights;
 * ``records``: ground-motion record files (relative to the spec's folder; formats detected)
   that each mechanism, once tied, must survive at its design scale by the exact solver;
 * ``upgrades``: connection upgrades to compare with the ties, from a scene only (a junction
@@ -41,11 +45,13 @@ from shared_schema.constants import validate_document
 from shared_schema.errors import InputError
 from shared_schema.paths import Source, read_source
 from shared_schema.search import Unit
+from shared_schema.spec import Selector
 from shared_schema.version import __version__
 
 __all__ = [
     "ANCHORAGE_MAX_N",
     "GAMMA_M0",
+    "HEIGHTS_MAX",
     "RETROFIT_UNITS",
     "STEEL_DENSITY",
     "STEEL_GRADES",
@@ -91,10 +97,14 @@ STEEL_DENSITY = 7850.0
 ANCHORAGE_MAX_N = 5.0e6
 #: Tie heights and bar lengths above these are refused as mistakes [m].
 HEIGHT_MAX_M, LENGTH_MAX_M = 200.0, 300.0
+#: Candidate tie heights of one mechanism: at most this many.
+HEIGHTS_MAX = 20
 #: Bars at one height sharing the force: at most this many.
 BARS_MAX = 20
 #: Connection upgrades in one spec: at most this many (each is one more search).
 UPGRADES_MAX = 20
+#: Tie-line selectors in one spec: at most this many.
+TIE_LINES_MAX = 50
 
 _MODEL = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
 
@@ -204,7 +214,7 @@ class MechanismTies(BaseModel):
     ----------
     heights_m : list of float, optional
         Candidate tie heights above the mechanism's hinge [m], each tried alone; default one
-        tie at the top of the moving part.
+        tie at the top of the moving part and one at each level (floor, roof) it carries.
     bars : int
         Bars at that height sharing the force equally (along the wall) [-], default 1.
     length_m : float, optional
@@ -220,8 +230,9 @@ class MechanismTies(BaseModel):
     heights_m: Optional[List[float]] = Field(
         None,
         min_length=1,
-        max_length=20,
-        description="Candidate tie heights above the hinge [m]; default the moving part's top.",
+        max_length=HEIGHTS_MAX,
+        description="Candidate tie heights above the hinge [m]; default the moving part's top "
+        "and each level it carries.",
     )
     bars: int = Field(1, ge=1, le=BARS_MAX, description="Bars at the height sharing the force.")
     length_m: Optional[float] = Field(
@@ -332,6 +343,15 @@ class RetrofitSpec(BaseModel):
     mechanisms: Dict[str, MechanismTies] = Field(
         default_factory=dict,
         description="Per mechanism id: candidate ties (mechanisms not listed: the default).",
+    )
+    tie_lines: Optional[List[Selector]] = Field(
+        None,
+        min_length=1,
+        max_length=TIE_LINES_MAX,
+        description="From a scene only: line objects of the scene where ties may go (an "
+        "object name, or {name|layer|id: ...}; a layer selects every line on it), each a "
+        "candidate tie of the mechanisms whose moving part it crosses, in place of the "
+        "default heights.",
     )
     records: List[str] = Field(
         default_factory=list,

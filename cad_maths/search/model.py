@@ -67,6 +67,7 @@ __all__ = [
     "TiePoint",
     "Wall",
     "building_from_scene",
+    "outer_face_crossing",
 ]
 
 #: A wall whose volume equals its elevation area times its thickness to this relative
@@ -1377,6 +1378,43 @@ def _point(xy: np.ndarray) -> Any:
     return shapely.Point(float(xy[0]), float(xy[1]))
 
 
+def outer_face_crossing(
+    wall: Wall, start: np.ndarray, end: np.ndarray
+) -> Optional[Tuple[np.ndarray, float, float]]:
+    """Return where a line meets a wall's outer face, as the search reads a tie-bar.
+
+    Parameters
+    ----------
+    wall : Wall
+        A wall of the building.
+    start, end : (3,) float
+        The line's end points [m].
+
+    Returns
+    -------
+    (point, s, z) or None
+        The crossing [m] and its place in the wall's elevation (``s`` along the wall,
+        ``z`` up) [m]; None when the line (to 1e-3 of the wall's size beyond its ends) does
+        not reach the outer face's plane, or reaches it outside the wall's length and height.
+    """
+    f = wall.frame
+    d = end - start
+    den = float(d @ f.e_n)
+    if abs(den) < 1e-12 * max(float(np.linalg.norm(d)), 1.0):
+        return None
+    u = float((f.origin - start) @ f.e_n) / den
+    v = wall.mesh.vertices
+    size = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+    tol = 1e-3 * size / max(float(np.linalg.norm(d)), 1e-12)
+    if not -tol <= u <= 1.0 + tol:
+        return None
+    p = start + u * d
+    s, _, z = (float(c) for c in f.to_frame(p))
+    if not (-1e-9 <= s <= wall.length + 1e-9 and wall.z_lo - 1e-9 <= z <= wall.z_hi + 1e-9):
+        return None
+    return p, s, z
+
+
 def _tie_points(
     scene: Any, spec: Any, walls: Dict[str, Wall], memory: MemoryScene
 ) -> Dict[str, List[TiePoint]]:
@@ -1388,21 +1426,11 @@ def _tie_points(
         memory.add(SceneObject(obj.id, obj.name, obj.layer, "line", {}, (start, end)))
         met = False
         for wall in walls.values():
+            hit = outer_face_crossing(wall, start, end)
+            if hit is None:
+                continue
+            p, s, z = hit
             f = wall.frame
-            d = end - start
-            den = float(d @ f.e_n)
-            if abs(den) < 1e-12 * max(float(np.linalg.norm(d)), 1.0):
-                continue
-            u = float((f.origin - start) @ f.e_n) / den
-            v = wall.mesh.vertices
-            size = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
-            tol = 1e-3 * size / max(float(np.linalg.norm(d)), 1e-12)
-            if not -tol <= u <= 1.0 + tol:
-                continue
-            p = start + u * d
-            s, _, z = (float(c) for c in f.to_frame(p))
-            if not (-1e-9 <= s <= wall.length + 1e-9 and wall.z_lo - 1e-9 <= z <= wall.z_hi + 1e-9):
-                continue
             # the bar pulls the façade towards its anchorage, inside the building (+e_n); a
             # line with no part on that side is anchored outside. A line through the wall (a
             # tie across the building meets several walls) keeps the inward pull.

@@ -568,6 +568,7 @@ _RETROFIT_SECTIONS = {
     "mechanisms": "spec",
     "steel": "spec",
     "anchorage": "spec",
+    "tie_lines": "spec",
     "local_mechanisms": "site",
     "building": "site",
     "hazard": "site",
@@ -576,7 +577,7 @@ _RETROFIT_SECTIONS = {
 
 def _retrofit_field(exc: InputError) -> InputError:
     """Return the error with its field as the request holds it (``spec.mechanisms.F9``)."""
-    head = (exc.field or "").split(".", 1)[0]
+    head = (exc.field or "").split(".", 1)[0].split("[", 1)[0]
     if head not in _RETROFIT_SECTIONS:
         return exc
     return InputError(exc.reason, f"{_RETROFIT_SECTIONS[head]}.{exc.field}")

@@ -617,11 +617,33 @@ def check_run(
         )
 
 
+def _candidates(mech: Any, spec: RetrofitSpec) -> int:
+    """Return the candidate tie heights of a mechanism: the spec's, or the default's at most.
+
+    The default is the top and each level (floor, roof) of the constants' loaded elements
+    (``retrofit.default_heights``); levels that merge with another or lie outside the moving
+    part make it fewer, never more.
+    """
+    ties = spec.mechanisms.get(mech.id)
+    if ties is not None and ties.heights_m is not None:
+        return len(ties.heights_m)
+    geo = mech.geometry if isinstance(mech.geometry, dict) else {}
+    loaded = geo.get("loaded")
+    elements = loaded.get("elements") if isinstance(loaded, dict) else None
+    levels = [
+        e
+        for e in (elements if isinstance(elements, list) else [])
+        if isinstance(e, dict) and e.get("kind") in ("floor", "roof") and "at_m" in e
+    ]
+    return 1 + len(levels)
+
+
 def retrofit_checks(cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec) -> int:
     """Return the code checks a retrofit plans, before any is run.
 
     The plan counts every mechanism as failing every check (which fail is known only once
-    the checks run): per candidate tie height (the spec's, or the one default height), the
+    the checks run): per candidate tie height (the spec's, or the default's: the top and
+    each level the constants' loaded elements list, at most), the
     check after the tie and, per nonlinear limit state the site gives (SLV, and SLC where
     ``hazard.limit_states`` has it), the ``RETROFIT_BISECTION_STEPS`` checks a bisection on
     the tie force takes at the least.
@@ -644,9 +666,7 @@ def retrofit_checks(cf: ConstantsFile, site: SiteFile, spec: RetrofitSpec) -> in
     per_option = 1 + states * RETROFIT_BISECTION_STEPS
     total = 0
     for mech in cf.mechanisms:
-        ties = spec.mechanisms.get(mech.id)
-        heights = ties.heights_m if ties is not None and ties.heights_m is not None else [0.0]
-        total += len(heights) * per_option
+        total += _candidates(mech, spec) * per_option
     return total
 
 
@@ -670,9 +690,8 @@ def retrofit_record_runs(cf: ConstantsFile, spec: RetrofitSpec) -> int:
     """
     total = 0
     for mech in cf.mechanisms:
-        ties = spec.mechanisms.get(mech.id)
-        heights = ties.heights_m if ties is not None and ties.heights_m is not None else [0.0]
-        total += RETROFIT_SCALE_RUNS + len(heights) * (RETROFIT_RECORD_RUNS + RETROFIT_SCALE_RUNS)
+        n = _candidates(mech, spec)
+        total += RETROFIT_SCALE_RUNS + n * (RETROFIT_RECORD_RUNS + RETROFIT_SCALE_RUNS)
     return total
 
 

@@ -60,13 +60,19 @@ from .retrofit_records import RECORD_DECISIONS, MechanismRecords, tie_slope
 
 __all__ = [
     "ALPHA0_MAX",
+    "HEIGHT_SAME_M",
+    "HEIGHT_SAME_REL",
+    "LEVEL_KINDS",
     "RECORDS_DEMAND_DECISION",
     "RETROFIT_DECISIONS",
     "SINGLE_BLOCK_TYPOLOGIES",
     "T_REL_TOL",
+    "default_heights",
     "governs_next",
     "least_margin",
+    "level_height",
     "retrofit_doc",
+    "top_height",
     "with_tie",
 ]
 
@@ -161,7 +167,7 @@ def _single_block_problem(mech: Mechanism) -> Optional[str]:
     return None
 
 
-def _top_height(mech: Mechanism) -> tuple[Optional[float], str]:
+def top_height(mech: Mechanism) -> tuple[Optional[float], str]:
     """Height of the moving part's top above the hinge [m], and where it comes from."""
     geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
     h = geo.get("h_m")
@@ -730,21 +736,109 @@ def _standing(
     return None
 
 
+#: The element kinds of the constants' ``geometry.loaded.elements`` that are levels: each
+#: one the moving part carries is a default candidate tie height (docs/theory.md §11.12).
+LEVEL_KINDS = ("floor", "roof")
+#: Candidate heights closer than the larger of these are one candidate (a level at the top
+#: is the top's): 1 mm [m], or 0.5 % of the top's height [-] (the top read as 2 R cos α of a
+#: block that is not a rectangle is a few millimetres off the wall's top).
+HEIGHT_SAME_M, HEIGHT_SAME_REL = 1e-3, 0.005
+
+
+def level_height(mech: Mechanism, at: Sequence[float]) -> Optional[float]:
+    """Return the height [m] of a point above the mechanism's hinge axis, along the vertical.
+
+    The height is the point's ``z`` less the ``z`` of the hinge axis where the axis passes
+    below (or above) the point in plan: the lever arm of a horizontal tie about a horizontal
+    hinge, as ``with_tie`` takes it. None without a hinge in the geometry, or for a vertical
+    axis.
+    """
+    geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
+    got = geo.get("positive")
+    pos: dict[str, Any] = got if isinstance(got, dict) else {}
+    p, d = pos.get("axis_point_m"), pos.get("axis_direction", [0.0, 0.0, 0.0])
+    if not isinstance(p, list) or len(p) != 3 or len(at) != 3:
+        return None
+    dh = math.hypot(float(d[0]), float(d[1]))
+    if dh == 0.0 and float(d[2]) != 0.0:
+        return None
+    t = 0.0
+    if dh > 0.0:
+        t = ((at[0] - p[0]) * d[0] + (at[1] - p[1]) * d[1]) / (dh * dh)
+    return float(at[2]) - (float(p[2]) + t * float(d[2]))
+
+
+def _level_points(mech: Mechanism) -> list[tuple[float, str]]:
+    """Return the heights [m] above the hinge of the levels the moving part carries."""
+    geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
+    loaded = geo.get("loaded")
+    elements = loaded.get("elements") if isinstance(loaded, dict) else None
+    out = []
+    for e in elements if isinstance(elements, list) else []:
+        if not isinstance(e, dict) or e.get("kind") not in LEVEL_KINDS:
+            continue
+        at = e.get("at_m")
+        h = level_height(mech, at) if isinstance(at, list) else None
+        if h is not None:
+            out.append((h, f"{e['kind']} {e.get('element', '?')}"))
+    return sorted(out)
+
+
+def default_heights(
+    mech: Mechanism, top: float, top_words: str, label: str = "default"
+) -> tuple[list[tuple[float, str]], list[str]]:
+    """Return the default candidate heights [m] with their sources, and notes.
+
+    ``top`` is the moving part's top above the hinge [m], ``top_words`` where it comes from
+    (``"the top of the moving part (the geometry's h_m)"``) and ``label`` the sources' first
+    words (``"default"``).
+
+    One tie at the top of the moving part and one at each level (``LEVEL_KINDS`` of the
+    constants' ``geometry.loaded.elements``) strictly between the hinge and the top, in
+    ascending order; heights within ``max(HEIGHT_SAME_M, HEIGHT_SAME_REL top)`` are one
+    candidate whose source names each level (a level at the top is the top's candidate, at
+    the top's height).
+    """
+    tol = max(HEIGHT_SAME_M, HEIGHT_SAME_REL * top)
+    groups: list[tuple[float, list[str]]] = []
+    notes: list[str] = []
+    top_names: list[str] = []
+    for h, name in _level_points(mech):
+        if abs(h - top) <= tol:
+            top_names.append(f"{name} at {h:.4g} m")
+        elif not 0.0 < h < top:
+            notes.append(
+                f"the {name} at {h:.4g} m above the hinge is not between the hinge and the "
+                f"moving part's top ({top:.4g} m): no default tie there"
+            )
+        elif groups and h - groups[-1][0] <= tol:
+            groups[-1][1].append(name)
+        else:
+            groups.append((h, [name]))
+    heights = [
+        (h, f"{label}: {' and '.join(names)} at {h:.4g} m above the hinge") for h, names in groups
+    ]
+    src = f"{label}: {top_words}"
+    if top_names:
+        src += ", with the " + " and the ".join(top_names)
+    return [*heights, (top, src)], notes
+
+
 def _heights(
     mech: Mechanism, ties: MechanismTies
-) -> tuple[list[tuple[float, str]], Optional[float]]:
-    """Return the candidate tie heights [m] with their sources, and the moving part's top."""
-    top, top_source = _top_height(mech)
+) -> tuple[list[tuple[float, str]], Optional[float], list[str]]:
+    """Return the candidate tie heights [m] with their sources, the moving part's top, notes."""
+    top, top_source = top_height(mech)
     if ties.heights_m is not None:
         heights = [(h, f"retrofit spec mechanisms.{mech.id}.heights_m") for h in ties.heights_m]
-    elif top is not None:
-        heights = [(top, f"default: the top of the moving part ({top_source})")]
-    else:
+        return heights, top, []
+    if top is None:
         raise InputError(
             f"mechanism {mech.id}: {top_source}; give the tie heights",
             f"mechanisms.{mech.id}.heights_m",
         )
-    return heights, top
+    heights, notes = default_heights(mech, top, f"the top of the moving part ({top_source})")
+    return heights, top, notes
 
 
 def _choice(options: list[TieOption]) -> tuple[Optional[int], list[str]]:
@@ -783,7 +877,7 @@ def _mechanism(
     if standing is not None:
         return standing
     ties = spec.mechanisms.get(mech.id) or MechanismTies()
-    heights, top = _heights(mech, ties)
+    heights, top, height_notes = _heights(mech, ties)
     checker = _Checker(cf, site, mech, motions)
     options = [
         _option(checker, spec, ties, row, h, src, top, recs, records_before) for h, src in heights
@@ -794,7 +888,7 @@ def _mechanism(
         status="designed" if chosen is not None else "not_achievable",
         options=options,
         chosen=chosen,
-        decisions=decisions + record_notes,
+        decisions=decisions + height_notes + record_notes,
     )
 
 
@@ -827,16 +921,23 @@ def retrofit_doc(
     Raises
     ------
     InputError
-        The spec gives connection upgrades (field ``upgrades``: they need the scene,
-        ``retrofit_scene.retrofit_search``); it names a mechanism the constants do not have;
-        the site contradicts the constants (``codecheck.check_site_inputs``); a default tie
-        height with no height of the moving part in the constants.
+        The spec gives connection upgrades (field ``upgrades``) or tie lines (field
+        ``tie_lines``): they need the scene (``retrofit_scene.retrofit_search``); it names a
+        mechanism the constants do not have; the site contradicts the constants
+        (``codecheck.check_site_inputs``); a default tie height with no height of the moving
+        part in the constants.
     """
     if spec.upgrades:
         raise InputError(
             "connection upgrades are compared by searching the scene again with each, which "
             "a constants file cannot do: retrofit from the scene with --scene and --search-spec",
             "upgrades",
+        )
+    if spec.tie_lines is not None:
+        raise InputError(
+            "tie lines are line objects of a scene, which a constants file does not have: "
+            "retrofit from the scene with --scene and --search-spec",
+            "tie_lines",
         )
     ids = [m.id for m in cf.mechanisms]
     for key in spec.mechanisms:

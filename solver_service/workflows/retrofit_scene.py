@@ -37,6 +37,7 @@ from cad_maths.scene_base import BaseScene, SceneObject
 from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.retrofit import (
+    HEIGHTS_MAX,
     CheckFigures,
     ConnectionUpgrade,
     MechanismTies,
@@ -52,7 +53,8 @@ from shared_schema.search import SearchSpec
 from shared_schema.site import SiteFile
 
 from .assess import check_doc_with_records
-from .retrofit import least_margin, retrofit_doc
+from .retrofit import default_heights, least_margin, retrofit_doc
+from .retrofit_lines import LineCandidates, tie_line_candidates
 from .retrofit_records import MechanismRecords
 from .retrofit_upgrades import apply_upgrades, check_upgrades, check_upgrades_meet
 from .search import SearchRun, search_run
@@ -62,6 +64,7 @@ __all__ = [
     "TIE_IDEALISATION",
     "TIE_LAYER",
     "RetrofitSearch",
+    "SceneCandidates",
     "TiedScene",
     "place_ties",
     "retrofit_search",
@@ -300,58 +303,136 @@ def _same_run(got: ConstantsFile, want: ConstantsFile) -> None:
         )
 
 
-def scene_heights(run: SearchRun, rspec: RetrofitSpec) -> tuple[RetrofitSpec, dict[str, str]]:
-    """Give each built mechanism without ``heights_m`` the tie height the scene gives.
+@dataclass
+class SceneCandidates:
+    """The candidate tie heights of a retrofit from a scene, and the rule that gave them.
 
-    From a scene the moving part's top on its façade is known: the wall's top above the
-    mechanism's hinge (``z_hi − z_hinge``), where the constants alone give only the
-    rectangle of the block's ``R`` and ``α``. Mechanisms that turn inward are left to the
-    retrofit's default (a tie is slack on that motion).
+    Attributes
+    ----------
+    spec : RetrofitSpec
+        The retrofit spec with each mechanism's candidate heights [m] filled in.
+    sources : dict of str to list of str
+        Per mechanism id whose heights were filled in: each height's source, in order.
+    decisions : dict of str to list of str
+        Per mechanism id: the rule that gave its candidates, and the notes on lines and
+        levels that are not its candidates.
+    notes : list of str
+        The document's: tie lines that are nobody's candidate.
+    """
+
+    spec: RetrofitSpec
+    sources: dict[str, list[str]] = field(default_factory=dict)
+    decisions: dict[str, list[str]] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+
+#: The rules that give a mechanism's candidate ties from a scene, as the document states them.
+RULE_LINES = "candidate ties: the retrofit spec's tie lines that cross its moving part"
+RULE_HEIGHTS = "candidate ties: the retrofit spec's heights_m"
+RULE_SCENE = (
+    "candidate ties (default from the scene): the top of its wall above the hinge and each "
+    "level its moving part carries"
+)
+RULE_CONSTANTS = (
+    "candidate ties (default of the constants): the top of the moving part and each level it "
+    "carries"
+)
+
+
+def _scene_default(
+    run: SearchRun, mech: Mechanism
+) -> Optional[tuple[list[tuple[float, str]], list[str]]]:
+    """Return the scene's default heights [m] of an outward mechanism, with notes, or None."""
+    by_id = {mid: run.result.candidates[k] for k, mid in run.ids.items()}
+    cand = by_id.get(mech.id)
+    geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
+    pos = geo.get("positive")
+    if cand is None or cand.direction != "outward":
+        return None
+    if not isinstance(pos, dict) or "axis_point_m" not in pos:
+        return None
+    wall = run.result.building.walls[cand.facade]
+    h = wall.z_hi - float(pos["axis_point_m"][2])
+    if not h > 0.0:
+        return None
+    words = f"the top of wall {wall.id} (z = {wall.z_hi:.4g} m) above the hinge"
+    return default_heights(mech, h, words, "default from the scene")
+
+
+def scene_heights(
+    run: SearchRun, rspec: RetrofitSpec, lines: Optional[LineCandidates] = None
+) -> SceneCandidates:
+    """Give each built mechanism its candidate tie heights from the scene.
+
+    A mechanism crossed by the spec's tie lines (``lines``, ``retrofit_lines``) takes their
+    heights after its own ``heights_m``, and no default. Otherwise one with ``heights_m``
+    keeps them; one without takes the default: from a scene the moving part's top on its
+    façade is known, the wall's top above the mechanism's hinge (``z_hi − z_hinge``), where
+    the constants alone give only the rectangle of the block's ``R`` and ``α``, and each
+    level the moving part carries (``retrofit.default_heights``). Mechanisms that turn
+    inward are left to the retrofit's default (a tie is slack on that motion).
 
     Returns
     -------
-    spec : RetrofitSpec
-        The spec with those heights [m].
-    sources : dict of str to str
-        Per mechanism id whose height was filled in: where it comes from.
+    SceneCandidates
+        The spec with those heights [m], their sources and each mechanism's rule.
+
+    Raises
+    ------
+    InputError
+        A mechanism given more candidates than a spec may list (field ``tie_lines``).
     """
+    out = SceneCandidates(rspec, notes=list(lines.decisions) if lines else [])
     if run.constants is None:
-        return rspec, {}
-    bld = run.result.building
-    by_id = {mid: run.result.candidates[k] for k, mid in run.ids.items()}
+        return out
     ties = dict(rspec.mechanisms)
-    sources: dict[str, str] = {}
     for mech in run.constants.mechanisms:
-        cand = by_id.get(mech.id)
         given = ties.get(mech.id)
-        if cand is None or cand.direction != "outward" or (given and given.heights_m):
-            continue
-        geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
-        pos = geo.get("positive")
-        if not isinstance(pos, dict) or "axis_point_m" not in pos:
-            continue
-        wall = bld.walls[cand.facade]
-        h = wall.z_hi - float(pos["axis_point_m"][2])
-        if not h > 0.0:
-            continue
-        base = given if given is not None else MechanismTies()
-        ties[mech.id] = base.model_copy(update={"heights_m": [h]})
-        sources[mech.id] = (
-            f"default from the scene: the top of wall {wall.id} (z = {wall.z_hi:.4g} m) above "
-            "the hinge"
-        )
-    return rspec.model_copy(update={"mechanisms": ties}), sources
+        own = list(given.heights_m or []) if given is not None else []
+        from_lines = lines.heights.get(mech.id, []) if lines else []
+        notes = list(lines.notes.get(mech.id, [])) if lines else []
+        got: list[tuple[float, str]] = []
+        if from_lines:
+            src = f"retrofit spec mechanisms.{mech.id}.heights_m"
+            got = [(h, src) for h in own] + from_lines
+            rule = RULE_LINES + (" and its heights_m" if own else "") + " (no default heights)"
+        elif own:
+            rule = RULE_HEIGHTS
+        else:
+            default = _scene_default(run, mech)
+            rule = RULE_CONSTANTS if default is None else RULE_SCENE
+            if default is not None:
+                got, level_notes = default
+                notes += level_notes
+        if len(got) > HEIGHTS_MAX:
+            raise InputError(
+                f"mechanism {mech.id} gets {len(got)} candidate ties; at most {HEIGHTS_MAX}",
+                "tie_lines",
+            )
+        if got:
+            base = given if given is not None else MechanismTies()
+            ties[mech.id] = base.model_copy(update={"heights_m": [h for h, _ in got]})
+            out.sources[mech.id] = [s for _, s in got]
+        out.decisions[mech.id] = [rule, *notes]
+    out.spec = rspec.model_copy(update={"mechanisms": ties})
+    return out
 
 
-def _with_sources(doc: RetrofitDoc, sources: dict[str, str]) -> RetrofitDoc:
-    """Name the scene as the source of the tie heights it gave."""
+def _with_sources(doc: RetrofitDoc, cands: SceneCandidates) -> RetrofitDoc:
+    """Name the scene (or its lines) as the source of the heights, and each rule."""
     out = []
     for m in doc.mechanisms:
-        if m.id in sources:
-            opts = [o.model_copy(update={"height_source": sources[m.id]}) for o in m.options]
+        srcs = cands.sources.get(m.id)
+        if srcs is not None and len(srcs) == len(m.options):
+            opts = [o.model_copy(update={"height_source": s}) for o, s in zip(m.options, srcs)]
             m = m.model_copy(update={"options": opts})
+        said = cands.decisions.get(m.id, [])
+        if not m.options:
+            said = said[1:]  # no candidate was tried: the rule says nothing
+        if said:
+            m = m.model_copy(update={"decisions": [*m.decisions, *said]})
         out.append(m)
-    return doc.model_copy(update={"mechanisms": out})
+    return doc.model_copy(update={"mechanisms": out, "decisions": [*doc.decisions, *cands.notes]})
 
 
 def _row_margin(
@@ -704,13 +785,18 @@ def retrofit_search(
     if expected is not None:
         _same_run(before.constants, expected)
     check_upgrades_meet(before.result.building, rspec.upgrades)
-    rspec, sources = scene_heights(before, rspec)
+    drawn = tie_line_candidates(scene, before, rspec) if rspec.tie_lines else None
+    cands = scene_heights(before, rspec, drawn)
+    rspec = cands.spec
     if check_work is not None:
         check_work(before.constants, rspec)
     designed = retrofit_doc(
-        before.constants, site, rspec.model_copy(update={"upgrades": []}), motions
+        before.constants,
+        site,
+        rspec.model_copy(update={"upgrades": [], "tie_lines": None}),
+        motions,
     )
-    doc = _with_sources(designed, sources)
+    doc = _with_sources(designed, cands)
     placed, lines, bars = place_ties(before, doc)
     after = None
     if lines:

@@ -178,10 +178,85 @@ def test_a_tie_above_the_moving_part_changes_nothing_and_says_why(wall: Constant
 def test_default_tie_is_at_the_top_of_the_moving_part(wall: ConstantsFile) -> None:
     spec = {k: v for k, v in SPEC.items() if k != "mechanisms"}
     m = rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(spec)).find("W")
-    opt = m.options[0]
+    (opt,) = m.options  # no loaded elements: the top only
     assert opt.height_m == pytest.approx(H, rel=1e-9)
     t_top = RHO * G * B * H * L * (1.0 * FC * A_G * 1.34 / Q * H - B) / (2.0 * H)
     assert opt.T_linear_N == pytest.approx(t_top, rel=1e-6)
+
+
+CHURCH = Path(__file__).resolve().parents[2] / "examples"
+
+
+def _church_default(order: int = 1) -> Any:
+    """The bundled church, its retrofit spec without heights; elements in order or reversed."""
+    data = json.loads((CHURCH / "constants" / "church_geometry.json").read_text())
+    for m in data["mechanisms"]:
+        loaded = m["geometry"].get("loaded")
+        if loaded is not None:
+            loaded["elements"] = loaded["elements"][::order]
+    spec = json.loads((CHURCH / "specs" / "church.retrofit.json").read_text())
+    spec["mechanisms"] = {}
+    site = CHURCH / "sites" / "ntc_site.json"
+    return data, rockmech.retrofit(
+        parse_constants(json.dumps(data)), site, parse_retrofit_spec(spec)
+    )
+
+
+def test_default_ties_are_the_top_and_each_level_the_moving_part_crosses() -> None:
+    data, doc = _church_default()
+    by_id = {m["id"]: m for m in data["mechanisms"]}
+    # F1 by hand: the hinge at z = axis_point_m[2] on a horizontal axis; the top 2 R cos α
+    # (the constants give no h_m); each floor's height its load point's z above the hinge;
+    # the roof within 0.5 % of the top is the top's candidate.
+    geo = by_id["F1"]["geometry"]
+    z0 = geo["positive"]["axis_point_m"][2]
+    top = 2.0 * geo["positive"]["R_m"] * math.cos(geo["positive"]["alpha_rad"])
+    levels = {e["element"]: e["at_m"][2] - z0 for e in geo["loaded"]["elements"]}
+    assert levels["F1.roof"] != top and abs(levels["F1.roof"] - top) < 0.005 * top
+    f1 = doc.find("F1")
+    want = [levels["F1.floors[0]"], levels["F1.floors[1]"], top]
+    assert [o.height_m for o in f1.options] == pytest.approx(want, abs=1e-12)
+    srcs = [o.height_source for o in f1.options]
+    assert srcs[0] == "default: floor F1.floors[0] at 3.5 m above the hinge"
+    assert srcs[1] == "default: floor F1.floors[1] at 6.6 m above the hinge"
+    assert "top of the moving part" in srcs[2] and "roof F1.roof at 8 m" in srcs[2]
+    # each tried alone: the top's option is the one a spec listing that height gives
+    spec = json.loads((CHURCH / "specs" / "church.retrofit.json").read_text())
+    spec["mechanisms"] = {"F1": {"heights_m": [levels["F1.floors[1]"]]}}
+    alone = rockmech.retrofit(
+        parse_constants(json.dumps(data)),
+        CHURCH / "sites" / "ntc_site.json",
+        parse_retrofit_spec(spec),
+    ).find("F1")
+    assert alone.options[0].T_star_N == f1.options[1].T_star_N
+    # F2 carries no levels: the top only
+    (f2,) = doc.find("F2").options
+    g2 = by_id["F2"]["geometry"]["positive"]
+    assert f2.height_m == pytest.approx(2.0 * g2["R_m"] * math.cos(g2["alpha_rad"]), abs=1e-12)
+
+
+def test_the_work_plan_counts_every_default_candidate() -> None:
+    # The plan (--time-limit) counts per candidate 1 check after the tie and 7 bisection steps
+    # per limit state; it must count at least the options the retrofit then tries.
+    from solver_service.workflows.limits import retrofit_checks
+
+    data, doc = _church_default()
+    cf = parse_constants(json.dumps(data))
+    site = parse_site((CHURCH / "sites" / "ntc_site.json").read_text())
+    states = 1 + int("SLC" in (site.hazard.limit_states or {}))
+    spec = json.loads((CHURCH / "specs" / "church.retrofit.json").read_text())
+    spec["mechanisms"] = {}
+    planned = retrofit_checks(cf, site, parse_retrofit_spec(spec))
+    tried = sum(max(len(m.options), 1) for m in doc.mechanisms)
+    assert len(doc.find("F1").options) == 3
+    assert planned >= tried * (1 + 7 * states)
+    assert planned == (4 + 1 + 1 + 1) * (1 + 7 * states)  # F1: top, 2 floors, roof; F2, A1, T1
+
+
+def test_default_ties_do_not_depend_on_the_order_of_the_elements() -> None:
+    _, a = _church_default(1)
+    _, b = _church_default(-1)
+    assert a.model_dump() == b.model_dump()
 
 
 def test_a_passing_mechanism_needs_no_tie(wall: ConstantsFile) -> None:
