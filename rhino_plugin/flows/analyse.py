@@ -217,7 +217,7 @@ def typed_answer(model: Type[_D], answer: Dict[str, Any], endpoint: str) -> _D:
         first = exc.errors()[0]
         where = ".".join(str(part) for part in first["loc"]) or "the document"
         raise InputError(
-            f"the service's answer to /{endpoint} is not a {model.__name__}: "
+            f"the service's answer to /{endpoint} is not its {model.__name__}: "
             f"{where}: {first['msg']}",
             "service",
         ) from None

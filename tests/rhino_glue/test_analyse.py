@@ -260,10 +260,10 @@ def test_service_answer_that_is_not_the_document_is_refused_naming_the_field(
     wrong = {k: v for k, v in answers["envelope"].items() if k != "critical"}
     recorder.answers["/api/v1/envelope"] = (200, wrong)
     cf = load_constants_files([str(WALLS)])
-    with pytest.raises(InputError, match=r"/envelope is not a EnvelopeDocument: critical: "):
+    with pytest.raises(InputError, match=r"/envelope is not its EnvelopeDocument: critical: "):
         run_envelopes(cf, out_dir=str(tmp_path), client=ServiceClient(url))
     recorder.answers["/api/v1/pulse"] = (200, dict(answers["pulse"], overturned="maybe"))
-    with pytest.raises(InputError, match=r"/pulse is not a PulseDocument: overturned: ") as err:
+    with pytest.raises(InputError, match=r"/pulse is not its PulseDocument: overturned: ") as err:
         run_pulse(cf, "W1", a_p_g=0.3, f_p=1.0, client=ServiceClient(url))
     assert err.value.field == "service"
 
