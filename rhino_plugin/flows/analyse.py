@@ -15,12 +15,17 @@ Python 3.9-clean: imported by Rhino 8.
 import json
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Type, TypeVar, Union
 
 from rhino_plugin.flows.mechanisms import checked_number
 from rhino_plugin.flows.prompter import Cancelled, Prompter
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.base import Document
+from shared_schema.documents.check import CheckDocument
+from shared_schema.documents.envelope import EnvelopeDocument
+from shared_schema.documents.history import HistoryDocument
+from shared_schema.documents.pulse import PulseDocument
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.io import load_constants
 from solver_service.workflows.documents import frequency_grid, pick_mechanism, solve_pulse
@@ -36,6 +41,7 @@ __all__ = [
     "run_envelopes",
     "run_history",
     "run_pulse",
+    "typed_answer",
 ]
 
 #: What RM_Analyse offers.
@@ -46,6 +52,9 @@ RECORD_UNITS = {"g": "g", "ms2": "m/s2", "cms2": "cm/s2"}
 SERVICE_TIMEOUT_S = 300.0
 #: Frequencies of the envelopes [-]: log-spaced points between f_min and f_max.
 N_FREQUENCIES = 200
+#: The documents an analysis gives (``AnalysisResult.doc``).
+AnalysisDoc = Union[EnvelopeDocument, HistoryDocument, PulseDocument, CheckDocument]
+_D = TypeVar("_D", bound=Document)
 
 
 @dataclass
@@ -56,8 +65,9 @@ class AnalysisResult:
     ----------
     kind : str
         One of :data:`ANALYSES`.
-    doc : dict
-        The JSON result (as the CLI's ``--json`` and the service return it).
+    doc : EnvelopeDocument, HistoryDocument, PulseDocument or CheckDocument
+        The result (its ``to_dict()`` is what the CLI's ``--json`` prints and the service
+        answers; the service's answer is validated into it).
     summary : list of str
         Lines for the command line.
     plot : str, optional
@@ -67,7 +77,7 @@ class AnalysisResult:
     """
 
     kind: str
-    doc: Dict[str, Any]
+    doc: AnalysisDoc
     summary: List[str] = field(default_factory=list)
     plot: Optional[str] = None
     files: List[str] = field(default_factory=list)
@@ -191,15 +201,41 @@ def load_constants_files(paths: Sequence[str]) -> Any:
     return ConstantsFile(mechanisms=mechanisms)
 
 
+def typed_answer(model: Type[_D], answer: Dict[str, Any], endpoint: str) -> _D:
+    """Return the service's answer validated into its document.
+
+    Raises
+    ------
+    InputError
+        The answer is not that document (field ``service``, naming the first wrong field).
+    """
+    from pydantic import ValidationError
+
+    try:
+        return model.model_validate(answer)
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        where = ".".join(str(part) for part in first["loc"]) or "the document"
+        raise InputError(
+            f"the service's answer to /{endpoint} is not its {model.__name__}: "
+            f"{where}: {first['msg']}",
+            "service",
+        ) from None
+
+
 def _constants_json(cf: Any) -> Dict[str, Any]:
     return dict(json.loads(cf.model_dump_json(exclude_none=True)))
 
 
-def _band_lines(doc: Dict[str, Any]) -> List[str]:
+def _band_lines(doc: EnvelopeDocument) -> List[str]:
     lines = ["critical mechanism by pulse frequency:"]
-    for band in doc.get("critical") or []:
-        lines.append(f"  {band['mechanism']}: {band['f_min']:.3g} to {band['f_max']:.3g} Hz")
+    for band in doc.critical:
+        lines.append(f"  {band.mechanism}: {_g3(band.f_min)} to {_g3(band.f_max)} Hz")
     return lines
+
+
+def _g3(value: Optional[float]) -> str:
+    return "-" if value is None else f"{value:.3g}"
 
 
 def run_envelopes(
@@ -219,26 +255,25 @@ def run_envelopes(
     json_path = os.path.join(out_dir, f"{stem}.json")
     if client is not None:
         payload = {"constants": _constants_json(cf), "f_min": f_min, "f_max": f_max, "n": n}
-        doc = client.post("envelope", payload)
-        write_atomic(json_path, json.dumps(doc, indent=2) + "\n")
+        doc = typed_answer(EnvelopeDocument, client.post("envelope", payload), "envelope")
+        write_atomic(json_path, json.dumps(doc.to_dict(), indent=2) + "\n")
         return AnalysisResult("Envelopes", doc, _band_lines(doc), None, [json_path])
 
     doc = write_envelope(
         cf, frequency_grid(f_min, f_max, n), Path(out_dir), stem=stem, title="Overturning envelopes"
-    ).to_dict()
+    )
     plot = os.path.join(out_dir, f"{stem}.png")
     files = [json_path, os.path.join(out_dir, f"{stem}.csv"), plot]
     return AnalysisResult("Envelopes", doc, _band_lines(doc), plot, files)
 
 
-def _history_lines(doc: Dict[str, Any]) -> List[str]:
+def _history_lines(doc: HistoryDocument) -> List[str]:
     lines = []
-    for row in doc.get("results") or []:
-        verdict = "OVERTURNS" if row.get("overturned") else "survives"
-        lines.append(
-            f"  {row['mechanism']} x {row['scale']:g}: peak |phi|/phi_ov = "
-            f"{row['peak_ratio']:.4f}, {verdict}"
-        )
+    for row in doc.results:
+        verdict = "OVERTURNS" if row.overturned else "survives"
+        scale = "-" if row.scale is None else f"{row.scale:g}"
+        peak = "-" if row.peak_ratio is None else f"{row.peak_ratio:.4f}"
+        lines.append(f"  {row.mechanism} x {scale}: peak |phi|/phi_ov = {peak}, {verdict}")
     return lines
 
 
@@ -269,13 +304,11 @@ def run_history(
             "name": motion.name,
         }
         payload = {"constants": _constants_json(cf), "record": samples, "scales": list(scales)}
-        doc = client.post("history", payload)
-        write_atomic(json_path, json.dumps(doc, indent=2) + "\n")
+        doc = typed_answer(HistoryDocument, client.post("history", payload), "history")
+        write_atomic(json_path, json.dumps(doc.to_dict(), indent=2) + "\n")
         return AnalysisResult("History", doc, said + _history_lines(doc), None, [json_path])
 
-    doc = write_history(
-        cf, motion, list(scales), Path(out_dir), stem=stem, title=motion.name
-    ).to_dict()
+    doc = write_history(cf, motion, list(scales), Path(out_dir), stem=stem, title=motion.name)
     plot = os.path.join(out_dir, f"{stem}.png")
     files = [json_path, plot, os.path.join(out_dir, f"{stem}_record.png")]
     return AnalysisResult("History", doc, said + _history_lines(doc), plot, files)
@@ -292,13 +325,13 @@ def run_pulse(
     """
     payload = {"mechanism": pick_mechanism(cf, mechanism), "a_p_g": a_p_g, "f_p": f_p}
     if client is not None:
-        doc = client.post("pulse", payload)
+        doc = typed_answer(PulseDocument, client.post("pulse", payload), "pulse")
     else:
-        doc = solve_pulse(payload).to_dict()
-    verdict = "OVERTURNS" if doc.get("overturned") else "survives"
+        doc = solve_pulse(payload)
+    verdict = "OVERTURNS" if doc.overturned else "survives"
     line = f"  {mechanism}: sine pulse a_p = {a_p_g:g} g, f_p = {f_p:g} Hz: {verdict}"
-    if "peak_ratio" in doc:
-        line += f" (peak |phi|/phi_ov = {doc['peak_ratio']:.4f})"
+    if doc.peak_ratio is not None:
+        line += f" (peak |phi|/phi_ov = {doc.peak_ratio:.4f})"
     return AnalysisResult("Pulse", doc, [line])
 
 

@@ -10,9 +10,17 @@ Python 3.9-clean: imported by Rhino 8.
 """
 
 import json
-from typing import Any, Dict, List, Optional
+from typing import Any, List, Optional, Union
 
-from rhino_plugin.flows.analyse import AnalysisResult, ServiceClient
+from rhino_plugin.flows.analyse import AnalysisResult, ServiceClient, typed_answer
+from shared_schema.documents.check import (
+    CheckDocument,
+    LimitStateCheck,
+    LinearCheck,
+    Nonlinear2019,
+    NonlinearCheck,
+    NotRun,
+)
 from shared_schema.errors import InputError
 from shared_schema.site import parse_site
 from solver_service.workflows.assess import check_document
@@ -27,28 +35,28 @@ def parse_site_text(text: Any) -> Any:
     return parse_site(text)
 
 
-def _cell(check: Dict[str, Any]) -> str:
-    if check.get("status") != "ok":
+def _cell(check: Union[LinearCheck, NonlinearCheck, LimitStateCheck]) -> str:
+    if isinstance(check, NotRun):
         return "not run"
-    ratio = "{:.3g}".format(check["capacity_ratio"])
-    verdict = {True: "passes", False: "FAILS", None: "incomplete"}[check["passes"]]
+    ratio = "-" if check.capacity_ratio is None else f"{check.capacity_ratio:.3g}"
+    verdict = {True: "passes", False: "FAILS", None: "incomplete"}[check.passes]
     return f"{verdict} ({ratio})"
 
 
-def check_lines(doc: Dict[str, Any]) -> List[str]:
+def check_lines(doc: CheckDocument) -> List[str]:
     """One line per mechanism: linear and nonlinear verdicts (capacity/demand), notes."""
     lines: List[str] = []
-    for row in doc.get("mechanisms") or []:
-        lin, non = row["linear"], row["nonlinear"]
-        line = "{}: linear {}, nonlinear {}".format(row["id"], _cell(lin), _cell(non))
-        slc = non.get("SLC") if non.get("status") == "ok" else None
-        if slc is not None and slc.get("passes") is not None:
-            line += ", SLC {}".format(_cell(dict(slc, status="ok")))
+    for row in doc.mechanisms:
+        lin, non = row.linear, row.nonlinear
+        line = f"{row.id}: linear {_cell(lin)}, nonlinear {_cell(non)}"
+        slc = non.SLC if isinstance(non, Nonlinear2019) else None
+        if slc is not None and slc.passes is not None:
+            line += f", SLC {_cell(slc)}"
         lines.append(line)
-        for note in sorted({lin.get("note") or "", non.get("note") or ""} - {""}):
+        for note in sorted({lin.note or "", non.note or ""} - {""}):
             lines.append(f"  note: {note}")
-    if doc.get("governing"):
-        lines.append("governing mechanism: {}".format(doc["governing"]))
+    if doc.governing:
+        lines.append(f"governing mechanism: {doc.governing}")
     return lines
 
 
@@ -59,7 +67,7 @@ def run_check(cf: Any, site: Any, *, client: Optional[ServiceClient] = None) -> 
             "constants": json.loads(cf.model_dump_json(exclude_none=True)),
             "site": json.loads(site.model_dump_json(exclude_none=True)),
         }
-        doc = client.post("check", payload)
+        doc = typed_answer(CheckDocument, client.post("check", payload), "check")
     else:
-        doc = check_document(cf, site).to_dict()
+        doc = check_document(cf, site)
     return AnalysisResult("Check", doc, check_lines(doc))

@@ -36,18 +36,36 @@ import tempfile
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Optional, Union
 
 import numpy as np
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.assess import AssessDocument
+from shared_schema.documents.check import (
+    AssessEnvelope,
+    CheckMechanism,
+    CheckSite,
+    LimitStateCheck,
+    Linear2009,
+    Linear2019,
+    LinearCheck,
+    MechanismVerdict,
+    NoCurve2019,
+    Nonlinear2009,
+    Nonlinear2019,
+    NonlinearCheck,
+    NotRun,
+    PulseMargin,
+    Ties,
+)
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.retrofit import RetrofitDoc
 from shared_schema.site import SiteFile
 from shared_schema.version import __version__
 
 from ..core.model import G
-from .labels import ratio_label, worst_pulse
+from .labels import ratio_label
 from .plots import load_pyplot, plain, save_figure_atomic
 from .retrofit import records_notes, retrofit_summary
 
@@ -162,7 +180,7 @@ def _plot_spectrum(spectrum: Any, path: Path) -> Path:
         plt.close(fig)
 
 
-def _plot_limit_state(ax: Any, name: str, color: str, ls: dict[str, Any]) -> float:
+def _plot_limit_state(ax: Any, name: str, color: str, ls: LimitStateCheck) -> float:
     """Draw one limit state of the 2019 check on the ADRS axes; return its demand's ``a``.
 
     Parameters
@@ -173,8 +191,8 @@ def _plot_limit_state(ax: Any, name: str, color: str, ls: dict[str, Any]) -> flo
         ``"SLV"`` or ``"SLC"``.
     color : str
         The limit state's colour.
-    ls : dict
-        The check's record of the limit state (``adrs``, ``T_<name>``, ``demand_code``,
+    ls : LimitStateCheck
+        The check's limit state (``adrs``, ``T_<name>``, ``demand_code``,
         ``demand_records``, ``d``, ``a``, ``capacity_ratio``, ``passes``...).
 
     Returns
@@ -182,78 +200,104 @@ def _plot_limit_state(ax: Any, name: str, color: str, ls: dict[str, Any]) -> flo
     float
         The code demand's acceleration ``d (2π/T)²`` [m/s²] (for the axes' top).
     """
-    adrs = ls["adrs"]
-    word = _word(ls["passes"])
+    word = _word(ls.passes)
     ax.plot(
-        adrs["d"],
-        adrs["a"],
+        ls.adrs.d,
+        ls.adrs.a,
         color=color,
         lw=0.9,
         alpha=0.7,
-        label=f"{name} demand spectrum (ξ = {ls['xi_percent']:g} %)",
+        label=f"{name} demand spectrum (ξ = {ls.xi_percent:g} %)",
     )
-    t = ls[f"T_{name}"]
-    a_dem: float = ls["demand_code"] * (2.0 * math.pi / t) ** 2
+    t = _period(ls, name)
+    demand_code = _given(ls.demand_code)
+    a_dem: float = demand_code * (2.0 * math.pi / t) ** 2
     ax.plot(
-        [ls["demand_code"]],
+        [demand_code],
         [a_dem],
         "o",
         color=color,
-        label=f"{name} code demand {ls['demand_code']:.3g} m at T = {t:.3g} s",
+        label=f"{name} code demand {demand_code:.3g} m at T = {t:.3g} s",
     )
-    if ls.get("demand_records") is not None:
+    if ls.demand_records is not None:
         ax.plot(
-            [ls["demand_records"]],
+            [ls.demand_records],
             [a_dem],
             "x",
             color=color,
-            label=f"{name} records' demand {ls['demand_records']:.3g} m",
+            label=f"{name} records' demand {ls.demand_records:.3g} m",
         )
-    bound = " (a_g,SLD bound)" if ls.get("lower_bound_applied") else ""
+    bound = " (a_g,SLD bound)" if ls.lower_bound_applied else ""
     ax.axvline(
-        ls["d"],
+        ls.d,
         color=color,
         ls="--",
         lw=1.0,
-        label=f"d_{name} = {ls['d']:.3g} m: {word}, ratio {ls['capacity_ratio']:.3g}{bound}",
+        label=f"d_{name} = {ls.d:.3g} m: {word}, ratio {ls.capacity_ratio:.3g}{bound}",
     )
-    ax.plot([ls["d"]], [ls["a"]], "s", color=color, ms=5)
+    ax.plot([ls.d], [ls.a], "s", color=color, ms=5)
     return a_dem
 
 
-def _plot_linear(ax: Any, lin: dict[str, Any]) -> list[float]:
+def _given(value: Optional[float]) -> float:
+    """Return a figure a drawing needs; a check without it cannot be drawn (its note says so)."""
+    if value is None:
+        raise ValueError("a figure of the check is missing")
+    return float(value)
+
+
+def _period(ls: LimitStateCheck, name: str) -> float:
+    """Return the secant period of a limit state, ``T_SLV`` or ``T_SLC`` [s]."""
+    return _given(ls.T_SLV if name == "SLV" else ls.T_SLC)
+
+
+def _plot_linear(ax: Any, lin: LinearCheck) -> list[float]:
     """Draw the linear check's capacity ``a0*`` and its demand; return both (or none) [m/s²]."""
-    if lin.get("status") != "ok":
+    if isinstance(lin, NotRun):
         return []
+    a0_star, demand = _given(lin.a0_star), _given(lin.demand)
     ax.axhline(
-        lin["a0_star"],
+        a0_star,
         color="tab:blue",
         lw=0.9,
-        label=f"linear: a0* = {lin['a0_star']:.3g} m/s²",
+        label=f"linear: a0* = {a0_star:.3g} m/s²",
     )
     ax.axhline(
-        lin["demand"],
+        demand,
         color="tab:blue",
         ls=":",
         lw=1.0,
-        label=f"linear demand/q = {lin['demand']:.3g}: {_word(lin['passes'])}",
+        label=f"linear demand/q = {demand:.3g}: {_word(lin.passes)}",
     )
-    return [lin["a0_star"], lin["demand"]]
+    return [a0_star, demand]
 
 
-def _plot_2009(ax: Any, non: dict[str, Any], spectrum: Any) -> None:
+def _plot_2009(ax: Any, non: Nonlinear2009, spectrum: Any) -> None:
     """Draw the 2009 check's forms: the 5 % site spectrum, ``d_u*`` and the demand."""
     t = np.linspace(0.02, 6.0, 600)
     ax.plot(spectrum.SDe(t), spectrum.Se(t) * G, color="0.5", lw=1.0, label="site spectrum (5 %)")
-    ax.axvline(non["du_star"], color="tab:blue", ls="--", lw=1, label="d_u* = 0.4 d_0* (2009)")
-    ax.axvline(
-        non["demand"], color="crimson", ls="--", lw=1, label=f"demand: {_word(non['passes'])}"
-    )
-    ax.set_xlim(0.0, 1.15 * max(non["d0_star"], non["demand"]))
-    ax.set_ylim(0.0, 1.2 * non["a0_star"])
+    ax.axvline(non.du_star, color="tab:blue", ls="--", lw=1, label="d_u* = 0.4 d_0* (2009)")
+    ax.axvline(non.demand, color="crimson", ls="--", lw=1, label=f"demand: {_word(non.passes)}")
+    ax.set_xlim(0.0, 1.15 * max(_given(non.d0_star), _given(non.demand)))
+    ax.set_ylim(0.0, 1.2 * _given(non.a0_star))
 
 
-def _plot_capacity(lin: dict[str, Any], non: dict[str, Any], spectrum: Any, path: Path) -> Path:
+def _plot_2019(ax: Any, lin: LinearCheck, non: Nonlinear2019) -> None:
+    """Draw the 2019 check's limit states and the linear check; set the axes' limits."""
+    tops = [max(_given(v) for v in non.curve.a)]
+    for name, color, ls in (("SLV", "crimson", non.SLV), ("SLC", "tab:purple", non.SLC)):
+        tops.append(_plot_limit_state(ax, name, color, ls))
+    tops += _plot_linear(ax, lin)
+    d0, slc_d = _given(non.d0), _given(non.SLC.d)
+    d_top = max(d0, _given(non.SLV.demand), _given(non.SLC.demand), slc_d)
+    d_top = min(d_top, 3.0 * max(d0, slc_d))
+    ax.set_xlim(0.0, 1.2 * d_top)
+    ax.set_ylim(0.0, 1.25 * max(tops))
+
+
+def _plot_capacity(
+    lin: LinearCheck, non: Union[Nonlinear2019, Nonlinear2009], spectrum: Any, path: Path
+) -> Path:
     """Plot the checks on the capacity curve in ADRS form: capacity, demand, verdict of each.
 
     Circolare 2019: the capacity curve ``a(d)``; the demand spectra of the SLV and SLC
@@ -264,19 +308,11 @@ def _plot_capacity(lin: dict[str, Any], non: dict[str, Any], spectrum: Any, path
     """
     plt = load_pyplot()
     fig, ax = plt.subplots(figsize=(6.8, 3.9))
-    d_cur = non["curve"].get("d", non["curve"].get("d_star"))
-    a_cur = non["curve"].get("a", non["curve"].get("a_star"))
-    ax.plot(d_cur, a_cur, color="k", lw=1.6, label="capacity a(d)")
-    if non.get("method") == "circ2019" and "SLV" in non:
-        tops = [max(a_cur)]
-        for name, color in (("SLV", "crimson"), ("SLC", "tab:purple")):
-            tops.append(_plot_limit_state(ax, name, color, non[name]))
-        tops += _plot_linear(ax, lin)
-        d_top = max(non["d0"], non["SLV"]["demand"], non["SLC"]["demand"], non["SLC"]["d"])
-        d_top = min(d_top, 3.0 * max(non["d0"], non["SLC"]["d"]))
-        ax.set_xlim(0.0, 1.2 * d_top)
-        ax.set_ylim(0.0, 1.25 * max(tops))
+    if isinstance(non, Nonlinear2019):
+        ax.plot(non.curve.d, non.curve.a, color="k", lw=1.6, label="capacity a(d)")
+        _plot_2019(ax, lin, non)
     else:
+        ax.plot(non.curve.d_star, non.curve.a_star, color="k", lw=1.6, label="capacity a(d)")
         _plot_2009(ax, non, spectrum)
     ax.set_xlabel("d [m]")
     ax.set_ylabel("a [m/s²]")
@@ -297,141 +333,164 @@ def _row(label: str, value: Any, unit: str, clause: str) -> dict[str, str]:
     return {"label": label, "value": sig(value), "unit": unit, "clause": clause}
 
 
-def _check_rows(check: dict[str, Any]) -> list[dict[str, str]]:
+def _add(rows: list[dict[str, str]], label: str, value: Any, unit: str, clause: str) -> None:
+    """Append the row of a figure the check gives (none where it is absent or null)."""
+    if value is not None:
+        rows.append(_row(label, value, unit, clause))
+
+
+def _check_rows(check: Union[LinearCheck, NonlinearCheck]) -> list[dict[str, str]]:
     """Return the worked-out rows of a check: quantity, value, unit and the clause of each."""
-    if check.get("status") != "ok":
+    if isinstance(check, NotRun):
         return []
-    cl = check.get("clauses", {})
-    if check.get("method") != "circ2019":
+    if isinstance(check, (Linear2009, Nonlinear2009)):
         return _rows_2009(check)
+    if isinstance(check, NoCurve2019):  # no curve: the static forces alone overturn it
+        return _ties_rows(check.ties)
+    cl = check.clauses
+    nonlinear = isinstance(check, Nonlinear2019)
     rows: list[dict[str, str]] = []
-
-    def add(label: str, key: str, unit: str) -> None:
-        if check.get(key) is not None:
-            rows.append(_row(label, check[key], unit, cl.get(key, "")))
-
-    nonlinear = "SLV" in check
-    add("α0 of the capacity curve" if nonlinear else "α0", "alpha0", "-")
-    add("M*", "M_star", "kg")
-    add("e*", "e_star", "-")
-    add("FC", "FC", "-")
-    add("a0* at activation" if nonlinear else "a0* = α0 g/(e* FC)", "a0_star", "m/s²")
-    if check.get("free_standing"):
-        for label, key, unit in (
-            ("κ", "kappa", "-"),
-            ("L", "L", "m"),
-            ("t", "t", "m"),
-            ("λ = L/t", "lambda", "-"),
-            ("W", "W", "N/m³"),
-            ("E", "E", "Pa"),
-            ("T0", "T0", "s"),
-            ("d_y", "d_y", "m"),
-            ("a_y", "a_y", "m/s²"),
-        ):
-            add(label, key, unit)
+    _add(rows, "α0 of the capacity curve" if nonlinear else "α0", check.alpha0, "-",
+         cl.get("alpha0", ""))  # fmt: skip
+    if isinstance(check, Linear2019):
+        _add(rows, "M*", check.M_star, "kg", cl.get("M_star", ""))
+    _add(rows, "e*", check.e_star, "-", cl.get("e_star", ""))
+    _add(rows, "FC", check.FC, "-", cl.get("FC", ""))
+    _add(rows, "a0* at activation" if nonlinear else "a0* = α0 g/(e* FC)", check.a0_star,
+         "m/s²", cl.get("a0_star", ""))  # fmt: skip
+    if check.free_standing:
+        rows.extend(_free_standing_rows(check))
     units = {"T1": "s", "T_k": "s", "xi_k_percent": "%", "a_Z_g": "g", "Se_Tk_g": "g"}
-    for key, value in (check.get("floor") or {}).items():
+    floor = {} if check.floor is None else check.floor.model_dump(exclude_unset=True)
+    for key, value in floor.items():  # the floor's terms, as the document gives them
         rows.append(_row(f"floor {key}", value, units.get(key, "-"), cl.get(f"floor.{key}", "")))
-    if "SLV" not in check:  # the linear check
-        add("q", "q", "-")
-        rows.append(
-            _row(
-                "activation demand",
-                check["demand_activation"],
-                "m/s²",
-                f"{cl.get('demand_activation', '')}; {check.get('demand_rule', '')}",
-            )
+    if isinstance(check, Linear2019):
+        return rows + _linear_rows(check)
+    rows.extend(_ties_rows(check.ties))
+    _add(rows, "J/S (d per unit rotation)", check.d_per_rad, "m/rad", cl.get("d_per_rad", ""))
+    _add(rows, "φ0", check.phi0, "rad", cl.get("phi0", ""))
+    _add(rows, "d0", check.d0, "m", cl.get("d0", ""))
+    rows.extend(_limit_state_rows("SLV", check.SLV))
+    rows.extend(_limit_state_rows("SLC", check.SLC))
+    return rows
+
+
+def _free_standing_rows(check: Union[Linear2019, Nonlinear2019]) -> list[dict[str, str]]:
+    """Return the rows of a free-standing element's figures ([C8.7.1.7]): κ, L, t, λ, ..."""
+    cl = check.clauses
+    rows: list[dict[str, str]] = []
+    for label, value, key, unit in (
+        ("κ", check.kappa, "kappa", "-"),
+        ("L", check.L, "L", "m"),
+        ("t", check.t, "t", "m"),
+        ("λ = L/t", check.lambda_, "lambda", "-"),
+        ("W", check.W, "W", "N/m³"),
+        ("E", check.E, "E", "Pa"),
+        ("T0", check.T0, "T0", "s"),
+    ):
+        _add(rows, label, value, unit, cl.get(key, ""))
+    if isinstance(check, Nonlinear2019):
+        _add(rows, "d_y", check.d_y, "m", cl.get("d_y", ""))
+        _add(rows, "a_y", check.a_y, "m/s²", cl.get("a_y", ""))
+    return rows
+
+
+def _linear_rows(check: Linear2019) -> list[dict[str, str]]:
+    """Return the linear check's rows after the common ones: q, the demand and the ratio."""
+    cl = check.clauses
+    rows: list[dict[str, str]] = []
+    _add(rows, "q", check.q, "-", cl.get("q", ""))
+    rows.append(
+        _row(
+            "activation demand",
+            check.demand_activation,
+            "m/s²",
+            f"{cl.get('demand_activation', '')}; {check.demand_rule}",
         )
-        add("a_g,SLD", "a_g_SLD", "g")
-        add("a_g,SLV = q a_g,SLD", "a_g_SLV", "g")
-        add("a_g (SLV hazard)", "a_g", "g")
-        add("a_g,SLV / a_g", "capacity_ratio", "-")
-        return rows
-    rows.extend(_ties_rows(check.get("ties") or {}))
-    add("J/S (d per unit rotation)", "d_per_rad", "m/rad")
-    add("φ0", "phi0", "rad")
-    add("d0", "d0", "m")
-    for name in ("SLV", "SLC"):
-        rows.extend(_limit_state_rows(name, check[name]))
+    )
+    _add(rows, "a_g,SLD", check.a_g_SLD, "g", cl.get("a_g_SLD", ""))
+    _add(rows, "a_g,SLV = q a_g,SLD", check.a_g_SLV, "g", cl.get("a_g_SLV", ""))
+    _add(rows, "a_g (SLV hazard)", check.a_g, "g", cl.get("a_g", ""))
+    _add(rows, "a_g,SLV / a_g", check.capacity_ratio, "-", cl.get("capacity_ratio", ""))
     return rows
 
 
-def _ties_rows(ties: dict[str, Any]) -> list[dict[str, str]]:
+def _ties_rows(ties: Ties) -> list[dict[str, str]]:
     """Return the rows of a nonlinear check's ties: their treatment and φ0 with and without."""
-    if not ties.get("present"):
+    if not ties.present:
         return []
-    rows = [
-        {
-            "label": "ties",
-            "value": ties.get("treatment", ""),
-            "unit": "",
-            "clause": ties.get("rule", ""),
-        }
-    ]
-    for label, key in (("φ0 with the ties", "phi0_with"), ("φ0 without", "phi0_without")):
-        rows.append(_row(label, ties[key], "rad", "theory §1.7 Eq. 6; C8.7.1.2.1.6"))
+    rows = [{"label": "ties", "value": ties.treatment or "", "unit": "", "clause": ties.rule or ""}]
+    for label, value in (("φ0 with the ties", ties.phi0_with), ("φ0 without", ties.phi0_without)):
+        rows.append(_row(label, value, "rad", "theory §1.7 Eq. 6; C8.7.1.2.1.6"))
     return rows
 
 
-def _limit_state_rows(name: str, ls: dict[str, Any]) -> list[dict[str, str]]:
+def _limit_state_rows(name: str, ls: LimitStateCheck) -> list[dict[str, str]]:
     """Return the rows of one limit state (SLV or SLC) of a nonlinear check."""
-    lcl = ls.get("clauses", {})
-    rows = [_row(f"d_{name}", ls["d"], "m", f"{lcl.get('d', '')}: {ls['d_rule']}")]
-
-    def add(label: str, key: str, unit: str) -> None:
-        if ls.get(key) is not None:
-            rows.append(_row(label, ls[key], unit, lcl.get(key, "")))
-
-    add(f"a(d_{name})", "a", "m/s²")
-    add(f"T_{name}", f"T_{name}", "s")
-    add(f"ξ ({name})", "xi_percent", "%")
+    lcl = ls.clauses
+    rows = [_row(f"d_{name}", ls.d, "m", f"{lcl.get('d', '')}: {ls.d_rule}")]
+    _add(rows, f"a(d_{name})", ls.a, "m/s²", lcl.get("a", ""))
+    period = ls.T_SLV if name == "SLV" else ls.T_SLC
+    _add(rows, f"T_{name}", period, "s", lcl.get(f"T_{name}", ""))
+    _add(rows, f"ξ ({name})", ls.xi_percent, "%", lcl.get("xi_percent", ""))
     rows.append(
         _row(
             f"demand {name} (code)",
-            ls["demand_code"],
+            ls.demand_code,
             "m",
-            f"{lcl.get('demand_code', '')}: {ls['demand_rule']}",
+            f"{lcl.get('demand_code', '')}: {ls.demand_rule}",
         )
     )
-    add(f"demand {name} (records)", "demand_records", "m")
-    add(f"a_g,{name} (capacity)", "a_g_capacity", "g")
-    add("a_g,SLD (lower bound)", "a_g_SLD", "g")
-    add(f"a_g ({name} hazard)", "a_g", "g")
-    add(f"a_g,{name} / a_g", "capacity_ratio", "-")
+    _add(rows, f"demand {name} (records)", ls.demand_records, "m", lcl.get("demand_records", ""))
+    _add(rows, f"a_g,{name} (capacity)", ls.a_g_capacity, "g", lcl.get("a_g_capacity", ""))
+    _add(rows, "a_g,SLD (lower bound)", ls.a_g_SLD, "g", lcl.get("a_g_SLD", ""))
+    _add(rows, f"a_g ({name} hazard)", ls.a_g, "g", lcl.get("a_g", ""))
+    _add(rows, f"a_g,{name} / a_g", ls.capacity_ratio, "-", lcl.get("capacity_ratio", ""))
     return rows
 
 
-def _rows_2009(check: dict[str, Any]) -> list[dict[str, str]]:
+def _rows_2009(check: Union[Linear2009, Nonlinear2009]) -> list[dict[str, str]]:
     src = "Circolare 617/2009 C8A.4 (2009 forms, from memory; for comparison)"
-    rows = []
-    per = "m" if "du_star" in check else "m/s²"
-    for label, key, unit in (
-        ("α0", "alpha0", "-"),
-        ("M*", "M_star", "kg"),
-        ("e*", "e_star", "-"),
-        ("a0*", "a0_star", "m/s²"),
-        ("demand at ground", "demand_ground", per),
-        ("d0*", "d0_star", "m"),
-        ("du* = 0.4 d0*", "du_star", "m"),
-        ("Ts", "Ts", "s"),
-        ("demand at height", "demand_height", per),
-        ("demand", "demand", per),
-        ("capacity/demand", "capacity_ratio", "-"),
-    ):
-        if check.get(key) is not None:
-            rows.append(_row(label, check[key], unit, src))
+    figures: list[tuple[str, Optional[float], str]]
+    if isinstance(check, Linear2009):
+        per = "m/s²"
+        figures = [
+            ("α0", check.alpha0, "-"),
+            ("M*", check.M_star, "kg"),
+            ("e*", check.e_star, "-"),
+            ("a0*", check.a0_star, "m/s²"),
+            ("demand at ground", check.demand_ground, per),
+        ]
+    else:
+        per = "m"
+        figures = [
+            ("e*", check.e_star, "-"),
+            ("a0*", check.a0_star, "m/s²"),
+            ("demand at ground", check.demand_ground, per),
+            ("d0*", check.d0_star, "m"),
+            ("du* = 0.4 d0*", check.du_star, "m"),
+            ("Ts", check.Ts, "s"),
+        ]
+    figures += [
+        ("demand at height", check.demand_height, per),
+        ("demand", check.demand, per),
+        ("capacity/demand", check.capacity_ratio, "-"),
+    ]
+    rows: list[dict[str, str]] = []
+    for label, value, unit in figures:
+        _add(rows, label, value, unit, src)
     return rows
 
 
-def _plot_envelope(env: dict[str, Any], path: Path) -> Path:
+def _plot_envelope(env: AssessEnvelope, path: Path) -> Path:
     plt = load_pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 3.6))
-    f = np.asarray(env["f_p"], dtype=float)
-    a = np.array([np.nan if v is None else v for v in env["a_p_min_g"]], dtype=float)
+    f = np.asarray(env.f_p, dtype=float)
+    a = np.array([np.nan if v is None else v for v in env.a_p_min_g or []], dtype=float)
     ax.loglog(f, a, color="k", lw=1.3, label="overturning envelope a_p,min")
-    for p in env.get("pulses", []):
-        text = f"{plain(p['record'])} pulse at design scale"
-        ax.loglog([p["f_p"]], [p["a_p_g"]], "o", label=text)
+    for p in env.pulses or []:
+        text = f"{plain(p.record)} pulse at design scale"
+        ax.loglog([p.f_p], [p.a_p_g], "o", label=text)
     ax.set_xlabel("pulse frequency f_p [Hz]")
     ax.set_ylabel("amplitude [g]")
     ax.grid(alpha=0.3, which="both")
@@ -512,70 +571,76 @@ def _short(note: str) -> str:
     return head.split(" (")[0].split(";")[0]
 
 
-def _verdict_cell(check: dict[str, Any], what: str) -> dict[str, str]:
-    if check.get("status") != "ok":
-        return {"text": "not run", "cls": "na", "note": _short(check.get("note", ""))}
-    ratio = sig(check["capacity_ratio"], 3)
-    if check["passes"] is None:
-        return {"text": f"incomplete ({what} {ratio})", "cls": "na", "note": _short(check["note"])}
-    word = "passes" if check["passes"] else "fails"
+def _verdict_cell(check: Union[LinearCheck, NonlinearCheck], what: str) -> dict[str, str]:
+    if isinstance(check, NotRun):
+        return {"text": "not run", "cls": "na", "note": _short(check.note)}
+    ratio = sig(check.capacity_ratio, 3)
+    if check.passes is None:
+        return {"text": f"incomplete ({what} {ratio})", "cls": "na", "note": _short(check.note)}
+    word = "passes" if check.passes else "fails"
     return {
         "text": f"{word} ({what} {ratio})",
-        "cls": "ok" if check["passes"] else "ko",
+        "cls": "ok" if check.passes else "ko",
         "note": "",
     }
 
 
-def _dynamics_cell(row: dict[str, Any]) -> dict[str, str]:
-    dyn = row.get("dynamics") or []
+def _dynamics_cell(row: CheckMechanism) -> dict[str, str]:
+    dyn = row.dynamics or []
     if not dyn:
-        return {"text": "not run", "cls": "na", "note": row.get("dynamics_note", "")}
+        return {"text": "not run", "cls": "na", "note": row.dynamics_note or ""}
     parts, cls = [], "ok"
     notes = []
     for d in dyn:
-        if "runs" not in d:
-            parts.append(f"{d['record']}: not run")
-            notes.append(_short(d.get("note", "").removeprefix("not run: ")))
+        if d.runs is None:
+            parts.append(f"{d.record}: not run")
+            notes.append(_short((d.note or "").removeprefix("not run: ")))
             cls = "na"
             continue
-        first = d["first_overturning_multiple"]
-        state = "survives" if d["survives_design"] else "overturns"
-        tail = "no overturning up to ×" + sig(max(r["multiple"] for r in d["runs"]), 3)
+        first = d.first_overturning_multiple
+        state = "survives" if d.survives_design else "overturns"
+        top = max((r.multiple for r in d.runs if r.multiple is not None), default=None)
+        tail = "no overturning up to ×" + sig(top, 3)
         if first is not None:
             tail = f"overturns at ×{sig(first, 3)}"
-        parts.append(f"{d['record']}: {state} at design; {tail}")
-        if not d["survives_design"]:
+        parts.append(f"{d.record}: {state} at design; {tail}")
+        if not d.survives_design:
             cls = "ko"
     return {"text": "; ".join(parts), "cls": cls, "note": "; ".join(n for n in notes if n)}
 
 
-def _margin_cell(row: dict[str, Any], verdict: dict[str, Any]) -> dict[str, str]:
-    env = row.get("envelope") or {}
-    if "note" in env:
-        return {"text": "not run", "cls": "na", "note": _short(env["note"])}
-    worst = worst_pulse(row)
-    if worst is None:
+def _worst_pulse(env: Optional[AssessEnvelope]) -> Optional[PulseMargin]:
+    """Return the record pulse of a mechanism's envelope with the smallest margin, or None."""
+    pulses = [p for p in (env.pulses if env is not None else None) or [] if p.margin is not None]
+    return min(pulses, key=lambda p: float(p.margin or 0.0)) if pulses else None
+
+
+def _margin_cell(row: CheckMechanism, verdict: MechanismVerdict) -> dict[str, str]:
+    env = row.envelope
+    if env is not None and env.note is not None:
+        return {"text": "not run", "cls": "na", "note": _short(env.note)}
+    worst = _worst_pulse(env)
+    if worst is None or worst.margin is None:
         return {"text": "–", "cls": "na", "note": "no pulse found in the records"}
-    text = f"{sig(worst['margin'], 3)} ({worst['record']}, {sig(worst['f_p'], 3)} Hz)"
-    if "pulse_margin" in verdict:
+    text = f"{sig(worst.margin, 3)} ({worst.record}, {sig(worst.f_p, 3)} Hz)"
+    if verdict.pulse_margin is not None:
         # It disagrees with the time history, which governs: shown, not coloured.
         return {"text": text, "cls": "na", "note": "screening only: the time history governs"}
-    return {"text": text, "cls": "ok" if worst["margin"] >= 1.0 else "ko", "note": ""}
+    return {"text": text, "cls": "ok" if worst.margin >= 1.0 else "ko", "note": ""}
 
 
-def _final_cell(verdict: dict[str, Any]) -> dict[str, str]:
-    word = {"fails": "FAILS", "passes": "PASSES", "incomplete": "INCOMPLETE"}[verdict["verdict"]]
-    cls = {"fails": "ko", "passes": "ok", "incomplete": "na"}[verdict["verdict"]]
-    code = verdict.get("code_check")
-    if verdict["verdict"] == "incomplete":
-        return {"text": word, "cls": cls, "note": _short(verdict["reason"])}
-    governs = verdict["governs"] or ""
+def _final_cell(verdict: MechanismVerdict) -> dict[str, str]:
+    word = {"fails": "FAILS", "passes": "PASSES", "incomplete": "INCOMPLETE"}[verdict.verdict]
+    cls = {"fails": "ko", "passes": "ok", "incomplete": "na"}[verdict.verdict]
+    code = verdict.code_check
+    if verdict.verdict == "incomplete":
+        return {"text": word, "cls": cls, "note": _short(verdict.reason)}
+    governs = verdict.governs or ""
     if governs.startswith("rocking"):
         detail = "governed by the rocking time history at design scale"
     elif code is not None:
         detail = (
-            f"governed by the {code['check']} check, {code['ratio_name']} = "
-            f"{sig(code['capacity_ratio'], 3)}"
+            f"governed by the {code.check} check, {code.ratio_name} = {sig(code.capacity_ratio, 3)}"
         )
     else:
         detail = governs
@@ -662,13 +727,13 @@ _DERIVED_ROWS: tuple[tuple[str, str, str, str], ...] = (
 )
 
 
-def hazard_table(site_doc: dict[str, Any]) -> list[dict[str, str]]:
+def hazard_table(site_doc: CheckSite) -> list[dict[str, str]]:
     """One row per hazard quantity: quantity, symbol, value, unit and source.
 
     Parameters
     ----------
-    site_doc : dict
-        The check document's ``site`` block (``check_doc``).
+    site_doc : CheckSite
+        The check document's ``site`` block (``check_document``).
 
     Returns
     -------
@@ -676,15 +741,15 @@ def hazard_table(site_doc: dict[str, Any]) -> list[dict[str, str]]:
         ``quantity``, ``symbol`` (HTML), ``value``, ``unit`` and ``source`` (the site
         file's field, or the clause that gives a derived value).
     """
-    clauses = site_doc.get("clauses", {})
+    clauses = site_doc.clauses
     rows = [
-        {"quantity": "code of the hazard", "symbol": "–", "value": str(site_doc["code"]),
+        {"quantity": "code of the hazard", "symbol": "–", "value": str(site_doc.code),
          "unit": "–", "source": "site file: hazard.code"},
         {"quantity": "limit state of the checks", "symbol": "–",
-         "value": str(site_doc.get("limit_state", "SLV")), "unit": "–",
+         "value": str(site_doc.limit_state), "unit": "–",
          "source": "site file: hazard.limit_state"},
     ]  # fmt: skip
-    for key, value in site_doc.get("params", {}).items():
+    for key, value in site_doc.params.model_dump(exclude_unset=True).items():
         if value is None or key not in _PARAM_ROWS:
             continue
         quantity, symbol, unit, source = _PARAM_ROWS[key]
@@ -692,22 +757,34 @@ def hazard_table(site_doc: dict[str, Any]) -> list[dict[str, str]]:
             {"quantity": quantity, "symbol": symbol, "value": sig(value), "unit": unit,
              "source": source}
         )  # fmt: skip
+    derived = {
+        "S": site_doc.S, "pga_g": site_doc.pga_g, "F": site_doc.F, "eta": site_doc.eta,
+        "T_B": site_doc.T_B, "T_C": site_doc.T_C, "T_D": site_doc.T_D, "FC": site_doc.FC,
+        "q": site_doc.q,
+    }  # fmt: skip
     for key, quantity, symbol, unit in _DERIVED_ROWS:
-        if site_doc.get(key) is None:
+        if derived[key] is None:
             continue
         rows.append(
-            {"quantity": quantity, "symbol": symbol, "value": sig(site_doc[key]), "unit": unit,
+            {"quantity": quantity, "symbol": symbol, "value": sig(derived[key]), "unit": unit,
              "source": clauses.get(key, "site file")}
         )  # fmt: skip
-    for name, ls in (site_doc.get("limit_states") or {}).items():
-        if not ls or name == site_doc.get("limit_state"):
+    states = site_doc.limit_states
+    for name, ls in (("SLV", states.SLV), ("SLC", states.SLC)):
+        if ls is None or name == site_doc.limit_state:
             continue
         rows.append(
             {"quantity": f"{name} hazard (for the {name} checks)", "symbol": "a<sub>g</sub>, F, "
-             "T<sub>C</sub>", "value": f"{sig(ls['a_g'])}, {sig(ls['F'])}, {sig(ls['T_C'])}",
-             "unit": "g, –, s", "source": f"site file: {ls.get('source', name)}"}
+             "T<sub>C</sub>", "value": f"{sig(ls.a_g)}, {sig(ls.F)}, {sig(ls.T_C)}",
+             "unit": "g, –, s", "source": f"site file: {ls.source}"}
         )  # fmt: skip
-    building = site_doc.get("building") or {}
+    return rows + _building_rows(site_doc)
+
+
+def _building_rows(site_doc: CheckSite) -> list[dict[str, str]]:
+    """Return the hazard table's rows of the building: its height, storeys, damping, T1."""
+    rows = []
+    building = site_doc.building or {}  # the site file's block, as given
     for key, quantity, symbol, unit in (
         ("height", "height of the building", "H", "m"),
         ("storeys", "storeys", "–", "–"),
@@ -719,11 +796,10 @@ def hazard_table(site_doc: dict[str, Any]) -> list[dict[str, str]]:
                 {"quantity": quantity, "symbol": symbol, "value": sig(building[key]),
                  "unit": unit, "source": f"site file: building.{key}"}
             )  # fmt: skip
-    if site_doc.get("T1") is not None:
+    if site_doc.T1 is not None:
         rows.append(
             {"quantity": "fundamental period of the building", "symbol": "T<sub>1</sub>",
-             "value": sig(site_doc["T1"]), "unit": "s",
-             "source": str(site_doc.get("T1_source", ""))}
+             "value": sig(site_doc.T1), "unit": "s", "source": str(site_doc.T1_source)}
         )  # fmt: skip
     return rows
 
@@ -875,32 +951,31 @@ def _render(template_dir: Optional[Path], context: Optional[dict[str, Any]] = No
 
 
 def _mechanism_figures(
-    row: dict[str, Any], spectrum: Any, runs: Sequence[HistoryRun], folder: Path
+    row: CheckMechanism, spectrum: Any, runs: Sequence[HistoryRun], folder: Path
 ) -> list[dict[str, str]]:
     """Return a mechanism's figures: its checks on the capacity curve, envelope, histories."""
-    non = row["nonlinear"]
+    non = row.nonlinear
     figs = []
-    if non.get("status") == "ok" and non.get("curve"):
+    if isinstance(non, (Nonlinear2019, Nonlinear2009)):
         figs.append(
             _embed(
                 functools.partial(
                     _plot_capacity,
-                    row["linear"],
+                    row.linear,
                     non,
                     spectrum,
-                    folder / f"{row['id']}_capacity.png",
+                    folder / f"{row.id}_capacity.png",
                 ),
-                f"{row['id']}: the checks on the capacity curve (ADRS): capacity, "
+                f"{row.id}: the checks on the capacity curve (ADRS): capacity, "
                 "demand and verdict of each (Circ. 2019 C8.7.1.2.1.7-8)",
             )
         )
-    env_doc = row.get("envelope") or {}
-    if "a_p_min_g" in env_doc:
+    env_doc = row.envelope
+    if env_doc is not None and env_doc.a_p_min_g is not None:
         figs.append(
             _embed(
-                functools.partial(_plot_envelope, env_doc, folder / f"{row['id']}_envelope.png"),
-                f"{row['id']}: overturning envelope and the records' largest pulses "
-                "at design scale",
+                functools.partial(_plot_envelope, env_doc, folder / f"{row.id}_envelope.png"),
+                f"{row.id}: overturning envelope and the records' largest pulses at design scale",
             )
         )
     figs.extend(_history_figures(runs, folder))
@@ -908,7 +983,7 @@ def _mechanism_figures(
 
 
 def render_assessment(
-    doc: dict[str, Any],
+    doc: AssessDocument,
     cf: ConstantsFile,
     site: SiteFile,
     spectrum: Any,
@@ -922,8 +997,8 @@ def render_assessment(
 
     Parameters
     ----------
-    doc : dict
-        ``workflows.assess.assessment_doc(cf, site, motions, ...)``.
+    doc : AssessDocument
+        ``workflows.assess.assessment_document(cf, site, motions, ...)``.
     cf, site
         The inputs of ``doc`` (for the constants and the project).
     spectrum : Spectrum
@@ -946,23 +1021,23 @@ def render_assessment(
     """
     check_template(template_dir)  # a user template's syntax error before any figure is drawn
     by_id = {m.id: m for m in cf.mechanisms}
-    method = doc.get("method", {}).get("name", "circ2019")
-    verdicts_by_id = {v["id"]: v for v in doc["conclusion"]["mechanisms"]}
+    method = doc.method.name
+    verdicts_by_id = {v.id: v for v in doc.conclusion.mechanisms}
     with tempfile.TemporaryDirectory(prefix="rockmech-assess-") as tmp:
         folder = Path(tmp)
         spectrum_fig = _embed(
             functools.partial(_plot_spectrum, spectrum, folder / "spectrum.png"),
-            f"Site spectrum ({doc['site']['code']}): a_g S = {sig(doc['site']['pga_g'])} g",
+            f"Site spectrum ({doc.site.code}): a_g S = {sig(doc.site.pga_g)} g",
         )
         sections = []
         verdicts = []
-        for row in doc["mechanisms"]:
-            figs = _mechanism_figures(row, spectrum, histories.get(row["id"], ()), folder)
-            verdict = verdicts_by_id[row["id"]]
+        for row in doc.mechanisms:
+            figs = _mechanism_figures(row, spectrum, histories.get(row.id, ()), folder)
+            verdict = verdicts_by_id[row.id]
             cells = {
                 "verdict": _final_cell(verdict),
-                "linear": _verdict_cell(row["linear"], ratio_label(method, "linear")),
-                "nonlinear": _verdict_cell(row["nonlinear"], ratio_label(method, "nonlinear")),
+                "linear": _verdict_cell(row.linear, ratio_label(method, "linear")),
+                "nonlinear": _verdict_cell(row.nonlinear, ratio_label(method, "nonlinear")),
                 "dynamics": _dynamics_cell(row),
                 "margin": _margin_cell(row, verdict),
             }
@@ -970,35 +1045,35 @@ def render_assessment(
             sections.append(
                 {
                     "row": row,
-                    "mech": by_id[row["id"]],
-                    "constants": _constants_rows(by_id[row["id"]]),
+                    "mech": by_id[row.id],
+                    "constants": _constants_rows(by_id[row.id]),
                     "figures": figs,
                     "cells": cells,
-                    "linear_rows": _check_rows(row["linear"]),
-                    "nonlinear_rows": _check_rows(row["nonlinear"]),
+                    "linear_rows": _check_rows(row.linear),
+                    "nonlinear_rows": _check_rows(row.nonlinear),
                 }
             )
     project = site.project.model_dump()
     context = {
-        "retrofit": _retrofit_context(doc.get("retrofit"), doc["mechanisms"]),
+        "retrofit": _retrofit_context(doc.retrofit, doc.mechanisms),
         "title": project.get("title") or "Seismic assessment of local collapse mechanisms",
         "project": project,
         "generated": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
-        "site": doc["site"],
-        "method": doc.get("method", {}),
-        "hazard_table": hazard_table(doc["site"]),
+        "site": doc.site,
+        "method": doc.method,
+        "hazard_table": hazard_table(doc.site),
         "ratio_linear": ratio_label(method, "linear"),
         "ratio_nonlinear": ratio_label(method, "nonlinear"),
-        "conclusion": doc["conclusion"],
-        "disagreements": [v for v in doc["conclusion"]["mechanisms"] if "pulse_margin" in v],
+        "conclusion": doc.conclusion,
+        "disagreements": [v for v in doc.conclusion.mechanisms if v.pulse_margin is not None],
         "commands": reproduce_commands(sources, options),
         "version": __version__,
         "spectrum_figure": spectrum_fig,
         "verdicts": verdicts,
         "sections": sections,
-        "governing": doc["governing"],
-        "records": doc.get("records", []),
-        "multiples": doc.get("multiples", []),
+        "governing": doc.governing,
+        "records": doc.records,
+        "multiples": doc.multiples,
         "sources": list(sources),
         "options_rows": _table_of(options or {}),
         "versions_rows": _table_of(_versions()),
@@ -1050,16 +1125,15 @@ def _upgrade_rows(rdoc: RetrofitDoc) -> list[dict[str, Any]]:
 
 
 def _retrofit_context(
-    data: Optional[dict[str, Any]], mechanisms: list[dict[str, Any]]
+    rdoc: Optional[RetrofitDoc], mechanisms: Sequence[CheckMechanism]
 ) -> Optional[dict[str, Any]]:
     """Return page one's retrofit table (rows, sentences, steel and anchorage), or None.
 
-    ``data`` is the document's ``retrofit`` (a retrofit document as data), absent without
-    ``--retrofit``; ``mechanisms`` the assessment's rows (``records_notes``).
+    ``rdoc`` is the document's ``retrofit``, absent without ``--retrofit``; ``mechanisms``
+    the assessment's rows (``records_notes``).
     """
-    if data is None:
+    if rdoc is None:
         return None
-    rdoc = RetrofitDoc.model_validate(data)
     notes = records_notes(rdoc, mechanisms)
     rows = []
     for r in retrofit_summary(rdoc):

@@ -31,11 +31,13 @@ import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Optional, Union
 
 import numpy as np
 
 from shared_schema.atomic import write_atomic
+from shared_schema.documents.envelope import EnvelopeDocument, ExactMethod, LibraryMethod
+from shared_schema.documents.history import HistoryDocument
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.paths import PathLike, as_path
 
@@ -65,13 +67,13 @@ class ReportContent:
     ----------
     cf : ConstantsFile
         The mechanisms.
-    env : dict
+    env : EnvelopeDocument
         The envelope document (``envelope_doc``).
     envelopes : list
         The envelopes it was made from, for the figure.
     motion : GroundMotion, optional
         The record, if any.
-    hist : dict, optional
+    hist : HistoryDocument, optional
         The time-history document (``history_doc``), with a record.
     top : float
         The largest scale factor [-]: the time histories drawn.
@@ -91,10 +93,10 @@ class ReportContent:
     """
 
     cf: Any
-    env: dict[str, Any]
+    env: EnvelopeDocument
     envelopes: Sequence[Any]
     motion: Optional[Any] = None
-    hist: Optional[dict[str, Any]] = None
+    hist: Optional[HistoryDocument] = None
     top: float = 1.0
     runs: Sequence[tuple[str, Any]] = ()
     runs_error: Optional[str] = None
@@ -221,26 +223,26 @@ def _constants_section(cf: Any) -> str:
     return "<h2>Kinematic constants</h2>" + _table(headers, rows, left=4)
 
 
-def _envelope_section(doc: dict[str, Any], figure: str) -> str:
-    bands = [[_e(b["mechanism"]), _num(b["f_min"]), _num(b["f_max"])] for b in doc["critical"]]
-    method = doc["method"]
-    if method.get("source") == "exact":
+def _envelope_section(doc: EnvelopeDocument, figure: str) -> str:
+    bands = [[_e(b.mechanism), _num(b.f_min), _num(b.f_max)] for b in doc.critical]
+    method = doc.method
+    if isinstance(method, ExactMethod):
         how = (
             "Exact boundaries at every frequency: each amplitude simulated with the exact "
             "integrator and the exact overturning criterion; changes of outcome bisected to a "
-            f"relative 1e-6 (search limit A_max = {method.get('a_max')}). Each band edge lies "
-            "between the last frequency of one band and the first of the next (hatched)."
+            f"relative 1e-6 (search limit A_max = {method.a_max}). Each band edge "
+            "lies between the last frequency of one band and the first of the next (hatched)."
         )
     else:
-        bound = method.get("bound", {})
+        bound = method.bound
         how = (
-            f"Fast mode: library {_e(method.get('library_version', ''))} "
-            f"(generated {_e(method.get('generated', ''))}), "
-            f"{_e(method.get('interpolation', ''))}; {_e(method.get('exact_points', 0))} "
+            f"Fast mode: library {_e(method.library_version or '')} "
+            f"(generated {_e(method.generated or '')}), "
+            f"{_e(method.interpolation)}; {_e(method.exact_points)} "
             "points computed exactly. Never above the exact value (to "
-            f"{_num(bound.get('above_exact'))}), at most "
-            f"{_num(100 * bound.get('below_exact', 0))} % below it; band edges within a "
-            f"factor {_num(method.get('edge_ratio'))} in frequency (hatched)."
+            f"{_num(bound.above_exact)}), at most "
+            f"{_num(100 * bound.below_exact)} % below it; band edges within a "
+            f"factor {_num(method.edge_ratio)} in frequency (hatched)."
         )
     return (
         "<h2>Overturning envelopes and critical mechanism</h2>"
@@ -250,40 +252,41 @@ def _envelope_section(doc: dict[str, Any], figure: str) -> str:
     )
 
 
-def _history_table(doc: dict[str, Any]) -> str:
+def _history_table(doc: HistoryDocument) -> str:
     """Every mechanism at every scale; the scale factors up the structure, when used."""
-    disp = "displacement" in doc
+    disp = doc.displacement
     headers = ["mechanism", "scale", "effective scale", "peak |φ|/φ_ov", "overturned"]
     headers += ["t_overturn [s]", "impacts", "error estimate", "status"]
-    if disp:
-        headers.append(f"peak displacement at {doc['displacement']['height_m']:g} m [m]")
+    if disp is not None:
+        headers.append(f"peak displacement at {disp.height_m:g} m [m]")
     rows = []
-    for r in doc["results"]:
-        verdict = '<span class="yes">yes</span>' if r["overturned"] else "no"
+    for r in doc.results:
+        verdict = '<span class="yes">yes</span>' if r.overturned else "no"
+        given = "effective_scale" in r.model_fields_set  # as the JSON holds it
         row = [
-            _e(r["mechanism"]),
-            _num(r["scale"]),
-            _num(r.get("effective_scale", r["scale"])),
-            _num(r["peak_ratio"]),
+            _e(r.mechanism),
+            _num(r.scale),
+            _num(r.effective_scale if given else r.scale),
+            _num(r.peak_ratio),
             verdict,
-            _num(r["t_overturn"]),
-            _num(r["n_impacts"]),
-            _num(r["error_estimate"], ".1e"),
-            _e(r["message"]),
+            _num(r.t_overturn),
+            _num(r.n_impacts),
+            _num(r.error_estimate, ".1e"),
+            _e(r.message),
         ]
-        if disp:
-            row.append(_num(r.get("peak_displacement_m")))
+        if disp is not None:
+            row.append(_num(r.peak_displacement_m))
         rows.append(row)
     out = _table(headers, rows)
-    factors = doc.get("scale_factors") or {}
+    factors = doc.scale_factors or {}
     if factors:
         sf_rows = [
             [
                 _e(k),
-                _num(v["value"]),
-                _e(v["method"]),
-                _e(v["formula"]),
-                _e(json.dumps(v["inputs"])),
+                _num(v.value),
+                _e(v.method),
+                _e(v.formula),
+                _e(json.dumps(v.to_dict()["inputs"])),
             ]
             for k, v in factors.items()
         ]
@@ -293,14 +296,13 @@ def _history_table(doc: dict[str, Any]) -> str:
     return out
 
 
-def _skipped_section(doc: dict[str, Any]) -> str:
-    """Every mechanism the time histories left out, and why (``doc["skipped"]``; #25)."""
-    skipped = doc.get("skipped") or []
+def _skipped_section(doc: HistoryDocument) -> str:
+    """Every mechanism the time histories left out, and why (``doc.skipped``; #25)."""
+    skipped = doc.skipped or []
     if not skipped:
         return ""
     items = "".join(
-        f"<li><strong>{_e(s['mechanism'])}</strong> skipped: {_e(s['reason'])}</li>"
-        for s in skipped
+        f"<li><strong>{_e(s.mechanism)}</strong> skipped: {_e(s.reason)}</li>" for s in skipped
     )
     return (
         f"<div class='skipped'><p>{len(skipped)} mechanism(s) left out of the time histories "
@@ -374,7 +376,7 @@ def _provenance(
     motion: Optional[Any],
     sources: Sequence[dict[str, Any]],
     request: dict[str, Any],
-    env_method: dict[str, Any],
+    env_method: Union[ExactMethod, LibraryMethod],
 ) -> str:
     src_rows = [
         [_e(s["role"]), _e(s["name"]), _num(s["bytes"]), f"<code>{_e(s['sha256'])}</code>"]
@@ -383,7 +385,7 @@ def _provenance(
     parts = ["<h2>Inputs and provenance</h2>"]
     parts.append(_table(["input", "name", "bytes", "SHA-256"], src_rows, left=2))
     opts = [[_e(k), _e(json.dumps(v))] for k, v in request.items()]
-    opts.append(["envelope method", _e(json.dumps(env_method))])
+    opts.append(["envelope method", _e(json.dumps(env_method.to_dict()))])
     parts.append("<h3>Analysis options</h3>" + _table(["option", "value"], opts, left=2))
     mech = []
     for m in cf.mechanisms:
@@ -404,7 +406,7 @@ def _provenance(
     return "".join(parts)
 
 
-def _accuracy(hist: Optional[dict[str, Any]]) -> str:
+def _accuracy(hist: Optional[HistoryDocument]) -> str:
     items = [
         "<li>Time histories and pulses: exact closed-form integration between impacts, impacts "
         "located to machine precision; each result carries the estimated absolute error of "
@@ -413,8 +415,13 @@ def _accuracy(hist: Optional[dict[str, Any]]) -> str:
         "<li>Response spectrum: exact for a record linear between samples (Nigam–Jennings); "
         "only roundoff remains.</li>",
     ]
-    if hist is not None and hist["results"]:
-        errs = [r["error_estimate"] for r in hist["results"] if r["error_estimate"] is not None]
+    if hist is not None and hist.results:
+        # as the JSON holds them: a value not finite is null there, and left out here
+        errs = [
+            r.error_estimate
+            for r in hist.results
+            if r.error_estimate is not None and math.isfinite(r.error_estimate)
+        ]
         worst = max(errs) if errs else float("nan")
         items.append(
             f"<li>Largest error estimate in the time histories: {_num(worst, '.1e')}.</li>"
@@ -454,7 +461,7 @@ def render_report(
         draw = functools.partial(
             plot_envelopes,
             content.envelopes,
-            env["critical"],
+            [b.to_dict() for b in env.critical],
             folder / "envelope.png",
             labels={m.id: f"{m.id}: {m.name}" for m in cf.mechanisms},
             title="Minimum overturning one-sine pulse (ground level)",
@@ -469,7 +476,7 @@ def render_report(
             body.append(_record_section(content, folder))
             body.append(_history_section(hist, _history_figures(content, folder)))
         body.append(_accuracy(hist))
-        body.append(_provenance(cf, motion, sources, dict(request or {}), env["method"]))
+        body.append(_provenance(cf, motion, sources, dict(request or {}), env.method))
     when = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     return (
         '<!DOCTYPE html>\n<html lang="en" data-plots-loaded="pending"><head>'
@@ -481,13 +488,13 @@ def render_report(
     )
 
 
-def _history_section(hist: dict[str, Any], figures: list[str]) -> str:
+def _history_section(hist: HistoryDocument, figures: list[str]) -> str:
     return (
         "<h2>Time histories</h2>"
-        f"<p>criterion: {_e(hist['criterion'])}; method: {_e(hist['method'])}"
+        f"<p>criterion: {_e(hist.criterion)}; method: {_e(hist.method)}"
         + (
-            f"; scale factor up the structure: {_e(hist['scale_factor_method'])}"
-            if "scale_factor_method" in hist
+            f"; scale factor up the structure: {_e(hist.scale_factor_method)}"
+            if hist.scale_factor_method is not None
             else ""
         )
         + "</p>"

@@ -14,9 +14,11 @@ Light on purpose (the document's model only): the command line loads it when it 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Optional
 
+from shared_schema.documents.check import CheckMechanism, Nonlinear2019
 from shared_schema.errors import InputError
 from shared_schema.retrofit import (
     CheckFigures,
@@ -199,28 +201,25 @@ def check_retrofit_ids(doc: RetrofitDoc, ids: list[str]) -> None:
         )
 
 
-def _check_ratios(row: dict[str, Any]) -> dict[str, Optional[float]]:
+def _check_ratios(row: CheckMechanism) -> dict[str, Optional[float]]:
     """Return an assessment row's governing ratios, named as ``CheckFigures`` names them."""
-    lin, non = row.get("linear") or {}, row.get("nonlinear") or {}
-    out: dict[str, Optional[float]] = {"linear_ratio": None, "SLV_ratio": None, "SLC_ratio": None}
-    if lin.get("status") == "ok":
-        out["linear_ratio"] = lin.get("capacity_ratio")
-    if non.get("status") == "ok":
-        out["SLV_ratio"] = non.get("capacity_ratio")
-        slc = non.get("SLC")
-        if isinstance(slc, dict):
-            out["SLC_ratio"] = slc.get("capacity_ratio")
-    return out
+    non = row.nonlinear
+    slc = non.SLC.capacity_ratio if isinstance(non, Nonlinear2019) else None
+    return {
+        "linear_ratio": row.linear_ratio,
+        "SLV_ratio": row.nonlinear_ratio,
+        "SLC_ratio": None if slc is None else float(slc),
+    }
 
 
-def check_retrofit_matches(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> None:
+def check_retrofit_matches(doc: RetrofitDoc, rows: Sequence[CheckMechanism]) -> None:
     """Refuse a retrofit document that was not made from this assessment's inputs.
 
     Parameters
     ----------
     doc : RetrofitDoc
         A ``retrofit.json`` read back.
-    rows : list of dict
+    rows : sequence of CheckMechanism
         The mechanism rows of the code checks as the retrofit ran them
         (``assess.check_doc_with_records``: with the records' demand where it had records).
 
@@ -231,8 +230,8 @@ def check_retrofit_matches(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> None
         whose checks before the tie (``before``: a_g,X/a_g) are not the assessment's own to
         ``MATCH_RTOL``: the document was made from other constants or another site.
     """
-    check_retrofit_ids(doc, [str(r["id"]) for r in rows])
-    by_id = {str(r["id"]): r for r in rows}
+    check_retrofit_ids(doc, [r.id for r in rows])
+    by_id = {r.id: r for r in rows}
     for m in doc.mechanisms:
         here = _check_ratios(by_id[m.id])
         for key, label in RATIO_LABELS.items():
@@ -254,7 +253,7 @@ def check_retrofit_matches(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> None
                 )
 
 
-def records_notes(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> dict[str, str]:
+def records_notes(doc: RetrofitDoc, rows: Sequence[CheckMechanism]) -> dict[str, str]:
     """Say where the assessment's records raise a demand the retrofit did not size for.
 
     A retrofit run with the assessment's records takes their demand as the assessment does
@@ -267,15 +266,15 @@ def records_notes(doc: RetrofitDoc, rows: list[dict[str, Any]]) -> dict[str, str
     ----------
     doc : RetrofitDoc
         The retrofit.
-    rows : list of dict
-        The assessment's mechanism rows (``assessment_doc(...)["mechanisms"]``).
+    rows : sequence of CheckMechanism
+        The assessment's mechanism rows (``assessment_document(...).mechanisms``).
 
     Returns
     -------
     dict
         ``{mechanism id: sentence}`` for the mechanisms whose nonlinear ratio differs.
     """
-    by_id = {str(r["id"]): r for r in rows}
+    by_id = {r.id: r for r in rows}
     notes = {}
     for m in doc.mechanisms:
         row = by_id.get(m.id)

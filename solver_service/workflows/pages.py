@@ -15,6 +15,9 @@ from typing import Any, Optional, Union
 import numpy as np
 
 from shared_schema.constants import ConstantsFile
+from shared_schema.documents.assess import AssessDocument
+from shared_schema.documents.check import CheckMechanism
+from shared_schema.documents.history import HistoryDocument
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.paths import PATH_TYPES, PathLike, as_path
 from shared_schema.retrofit import RetrofitDoc, RetrofitSpec
@@ -30,7 +33,13 @@ from ..report.assess import HistoryRun, check_template, render_assessment, sig
 from ..report.html import SPECTRUM_PERIODS, ReportContent, render_report
 from ..report.retrofit import check_retrofit_matches
 from .adapter import to_rocking_model
-from .assess import assessment_doc, check_doc_with_records, site_spectrum
+from .assess import (
+    assessment_doc,
+    check_doc_with_records,
+    site_spectrum,
+    typed_assessment,
+    typed_check,
+)
 from .documents import envelope_doc, history_doc
 from .scaling import Building, dense_runs, mechanism_scale_factor
 
@@ -109,14 +118,14 @@ def _record_content(cf: ConstantsFile, motion: GroundMotion) -> dict[str, Any]:
 
 
 def _history_runs(
-    cf: ConstantsFile, motion: GroundMotion, hist: dict[str, Any], top: float
+    cf: ConstantsFile, motion: GroundMotion, hist: HistoryDocument, top: float
 ) -> dict[str, Any]:
     """Return the runs at the largest scale with their time series, or why they cannot be made."""
     try:
         # the runs are made again with their time series: a run can fail here alone
         runs = [
             (f"{mech_id} ×{scale:.3g}", res)
-            for mech_id, scale, res in dense_runs(cf, motion, hist, top)
+            for mech_id, scale, res in dense_runs(cf, motion, hist.to_dict(), top)
         ]
     except FIGURE_ERRORS as exc:
         return {"runs_error": str(exc)}
@@ -180,19 +189,18 @@ def build_report(
     env_doc, envelopes = envelope_doc(
         cf, np.asarray(f_p, dtype=float), method=method, library=library
     )
-    env = env_doc.to_dict()  # the report renders the documents' JSON form
     extra: dict[str, Any] = {}
     if record is not None:
-        hist = history_doc(cf, record, list(scales), **(history or {})).to_dict()
+        hist = history_doc(cf, record, list(scales), **(history or {}))
         top = max(scales)
         extra = {"hist": hist, "top": top, **_record_content(cf, record)}
         extra.update(_history_runs(cf, record, hist, top))
-    content = ReportContent(cf, env, envelopes, record, **extra)
+    content = ReportContent(cf, env_doc, envelopes, record, **extra)
     return render_report(content, title=title, sources=sources, request=request)
 
 
 def _mechanism_histories(
-    mech: Any, row: dict[str, Any], motions: Sequence[GroundMotion]
+    mech: Any, row: CheckMechanism, motions: Sequence[GroundMotion]
 ) -> list[HistoryRun]:
     """One mechanism's time histories at each record's design scale (× Eq. 28 up the building)."""
     try:
@@ -200,10 +208,10 @@ def _mechanism_histories(
     except RockmechError as exc:
         return [HistoryRun("time histories", note=f"not run: {exc}")]
     out: list[HistoryRun] = []
-    for k, (motion, dyn) in enumerate(zip(motions, row.get("dynamics", []))):
-        if "scale_factor" not in dyn:
+    for k, (motion, dyn) in enumerate(zip(motions, row.dynamics or [])):
+        if dyn.scale_factor is None or dyn.scale_factor.value is None:
             continue
-        design = float(dyn["scale_factor"]["value"])
+        design = float(dyn.scale_factor.value)
         caption = f"{mech.id} on {motion.name} at the design scale {sig(design)}"
         try:
             height = mechanism_scale_factor(mech, motion, "eq28")
@@ -225,7 +233,7 @@ def _mechanism_histories(
 
 
 def assessment_histories(
-    cf: ConstantsFile, doc: dict[str, Any], motions: Sequence[GroundMotion]
+    cf: ConstantsFile, doc: AssessDocument, motions: Sequence[GroundMotion]
 ) -> dict[str, list[HistoryRun]]:
     """Per mechanism of an assessment document, its time histories at the design scale.
 
@@ -233,8 +241,8 @@ def assessment_histories(
     ----------
     cf : ConstantsFile
         The mechanisms of ``doc``.
-    doc : dict
-        ``workflows.assess.assessment_doc(cf, site, motions, ...)``.
+    doc : AssessDocument
+        ``workflows.assess.assessment_document(cf, site, motions, ...)``.
     motions : sequence of GroundMotion
         Its records, in its order.
 
@@ -244,9 +252,7 @@ def assessment_histories(
         Each run with its time series, or the note on why it was not run or drawn.
     """
     by_id = {m.id: m for m in cf.mechanisms}
-    return {
-        row["id"]: _mechanism_histories(by_id[row["id"]], row, motions) for row in doc["mechanisms"]
-    }
+    return {row.id: _mechanism_histories(by_id[row.id], row, motions) for row in doc.mechanisms}
 
 
 def assessment_retrofit(
@@ -279,7 +285,7 @@ def assessment_retrofit(
     if isinstance(source, RetrofitDoc):
         # The code checks as the retrofit ran them: with the records' demand if it had any.
         doc, _ = check_doc_with_records(cf, site, motions if source.records else ())
-        check_retrofit_matches(source, doc["mechanisms"])
+        check_retrofit_matches(source, typed_check(doc).mechanisms)
         return source
     # The retrofit (its bisections on the code checks) is loaded only when a spec is given.
     from .retrofit import retrofit_doc
@@ -327,12 +333,13 @@ def assess_report(
     if retrofit is not None:
         made = assessment_retrofit(cf, site, retrofit, motions)
         doc["retrofit"] = made.model_dump(mode="json")
+    typed = typed_assessment(doc)  # the page reads the typed document
     text = render_assessment(
-        doc,
+        typed,
         cf,
         site,
         site_spectrum(site),
-        assessment_histories(cf, doc, motions),
+        assessment_histories(cf, typed, motions),
         sources=sources,
         options=options,
         template_dir=template_dir,

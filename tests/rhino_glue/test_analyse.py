@@ -23,6 +23,7 @@ from rhino_plugin.flows.analyse import (
     run_pulse,
 )
 from shared_schema.errors import InputError
+from solver_service.workflows.documents import envelope_doc, history_doc, solve_pulse
 
 from .conftest import CANCEL, ROOT, ScriptedPrompter
 
@@ -47,8 +48,9 @@ def test_local_envelopes_equal_the_cli(tmp_path: Path) -> None:
     result = run_envelopes(cf, f_min=0.5, f_max=5.0, n=30, out_dir=str(tmp_path))
     want = cli_json("envelope", str(CHURCH), "--out", str(tmp_path / "cli"),
                     "--f-min", "0.5", "--f-max", "5", "--n", "30")  # fmt: skip
+    got = result.doc.to_dict()
     for key in ("f_p", "mechanisms", "critical", "governing"):
-        assert result.doc[key] == want[key], key
+        assert got[key] == want[key], key
     assert Path(result.plot or "").stat().st_size > 0
     assert json.loads((tmp_path / "envelope.json").read_text())["critical"] == want["critical"]
     assert result.summary[0] == "critical mechanism by pulse frequency:"
@@ -62,7 +64,8 @@ def test_local_history_equals_the_cli(tmp_path: Path) -> None:
     )  # fmt: skip
     want = cli_json("history", str(WALLS), str(RECORD), "--scale", "0.5", "1")
     strip = ("runtime_s",)
-    got_rows = [{k: v for k, v in r.items() if k not in strip} for r in result.doc["results"]]
+    got = result.doc.to_dict()["results"]
+    got_rows = [{k: v for k, v in r.items() if k not in strip} for r in got]
     want_rows = [{k: v for k, v in r.items() if k not in strip} for r in want["results"]]
     assert got_rows == want_rows
     assert Path(result.plot or "").stat().st_size > 0
@@ -75,7 +78,7 @@ def test_history_states_the_record_warning_first(tmp_path: Path) -> None:
     result = run_history(cf, str(RECORD), units="cm/s2", scales=[1.0], out_dir=str(tmp_path))
     assert result.summary[0].startswith("  warning: record: PGA 0.000356 g is outside"), result
     assert "(read in cm/s2)" in result.summary[0]
-    assert len(result.summary) == 1 + len(result.doc["results"])
+    assert len(result.summary) == 1 + len(result.doc.to_dict()["results"])
 
 
 def test_local_pulse_equals_the_cli() -> None:
@@ -84,8 +87,9 @@ def test_local_pulse_equals_the_cli() -> None:
     result = run_pulse(cf, mech.id, a_p_g=-0.61, f_p=1.59)
     want = cli_json("pulse", "--p-eq", repr(mech.positive.p_eq), "--lam", repr(mech.positive.lam),
                     "--eta", repr(mech.eta), "--a-p-g", "-0.61", "--f-p", "1.59")  # fmt: skip
+    got = result.doc.to_dict()
     for key in ("peak_ratio", "overturned", "t_peak", "n_impacts"):
-        assert result.doc[key] == want[key], key
+        assert got[key] == want[key], key
 
 
 def test_constants_files_are_merged_and_duplicate_ids_refused(tmp_path: Path) -> None:
@@ -116,7 +120,7 @@ def test_analyse_flow_envelopes_of_the_current_mechanisms(tmp_path: Path) -> Non
     assert prompter.done()
     want = cli_json("envelope", str(CHURCH), "--out", str(tmp_path / "cli"),
                     "--f-min", "0.5", "--f-max", "5")  # fmt: skip
-    assert result.doc["critical"] == want["critical"]
+    assert result.doc.to_dict()["critical"] == want["critical"]
     assert any("via the Python API" in m for m in prompter.messages)
     assert any(m.endswith("envelope.png") for m in prompter.messages)
 
@@ -135,7 +139,7 @@ def test_analyse_flow_history_with_several_scales(tmp_path: Path) -> None:
     prompter = ScriptedPrompter(None, steps)
     result = analyse_flow(prompter, str(tmp_path))
     assert result is not None, prompter.messages
-    assert sorted({r["scale"] for r in result.doc["results"]}) == [0.5, 1.0]
+    assert sorted({r["scale"] for r in result.doc.to_dict()["results"]}) == [0.5, 1.0]
 
 
 @pytest.mark.parametrize("k", range(4))
@@ -211,11 +215,31 @@ def service() -> Iterator[Tuple[str, Any]]:
         server.server_close()
 
 
+@pytest.fixture(scope="module")
+def answers() -> Dict[str, Dict[str, Any]]:
+    """Real documents the service could answer for WALLS (made here with the workflows).
+
+    The envelope's critical band is replaced by one the flow could not compute itself (W1
+    over 0.1-10 Hz): what the flow keeps and summarises is the service's answer.
+    """
+    import numpy as np
+
+    from solver_service.core.records import GroundMotion
+
+    cf = load_constants_files([str(WALLS)])
+    env = envelope_doc(cf, np.array([0.5, 2.0]))[0].to_dict()
+    env["critical"] = [{"mechanism": "W1", "f_min": 0.1, "f_max": 10.0}]
+    motion = GroundMotion.from_file(str(RECORD), units="g")
+    hist = history_doc(cf, motion, [1.0]).to_dict()
+    pulse = solve_pulse({"mechanism": cf.mechanisms[0], "a_p_g": 0.3, "f_p": 1.0}).to_dict()
+    return {"envelope": env, "history": hist, "pulse": pulse}
+
+
 def test_service_envelopes_post_the_constants_and_keep_the_answer(
-    service: Any, tmp_path: Path
+    service: Any, tmp_path: Path, answers: Dict[str, Dict[str, Any]]
 ) -> None:
     url, recorder = service
-    answer = {"critical": [{"mechanism": "W1", "f_min": 0.1, "f_max": 10.0}], "f_p": [0.1]}
+    answer = answers["envelope"]
     recorder.answers["/api/v1/envelope"] = (200, answer)
     cf = load_constants_files([str(WALLS)])
     result = run_envelopes(cf, f_min=0.2, f_max=8.0, n=50, out_dir=str(tmp_path),
@@ -224,16 +248,33 @@ def test_service_envelopes_post_the_constants_and_keep_the_answer(
     assert path == "/api/v1/envelope"
     assert (body["f_min"], body["f_max"], body["n"]) == (0.2, 8.0, 50)
     assert [m["id"] for m in body["constants"]["mechanisms"]] == [m.id for m in cf.mechanisms]
-    assert result.doc == answer
+    assert result.doc.to_dict() == answer  # validated into the envelope document
     assert json.loads((tmp_path / "envelope.json").read_text()) == answer
     assert result.summary == ["critical mechanism by pulse frequency:", "  W1: 0.1 to 10 Hz"]
 
 
-def test_service_history_sends_the_record_in_si(service: Any, tmp_path: Path) -> None:
+def test_service_answer_that_is_not_the_document_is_refused_naming_the_field(
+    service: Any, tmp_path: Path, answers: Dict[str, Dict[str, Any]]
+) -> None:
+    url, recorder = service
+    wrong = {k: v for k, v in answers["envelope"].items() if k != "critical"}
+    recorder.answers["/api/v1/envelope"] = (200, wrong)
+    cf = load_constants_files([str(WALLS)])
+    with pytest.raises(InputError, match=r"/envelope is not its EnvelopeDocument: critical: "):
+        run_envelopes(cf, out_dir=str(tmp_path), client=ServiceClient(url))
+    recorder.answers["/api/v1/pulse"] = (200, dict(answers["pulse"], overturned="maybe"))
+    with pytest.raises(InputError, match=r"/pulse is not its PulseDocument: overturned: ") as err:
+        run_pulse(cf, "W1", a_p_g=0.3, f_p=1.0, client=ServiceClient(url))
+    assert err.value.field == "service"
+
+
+def test_service_history_sends_the_record_in_si(
+    service: Any, tmp_path: Path, answers: Dict[str, Dict[str, Any]]
+) -> None:
     from solver_service.core.records import GroundMotion
 
     url, recorder = service
-    recorder.answers["/api/v1/history"] = (200, {"results": []})
+    recorder.answers["/api/v1/history"] = (200, answers["history"])
     cf = load_constants_files([str(WALLS)])
     run_history(cf, str(RECORD), units="g", scales=[1.0, 2.0], out_dir=str(tmp_path),
                 client=ServiceClient(url))  # fmt: skip
@@ -269,12 +310,14 @@ def test_service_url_must_be_http() -> None:
         ServiceClient("ftp://example")
 
 
-def test_service_payloads_match_the_api_request_models(service: Any, tmp_path: Path) -> None:
+def test_service_payloads_match_the_api_request_models(
+    service: Any, tmp_path: Path, answers: Dict[str, Dict[str, Any]]
+) -> None:
     """The bodies validate against shared_schema.api's request models, where present."""
     api = pytest.importorskip("shared_schema.api", reason="the REST request models are absent")
     url, recorder = service
     for endpoint in ("envelope", "history", "pulse"):
-        recorder.answers[f"/api/v1/{endpoint}"] = (200, {})
+        recorder.answers[f"/api/v1/{endpoint}"] = (200, answers[endpoint])
     cf = load_constants_files([str(WALLS)])
     client = ServiceClient(url)
     run_envelopes(cf, out_dir=str(tmp_path), client=client)

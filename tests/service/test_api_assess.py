@@ -248,7 +248,7 @@ def test_code_check_flow_through_the_service_equals_the_python_api(server: Any) 
     cf = parse_constants(GEOMETRY.read_bytes())
     site = parse_site(NTC.read_bytes())
     result = run_check(cf, site, client=ServiceClient(server.url))
-    assert result.doc == stamp(check_doc(cf, site), "check")  # units and version added
+    assert result.doc.to_dict() == stamp(check_doc(cf, site), "check")  # units and version added
     assert result.summary == run_check(cf, site).summary
 
 

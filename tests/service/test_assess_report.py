@@ -20,7 +20,7 @@ from shared_schema.constants import parse_constants
 from shared_schema.site import parse_site
 from solver_service.cli import app
 from solver_service.core.records import GroundMotion
-from solver_service.workflows.assess import assessment_doc, site_spectrum
+from solver_service.workflows.assess import assessment_document, site_spectrum
 from solver_service.workflows.pages import assessment_histories
 
 pytest.importorskip("jinja2")
@@ -68,7 +68,7 @@ def test_short_form_church_gets_notes_in_every_row_not_an_abort() -> None:
     cf = parse_constants(CHURCH_SHORT.read_bytes())
     site = parse_site(NTC_SITE.read_bytes())
     motion = GroundMotion.from_two_column(RECORD)
-    doc = assessment_doc(cf, site, [motion], multiples=(1.0,))
+    doc = assessment_document(cf, site, [motion], multiples=(1.0,))
     text = render_assessment(
         doc, cf, site, site_spectrum(site), assessment_histories(cf, doc, [motion])
     )
@@ -76,14 +76,14 @@ def test_short_form_church_gets_notes_in_every_row_not_an_abort() -> None:
     assert rows == [m.id for m in cf.mechanisms]
     assert text.count("no virtual_work in the constants") >= len(rows)
     # F1 is one-sided without eta: its dynamics and envelope say why they did not run.
-    f1 = next(r for r in doc["mechanisms"] if r["id"] == "F1")
-    assert "eta" in f1["envelope"]["note"]
+    f1 = next(r for r in doc.mechanisms if r.id == "F1")
+    assert f1.envelope is not None and "eta" in (f1.envelope.note or "")
 
 
 def test_each_number_of_the_worked_checks_names_its_clause() -> None:
     cf = parse_constants(CHURCH_GEOMETRY.read_bytes())
     site = parse_site(NTC_SITE.read_bytes())
-    doc = assessment_doc(cf, site, [], multiples=(1.0,))
+    doc = assessment_document(cf, site, [], multiples=(1.0,))
     text = render_assessment(doc, cf, site, site_spectrum(site), {})
     tables = re.findall(r'<table class="worked">(.*?)</table>', text, flags=re.S)
     assert len(tables) == 2 * len(cf.mechanisms)  # linear and nonlinear, per mechanism
@@ -114,7 +114,7 @@ def test_project_fields_are_escaped_and_a_user_template_wins(tmp_path: Path) -> 
     data = json.loads(NTC_SITE.read_text(encoding="utf-8"))
     data["project"]["client"] = "<script>alert(1)</script>"
     site = parse_site(data)
-    doc = assessment_doc(cf, site, [], multiples=(1.0,))
+    doc = assessment_document(cf, site, [], multiples=(1.0,))
     text = render_assessment(doc, cf, site, site_spectrum(site), {})
     assert "<script>alert(1)</script>" not in text and "&lt;script&gt;" in text
     firm = tmp_path / "firm"
@@ -199,7 +199,7 @@ def _page_and_doc(tmp_path: Path) -> tuple[str, dict]:
     cf = parse_constants(CHURCH_GEOMETRY.read_bytes())
     site = parse_site(NTC_SITE.read_bytes())
     motion = GroundMotion.from_two_column(RECORD)
-    doc = assessment_doc(cf, site, [motion], multiples=[1.0, 2.0])
+    doc = assessment_document(cf, site, [motion], multiples=[1.0, 2.0])
     sources = [
         input_source("constants", CHURCH_GEOMETRY.name, CHURCH_GEOMETRY.read_bytes()),
         input_source("site", NTC_SITE.name, NTC_SITE.read_bytes()),
@@ -214,7 +214,7 @@ def _page_and_doc(tmp_path: Path) -> tuple[str, dict]:
         sources=sources,
         options={"multiples": [1.0, 2.0]},
     )
-    return page, doc
+    return page, doc.to_dict()
 
 
 def test_hazard_table_has_one_row_per_quantity_with_its_unit_and_source(tmp_path: Path) -> None:

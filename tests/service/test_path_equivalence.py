@@ -286,6 +286,6 @@ def test_every_history_path_gives_the_same_answer(
                 out_dir=str(tmp_path / f"{path.stem}-{where}"),
                 client=ServiceClient(url) if url else None,
             )
-            got[where] = result.doc
+            got[where] = result.doc.to_dict()
         for where, doc in got.items():
             assert _answer_rows(doc) == want, (path.name, where)

@@ -21,4 +21,4 @@ class RM_CodeCheck(Grasshopper.Kernel.GH_ScriptInstance):
         site_file = parse_site_text(site)
         client = ServiceClient(str(service)) if service else None
         result = run_check(cf, site_file, client=client)
-        return json.dumps(result.doc, indent=2), result.summary
+        return json.dumps(result.doc.to_dict(), indent=2), result.summary

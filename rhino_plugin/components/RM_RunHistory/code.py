@@ -30,4 +30,4 @@ class RM_RunHistory(Grasshopper.Kernel.GH_ScriptInstance):
             out_dir=out,
             client=client,
         )
-        return json.dumps(result.doc, indent=2), result.summary, result.plot
+        return json.dumps(result.doc.to_dict(), indent=2), result.summary, result.plot

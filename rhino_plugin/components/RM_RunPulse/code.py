@@ -20,4 +20,4 @@ class RM_RunPulse(Grasshopper.Kernel.GH_ScriptInstance):
         client = ServiceClient(str(service)) if service else None
         mech = str(mechanism) if mechanism else cf.mechanisms[0].id
         result = run_pulse(cf, mech, a_p_g=float(a_p_g), f_p=float(f_p), client=client)
-        return json.dumps(result.doc, indent=2), result.summary
+        return json.dumps(result.doc.to_dict(), indent=2), result.summary
