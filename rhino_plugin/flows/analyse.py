@@ -17,11 +17,12 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Type, TypeVar, Union
 
+from pydantic import BaseModel
+
 from rhino_plugin.flows.mechanisms import checked_number
 from rhino_plugin.flows.prompter import Cancelled, Prompter
 from shared_schema.atomic import write_atomic
 from shared_schema.constants import ConstantsFile
-from shared_schema.documents.base import Document
 from shared_schema.documents.check import CheckDocument
 from shared_schema.documents.envelope import EnvelopeDocument
 from shared_schema.documents.history import HistoryDocument
@@ -54,7 +55,7 @@ SERVICE_TIMEOUT_S = 300.0
 N_FREQUENCIES = 200
 #: The documents an analysis gives (``AnalysisResult.doc``).
 AnalysisDoc = Union[EnvelopeDocument, HistoryDocument, PulseDocument, CheckDocument]
-_D = TypeVar("_D", bound=Document)
+_D = TypeVar("_D", bound="BaseModel")
 
 
 @dataclass

@@ -33,7 +33,7 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
-from rhino_plugin.flows.analyse import ServiceClient
+from rhino_plugin.flows.analyse import ServiceClient, typed_answer
 from rhino_plugin.flows.marks import Mark
 from rhino_plugin.flows.prompter import Prompter
 from shared_schema.constants import ConstantsFile
@@ -298,7 +298,7 @@ def _scene_retrofit(
         "spec": _read(spec_path),
     }
     answer = ServiceClient(service_url).post_files("retrofit", files)
-    return RetrofitDoc.model_validate(answer), "the service"
+    return typed_answer(RetrofitDoc, answer, "retrofit"), "the service"
 
 
 def _constants_retrofit(
@@ -317,7 +317,8 @@ def _constants_retrofit(
             "site": json.loads(site.model_dump_json(exclude_none=True)),
             "spec": json.loads(spec.model_dump_json(exclude_none=True)),
         }
-        doc = RetrofitDoc.model_validate(ServiceClient(service_url).post("retrofit", payload))
+        answer = ServiceClient(service_url).post("retrofit", payload)
+        doc = typed_answer(RetrofitDoc, answer, "retrofit")
         where = "the service"
     else:
         check_retrofit_work(

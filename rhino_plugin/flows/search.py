@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, List, Optional, Sequence, Tuple
 
-from rhino_plugin.flows.analyse import ServiceClient
+from rhino_plugin.flows.analyse import ServiceClient, typed_answer
 from rhino_plugin.flows.marks import Mark
 from rhino_plugin.flows.prepared import PreparedScene
 from rhino_plugin.flows.prompter import Prompter
@@ -135,15 +135,14 @@ def search_flow(
         if not scene_path:
             raise InputError("save the model first: the service searches the saved file", "scene")
         client = ServiceClient(service_url)
-        doc = SearchDocument.model_validate(
-            client.post_files(
-                "search",
-                {
-                    "scene": (scene_name, Path(scene_path).read_bytes()),
-                    "spec": (spec_path.name, spec_path.read_bytes()),
-                },
-            )
+        answer = client.post_files(
+            "search",
+            {
+                "scene": (scene_name, Path(scene_path).read_bytes()),
+                "spec": (spec_path.name, spec_path.read_bytes()),
+            },
         )
+        doc = typed_answer(SearchDocument, answer, "search")
         result = SearchFlowResult(doc, search_lines(doc), search_marks(doc, scene.unit_scale))
     else:
         spec = read_search_spec(spec_path)

@@ -327,3 +327,25 @@ def test_service_payloads_match_the_api_request_models(
               "pulse": api.PulseRequest}  # fmt: skip
     for path, body in recorder.received:
         models[path.rsplit("/", 1)[1]].model_validate_json(json.dumps(body))
+
+
+def test_a_service_retrofit_that_is_not_the_document_is_refused_naming_the_field(
+    service: Any, tmp_path: Path
+) -> None:
+    # RM_Retrofit on the service: its answer is validated into the retrofit document too.
+    from rhino_plugin.flows.retrofit import retrofit_flow
+
+    from .conftest import ScriptedPrompter
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    files = [
+        ("get_file", str(examples / "constants" / "church_geometry.json")),
+        ("get_file", str(examples / "sites" / "ntc_site.json")),
+        ("get_file", str(examples / "specs" / "church.retrofit.json")),
+    ]
+    url, recorder = service
+    recorder.answers["/api/v1/retrofit"] = (200, {"rockmech_version": "0", "mechanisms": "x"})
+    with pytest.raises(InputError, match=r"/retrofit is not its RetrofitDoc: ") as err:
+        retrofit_flow(ScriptedPrompter(None, files), str(tmp_path), stem="c", service_url=url)
+    assert err.value.field == "service"
+    assert not (tmp_path / "c.retrofit").exists()  # nothing written from a wrong answer
