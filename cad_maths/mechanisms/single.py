@@ -368,7 +368,9 @@ def rigid_body(spec: Any, scene: Any) -> Tuple[Body, RockingSide, Dict[str, Any]
     side : RockingSide
         The positive side about ``spec.axis``.
     geometry : dict
-        ``mass_kg``, ``volume_m3``, ``com_m`` and the positive side's summary.
+        ``mass_kg``, ``volume_m3``, ``com_m``, ``top_m`` (the height of the moving part's
+        highest point above the positive hinge's axis point [m]: where a tie at the top of
+        the moving part goes) and the positive side's summary.
     """
     where = spec.id
     start, end = resolve_axis(scene, spec.axis, f"{where}.axis")
@@ -380,6 +382,7 @@ def rigid_body(spec: Any, scene: Any) -> Tuple[Body, RockingSide, Dict[str, Any]
         "mass_kg": float(body.props.mass),
         "volume_m3": float(sum(p.volume for p in body.parts)),
         "com_m": [float(v) for v in body.props.com],
+        "top_m": float(body.vertices[:, 2].max() - pos.point[2]),
         "positive": side_summary(pos),
     }
     return body, pos, geometry

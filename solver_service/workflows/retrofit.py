@@ -173,15 +173,46 @@ def top_height(mech: Mechanism) -> tuple[Optional[float], str]:
     h = geo.get("h_m")
     if isinstance(h, (int, float)) and not isinstance(h, bool):
         return float(h), "the geometry's h_m"
+    top = geo.get("top_m")  # the builder's: the moving part's highest point above the hinge
+    if isinstance(top, (int, float)) and not isinstance(top, bool) and top > 0.0:
+        return float(top), "the geometry's top_m (the moving part's highest point)"
     got = geo.get("positive")
     pos: dict[str, Any] = got if isinstance(got, dict) else {}
     r, a = pos.get("R_m"), pos.get("alpha_rad")
     if isinstance(r, (int, float)) and isinstance(a, (int, float)):
+        not_rectangle = _not_a_rectangle(geo, float(r))
+        if not_rectangle is not None:
+            return None, not_rectangle
         return (
             2.0 * float(r) * math.cos(float(a)),
             "the rectangle of the block's R and alpha (2 R cos α)",
         )
     return None, "the constants' geometry gives no height of the moving part"
+
+
+#: A homogeneous rectangular block has I_O = 4/3 M R² about its edge: within this, it is one.
+RECTANGLE_RTOL = 1e-6
+
+
+def _not_a_rectangle(geo: dict[str, Any], r: float) -> Optional[str]:
+    """Why 2 R cos α is not the block's top (None: a rectangle, or nothing tells).
+
+    Only a homogeneous rectangle has its top at twice its centre of mass's height; its
+    inertia about the hinge is then ``4/3 M R²``, which the constants' geometry can show.
+    """
+    pos = geo.get("positive")
+    i_o = pos.get("I_O_kg_m2") if isinstance(pos, dict) else None
+    mass = geo.get("mass_kg")
+    if not isinstance(i_o, (int, float)) or not isinstance(mass, (int, float)) or mass <= 0:
+        return None
+    ratio = float(i_o) / (4.0 / 3.0 * float(mass) * r * r)
+    if abs(ratio - 1.0) <= RECTANGLE_RTOL:
+        return None
+    return (
+        "the constants' geometry gives no top of the moving part (top_m), and the block is "
+        f"not a homogeneous rectangle (I_O = {ratio:.4g} x 4/3 M R^2), so 2 R cos α is not "
+        "its top"
+    )
 
 
 def with_tie(mech: Mechanism, force: float, height: float, *, listed: bool) -> Mechanism:

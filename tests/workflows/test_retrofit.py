@@ -205,14 +205,14 @@ def _church_default(order: int = 1) -> Any:
 def test_default_ties_are_the_top_and_each_level_the_moving_part_crosses() -> None:
     data, doc = _church_default()
     by_id = {m["id"]: m for m in data["mechanisms"]}
-    # F1 by hand: the hinge at z = axis_point_m[2] on a horizontal axis; the top 2 R cos α
-    # (the constants give no h_m); each floor's height its load point's z above the hinge;
-    # the roof within 0.5 % of the top is the top's candidate.
+    # F1 by hand: the hinge at z = axis_point_m[2] on a horizontal axis; the top the
+    # builder's top_m (the wall's highest point, 8 m); each floor's height its load point's z
+    # above the hinge; the roof at the top is the top's candidate.
     geo = by_id["F1"]["geometry"]
     z0 = geo["positive"]["axis_point_m"][2]
-    top = 2.0 * geo["positive"]["R_m"] * math.cos(geo["positive"]["alpha_rad"])
+    top = geo["top_m"]
     levels = {e["element"]: e["at_m"][2] - z0 for e in geo["loaded"]["elements"]}
-    assert levels["F1.roof"] != top and abs(levels["F1.roof"] - top) < 0.005 * top
+    assert abs(levels["F1.roof"] - top) < 1e-9
     f1 = doc.find("F1")
     want = [levels["F1.floors[0]"], levels["F1.floors[1]"], top]
     assert [o.height_m for o in f1.options] == pytest.approx(want, abs=1e-12)
@@ -229,10 +229,10 @@ def test_default_ties_are_the_top_and_each_level_the_moving_part_crosses() -> No
         parse_retrofit_spec(spec),
     ).find("F1")
     assert alone.options[0].T_star_N == f1.options[1].T_star_N
-    # F2 carries no levels: the top only
+    # F2 carries no levels: the top only (its top_m: 8 m, where 2 R cos α would say 6.33 m,
+    # its wall not being a homogeneous rectangle)
     (f2,) = doc.find("F2").options
-    g2 = by_id["F2"]["geometry"]["positive"]
-    assert f2.height_m == pytest.approx(2.0 * g2["R_m"] * math.cos(g2["alpha_rad"]), abs=1e-12)
+    assert f2.height_m == by_id["F2"]["geometry"]["top_m"] == 8.0
 
 
 def test_the_work_plan_counts_every_default_candidate() -> None:
@@ -335,3 +335,39 @@ def test_a_spec_naming_a_missing_mechanism_is_refused(wall: ConstantsFile) -> No
     with pytest.raises(InputError, match="no mechanism 'F9'") as err:
         rockmech.retrofit(wall, parse_site(SITE), parse_retrofit_spec(spec))
     assert err.value.field == "mechanisms.F9"
+
+
+def test_the_default_top_is_the_moving_parts_highest_point_not_twice_its_centre(
+    tmp_path: Path,
+) -> None:
+    # A stepped wall: the 0.5 m wall (6 m) with a 0.25 m parapet (1 m) on its outer half.
+    # Its top is 7 m above the hinge; twice the centre of mass's height is not (by hand).
+    b = BUILD.Builder("stepped")
+    b.box("wall", "Walls", (0, 0, 0), (B, L, H), "brick")
+    b.box("parapet", "Walls", (0, 0, H), (B / 2, L, H + 1.0), "brick")
+    b.line("axis", "Axes", (0, 0, 0), (0, L, 0))
+    scene = Path(b.write(tmp_path / "stepped.3dm"))
+    mech = {"id": "W", "groups": [{"objects": ["wall", "parapet"], "density": RHO}],
+            "axis": {"object": "axis"}, "rocking": "one_sided"}  # fmt: skip
+    spec = tmp_path / "stepped.spec.json"
+    spec.write_text(json.dumps({"mechanisms": [mech]}))
+    out = tmp_path / "stepped.json"
+    res = CliRunner().invoke(app, ["constants", str(scene), str(spec), "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    cf = parse_constants(out.read_text())
+    geo = cf.mechanisms[0].geometry or {}
+    assert geo["top_m"] == pytest.approx(H + 1.0, abs=1e-9)
+    v_wall, v_par = B * L * H, B / 2 * L * 1.0
+    z_g = (v_wall * H / 2 + v_par * (H + 0.5)) / (v_wall + v_par)
+    assert (H + 1.0) - 2 * z_g > 0.4  # the old rule (2 R cos α) put the tie 0.46 m too low
+    rspec = parse_retrofit_spec({k: v for k, v in SPEC.items() if k != "mechanisms"})
+    m = rockmech.retrofit(cf, parse_site(SITE), rspec).find("W")
+    assert [o.height_m for o in m.options] == [pytest.approx(H + 1.0, abs=1e-9)]
+    assert "top_m" in m.options[0].height_source
+    # Without top_m, a block that is not a rectangle (I_O != 4/3 M R^2) has no default top:
+    # refused, naming the heights to give, rather than a tie at 2 R cos α.
+    data = json.loads(out.read_text())
+    del data["mechanisms"][0]["geometry"]["top_m"]
+    with pytest.raises(InputError, match="not a homogeneous rectangle") as err:
+        rockmech.retrofit(parse_constants(json.dumps(data)), parse_site(SITE), rspec)
+    assert err.value.field == "mechanisms.W.heights_m"

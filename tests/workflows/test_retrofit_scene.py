@@ -190,20 +190,24 @@ def test_cli_retrofit_from_a_search_run_folder(run: Any, tmp_path: Path) -> None
     assert res.exit_code == 2 and "error: search_spec:" in res.output, res.output
 
 
-def test_a_tie_above_the_wall_is_not_placed_and_its_mechanism_still_governs() -> None:
-    # S10 (hinge at z = 7 m): the constants' rectangle puts its top 3.81 m above the hinge,
-    # the scene's wall ends 3.5 m above it: a tie designed at 3.7 m has no wall to meet
+def test_a_tie_above_the_moving_part_is_refused_there_and_its_mechanism_still_governs() -> None:
+    # S10 (hinge at z = 7 m): the scene's wall ends 3.5 m above its hinge (the builder's
+    # top_m); a tie asked for at 3.7 m meets no block that moves: refused, said, not placed
     high = {**RSPEC, "mechanisms": {"S10": {"heights_m": [3.7]}}}
     got = retrofit_search(
         read_scene(EXAMPLE_SCENE), _lighter(), read_site(SITE), parse_retrofit_spec(high)
     )
-    assert got.doc.find("S10").status == "designed"
+    m = got.doc.find("S10")
+    assert m.status == "not_achievable"
+    (opt,) = m.options
+    assert opt.status == "above_moving_part"
+    assert "its top is 3.5 m above the hinge" in opt.decisions[0]
     sa = got.doc.search_after
     by = {t.mechanism: t for t in sa.ties}
-    assert by["S10"].status == "not_placed" and "off the wall F" in (by["S10"].note or "")
+    assert "S10" not in by
     assert by["S11"].status == "placed" and by["S13"].status == "placed"
-    # the rerun: S10 carries only the others' top tie, less than it needs, and governs, failing
-    s10 = got.doc.find("S10").name
+    # the rerun: S10, untied, governs, failing
+    s10 = m.name
     row = next(r for r in sa.rows if r.name == s10)
-    assert row.ties and row.margin is not None and row.margin < 1.0
+    assert row.margin is not None and row.margin < 1.0
     assert sa.after_name == s10 and sa.after_margin == row.margin and not sa.moved
