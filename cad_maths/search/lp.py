@@ -200,9 +200,10 @@ def _clip_segment(
 ) -> Optional[Tuple[float, float]]:
     """Parameter interval of the segment p0 -> p1 inside every half-plane (None if empty)."""
     lo, hi = 0.0, 1.0
+    s0, z0, s1, z1 = float(p0[0]), float(p0[1]), float(p1[0]), float(p1[1])
     for h in constraints:
-        f0 = _eval(h, float(p0[0]), float(p0[1]))
-        f1 = _eval(h, float(p1[0]), float(p1[1]))
+        f0 = h[0] * s0 + h[1] * z0 + h[2]  # _eval, inlined: the same sums
+        f1 = h[0] * s1 + h[1] * z1 + h[2]
         if f0 < 0.0 and f1 < 0.0:
             return None
         if f0 < 0.0:

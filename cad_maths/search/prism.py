@@ -261,10 +261,11 @@ def segment_intervals(
     """
     if len(rings) == 0:
         return []
-    d = np.asarray(p1, dtype=float) - np.asarray(p0, dtype=float)
+    p0 = np.asarray(p0, dtype=float)
+    d = np.asarray(p1, dtype=float) - p0
     # every ring's edges at once: the cuts and the winding numbers are sums over edges
     a = np.concatenate(list(rings)) if len(rings) > 1 else np.asarray(rings[0])
-    b = np.concatenate([np.roll(ring, -1, axis=0) for ring in rings])
+    b = np.concatenate([x for ring in rings for x in (ring[1:], ring[:1])])
     e = b - a
     den = d[0] * e[:, 1] - d[1] * e[:, 0]
     w = a - p0
@@ -278,9 +279,7 @@ def segment_intervals(
     if not pieces:
         return []
     # the winding number at every piece's middle at once (``winding``'s rule, point-wise)
-    mids = (
-        np.asarray(p0, dtype=float) + np.array([0.5 * (lo + hi) for lo, hi in pieces])[:, None] * d
-    )
+    mids = p0 + np.array([0.5 * (lo + hi) for lo, hi in pieces])[:, None] * d
     px, pz = mids[:, :1], mids[:, 1:]
     up = (a[:, 1] <= pz) & (b[:, 1] > pz)
     down = (a[:, 1] > pz) & (b[:, 1] <= pz)
