@@ -43,7 +43,14 @@ from cad_maths.search.model import (
     Wall,
 )
 from cad_maths.search.multiplier import Force, rotation_multiplier, two_block_multiplier
-from cad_maths.search.prism import Lump, clip_rings, point_lump, ring_moments
+from cad_maths.search.prism import (
+    FirstMoments,
+    Lump,
+    clip_rings,
+    point_lump,
+    ring_first_moments,
+    ring_moments,
+)
 from cad_maths.search.refine import minimise
 from shared_schema.errors import InputError
 from shared_schema.rules import G
@@ -379,7 +386,7 @@ def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = 
             if whole[r]:
                 moments = table.moments[r]
                 if moments is None:
-                    moments = table.moments[r] = tuple(float(x) for x in ring_moments(rings)[:3])
+                    moments = table.moments[r] = ring_first_moments(rings)
                 area, su, sv = moments
             else:
                 u, v, o = region.u.tolist(), region.v.tolist(), region.origin.tolist()
@@ -390,7 +397,7 @@ def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = 
                         m0 * v[0] + m1 * v[1] + m2 * v[2],
                         m0 * (o[0] - p0) + m1 * (o[1] - p1) + m2 * (o[2] - p2),
                     )
-                area, su, sv = (float(x) for x in ring_moments(rings)[:3])
+                area, su, sv = ring_first_moments(rings)
             if not area > 0.0:
                 continue
             # clipping only shrinks a region: past the whole region's extent the touch
@@ -465,6 +472,25 @@ def _loads(
     return weighing, abutting, forces, pulls
 
 
+def _first_loads(
+    contacts: Sequence[LevelLoad], ties: Sequence[TiePoint], d: np.ndarray
+) -> Tuple[FirstMoments, FirstMoments, List[Force], List[Force]]:
+    """Return ``_loads`` with masses and first moments only (the same sums, no second ones)."""
+    w_m, w_s = 0.0, np.zeros(3)
+    a_m, a_s = 0.0, np.zeros(3)
+    forces: List[Force] = []
+    for c in contacts:
+        s = c.mass * np.asarray(c.point, dtype=float)  # point_lump's first moment
+        if c.bearing:
+            w_m, w_s = w_m + float(c.mass), w_s + s
+        else:
+            a_m, a_s = a_m + float(c.mass), a_s + s
+        if c.thrust > 0.0:
+            forces.append((c.thrust * d, c.point))
+    pulls: List[Force] = [(tie.tie.force * tie.pull, tie.point) for tie in ties]
+    return FirstMoments(w_m, w_s), FirstMoments(a_m, a_s), forces, pulls
+
+
 @dataclass
 class Template:
     """A rigid mechanism before refinement: fixed pieces, pieces set by the parameters.
@@ -521,19 +547,25 @@ class Template:
         return self.fixed + self.variable(x)
 
     def lam(self, x: Sequence[float]) -> float:
-        """Return λ0 at parameters ``x`` (``inf`` where nothing moves, or a tied level holds)."""
+        """Return λ0 at parameters ``x`` (``inf`` where nothing moves, or a tied level holds).
+
+        The rigid multiplier needs only masses and first moments: they are summed as the
+        lumps' (``Lump.__add__``, in the same order), without the second moments.
+        """
         variable = self.variable(x)
-        body = self._fixed_lump
+        mass, first = self._fixed_lump.mass, self._fixed_lump.S
         for p in variable:
-            body = body + p.lump()
-        if not body.mass > 0.0:
+            m, s = p.wall.first_moments(p.planes)
+            mass, first = mass + m, first + s
+        if not mass > 0.0:
             return math.inf
         loads, held = level_loads(self.bld, variable, self.d, self._fixed_hits)
         if held is not None:
             return math.inf
-        weighing, abutting, forces, pulls = _loads(loads, self.ties, self.d)
-        w = body + weighing
-        return rotation_multiplier(w, w + abutting, self.point, self.d, forces, pulls)
+        (w_m, w_s), (a_m, a_s), forces, pulls = _first_loads(loads, self.ties, self.d)
+        w = FirstMoments(mass + w_m, first + w_s)
+        inertial = FirstMoments(w.mass + a_m, w.S + a_s)
+        return rotation_multiplier(w, inertial, self.point, self.d, forces, pulls)
 
     def refine(
         self, facade: str, direction: str, grid: int, budget: Optional[Budget] = None

@@ -47,6 +47,7 @@ from cad_maths.search.plan import Plan, footprint, least_width, outer_side, read
 from cad_maths.search.prism import (
     PIER_ASPECT_MIN,
     PLUMB_TOL_DEG,
+    FirstMoments,
     Lump,
     WallAxes,
     WallFrame,
@@ -201,6 +202,10 @@ class Wall:
     def lump(self, planes: Sequence[Tuple[np.ndarray, np.ndarray]]) -> Lump:
         """Mass moments of the part of the wall the half-spaces keep."""
         return self.frame.prism_lump(self.region(planes), self.lump_density)
+
+    def first_moments(self, planes: Sequence[Tuple[np.ndarray, np.ndarray]]) -> FirstMoments:
+        """Mass and first moment of the part of the wall the half-spaces keep (``lump``'s)."""
+        return self.frame.prism_first_moments(self.region(planes), self.lump_density)
 
     @property
     def inner_face(self) -> float:

@@ -22,7 +22,7 @@ Python 3.9-clean: imported by Rhino 8.
 
 import math
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple, cast
+from typing import List, NamedTuple, Optional, Sequence, Tuple, cast
 
 import numpy as np
 
@@ -31,11 +31,13 @@ from shared_schema.errors import GeometryError
 __all__ = [
     "PIER_ASPECT_MIN",
     "PLUMB_TOL_DEG",
+    "FirstMoments",
     "Lump",
     "WallAxes",
     "WallFrame",
     "clip_rings",
     "point_lump",
+    "ring_first_moments",
     "ring_moments",
     "rings_area",
     "segment_intervals",
@@ -185,6 +187,56 @@ def ring_moments(rings: Sequence[np.ndarray]) -> np.ndarray:
             ssz += (p0 * q1 + 2.0 * p0 * q0 + 2.0 * p1 * q1 + p1 * q0) * c
             p0, q0 = p1, q1
     return np.array([a / 2.0, ss / 6.0, sz / 6.0, sss / 12.0, szz / 12.0, ssz / 24.0])
+
+
+def ring_first_moments(rings: Sequence[np.ndarray]) -> Tuple[float, float, float]:
+    """Return the first three of ``ring_moments``: ``A, ∫s, ∫z`` [m², m³, m³], the same sums.
+
+    Each of ``ring_moments``' sums runs on its own, so these are its values to the bit; the
+    second moments are not summed (the rigid multiplier needs only masses and first moments).
+
+    Examples
+    --------
+    >>> ring_first_moments([np.array([[0.0, 0], [2, 0], [2, 1], [0, 1]])])
+    (2.0, 2.0, 1.0)
+    """
+    a = ss = sz = 0.0
+    for ring in rings:
+        n = len(ring)
+        if n < 3:
+            continue
+        if n > LOOP_MAX:
+            s0, z0 = ring[:, 0], ring[:, 1]
+            s1, z1 = np.roll(s0, -1), np.roll(z0, -1)
+            c = s0 * z1 - s1 * z0
+            a += float(np.sum(c))
+            ss += float(np.sum((s0 + s1) * c))
+            sz += float(np.sum((z0 + z1) * c))
+            continue
+        pts = ring.tolist()
+        p0, q0 = pts[-1]
+        for p1, q1 in pts:
+            c = p0 * q1 - p1 * q0
+            a += c
+            ss += (p0 + p1) * c
+            sz += (q0 + q1) * c
+            p0, q0 = p1, q1
+    return a / 2.0, ss / 6.0, sz / 6.0
+
+
+class FirstMoments(NamedTuple):
+    """Mass and first moment of a body about the model origin (a ``Lump`` without ``C``).
+
+    Attributes
+    ----------
+    mass : float
+        [kg].
+    S : (3,) float
+        ``∫ x dm`` [kg m].
+    """
+
+    mass: float
+    S: np.ndarray
 
 
 def rings_area(rings: Sequence[np.ndarray]) -> float:
@@ -411,6 +463,15 @@ class WallFrame:
         so = np.outer(o, s_world)
         c_world = c_world + so + so.T + m * np.outer(o, o)
         return Lump(m, m * o + s_world, c_world)
+
+    def prism_first_moments(self, rings: Sequence[np.ndarray], density: float) -> FirstMoments:
+        """Mass and first moment of ``prism_lump``'s prism, the same sums, without ``C``."""
+        A, Ss, Sz = ring_first_moments(rings)
+        t = self.thickness
+        rho = float(density)
+        m = rho * t * A
+        first = np.array([rho * t * Ss, rho * A * t * t / 2.0, rho * t * Sz])
+        return FirstMoments(m, m * self.origin + self._rotation @ first)
 
     @property
     def _rotation(self) -> np.ndarray:
