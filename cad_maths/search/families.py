@@ -46,6 +46,7 @@ from cad_maths.search.multiplier import Force, rotation_multiplier, two_block_mu
 from cad_maths.search.prism import (
     FirstMoments,
     Lump,
+    clip_point_rings,
     clip_rings,
     point_lump,
     ring_first_moments,
@@ -379,19 +380,19 @@ def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = 
             for p, n in piece.planes
         ]
         whole, clear = _screen(table, piece.planes)
-        for r, (c, j, region) in enumerate(table.entries):
+        for r, (c, _, region) in enumerate(table.entries):
             if clear[r]:
                 continue  # every vertex well outside one half-space: nothing of it moves
-            rings = list(region.rings)
+            rings = table.rings[r]
             if whole[r]:
                 moments = table.moments[r]
                 if moments is None:
                     moments = table.moments[r] = ring_first_moments(rings)
                 area, su, sv = moments
             else:
-                u, v, o = region.u.tolist(), region.v.tolist(), region.origin.tolist()
+                u, v, o = table.axes[r]
                 for m0, m1, m2, p0, p1, p2 in planes:
-                    rings = clip_rings(
+                    rings = clip_point_rings(
                         rings,
                         m0 * u[0] + m1 * u[1] + m2 * u[2],
                         m0 * v[0] + m1 * v[1] + m2 * v[2],
@@ -402,8 +403,8 @@ def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = 
                 continue
             # clipping only shrinks a region: past the whole region's extent the touch
             # test passes without measuring the clipped part
-            if area <= tol * bld.region_extent((piece.wall.id, c.index, j), region.rings):
-                pts = np.vstack(rings) if len(rings) > 1 else rings[0]
+            if area <= tol * table.extents[r]:
+                pts = np.array([q for ring in rings for q in ring], dtype=float)
                 extent = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
                 if area <= tol * extent:
                     continue  # a touch along a line (the builder's MIN_WIDTH_FACTOR)

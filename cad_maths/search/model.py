@@ -359,6 +359,12 @@ class RegionTable:
     moments : list of (float, float, float) or None
         Each whole region's area [m²] and first moments [m³] in its own (u, v), once
         computed.
+    rings : list of list of [s, z]
+        Each region's rings as Python lists (``prism.clip_point_rings``) [m].
+    axes : list of (list, list, list)
+        Each region's ``u``, ``v`` and ``origin`` as Python lists.
+    extents : list of float
+        Each region's larger side of its bounding box in its own (u, v) [m].
     """
 
     entries: List[Tuple["LevelContact", int, Any]]
@@ -366,10 +372,20 @@ class RegionTable:
     starts: np.ndarray
     scale: float
     moments: List[Optional[Tuple[float, ...]]] = field(default_factory=list)
+    rings: List[List[List[List[float]]]] = field(default_factory=list)
+    axes: List[Tuple[List[float], List[float], List[float]]] = field(default_factory=list)
+    extents: List[float] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         if not self.moments:
             self.moments = [None] * len(self.entries)
+        regions = [region for _, _, region in self.entries]
+        self.rings = [[ring.tolist() for ring in region.rings] for region in regions]
+        self.axes = [(g.u.tolist(), g.v.tolist(), g.origin.tolist()) for g in regions]
+        self.extents = []
+        for region in regions:
+            pts = np.vstack(list(region.rings))
+            self.extents.append(float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1]))))
 
 
 @dataclass
@@ -404,7 +420,6 @@ class Building:
     level_objects: Dict[str, List[SceneObject]] = field(default_factory=dict)
     contact_tol: float = 0.0
     _thrusts: Dict[Tuple[int, Tuple[float, ...]], float] = field(default_factory=dict)
-    _extents: Dict[Tuple[str, int, int], float] = field(default_factory=dict)
     _region_tables: Dict[str, "RegionTable"] = field(default_factory=dict)
 
     def roof_thrust(self, contact: "LevelContact", d: np.ndarray) -> float:
@@ -424,17 +439,6 @@ class Building:
                 contact.weight, float(ext[0]), float(abs(ext[2])), not contact.level.pushes
             )
         return self._thrusts[key]
-
-    def region_extent(self, key: Tuple[str, int, int], rings: Sequence[np.ndarray]) -> float:
-        """Larger side of the bounding box of a level's contact region with a wall [m].
-
-        ``key`` (wall id, level index, region index) names the region; the value is
-        computed once per building.
-        """
-        if key not in self._extents:
-            pts = np.vstack(list(rings))
-            self._extents[key] = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
-        return self._extents[key]
 
     def region_table(self, wall: str) -> "RegionTable":
         """Every level contact region of a wall with its vertices in world coordinates.

@@ -22,7 +22,7 @@ Python 3.9-clean: imported by Rhino 8.
 
 import math
 from dataclasses import dataclass
-from typing import List, NamedTuple, Optional, Sequence, Tuple, cast
+from typing import Any, List, NamedTuple, Optional, Sequence, Tuple, cast
 
 import numpy as np
 
@@ -35,6 +35,7 @@ __all__ = [
     "Lump",
     "WallAxes",
     "WallFrame",
+    "clip_point_rings",
     "clip_rings",
     "point_lump",
     "ring_first_moments",
@@ -189,11 +190,12 @@ def ring_moments(rings: Sequence[np.ndarray]) -> np.ndarray:
     return np.array([a / 2.0, ss / 6.0, sz / 6.0, sss / 12.0, szz / 12.0, ssz / 24.0])
 
 
-def ring_first_moments(rings: Sequence[np.ndarray]) -> Tuple[float, float, float]:
+def ring_first_moments(rings: Sequence[Any]) -> Tuple[float, float, float]:
     """Return the first three of ``ring_moments``: ``A, ∫s, ∫z`` [m², m³, m³], the same sums.
 
     Each of ``ring_moments``' sums runs on its own, so these are its values to the bit; the
     second moments are not summed (the rigid multiplier needs only masses and first moments).
+    The rings may be arrays or lists of [s, z] (``clip_point_rings``).
 
     Examples
     --------
@@ -206,14 +208,15 @@ def ring_first_moments(rings: Sequence[np.ndarray]) -> Tuple[float, float, float
         if n < 3:
             continue
         if n > LOOP_MAX:
-            s0, z0 = ring[:, 0], ring[:, 1]
+            arr = np.asarray(ring, dtype=float)
+            s0, z0 = arr[:, 0], arr[:, 1]
             s1, z1 = np.roll(s0, -1), np.roll(z0, -1)
             c = s0 * z1 - s1 * z0
             a += float(np.sum(c))
             ss += float(np.sum((s0 + s1) * c))
             sz += float(np.sum((z0 + z1) * c))
             continue
-        pts = ring.tolist()
+        pts = ring.tolist() if isinstance(ring, np.ndarray) else ring
         p0, q0 = pts[-1]
         for p1, q1 in pts:
             c = p0 * q1 - p1 * q0
@@ -267,30 +270,51 @@ def clip_rings(rings: Sequence[np.ndarray], a: float, b: float, c: float) -> Rin
     out: Rings = []
     for ring in rings:
         pts = ring.tolist()
-        f = [a * p + b * q + c for p, q in pts]
-        if min(f) >= 0.0:
+        kept = _clip_points(pts, a, b, c)
+        if kept is pts:
             out.append(ring)
-            continue
-        if max(f) <= 0.0:
-            continue
-        kept: List[Tuple[float, float]] = []
-        n = len(pts)
-        for i in range(n):
-            j = i + 1 if i + 1 < n else 0
-            fi, fj = f[i], f[j]
-            if fi >= 0.0:
-                kept.append((pts[i][0], pts[i][1]))
-            if (fi > 0.0 and fj < 0.0) or (fi < 0.0 and fj > 0.0):
-                w = fi / (fi - fj)
-                kept.append(
-                    (
-                        pts[i][0] + w * (pts[j][0] - pts[i][0]),
-                        pts[i][1] + w * (pts[j][1] - pts[i][1]),
-                    )
-                )
-        if len(kept) >= 3:
+        elif kept:
             out.append(np.array(kept, dtype=float))
     return out
+
+
+Points = List[List[float]]
+
+
+def clip_point_rings(rings: Sequence[Points], a: float, b: float, c: float) -> List[Points]:
+    """``clip_rings`` on rings given as lists of [s, z] (the same arithmetic, no arrays).
+
+    For the loops that clip one region by several half-planes in a row (``contact_hits``):
+    the rings stay Python lists between the clips.
+    """
+    out: List[Points] = []
+    for pts in rings:
+        kept = _clip_points(pts, a, b, c)
+        if kept:
+            out.append(kept)
+    return out
+
+
+def _clip_points(pts: Points, a: float, b: float, c: float) -> Optional[Points]:
+    """Clip one ring (Sutherland-Hodgman): ``pts`` itself where wholly kept, None if empty."""
+    f = [a * p + b * q + c for p, q in pts]
+    if min(f) >= 0.0:
+        return pts
+    if max(f) <= 0.0:
+        return None
+    kept: Points = []
+    n = len(pts)
+    for i in range(n):
+        j = i + 1 if i + 1 < n else 0
+        fi, fj = f[i], f[j]
+        if fi >= 0.0:
+            kept.append([pts[i][0], pts[i][1]])
+        if (fi > 0.0 and fj < 0.0) or (fi < 0.0 and fj > 0.0):
+            w = fi / (fi - fj)
+            kept.append(
+                [pts[i][0] + w * (pts[j][0] - pts[i][0]), pts[i][1] + w * (pts[j][1] - pts[i][1])]
+            )
+    return kept if len(kept) >= 3 else None
 
 
 def segment_intervals(
