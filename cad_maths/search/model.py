@@ -190,13 +190,25 @@ class Wall:
             A plane does not contain the wall's thickness direction.
         """
         rings = list(self.rings)
-        for point, normal in planes:
+        for k, (point, normal) in enumerate(planes):
             line = self.frame.line_of_plane(point, normal)
             if line is None:
                 raise GeometryError(
                     f"{self.id}: a crack plane cuts the wall obliquely through its thickness"
                 )
-            rings = clip_rings(rings, *line)
+            if k > 0:
+                rings = clip_rings(rings, *line)
+                continue
+            # A mechanism's first plane (its hinge line's cut) is the same at every
+            # evaluation of its refinement: the wall clipped by it is kept, by the line.
+            clips: Dict[Tuple[float, float, float], List[np.ndarray]]
+            clips = self.__dict__.setdefault("_first_clips", {})
+            kept = clips.get(line)
+            if kept is None:
+                if len(clips) >= FIRST_CLIPS_MAX:
+                    clips.clear()
+                kept = clips[line] = clip_rings(rings, *line)
+            rings = list(kept)
         return rings
 
     def lump(self, planes: Sequence[Tuple[np.ndarray, np.ndarray]]) -> Lump:
@@ -340,6 +352,10 @@ class TiePoint:
     s: float
     z: float
     pull: np.ndarray
+
+
+#: Walls clipped by a first plane kept per wall (``Wall.region``), at most.
+FIRST_CLIPS_MAX = 512
 
 
 @dataclass
