@@ -343,28 +343,29 @@ SCREEN_RTOL = 1e-9
 
 def _screen(
     table: RegionTable, planes: Sequence[Plane]
-) -> Tuple[List[bool], List[bool], List[List[bool]]]:
-    """Which regions lie wholly inside every half-space, and which wholly outside one.
+) -> Tuple[List[int], List[bool], List[List[bool]]]:
+    """Which regions may meet the half-spaces' intersection, and which lie wholly inside it.
 
     One product of the regions' vertices with the planes' normals replaces a clip per
     region and plane; vertices near a plane (``SCREEN_RTOL``) leave the region to the clip.
-    The third list tells, per region and plane, whether the region lies wholly inside that
-    half-space: clipping by it keeps the region as it is (every point of the region, and of
-    any part of it cut by the other planes, is well inside), so it is not clipped by it.
+    Returns the regions not wholly outside one half-space, whether each lies wholly inside
+    every half-space, and per plane whether it lies wholly inside that half-space: clipping
+    by it keeps the region as it is (every point of the region, and of any part of it cut
+    by the other planes, is well inside), so it is not clipped by it.
     """
     k = len(table.entries)
     if not planes:
-        return [True] * k, [False] * k, [[] for _ in range(k)]
+        return list(range(k)), [True] * k, [[] for _ in range(k)]
     normals = np.array([n for _, n in planes], dtype=float)
     offsets = np.einsum("ij,ij->i", normals, np.array([p for p, _ in planes], dtype=float))
     f = table.vertices @ normals.T - offsets
     margin = SCREEN_RTOL * table.scale * float(np.abs(normals).sum(axis=1).max())
     lo = np.minimum.reduceat(f, table.starts, axis=0)
     hi = np.maximum.reduceat(f, table.starts, axis=0)
-    inside = lo > margin
+    todo = np.flatnonzero(~np.any(hi < -margin, axis=1))
+    inside = lo[todo] > margin
     whole: List[bool] = np.all(inside, axis=1).tolist()
-    clear: List[bool] = np.any(hi < -margin, axis=1).tolist()
-    return whole, clear, inside.tolist()
+    return todo.tolist(), whole, inside.tolist()
 
 
 def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = None) -> Hits:
@@ -385,19 +386,19 @@ def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = 
             (float(n[0]), float(n[1]), float(n[2]), float(p[0]), float(p[1]), float(p[2]))
             for p, n in piece.planes
         ]
-        whole, clear, inside = _screen(table, piece.planes)
-        for r, (c, _, region) in enumerate(table.entries):
-            if clear[r]:
-                continue  # every vertex well outside one half-space: nothing of it moves
+        # the regions left out have every vertex well outside one half-space: none moves
+        todo, whole, inside = _screen(table, piece.planes)
+        for r, r_whole, r_inside in zip(todo, whole, inside):
+            c, _, region = table.entries[r]
             rings = table.rings[r]
-            if whole[r]:
+            if r_whole:
                 moments = table.moments[r]
                 if moments is None:
                     moments = table.moments[r] = ring_first_moments(rings)
                 area, su, sv = moments
             else:
                 u, v, o = table.axes[r]
-                for (m0, m1, m2, p0, p1, p2), keeps in zip(planes, inside[r]):
+                for (m0, m1, m2, p0, p1, p2), keeps in zip(planes, r_inside):
                     if keeps:
                         continue  # the clip would keep every vertex: the rings as they are
                     rings = clip_point_rings(
