@@ -484,9 +484,14 @@ class Building:
 
     @property
     def size(self) -> float:
-        """Diagonal of the walls' bounding box [m]."""
-        v = np.vstack([w.mesh.vertices for w in self.walls.values()])
-        return float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+        """Diagonal of the walls' bounding box [m] (computed once for the same walls)."""
+        key = tuple(id(w.mesh) for w in self.walls.values())
+        cached = self.__dict__.get("_size")
+        if cached is None or cached[0] != key:
+            v = np.vstack([w.mesh.vertices for w in self.walls.values()])
+            cached = (key, float(np.linalg.norm(v.max(axis=0) - v.min(axis=0))))
+            self.__dict__["_size"] = cached
+        return float(cached[1])
 
     def free_standing(self, wall: str) -> bool:
         """Tell whether nothing holds either face of a wall (no return walls, levels, ties)."""
