@@ -407,7 +407,18 @@ class WallFrame:
     thickness: float
 
     def to_world(self, s: float, n: float, z: float) -> np.ndarray:
-        """World point of frame coordinates [m]."""
+        """World point of frame coordinates [m].
+
+        Numbers are summed per coordinate on the axes as Python floats (the same sums as
+        the arrays'); arrays of coordinates go through numpy.
+        """
+        if (
+            isinstance(s, (float, int))
+            and isinstance(n, (float, int))
+            and isinstance(z, (float, int))
+        ):
+            es, en, ez, o = self._axes
+            return np.array([o[k] + s * es[k] + n * en[k] + z * ez[k] for k in range(3)])
         return self.origin + s * self.e_s + n * self.e_n + z * self.e_z
 
     def to_frame(self, x: np.ndarray) -> np.ndarray:
