@@ -902,8 +902,9 @@ def _programme(model: LPModel, friction: Optional[float]) -> _Programme:
             continue
         t1, t2 = _basis(itf.normal)
         n = itf.normal / float(np.linalg.norm(itf.normal))
+        minus_n = -n
         for p in itf.points:
-            ub.add(bj, bi, p, -n)  # n·Δv >= 0
+            ub.add(bj, bi, p, minus_n)  # n·Δv >= 0
         if itf.kind == "free":
             continue
         if itf.kind == "crack":
@@ -926,10 +927,12 @@ def _programme(model: LPModel, friction: Optional[float]) -> _Programme:
         slip.add(bj, bi, c, t1)
         slip.add(bj, bi, c, t2)
         slip.twist(bj, bi, n)
+        # n·Δv >= μ |t·Δv|: an outer pyramid of the friction cone (its 4 faces, the same
+        # at every point of the contact)
+        cone = [e for tk in (t1, t2) for e in (-n + friction * tk, -n - friction * tk)]
         for p in itf.points:
-            for tk in (t1, t2):  # n·Δv >= μ |t·Δv|: an outer pyramid of the friction cone
-                ub.add(bj, bi, p, -n + friction * tk)
-                ub.add(bj, bi, p, -n - friction * tk)
+            for e in cone:
+                ub.add(bj, bi, p, e)
     for b, p, direction in model.restraints:
         if bid(b) >= 0:
             ub.add(bid(b), -1, p, direction)
