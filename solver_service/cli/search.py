@@ -123,13 +123,17 @@ def collector_paused() -> Iterator[None]:
     objects in all on the palazzo); with the collector on, its passes walk the objects the
     imports left (numpy, scipy, matplotlib) again and again, about 5 % of the palazzo's run.
     Reference counting still frees everything not in a cycle; the collector is switched back
-    on (if it was on) when the block ends, and collects the cycles then.
+    on (if it was on) when the block ends, and collects the cycles at its next full pass.
+    The objects made meanwhile are moved to the oldest generation first (``gc.freeze`` then
+    ``gc.unfreeze``), so that switching it back on does not walk them all at once.
     """
     was_on = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
+        gc.freeze()
+        gc.unfreeze()
         if was_on:
             gc.enable()
 
