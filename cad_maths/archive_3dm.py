@@ -185,22 +185,19 @@ class _CrcCheck:
         self.headers = self._headers()
 
     def _headers(self) -> List[int]:
-        """Offsets of every byte sequence that may be a nested chunk's header, sorted."""
+        """Offsets of every byte sequence that may be a nested chunk's header, sorted.
+
+        A header at q (32 or more) has its length's top three bytes, zero, at q + 9 and a
+        type code that ``_nested_code`` accepts. ``_HEADER_AT`` finds (in C) every such q + 9
+        whose code may pass; each code is then checked exactly.
+        """
         data = self.data
-        found: List[int] = []
-        nonzero = re.compile(b"[^\x00]")
-        zeros = data.find(b"\x00\x00\x00", 32)
-        while zeros >= 0:
-            # A header at q has its length's top three bytes, zero, at q + 9.
-            for q in range(max(32, zeros - 9), zeros - 1):
-                code = self._LONG.unpack_from(data, q)[0] if q + 12 <= len(data) else 0
-                if _nested_code(code) and data[q + 9 : q + 12] == b"\x00\x00\x00":
-                    found.append(q)
-            more = nonzero.search(data, zeros + 3)
-            if more is None:
-                break
-            zeros = data.find(b"\x00\x00\x00", more.start())
-        return sorted(set(found))
+        unpack = self._LONG.unpack_from
+        return [
+            q
+            for q in (m.start() - 9 for m in _HEADER_AT.finditer(data, 41))
+            if _nested_code(unpack(data, q)[0])
+        ]
 
     def sequence(self, start: int, end: int) -> Optional[List[Tuple[int, int, int]]]:
         """Return (code, content start, content end) of the chunks exactly filling [start, end).
@@ -301,6 +298,23 @@ class _CrcCheck:
                 self._damaged(code, q + 12)
                 return crc, found, True
         return zlib.crc32(data[pos:end], crc), found, False
+
+
+def _header_at() -> "re.Pattern[bytes]":
+    """Compile the pattern of the candidates of ``_CrcCheck._headers``.
+
+    A candidate is 3 zero bytes (the match's start and the two that follow it, looked ahead
+    at so that overlapping candidates are all found) 9 bytes after a type code that may pass
+    ``_nested_code``: one with ``TCODE_CRC`` (its second byte 0x80 or more) or a nested code
+    without it (looked behind at). The match starts with a literal byte, which the
+    regular-expression engine scans for in C.
+    """
+    plain = sorted(c for c in CONTAINERS | {TCODE_CLASS_USERDATA} if not c & TCODE_CRC)
+    codes = [rb".[\x80-\xff].."] + [re.escape(struct.pack("<I", c)) for c in plain]
+    return re.compile(rb"\x00(?=\x00\x00)(?<=(?:" + b"|".join(codes) + rb").{5}\x00)", re.DOTALL)
+
+
+_HEADER_AT = _header_at()
 
 
 def _class_layout(inner: Optional[List[Tuple[int, int, int]]]) -> bool:

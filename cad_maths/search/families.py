@@ -43,7 +43,15 @@ from cad_maths.search.model import (
     Wall,
 )
 from cad_maths.search.multiplier import Force, rotation_multiplier, two_block_multiplier
-from cad_maths.search.prism import Lump, clip_rings, point_lump, ring_moments
+from cad_maths.search.prism import (
+    FirstMoments,
+    Lump,
+    clip_point_rings,
+    clip_rings,
+    point_lump,
+    ring_first_moments,
+    ring_moments,
+)
 from cad_maths.search.refine import minimise
 from shared_schema.errors import InputError
 from shared_schema.rules import G
@@ -333,24 +341,31 @@ Hits = Dict[int, Tuple[float, np.ndarray, LevelContact, Any]]
 SCREEN_RTOL = 1e-9
 
 
-def _screen(table: RegionTable, planes: Sequence[Plane]) -> Tuple[List[bool], List[bool]]:
-    """Which regions lie wholly inside every half-space, and which wholly outside one.
+def _screen(
+    table: RegionTable, planes: Sequence[Plane]
+) -> Tuple[List[int], List[bool], List[List[bool]]]:
+    """Which regions may meet the half-spaces' intersection, and which lie wholly inside it.
 
     One product of the regions' vertices with the planes' normals replaces a clip per
     region and plane; vertices near a plane (``SCREEN_RTOL``) leave the region to the clip.
+    Returns the regions not wholly outside one half-space, whether each lies wholly inside
+    every half-space, and per plane whether it lies wholly inside that half-space: clipping
+    by it keeps the region as it is (every point of the region, and of any part of it cut
+    by the other planes, is well inside), so it is not clipped by it.
     """
     k = len(table.entries)
     if not planes:
-        return [True] * k, [False] * k
+        return list(range(k)), [True] * k, [[] for _ in range(k)]
     normals = np.array([n for _, n in planes], dtype=float)
     offsets = np.einsum("ij,ij->i", normals, np.array([p for p, _ in planes], dtype=float))
     f = table.vertices @ normals.T - offsets
     margin = SCREEN_RTOL * table.scale * float(np.abs(normals).sum(axis=1).max())
     lo = np.minimum.reduceat(f, table.starts, axis=0)
     hi = np.maximum.reduceat(f, table.starts, axis=0)
-    whole = [bool(x) for x in np.all(lo > margin, axis=1)]
-    clear = [bool(x) for x in np.any(hi < -margin, axis=1)]
-    return whole, clear
+    todo = np.flatnonzero(~np.any(hi < -margin, axis=1))
+    inside = lo[todo] > margin
+    whole: List[bool] = np.all(inside, axis=1).tolist()
+    return todo.tolist(), whole, inside.tolist()
 
 
 def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = None) -> Hits:
@@ -371,32 +386,34 @@ def contact_hits(bld: Building, pieces: Sequence[Piece], best: Optional[Hits] = 
             (float(n[0]), float(n[1]), float(n[2]), float(p[0]), float(p[1]), float(p[2]))
             for p, n in piece.planes
         ]
-        whole, clear = _screen(table, piece.planes)
-        for r, (c, j, region) in enumerate(table.entries):
-            if clear[r]:
-                continue  # every vertex well outside one half-space: nothing of it moves
-            rings = list(region.rings)
-            if whole[r]:
+        # the regions left out have every vertex well outside one half-space: none moves
+        todo, whole, inside = _screen(table, piece.planes)
+        for r, r_whole, r_inside in zip(todo, whole, inside):
+            c, _, region = table.entries[r]
+            rings = table.rings[r]
+            if r_whole:
                 moments = table.moments[r]
                 if moments is None:
-                    moments = table.moments[r] = tuple(float(x) for x in ring_moments(rings)[:3])
+                    moments = table.moments[r] = ring_first_moments(rings)
                 area, su, sv = moments
             else:
-                u, v, o = region.u.tolist(), region.v.tolist(), region.origin.tolist()
-                for m0, m1, m2, p0, p1, p2 in planes:
-                    rings = clip_rings(
+                u, v, o = table.axes[r]
+                for (m0, m1, m2, p0, p1, p2), keeps in zip(planes, r_inside):
+                    if keeps:
+                        continue  # the clip would keep every vertex: the rings as they are
+                    rings = clip_point_rings(
                         rings,
                         m0 * u[0] + m1 * u[1] + m2 * u[2],
                         m0 * v[0] + m1 * v[1] + m2 * v[2],
                         m0 * (o[0] - p0) + m1 * (o[1] - p1) + m2 * (o[2] - p2),
                     )
-                area, su, sv = (float(x) for x in ring_moments(rings)[:3])
+                area, su, sv = ring_first_moments(rings)
             if not area > 0.0:
                 continue
             # clipping only shrinks a region: past the whole region's extent the touch
             # test passes without measuring the clipped part
-            if area <= tol * bld.region_extent((piece.wall.id, c.index, j), region.rings):
-                pts = np.vstack(rings) if len(rings) > 1 else rings[0]
+            if area <= tol * table.extents[r]:
+                pts = np.array([q for ring in rings for q in ring], dtype=float)
                 extent = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
                 if area <= tol * extent:
                     continue  # a touch along a line (the builder's MIN_WIDTH_FACTOR)
@@ -465,6 +482,25 @@ def _loads(
     return weighing, abutting, forces, pulls
 
 
+def _first_loads(
+    contacts: Sequence[LevelLoad], ties: Sequence[TiePoint], d: np.ndarray
+) -> Tuple[FirstMoments, FirstMoments, List[Force], List[Force]]:
+    """Return ``_loads`` with masses and first moments only (the same sums, no second ones)."""
+    w_m, w_s = 0.0, np.zeros(3)
+    a_m, a_s = 0.0, np.zeros(3)
+    forces: List[Force] = []
+    for c in contacts:
+        s = c.mass * np.asarray(c.point, dtype=float)  # point_lump's first moment
+        if c.bearing:
+            w_m, w_s = w_m + float(c.mass), w_s + s
+        else:
+            a_m, a_s = a_m + float(c.mass), a_s + s
+        if c.thrust > 0.0:
+            forces.append((c.thrust * d, c.point))
+    pulls: List[Force] = [(tie.tie.force * tie.pull, tie.point) for tie in ties]
+    return FirstMoments(w_m, w_s), FirstMoments(a_m, a_s), forces, pulls
+
+
 @dataclass
 class Template:
     """A rigid mechanism before refinement: fixed pieces, pieces set by the parameters.
@@ -521,19 +557,25 @@ class Template:
         return self.fixed + self.variable(x)
 
     def lam(self, x: Sequence[float]) -> float:
-        """Return λ0 at parameters ``x`` (``inf`` where nothing moves, or a tied level holds)."""
+        """Return λ0 at parameters ``x`` (``inf`` where nothing moves, or a tied level holds).
+
+        The rigid multiplier needs only masses and first moments: they are summed as the
+        lumps' (``Lump.__add__``, in the same order), without the second moments.
+        """
         variable = self.variable(x)
-        body = self._fixed_lump
+        mass, first = self._fixed_lump.mass, self._fixed_lump.S
         for p in variable:
-            body = body + p.lump()
-        if not body.mass > 0.0:
+            m, s = p.wall.first_moments(p.planes)
+            mass, first = mass + m, first + s
+        if not mass > 0.0:
             return math.inf
         loads, held = level_loads(self.bld, variable, self.d, self._fixed_hits)
         if held is not None:
             return math.inf
-        weighing, abutting, forces, pulls = _loads(loads, self.ties, self.d)
-        w = body + weighing
-        return rotation_multiplier(w, w + abutting, self.point, self.d, forces, pulls)
+        (w_m, w_s), (a_m, a_s), forces, pulls = _first_loads(loads, self.ties, self.d)
+        w = FirstMoments(mass + w_m, first + w_s)
+        inertial = FirstMoments(w.mass + a_m, w.S + a_s)
+        return rotation_multiplier(w, inertial, self.point, self.d, forces, pulls)
 
     def refine(
         self, facade: str, direction: str, grid: int, budget: Optional[Budget] = None

@@ -200,9 +200,10 @@ def _clip_segment(
 ) -> Optional[Tuple[float, float]]:
     """Parameter interval of the segment p0 -> p1 inside every half-plane (None if empty)."""
     lo, hi = 0.0, 1.0
+    s0, z0, s1, z1 = float(p0[0]), float(p0[1]), float(p1[0]), float(p1[1])
     for h in constraints:
-        f0 = _eval(h, float(p0[0]), float(p0[1]))
-        f1 = _eval(h, float(p1[0]), float(p1[1]))
+        f0 = h[0] * s0 + h[1] * z0 + h[2]  # _eval, inlined: the same sums
+        f1 = h[0] * s1 + h[1] * z1 + h[2]
         if f0 < 0.0 and f1 < 0.0:
             return None
         if f0 < 0.0:
@@ -901,8 +902,9 @@ def _programme(model: LPModel, friction: Optional[float]) -> _Programme:
             continue
         t1, t2 = _basis(itf.normal)
         n = itf.normal / float(np.linalg.norm(itf.normal))
+        minus_n = -n
         for p in itf.points:
-            ub.add(bj, bi, p, -n)  # n·Δv >= 0
+            ub.add(bj, bi, p, minus_n)  # n·Δv >= 0
         if itf.kind == "free":
             continue
         if itf.kind == "crack":
@@ -925,10 +927,12 @@ def _programme(model: LPModel, friction: Optional[float]) -> _Programme:
         slip.add(bj, bi, c, t1)
         slip.add(bj, bi, c, t2)
         slip.twist(bj, bi, n)
+        # n·Δv >= μ |t·Δv|: an outer pyramid of the friction cone (its 4 faces, the same
+        # at every point of the contact)
+        cone = [e for tk in (t1, t2) for e in (-n + friction * tk, -n - friction * tk)]
         for p in itf.points:
-            for tk in (t1, t2):  # n·Δv >= μ |t·Δv|: an outer pyramid of the friction cone
-                ub.add(bj, bi, p, -n + friction * tk)
-                ub.add(bj, bi, p, -n - friction * tk)
+            for e in cone:
+                ub.add(bj, bi, p, e)
     for b, p, direction in model.restraints:
         if bid(b) >= 0:
             ub.add(bid(b), -1, p, direction)

@@ -47,6 +47,7 @@ from cad_maths.search.plan import Plan, footprint, least_width, outer_side, read
 from cad_maths.search.prism import (
     PIER_ASPECT_MIN,
     PLUMB_TOL_DEG,
+    FirstMoments,
     Lump,
     WallAxes,
     WallFrame,
@@ -190,18 +191,34 @@ class Wall:
             A plane does not contain the wall's thickness direction.
         """
         rings = list(self.rings)
-        for point, normal in planes:
+        for k, (point, normal) in enumerate(planes):
             line = self.frame.line_of_plane(point, normal)
             if line is None:
                 raise GeometryError(
                     f"{self.id}: a crack plane cuts the wall obliquely through its thickness"
                 )
-            rings = clip_rings(rings, *line)
+            if k > 0:
+                rings = clip_rings(rings, *line)
+                continue
+            # A mechanism's first plane (its hinge line's cut) is the same at every
+            # evaluation of its refinement: the wall clipped by it is kept, by the line.
+            clips: Dict[Tuple[float, float, float], List[np.ndarray]]
+            clips = self.__dict__.setdefault("_first_clips", {})
+            kept = clips.get(line)
+            if kept is None:
+                if len(clips) >= FIRST_CLIPS_MAX:
+                    clips.clear()
+                kept = clips[line] = clip_rings(rings, *line)
+            rings = list(kept)
         return rings
 
     def lump(self, planes: Sequence[Tuple[np.ndarray, np.ndarray]]) -> Lump:
         """Mass moments of the part of the wall the half-spaces keep."""
         return self.frame.prism_lump(self.region(planes), self.lump_density)
+
+    def first_moments(self, planes: Sequence[Tuple[np.ndarray, np.ndarray]]) -> FirstMoments:
+        """Mass and first moment of the part of the wall the half-spaces keep (``lump``'s)."""
+        return self.frame.prism_first_moments(self.region(planes), self.lump_density)
 
     @property
     def inner_face(self) -> float:
@@ -338,6 +355,10 @@ class TiePoint:
     pull: np.ndarray
 
 
+#: Walls clipped by a first plane kept per wall (``Wall.region``), at most.
+FIRST_CLIPS_MAX = 512
+
+
 @dataclass
 class RegionTable:
     """A wall's level contact regions, stacked for screening (``Building.region_table``).
@@ -355,6 +376,12 @@ class RegionTable:
     moments : list of (float, float, float) or None
         Each whole region's area [m²] and first moments [m³] in its own (u, v), once
         computed.
+    rings : list of list of [s, z]
+        Each region's rings as Python lists (``prism.clip_point_rings``) [m].
+    axes : list of (list, list, list)
+        Each region's ``u``, ``v`` and ``origin`` as Python lists.
+    extents : list of float
+        Each region's larger side of its bounding box in its own (u, v) [m].
     """
 
     entries: List[Tuple["LevelContact", int, Any]]
@@ -362,10 +389,20 @@ class RegionTable:
     starts: np.ndarray
     scale: float
     moments: List[Optional[Tuple[float, ...]]] = field(default_factory=list)
+    rings: List[List[List[List[float]]]] = field(default_factory=list)
+    axes: List[Tuple[List[float], List[float], List[float]]] = field(default_factory=list)
+    extents: List[float] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         if not self.moments:
             self.moments = [None] * len(self.entries)
+        regions = [region for _, _, region in self.entries]
+        self.rings = [[ring.tolist() for ring in region.rings] for region in regions]
+        self.axes = [(g.u.tolist(), g.v.tolist(), g.origin.tolist()) for g in regions]
+        self.extents = []
+        for region in regions:
+            pts = np.vstack(list(region.rings))
+            self.extents.append(float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1]))))
 
 
 @dataclass
@@ -400,7 +437,6 @@ class Building:
     level_objects: Dict[str, List[SceneObject]] = field(default_factory=dict)
     contact_tol: float = 0.0
     _thrusts: Dict[Tuple[int, Tuple[float, ...]], float] = field(default_factory=dict)
-    _extents: Dict[Tuple[str, int, int], float] = field(default_factory=dict)
     _region_tables: Dict[str, "RegionTable"] = field(default_factory=dict)
 
     def roof_thrust(self, contact: "LevelContact", d: np.ndarray) -> float:
@@ -420,17 +456,6 @@ class Building:
                 contact.weight, float(ext[0]), float(abs(ext[2])), not contact.level.pushes
             )
         return self._thrusts[key]
-
-    def region_extent(self, key: Tuple[str, int, int], rings: Sequence[np.ndarray]) -> float:
-        """Larger side of the bounding box of a level's contact region with a wall [m].
-
-        ``key`` (wall id, level index, region index) names the region; the value is
-        computed once per building.
-        """
-        if key not in self._extents:
-            pts = np.vstack(list(rings))
-            self._extents[key] = float(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
-        return self._extents[key]
 
     def region_table(self, wall: str) -> "RegionTable":
         """Every level contact region of a wall with its vertices in world coordinates.
@@ -460,9 +485,14 @@ class Building:
 
     @property
     def size(self) -> float:
-        """Diagonal of the walls' bounding box [m]."""
-        v = np.vstack([w.mesh.vertices for w in self.walls.values()])
-        return float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+        """Diagonal of the walls' bounding box [m] (computed once for the same walls)."""
+        key = tuple(id(w.mesh) for w in self.walls.values())
+        cached = self.__dict__.get("_size")
+        if cached is None or cached[0] != key:
+            v = np.vstack([w.mesh.vertices for w in self.walls.values()])
+            cached = (key, float(np.linalg.norm(v.max(axis=0) - v.min(axis=0))))
+            self.__dict__["_size"] = cached
+        return float(cached[1])
 
     def free_standing(self, wall: str) -> bool:
         """Tell whether nothing holds either face of a wall (no return walls, levels, ties)."""

@@ -17,11 +17,11 @@ Python 3.9-clean: imported by Rhino 8.
 """
 
 import math
-from typing import Optional, Sequence, Tuple
+from typing import Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from cad_maths.search.prism import Lump
+from cad_maths.search.prism import FirstMoments, Lump
 from shared_schema.errors import GeometryError
 from shared_schema.rules import G
 
@@ -43,8 +43,8 @@ def axis_for(direction: np.ndarray) -> np.ndarray:
 
 
 def rotation_multiplier(
-    weighing: Lump,
-    inertial: Lump,
+    weighing: Union[Lump, FirstMoments],
+    inertial: Union[Lump, FirstMoments],
     point: np.ndarray,
     direction: np.ndarray,
     forces: Sequence[Force] = (),
@@ -54,9 +54,9 @@ def rotation_multiplier(
 
     Parameters
     ----------
-    weighing : Lump
+    weighing : Lump or FirstMoments
         Masses whose weight acts on the body (the blocks and bearing floors).
-    inertial : Lump
+    inertial : Lump or FirstMoments
         Masses whose horizontal inertia the body carries (``weighing`` plus abutting
         floors).
     point : (3,) float

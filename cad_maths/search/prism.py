@@ -22,7 +22,7 @@ Python 3.9-clean: imported by Rhino 8.
 
 import math
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple, cast
+from typing import Any, List, NamedTuple, Optional, Sequence, Tuple, cast
 
 import numpy as np
 
@@ -31,11 +31,14 @@ from shared_schema.errors import GeometryError
 __all__ = [
     "PIER_ASPECT_MIN",
     "PLUMB_TOL_DEG",
+    "FirstMoments",
     "Lump",
     "WallAxes",
     "WallFrame",
+    "clip_point_rings",
     "clip_rings",
     "point_lump",
+    "ring_first_moments",
     "ring_moments",
     "rings_area",
     "segment_intervals",
@@ -187,6 +190,58 @@ def ring_moments(rings: Sequence[np.ndarray]) -> np.ndarray:
     return np.array([a / 2.0, ss / 6.0, sz / 6.0, sss / 12.0, szz / 12.0, ssz / 24.0])
 
 
+def ring_first_moments(rings: Sequence[Any]) -> Tuple[float, float, float]:
+    """Return the first three of ``ring_moments``: ``A, ∫s, ∫z`` [m², m³, m³], the same sums.
+
+    Each of ``ring_moments``' sums runs on its own, so these are its values to the bit; the
+    second moments are not summed (the rigid multiplier needs only masses and first moments).
+    The rings may be arrays or lists of [s, z] (``clip_point_rings``).
+
+    Examples
+    --------
+    >>> ring_first_moments([np.array([[0.0, 0], [2, 0], [2, 1], [0, 1]])])
+    (2.0, 2.0, 1.0)
+    """
+    a = ss = sz = 0.0
+    for ring in rings:
+        n = len(ring)
+        if n < 3:
+            continue
+        if n > LOOP_MAX:
+            arr = np.asarray(ring, dtype=float)
+            s0, z0 = arr[:, 0], arr[:, 1]
+            s1, z1 = np.roll(s0, -1), np.roll(z0, -1)
+            c = s0 * z1 - s1 * z0
+            a += float(np.sum(c))
+            ss += float(np.sum((s0 + s1) * c))
+            sz += float(np.sum((z0 + z1) * c))
+            continue
+        pts = ring.tolist() if isinstance(ring, np.ndarray) else ring
+        p0, q0 = pts[-1]
+        for p1, q1 in pts:
+            c = p0 * q1 - p1 * q0
+            a += c
+            ss += (p0 + p1) * c
+            sz += (q0 + q1) * c
+            p0, q0 = p1, q1
+    return a / 2.0, ss / 6.0, sz / 6.0
+
+
+class FirstMoments(NamedTuple):
+    """Mass and first moment of a body about the model origin (a ``Lump`` without ``C``).
+
+    Attributes
+    ----------
+    mass : float
+        [kg].
+    S : (3,) float
+        ``∫ x dm`` [kg m].
+    """
+
+    mass: float
+    S: np.ndarray
+
+
 def rings_area(rings: Sequence[np.ndarray]) -> float:
     """Area of a polygon with holes [m²] (the first of ``ring_moments``)."""
     return float(ring_moments(rings)[0])
@@ -215,30 +270,51 @@ def clip_rings(rings: Sequence[np.ndarray], a: float, b: float, c: float) -> Rin
     out: Rings = []
     for ring in rings:
         pts = ring.tolist()
-        f = [a * p + b * q + c for p, q in pts]
-        if min(f) >= 0.0:
+        kept = _clip_points(pts, a, b, c)
+        if kept is pts:
             out.append(ring)
-            continue
-        if max(f) <= 0.0:
-            continue
-        kept: List[Tuple[float, float]] = []
-        n = len(pts)
-        for i in range(n):
-            j = i + 1 if i + 1 < n else 0
-            fi, fj = f[i], f[j]
-            if fi >= 0.0:
-                kept.append((pts[i][0], pts[i][1]))
-            if (fi > 0.0 and fj < 0.0) or (fi < 0.0 and fj > 0.0):
-                w = fi / (fi - fj)
-                kept.append(
-                    (
-                        pts[i][0] + w * (pts[j][0] - pts[i][0]),
-                        pts[i][1] + w * (pts[j][1] - pts[i][1]),
-                    )
-                )
-        if len(kept) >= 3:
+        elif kept:
             out.append(np.array(kept, dtype=float))
     return out
+
+
+Points = List[List[float]]
+
+
+def clip_point_rings(rings: Sequence[Points], a: float, b: float, c: float) -> List[Points]:
+    """``clip_rings`` on rings given as lists of [s, z] (the same arithmetic, no arrays).
+
+    For the loops that clip one region by several half-planes in a row (``contact_hits``):
+    the rings stay Python lists between the clips.
+    """
+    out: List[Points] = []
+    for pts in rings:
+        kept = _clip_points(pts, a, b, c)
+        if kept:
+            out.append(kept)
+    return out
+
+
+def _clip_points(pts: Points, a: float, b: float, c: float) -> Optional[Points]:
+    """Clip one ring (Sutherland-Hodgman): ``pts`` itself where wholly kept, None if empty."""
+    f = [a * p + b * q + c for p, q in pts]
+    if min(f) >= 0.0:
+        return pts
+    if max(f) <= 0.0:
+        return None
+    kept: Points = []
+    n = len(pts)
+    for i in range(n):
+        j = i + 1 if i + 1 < n else 0
+        fi, fj = f[i], f[j]
+        if fi >= 0.0:
+            kept.append([pts[i][0], pts[i][1]])
+        if (fi > 0.0 and fj < 0.0) or (fi < 0.0 and fj > 0.0):
+            w = fi / (fi - fj)
+            kept.append(
+                [pts[i][0] + w * (pts[j][0] - pts[i][0]), pts[i][1] + w * (pts[j][1] - pts[i][1])]
+            )
+    return kept if len(kept) >= 3 else None
 
 
 def segment_intervals(
@@ -261,10 +337,11 @@ def segment_intervals(
     """
     if len(rings) == 0:
         return []
-    d = np.asarray(p1, dtype=float) - np.asarray(p0, dtype=float)
+    p0 = np.asarray(p0, dtype=float)
+    d = np.asarray(p1, dtype=float) - p0
     # every ring's edges at once: the cuts and the winding numbers are sums over edges
     a = np.concatenate(list(rings)) if len(rings) > 1 else np.asarray(rings[0])
-    b = np.concatenate([np.roll(ring, -1, axis=0) for ring in rings])
+    b = np.concatenate([x for ring in rings for x in (ring[1:], ring[:1])])
     e = b - a
     den = d[0] * e[:, 1] - d[1] * e[:, 0]
     w = a - p0
@@ -278,9 +355,7 @@ def segment_intervals(
     if not pieces:
         return []
     # the winding number at every piece's middle at once (``winding``'s rule, point-wise)
-    mids = (
-        np.asarray(p0, dtype=float) + np.array([0.5 * (lo + hi) for lo, hi in pieces])[:, None] * d
-    )
+    mids = p0 + np.array([0.5 * (lo + hi) for lo, hi in pieces])[:, None] * d
     px, pz = mids[:, :1], mids[:, 1:]
     up = (a[:, 1] <= pz) & (b[:, 1] > pz)
     down = (a[:, 1] > pz) & (b[:, 1] <= pz)
@@ -332,7 +407,18 @@ class WallFrame:
     thickness: float
 
     def to_world(self, s: float, n: float, z: float) -> np.ndarray:
-        """World point of frame coordinates [m]."""
+        """World point of frame coordinates [m].
+
+        Numbers are summed per coordinate on the axes as Python floats (the same sums as
+        the arrays'); arrays of coordinates go through numpy.
+        """
+        if (
+            isinstance(s, (float, int))
+            and isinstance(n, (float, int))
+            and isinstance(z, (float, int))
+        ):
+            es, en, ez, o = self._axes
+            return np.array([o[k] + s * es[k] + n * en[k] + z * ez[k] for k in range(3)])
         return self.origin + s * self.e_s + n * self.e_n + z * self.e_z
 
     def to_frame(self, x: np.ndarray) -> np.ndarray:
@@ -412,6 +498,15 @@ class WallFrame:
         so = np.outer(o, s_world)
         c_world = c_world + so + so.T + m * np.outer(o, o)
         return Lump(m, m * o + s_world, c_world)
+
+    def prism_first_moments(self, rings: Sequence[np.ndarray], density: float) -> FirstMoments:
+        """Mass and first moment of ``prism_lump``'s prism, the same sums, without ``C``."""
+        A, Ss, Sz = ring_first_moments(rings)
+        t = self.thickness
+        rho = float(density)
+        m = rho * t * A
+        first = np.array([rho * t * Ss, rho * A * t * t / 2.0, rho * t * Sz])
+        return FirstMoments(m, m * self.origin + self._rotation @ first)
 
     @property
     def _rotation(self) -> np.ndarray:

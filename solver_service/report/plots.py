@@ -55,12 +55,17 @@ def plain(text: str) -> str:
     return str(text).replace("$", r"\$")
 
 
-def save_figure_atomic(fig: Any, path: Union[str, Path]) -> Path:
-    """Render a figure in memory and write it atomically (format from the suffix)."""
+def save_figure_atomic(fig: Any, path: Union[str, Path], *, tight: bool = True) -> Path:
+    """Render a figure in memory and write it atomically (format from the suffix).
+
+    ``tight`` crops the image to what is drawn (``bbox_inches="tight"``, which draws the
+    figure twice); a figure laid out in fixed margins is drawn once with ``tight=False``.
+    """
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     buf = io.BytesIO()
-    fig.savefig(buf, dpi=120, bbox_inches="tight", format=out.suffix.lstrip(".") or "png")
+    fmt = out.suffix.lstrip(".") or "png"
+    fig.savefig(buf, dpi=120, bbox_inches="tight" if tight else None, format=fmt)
     write_atomic(out, buf.getvalue())
     return out
 

@@ -22,6 +22,40 @@ __all__ = ["plot_search"]
 
 #: Panels per row of the figure.
 COLUMNS = 3
+#: Size of a panel's cell [in] (width, height).
+PANEL = (5.0, 4.2)
+#: Fixed margins [in]: left, right, bottom, top of the figure, then the gaps between
+#: columns and rows (room for the y labels, the x labels and the two-line panel titles).
+MARGINS = (0.75, 0.2, 0.6, 0.5, 0.85, 1.05)
+#: Height added above the panels for the figure's title [in].
+TITLE_BAND = 0.4
+
+
+def _size(cols: int, rows: int, title: str) -> tuple[float, float]:
+    """Return the figure's size [in]: the panels, their margins and the title's band."""
+    return (PANEL[0] * cols, PANEL[1] * rows + (TITLE_BAND if title else 0.0))
+
+
+def _margins(cols: int, rows: int, title: str) -> dict[str, float]:
+    """Return the fixed layout of the panels (``GridSpec`` fractions of the figure).
+
+    The margins are fixed in inches (``MARGINS``), so that every panel's title, axis labels
+    and tick labels fit without measuring the text (which ``tight_layout`` and a tight
+    bounding box do by drawing the figure once more).
+    """
+    width, height = _size(cols, rows, title)
+    left, right, bottom, top, gap_w, gap_h = MARGINS
+    top += TITLE_BAND if title else 0.0
+    axis_w = (width - left - right - (cols - 1) * gap_w) / cols
+    axis_h = (height - bottom - top - (rows - 1) * gap_h) / rows
+    return {
+        "left": left / width,
+        "right": 1.0 - right / width,
+        "bottom": bottom / height,
+        "top": 1.0 - top / height,
+        "wspace": gap_w / axis_w,
+        "hspace": gap_h / axis_h,
+    }
 
 
 def _unfold(facade: Any, wall: Any, returns: Sequence[Any]) -> Optional[Any]:
@@ -92,9 +126,9 @@ def plot_search(
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(5.0 * cols, 4.2 * rows))
+    fig = Figure(figsize=_size(cols, rows, title))
     FigureCanvasAgg(fig)
-    axes = fig.subplots(rows, cols, squeeze=False)
+    axes = fig.subplots(rows, cols, squeeze=False, gridspec_kw=_margins(cols, rows, title))
     for ax in axes.ravel()[n:]:
         ax.axis("off")
     for ax, d in zip(axes.ravel(), ranked):
@@ -136,5 +170,4 @@ def plot_search(
         ax.tick_params(labelsize=7)
     if title:
         fig.suptitle(title)
-    fig.tight_layout()
-    return save_figure_atomic(fig, path)
+    return save_figure_atomic(fig, path, tight=False)

@@ -193,3 +193,36 @@ def test_an_implausible_masonry_unit_gets_a_warning_naming_the_field(
     )
     quiet = rockmech.search(scene, spec).doc.to_dict()
     assert not [n for n in quiet["warnings"] + quiet["notes"] if "unit." in n]
+
+
+def test_cli_pauses_the_collector_while_it_works_and_restores_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The collector is off during the search and back on after it, on success and on error."""
+    import gc
+
+    from solver_service.workflows import search as workflow
+
+    seen: list[bool] = []
+    real = workflow.search_from_files
+
+    def spy(*args: object, **kwargs: object) -> object:
+        seen.append(gc.isenabled())
+        return real(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(workflow, "search_from_files", spy)
+    scene = wedge_facade(tmp_path)
+    spec = write_spec(tmp_path / "s.json", wedge_spec("good", (0.25, 0.12)))
+    assert gc.isenabled()
+    res = runner.invoke(
+        app, ["search", str(scene), str(spec), "-o", str(tmp_path / "o"), "--no-figure"]
+    )
+    assert res.exit_code == 0, res.output
+    assert seen == [False] and gc.isenabled()
+    bad = tmp_path / "bad.json"
+    bad.write_text("{}")
+    res = runner.invoke(
+        app, ["search", str(scene), str(bad), "-o", str(tmp_path / "p"), "--no-figure"]
+    )
+    assert res.exit_code != 0 and "Traceback" not in res.output
+    assert seen == [False, False] and gc.isenabled()
