@@ -54,7 +54,7 @@ def plain(text: str) -> str:
     return str(text).replace("$", r"\$")
 
 
-def save_figure_atomic(fig: Any, path: Union[str, Path]) -> Path:
+def write_figure_atomic(fig: Any, path: Union[str, Path]) -> Path:
     """Render a figure in memory and write it atomically (format from the suffix)."""
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -123,7 +123,7 @@ def plot_time_histories(
     axes[-1, 0].set_xlabel("time [s]")
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -181,7 +181,7 @@ def plot_ratio_histories(
         axes[0, 0].set_title(f"{plain(title)}  (× overturned; dotted: time of overturning)")
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -236,7 +236,7 @@ def plot_record(
     ax_s.grid(which="both", alpha=0.3)
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -333,7 +333,7 @@ def plot_envelopes(
         ax.set_title(plain(title))
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -379,6 +379,6 @@ def plot_fragility(doc: dict[str, Any], path: Union[str, Path], *, title: str = 
     ax.set_title(plain(title) or "Fragility from incremental dynamic analysis (lognormal MLE)")
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)

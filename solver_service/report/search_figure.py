@@ -16,7 +16,7 @@ from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
-from .plots import save_figure_atomic
+from .plots import write_figure_atomic
 
 __all__ = ["plot_search"]
 
@@ -139,4 +139,4 @@ def plot_search(
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    return save_figure_atomic(fig, path)
+    return write_figure_atomic(fig, path)
