@@ -12,7 +12,8 @@ shared options and option groups), ``output`` (tables, notes, JSON), ``app`` (th
 application and ``--version``) and one module per family of commands, each of which imports
 its workflows inside the command's body, when it runs. ``rockmech --help`` and a one-pulse
 ``rockmech pulse`` load neither the envelopes, nor scipy.optimize, nor ``cad_maths``, nor
-matplotlib (tests/test_cli_imports.py; docs/benchmarks.md times them).
+matplotlib (tests/test_cli_imports.py; docs/benchmarks.md times them). The console script
+(``main``) has typer build the one command it runs (``command_app``), not all of them.
 """
 
 from __future__ import annotations
