@@ -3,7 +3,9 @@
 What is measured
 ----------------
 Wall-clock time of whole processes, each the best of ``REPEATS`` runs after one warm-up run
-(which also compiles any solver kernel the command needs, so no run waits for numba):
+(which also compiles any solver kernel the command needs, so no run waits for numba, and
+writes Python's bytecode caches, as an installed rockmech has them); the first three are
+run in turn, one run of each per round:
 
 1. ``python -c "import numpy"``: the yardstick, measured in the same run;
 2. ``rockmech --help`` and ``rockmech --version`` (this one reads numba's version and the
@@ -29,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -68,20 +71,43 @@ def _rockmech() -> str:
     return exe
 
 
+def _command_env() -> dict[str, str]:
+    """Return the environment of the timed commands: this one, with bytecode caches on.
+
+    An installed rockmech has its modules' caches (``__pycache__``: pip byte-compiles a
+    package when it installs it, and an editable install writes them on its first run), as
+    the yardstick's numpy has its own. ``PYTHONDONTWRITEBYTECODE`` would have every run of
+    ``rockmech`` compile its modules from source again, which no user's run does: it is
+    removed, so that the warm-up run writes the caches the timed runs read.
+    """
+    env = dict(os.environ)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    return env
+
+
 def _wall(argv: Sequence[str]) -> float:
     """Run ``argv`` once (output discarded); its wall-clock time [s]. A failure stops here."""
     t = time.perf_counter()
-    proc = subprocess.run(list(argv), capture_output=True, text=True, cwd=REPO)
+    proc = subprocess.run(list(argv), capture_output=True, text=True, cwd=REPO, env=_command_env())
     wall = time.perf_counter() - t
     if proc.returncode != 0:
         raise SystemExit(f"`{' '.join(argv)}` failed ({proc.returncode}):\n{proc.stderr}")
     return wall
 
 
-def best_wall(argv: Sequence[str], repeats: int = REPEATS) -> float:
-    """Best wall-clock time [s] of ``repeats`` runs of ``argv`` after one warm-up run."""
-    _wall(argv)
-    return min(_wall(argv) for _ in range(repeats))
+def best_walls(commands: dict[str, Sequence[str]], repeats: int = REPEATS) -> dict[str, float]:
+    """Best wall-clock time [s] of each command over ``repeats`` rounds, after a warm-up round.
+
+    Each round runs every command once, in turn, so that a change of the shared machine's
+    load falls on the yardstick and on the commands alike rather than on one of them.
+    """
+    for argv in commands.values():
+        _wall(argv)
+    walls: dict[str, list[float]] = {key: [] for key in commands}
+    for _ in range(repeats):
+        for key, argv in commands.items():
+            walls[key].append(_wall(argv))
+    return {key: min(times) for key, times in walls.items()}
 
 
 def search_runs(exe: str, repeats: int = SEARCH_REPEATS) -> tuple[float, float]:
@@ -106,12 +132,15 @@ def main(argv: list[str] | None = None) -> int:
     t_all = time.perf_counter()
     info = machine_info(("numpy", "scipy", "numba", "typer"))
     exe = _rockmech()
-    numpy_s = best_wall([sys.executable, "-c", "import numpy"])
-    times = {
-        "help": best_wall([exe, "--help"]),
-        "version": best_wall([exe, "--version"]),
-        "pulse": best_wall([exe, *PULSE]),
-    }
+    times = best_walls(
+        {
+            "numpy": [sys.executable, "-c", "import numpy"],
+            "help": [exe, "--help"],
+            "version": [exe, "--version"],
+            "pulse": [exe, *PULSE],
+        }
+    )
+    numpy_s = times.pop("numpy")
     search_s, total_s = search_runs(exe)
     total = time.perf_counter() - t_all
     md = report(info, numpy_s, times, search_s, total_s, total)
@@ -170,8 +199,11 @@ def report(
         "### Method",
         "",
         "Each command runs as a whole process (`rockmech` of the project's environment), "
-        f"once to warm up (numba's kernels compiled and the files in the page cache), then "
-        f"{REPEATS} times ({SEARCH_REPEATS} for the search); the best wall-clock time is "
+        "once to warm up (numba's kernels compiled, Python's bytecode caches written and the "
+        "files in the page cache; `PYTHONDONTWRITEBYTECODE` is unset for the commands, as an "
+        "installed rockmech has its caches like the yardstick's numpy), then "
+        f"{REPEATS} times ({SEARCH_REPEATS} for the search), the yardstick and the light "
+        "commands in turn (one run of each per round); the best wall-clock time is "
         'given, and its ratio to the best of `python -c "import numpy"` in the same run. '
         "The search command is held to "
         f"{SEARCH_FACTOR:g} times its own `total_s` (search.json: the scene read, the search, "
@@ -193,8 +225,11 @@ def report(
         "build stamps from numba's cache folder. The one-pulse `pulse` runs the solver's "
         "pure-Python kernels (the same numbers as the compiled ones, bit for bit) instead "
         "of loading numba and its cached kernels; what it still loads beyond `--help` is "
-        "numpy, the solver's modules and pydantic's request model (`shared_schema.api`, "
-        "with the constants file's models it holds). The search loads neither numba nor "
+        "numpy, pydantic (typer validates the options with it), the solver's modules, the "
+        "pulse request (`shared_schema.pulse_request`, with the constants file's models it "
+        "holds; not the other requests of `shared_schema.api`) and its document. The "
+        "console script builds the options of the one command it runs (typer builds every "
+        "registered command's otherwise). The search loads neither numba nor "
         "the code check when its spec has no records and no site (not the case of the "
         "bundled façade, which has both), and draws its figure without pyplot.",
     ]

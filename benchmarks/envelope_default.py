@@ -58,7 +58,7 @@ from _docs import (  # noqa: E402  (benchmarks/ is not a package)
     write_section,
 )
 
-from shared_schema.io import load_constants  # noqa: E402
+from shared_schema.io import read_constants  # noqa: E402
 from solver_service.core.envelope import OverturningLibrary  # noqa: E402
 from solver_service.workflows.documents import envelope_doc, frequency_grid  # noqa: E402
 
@@ -117,7 +117,7 @@ def run(quick: bool) -> list[dict[str, Any]]:
     lib = OverturningLibrary.load()
     rows = []
     for path in FILES:
-        cf = load_constants(path)
+        cf = read_constants(path)
         envelope_doc(cf, f_p)  # warm-up: numba cache, imports
         envelope_doc(cf, f_p, method="library", library=lib)
         t_exact, _, (exact, _) = best_of(functools.partial(envelope_doc, cf, f_p), REPEATS)

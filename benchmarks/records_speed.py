@@ -104,10 +104,10 @@ def derived_records(n: int) -> list[Any]:
 def mechanisms() -> Any:
     """Return the ten example mechanisms that have a coefficient of restitution."""
     from shared_schema.constants import ConstantsFile
-    from shared_schema.io import load_constants
+    from shared_schema.io import read_constants
 
-    walls = load_constants(REPO / "examples" / "constants" / "rect_walls.json")
-    church = load_constants(REPO / "examples" / "constants" / "church.json")
+    walls = read_constants(REPO / "examples" / "constants" / "rect_walls.json")
+    church = read_constants(REPO / "examples" / "constants" / "church.json")
     mechs = [m for m in walls.mechanisms + church.mechanisms if m.eta is not None]
     return ConstantsFile.model_validate(
         {"mechanisms": [m.model_dump(exclude_none=True) for m in mechs[:N_MECHANISMS]]}

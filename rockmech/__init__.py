@@ -25,7 +25,6 @@ from rockmech._version import __version__
 
 if TYPE_CHECKING:  # the real types for type checkers and editors
     from cad_maths.scenes import read_scene as read_scene
-    from shared_schema.api import PulseRequest as PulseRequest
     from shared_schema.constants import ConstantsFile as ConstantsFile
     from shared_schema.documents.assess import AssessDocument as AssessDocument
     from shared_schema.documents.boundary import BoundaryDocument as BoundaryDocument
@@ -55,6 +54,7 @@ if TYPE_CHECKING:  # the real types for type checkers and editors
     )
     from shared_schema.extras import MissingExtra as MissingExtra
     from shared_schema.io import write_constants as write_constants
+    from shared_schema.pulse_request import PulseRequest as PulseRequest
     from shared_schema.retrofit import RetrofitDoc as RetrofitDoc
     from shared_schema.retrofit import RetrofitSpec as RetrofitSpec
     from shared_schema.retrofit import read_retrofit_spec as read_retrofit_spec
@@ -187,7 +187,7 @@ _SOURCES = {
     "simulate": "solver_service.core.exact",
     "simulate_batch": "solver_service.core.exact",
     # One pulse request, one function: the same verdict as the CLI, REST, Hops and Rhino.
-    "PulseRequest": "shared_schema.api",
+    "PulseRequest": "shared_schema.pulse_request",
     "PulseDocument": "shared_schema.documents.pulse",
     "BoundaryDocument": "shared_schema.documents.boundary",
     "solve_pulse": "solver_service.workflows.documents",

@@ -124,7 +124,7 @@ def constants_from_scene(
     -------
     ConstantsFile
     """
-    return _inputs.constants_from_files(as_path(scene, "scene"), as_path(spec, "spec"), units)
+    return _inputs.constants_from_scene_files(as_path(scene, "scene"), as_path(spec, "spec"), units)
 
 
 def _constants(constants: Constants) -> ConstantsFile:

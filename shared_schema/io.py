@@ -15,8 +15,8 @@ from shared_schema.version import __version__
 
 __all__ = [
     "CONSTANTS_EXPECTED",
-    "load_constants",
     "parse_constants",
+    "read_constants",
     "stamped",
     "write_atomic",
     "write_constants",
@@ -29,7 +29,7 @@ CONSTANTS_EXPECTED = (
 )
 
 
-def load_constants(path: PathLike) -> ConstantsFile:
+def read_constants(path: PathLike) -> ConstantsFile:
     """Read and validate a kinematic-constants file.
 
     Parameters

@@ -93,7 +93,10 @@ SPEC_VERSIONS = ("1.0",)
 #: warning whenever it is used.
 TRIBUTARY_DEFAULT = 0.5
 
-_STRICT = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
+#: The spec's models (not ``Amplification``, which the constants file holds) build their
+#: validators on first use: the constants file's models, and so a pulse, import this module
+#: for ``Amplification`` and ``TYPOLOGIES`` and need none of them (#38).
+_STRICT = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False, defer_build=True)
 
 #: An object selector: a name, or one of {"name": ...}, {"layer": ...}, {"id": ...}.
 Selector = Union[str, Dict[Literal["name", "layer", "id"], str]]

@@ -29,13 +29,13 @@ from typing import Any, Optional
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
 from shared_schema.extras import MissingExtra
-from shared_schema.io import load_constants, write_constants
+from shared_schema.io import read_constants, write_constants
 from shared_schema.paths import PathLike, as_path
 
 from .core.model import G
 from .core.records import GroundMotion
 from .workflows.documents import frequency_grid
-from .workflows.inputs import constants_from_files
+from .workflows.inputs import constants_from_scene_files
 from .workflows.outputs import write_envelope, write_history
 from .workflows.rundir import run_folder
 
@@ -266,7 +266,7 @@ def facade_from_scene(out_dir: Path) -> dict[str, Path]:
     """Scene -> constants -> envelopes for the example façade (the CAD path end to end)."""
     scene_path = EXAMPLES_DIR / "scenes" / "facade.3dm"
     spec_path = EXAMPLES_DIR / "specs" / "facade.spec.json"
-    cf = constants_from_files(scene_path, spec_path)
+    cf = constants_from_scene_files(scene_path, spec_path)
     constants_path = out_dir / "facade_constants.json"
     write_constants(cf, constants_path)
     write_envelope(
@@ -289,7 +289,7 @@ def church_history(out_dir: Path, record: GroundMotion) -> Path:
     A time history needs a coefficient of restitution: the one-sided façade without eta (an
     envelope-only example) is listed under ``skipped`` in the document, with the reason.
     """
-    cf = load_constants(EXAMPLES_DIR / "constants" / "church.json")
+    cf = read_constants(EXAMPLES_DIR / "constants" / "church.json")
     write_history(
         cf,
         record,
@@ -304,7 +304,7 @@ def church_history(out_dir: Path, record: GroundMotion) -> Path:
 
 def church_envelope(out_dir: Path) -> dict[str, Path]:
     """Write the example church's envelopes and critical bands (JSON, CSV, PNG)."""
-    cf = load_constants(EXAMPLES_DIR / "constants" / "church.json")
+    cf = read_constants(EXAMPLES_DIR / "constants" / "church.json")
     stem = "church_envelope"
     write_envelope(
         cf,

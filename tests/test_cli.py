@@ -506,11 +506,11 @@ def test_history_displacement_at_a_height(tmp_path: Path) -> None:
     assert res.exit_code == 0, res.output
     doc = json.loads(res.stdout)
     assert doc["displacement"]["height_m"] == 2.5
-    from shared_schema.io import load_constants
+    from shared_schema.io import read_constants
     from solver_service.workflows.adapter import models_from_file
 
     motion = GroundMotion.from_two_column(record)
-    for model, row in zip(models_from_file(load_constants(constants)), doc["results"]):
+    for model, row in zip(models_from_file(read_constants(constants)), doc["results"]):
         dense = simulate(model, motion.accel, scale=0.6, dense=True)
         assert dense.ratio is not None
         # Independent: the largest |phi| over the traced response, in radians, times z.
@@ -573,12 +573,12 @@ def test_envelope_with_a_records_pulse_agrees_with_the_exact_solver(tmp_path: Pa
     doc = json.loads(res.stdout)
     rp = doc["record_pulse"]
     assert [p["scale"] for p in rp["points"]] == [0.3, 1.0, 3.0]
-    from shared_schema.io import load_constants
+    from shared_schema.io import read_constants
     from solver_service.workflows.adapter import models_from_file
 
     # Each verdict against a direct exact run of that pulse (both directions; governing).
     for point in rp["points"]:
-        for model in models_from_file(load_constants(constants)):
+        for model in models_from_file(read_constants(constants)):
             a_min = rp["a_p_min_g_at_f_p"][model.name]
             if abs(point["a_p_g"] / a_min - 1) < 1e-3:
                 continue  # too close to the boundary to be a fair check

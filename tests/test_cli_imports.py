@@ -198,3 +198,65 @@ def test_the_app_called_in_a_longer_lived_process_keeps_numba() -> None:
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert res.stderr.strip().splitlines()[-1] == "True", res.stderr
     assert json.loads(res.stdout)["method"] == "exact:numba"
+
+
+def test_a_pulse_loads_no_other_request_model_and_no_masked_arrays() -> None:
+    # The pulse request has its own module (shared_schema.pulse_request): a pulse loads
+    # neither the other requests (shared_schema.api) nor the site file's or the retrofit's
+    # models, nor numpy.ma (np.median's check for NaN).
+    others = ("shared_schema.api", "shared_schema.site", "shared_schema.retrofit", "numpy.ma")
+    code, heavy, stdout = _loaded(PULSE, heavy=others)
+    assert code == 0, stdout
+    assert heavy == []
+
+
+# Runs argv in a fresh interpreter as the console script does (``main``: the application
+# with the one command argv names), or with the whole application (``app``, the reference),
+# both as one process that ends after the command.
+WHOLE_OR_ONE = """
+import sys
+from solver_service.cli import CONSOLE, app, main
+sys.argv[0] = "rockmech"
+CONSOLE["process"] = True
+main() if sys.argv.pop(1) == "one" else app()
+"""
+
+
+def _run(how: str, argv: list[str]) -> tuple[int, str, str]:
+    res = subprocess.run(
+        [sys.executable, "-c", WHOLE_OR_ONE, how, *argv], capture_output=True, text=True, cwd=ROOT
+    )
+    return res.returncode, res.stdout, res.stderr
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        PULSE,
+        ["pulse", "--help"],
+        [*PULSE, "--bogus"],
+        ["pulse", "--p-eq", "x", "--a-p-g", "1", "--f-p", "1"],
+        ["pulse", "--lam", "0.2", "--a-p-g", "0.3", "--f-p", "1", "--eta", "0.9"],
+        ["boundary", "--omega", "2", "--eta", "0.9"],
+        ["pulsee", "--f-p", "1"],
+        ["library", "--help"],
+        ["--version"],
+    ],
+    ids=[
+        "pulse",
+        "help",
+        "bad-option",
+        "bad-number",
+        "no-p-eq",
+        "boundary",
+        "typo",
+        "group",
+        "version",
+    ],
+)
+def test_the_console_script_answers_as_the_whole_application(argv: list[str]) -> None:
+    # The console script builds the one command it runs; what it prints, on stdout and
+    # stderr, and its exit status are the whole application's, help and errors included.
+    one, whole = _run("one", argv), _run("whole", argv)
+    assert one[1] or one[2], "the command printed nothing"
+    assert one == whole

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from shared_schema.io import load_constants, stamped
+from shared_schema.io import read_constants, stamped
 from solver_service.core.model import G
 from solver_service.demo import DEMO_SCALES, DEMO_WALLS, demo_constants, run_demo
 
@@ -30,13 +30,13 @@ def test_rectangular_wall_constants_are_housners() -> None:
 
 
 def test_committed_example_matches_the_demo_constants() -> None:
-    committed = load_constants(EXAMPLES / "constants" / "rect_walls.json")
+    committed = read_constants(EXAMPLES / "constants" / "rect_walls.json")
     assert committed == demo_constants()
 
 
 def test_demo_writes_constants_results_and_plot(tmp_path: Path) -> None:
     paths = run_demo(tmp_path)
-    assert load_constants(paths["constants"]) == stamped(demo_constants())
+    assert read_constants(paths["constants"]) == stamped(demo_constants())
     doc = json.loads(paths["history"].read_text())
     assert len(doc["results"]) == len(DEMO_WALLS) * len(DEMO_SCALES)
     assert all(0.0 <= r["peak_ratio"] <= 1.0 or not r["overturned"] for r in doc["results"])

@@ -23,7 +23,7 @@ from typer.testing import CliRunner
 
 from shared_schema.documents.ida import IdaDocument
 from shared_schema.errors import InputError
-from shared_schema.io import load_constants
+from shared_schema.io import read_constants
 from solver_service.cli import app
 from solver_service.cli.ida import parse_levels
 from solver_service.core.exact import simulate
@@ -99,7 +99,7 @@ def _peak_rows(path: Path) -> list[tuple[Any, ...]]:
 
 
 def test_local_ida_counts_equal_direct_simulations(motions: list[GroundMotion]) -> None:
-    cf = load_constants(CONSTANTS)
+    cf = read_constants(CONSTANTS)
     seen: list[tuple[int, int]] = []
     doc = run_ida(
         cf, motions, LEVELS[::-1], progress=lambda done, total: seen.append((done, total))
@@ -193,7 +193,7 @@ def _interleaving_task_s(cf: Any, mixed: list[GroundMotion]) -> float:
 def test_results_are_identical_on_every_cutting_and_number_of_threads(
     mixed: list[GroundMotion], jobs: int, task_s: Optional[float]
 ) -> None:
-    cf = load_constants(CONSTANTS)
+    cf = read_constants(CONSTANTS)
     if task_s is None:  # interleaved blocks of levels beside a pack of short records
         task_s = _interleaving_task_s(cf, mixed)
     reference = run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9)  # one task, one thread
@@ -206,7 +206,7 @@ def test_results_are_identical_on_every_cutting_and_number_of_threads(
 
 
 def test_pga_intensity_scales_each_record_to_the_level(motions: list[GroundMotion]) -> None:
-    cf = load_constants(CONSTANTS)
+    cf = read_constants(CONSTANTS)
     levels = [0.1, 0.3, 0.6]
     doc = run_ida(cf, motions, levels, measure="pga")
     assert doc.intensity.units == "g" and doc.measure == "pga"
@@ -222,7 +222,7 @@ def test_peaks_file_holds_every_run_as_a_direct_simulation_gives_it(
     mixed: list[GroundMotion], tmp_path: Path
 ) -> None:
     pq = pytest.importorskip("pyarrow.parquet")
-    cf = load_constants(CONSTANTS)
+    cf = read_constants(CONSTANTS)
     path = tmp_path / "peaks.parquet"
     doc = run_ida(cf, mixed, LEVELS, jobs=2, task_s=1e-9, peaks=path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["peaks.parquet"]  # no temp left
@@ -254,7 +254,7 @@ def test_peaks_file_holds_every_run_as_a_direct_simulation_gives_it(
 
 def test_a_stopped_run_leaves_no_peaks_file(motions: list[GroundMotion], tmp_path: Path) -> None:
     pytest.importorskip("pyarrow")
-    cf = load_constants(CONSTANTS)
+    cf = read_constants(CONSTANTS)
 
     def stop(done: int, total: int) -> None:
         if done:
@@ -272,7 +272,7 @@ def test_dask_local_cluster_gives_the_local_numbers_on_every_cutting(
 ) -> None:
     distributed = pytest.importorskip("distributed")
     pytest.importorskip("pyarrow")
-    cf = load_constants(CONSTANTS)
+    cf = read_constants(CONSTANTS)
     local = run_ida(cf, mixed, LEVELS, jobs=1, task_s=1e9, peaks=tmp_path / "local.parquet")
     with distributed.LocalCluster(
         n_workers=2, threads_per_worker=1, processes=True, **NO_DASHBOARD
@@ -311,7 +311,7 @@ def test_a_scheduler_without_workers_or_with_another_rockmech_is_a_clear_error(
     motions: list[GroundMotion], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     distributed = pytest.importorskip("distributed")
-    cf = load_constants(CONSTANTS)
+    cf = read_constants(CONSTANTS)
     with distributed.LocalCluster(n_workers=0, **NO_DASHBOARD) as cluster:
         address = cluster.scheduler_address
         with pytest.raises(InputError, match=f"no worker joined the Dask scheduler at {address}"):
@@ -328,7 +328,7 @@ def test_unreachable_scheduler_is_a_clear_error_not_a_hang(motions: list[GroundM
     address = f"tcp://127.0.0.1:{_free_port()}"
     start = time.perf_counter()
     with pytest.raises(InputError, match=f"cannot reach the Dask scheduler at {address}"):
-        run_ida(load_constants(CONSTANTS), motions[:1], [1.0], scheduler=address, timeout=1.0)
+        run_ida(read_constants(CONSTANTS), motions[:1], [1.0], scheduler=address, timeout=1.0)
     assert time.perf_counter() - start < 30.0  # bounded by the timeout, with margin
     res = runner.invoke(
         app,
@@ -357,7 +357,7 @@ def test_a_malformed_scheduler_address_is_refused_before_any_connection(
     pytest.importorskip("distributed")
     start = time.perf_counter()
     with pytest.raises(InputError, match="expected a Dask scheduler address") as err:
-        run_ida(load_constants(CONSTANTS), motions[:1], [1.0], scheduler=address)
+        run_ida(read_constants(CONSTANTS), motions[:1], [1.0], scheduler=address)
     assert err.value.field == "scheduler" and problem in str(err.value)
     assert time.perf_counter() - start < 5.0  # no connection tried, no timeout waited
 
@@ -419,7 +419,7 @@ def test_parse_levels() -> None:
 def test_a_mechanism_without_eta_is_skipped_with_a_note_not_fatal(
     motions: list[GroundMotion], tmp_path: Path
 ) -> None:
-    church = load_constants(EXAMPLES / "constants" / "church.json")
+    church = read_constants(EXAMPLES / "constants" / "church.json")
     no_eta = [m.id for m in church.mechanisms if m.eta is None]
     assert no_eta == ["F1"]
     levels = [0.5, 1.0, 2.0]
@@ -446,7 +446,7 @@ def test_a_worker_lost_during_the_run_costs_its_tasks_not_the_run(
 ) -> None:
     distributed = pytest.importorskip("distributed")
     dask = pytest.importorskip("dask")
-    cf = load_constants(CONSTANTS)
+    cf = read_constants(CONSTANTS)
     local = run_ida(cf, mixed, LEVELS, jobs=1)
     killed: list[int] = []
     # Started with rockmech's Dask settings (docs/cluster.md): the nannies hand them to the
@@ -524,7 +524,7 @@ def _stopped_in_the_first_fill(
         n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", **NO_DASHBOARD
     ) as cluster:
         with pytest.raises(stop), limited:
-            cf = load_constants(CONSTANTS)
+            cf = read_constants(CONSTANTS)
             run_ida(cf, mixed, LEVELS, scheduler=cluster.scheduler_address, task_s=1e-9)
         assert calls and calls[0] > 0  # the first fill ran to its end and submitted tasks
         scheduler = cluster.scheduler

@@ -43,7 +43,7 @@ def test_envelope_plot_draws_where_each_band_edge_lies(
     from matplotlib.figure import Figure
     from matplotlib.patches import Polygon, Rectangle
 
-    from shared_schema.io import load_constants
+    from shared_schema.io import read_constants
     from solver_service.workflows.documents import frequency_grid
     from solver_service.workflows.outputs import write_envelope
 
@@ -55,7 +55,7 @@ def test_envelope_plot_draws_where_each_band_edge_lies(
         return savefig(self, *args, **kwargs)
 
     monkeypatch.setattr(Figure, "savefig", spy)
-    cf = load_constants(Path(__file__).resolve().parents[1] / "examples/constants/church.json")
+    cf = read_constants(Path(__file__).resolve().parents[1] / "examples/constants/church.json")
     for method, label in (("exact", "between two grid frequencies"), ("library", "×1.05")):
         seen.clear()
         doc = write_envelope(

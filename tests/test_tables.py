@@ -15,8 +15,9 @@ from typing import Any
 import pytest
 from typer.testing import CliRunner
 
+from shared_schema import io as constants_io
 from shared_schema.errors import InputError
-from shared_schema.io import load_constants, parse_constants, stamped
+from shared_schema.io import parse_constants, stamped
 from solver_service.cli import app
 from solver_service.workflows.inputs import read_constants
 from solver_service.workflows.tables import COLUMNS, XLSX_HINT, constants_from_table
@@ -54,7 +55,7 @@ CHURCH_COLUMNS += ["eta_source", "f_n", "h_e", "h", "source"]
 
 
 def test_church_table_round_trips_to_the_same_constants_as_its_json(tmp_path: Path) -> None:
-    reference = load_constants(EXAMPLES / "church.json")
+    reference = constants_io.read_constants(EXAMPLES / "church.json")
     mechanisms = json.loads((EXAMPLES / "church.json").read_text())["mechanisms"]
     table = _write_csv(tmp_path / "church.csv", CHURCH_COLUMNS, _rows(mechanisms, CHURCH_COLUMNS))
     cf = constants_from_table(table)
@@ -64,7 +65,9 @@ def test_church_table_round_trips_to_the_same_constants_as_its_json(tmp_path: Pa
     result = runner.invoke(app, ["constants-table", str(table), "-o", str(out)])
     assert result.exit_code == 0, result.output
     assert "8 mechanism(s)" in result.output
-    assert load_constants(out).model_dump_json() == stamped(reference).model_dump_json()
+    assert (
+        constants_io.read_constants(out).model_dump_json() == stamped(reference).model_dump_json()
+    )
 
 
 def test_utf16_and_semicolon_tables_give_the_same_constants(tmp_path: Path) -> None:
@@ -169,7 +172,7 @@ def test_xlsx_table_gives_the_same_constants(tmp_path: Path) -> None:
         constants_from_table(path)
     sheet.delete_rows(10)
     book.save(path)
-    reference = load_constants(EXAMPLES / "church.json")
+    reference = constants_io.read_constants(EXAMPLES / "church.json")
     assert read_constants(path).model_dump() == reference.model_dump()
 
 

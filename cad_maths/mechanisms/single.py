@@ -33,9 +33,9 @@ __all__ = [
     "AXIS_TILT_TOL",
     "Body",
     "RockingSide",
+    "body_from_spec",
     "claim_once",
     "find_objects",
-    "load_body",
     "negative_axis",
     "resolve_axis",
     "rocking_side",
@@ -135,7 +135,7 @@ def _crack_plane(scene: Any, crack: Any, where: str) -> Tuple[np.ndarray, np.nda
     return p[0], n / norm
 
 
-def load_body(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
+def body_from_spec(spec: Any, scene: Any, axis_mid: np.ndarray) -> Body:
     """Validate the spec's solids, cut them by its cracks and compute their mass properties."""
     where = f"{spec.id}"
     solids: List[Tuple[Any, float, str]] = []  # (mesh, density, object id)
@@ -374,7 +374,7 @@ def rigid_body(spec: Any, scene: Any) -> Tuple[Body, RockingSide, Dict[str, Any]
     """
     where = spec.id
     start, end = resolve_axis(scene, spec.axis, f"{where}.axis")
-    body = load_body(spec, scene, 0.5 * (start + end))
+    body = body_from_spec(spec, scene, 0.5 * (start + end))
     pos = rocking_side(
         body, start, end, where=f"{where}.axis", allow_tilt=spec.allow_non_horizontal_axis
     )

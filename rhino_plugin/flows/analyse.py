@@ -28,7 +28,7 @@ from shared_schema.documents.envelope import EnvelopeDocument
 from shared_schema.documents.history import HistoryDocument
 from shared_schema.documents.pulse import PulseDocument
 from shared_schema.errors import InputError, RockmechError
-from shared_schema.io import load_constants
+from shared_schema.io import read_constants
 from solver_service.workflows.documents import frequency_grid, pick_mechanism, solve_pulse
 from solver_service.workflows.inputs import read_record
 from solver_service.workflows.outputs import write_envelope, write_history
@@ -38,7 +38,7 @@ __all__ = [
     "AnalysisResult",
     "ServiceClient",
     "analyse_flow",
-    "load_constants_files",
+    "read_constants_files",
     "run_envelopes",
     "run_history",
     "run_pulse",
@@ -185,14 +185,14 @@ def _post_files(
     return client.request(endpoint, body, f"multipart/form-data; boundary={boundary}")
 
 
-def load_constants_files(paths: Sequence[str]) -> Any:
+def read_constants_files(paths: Sequence[str]) -> Any:
     """Read one or more constants files as one (mechanism ids must differ)."""
     if not paths:
         raise InputError("no constants file was given", "constants")
     mechanisms: List[Any] = []
     seen: Dict[str, str] = {}
     for path in paths:
-        for mech in load_constants(path).mechanisms:
+        for mech in read_constants(path).mechanisms:
             if mech.id in seen:
                 raise InputError(
                     f"mechanism id {mech.id!r} is in both {seen[mech.id]} and {path}", "constants"
@@ -371,7 +371,7 @@ def analyse_flow(
             paths = list(current)
         else:
             paths = [prompter.get_file("Kinematic-constants file", [".json"])]
-        cf = load_constants_files(paths)
+        cf = read_constants_files(paths)
         kind = prompter.get_option("Analysis", list(ANALYSES), 0)
         client = None
         if service_url:

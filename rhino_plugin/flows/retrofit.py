@@ -38,7 +38,7 @@ from rhino_plugin.flows.marks import Mark
 from rhino_plugin.flows.prompter import Prompter
 from shared_schema.constants import ConstantsFile
 from shared_schema.errors import InputError
-from shared_schema.io import load_constants
+from shared_schema.io import read_constants
 from shared_schema.retrofit import RetrofitDoc, RetrofitSpec, read_retrofit_spec
 from shared_schema.site import SiteFile
 from solver_service.report.retrofit import retrofit_summary
@@ -308,7 +308,7 @@ def _constants_retrofit(
     constants_path = ask.get_file("Kinematic-constants file", [".json"])
     site_path = ask.get_file("Site file (SITE.json)", [".json"])
     spec_path = ask.get_file("Retrofit spec (JSON)", [".json"])
-    cf = load_constants(constants_path)
+    cf = read_constants(constants_path)
     site: SiteFile = read_site_file(site_path)
     spec = read_retrofit_spec(spec_path)
     if service_url:

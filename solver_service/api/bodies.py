@@ -17,7 +17,7 @@ from pydantic import TypeAdapter, ValidationError
 
 from .problems import Problem, validation_message
 
-__all__ = ["MAX_BODY_DEPTH", "json_body", "load_json", "out_of_range", "validate_json"]
+__all__ = ["MAX_BODY_DEPTH", "json_body", "out_of_range", "parse_json", "validate_json"]
 
 #: Deepest nesting of a JSON body that is parsed [levels]: the recursion limit of pydantic's
 #: JSON parser (a test pins it), well above the few levels a request needs.
@@ -63,7 +63,7 @@ def _too_deep(exc: ValidationError) -> bool:
 _ANY_JSON: TypeAdapter[Any] = TypeAdapter(Any)
 
 
-def load_json(body: bytes) -> Any:
+def parse_json(body: bytes) -> Any:
     """Return the JSON value of ``body``, read with the depth limit of every request body.
 
     For the routes that take JSON outside a model (Hops), so that they refuse a deep body

@@ -36,7 +36,7 @@ from shared_schema.api import EnvelopeRequest, PulseRequest
 from shared_schema.constants import parse_constants, validation_lines
 from shared_schema.errors import InputError
 
-from .bodies import load_json
+from .bodies import parse_json
 from .errors import clip_echoes
 from .jobspec import EnvelopeJob, HistoryJob, Job, PulseJob
 
@@ -323,7 +323,7 @@ class RockmechHops:
     def solve(self, uri: str, payload: bytes) -> tuple[int, bytes]:
         """Answer ``POST`` on a component URI, or on ``/solve`` with a ``pointer``."""
         try:
-            data = load_json(payload)
+            data = parse_json(payload)
             if not isinstance(data, dict):
                 raise HopsError(400, "a Hops solve request is a JSON object")
             if uri == "/solve":

@@ -6,6 +6,7 @@ Each command imports its workflow when it runs: ``pulse`` loads the exact solver
 
 from __future__ import annotations
 
+import gc
 from pathlib import Path
 from typing import Any, Optional
 
@@ -70,8 +71,11 @@ def pulse(
     """Response of one mechanism to a one-cycle sine or cosine acceleration pulse."""
     if CONSOLE["process"] and constants is None and _settles_fast(eta):
         # One pulse that settles in a few hundred impacts: the pure-Python kernels give the
-        # compiled kernels' numbers in less time than numba takes to load (#38).
+        # compiled kernels' numbers in less time than numba takes to load (#38). The process
+        # ends after it: no cyclic collection while the workflow's modules load (they hold
+        # no garbage; a short pulse makes little).
         without_numba()
+        gc.disable()
     # The pulse workflow (the exact solver) is loaded when the command runs (#38).
     from ..workflows import pulse as workflow
 

@@ -60,9 +60,9 @@ def constants(
     failures: list[MechanismFailure] = []
     with status(f"constants: reading {scene.name}"):
         if keep_going:
-            cf, failures = inputs.constants_keep_going(scene, spec, units)
+            cf, failures = inputs.constants_and_failures_from_scene_files(scene, spec, units)
         else:
-            cf = inputs.constants_from_files(scene, spec, units)
+            cf = inputs.constants_from_scene_files(scene, spec, units)
     io.write_constants(cf, output)
     if failures:
         typer.echo(

@@ -47,7 +47,7 @@ def _linearisation_map() -> Optional[dict[str, Any]]:
     # Records: the typical (median over the map's p) error. A single record's peak is
     # sensitive to any change of the model (many impacts), so the largest value over p
     # scatters from case to case; the median shows the systematic part.
-    out["record_typical"] = np.median(np.nan_to_num(out["record_error"], nan=np.inf), axis=1)
+    out["record_typical"] = _row_medians(np.nan_to_num(out["record_error"], nan=np.inf))
     worst = np.maximum(
         np.nan_to_num(out["amplitude_error"], nan=np.inf).max(axis=1), out["record_typical"]
     )
@@ -60,6 +60,20 @@ def _linearisation_map() -> Optional[dict[str, Any]]:
     out["amplitude_list"] = np.nan_to_num(out["amplitude_error"], nan=np.inf).tolist()
     out["record_list"] = [float(x) for x in out["record_typical"]]
     return out
+
+
+def _row_medians(values: Any) -> Any:
+    """Median of each row of a 2-D array without NaN: ``np.median(values, axis=1)``, bit for bit.
+
+    ``np.median`` looks for NaN through ``np.ma``, whose import costs a one-pulse ``rockmech
+    pulse`` more than its integration (#38); the middle of the sorted row (the mean of the
+    two middle values for an even length) is the same number.
+    """
+    ordered = np.sort(values, axis=1)
+    half = ordered.shape[1] // 2
+    if ordered.shape[1] % 2:
+        return ordered[:, half]
+    return (ordered[:, half - 1] + ordered[:, half]) / 2
 
 
 def _bracket(grid: list[float], value: float) -> tuple[int, int]:

@@ -66,7 +66,7 @@ from shared_schema.version import __version__
 
 from ..core.model import G
 from .labels import ratio_label
-from .plots import load_pyplot, plain, save_figure_atomic
+from .plots import load_pyplot, plain, write_figure_atomic
 from .retrofit import records_notes, retrofit_summary
 
 __all__ = [
@@ -175,7 +175,7 @@ def _plot_spectrum(spectrum: Any, path: Path) -> Path:
     ax2.grid(alpha=0.3)
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -320,7 +320,7 @@ def _plot_capacity(
     ax.legend(fontsize=6, loc="upper right")
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -497,7 +497,7 @@ def _plot_envelope(env: AssessEnvelope, path: Path) -> Path:
     ax.legend(fontsize=7)
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -541,7 +541,7 @@ def _plot_history(
     axr.set_xlim(lo, hi)
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path), (lo, hi)
+        return write_figure_atomic(fig, path), (lo, hi)
     finally:
         plt.close(fig)
 

@@ -55,7 +55,7 @@ def plain(text: str) -> str:
     return str(text).replace("$", r"\$")
 
 
-def save_figure_atomic(fig: Any, path: Union[str, Path], *, tight: bool = True) -> Path:
+def write_figure_atomic(fig: Any, path: Union[str, Path], *, tight: bool = True) -> Path:
     """Render a figure in memory and write it atomically (format from the suffix).
 
     ``tight`` crops the image to what is drawn (``bbox_inches="tight"``, which draws the
@@ -129,7 +129,7 @@ def plot_time_histories(
     axes[-1, 0].set_xlabel("time [s]")
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -187,7 +187,7 @@ def plot_ratio_histories(
         axes[0, 0].set_title(f"{plain(title)}  (× overturned; dotted: time of overturning)")
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -242,7 +242,7 @@ def plot_record(
     ax_s.grid(which="both", alpha=0.3)
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -339,7 +339,7 @@ def plot_envelopes(
         ax.set_title(plain(title))
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)
 
@@ -385,6 +385,6 @@ def plot_fragility(doc: IdaDocument, path: Union[str, Path], *, title: str = "")
     ax.set_title(plain(title) or "Fragility from incremental dynamic analysis (lognormal MLE)")
     fig.tight_layout()
     try:
-        return save_figure_atomic(fig, path)
+        return write_figure_atomic(fig, path)
     finally:
         plt.close(fig)

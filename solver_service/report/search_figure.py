@@ -16,7 +16,7 @@ from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
-from .plots import save_figure_atomic
+from .plots import write_figure_atomic
 
 __all__ = ["plot_search"]
 
@@ -170,4 +170,4 @@ def plot_search(
         ax.tick_params(labelsize=7)
     if title:
         fig.suptitle(title)
-    return save_figure_atomic(fig, path, tight=False)
+    return write_figure_atomic(fig, path, tight=False)

@@ -17,10 +17,11 @@ from cad_maths.mechanisms.build import (
     failures_error,
 )
 from cad_maths.scenes import SCENE_FORMATS, read_scene
+from shared_schema import io as constants_io
 from shared_schema.api import time_domain_problem
 from shared_schema.constants import ConstantsFile, json_document
 from shared_schema.errors import InputError, RockmechError
-from shared_schema.io import CONSTANTS_EXPECTED, load_constants, parse_constants
+from shared_schema.io import CONSTANTS_EXPECTED, parse_constants
 from shared_schema.paths import (
     SOURCE_TYPES,
     PathLike,
@@ -40,8 +41,8 @@ from .tables import constants_from_table, is_table
 
 __all__ = [
     "RecordSpec",
-    "constants_from_files",
-    "constants_keep_going",
+    "constants_and_failures_from_scene_files",
+    "constants_from_scene_files",
     "file_kind",
     "read_constants",
     "read_record",
@@ -312,7 +313,7 @@ def read_constants(path: Source, *, time_domain: bool = False) -> ConstantsFile:
     if is_table(path):
         return constants_from_table(path, time_domain=time_domain)
     try:
-        cf = load_constants(path)
+        cf = constants_io.read_constants(path)
     except InputError as exc:
         wrong = _wrong_file(
             path,
@@ -397,7 +398,7 @@ def _spec_and_scene(
     return scene, spec, parse_spec(text, spec.name), read_scene(scene, units=units)
 
 
-def constants_from_files(
+def constants_from_scene_files(
     scene: PathLike, spec: PathLike, units: Optional[str] = None
 ) -> ConstantsFile:
     """Kinematic constants of every mechanism of a spec file from the solids of a scene file.
@@ -430,10 +431,10 @@ def constants_from_files(
     )
 
 
-def constants_keep_going(
+def constants_and_failures_from_scene_files(
     scene: PathLike, spec: PathLike, units: Optional[str] = None
 ) -> tuple[ConstantsFile, list[MechanismFailure]]:
-    """Like ``constants_from_files``, but keep the mechanisms that succeed.
+    """Like ``constants_from_scene_files``, but keep the mechanisms that succeed.
 
     Returns
     -------

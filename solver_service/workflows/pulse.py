@@ -13,10 +13,10 @@ from typing import Any, Optional, Union
 
 from pydantic import ValidationError
 
-from shared_schema.api import PulseRequest
 from shared_schema.constants import ConstantsFile, input_error_from_validation
 from shared_schema.documents.pulse import PulseDocument
 from shared_schema.errors import InputError, wrong_type
+from shared_schema.pulse_request import PulseRequest
 
 from ..core.exact import simulate
 from ..core.excitation import Pulse

@@ -237,8 +237,8 @@ def constants_from_table(path: PathLike, *, time_domain: bool = False) -> Consta
     Returns
     -------
     ConstantsFile
-        The same model ``load_constants`` gives for the equivalent JSON file (short-form
-        mechanisms written flat, ``phi_ov`` defaulting to ``lam``).
+        The same model ``shared_schema.io.read_constants`` gives for the equivalent JSON
+        file (short-form mechanisms written flat, ``phi_ov`` defaulting to ``lam``).
 
     Raises
     ------

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from shared_schema.documents.base import Part
-from shared_schema.retrofit import RETROFIT_UNITS
+from shared_schema.retrofit_units import RETROFIT_UNITS
 from shared_schema.version import __version__
 
 __all__ = ["DOCUMENT_UNITS", "VERSION_KEY", "finite_json", "stamp"]

@@ -75,6 +75,16 @@ def test_estimate_errs_high_between_grid_points() -> None:
     assert math.isfinite(linearisation_estimate(0.3))  # records: no Omega
 
 
+def test_record_estimate_is_the_median_over_the_maps_p() -> None:
+    # At a node alpha_i of the grid the record estimate is the larger of the medians (over
+    # the map's p) of rows i-1 and i, missing values counting as infinite.
+    tab = _table()
+    median = np.median(np.nan_to_num(tab["record_error"], nan=np.inf), axis=1)
+    for i, alpha in enumerate(tab["alpha"]):
+        expected = max(median[max(i - 1, 0)], median[i])
+        assert linearisation_estimate(float(alpha)) == expected
+
+
 def test_warnings_name_the_case_and_are_silent_for_slender_mechanisms() -> None:
     stocky = RockingModel.symmetric(2.0, 0.9, 0.3)
     notes = linearisation_warnings(stocky, omega_p=2.0)

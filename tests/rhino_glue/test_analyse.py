@@ -17,7 +17,7 @@ import pytest
 from rhino_plugin.flows.analyse import (
     ServiceClient,
     analyse_flow,
-    load_constants_files,
+    read_constants_files,
     run_envelopes,
     run_history,
     run_pulse,
@@ -44,7 +44,7 @@ def cli_json(*args: str) -> Any:
 
 
 def test_local_envelopes_equal_the_cli(tmp_path: Path) -> None:
-    cf = load_constants_files([str(CHURCH)])
+    cf = read_constants_files([str(CHURCH)])
     result = run_envelopes(cf, f_min=0.5, f_max=5.0, n=30, out_dir=str(tmp_path))
     want = cli_json("envelope", str(CHURCH), "--out", str(tmp_path / "cli"),
                     "--f-min", "0.5", "--f-max", "5", "--n", "30")  # fmt: skip
@@ -58,7 +58,7 @@ def test_local_envelopes_equal_the_cli(tmp_path: Path) -> None:
 
 
 def test_local_history_equals_the_cli(tmp_path: Path) -> None:
-    cf = load_constants_files([str(WALLS)])
+    cf = read_constants_files([str(WALLS)])
     result = run_history(
         cf, str(RECORD), units="g", scales=[0.5, 1.0], out_dir=str(tmp_path)
     )  # fmt: skip
@@ -74,7 +74,7 @@ def test_local_history_equals_the_cli(tmp_path: Path) -> None:
 
 def test_history_states_the_record_warning_first(tmp_path: Path) -> None:
     # El Centro (in g) read as cm/s2: PGA 0.000356 g, the warning the CLI prints (#25)
-    cf = load_constants_files([str(WALLS)])
+    cf = read_constants_files([str(WALLS)])
     result = run_history(cf, str(RECORD), units="cm/s2", scales=[1.0], out_dir=str(tmp_path))
     assert result.summary[0].startswith("  warning: record: PGA 0.000356 g is outside"), result
     assert "(read in cm/s2)" in result.summary[0]
@@ -82,7 +82,7 @@ def test_history_states_the_record_warning_first(tmp_path: Path) -> None:
 
 
 def test_local_pulse_equals_the_cli() -> None:
-    cf = load_constants_files([str(WALLS)])
+    cf = read_constants_files([str(WALLS)])
     mech = cf.mechanisms[0]
     result = run_pulse(cf, mech.id, a_p_g=-0.61, f_p=1.59)
     want = cli_json("pulse", "--p-eq", repr(mech.positive.p_eq), "--lam", repr(mech.positive.lam),
@@ -97,10 +97,10 @@ def test_constants_files_are_merged_and_duplicate_ids_refused(tmp_path: Path) ->
     first, rest = tmp_path / "first.json", tmp_path / "rest.json"
     first.write_text(json.dumps({**doc, "mechanisms": doc["mechanisms"][:1]}))
     rest.write_text(json.dumps({**doc, "mechanisms": doc["mechanisms"][1:]}))
-    merged = load_constants_files([str(first), str(rest)])
+    merged = read_constants_files([str(first), str(rest)])
     assert [m.id for m in merged.mechanisms] == [m["id"] for m in doc["mechanisms"]]
     with pytest.raises(InputError, match="is in both"):
-        load_constants_files([str(WALLS), str(first)])
+        read_constants_files([str(WALLS), str(first)])
 
 
 # ---------------------------------------------------------------------- the flow
@@ -226,7 +226,7 @@ def answers() -> Dict[str, Dict[str, Any]]:
 
     from solver_service.core.records import GroundMotion
 
-    cf = load_constants_files([str(WALLS)])
+    cf = read_constants_files([str(WALLS)])
     env = envelope_doc(cf, np.array([0.5, 2.0]))[0].to_dict()
     env["critical"] = [{"mechanism": "W1", "f_min": 0.1, "f_max": 10.0}]
     motion = GroundMotion.from_file(str(RECORD), units="g")
@@ -241,7 +241,7 @@ def test_service_envelopes_post_the_constants_and_keep_the_answer(
     url, recorder = service
     answer = answers["envelope"]
     recorder.answers["/api/v1/envelope"] = (200, answer)
-    cf = load_constants_files([str(WALLS)])
+    cf = read_constants_files([str(WALLS)])
     result = run_envelopes(cf, f_min=0.2, f_max=8.0, n=50, out_dir=str(tmp_path),
                            client=ServiceClient(url))  # fmt: skip
     path, body = recorder.received[0]
@@ -259,7 +259,7 @@ def test_service_answer_that_is_not_the_document_is_refused_naming_the_field(
     url, recorder = service
     wrong = {k: v for k, v in answers["envelope"].items() if k != "critical"}
     recorder.answers["/api/v1/envelope"] = (200, wrong)
-    cf = load_constants_files([str(WALLS)])
+    cf = read_constants_files([str(WALLS)])
     with pytest.raises(InputError, match=r"/envelope is not its EnvelopeDocument: critical: "):
         run_envelopes(cf, out_dir=str(tmp_path), client=ServiceClient(url))
     recorder.answers["/api/v1/pulse"] = (200, dict(answers["pulse"], overturned="maybe"))
@@ -275,7 +275,7 @@ def test_service_history_sends_the_record_in_si(
 
     url, recorder = service
     recorder.answers["/api/v1/history"] = (200, answers["history"])
-    cf = load_constants_files([str(WALLS)])
+    cf = read_constants_files([str(WALLS)])
     run_history(cf, str(RECORD), units="g", scales=[1.0, 2.0], out_dir=str(tmp_path),
                 client=ServiceClient(url))  # fmt: skip
     _, body = recorder.received[0]
@@ -289,7 +289,7 @@ def test_service_history_sends_the_record_in_si(
 def test_service_error_detail_becomes_the_message(service: Any) -> None:
     url, recorder = service
     recorder.answers["/api/v1/pulse"] = (422, {"detail": "f_p: must be > 0, got -1"})
-    cf = load_constants_files([str(WALLS)])
+    cf = read_constants_files([str(WALLS)])
     with pytest.raises(InputError, match=r"answered 422: f_p: must be > 0, got -1"):
         run_pulse(cf, "W1", a_p_g=0.3, f_p=1.0, client=ServiceClient(url))
 
@@ -300,7 +300,7 @@ def test_unreachable_service_is_a_clear_error() -> None:
     with socket.socket() as sock:  # a free port that nothing listens on
         sock.bind(("127.0.0.1", 0))
         port = sock.getsockname()[1]
-    cf = load_constants_files([str(WALLS)])
+    cf = read_constants_files([str(WALLS)])
     with pytest.raises(InputError, match="cannot reach the rockmech service"):
         run_pulse(cf, "W1", a_p_g=0.3, f_p=1.0, client=ServiceClient(f"http://127.0.0.1:{port}"))
 
@@ -318,7 +318,7 @@ def test_service_payloads_match_the_api_request_models(
     url, recorder = service
     for endpoint in ("envelope", "history", "pulse"):
         recorder.answers[f"/api/v1/{endpoint}"] = (200, answers[endpoint])
-    cf = load_constants_files([str(WALLS)])
+    cf = read_constants_files([str(WALLS)])
     client = ServiceClient(url)
     run_envelopes(cf, out_dir=str(tmp_path), client=client)
     run_history(cf, str(RECORD), units="g", scales=[1.0], out_dir=str(tmp_path), client=client)

@@ -14,7 +14,7 @@ from typing import Any, Dict, List, Tuple
 import pytest
 
 from rhino_plugin.flows.mechanisms import run_mechanism_command
-from shared_schema.io import load_constants
+from shared_schema.io import read_constants
 
 from .conftest import CANCEL, ENTER, ScriptedPrompter
 
@@ -184,7 +184,7 @@ def test_flow_writes_the_constants_of_the_headless_cli(
     assert len(written) == 1
     assert _comparable(written[0]) == _comparable(cli_constants(stem)[ident])
     # the files are the headless path's: the spec reads back and the constants validate
-    assert load_constants(result.constants_path).mechanisms[0].id == ident
+    assert read_constants(result.constants_path).mechanisms[0].id == ident
     spec = json.loads(Path(result.spec_path).read_text())
     assert spec["mechanisms"][0]["typology"] == result.spec.mechanisms[0].typology
     assert sorted(os.listdir(tmp_path)) == sorted(

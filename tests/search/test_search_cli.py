@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 import rockmech
 from shared_schema.errors import InputError
 from solver_service.cli import app
-from solver_service.workflows.inputs import constants_from_files
+from solver_service.workflows.inputs import constants_from_scene_files
 
 runner = CliRunner()
 
@@ -31,7 +31,7 @@ def test_cli_writes_the_outputs_and_the_spec_reopens(tmp_path: Path) -> None:
     # the spec reopens with the existing constants command, on the input and on search.3dm
     mine = json.loads((out / "constants.json").read_text())["mechanisms"]
     for scene_file in (scene, out / "search.3dm"):
-        cf = constants_from_files(scene_file, out / "search.spec.json")
+        cf = constants_from_scene_files(scene_file, out / "search.spec.json")
         for m, again in zip(mine, cf.mechanisms):
             assert again.positive.p_eq == pytest.approx(m["positive"]["p_eq"], rel=1e-12)
     res = runner.invoke(

@@ -20,7 +20,7 @@ from cad_maths.search.engine import run_search
 from cad_maths.search.specs import build_candidates
 from shared_schema.errors import InputError
 from shared_schema.search import SearchSpec
-from solver_service.workflows.inputs import constants_from_files
+from solver_service.workflows.inputs import constants_from_scene_files
 from solver_service.workflows.search import search_run, write_search_files
 
 REPO = Path(__file__).resolve().parents[2]
@@ -118,11 +118,11 @@ def test_openings_drawn_as_solids_are_cut_and_the_spec_reopens_only_the_search_s
     out = tmp_path / "out"
     out.mkdir()
     write_search_files(run, out, figure=False)
-    again = constants_from_files(out / "search.3dm", out / "search.spec.json")
+    again = constants_from_scene_files(out / "search.3dm", out / "search.spec.json")
     for m1, m2 in zip(run.constants.mechanisms, again.mechanisms):
         assert m2.positive.p_eq == pytest.approx(m1.positive.p_eq, rel=1e-12)
     with pytest.raises(InputError, match=r"no object with name 'facade \(openings cut\)'"):
-        constants_from_files(scene_path, out / "search.spec.json")
+        constants_from_scene_files(scene_path, out / "search.spec.json")
 
 
 def test_scan_mesh_is_idealised_and_the_difference_is_reported() -> None:

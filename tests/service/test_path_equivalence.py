@@ -34,13 +34,13 @@ import rockmech
 from rhino_plugin.flows.analyse import (
     ServiceClient,
     analyse_flow,
-    load_constants_files,
+    read_constants_files,
     run_envelopes,
     run_history,
     run_pulse,
 )
 from shared_schema.errors import RockmechError
-from shared_schema.io import load_constants
+from shared_schema.io import read_constants
 from solver_service.cli import app
 from solver_service.core.records import GroundMotion
 from solver_service.workflows.adapter import to_rocking_model
@@ -55,7 +55,7 @@ FREQUENCIES_HZ = (0.5, 1.5, 4.0)
 def _cases() -> list[tuple[Path, str, float, float]]:
     cases = []
     for path in CONSTANTS:
-        for mech in load_constants(path).mechanisms:
+        for mech in read_constants(path).mechanisms:
             for a, sign, f in itertools.product(AMPLITUDES_G, (1.0, -1.0), FREQUENCIES_HZ):
                 cases.append((path, mech.id, sign * a, f))
     return cases
@@ -127,7 +127,7 @@ def _rest(client: httpx.Client, body: dict[str, Any]) -> tuple[str, Any]:
 
 
 def _flow(path: Path, mech: str, a: float, f: float, url: Optional[str]) -> tuple[str, Any]:
-    cf = load_constants_files([str(path)])
+    cf = read_constants_files([str(path)])
     client = ServiceClient(url) if url else None
     try:
         return "doc", without_runtime(run_pulse(cf, mech, a_p_g=a, f_p=f, client=client).doc)
@@ -150,7 +150,7 @@ def test_every_pulse_path_gives_the_same_answer(server: Server, client: httpx.Cl
     by_hops = 0
     refused = 0
     for path, mech_id, a, f in CASES:
-        cf = load_constants(path)
+        cf = read_constants(path)
         mech = next(m for m in cf.mechanisms if m.id == mech_id)
         body = {
             "mechanism": json.loads(mech.model_dump_json(exclude_none=True)),
@@ -184,7 +184,7 @@ def test_the_rhino_flow_asks_and_answers_as_the_api(server: Server, tmp_path: Pa
     church = EXAMPLES / "constants" / "church_geometry.json"
     body = {"mechanism": None, "a_p_g": 0.3, "f_p": 1.5}
     body["mechanism"] = json.loads(
-        next(m for m in load_constants(church).mechanisms if m.id == "A1").model_dump_json(
+        next(m for m in read_constants(church).mechanisms if m.id == "A1").model_dump_json(
             exclude_none=True
         )
     )
@@ -213,7 +213,7 @@ def test_every_envelope_path_gives_the_same_answer(
 ) -> None:
     for path in CONSTANTS:
         text = path.read_text()
-        cf = load_constants(path)
+        cf = read_constants(path)
         out = tmp_path / path.stem
         want = without_runtime(envelope_doc(cf, frequency_grid(0.1, 10.0, N_ENVELOPE))[0])
         got = {
@@ -225,7 +225,7 @@ def test_every_envelope_path_gives_the_same_answer(
         }
         body = hops_payload(constants=text, f_min=0.1, f_max=10.0, n=N_ENVELOPE)
         got["hops"] = json.loads(outputs(client.post("/hops/envelope", json=body))["json"][0])
-        flows = load_constants_files([str(path)])
+        flows = read_constants_files([str(path)])
         for where, url in (("flow", None), ("flow-service", server.url)):
             result = run_envelopes(
                 flows,
@@ -260,7 +260,7 @@ def test_every_history_path_gives_the_same_answer(
         EXAMPLES / "constants" / "church.json",
     ):
         text = path.read_text()
-        cf = load_constants(path)
+        cf = read_constants(path)
         want = _answer_rows(history_doc(cf, motion, scales).to_dict())
         assert sum(r["overturned"] for r in want["results"]) >= 1  # something to disagree on
         got = {
@@ -276,7 +276,7 @@ def test_every_history_path_gives_the_same_answer(
         }
         body = hops_payload(constants=text, accel_g=accel_g, dt=dt, scales=scales)
         got["hops"] = json.loads(outputs(client.post("/hops/history", json=body))["json"][0])
-        flows = load_constants_files([str(path)])
+        flows = read_constants_files([str(path)])
         for where, url in (("flow", None), ("flow-service", server.url)):
             result = run_history(
                 flows,

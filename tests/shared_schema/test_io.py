@@ -11,7 +11,7 @@ from pydantic_core import PydanticSerializationError
 import shared_schema.atomic as atomic
 from shared_schema.constants import ConstantsFile, Mechanism, parse_constants
 from shared_schema.errors import InputError
-from shared_schema.io import load_constants, stamped, write_atomic, write_constants
+from shared_schema.io import read_constants, stamped, write_atomic, write_constants
 from shared_schema.version import __version__
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "constants"
@@ -57,7 +57,7 @@ def test_published_table_form_round_trips_and_omits_absent_sections(tmp_path):
     assert saved["schema_version"] == "1.0"
     assert saved["units"]["p_eq"] == "rad/s"
     assert saved["rockmech_version"] == __version__  # the writer's version
-    assert load_constants(path) == stamped(original)
+    assert read_constants(path) == stamped(original)
 
 
 def test_physical_form_round_trips_exactly(tmp_path):
@@ -76,7 +76,7 @@ def test_physical_form_round_trips_exactly(tmp_path):
     )
     path = tmp_path / "loaded.json"
     write_constants(original, path)
-    loaded = load_constants(path)
+    loaded = read_constants(path)
     assert loaded == stamped(original)
     # Derived values are written next to the physical ones; nulls inside free-form data stay.
     mech = json.loads(path.read_text())["mechanisms"][0]
@@ -87,7 +87,7 @@ def test_physical_form_round_trips_exactly(tmp_path):
 def test_saving_twice_gives_identical_bytes(tmp_path):
     cf = parse_constants([W1])
     write_constants(cf, tmp_path / "a.json")
-    write_constants(load_constants(tmp_path / "a.json"), tmp_path / "b.json")
+    write_constants(read_constants(tmp_path / "a.json"), tmp_path / "b.json")
     assert (tmp_path / "a.json").read_bytes() == (tmp_path / "b.json").read_bytes()
 
 
@@ -97,14 +97,14 @@ def test_saving_twice_gives_identical_bytes(tmp_path):
 def test_missing_file_names_the_file(tmp_path):
     path = tmp_path / "nowhere.json"
     with pytest.raises(InputError) as info:
-        load_constants(path)
+        read_constants(path)
     assert info.value.field == str(path)
     assert str(info.value) == f"{path}: constants file not found"
 
 
 def test_directory_instead_of_file_is_an_input_error(tmp_path):
     with pytest.raises(InputError) as info:
-        load_constants(tmp_path)
+        read_constants(tmp_path)
     assert str(info.value) == f"{tmp_path}: is a folder, not a constants file"
 
 
@@ -112,7 +112,7 @@ def test_invalid_json_names_the_file_and_position(tmp_path):
     path = tmp_path / "broken.json"
     path.write_text('{"mechanisms": [\n  {"id": "W1",}\n]}\n')
     with pytest.raises(InputError) as info:
-        load_constants(path)
+        read_constants(path)
     message = str(info.value)
     assert message.startswith(f"{path}: invalid JSON")
     assert "line 2" in message
@@ -123,7 +123,7 @@ def test_invalid_value_names_file_mechanism_and_field(tmp_path):
     bad = dict(W1, id="W2", p_eq=-2.15)
     path.write_text(json.dumps({"mechanisms": [W1, bad]}))
     with pytest.raises(InputError) as info:
-        load_constants(path)
+        read_constants(path)
     assert str(info.value) == (
         f"{path}: mechanisms[1] (id 'W2').positive.p_eq: Input should be greater than 0"
     )
@@ -135,13 +135,13 @@ def test_nan_literal_in_file_is_rejected(tmp_path):
     path = tmp_path / "nan.json"
     path.write_text('[{"id": "W1", "p_eq": NaN, "lam": 0.25}]')
     with pytest.raises(InputError, match=r"\(id 'W1'\)\.positive\.p_eq: .*finite"):
-        load_constants(path)
+        read_constants(path)
 
 
 def test_bare_list_file_and_byte_order_mark_are_accepted(tmp_path):
     path = tmp_path / "list.json"
     path.write_bytes(b"\xef\xbb\xbf" + json.dumps([W1, dict(W1, id="W2")]).encode())
-    cf = load_constants(path)
+    cf = read_constants(path)
     assert [m.id for m in cf.mechanisms] == ["W1", "W2"]
 
 
@@ -149,7 +149,7 @@ def test_non_utf8_file_is_an_input_error(tmp_path):
     path = tmp_path / "latin1.json"
     path.write_bytes('[{"id": "Fa\u00e7ade", "p_eq": 2, "lam": 0.2}]'.encode("latin-1"))
     with pytest.raises(InputError, match="not UTF-8"):
-        load_constants(path)
+        read_constants(path)
 
 
 # --- atomic writes -----------------------------------------------------------------------
@@ -221,7 +221,7 @@ def test_existing_file_keeps_its_permissions(tmp_path):
 
 
 def test_church_example_loads_with_plausible_constants():
-    cf = load_constants(EXAMPLES / "church.json")
+    cf = read_constants(EXAMPLES / "church.json")
     assert len(cf.mechanisms) >= 6
     kinds = {m.rocking for m in cf.mechanisms}
     assert kinds == {"one_sided", "two_sided"}

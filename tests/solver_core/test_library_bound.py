@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from shared_schema.constants import ConstantsFile
-from shared_schema.io import load_constants
+from shared_schema.io import read_constants
 from solver_service.core.envelope import (
     LIBRARY_ABOVE,
     LIBRARY_BELOW,
@@ -68,7 +68,7 @@ def _check(fast_doc: dict, exact_doc: dict) -> tuple[float, float]:
 def test_bundled_mechanisms_keep_the_bounds_and_the_bands(
     path: Path, library: OverturningLibrary
 ) -> None:
-    cf = load_constants(path)
+    cf = read_constants(path)
     for f_min, f_max, n in ((0.1, 10.0, 200), (0.05, 20.0, 300)):
         f_p = frequency_grid(f_min, f_max, n)
         exact = envelope_doc(cf, f_p)[0].to_dict()
@@ -122,7 +122,7 @@ def test_a_sweep_of_mechanisms_keeps_the_bounds(library: OverturningLibrary) -> 
 
 def test_the_issue_cases_are_now_within_the_bounds(library: OverturningLibrary) -> None:
     """N1 (church.json) was 1.19 % above; G1/F1's edge at 5.35 Hz instead of 4.66 Hz."""
-    cf = load_constants(EXAMPLES / "church.json")
+    cf = read_constants(EXAMPLES / "church.json")
     f_p = frequency_grid(0.1, 10.0, 200)
     exact = envelope_doc(cf, f_p)[0].to_dict()
     fast = envelope_doc(cf, f_p, method="library", library=library)[0].to_dict()

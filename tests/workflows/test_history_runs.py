@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from shared_schema.io import load_constants
+from shared_schema.io import read_constants
 from solver_service.core import exact
 from solver_service.core.records import GroundMotion
 from solver_service.workflows.documents import history_doc
@@ -20,7 +20,7 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 @pytest.fixture(scope="module")
 def church_and_record() -> tuple[Any, Any]:
-    cf = load_constants(EXAMPLES / "constants" / "church.json")
+    cf = read_constants(EXAMPLES / "constants" / "church.json")
     motion = GroundMotion.from_two_column(EXAMPLES / "records" / "elcentro_NS.dat", units="g")
     return cf, motion
 
