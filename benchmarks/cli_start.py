@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import shutil
 import subprocess
 import sys
@@ -45,7 +44,7 @@ REPO = HERE.parent
 if str(HERE) not in sys.path:
     sys.path.insert(0, str(HERE))
 
-from _docs import DOC_MD, fmt_time, machine_info, md_table, write_section  # noqa: E402
+from _docs import DOC_MD, command_env, fmt_time, machine_info, md_table, write_section  # noqa: E402
 
 SCENE = REPO / "examples" / "scenes" / "search_facade.3dm"
 SPEC = REPO / "examples" / "specs" / "search_facade.search.json"
@@ -71,24 +70,10 @@ def _rockmech() -> str:
     return exe
 
 
-def _command_env() -> dict[str, str]:
-    """Return the environment of the timed commands: this one, with bytecode caches on.
-
-    An installed rockmech has its modules' caches (``__pycache__``: pip byte-compiles a
-    package when it installs it, and an editable install writes them on its first run), as
-    the yardstick's numpy has its own. ``PYTHONDONTWRITEBYTECODE`` would have every run of
-    ``rockmech`` compile its modules from source again, which no user's run does: it is
-    removed, so that the warm-up run writes the caches the timed runs read.
-    """
-    env = dict(os.environ)
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
-    return env
-
-
 def _wall(argv: Sequence[str]) -> float:
     """Run ``argv`` once (output discarded); its wall-clock time [s]. A failure stops here."""
     t = time.perf_counter()
-    proc = subprocess.run(list(argv), capture_output=True, text=True, cwd=REPO, env=_command_env())
+    proc = subprocess.run(list(argv), capture_output=True, text=True, cwd=REPO, env=command_env())
     wall = time.perf_counter() - t
     if proc.returncode != 0:
         raise SystemExit(f"`{' '.join(argv)}` failed ({proc.returncode}):\n{proc.stderr}")
