@@ -261,14 +261,14 @@ def time_limit(seconds: Optional[float]) -> Iterator[None]:
 
     def stop(frame: Any, event: str = "", arg: Any = None) -> None:
         if fired and sys.exc_info()[1] is not None:
-            sys.setprofile(profiler)  # the limit is on its way out: let the cleanup run
+            _restore_profile(profiler)  # the limit is on its way out: let the cleanup run
             return
         if _in_compiler(frame):
             # Inside compiled code's call back into Python: raise at the first event (a
             # call or a return) outside it, e.g. when the kernel returns to its caller.
             sys.setprofile(stop)
             return
-        sys.setprofile(profiler)
+        _restore_profile(profiler)
         fired.append(True)
         raise TimeLimitExceeded(seconds)
 
@@ -289,11 +289,27 @@ def time_limit(seconds: Optional[float]) -> Iterator[None]:
         raise
     finally:
         timer(signal.ITIMER_REAL, 0)
-        sys.setprofile(profiler)
+        _restore_profile(profiler)
         signal.signal(signal.SIGALRM, previous)
         _active.pop()
         if outer > 0:  # an enclosing timer (a test runner's) gets its remaining time back
             timer(signal.ITIMER_REAL, max(outer - (time.monotonic() - start), 1e-3))
+
+
+def _restore_profile(profiler: Any) -> None:
+    """Put back the profile hook found before a time limit (``sys.getprofile()``'s).
+
+    A Python-level hook (a function, or None) goes back through ``sys.setprofile``. A
+    C-level profiler (``cProfile.Profile``: ``sys.getprofile()`` gives the object, which is
+    not callable) is switched on again with its own ``enable()``, so that profiling a command
+    neither breaks its time limit nor loses the rest of the profile.
+    """
+    if profiler is None or callable(profiler):
+        sys.setprofile(profiler)
+    elif callable(getattr(profiler, "enable", None)):
+        profiler.enable()
+    else:  # pragma: no cover - no other kind of profile hook is known
+        sys.setprofile(None)
 
 
 def cores() -> int:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import signal
 import time
+from pathlib import Path
 
 import pytest
 
@@ -102,3 +103,27 @@ def test_the_up_front_estimate_uses_the_time_limit() -> None:
         with time_limit(1.0):
             limits.check_run(cf, envelope=envelope)
     assert "give --time-limit with more seconds, or --no-limits" in str(exc.value)
+
+
+def test_a_command_profiled_with_cprofile_keeps_its_time_limit_and_its_profile(
+    tmp_path: Path,
+) -> None:
+    # `python -m cProfile -m rockmech ...`: sys.getprofile() is the profiler object (not a
+    # function); the time limit put it back with sys.setprofile and crashed with TypeError.
+    import pstats
+    import subprocess
+    import sys
+
+    ex = Path(__file__).resolve().parents[2] / "examples"
+    prof = tmp_path / "retrofit.prof"
+    args = [sys.executable, "-m", "cProfile", "-o", str(prof), "-m", "rockmech", "retrofit",
+            str(ex / "constants" / "church_geometry.json"), "--site",
+            str(ex / "sites" / "ntc_site.json"), "--spec",
+            str(ex / "specs" / "church.retrofit.json"),
+            "--out", str(tmp_path / "out"), "--time-limit", "300"]  # fmt: skip
+    res = subprocess.run(args, capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr
+    assert (tmp_path / "out" / "retrofit.json").is_file()
+    # the profile still holds the retrofit's work, done inside the time limit
+    names = {fn for (_, _, fn) in pstats.Stats(str(prof)).stats}
+    assert "retrofit_doc" in names
