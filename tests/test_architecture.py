@@ -333,8 +333,6 @@ SIZE_EXCEPTIONS: dict[str, str] = {
     "check (the SLC's hazard, a free-standing element, records, damping); its steps, one "
     "clause each, are split out",
     # Modules other work of #37 and #39 is changing now; split there.
-    "cad_maths.search.lp:_wall_interfaces": "the search's LP (#37)",
-    "cad_maths.search.lp:_programme": "the search's LP (#37)",
     "cad_maths.search.model:_orient": "the search's building model (#37)",
     "cad_maths.search.model:_level_contacts": "the search's building model (#37)",
     "cad_maths.search.model:building_from_scene": "the search's building model (#37)",
