@@ -332,10 +332,7 @@ SIZE_EXCEPTIONS: dict[str, str] = {
     "solver_service.codes.circ2019:nonlinear_check_2019": "public keyword options of the "
     "check (the SLC's hazard, a free-standing element, records, damping); its steps, one "
     "clause each, are split out",
-    # Modules other work of #37 and #39 is changing now; split there.
-    "cad_maths.search.model:_orient": "the search's building model (#37)",
-    "cad_maths.search.model:_level_contacts": "the search's building model (#37)",
-    "cad_maths.search.model:building_from_scene": "the search's building model (#37)",
+    # A workflow entry: its keyword options, each documented.
     "solver_service.workflows.retrofit_scene:retrofit_search": "a workflow entry: the search's "
     "keyword options (names, work limits, the work check, the expected run) beside the retrofit's",
 }
