@@ -292,10 +292,29 @@ def _wall_interfaces(
     kinds: Dict[str, str],
     axes: Dict[HalfPlane, Tuple[np.ndarray, np.ndarray]],
 ) -> List[LPInterface]:
-    """Contacts between a wall's blocks, and with the ground."""
-    f = wall.frame
+    """Contacts between a wall's blocks, and with the ground.
+
+    Parameters
+    ----------
+    wall : Wall
+        The wall.
+    blocks : list of int
+        Its blocks' indices into ``all_blocks``.
+    all_blocks : list of LPBlock
+        Every block of the building.
+    size : float
+        The building's size [m], the scale of the probes and of the shortest contact.
+    kinds : dict of str to str
+        The interface kind of each joint family (``"diagonal"``).
+    axes : dict
+        A diagonal crack's half-plane -> its interface's hinge axis, where it has one.
+
+    Returns
+    -------
+    list of LPInterface
+        The ground's contacts, then the bed joints, then the diagonal cracks.
+    """
     eps = PROBE_RTOL * size
-    out: List[LPInterface] = []
     s_lo = float(wall.rings[0][:, 0].min()) - 1.0
     s_hi = float(wall.rings[0][:, 0].max()) + 1.0
     by_strip: Dict[int, List[int]] = {}
@@ -309,8 +328,46 @@ def _wall_interfaces(
         zs.setdefault(blk.strip, z_min)
         zs[blk.strip] = min(zs[blk.strip], z_min)
     up = np.array([0.0, eps])
-    # ground
-    for b in by_strip.get(strips[0], []):
+    out = _ground_interfaces(wall, by_strip.get(strips[0], []), all_blocks, s_lo, s_hi, up, size)
+    out += _bed_interfaces(wall, by_strip, strips, zs, all_blocks, s_lo, s_hi, up, size)
+    out += _diagonal_interfaces(wall, by_strip, strips, all_blocks, eps, size, kinds, axes)
+    return out
+
+
+def _ground_interfaces(
+    wall: Wall,
+    bottom: List[int],
+    all_blocks: List[LPBlock],
+    s_lo: float,
+    s_hi: float,
+    up: np.ndarray,
+    size: float,
+) -> List[LPInterface]:
+    """Find a wall's contacts with the ground: its bottom strip's blocks along ``z_lo``.
+
+    Parameters
+    ----------
+    wall : Wall
+        The wall.
+    bottom : list of int
+        The blocks of its bottom strip (indices into ``all_blocks``).
+    all_blocks : list of LPBlock
+        Every block of the building.
+    s_lo, s_hi : float
+        Along-wall bounds past the wall's ends [m].
+    up : numpy.ndarray
+        The probe offset above the line, ``(0, eps)`` [m].
+    size : float
+        The building's size [m].
+
+    Returns
+    -------
+    list of LPInterface
+        One hinge per contact span longer than ``CONTACT_RTOL * size``.
+    """
+    f = wall.frame
+    out: List[LPInterface] = []
+    for b in bottom:
         blk = all_blocks[b]
         p0, p1 = np.array([s_lo, wall.z_lo]), np.array([s_hi, wall.z_lo])
         for lo, hi in _intervals_one_side(blk.rings, p0, p1, up):
@@ -324,7 +381,48 @@ def _wall_interfaces(
                 out.append(
                     LPInterface(-1, b, _quad(wall, a[0], a[1], c[0], c[1]), f.e_z.copy(), "hinge")
                 )
-    # bed joints between strips
+    return out
+
+
+def _bed_interfaces(
+    wall: Wall,
+    by_strip: Dict[int, List[int]],
+    strips: List[int],
+    zs: Dict[int, float],
+    all_blocks: List[LPBlock],
+    s_lo: float,
+    s_hi: float,
+    up: np.ndarray,
+    size: float,
+) -> List[LPInterface]:
+    """Find a wall's bed joints: contacts between the blocks of strips one above the other.
+
+    Parameters
+    ----------
+    wall : Wall
+        The wall.
+    by_strip : dict of int to list of int
+        Each strip's blocks (indices into ``all_blocks``).
+    strips : list of int
+        The strips, bottom up.
+    zs : dict of int to float
+        Each strip's lowest height [m], its bed joint's.
+    all_blocks : list of LPBlock
+        Every block of the building.
+    s_lo, s_hi : float
+        Along-wall bounds past the wall's ends [m].
+    up : numpy.ndarray
+        The probe offset above the line, ``(0, eps)`` [m].
+    size : float
+        The building's size [m].
+
+    Returns
+    -------
+    list of LPInterface
+        One hinge per contact span longer than ``CONTACT_RTOL * size``.
+    """
+    f = wall.frame
+    out: List[LPInterface] = []
     for k_lo, k_hi in zip(strips[:-1], strips[1:]):
         z = zs[k_hi]
         p0, p1 = np.array([s_lo, z]), np.array([s_hi, z])
@@ -348,7 +446,48 @@ def _wall_interfaces(
                                 "hinge",
                             )
                         )
-    # diagonal cracks inside a strip
+    return out
+
+
+def _diagonal_interfaces(
+    wall: Wall,
+    by_strip: Dict[int, List[int]],
+    strips: List[int],
+    all_blocks: List[LPBlock],
+    eps: float,
+    size: float,
+    kinds: Dict[str, str],
+    axes: Dict[HalfPlane, Tuple[np.ndarray, np.ndarray]],
+) -> List[LPInterface]:
+    """Find a wall's diagonal cracks: contacts of two blocks of a strip that one cut parts.
+
+    Parameters
+    ----------
+    wall : Wall
+        The wall.
+    by_strip : dict of int to list of int
+        Each strip's blocks (indices into ``all_blocks``).
+    strips : list of int
+        The strips, bottom up.
+    all_blocks : list of LPBlock
+        Every block of the building.
+    eps : float
+        The probe distance off the crack's line [m].
+    size : float
+        The building's size [m].
+    kinds : dict of str to str
+        The interface kind of each joint family (``"diagonal"``).
+    axes : dict
+        A crack's half-plane -> its interface's hinge axis, where it has one.
+
+    Returns
+    -------
+    list of LPInterface
+        One per contact span longer than ``CONTACT_RTOL * size``, its normal from the
+        negative side's block into the positive side's.
+    """
+    f = wall.frame
+    out: List[LPInterface] = []
     for k in strips:
         members = by_strip[k]
         for ii, bi in enumerate(members):
@@ -883,7 +1022,20 @@ class _Programme:
 
 
 def _programme(model: LPModel, friction: Optional[float]) -> _Programme:
-    """Assemble the check's programme (``solve_lp``'s docstring)."""
+    """Assemble the check's programme (``solve_lp``'s docstring).
+
+    Parameters
+    ----------
+    model : LPModel
+        The building's blocks, interfaces, loads and restraints.
+    friction : float, optional
+        The joints' friction coefficient [-]; ``None`` bars sliding.
+
+    Returns
+    -------
+    _Programme
+        The LP's cost, constraint rows and bookkeeping.
+    """
     from scipy.sparse import csr_matrix, vstack
 
     t0 = time.perf_counter()
@@ -891,9 +1043,59 @@ def _programme(model: LPModel, friction: Optional[float]) -> _Programme:
     nbody = len(refs)
     ncol = 6 * nbody
     coms = np.array([model.blocks[r].lump.com for r in refs]) if nbody else np.zeros((0, 3))
+    ub, eq, slip = _contact_rows(model, body, friction)
+    a_ub = ub.matrix(coms, ncol)
+    scale, norm, cost = _work_vectors(model, body, coms, ncol)
+    ties = [(body[k], f, p) for k, f, p in model.ties if body[k] >= 0]
+    n_ties = len(ties)
+    cost, norm, a_ub, eq_rows = _tie_columns(
+        ties, coms, scale, (cost, norm, a_ub, eq.matrix(coms, ncol))
+    )
+    a_eq = vstack([eq_rows, csr_matrix(norm.reshape(1, -1))]).tocsr()
+    b_eq = np.zeros(a_eq.shape[0])
+    b_eq[-1] = 1.0
+    return _Programme(
+        cost,
+        a_ub,
+        a_eq,
+        b_eq,
+        n_ties,
+        body,
+        coms,
+        friction,
+        slip.matrix(coms, ncol) if friction is not None else None,
+        t0,
+    )
+
+
+def _contact_rows(
+    model: LPModel, body: List[int], friction: Optional[float]
+) -> Tuple[_Rows, _Rows, _Rows]:
+    """Write the rows of the contacts and restraints: no overlap, no sliding, or friction.
+
+    Parameters
+    ----------
+    model : LPModel
+        The building's interfaces and restraints.
+    body : list of int
+        Each block's glued body (``-1``: the ground).
+    friction : float, optional
+        The joints' friction coefficient [-]; ``None`` bars sliding.
+
+    Returns
+    -------
+    ub : _Rows
+        The inequalities (``n·Δv >= 0`` at each contact point, the friction cone's faces,
+        the restraints).
+    eq : _Rows
+        The equalities (a crack's hinge line, no sliding without friction).
+    slip : _Rows
+        The sliding rates of the contacts with friction (to report).
+    """
     ub, eq, slip = _Rows(), _Rows(), _Rows()
 
     def bid(block: int) -> int:
+        """Return the glued body of a block, ``-1`` for the ground."""
         return -1 if block < 0 else body[block]
 
     for itf in model.interfaces:
@@ -936,7 +1138,34 @@ def _programme(model: LPModel, friction: Optional[float]) -> _Programme:
     for b, p, direction in model.restraints:
         if bid(b) >= 0:
             ub.add(bid(b), -1, p, direction)
-    a_ub = ub.matrix(coms, ncol)
+    return ub, eq, slip
+
+
+def _work_vectors(
+    model: LPModel, body: List[int], coms: np.ndarray, ncol: int
+) -> Tuple[float, np.ndarray, np.ndarray]:
+    """Weigh the bodies' velocities: the horizontal load's work and the loads' cost.
+
+    Parameters
+    ----------
+    model : LPModel
+        The building's blocks, masses borne and abutting, and forces.
+    body : list of int
+        Each block's glued body (``-1``: the ground).
+    coms : numpy.ndarray
+        Each body's reference point, shape ``(nbody, 3)`` [m].
+    ncol : int
+        The unknowns, six per body.
+
+    Returns
+    -------
+    scale : float
+        One over the blocks' total mass [1/kg].
+    norm : numpy.ndarray
+        The horizontal load's work per unknown (its row is set to one), shape ``(ncol,)``.
+    cost : numpy.ndarray
+        The gravity loads' and forces' work per unknown, shape ``(ncol,)``.
+    """
     # normalisation: unit work of the horizontal load. Masses enter as fractions of the
     # blocks' total, so that the unknowns are of order one (HiGHS's tolerances are absolute).
     d = model.d
@@ -963,26 +1192,7 @@ def _programme(model: LPModel, friction: Optional[float]) -> _Programme:
         if size > 0.0 and body[k] >= 0:
             b = body[k]
             cost[6 * b : 6 * b + 6] -= scale * size * _point_map(coms, b, p, f / size) / G
-    ties = [(body[k], f, p) for k, f, p in model.ties if body[k] >= 0]
-    n_ties = len(ties)
-    cost, norm, a_ub, eq_rows = _tie_columns(
-        ties, coms, scale, (cost, norm, a_ub, eq.matrix(coms, ncol))
-    )
-    a_eq = vstack([eq_rows, csr_matrix(norm.reshape(1, -1))]).tocsr()
-    b_eq = np.zeros(a_eq.shape[0])
-    b_eq[-1] = 1.0
-    return _Programme(
-        cost,
-        a_ub,
-        a_eq,
-        b_eq,
-        n_ties,
-        body,
-        coms,
-        friction,
-        slip.matrix(coms, ncol) if friction is not None else None,
-        t0,
-    )
+    return scale, norm, cost
 
 
 def _run(model: LPModel, prog: _Programme) -> Tuple[LPResult, Optional[np.ndarray]]:

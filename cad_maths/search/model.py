@@ -43,7 +43,14 @@ from cad_maths.mechanisms.loaded import BEARING_ANGLE, contact_tolerance
 from cad_maths.mechanisms.single import find_objects
 from cad_maths.mechanisms.thrust import roof_thrust
 from cad_maths.scene_base import SceneObject
-from cad_maths.search.plan import Plan, footprint, least_width, outer_side, read_plan
+from cad_maths.search.plan import (
+    FaceReading,
+    Plan,
+    footprint,
+    least_width,
+    outer_side,
+    read_plan,
+)
 from cad_maths.search.prism import (
     PIER_ASPECT_MIN,
     PLUMB_TOL_DEG,
@@ -648,32 +655,7 @@ def _orient(
     axes = frame_from_mesh(v, mesh.faces, name, None if levels is None else levels - com)
     e_n, e_s = axes.e_n, axes.e_s
     reading = plan.read_faces(name, e_n, e_s, v[:, :2])
-    outer, lone_notes = outer_side(reading, name)
-    toward = None if levels is None else float((levels - com) @ e_n)
-    if outer is not None:
-        flip = outer == 1  # e_n points from the outer face into the building
-    elif reading.exposed[0] == 0.0:  # an inner wall: inner side towards its plan's centre
-        c = np.asarray(plan.parts[reading.building].centroid.coords[0]) + plan.origin
-        ahead = float((c - com[:2]) @ e_n[:2])
-        if abs(ahead) <= CENTRE_RTOL * size:
-            # on the centre line: a fixed rule (e_n towards +x, else +y) names its sides
-            flip = e_n[0] < -1e-12 or (abs(e_n[0]) <= 1e-12 and e_n[1] < 0.0)
-            lone_notes.append(
-                f"{name}: an inner wall on its building's centre line; its sides are named by "
-                "a fixed rule (its inner side towards +x, else +y): 'outward' and 'inward' "
-                "are the two directions across it"
-            )
-        else:
-            flip = ahead < 0.0
-    elif toward is not None and abs(toward) > 1e-9 * size:
-        flip = toward < 0.0
-        lone_notes.append(
-            f"{name}: a lone wall; its inner side is taken to face the levels it carries "
-            "(its outward mechanisms move away from them)"
-        )
-    else:
-        # A lone wall without levels: a fixed rule (e_n towards +x, else +y) names its sides.
-        flip = e_n[0] < -1e-12 or (abs(e_n[0]) <= 1e-12 and e_n[1] < 0.0)
+    flip, lone_notes = _outer_is_first(plan, reading, com, e_n, levels, size, name)
     if flip:
         axes = axes.flipped()
         e_n, e_s = axes.e_n, axes.e_s
@@ -725,6 +707,74 @@ def _orient(
         )
     held = _held_by(plan, reading.covered[1 if flip else 0], e_s if not flip else -e_s, frame)
     return frame, rings, volume, exact, notes, (held, reading.building, scale)
+
+
+def _outer_is_first(
+    plan: Plan,
+    reading: FaceReading,
+    com: np.ndarray,
+    e_n: np.ndarray,
+    levels: Optional[np.ndarray],
+    size: float,
+    name: str,
+) -> Tuple[bool, List[str]]:
+    """Tell whether the wall's frame is to be flipped so that e_n points into the building.
+
+    The outer face is the one the plan finds on the outside (``plan.outer_side``); a lone
+    wall faces the levels it carries with its inner side, or follows a fixed rule; an inner
+    wall faces the centre of its building's plan (``_orient``).
+
+    Parameters
+    ----------
+    plan : Plan
+        The buildings' plans.
+    reading : FaceReading
+        The plan's reading of the wall's two faces (``plan.read_faces``).
+    com : numpy.ndarray
+        The wall's mean vertex [m].
+    e_n : numpy.ndarray
+        The frame's normal as found (unit).
+    levels : numpy.ndarray, optional
+        A point of the levels the wall carries [m].
+    size : float
+        The building's size [m].
+    name : str
+        The wall's name, for the notes.
+
+    Returns
+    -------
+    flip : bool
+        Flip the frame.
+    notes : list of str
+        How a lone or inner wall's sides were named.
+    """
+    outer, lone_notes = outer_side(reading, name)
+    toward = None if levels is None else float((levels - com) @ e_n)
+    if outer is not None:
+        flip = outer == 1  # e_n points from the outer face into the building
+    elif reading.exposed[0] == 0.0:  # an inner wall: inner side towards its plan's centre
+        c = np.asarray(plan.parts[reading.building].centroid.coords[0]) + plan.origin
+        ahead = float((c - com[:2]) @ e_n[:2])
+        if abs(ahead) <= CENTRE_RTOL * size:
+            # on the centre line: a fixed rule (e_n towards +x, else +y) names its sides
+            flip = e_n[0] < -1e-12 or (abs(e_n[0]) <= 1e-12 and e_n[1] < 0.0)
+            lone_notes.append(
+                f"{name}: an inner wall on its building's centre line; its sides are named by "
+                "a fixed rule (its inner side towards +x, else +y): 'outward' and 'inward' "
+                "are the two directions across it"
+            )
+        else:
+            flip = ahead < 0.0
+    elif toward is not None and abs(toward) > 1e-9 * size:
+        flip = toward < 0.0
+        lone_notes.append(
+            f"{name}: a lone wall; its inner side is taken to face the levels it carries "
+            "(its outward mechanisms move away from them)"
+        )
+    else:
+        # A lone wall without levels: a fixed rule (e_n towards +x, else +y) names its sides.
+        flip = e_n[0] < -1e-12 or (abs(e_n[0]) <= 1e-12 and e_n[1] < 0.0)
+    return flip, lone_notes
 
 
 def _axes_notes(
@@ -1151,14 +1201,7 @@ def _level_contacts(
             bearing = level.kind == "roof" or abs(float(normal[2])) >= math.cos(BEARING_ANGLE)
             thrust = 0.0
             if level.kind == "roof" and level.pushes:
-                lo_hi = [
-                    bounding_box_in_frame(m, wall.frame.origin, -wall.frame.e_n, wall.frame.e_s)
-                    for m in meshes
-                ]
-                lo = np.min([p[0] for p in lo_hi], axis=0)
-                hi = np.max([p[1] for p in lo_hi], axis=0)
-                ext = hi - lo
-                thrust = roof_thrust(G * total, float(ext[0]), float(abs(ext[2])), not level.pushes)
+                thrust = _roof_push(level, wall, meshes, total)
             out[wall.id].append(
                 LevelContact(
                     level,
@@ -1177,25 +1220,86 @@ def _level_contacts(
                 )
             )
             touched.append(wall.id)
-        if not touched and carried:
-            raise GeometryError(
-                f"{where} ({level.id}): the walls {', '.join(sorted(set(carried)))} stand on it, "
-                "and it rests on no wall: a level is carried by walls (on their tops or against "
-                "their faces); the ground or a foundation is not a level: remove it from levels"
-            )
         if not touched:
-            raise GeometryError(
-                f"{where} ({level.id}): touches no wall (no shared face with any wall solid "
-                f"within {1000 * tol:.3g} mm); {_nearest_wall(meshes, walls, plan)}: draw it "
-                "onto the walls that carry it (its underside on their tops, or its edge against "
-                "their inner faces), or remove it from levels"
-            )
+            _no_wall_carries(f"{where} ({level.id})", carried, meshes, walls, plan, tol)
         if "tributary" not in level.model_fields_set:
             notes.append(
                 f"{where} ({level.id}): tributary not given; each wall it touches carries the "
                 f"default {level.tributary:g} of the weight and inertia of its solids on that wall"
             )
     return out, objects, under
+
+
+def _roof_push(level: Any, wall: Wall, meshes: List[TriMesh], total: float) -> float:
+    """Return the horizontal thrust of a pushing roof on a wall it touches [N].
+
+    Parameters
+    ----------
+    level : LevelSpec
+        The roof level (``pushes`` set).
+    wall : Wall
+        The wall it touches.
+    meshes : list of TriMesh
+        The roof's solids.
+    total : float
+        Their mass [kg].
+
+    Returns
+    -------
+    float
+        ``roof_thrust`` of the roof's weight over its span across the wall and its rise.
+    """
+    lo_hi = [
+        bounding_box_in_frame(m, wall.frame.origin, -wall.frame.e_n, wall.frame.e_s) for m in meshes
+    ]
+    lo = np.min([p[0] for p in lo_hi], axis=0)
+    hi = np.max([p[1] for p in lo_hi], axis=0)
+    ext = hi - lo
+    return roof_thrust(G * total, float(ext[0]), float(abs(ext[2])), not level.pushes)
+
+
+def _no_wall_carries(
+    label: str,
+    carried: List[str],
+    meshes: List[TriMesh],
+    walls: Dict[str, Wall],
+    plan: Plan,
+    tol: float,
+) -> None:
+    """Refuse a level that rests on no wall, saying what it does touch.
+
+    Parameters
+    ----------
+    label : str
+        The level's place and id (``levels[k] (id)``).
+    carried : list of str
+        The walls that stand on it.
+    meshes : list of TriMesh
+        Its solids.
+    walls : dict of str to Wall
+        The walls.
+    plan : Plan
+        The buildings' plans (for the nearest wall).
+    tol : float
+        The contact tolerance [m].
+
+    Raises
+    ------
+    GeometryError
+        Always: walls stand on it, or it touches no wall.
+    """
+    if carried:
+        raise GeometryError(
+            f"{label}: the walls {', '.join(sorted(set(carried)))} stand on it, "
+            "and it rests on no wall: a level is carried by walls (on their tops or against "
+            "their faces); the ground or a foundation is not a level: remove it from levels"
+        )
+    raise GeometryError(
+        f"{label}: touches no wall (no shared face with any wall solid "
+        f"within {1000 * tol:.3g} mm); {_nearest_wall(meshes, walls, plan)}: draw it "
+        "onto the walls that carry it (its underside on their tops, or its edge against "
+        "their inner faces), or remove it from levels"
+    )
 
 
 def _is_base(hit: Tuple[Any, ...], wall: Wall, level: TriMesh, tol: float) -> bool:
@@ -1504,6 +1608,61 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
     # the spec's implausible values are warnings of the search's document (issue #36), not notes
     notes: List[str] = []
     memory = MemoryScene([], path=scene.path, tolerance=scene.tolerance, source_units=scene.units)
+    raw = _read_walls(scene, spec, memory, notes)
+    _trim_overlaps(raw, notes)
+    for _, obj, _, _ in raw:
+        memory.add(obj)
+    verts = np.vstack([m.vertices for _, _, m, _ in raw])
+    size = float(np.linalg.norm(verts.max(axis=0) - verts.min(axis=0)))
+    level_read = _read_levels(scene, spec)
+    level_meshes = [m for _, meshes, _ in level_read for m in meshes]
+    level_points = [m.vertices for m in level_meshes]
+    plan = read_plan(
+        [(w.id, m.vertices) for w, _, m, _ in raw], [(m.vertices, m.faces) for m in level_meshes]
+    )
+    if len(plan.parts) > 1:
+        groups: Dict[int, List[str]] = {}
+        for w, _, _, _ in raw:
+            groups.setdefault(plan.building_of(w.id), []).append(w.id)
+        said = "; ".join(", ".join(ids) for _, ids in sorted(groups.items()))
+        notes.append(
+            f"the walls stand in {len(plan.parts)} separate buildings ({said}): each has its "
+            "own outline and outer faces"
+        )
+    levels = np.vstack(level_points).mean(axis=0) if level_points else None
+    walls = _oriented_walls(raw, plan, size, levels, notes)
+    tol = max(contact_tolerance(scene), 1e-9 * size)
+    returns = _returns(walls, spec, tol, notes, plan)
+    _near_misses(walls, plan, tol, notes)
+    contacts, level_objects, under = _level_contacts(
+        spec, walls, tol, notes, memory, level_read, plan
+    )
+    _check_bases(walls, under, level_meshes, plan, tol, notes)
+    ties = _tie_points(scene, spec, walls, memory)
+    return Building(memory, walls, returns, contacts, ties, notes, spec, level_objects, tol)
+
+
+def _read_walls(
+    scene: Any, spec: Any, memory: MemoryScene, notes: List[str]
+) -> List[Tuple[Any, SceneObject, TriMesh, Any]]:
+    """Read the spec's walls, with its openings cut out and their overburdens' solids.
+
+    Parameters
+    ----------
+    scene : BaseScene
+        The input scene, in metres.
+    spec : SearchSpec
+        The search spec (``openings``, ``walls``).
+    memory : MemoryScene
+        The building's scene; each overburden's solids are added to it.
+    notes : list of str
+        The search's notes, extended with the reading's.
+
+    Returns
+    -------
+    list of (WallSpec, SceneObject, TriMesh, selector)
+        Each wall's spec, object (its voids cut), solid and the selector that names it.
+    """
     openings: List[Tuple[SceneObject, TriMesh]] = []
     for k, sel in enumerate(spec.openings):
         for obj in _find(scene, [sel], f"openings[{k}]"):
@@ -1533,27 +1692,36 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
                 notes.extend(warn)
                 memory.add(SceneObject(o.id, o.name, o.layer, "mesh", dict(o.user_text), m))
         raw.append((w, obj, mesh, selector))
-    _trim_overlaps(raw, notes)
-    for _, obj, _, _ in raw:
-        memory.add(obj)
-    verts = np.vstack([m.vertices for _, _, m, _ in raw])
-    size = float(np.linalg.norm(verts.max(axis=0) - verts.min(axis=0)))
-    level_read = _read_levels(scene, spec)
-    level_meshes = [m for _, meshes, _ in level_read for m in meshes]
-    level_points = [m.vertices for m in level_meshes]
-    plan = read_plan(
-        [(w.id, m.vertices) for w, _, m, _ in raw], [(m.vertices, m.faces) for m in level_meshes]
-    )
-    if len(plan.parts) > 1:
-        groups: Dict[int, List[str]] = {}
-        for w, _, _, _ in raw:
-            groups.setdefault(plan.building_of(w.id), []).append(w.id)
-        said = "; ".join(", ".join(ids) for _, ids in sorted(groups.items()))
-        notes.append(
-            f"the walls stand in {len(plan.parts)} separate buildings ({said}): each has its "
-            "own outline and outer faces"
-        )
-    levels = np.vstack(level_points).mean(axis=0) if level_points else None
+    return raw
+
+
+def _oriented_walls(
+    raw: List[Tuple[Any, SceneObject, TriMesh, Any]],
+    plan: Plan,
+    size: float,
+    levels: Optional[np.ndarray],
+    notes: List[str],
+) -> Dict[str, Wall]:
+    """Orient each wall in the plan (``_orient``) and make its ``Wall``.
+
+    Parameters
+    ----------
+    raw : list of (WallSpec, SceneObject, TriMesh, selector)
+        The walls as read (``_read_walls``), their overlaps trimmed.
+    plan : Plan
+        The buildings' plans.
+    size : float
+        The building's size [m].
+    levels : numpy.ndarray, optional
+        The levels' mean vertex [m].
+    notes : list of str
+        The search's notes, extended with the walls' (and what stands against them).
+
+    Returns
+    -------
+    dict of str to Wall
+        The walls by id, in the spec's order.
+    """
     walls: Dict[str, Wall] = {}
     for w, obj, mesh, selector in raw:
         frame, rings, volume, exact, wall_notes, (held, building, scale) = _orient(
@@ -1588,12 +1756,4 @@ def building_from_scene(scene: Any, spec: Any) -> Building:
                 f"{length:.3f} m): {w.id} cannot move outward there, and its outward mechanisms "
                 "(the whole façade above a hinge line, its corners) are not searched"
             )
-    tol = max(contact_tolerance(scene), 1e-9 * size)
-    returns = _returns(walls, spec, tol, notes, plan)
-    _near_misses(walls, plan, tol, notes)
-    contacts, level_objects, under = _level_contacts(
-        spec, walls, tol, notes, memory, level_read, plan
-    )
-    _check_bases(walls, under, level_meshes, plan, tol, notes)
-    ties = _tie_points(scene, spec, walls, memory)
-    return Building(memory, walls, returns, contacts, ties, notes, spec, level_objects, tol)
+    return walls

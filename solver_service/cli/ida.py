@@ -12,7 +12,7 @@ import functools
 import math
 import re
 from pathlib import Path
-from typing import Optional
+from typing import TYPE_CHECKING, Callable, Optional
 
 import typer
 
@@ -36,6 +36,12 @@ from .options import (
     grouped,
 )
 from .output import choices, g4, out_note, print_json, record_warning, skipped_notes, table
+
+if TYPE_CHECKING:
+    from shared_schema.constants import ConstantsFile
+    from shared_schema.documents.ida import IdaDocument
+
+    from ..core.records import GroundMotion
 
 __all__ = ["MAX_RANGE_LEVELS", "ida", "parse_levels"]
 
@@ -197,85 +203,106 @@ def ida(
     as_json: bool = JSON_OPT,
 ) -> None:
     """Incremental dynamic analysis: overturned fraction per intensity and fragility fits."""
-    # long: the progress bar and the summary table
-    from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
-
-    # The solver's own check of a positive number.
-    from ..core.model import check_positive
-
-    # The readers and the writer of the IDA's files.
-    from ..workflows import inputs, outputs
-
-    # The IDA, its inputs and its writer are loaded when the command runs (#38).
+    # The IDA is loaded when the command runs (#38).
     from ..workflows.ida import run as workflow
 
-    levels = parse_levels(scales)
-    limits.check(scales=len(levels))
-    if out is not None:
-        check_folder_target(out)
-    if peaks:
-        if out is None:
-            fail(f"peaks: --peaks writes {PEAKS_FILE} into the --out folder; give --out DIR")
-        require("pyarrow.parquet", "parquet", "for ida --peaks")
-    cf = inputs.read_constants(constants, time_domain=True)
-    motions = [reading.read(p) for p in records or []]
-    specs = inputs.read_record_spec(record_spec) if record_spec else []
-    motions += [spec.read(on_warning=record_warning) for spec in specs]
-    if not motions:
-        fail("records: give record files or --record-spec")
-    limits.check(cf, scales=len(levels), record=record_size(motions), records=len(motions))
-    console = Console(stderr=True)
-    show = console.is_terminal if progress is None else progress
-    bar = Progress(
-        "[progress.description]{task.description}",
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=console,
-        disable=not show,
-        transient=True,
+    cf, motions, levels = _read_inputs(
+        constants, records, record_spec, reading, scales, out, peaks, limits
     )
-    task = bar.add_task("runs", total=None)
-    seen = [0, 0]  # runs done, runs in all
-
-    def advance(done: int, total: int) -> None:
-        seen[:] = [done, total]
-        bar.update(task, completed=done, total=total)
-
-    try:
-        # With --peaks the output folder's stage is open during the run (the peaks stream
-        # into it); a stopped run leaves the folder as it was.
-        with contextlib.ExitStack() as stack:
-            folder = functools.partial(run_folder, on_note=out_note, command="ida")
-            stage = stack.enter_context(folder(out)) if out is not None and peaks else None
-            with bar:
-                doc = workflow.run_ida(
-                    cf,
-                    motions,
-                    levels,
-                    measure=measure,
-                    sf=scaling.sf,
-                    building=scaling.building,
-                    criterion=criterion,
-                    scheduler=scheduler,
-                    progress=advance,
-                    timeout=check_positive(timeout, "timeout"),
-                    jobs=jobs,
-                    peaks=None if stage is None else stage / PEAKS_FILE,
-                )
-            if out is not None:
-                stage = stage or stack.enter_context(folder(out))
-                outputs.write_ida(doc, stage, title=f"Fragility: {constants.name}")
-    except KeyboardInterrupt:
-        where = "its tasks on the cluster were cancelled" if scheduler else "no task is left"
-        done = f"{seen[0]} of {seen[1]}" if seen[1] else "0"
-        note(f"interrupted: stopped after {done} runs; {where}; nothing written")
-        raise typer.Exit(code=130) from None
+    run = functools.partial(
+        workflow.run_ida,
+        cf,
+        motions,
+        levels,
+        measure=measure,
+        sf=scaling.sf,
+        building=scaling.building,
+        criterion=criterion,
+    )
+    doc = _run_and_write(
+        run,
+        _RunsBar(progress),
+        scheduler=scheduler,
+        timeout=timeout,
+        jobs=jobs,
+        out=out,
+        peaks=peaks,
+        title=f"Fragility: {constants.name}",
+    )
     skipped_notes(doc)
     if as_json:
         print_json(doc.to_dict())
         return
+    _print_summary(doc, len(motions), len(levels), out, peaks)
+
+
+class _RunsBar:
+    """The IDA's progress bar on stderr: runs done of the runs in all.
+
+    Parameters
+    ----------
+    progress : bool, optional
+        Show the bar (``--progress/--no-progress``); ``None`` shows it on a terminal.
+
+    Attributes
+    ----------
+    bar : rich.progress.Progress
+        The bar, entered (``with bar.bar:``) while the runs run; transient.
+    seen : list of int
+        ``[runs done, runs in all]`` as last reported, for the note of a stopped run.
+    """
+
+    def __init__(self, progress: Optional[bool]) -> None:
+        # rich is loaded when the command runs
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
+
+        console = Console(stderr=True)
+        show = console.is_terminal if progress is None else progress
+        self.bar = Progress(
+            "[progress.description]{task.description}",
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            console=console,
+            disable=not show,
+            transient=True,
+        )
+        self._task = self.bar.add_task("runs", total=None)
+        self.seen = [0, 0]  # runs done, runs in all
+
+    def advance(self, done: int, total: int) -> None:
+        """Show ``done`` runs of ``total`` (the IDA's ``progress`` callback).
+
+        Parameters
+        ----------
+        done : int
+            Runs done so far.
+        total : int
+            Runs in all.
+        """
+        self.seen[:] = [done, total]
+        self.bar.update(self._task, completed=done, total=total)
+
+
+def _print_summary(
+    doc: IdaDocument, n_records: int, n_levels: int, out: Optional[Path], peaks: bool
+) -> None:
+    """Print the IDA's summary: where and how long it ran, each mechanism's fragility, the files.
+
+    Parameters
+    ----------
+    doc : IdaDocument
+        The IDA's document (``ida.json``).
+    n_records : int
+        Records the IDA ran.
+    n_levels : int
+        Intensity levels the IDA ran.
+    out : Path, optional
+        The output folder the files were written to.
+    peaks : bool
+        Whether the peaks file was written too.
+    """
     backend, err = doc.backend, doc.max_error_estimate
     where = (
         f"locally on {backend.jobs} threads"
@@ -283,7 +310,7 @@ def ida(
         else f"on Dask at {backend.scheduler} ({backend.threads} worker threads)"
     )
     typer.echo(
-        f"{doc.runs} runs ({len(motions)} records x {len(levels)} levels x "
+        f"{doc.runs} runs ({n_records} records x {n_levels} levels x "
         f"{len(doc.mechanisms)} mechanisms) {where} in {doc.runtime_s:.2f} s "
         f"({backend.tasks} tasks, overhead {100 * backend.overhead_fraction:.1f} % of "
         f"task time); largest error estimate {'n/a' if err is None else f'{err:.1e}'}"
@@ -307,3 +334,138 @@ def ida(
         typer.echo(
             f"wrote {out / 'ida.json'}, ida.csv, ida.png" + (f", {PEAKS_FILE}" if peaks else "")
         )
+
+
+def _read_inputs(
+    constants: Path,
+    records: Optional[list[Path]],
+    record_spec: Optional[Path],
+    reading: RecordOptions,
+    scales: str,
+    out: Optional[Path],
+    peaks: bool,
+    limits: Limits,
+) -> tuple[ConstantsFile, list[GroundMotion], list[float]]:
+    """Check the IDA's options and read its constants, records and levels.
+
+    Parameters
+    ----------
+    constants : Path
+        The constants file (time-domain checked).
+    records : list of Path, optional
+        Record files, read with ``reading``.
+    record_spec : Path, optional
+        A record spec (``--record-spec``), each record with its own options.
+    reading : RecordOptions
+        How the record files are read (``--format``, ``--units``, ...).
+    scales : str
+        The ``--scales`` text (``parse_levels``).
+    out : Path, optional
+        The output folder, checked as a target.
+    peaks : bool
+        ``--peaks``: needs ``out`` and the parquet extra.
+    limits : Limits
+        The work limits, checked on the levels, the constants and the records.
+
+    Returns
+    -------
+    cf : ConstantsFile
+        The constants.
+    motions : list of GroundMotion
+        The records (files, then the spec's).
+    levels : list of float
+        The intensity levels, in the measure's unit.
+    """
+    # The readers of the IDA's inputs are loaded when the command runs (#38).
+    from ..workflows import inputs
+
+    levels = parse_levels(scales)
+    limits.check(scales=len(levels))
+    if out is not None:
+        check_folder_target(out)
+    if peaks:
+        if out is None:
+            fail(f"peaks: --peaks writes {PEAKS_FILE} into the --out folder; give --out DIR")
+        require("pyarrow.parquet", "parquet", "for ida --peaks")
+    cf = inputs.read_constants(constants, time_domain=True)
+    motions = [reading.read(p) for p in records or []]
+    specs = inputs.read_record_spec(record_spec) if record_spec else []
+    motions += [spec.read(on_warning=record_warning) for spec in specs]
+    if not motions:
+        fail("records: give record files or --record-spec")
+    limits.check(cf, scales=len(levels), record=record_size(motions), records=len(motions))
+    return cf, motions, levels
+
+
+def _run_and_write(
+    run: Callable[..., IdaDocument],
+    bar: _RunsBar,
+    *,
+    scheduler: Optional[str],
+    timeout: float,
+    jobs: Optional[int],
+    out: Optional[Path],
+    peaks: bool,
+    title: str,
+) -> IdaDocument:
+    """Run the IDA under its progress bar and write its files; a stopped run writes nothing.
+
+    Parameters
+    ----------
+    run : callable
+        ``run_ida`` with its constants, records, levels and options bound; given here its
+        ``scheduler``, ``progress``, ``timeout``, ``jobs`` and ``peaks``.
+    bar : _RunsBar
+        The progress bar.
+    scheduler : str, optional
+        The Dask scheduler's address; ``None`` runs locally.
+    timeout : float
+        Seconds to wait for the Dask scheduler [s], checked positive.
+    jobs : int, optional
+        Threads of a local run.
+    out : Path, optional
+        The output folder (``ida.json``, ``ida.csv``, ``ida.png``).
+    peaks : bool
+        Stream every run's peak into the output folder's stage.
+    title : str
+        The fragility figure's title.
+
+    Returns
+    -------
+    IdaDocument
+        The IDA's document.
+
+    Raises
+    ------
+    typer.Exit
+        Code 130 on Ctrl-C, after a note of the runs done.
+    """
+    # The solver's own check of a positive number.
+    from ..core.model import check_positive
+
+    # The writer of the IDA's files.
+    from ..workflows import outputs
+
+    try:
+        # With --peaks the output folder's stage is open during the run (the peaks stream
+        # into it); a stopped run leaves the folder as it was.
+        with contextlib.ExitStack() as stack:
+            folder = functools.partial(run_folder, on_note=out_note, command="ida")
+            stage = stack.enter_context(folder(out)) if out is not None and peaks else None
+            with bar.bar:
+                doc = run(
+                    scheduler=scheduler,
+                    progress=bar.advance,
+                    timeout=check_positive(timeout, "timeout"),
+                    jobs=jobs,
+                    peaks=None if stage is None else stage / PEAKS_FILE,
+                )
+            if out is not None:
+                stage = stage or stack.enter_context(folder(out))
+                outputs.write_ida(doc, stage, title=title)
+    except KeyboardInterrupt:
+        where = "its tasks on the cluster were cancelled" if scheduler else "no task is left"
+        done = f"{bar.seen[0]} of {bar.seen[1]}" if bar.seen[1] else "0"
+        note(f"interrupted: stopped after {done} runs; {where}; nothing written")
+        raise typer.Exit(code=130) from None
+    return doc

@@ -29,6 +29,7 @@ from .output import table as table_lines
 
 if TYPE_CHECKING:
     from cad_maths.mechanisms.build import MechanismFailure
+    from shared_schema.documents.search import SearchDocument
 
 __all__ = ["constants", "constants_table", "search"]
 
@@ -201,6 +202,21 @@ def search(
     if as_json:
         print_json(doc)
         return
+    _print_ranking(doc, out, figure)
+
+
+def _print_ranking(doc: SearchDocument, out: Path, figure: bool) -> None:
+    """Print the search's ranking table (the top 15), its LP checks and what it wrote.
+
+    Parameters
+    ----------
+    doc : SearchDocument
+        The search's document (``search.json``).
+    out : Path
+        The output folder the files were written to.
+    figure : bool
+        Whether ``search.png`` was drawn.
+    """
     rows = []
     for d in doc.ranked[:15]:
         score = None if d.overturning is None else d.overturning.band_score_g
