@@ -65,7 +65,7 @@ from shared_schema.site import SiteFile
 from shared_schema.version import __version__
 
 from ..core.model import G
-from .labels import ratio_label
+from .labels import least_margin_pulse, ratio_label
 from .plots import load_pyplot, plain, write_figure_atomic
 from .retrofit import records_notes, retrofit_summary
 
@@ -611,8 +611,7 @@ def _dynamics_cell(row: CheckMechanism) -> dict[str, str]:
 
 def _worst_pulse(env: Optional[AssessEnvelope]) -> Optional[PulseMargin]:
     """Return the record pulse of a mechanism's envelope with the smallest margin, or None."""
-    pulses = [p for p in (env.pulses if env is not None else None) or [] if p.margin is not None]
-    return min(pulses, key=lambda p: float(p.margin or 0.0)) if pulses else None
+    return least_margin_pulse((env.pulses if env is not None else None) or [], lambda p: p.margin)
 
 
 def _margin_cell(row: CheckMechanism, verdict: MechanismVerdict) -> dict[str, str]:
