@@ -764,7 +764,29 @@ class ConstantsForm(BaseModel):
 SEARCH_MAX_EVALUATIONS = 200_000
 
 
-class SearchForm(ConstantsForm):
+class SceneRecordFields(BaseModel):
+    """How to read the optional record uploaded beside a scene (``search``, ``retrofit``)."""
+
+    model_config = _FORM
+
+    record_format: Optional[str] = Field(
+        None,
+        description=f"Format of the record: {', '.join(RECORD_FORMATS)} (default: detected).",
+        json_schema_extra={"enum": list(RECORD_FORMATS)},
+    )
+    record_units: Optional[str] = Field(
+        None,
+        description=f"Acceleration units of the record: {', '.join(RECORD_UNITS)}.",
+        json_schema_extra={"enum": list(RECORD_UNITS)},
+    )
+    record_dt: Optional[float] = Field(
+        None,
+        description="Time step [s] of a record without a time column.",
+        json_schema_extra={"exclusiveMinimum": 0},
+    )
+
+
+class SearchForm(ConstantsForm, SceneRecordFields):
     """Multipart form of ``search``: files ``scene``, ``spec``, ``site``, ``record``, and fields.
 
     ``spec`` is the search spec (JSON); ``site`` (SITE.json) and ``record`` are optional. The
@@ -781,24 +803,9 @@ class SearchForm(ConstantsForm):
         "before it runs them.",
     )
     exact: bool = Field(False, description="Envelopes by the exact solver (not the library).")
-    record_format: Optional[str] = Field(
-        None,
-        description=f"Format of the record: {', '.join(RECORD_FORMATS)} (default: detected).",
-        json_schema_extra={"enum": list(RECORD_FORMATS)},
-    )
-    record_units: Optional[str] = Field(
-        None,
-        description=f"Acceleration units of the record: {', '.join(RECORD_UNITS)}.",
-        json_schema_extra={"enum": list(RECORD_UNITS)},
-    )
-    record_dt: Optional[float] = Field(
-        None,
-        description="Time step [s] of a record without a time column.",
-        json_schema_extra={"exclusiveMinimum": 0},
-    )
 
 
-class RetrofitForm(ConstantsForm):
+class RetrofitForm(ConstantsForm, SceneRecordFields):
     """Multipart form of ``retrofit`` from a scene: the scene, its search spec and these fields.
 
     Files ``scene``, ``search_spec``, ``site``, ``spec`` (the retrofit spec) and an optional
@@ -813,26 +820,11 @@ class RetrofitForm(ConstantsForm):
         None,
         ge=1,
         le=SEARCH_MAX_EVALUATIONS,
-        description="Work limit of the two searches together (the scene, then the scene with "
-        "the designed ties): most evaluations of the static multiplier λ0 (default and "
-        f"largest {SEARCH_MAX_EVALUATIONS}); the search's work estimate counts twice, and a "
-        "retrofit past the limit is refused before either search runs; each search may use "
-        "half of it.",
-    )
-    record_format: Optional[str] = Field(
-        None,
-        description=f"Format of the record: {', '.join(RECORD_FORMATS)} (default: detected).",
-        json_schema_extra={"enum": list(RECORD_FORMATS)},
-    )
-    record_units: Optional[str] = Field(
-        None,
-        description=f"Acceleration units of the record: {', '.join(RECORD_UNITS)}.",
-        json_schema_extra={"enum": list(RECORD_UNITS)},
-    )
-    record_dt: Optional[float] = Field(
-        None,
-        description="Time step [s] of a record without a time column.",
-        json_schema_extra={"exclusiveMinimum": 0},
+        description="Work limit of the searches together (the scene, the scene with the "
+        "designed ties, and one per connection upgrade and one with them all): most "
+        f"evaluations of the static multiplier λ0 (default and largest {SEARCH_MAX_EVALUATIONS}"
+        "); the search's work estimate counts once per search, and a retrofit past the limit "
+        "is refused before any search runs; each search may use its share.",
     )
 
 
