@@ -166,7 +166,7 @@ def _assign(
 ) -> None:
     """Give the line to each mechanism whose moving part its crossing is in, or say why not."""
     assert run.constants is not None
-    by_id = {mid: run.result.candidates[k] for k, mid in run.ids.items()}
+    by_id = run.candidates_by_id()
     for wall, p in hits:
         z = float(p[2])
         here = [

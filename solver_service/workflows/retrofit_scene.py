@@ -34,6 +34,7 @@ from typing import Any, Callable, Optional, Sequence
 import numpy as np
 
 from cad_maths.scene_base import BaseScene, SceneObject
+from cad_maths.search.families import Candidate
 from shared_schema.constants import ConstantsFile, Mechanism
 from shared_schema.errors import InputError, RockmechError
 from shared_schema.retrofit import (
@@ -223,7 +224,7 @@ def place_ties(
         The search spec's ``tie_bars`` entries of the lines (``object`` by id, ``force``).
     """
     bld = run.result.building
-    by_id = {mid: run.result.candidates[k] for k, mid in run.ids.items()}
+    by_id = run.candidates_by_id()
     mechs = {} if run.constants is None else {m.id: m for m in run.constants.mechanisms}
     placed: list[PlacedTie] = []
     groups: list[dict[str, Any]] = []
@@ -340,11 +341,12 @@ RULE_CONSTANTS = (
 
 
 def _scene_default(
-    run: SearchRun, mech: Mechanism
+    run: SearchRun, mech: Mechanism, cand: Optional[Candidate]
 ) -> Optional[tuple[list[tuple[float, str]], list[str]]]:
-    """Return the scene's default heights [m] of an outward mechanism, with notes, or None."""
-    by_id = {mid: run.result.candidates[k] for k, mid in run.ids.items()}
-    cand = by_id.get(mech.id)
+    """Return the scene's default heights [m] of an outward mechanism, with notes, or None.
+
+    ``cand`` is the search's candidate of ``mech`` (None: the search has none of its id).
+    """
     geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
     pos = geo.get("positive")
     if cand is None or cand.direction != "outward":
@@ -366,10 +368,9 @@ def scene_heights(
 
     A mechanism crossed by the spec's tie lines (``lines``, ``retrofit_lines``) takes their
     heights after its own ``heights_m``, and no default. Otherwise one with ``heights_m``
-    keeps them; one without takes the default: from a scene the moving part's top on its
-    façade is known, the wall's top above the mechanism's hinge (``z_hi − z_hinge``), where
-    the constants alone give only the rectangle of the block's ``R`` and ``α``, and each
-    level the moving part carries (``retrofit.default_heights``). Mechanisms that turn
+    keeps them; one without takes the default: the top of its wall above the mechanism's
+    hinge (``z_hi − z_hinge``, on the façade the tie goes through), and each level the moving
+    part carries (``retrofit.default_heights``). Mechanisms that turn
     inward are left to the retrofit's default (a tie is slack on that motion).
 
     Returns
@@ -386,6 +387,7 @@ def scene_heights(
     if run.constants is None:
         return out
     ties = dict(rspec.mechanisms)
+    by_id = run.candidates_by_id()
     for mech in run.constants.mechanisms:
         given = ties.get(mech.id)
         own = list(given.heights_m or []) if given is not None else []
@@ -399,7 +401,7 @@ def scene_heights(
         elif own:
             rule = RULE_HEIGHTS
         else:
-            default = _scene_default(run, mech)
+            default = _scene_default(run, mech, by_id.get(mech.id))
             rule = RULE_CONSTANTS if default is None else RULE_SCENE
             if default is not None:
                 got, level_notes = default

@@ -131,6 +131,10 @@ class SearchRun:
     result: SearchResult
     ids: dict[int, str] = field(default_factory=dict)
 
+    def candidates_by_id(self) -> dict[str, Candidate]:
+        """Return the search's candidate behind each mechanism id (``ids`` read the other way)."""
+        return {mid: self.result.candidates[k] for k, mid in self.ids.items()}
+
 
 #: What a search spec must be, for the messages on empty, binary or non-JSON files.
 SEARCH_SPEC_EXPECTED = 'a search spec (JSON, {"walls": [...], "levels": [...], ...})'
