@@ -16,7 +16,7 @@ Python 3.9-clean: imported by Rhino 8.
 
 import json
 import math
-from typing import Any, List, Literal, Optional, Union, cast
+from typing import Any, List, Literal, Optional, Tuple, Union, cast
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
@@ -384,6 +384,22 @@ class SearchSpec(BaseModel):
                 "no wall is a facade ('facade': false on every wall): nothing to search"
             )
         return self
+
+    def connection_of(self, a: str, b: str) -> Optional[Tuple[Connection, Optional[Unit], str]]:
+        """Return the connection the spec gives the junction of walls ``a`` and ``b``, or None.
+
+        The junction listed in ``junctions`` (either order), else ``default_junction``:
+        ``(connection, unit, where)`` with ``where`` ``"junctions[k]"`` or
+        ``"default_junction"``; None where the spec covers neither.
+        """
+        pair = sorted([a, b])
+        for k, j in enumerate(self.junctions):
+            if sorted(j.walls) == pair:
+                return j.connection, j.unit, f"junctions[{k}]"
+        if self.default_junction is not None:
+            d = self.default_junction
+            return d.connection, d.unit, "default_junction"
+        return None
 
     def plausibility_notes(self) -> List[str]:
         """Warnings for admissible but implausible inputs (``rules.QUANTITY_RANGES``)."""

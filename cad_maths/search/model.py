@@ -1012,11 +1012,9 @@ def _unit_angle(unit: Any) -> float:
 
 
 def _junction(spec: Any, a: str, b: str) -> Tuple[str, Optional[Any], str]:
-    for j in spec.junctions:
-        if sorted(j.walls) == sorted([a, b]):
-            return j.connection, j.unit, "junctions"
-    if spec.default_junction is not None:
-        return spec.default_junction.connection, spec.default_junction.unit, "default_junction"
+    found = spec.connection_of(a, b)
+    if found is not None:
+        return found
     raise InputError(
         f"the walls {a!r} and {b!r} meet, but the spec gives no connection for them; add "
         f'{{"walls": ["{a}", "{b}"], "connection": "good"|"poor"|"tied", ...}} to junctions, '

@@ -15,7 +15,7 @@ level is already tied). Connections rank ``poor < good < tied``.
 
 from __future__ import annotations
 
-from typing import Any, Optional, Sequence
+from typing import Any, Sequence
 
 from shared_schema.errors import InputError
 from shared_schema.retrofit import ConnectionUpgrade
@@ -25,17 +25,6 @@ __all__ = ["STRENGTH", "apply_upgrades", "check_upgrades", "check_upgrades_meet"
 
 #: How strongly each connection holds two walls together (an upgrade must raise it).
 STRENGTH = {"poor": 0, "good": 1, "tied": 2}
-
-
-def _connection(spec: SearchSpec, walls: Sequence[str]) -> tuple[Optional[str], str]:
-    """Return a junction's connection in the spec (None: not covered) and where it is given."""
-    pair = sorted(walls)
-    for k, j in enumerate(spec.junctions):
-        if sorted(j.walls) == pair:
-            return j.connection, f"junctions[{k}]"
-    if spec.default_junction is not None:
-        return spec.default_junction.connection, "default_junction"
-    return None, ""
 
 
 def _key(up: ConnectionUpgrade) -> tuple[str, ...]:
@@ -52,13 +41,14 @@ def _check_junction(spec: SearchSpec, up: ConnectionUpgrade, k: int) -> str:
                 f"upgrades[{k}].walls",
             )
     a, b = up.walls
-    now, where = _connection(spec, up.walls)
-    if now is None:
+    found = spec.connection_of(a, b)
+    if found is None:
         raise InputError(
             f"the search spec has no junction {a}-{b} (not in its junctions, and no "
             "default_junction): list the junction there before upgrading it",
             f"upgrades[{k}].walls",
         )
+    now, _, where = found
     if STRENGTH[up.to] <= STRENGTH[now]:
         what = "no change" if up.to == now else f"weaker than its {now}"
         raise InputError(
