@@ -57,6 +57,7 @@ __all__ = [
     "check_doc",
     "check_site_inputs",
     "limit_state_spectrum",
+    "number_at",
     "recheck_with_records",
     "site_spectrum",
 ]
@@ -248,7 +249,17 @@ def _options(site: SiteFile, mech: Mechanism) -> MechanismOptions:
     return site.local_mechanisms.mechanisms.get(mech.id) or MechanismOptions()
 
 
-def _number(mapping: Any, *keys: str) -> Optional[float]:
+def number_at(mapping: Any, *keys: str) -> Optional[float]:
+    """Return the real number at ``mapping[keys[0]][keys[1]]...`` (None: absent, or no number).
+
+    A free-form JSON part of the constants (``geometry``) read safely: a missing key, a
+    non-mapping on the way, a boolean or a text give None, never an error.
+
+    Examples
+    --------
+    >>> number_at({"positive": {"R_m": 2}}, "positive", "R_m"), number_at({"h_m": True}, "h_m")
+    (2.0, None)
+    """
     node = mapping
     for key in keys:
         if not isinstance(node, dict) or key not in node:
@@ -305,8 +316,8 @@ def _free_standing(
         f"site {where}.unit_weight" if opts.unit_weight else "site local_mechanisms.unit_weight"
     )
     if w is None:
-        rho = _number(geo, "density_kg_m3")
-        mass, vol = _number(geo, "mass_kg"), _number(geo, "volume_m3")
+        rho = number_at(geo, "density_kg_m3")
+        mass, vol = number_at(geo, "mass_kg"), number_at(geo, "volume_m3")
         if rho is None and mass is not None and vol:
             rho = mass / vol
         if rho is not None:
@@ -329,14 +340,14 @@ def _free_standing(
 
 def _geometry_size(geo: dict[str, Any]) -> tuple[Optional[float], Optional[float], str]:
     """Length and thickness of the element from the constants' geometry [m]."""
-    h, b = _number(geo, "h_m"), _number(geo, "b_m")
+    h, b = number_at(geo, "h_m"), number_at(geo, "b_m")
     if h is not None and b is not None:
         return h, b, "the geometry's h_m, b_m"
-    h, b = _number(geo, "two_block", "height_m"), _number(geo, "two_block", "thickness_m")
+    h, b = number_at(geo, "two_block", "height_m"), number_at(geo, "two_block", "thickness_m")
     if h is not None and b is not None:
         return h, b, "the geometry's two_block height_m, thickness_m"
-    r = _number(geo, "R_m") or _number(geo, "positive", "R_m")
-    a = _number(geo, "alpha_rad") or _number(geo, "positive", "alpha_rad")
+    r = number_at(geo, "R_m") or number_at(geo, "positive", "R_m")
+    a = number_at(geo, "alpha_rad") or number_at(geo, "positive", "alpha_rad")
     if r is not None and a is not None:
         return (
             2.0 * r * math.cos(a),
@@ -371,7 +382,7 @@ def _tie_terms(mech: Mechanism, side: SideConstants) -> Optional[dict[str, Any]]
     axis_p = np.asarray(pos.get("axis_point_m"), dtype=float)
     axis_u = np.asarray(pos.get("axis_direction"), dtype=float)
     com = np.asarray(geo.get("com_m"), dtype=float)
-    a_c = _number(loaded, "alpha_c_rad")
+    a_c = number_at(loaded, "alpha_c_rad")
     vw = side.virtual_work
     if axis_p.shape != (3,) or axis_u.shape != (3,) or com.shape != (3,) or a_c is None:
         return None
@@ -392,7 +403,7 @@ def _tie_terms(mech: Mechanism, side: SideConstants) -> Optional[dict[str, Any]]
     work_tie = 0.0
     listed = []
     for e in ties:
-        force = _number(e, "force_N") or 0.0
+        force = number_at(e, "force_N") or 0.0
         z, horiz = plane(np.asarray(e.get("at_m"), dtype=float))
         x = float(np.dot(horiz, inward))
         m_f_tie += -force * (z * math.cos(a_c) + x * math.sin(a_c))

@@ -56,6 +56,7 @@ from shared_schema.site import MechanismOptions, SiteFile
 from ..codes.circ2019 import CIRC2019
 from ..core.model import G
 from .assess import check_doc_with_records
+from .codecheck import number_at
 from .retrofit_records import RECORD_DECISIONS, MechanismRecords, tie_slope
 
 __all__ = [
@@ -169,24 +170,19 @@ def _single_block_problem(mech: Mechanism) -> Optional[str]:
 
 def top_height(mech: Mechanism) -> tuple[Optional[float], str]:
     """Height of the moving part's top above the hinge [m], and where it comes from."""
-    geo: dict[str, Any] = mech.geometry if isinstance(mech.geometry, dict) else {}
-    h = geo.get("h_m")
-    if isinstance(h, (int, float)) and not isinstance(h, bool):
-        return float(h), "the geometry's h_m"
-    top = geo.get("top_m")  # the builder's: the moving part's highest point above the hinge
-    if isinstance(top, (int, float)) and not isinstance(top, bool) and top > 0.0:
-        return float(top), "the geometry's top_m (the moving part's highest point)"
-    got = geo.get("positive")
-    pos: dict[str, Any] = got if isinstance(got, dict) else {}
-    r, a = pos.get("R_m"), pos.get("alpha_rad")
-    if isinstance(r, (int, float)) and isinstance(a, (int, float)):
-        not_rectangle = _not_a_rectangle(geo, float(r))
+    geo = mech.geometry
+    h = number_at(geo, "h_m")
+    if h is not None:
+        return h, "the geometry's h_m"
+    top = number_at(geo, "top_m")  # the builder's: the moving part's highest point
+    if top is not None and top > 0.0:
+        return top, "the geometry's top_m (the moving part's highest point)"
+    r, a = number_at(geo, "positive", "R_m"), number_at(geo, "positive", "alpha_rad")
+    if r is not None and a is not None:
+        not_rectangle = _not_a_rectangle(geo, r)
         if not_rectangle is not None:
             return None, not_rectangle
-        return (
-            2.0 * float(r) * math.cos(float(a)),
-            "the rectangle of the block's R and alpha (2 R cos α)",
-        )
+        return 2.0 * r * math.cos(a), "the rectangle of the block's R and alpha (2 R cos α)"
     return None, "the constants' geometry gives no height of the moving part"
 
 
@@ -194,18 +190,16 @@ def top_height(mech: Mechanism) -> tuple[Optional[float], str]:
 RECTANGLE_RTOL = 1e-6
 
 
-def _not_a_rectangle(geo: dict[str, Any], r: float) -> Optional[str]:
+def _not_a_rectangle(geo: Any, r: float) -> Optional[str]:
     """Why 2 R cos α is not the block's top (None: a rectangle, or nothing tells).
 
     Only a homogeneous rectangle has its top at twice its centre of mass's height; its
     inertia about the hinge is then ``4/3 M R²``, which the constants' geometry can show.
     """
-    pos = geo.get("positive")
-    i_o = pos.get("I_O_kg_m2") if isinstance(pos, dict) else None
-    mass = geo.get("mass_kg")
-    if not isinstance(i_o, (int, float)) or not isinstance(mass, (int, float)) or mass <= 0:
+    i_o, mass = number_at(geo, "positive", "I_O_kg_m2"), number_at(geo, "mass_kg")
+    if i_o is None or mass is None or mass <= 0:
         return None
-    ratio = float(i_o) / (4.0 / 3.0 * float(mass) * r * r)
+    ratio = i_o / (4.0 / 3.0 * mass * r * r)
     if abs(ratio - 1.0) <= RECTANGLE_RTOL:
         return None
     return (
