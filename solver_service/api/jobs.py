@@ -430,6 +430,21 @@ def run_scale_factor(job: ScaleFactorJob, blobs: list[bytes], limits: dict[str, 
     return dumps(stamp(scale_factor_doc(job.request, limits), "scale_factor"))
 
 
+def _uploaded_scene(data: bytes, name: str, units: Optional[str], needs: str) -> Any:
+    """Read an uploaded scene; a deployment without the geometry extra says what needs it.
+
+    ``needs`` starts the 503's message (``"the search needs"``): the geometry extra, which
+    this deployment lacks, follows, with the missing module.
+    """
+    try:
+        return read_scene(data, name=name, units=units)
+    except ImportError as exc:
+        raise ServiceUnavailable(
+            f"{needs} the geometry extra (pip install 'rockmech[geometry]'), which this "
+            f"deployment lacks ({exc.name} is missing)"
+        ) from None
+
+
 def run_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) -> bytes:
     """Answer the kinematic-constants file ``rockmech constants`` writes (blobs: scene, spec)."""
     scene_name = safe_filename(job.scene_name, "scene.3dm")
@@ -445,13 +460,9 @@ def run_constants(job: SceneJob, blobs: list[bytes], limits: dict[str, Any]) -> 
     check_limit(
         len(spec_file.mechanisms), limits["max_mechanisms"], "mechanisms", "spec", "max_mechanisms"
     )
-    try:
-        scene = read_scene(scene_bytes, name=scene_name, units=job.units)
-    except ImportError as exc:
-        raise ServiceUnavailable(
-            "constants from a scene (.3dm or scan mesh) need the geometry extra (pip install "
-            f"'rockmech[geometry]'), which this deployment lacks ({exc.name} is missing)"
-        ) from None
+    scene = _uploaded_scene(
+        scene_bytes, scene_name, job.units, "constants from a scene (.3dm or scan mesh) need"
+    )
     cf = constants_from_spec(spec_file, scene, scene_name=scene_name, spec_name=spec_name)
     return stamped(cf).model_dump_json(exclude_none=True).encode("utf-8")
 
@@ -474,13 +485,7 @@ def run_search(job: SearchJob, blobs: list[bytes], limits: dict[str, Any]) -> by
     motions = []
     if job.record is not None:
         motions.append(motion_from_params(None, job.record, rest[0], limits))
-    try:
-        scene = read_scene(scene_bytes, name=scene_name, units=job.units)
-    except ImportError as exc:
-        raise ServiceUnavailable(
-            "the search needs the geometry extra (pip install 'rockmech[geometry]'), which this "
-            f"deployment lacks ({exc.name} is missing)"
-        ) from None
+    scene = _uploaded_scene(scene_bytes, scene_name, job.units, "the search needs")
     run = search_run(
         scene,
         spec,
@@ -686,13 +691,7 @@ def run_retrofit_scene(job: RetrofitSceneJob, blobs: list[bytes], limits: dict[s
     motions = []
     if job.record is not None:
         motions.append(motion_from_params(None, job.record, rest[0], limits))
-    try:
-        scene = read_scene(scene_bytes, name=scene_name, units=job.units)
-    except ImportError as exc:
-        raise ServiceUnavailable(
-            "the retrofit of a scene needs the geometry extra (pip install "
-            f"'rockmech[geometry]'), which this deployment lacks ({exc.name} is missing)"
-        ) from None
+    scene = _uploaded_scene(scene_bytes, scene_name, job.units, "the retrofit of a scene needs")
     limit = min(job.max_evaluations or SEARCH_MAX_EVALUATIONS, SEARCH_MAX_EVALUATIONS)
     searches = retrofit_searches(rspec)
     check_scene_searches(scene, spec, searches, limit)
