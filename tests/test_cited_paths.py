@@ -23,17 +23,22 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-#: What a folder walk leaves out: tools' caches, environments and build outputs.
+#: What a folder walk leaves out: tools' caches, environments and build outputs, and
+#: ``out/``, where the README's commands write (``make demo``; git ignores all of these): a
+#: citation of ``out/church`` names an output, not a file of the repository.
 SKIP_DIRS = {
     ".git",
     ".venv",
     "venv",
     "build",
     "dist",
+    "out",
     "__pycache__",
     ".mypy_cache",
     ".pytest_cache",
     ".ruff_cache",
+    ".hypothesis",
+    ".schemathesis",
     "node_modules",
 }
 #: Paths cited on purpose that are not in the tree, each with why (a prefix covers below it).
